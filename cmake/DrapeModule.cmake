@@ -1,0 +1,34 @@
+# drape_add_module(NAME [DEPS target...])
+#
+# Builds src/NAME/*.cpp into the static library drape_NAME. Public headers live in
+# src/NAME/include/drape/NAME/ and are included as <drape/NAME/header.hpp>. A module sees
+# only the headers of the modules it links, so an upward include fails to compile.
+function(drape_add_module name)
+  cmake_parse_arguments(ARG "" "" "DEPS" ${ARGN})
+  file(GLOB_RECURSE sources CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.cpp")
+  add_library(drape_${name} STATIC ${sources})
+  target_include_directories(drape_${name} PUBLIC "${CMAKE_CURRENT_SOURCE_DIR}/include")
+  target_link_libraries(drape_${name} PUBLIC ${ARG_DEPS})
+  add_library(drape::${name} ALIAS drape_${name})
+endfunction()
+
+# drape_add_test(MODULE [DEPS target...])
+#
+# Builds tests/MODULE/*.cpp into test_MODULE and registers each GoogleTest case with CTest.
+# Tests find the project's data through DRAPE_DATA_DIR, the source tree through
+# DRAPE_SOURCE_DIR and the built CLI through DRAPE_EXE.
+function(drape_add_test module)
+  cmake_parse_arguments(ARG "" "TIMEOUT" "DEPS" ${ARGN})
+  file(GLOB_RECURSE sources CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.cpp")
+  add_executable(test_${module} ${sources})
+  target_link_libraries(test_${module} PRIVATE drape::${module} ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+  target_compile_definitions(test_${module} PRIVATE
+    DRAPE_DATA_DIR="${DRAPE_DATA_DIR}"
+    DRAPE_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    DRAPE_TEST_DATA_DIR="${PROJECT_SOURCE_DIR}/tests/data"
+    DRAPE_EXE="$<TARGET_FILE:drape>")
+  if(NOT ARG_TIMEOUT)
+    set(ARG_TIMEOUT 300)
+  endif()
+  gtest_discover_tests(test_${module} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT ${ARG_TIMEOUT})
+endfunction()

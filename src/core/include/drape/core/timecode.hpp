@@ -1,0 +1,21 @@
+#pragma once
+// Time codes: a frame number at a frame rate, printable as SMPTE HH:MM:SS:FF.
+// Every frame that leaves the simulation (cloth, pose) carries one.
+
+#include <cstdint>
+#include <string>
+
+namespace drape {
+
+struct TimeCode {
+  std::int64_t frame = 0;  ///< frame number from the start of the take
+  double rate = 30.0;      ///< frames per second
+
+  [[nodiscard]] double seconds() const { return static_cast<double>(frame) / rate; }
+  /// SMPTE non-drop-frame "HH:MM:SS:FF" (rate rounded to whole frames per second).
+  [[nodiscard]] std::string smpte() const;
+  /// Parses "HH:MM:SS:FF" at the given rate; throws drape::Error on malformed text.
+  [[nodiscard]] static TimeCode parseSmpte(const std::string& text, double rate);
+};
+
+}  // namespace drape

@@ -1,0 +1,32 @@
+#include "drape/core/timecode.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include <fmt/format.h>
+
+#include "drape/core/error.hpp"
+
+namespace drape {
+
+std::string TimeCode::smpte() const {
+  const auto fps = std::max<std::int64_t>(1, std::llround(rate));
+  const std::int64_t f = frame < 0 ? 0 : frame;
+  const std::int64_t ff = f % fps;
+  const std::int64_t totalSeconds = f / fps;
+  return fmt::format("{:02}:{:02}:{:02}:{:02}", totalSeconds / 3600, (totalSeconds / 60) % 60,
+                     totalSeconds % 60, ff);
+}
+
+TimeCode TimeCode::parseSmpte(const std::string& text, double rate) {
+  int h = 0, m = 0, s = 0, f = 0;
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%d:%d:%d:%d%c", &h, &m, &s, &f, &tail) != 4 || h < 0 || m < 0 ||
+      m > 59 || s < 0 || s > 59 || f < 0 || f >= std::llround(rate)) {
+    throw Error(fmt::format("time code '{}': expected HH:MM:SS:FF at {} frames/s", text, rate));
+  }
+  const auto fps = std::llround(rate);
+  return TimeCode{((static_cast<std::int64_t>(h) * 60 + m) * 60 + s) * fps + f, rate};
+}
+
+}  // namespace drape

@@ -1,0 +1,145 @@
+#include "drape/mesh/topology.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "drape/core/error.hpp"
+
+namespace drape::mesh {
+namespace {
+
+struct HalfEdge {
+  std::uint64_t key;       // (min vertex << 32) | max vertex
+  std::uint32_t face;
+  std::uint32_t corner;    // edge joins corner and corner+1 of the face
+};
+
+std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b) {
+  const auto lo = std::min(a, b), hi = std::max(a, b);
+  return (static_cast<std::uint64_t>(lo) << 32) | hi;
+}
+
+void checkTriangles(const TriMesh& mesh, double minArea) {
+  const std::size_t n = mesh.positions.size();
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Triangle& tri = mesh.triangles[t];
+    for (std::uint32_t v : tri) {
+      if (v >= n) {
+        throw Error(fmt::format("{}: triangle {} uses vertex {} but the mesh has {} vertices",
+                                mesh.name, t, v, n));
+      }
+    }
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
+      throw Error(fmt::format("{}: triangle {} is degenerate (vertices {}, {}, {} repeat)", mesh.name,
+                              t, tri[0], tri[1], tri[2]));
+    }
+    const double area = mesh.triangleArea(t);
+    if (!(area > minArea)) {
+      throw Error(fmt::format("{}: triangle {} is degenerate (area {:.3g} m^2 at vertices {}, {}, {})",
+                              mesh.name, t, area, tri[0], tri[1], tri[2]));
+    }
+  }
+}
+
+std::vector<HalfEdge> sortedHalfEdges(const TriMesh& mesh) {
+  std::vector<HalfEdge> half;
+  half.reserve(mesh.triangles.size() * 3);
+  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Triangle& tri = mesh.triangles[t];
+    for (std::uint32_t c = 0; c < 3; ++c) half.push_back({edgeKey(tri[c], tri[(c + 1) % 3]), t, c});
+  }
+  std::sort(half.begin(), half.end(), [](const HalfEdge& a, const HalfEdge& b) {
+    return a.key != b.key ? a.key < b.key : a.face < b.face;
+  });
+  return half;
+}
+
+std::vector<std::vector<std::uint32_t>> traceBoundaryLoops(const Topology& topo) {
+  // Boundary edges as undirected (vertex, edge) incidences sorted by vertex. Walking edges,
+  // not vertices, keeps a loop whole through a pinch vertex that two boundary runs touch,
+  // and ignoring winding keeps it whole across faces of inconsistent orientation.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> incident;  // (vertex, edge)
+  for (std::uint32_t e = 0; e < topo.edges.size(); ++e) {
+    if (!topo.edges[e].boundary()) continue;
+    incident.emplace_back(topo.edges[e].v0, e);
+    incident.emplace_back(topo.edges[e].v1, e);
+  }
+  std::sort(incident.begin(), incident.end());
+  std::vector<bool> used(topo.edges.size(), false);
+  auto unusedEdgeAt = [&](std::uint32_t v) -> std::uint32_t {
+    auto it = std::lower_bound(incident.begin(), incident.end(), std::make_pair(v, std::uint32_t{0}));
+    for (; it != incident.end() && it->first == v; ++it)
+      if (!used[it->second]) return it->second;
+    return kNone;
+  };
+  std::vector<std::vector<std::uint32_t>> loops;
+  for (std::uint32_t first = 0; first < topo.edges.size(); ++first) {
+    if (!topo.edges[first].boundary() || used[first]) continue;
+    std::vector<std::uint32_t> loop;
+    const std::uint32_t start = topo.edges[first].v0;
+    std::uint32_t v = start;
+    for (std::uint32_t e = first; e != kNone;) {
+      used[e] = true;
+      loop.push_back(v);
+      v = topo.edges[e].v0 == v ? topo.edges[e].v1 : topo.edges[e].v0;
+      if (v == start) break;
+      e = unusedEdgeAt(v);
+    }
+    loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+}  // namespace
+
+std::size_t Topology::interiorEdgeCount() const {
+  return static_cast<std::size_t>(std::count_if(edges.begin(), edges.end(), [](const Edge& e) { return !e.boundary(); }));
+}
+
+Topology Topology::build(const TriMesh& mesh, double minArea) {
+  checkTriangles(mesh, minArea);
+  const std::vector<HalfEdge> half = sortedHalfEdges(mesh);
+
+  Topology topo;
+  topo.triangleEdges.assign(mesh.triangles.size(), {kNone, kNone, kNone});
+  for (std::size_t i = 0; i < half.size();) {
+    std::size_t j = i + 1;
+    while (j < half.size() && half[j].key == half[i].key) ++j;
+    const auto v0 = static_cast<std::uint32_t>(half[i].key >> 32);
+    const auto v1 = static_cast<std::uint32_t>(half[i].key & 0xffffffffu);
+    if (j - i > 2) {
+      const Vec3& p = mesh.positions[v0];
+      throw Error(fmt::format("{}: non-manifold edge between vertices {} and {} (shared by {} triangles, "
+                              "near {:.4f} {:.4f} {:.4f} m)",
+                              mesh.name, v0, v1, j - i, p.x(), p.y(), p.z()));
+    }
+    Edge e{v0, v1, half[i].face, kNone, kNone, kNone};
+    auto opposite = [&](const HalfEdge& h) { return mesh.triangles[h.face][(h.corner + 2) % 3]; };
+    e.opposite0 = opposite(half[i]);
+    if (j - i == 2) {
+      e.face1 = half[i + 1].face;
+      e.opposite1 = opposite(half[i + 1]);
+    }
+    const auto index = static_cast<std::uint32_t>(topo.edges.size());
+    for (std::size_t k = i; k < j; ++k) topo.triangleEdges[half[k].face][half[k].corner] = index;
+    topo.edges.push_back(e);
+    i = j;
+  }
+  topo.boundaryLoops = traceBoundaryLoops(topo);
+  return topo;
+}
+
+std::size_t countNonManifoldEdges(const TriMesh& mesh) {
+  const std::vector<HalfEdge> half = sortedHalfEdges(mesh);
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < half.size();) {
+    std::size_t j = i + 1;
+    while (j < half.size() && half[j].key == half[i].key) ++j;
+    if (j - i > 2) ++count;
+    i = j;
+  }
+  return count;
+}
+
+}  // namespace drape::mesh

@@ -1,0 +1,88 @@
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <cstdlib>
+#include <thread>
+
+#include "drape/core/error.hpp"
+#include "drape/core/isolate.hpp"
+#include "drape/core/math.hpp"
+#include "drape/core/timecode.hpp"
+
+namespace drape {
+namespace {
+
+TEST(TimeCode, PrintsSmpte) {
+  EXPECT_EQ((TimeCode{0, 30}).smpte(), "00:00:00:00");
+  EXPECT_EQ((TimeCode{29, 30}).smpte(), "00:00:00:29");
+  EXPECT_EQ((TimeCode{30 * 3661 + 7, 30}).smpte(), "01:01:01:07");
+  EXPECT_EQ((TimeCode{25 * 60, 25}).smpte(), "00:01:00:00");
+}
+
+TEST(TimeCode, ParsesWhatItPrints) {
+  for (std::int64_t f : {0, 1, 29, 30, 1799, 108000 + 17}) {
+    const TimeCode tc{f, 30};
+    EXPECT_EQ(TimeCode::parseSmpte(tc.smpte(), 30).frame, f);
+  }
+  EXPECT_THROW((void)TimeCode::parseSmpte("00:00:00:30", 30), Error);
+  EXPECT_THROW((void)TimeCode::parseSmpte("1:2:3", 30), Error);
+}
+
+TEST(SourcePos, FormatsWhatIsKnown) {
+  EXPECT_EQ((SourcePos{"a.wrl", 3, 7}).str(), "a.wrl:3:7");
+  EXPECT_EQ((SourcePos{"a.wrl", 3, 0}).str(), "a.wrl:3");
+  EXPECT_EQ((SourcePos{"a.wrl", 0, 0}).str(), "a.wrl");
+  EXPECT_STREQ(Error::at({"f.bvh", 2, 5}, "expected a number").what(), "f.bvh:2:5: expected a number");
+}
+
+TEST(RigidTransform, InverseAndComposition) {
+  const RigidTransform a{Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized())), Vec3(1, -2, 0.5)};
+  const RigidTransform b{Quat(Eigen::AngleAxisd(-1.1, Vec3(0, 1, 0))), Vec3(0.3, 0, 2)};
+  const Vec3 p(0.2, -0.4, 1.5);
+  EXPECT_LT((a.inverse().apply(a.apply(p)) - p).norm(), 1e-12);
+  EXPECT_LT(((a * b).apply(p) - a.apply(b.apply(p))).norm(), 1e-12);
+}
+
+TEST(Isolate, ReturnsTheChildsBytes) {
+  const std::string bytes = runIsolated("x", "test reader", [] { return std::string("hello\0world", 11); });
+  EXPECT_EQ(bytes, std::string("hello\0world", 11));
+}
+
+TEST(Isolate, CarriesErrorsBack) {
+  try {
+    (void)runIsolated("x", "test reader", []() -> std::string { throw Error("f.wrl:3:4: expected '}'"); });
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "f.wrl:3:4: expected '}'");
+    EXPECT_EQ(e.code(), ExitCode::BadInput);
+  }
+}
+
+TEST(Isolate, SurvivesACrashingChild) {
+  try {
+    (void)runIsolated("bad.wrl", "VRML97 reader", []() -> std::string {
+      std::raise(SIGSEGV);
+      return {};
+    });
+    FAIL();
+  } catch (const Error& e) {
+    // "(signal 11)"; under AddressSanitizer its handler turns the crash into an exit status.
+    EXPECT_NE(std::string(e.what()).find("bad.wrl: the VRML97 reader failed ("), std::string::npos) << e.what();
+  }
+}
+
+TEST(Isolate, StopsAHangingChild) {
+  IsolationLimits limits;
+  limits.seconds = 0.5;
+  try {
+    (void)runIsolated("hang.3ds", "VRML97 reader", []() -> std::string {
+      for (;;) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }, limits);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("time limit"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace drape

@@ -1,0 +1,88 @@
+#include <gtest/gtest.h>
+
+#include "drape/core/error.hpp"
+#include "drape/mesh/topology.hpp"
+
+namespace drape::mesh {
+namespace {
+
+TriMesh grid(int nx, int ny) {
+  TriMesh m;
+  m.name = "grid";
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) m.positions.emplace_back(i, j, 0);
+  auto id = [&](int i, int j) { return static_cast<std::uint32_t>(j * (nx + 1) + i); };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  return m;
+}
+
+TEST(Topology, GridCountsMatchEuler) {
+  const int nx = 5, ny = 4;
+  const TriMesh m = grid(nx, ny);
+  const Topology t = Topology::build(m);
+  // Edges of a triangulated grid: horizontal + vertical + diagonal.
+  const std::size_t expected = nx * (ny + 1) + ny * (nx + 1) + nx * ny;
+  EXPECT_EQ(t.edges.size(), expected);
+  EXPECT_EQ(t.edges.size() - t.interiorEdgeCount(), static_cast<std::size_t>(2 * (nx + ny)));
+  ASSERT_EQ(t.boundaryLoops.size(), 1u);
+  EXPECT_EQ(t.boundaryLoops[0].size(), static_cast<std::size_t>(2 * (nx + ny)));
+  // V - E + F = 1 for a disc.
+  EXPECT_EQ(static_cast<long>(m.positions.size()) - static_cast<long>(t.edges.size()) + static_cast<long>(m.triangles.size()), 1);
+}
+
+TEST(Topology, OppositeVerticesAreTheThirdCorners) {
+  const TriMesh m = grid(3, 3);
+  const Topology t = Topology::build(m);
+  for (const Edge& e : t.edges) {
+    const Triangle& f0 = m.triangles[e.face0];
+    EXPECT_TRUE(std::count(f0.begin(), f0.end(), e.v0) == 1 && std::count(f0.begin(), f0.end(), e.v1) == 1);
+    EXPECT_TRUE(e.opposite0 != e.v0 && e.opposite0 != e.v1);
+    if (!e.boundary()) {
+      EXPECT_TRUE(e.opposite1 != e.v0 && e.opposite1 != e.v1 && e.opposite1 != e.opposite0);
+    }
+  }
+  for (std::size_t f = 0; f < m.triangles.size(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      const Edge& e = t.edges[t.triangleEdges[f][c]];
+      EXPECT_TRUE((e.v0 == std::min(m.triangles[f][c], m.triangles[f][(c + 1) % 3])));
+    }
+}
+
+TEST(Topology, RejectsNonManifoldEdges) {
+  TriMesh m = grid(1, 1);
+  m.positions.emplace_back(0.5, 0.5, 1.0);
+  m.triangles.push_back({0, 3, 4});  // a third face on the diagonal 0-3
+  try {
+    (void)Topology::build(m);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("grid: non-manifold edge between vertices 0 and 3"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(countNonManifoldEdges(m), 1u);
+}
+
+TEST(Topology, RejectsDegenerateAndOutOfRangeTriangles) {
+  TriMesh m = grid(1, 1);
+  m.triangles.push_back({0, 1, 1});
+  EXPECT_THROW((void)Topology::build(m), Error);
+  m = grid(1, 1);
+  m.positions.emplace_back(2, 0, 0);
+  m.triangles.push_back({0, 1, 4});  // collinear: zero area
+  EXPECT_THROW((void)Topology::build(m), Error);
+  m = grid(1, 1);
+  m.triangles.push_back({0, 1, 9});
+  EXPECT_THROW((void)Topology::build(m), Error);
+}
+
+TEST(TriMesh, AreaAndNormals) {
+  const TriMesh m = grid(2, 3);
+  EXPECT_NEAR(m.totalArea(), 6.0, 1e-12);
+  for (const Vec3& n : m.vertexNormals()) EXPECT_NEAR((n - Vec3(0, 0, 1)).norm(), 0.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace drape::mesh

@@ -9,6 +9,7 @@
 // a drape::Error thrown from it is printed on one line and becomes its exit code.
 
 #include <functional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,18 @@ struct Command {
 
 bool registerCommand(Command command);
 [[nodiscard]] std::vector<Command> registeredCommands();
+
+/// `drape inspect FILE` dispatches on the file's extension (lower case, with the dot) to
+/// the inspector registered for it; an inspector prints a readable summary to `out` and
+/// throws drape::Error on a bad file.
+using Inspector = std::function<void(const std::string& path, std::ostream& out)>;
+bool registerInspector(std::vector<std::string> extensions, std::string what, Inspector inspector);
+struct InspectorEntry {
+  std::vector<std::string> extensions;
+  std::string what;
+  Inspector inspect;
+};
+[[nodiscard]] const std::vector<InspectorEntry>& registeredInspectors();
 
 /// Global options shared by every subcommand.
 struct GlobalOptions {

@@ -1,0 +1,1 @@
+#include "drape/scene/avatar.hpp"

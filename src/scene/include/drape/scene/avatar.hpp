@@ -1,0 +1,60 @@
+#pragma once
+// A segmented avatar (paper section 4.2): a joint hierarchy, each joint carrying rigid
+// segment meshes. Loaders (H-Anim VRML97, glTF, MakeHuman) reset every segment to unit
+// scale in its joint's frame, so a pose only needs each joint's world rigid transform:
+//   segment vertex in world = jointWorld.apply(vertex in joint frame).
+// "What it is" only: poses and clips live in motion/.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "drape/core/math.hpp"
+#include "drape/mesh/trimesh.hpp"
+
+namespace drape::scene {
+
+struct Joint {
+  std::string name;
+  int parent = -1;          ///< index into Avatar::joints; -1 for the root. Parents come first.
+  Vec3 restCenter = Vec3::Zero();                ///< m, world position of the joint centre at rest
+  Quat restOrientation = Quat::Identity();       ///< world orientation of the joint frame at rest
+  /// World transform of the joint frame in the rest pose.
+  [[nodiscard]] RigidTransform restWorld() const { return {restOrientation, restCenter}; }
+};
+
+struct Segment {
+  std::string name;   ///< the name collision lists refer to (ClothSet.collidesWith)
+  int joint = -1;     ///< index of the joint it moves with
+  mesh::TriMesh mesh; ///< m, in the joint's frame
+};
+
+/// The skinned mesh a character is drawn with, when it came from a skinned source.
+struct SkinnedMesh {
+  mesh::TriMesh mesh;                                 ///< m, world rest pose
+  std::vector<std::array<std::uint16_t, 4>> joints;   ///< per vertex, indices into Avatar::joints
+  std::vector<std::array<float, 4>> weights;          ///< per vertex, summing to 1
+};
+
+struct Avatar {
+  std::string name;
+  std::string source;            ///< file it was loaded from, for messages
+  std::vector<Joint> joints;
+  std::vector<Segment> segments;
+  std::optional<SkinnedMesh> skin;
+
+  /// Index of the joint named `name`, or -1.
+  [[nodiscard]] int findJoint(const std::string& name) const {
+    for (std::size_t i = 0; i < joints.size(); ++i)
+      if (joints[i].name == name) return static_cast<int>(i);
+    return -1;
+  }
+  /// Index of the segment named `name`, or -1.
+  [[nodiscard]] int findSegment(const std::string& name) const {
+    for (std::size_t i = 0; i < segments.size(); ++i)
+      if (segments[i].name == name) return static_cast<int>(i);
+    return -1;
+  }
+};
+
+}  // namespace drape::scene

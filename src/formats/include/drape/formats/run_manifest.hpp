@@ -1,0 +1,37 @@
+#pragma once
+// The manifest of a run's output directory (DIR/manifest.json): what `drape run` wrote and
+// what players, renderers and exporters read back. Every animated mesh is a topology file
+// (OBJ, its frame-0 positions) plus a PC2 point cache of world positions in metres, one
+// sample per frame, Y up. Garments and avatar segments are listed alike; `role` tells a
+// renderer how to draw them.
+//
+//   {"format": "drape-run", "version": 1, "frame_rate": 30, "frames": 90, "start_frame": 0,
+//    "meshes": [{"name": "dress", "role": "garment", "topology": "garment.obj",
+//                "cache": "garment.pc2"}, ...]}
+
+#include <string>
+#include <vector>
+
+namespace drape::formats {
+
+struct RunMesh {
+  std::string name;
+  std::string role;      ///< "garment" or "segment" (an avatar body part)
+  std::string topology;  ///< OBJ file, relative to the run directory
+  std::string cache;     ///< PC2 file, relative to the run directory
+};
+
+struct RunManifest {
+  double frameRate = 30.0;   ///< frames per second of the caches
+  long frames = 0;           ///< frames in every cache
+  long startFrame = 0;       ///< time code frame number of the first sample
+  std::vector<RunMesh> meshes;
+};
+
+/// Writes DIR/manifest.json.
+void writeRunManifest(const std::string& directory, const RunManifest& manifest);
+/// Reads DIR/manifest.json; throws drape::Error naming the file and the key on anything
+/// missing or malformed (including a file that is not a drape run directory).
+[[nodiscard]] RunManifest readRunManifest(const std::string& directory);
+
+}  // namespace drape::formats

@@ -1,0 +1,50 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "drape/core/error.hpp"
+#include "drape/formats/run_manifest.hpp"
+
+namespace drape::formats {
+namespace {
+
+std::string tempDir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("drape_test_manifest_" + std::to_string(::getpid())) / name;
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+TEST(RunManifest, RoundTrips) {
+  const std::string dir = tempDir("ok");
+  RunManifest m;
+  m.frameRate = 25;
+  m.frames = 12;
+  m.startFrame = 3;
+  m.meshes = {{"skirt", "garment", "skirt.obj", "skirt.pc2"}, {"hips", "segment", "segments/hips.obj", "segments/hips.pc2"}};
+  writeRunManifest(dir, m);
+  const RunManifest r = readRunManifest(dir);
+  EXPECT_EQ(r.frameRate, 25);
+  EXPECT_EQ(r.frames, 12);
+  EXPECT_EQ(r.startFrame, 3);
+  ASSERT_EQ(r.meshes.size(), 2u);
+  EXPECT_EQ(r.meshes[1].cache, "segments/hips.pc2");
+  EXPECT_EQ(r.meshes[1].role, "segment");
+}
+
+TEST(RunManifest, ClearErrors) {
+  const std::string dir = tempDir("bad");
+  EXPECT_THROW((void)readRunManifest(dir), Error);
+  std::ofstream(dir + "/manifest.json") << "{\"format\": \"drape-run\", \"version\": 1, \"frames\": 3}";
+  try {
+    (void)readRunManifest(dir);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("missing key 'frame_rate'"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir + "/manifest.json") << "{not json";
+  EXPECT_THROW((void)readRunManifest(dir), Error);
+}
+
+}  // namespace
+}  // namespace drape::formats

@@ -171,6 +171,9 @@ DistanceField DistanceField::build(const mesh::TriMesh& part, const FieldSetting
   f.refs_ = std::move(prop.refs);
   f.stats_.finishMs = msSince(start);
 
+  for (auto* v : {&f.shellVoxels_, &f.refStart_, &f.refs_, &f.surfaceVoxels_, &f.surfaceNormalStart_})
+    v->shrink_to_fit();
+  f.surfaceNormals_.shrink_to_fit();
   f.stats_.voxels = n;
   f.stats_.surfaceVoxels = f.surfaceVoxels_.size();
   f.stats_.shellVoxels = f.shellVoxels_.size();

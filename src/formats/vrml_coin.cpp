@@ -91,6 +91,7 @@ void onReadError(const SoError* error, void*) {
   std::string what = firstLine(text);
   const std::string prefix = "Coin read error: ";
   if (what.rfind(prefix, 0) == 0) what = what.substr(prefix.size());
+  for (std::size_t at = what.find("\"VRML"); at != std::string::npos; at = what.find("\"VRML", at)) what.erase(at + 1, 4);
   gMessages->readErrors.push_back(what);
   gMessages->readErrorLines.push_back(line);
 }
@@ -113,6 +114,7 @@ struct Reader {
   std::vector<std::string> dirStack;  ///< where relative URLs of the file being read point
   std::vector<SoNode*> keepAlive;
   std::string pendingError;
+  std::vector<std::string> warnings;
 
   ~Reader() {
     for (SoNode* n : keepAlive) n->unref();
@@ -131,6 +133,17 @@ struct Reader {
       const std::string e = pendingError;
       pendingError.clear();
       throw Error(e);
+    }
+    // Coin reports a missing texture image as a read error; drape does not need textures.
+    for (std::size_t i = 0; i < messages.readErrors.size();) {
+      if (messages.readErrors[i].rfind("Could not read texture file", 0) == 0) {
+        warnings.push_back(fmt::format("{}: {} (drawn without it; drape does not need it to simulate)",
+                                       SourcePos{file, messages.readErrorLines[i], 0}.str(), messages.readErrors[i]));
+        messages.readErrors.erase(messages.readErrors.begin() + static_cast<std::ptrdiff_t>(i));
+        messages.readErrorLines.erase(messages.readErrorLines.begin() + static_cast<std::ptrdiff_t>(i));
+      } else {
+        ++i;
+      }
     }
     if (root == nullptr || !messages.readErrors.empty()) {
       if (root != nullptr) root->ref(), root->unref();
@@ -303,6 +316,9 @@ class Converter {
   const NodeSite* fields(SoFieldContainer& container, Node& out) {
     SoFieldList list;
     container.getFields(list);
+    // Coin leaves eventIns out of getFields(); the one drape follows (an interpolator's
+    // set_fraction, fed by a TimeSensor) is looked up by name.
+    if (SoField* fraction = container.getField("set_fraction"); fraction != nullptr && list.find(fraction) < 0) list.append(fraction);
     const NodeSite* site = nullptr;
     for (int i = 0; i < list.getLength(); ++i) {
       SoField* f = list[i];
@@ -450,7 +466,6 @@ class Converter {
         node->isOfType(SoVRMLCylinder::getClassTypeId()) || node->isOfType(SoVRMLCone::getClassTypeId()) ||
         node->isOfType(SoVRMLExtrusion::getClassTypeId()) || node->isOfType(SoVRMLElevationGrid::getClassTypeId()))
       return tessellate(node, out);
-    if (node->isOfType(SoVRMLImageTexture::getClassTypeId())) return texture(static_cast<SoVRMLImageTexture*>(node), out);
   }
 
   void faceSet(SoVRMLIndexedFaceSet* ifs, Node& out) {
@@ -494,19 +509,6 @@ class Converter {
     SoCallbackAction action;
     action.addTriangleCallback(SoNode::getClassTypeId(), triangleCallback, &welder);
     action.apply(node);
-  }
-
-  void texture(SoVRMLImageTexture* tex, Node& out) {
-    const std::string& baseDir = reader_.dirStack.back();
-    std::vector<std::string> urls;
-    for (int i = 0; i < tex->url.getNum(); ++i) {
-      urls.emplace_back(tex->url[i].getString());
-      if (!resolveUrl(urls.back(), baseDir).empty()) return;
-    }
-    if (urls.empty()) return;
-    doc_.warnings.push_back(fmt::format("{}: texture image {} not found (drawn without it; drape does not need it to simulate)",
-                                        files_.back(), fmt::join(urls, ", ")));
-    (void)out;
   }
 
   void inlineFile(SoVRMLInline* node, Node& out) {
@@ -574,6 +576,7 @@ Document readWithCoin(const ScanResult& scanned, const std::string& file, const 
   } else if (!root->isOfType(SoProto::getClassTypeId())) {
     doc.roots.push_back(converter.convertRoot(root, file));
   }
+  doc.warnings.insert(doc.warnings.end(), reader.warnings.begin(), reader.warnings.end());
   return doc;
 }
 

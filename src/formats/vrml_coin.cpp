@@ -565,7 +565,7 @@ Document readWithCoin(const ScanResult& scanned, const std::string& file, const 
   Converter converter(reader, doc, scanned.sites);
   // A file with several top-level nodes comes back as one Group holding them; a file with
   // one comes back as that node.
-  if (root->isOfType(SoVRMLGroup::getClassTypeId()) && root->getName() == SbName::empty() &&
+  if (root->getTypeId() == SoVRMLGroup::getClassTypeId() && root->getName() == SbName::empty() &&
       SoProtoInstance::findProtoInstance(root) == nullptr) {
     auto* group = static_cast<SoVRMLGroup*>(root);
     for (int i = 0; i < group->getNumChildren(); ++i) {

@@ -191,10 +191,16 @@ class Builder {
     if (index < 0) return;
     const Node& n = at(index);
     if (++depth_ > 1000) throw Error::at(where(n), "scene graph nested deeper than 1000 levels");
+    if (!n.def.empty()) names_.push_back(n.def);
     struct Leave {
       int& d;
-      ~Leave() { --d; }
-    } leave{depth_};
+      std::vector<std::string>& names;
+      bool named;
+      ~Leave() {
+        --d;
+        if (named) names.pop_back();
+      }
+    } leave{depth_, names_, !n.def.empty()};
     if (n.type == "Humanoid") return humanoid(index, world);
     if (n.type == "ClothSet") return pending_.push_back({index, world});
     if (n.type == "Avatar") return externalAvatar(n, world);
@@ -207,7 +213,8 @@ class Builder {
     if (n.type == "Shape") {
       const std::int32_t g = node(n, "geometry");
       if (g >= 0 && at(g).hasMesh && !at(g).triangles.empty()) {
-        std::string name = n.def.empty() ? at(g).def : n.def;
+        // Named after the nearest DEF: the geometry's, the Shape's or an enclosing node's.
+        std::string name = !at(g).def.empty() ? at(g).def : (names_.empty() ? std::string() : names_.back());
         if (name.empty()) name = fmt::format("{} {}", at(g).type, scene_.scenery.size() + 1);
         scene_.scenery.push_back({name, transformed(at(g), world, name)});
       }
@@ -460,6 +467,7 @@ class Builder {
   const Document& doc_;
   Scene scene_;
   int depth_ = 0;
+  std::vector<std::string> names_;  ///< DEF names of the nodes the walk is inside
   std::vector<PendingGarment> pending_;
   std::map<std::int32_t, int> humanoidIndex_;
   std::map<const Node*, int> externalIndex_;

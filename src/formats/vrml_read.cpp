@@ -3,6 +3,7 @@
 
 #include "drape/formats/vrml_read.hpp"
 
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -12,8 +13,22 @@
 #include "drape/core/error.hpp"
 #include "vrml_internal.hpp"
 
+// Present when a sanitizer runtime is linked (test and fuzz builds), absent otherwise.
+extern "C" void __sanitizer_set_death_callback(void (*callback)(void)) __attribute__((weak));
+
 namespace drape::formats::vrml {
 namespace detail {
+namespace {
+
+/// First thing in the reader's child: a crash inside Coin must end the child by its own
+/// signal so the parent reports it. Handlers inherited from the parent (a sanitizer's
+/// death callback, a fuzzer's crash dump) would report it as the parent's crash.
+void resetInheritedCrashHandlers() {
+  for (const int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) std::signal(sig, SIG_DFL);
+  if (__sanitizer_set_death_callback != nullptr) __sanitizer_set_death_callback(nullptr);
+}
+
+}  // namespace
 
 extern const std::string_view kPreludeText;
 
@@ -68,8 +83,11 @@ bool isDrapeNodeType(std::string_view type) {
 
 Document readText(std::string_view text, const std::string& name, const std::string& baseDir, const ReadOptions& options) {
   const ScanResult scanned = scan(text, name, detail::scanOptions());
-  const auto work = [&] { return detail::toWire(detail::readWithCoin(scanned, name, baseDir)); };
-  if (!options.isolate) return detail::fromWire(work(), name);
+  if (!options.isolate) return detail::fromWire(detail::toWire(detail::readWithCoin(scanned, name, baseDir)), name);
+  const auto work = [&] {
+    detail::resetInheritedCrashHandlers();
+    return detail::toWire(detail::readWithCoin(scanned, name, baseDir));
+  };
   return detail::fromWire(runIsolated(name, "VRML97 reader", work, options.limits), name);
 }
 

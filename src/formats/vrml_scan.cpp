@@ -139,7 +139,7 @@ struct Scope {
 class Scanner {
  public:
   Scanner(std::string_view text, const std::string& file, const ScanOptions& options)
-      : text_(text), file_(file), options_(options), lexer_(text, file) {
+      : text_(text), options_(options), lexer_(text, file) {
     for (const ProtoInterface& p : options.knownProtos) protos_[p.name] = {p, true};
     current_ = lexer_.next();
   }
@@ -429,7 +429,6 @@ class Scanner {
   }
 
   std::string_view text_;
-  const std::string& file_;
   const ScanOptions& options_;
   Lexer lexer_;
   Token current_;

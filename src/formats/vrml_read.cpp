@@ -82,7 +82,12 @@ bool isDrapeNodeType(std::string_view type) {
 }
 
 Document readText(std::string_view text, const std::string& name, const std::string& baseDir, const ReadOptions& options) {
-  const ScanResult scanned = scan(text, name, detail::scanOptions());
+  ScanResult scanned;
+  if (options.prescan) {
+    scanned = scan(text, name, detail::scanOptions());
+  } else {
+    scanned.text = std::string(text);
+  }
   if (!options.isolate) return detail::fromWire(detail::toWire(detail::readWithCoin(scanned, name, baseDir)), name);
   const auto work = [&] {
     detail::resetInheritedCrashHandlers();

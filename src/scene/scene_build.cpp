@@ -167,21 +167,32 @@ class Builder {
     if (found != nullptr) {
       const Node& n = *found;
       scene_.hasSimulationNode = true;
-      s.source = where(n);
-      s.gravity = vec3(n, "gravity", s.gravity);
-      s.frameRate = number(n, "frameRate", s.frameRate);
-      s.stepsPerFrame = static_cast<int>(number(n, "stepsPerFrame", s.stepsPerFrame));
-      s.airViscosity = number(n, "airViscosity", s.airViscosity);
-      s.wind = vec3(n, "wind", s.wind);
-      if (const Field* f = n.field("offsets")) {
+      // Field by field, validating after each, so an error names the line of its value.
+      const SourcePos nodePos = where(n);
+      const auto take = [&](const char* field, auto assign) {
+        if (n.field(field) == nullptr) return;
+        assign();
+        s.source = where(n, field);
+        validate(s);
+        s.source = nodePos;
+      };
+      take("gravity", [&] { s.gravity = vec3(n, "gravity", s.gravity); });
+      take("frameRate", [&] { s.frameRate = number(n, "frameRate", s.frameRate); });
+      take("stepsPerFrame", [&] { s.stepsPerFrame = static_cast<int>(number(n, "stepsPerFrame", s.stepsPerFrame)); });
+      take("airViscosity", [&] { s.airViscosity = number(n, "airViscosity", s.airViscosity); });
+      take("wind", [&] { s.wind = vec3(n, "wind", s.wind); });
+      take("offsets", [&] {
+        const Field* f = n.field("offsets");
         if (f->numbers.size() != 4)
           throw Error::at(where(n, "offsets"), fmt::format("Simulation: offsets needs 4 values (T0 T1 T2 T3 in m), found {}", f->numbers.size()));
         std::copy(f->numbers.begin(), f->numbers.end(), s.offsets.begin());
-      }
-      s.voxelSize = number(n, "voxelSize", s.voxelSize);
-      if (n.field("integrator") != nullptr) s.integrator = string(n, "integrator");
-      s.collisionEvery = static_cast<int>(number(n, "collisionEvery", s.collisionEvery));
-      if (const Field* f = n.field("unitScale"); f != nullptr && !f->isDefault) s.unitScale = number(n, "unitScale", 1.0);
+      });
+      take("voxelSize", [&] { s.voxelSize = number(n, "voxelSize", s.voxelSize); });
+      take("integrator", [&] { s.integrator = string(n, "integrator"); });
+      take("collisionEvery", [&] { s.collisionEvery = static_cast<int>(number(n, "collisionEvery", s.collisionEvery)); });
+      if (const Field* f = n.field("unitScale"); f != nullptr && !f->isDefault)
+        take("unitScale", [&] { s.unitScale = number(n, "unitScale", 1.0); });
+      s.source = nodePos;
     }
     validate(s);
   }

@@ -138,6 +138,20 @@ TEST(VrmlRead, CoinHangOn3dsBytesIsAScanError) {
   EXPECT_NE(errorOf([&] { (void)readText(text, "hang.wrl", "."); }).find("hang.wrl:1:1: not a VRML97 file"), std::string::npos);
 }
 
+// Without the pre-scan the same inputs reach Coin: its null dereference and its hang stay
+// inside the reader's child process and come back as errors.
+TEST(VrmlRead, CoinsOwnCrashAndHangStayInTheChild) {
+  ReadOptions raw;
+  raw.prescan = false;
+  raw.limits.seconds = 3.0;
+  const std::string crash = "#VRML V2.0 utf8\nDEF T Transform { children Shape { geometry USE T\n";
+  const std::string crashMessage = errorOf([&] { (void)readText(crash, "crash.wrl", ".", raw); });
+  EXPECT_EQ(crashMessage.rfind("crash.wrl: the VRML97 reader failed (signal ", 0), 0u) << crashMessage;
+  const std::string hang("MM\x02\x00", 4);
+  const std::string hangMessage = errorOf([&] { (void)readText(hang, "hang.wrl", ".", raw); });
+  EXPECT_EQ(hangMessage.rfind("hang.wrl: the VRML97 reader failed (time limit", 0), 0u) << hangMessage;
+}
+
 TEST(VrmlRead, PreludeIsTheShippedFile) {
   std::ifstream shipped(std::string(DRAPE_SOURCE_DIR) + "/share/drape/drape-nodes.wrl");
   std::stringstream s;

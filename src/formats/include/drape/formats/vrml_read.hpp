@@ -18,7 +18,10 @@ namespace drape::formats::vrml {
 
 struct ReadOptions {
   IsolationLimits limits{std::size_t{2} << 30, 60.0};
-  bool isolate = true;  ///< false: run Coin in this process (tests and the fuzzer's child only)
+  bool isolate = true;  ///< false: run Coin in this process (tests only: Coin may crash it)
+  /// false: hand the text to Coin without drape's pre-scan. Only for testing that the
+  /// child process contains Coin's own crashes and hangs; never for real input.
+  bool prescan = true;
 };
 
 /// Reads a VRML97 file. Throws drape::Error (exit code 2) with "file:line:column: what"

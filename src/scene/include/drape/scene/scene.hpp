@@ -1,0 +1,111 @@
+#pragma once
+// The scene model (paper section 4.1): avatars, garments, cloth materials and simulation
+// settings as plain domain objects, built from a VRML97 scene file. Units are SI: positions
+// in metres (file coordinates times the scene's unitScale), material and simulation values
+// as written (they are SI in the file already). Nothing here knows Coin3D or the cloth
+// solver: sim/ maps these onto cloth/'s parameters.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "drape/core/error.hpp"
+#include "drape/core/math.hpp"
+#include "drape/mesh/trimesh.hpp"
+#include "drape/scene/avatar.hpp"
+
+namespace drape::scene {
+
+/// Physical properties of a cloth (the ClothMaterial node). Defaults: a light cotton.
+struct ClothMaterial {
+  std::string name;                 ///< DEF name or `name`, for messages
+  double density = 300.0;           ///< kg/m^3 of the cloth itself
+  double thickness = 0.0005;        ///< m
+  double youngsModulus = 5.0e5;     ///< Pa, in-plane stiffness of the membrane
+  double poissonRatio = 0.3;        ///< in [0, 0.5)
+  /// N m; < 0 means "derive from E t^3 / (12 (1 - nu^2))" (bendingStiffnessOrDerived()).
+  double bendingStiffness = -1.0;
+  double damping = 0.02;            ///< internal damping ratio, dimensionless (>= 0)
+  double staticFriction = 0.5;      ///< coefficient against body surfaces
+  double dynamicFriction = 0.3;     ///< coefficient against body surfaces (<= static)
+  double compressionScale = 0.1;    ///< stiffness under compression relative to tension, in [0, 1]
+  SourcePos source;                 ///< where the node was written
+
+  /// kg/m^2: density x thickness, the mass per unit area of cloth.
+  [[nodiscard]] double arealDensity() const { return density * thickness; }
+  /// N m: the bending stiffness given, or the plate formula E t^3 / (12 (1 - nu^2)).
+  [[nodiscard]] double bendingStiffnessOrDerived() const;
+};
+
+/// Environment and solver settings (the Simulation node).
+struct SimulationSettings {
+  Vec3 gravity{0.0, -9.81, 0.0};     ///< m/s^2
+  double frameRate = 30.0;          ///< frames per second of output and motion
+  int stepsPerFrame = 33;           ///< explicit substeps per frame
+  double airViscosity = 0.02;       ///< N s/m^2 per unit area: drag on velocity relative to wind
+  Vec3 wind{0.0, 0.0, 0.0};         ///< m/s
+  /// m: the collision offset surfaces T0 < T1 < T2 < T3 of paper section 4.3.3.
+  std::array<double, 4> offsets{0.002, 0.004, 0.006, 0.008};
+  double voxelSize = 0.01;          ///< m, edge of a distance-field voxel
+  std::string integrator = "symplectic-euler";  ///< name the cloth solver resolves
+  int collisionEvery = 1;           ///< collide every N substeps
+  double unitScale = 1.0;           ///< metres per file unit (applied to all geometry on load)
+  SourcePos source;                 ///< where the node was written; empty when defaulted
+};
+
+/// A garment (a ClothSet): its mesh in world metres, the constraint mask matched onto it,
+/// the material and the avatar it is worn by.
+struct Garment {
+  std::string name;
+  mesh::TriMesh mesh;                      ///< m, world, rest shape as modelled
+  int material = -1;                       ///< index into Scene::materials
+  std::vector<std::uint32_t> maskVertices; ///< garment vertices matched by the mask, sorted
+  double maskTolerance = 0.001;            ///< m
+  double bindThreshold = 0.02;             ///< m, farthest a mask vertex binds to a body part
+  std::vector<std::string> collidesWith;   ///< segment names; empty: every segment
+  int avatar = -1;                         ///< index into Scene::avatars (a Humanoid), or -1
+  int externalAvatar = -1;                 ///< index into Scene::externalAvatars, or -1
+  SourcePos source;
+};
+
+/// An Avatar node: a character in another format, loaded by the characters code.
+struct ExternalAvatar {
+  std::string name;
+  std::vector<std::string> urls;      ///< resolved against the scene's directory
+  std::vector<std::string> jointMap;  ///< URL(s) of a joint-name map, or empty
+  RigidTransform placement;           ///< m, world placement of the character's root
+  double scale = 1.0;                 ///< the node's scale times unitScale
+  SourcePos source;
+};
+
+/// Geometry that is neither avatar nor garment (the set, props): world metres.
+struct Scenery {
+  std::string name;
+  mesh::TriMesh mesh;
+};
+
+struct Scene {
+  std::string source;                          ///< the scene file
+  std::vector<Avatar> avatars;                 ///< H-Anim humanoids, in file order
+  std::vector<ExternalAvatar> externalAvatars;
+  std::vector<Garment> garments;
+  std::vector<ClothMaterial> materials;        ///< each ClothMaterial node once (DEF/USE shares)
+  SimulationSettings simulation;
+  bool hasSimulationNode = false;
+  std::vector<Scenery> scenery;
+  std::vector<std::string> warnings;           ///< "file:line: what"
+};
+
+/// Reads a VRML97 scene (through formats' isolated reader) and builds the scene. Throws
+/// drape::Error (exit code 2) naming file and line for anything wrong: bad syntax, unknown
+/// nodes or fields, missing Inline/EXTERNPROTO targets, a ClothSet without cloth,
+/// impossible material values, a mask vertex matching no cloth vertex.
+[[nodiscard]] Scene loadScene(const std::string& path);
+
+/// Checks a material; throws "file:line: ClothMaterial NAME: what" for impossible values.
+void validate(const ClothMaterial& material);
+/// Checks simulation settings the same way.
+void validate(const SimulationSettings& settings);
+
+}  // namespace drape::scene

@@ -1,0 +1,72 @@
+#include "drape/scene/scene.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "drape/formats/vrml_read.hpp"
+#include "drape/scene/scene_build.hpp"
+
+namespace drape::scene {
+namespace {
+
+[[noreturn]] void bad(const SourcePos& at, const std::string& node, const std::string& what) {
+  throw Error::at(at, fmt::format("{}: {}", node, what));
+}
+
+std::string label(const char* type, const std::string& name) { return name.empty() ? type : fmt::format("{} {}", type, name); }
+
+}  // namespace
+
+double ClothMaterial::bendingStiffnessOrDerived() const {
+  if (bendingStiffness >= 0.0) return bendingStiffness;
+  return youngsModulus * thickness * thickness * thickness / (12.0 * (1.0 - poissonRatio * poissonRatio));
+}
+
+void validate(const ClothMaterial& m) {
+  const std::string node = label("ClothMaterial", m.name);
+  const auto positive = [&](double v, const char* field, const char* unit) {
+    if (!std::isfinite(v) || v <= 0.0)
+      bad(m.source, node, fmt::format("{} {:g} {} is {} (it must be greater than 0)", field, v, unit, v < 0 ? "negative" : "not positive"));
+  };
+  positive(m.density, "density", "kg/m^3");
+  positive(m.thickness, "thickness", "m");
+  positive(m.youngsModulus, "youngsModulus", "Pa");
+  if (!std::isfinite(m.poissonRatio) || m.poissonRatio < 0.0 || m.poissonRatio >= 0.5)
+    bad(m.source, node, fmt::format("poissonRatio {:g} is outside [0, 0.5)", m.poissonRatio));
+  const auto nonNegative = [&](double v, const char* field) {
+    if (!std::isfinite(v) || v < 0.0) bad(m.source, node, fmt::format("{} {:g} is negative (it must be >= 0)", field, v));
+  };
+  if (!std::isfinite(m.bendingStiffness)) bad(m.source, node, "bendingStiffness is not a number");
+  nonNegative(m.damping, "damping");
+  nonNegative(m.staticFriction, "staticFriction");
+  nonNegative(m.dynamicFriction, "dynamicFriction");
+  if (!std::isfinite(m.compressionScale) || m.compressionScale < 0.0 || m.compressionScale > 1.0)
+    bad(m.source, node, fmt::format("compressionScale {:g} is outside [0, 1]", m.compressionScale));
+}
+
+void validate(const SimulationSettings& s) {
+  const std::string node = "Simulation";
+  const auto positive = [&](double v, const char* field) {
+    if (!std::isfinite(v) || v <= 0.0) bad(s.source, node, fmt::format("{} {:g} must be greater than 0", field, v));
+  };
+  positive(s.frameRate, "frameRate");
+  positive(s.voxelSize, "voxelSize");
+  positive(s.unitScale, "unitScale");
+  if (s.stepsPerFrame < 1) bad(s.source, node, fmt::format("stepsPerFrame {} must be at least 1", s.stepsPerFrame));
+  if (s.collisionEvery < 1) bad(s.source, node, fmt::format("collisionEvery {} must be at least 1", s.collisionEvery));
+  if (!std::isfinite(s.airViscosity) || s.airViscosity < 0.0)
+    bad(s.source, node, fmt::format("airViscosity {:g} is negative", s.airViscosity));
+  if (!s.gravity.allFinite() || !s.wind.allFinite()) bad(s.source, node, "gravity and wind must be finite");
+  for (std::size_t i = 0; i < s.offsets.size(); ++i) {
+    if (!std::isfinite(s.offsets[i]) || s.offsets[i] < 0.0)
+      bad(s.source, node, fmt::format("offsets: T{} = {:g} m is negative", i, s.offsets[i]));
+    if (i > 0 && s.offsets[i] < s.offsets[i - 1])
+      bad(s.source, node, fmt::format("offsets must not decrease (T{} = {:g} m < T{} = {:g} m)", i, s.offsets[i], i - 1, s.offsets[i - 1]));
+  }
+  if (s.integrator.empty()) bad(s.source, node, "integrator is empty");
+}
+
+Scene loadScene(const std::string& path) { return buildScene(formats::vrml::readFile(path)); }
+
+}  // namespace drape::scene

@@ -43,8 +43,8 @@ class VideoEncoder {
     log_ = (fs::temp_directory_path() / fmt::format("drape-ffmpeg-{}.log", static_cast<long>(::getpid()))).string();
     const std::string command = fmt::format(
         "ffmpeg -hide_banner -loglevel error -y -f rawvideo -pixel_format rgb24 -video_size {}x{} -framerate {} -i - "
-        "-vf pad=ceil(iw/2)*2:ceil(ih/2)*2 -c:v libx264 -preset veryfast -crf 20 -pix_fmt yuv420p -movflags +faststart {} 2> {}",
-        width, height, frameRate, shellQuote(path), shellQuote(log_));
+        "-vf {} -c:v libx264 -preset veryfast -crf 20 -pix_fmt yuv420p -movflags +faststart {} 2> {}",
+        width, height, frameRate, shellQuote("pad=ceil(iw/2)*2:ceil(ih/2)*2"), shellQuote(path), shellQuote(log_));
     previousSigpipe_ = std::signal(SIGPIPE, SIG_IGN);  // a failing ffmpeg must not kill drape
     pipe_ = ::popen(command.c_str(), "w");
     if (pipe_ == nullptr) throw Error(fmt::format("{}: cannot start ffmpeg", path));

@@ -182,10 +182,10 @@ TEST_F(Headless, OffsetSurfacesAndSliceDrawAroundTheSegmentOnly) {
   // Shells reach T3 = 4 cm out; the slice plane spans the part's box (30 cm wide) plus a
   // margin of half its width on each side.
   std::vector<Vec3> grown;
-  for (const Vec3& p : f.positions[0]) {
-    grown.push_back(p + Vec3(0.31, 0.05, 0.31));
-    grown.push_back(p - Vec3(0.31, 0.05, 0.31));
-  }
+  for (const Vec3& p : f.positions[0])
+    for (double sx : {-1.0, 1.0})
+      for (double sy : {-1.0, 1.0})
+        for (double sz : {-1.0, 1.0}) grown.push_back(p + Vec3(0.31 * sx, 0.05 * sy, 0.31 * sz));
   const Box around = projectedBox(cam, grown);
   long shellChanged = 0, sliceChanged = 0;
   for (int y = 0; y < kH; ++y)

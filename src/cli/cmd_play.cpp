@@ -17,6 +17,7 @@ struct PlayOptions {
   long frames = 0;
   bool once = false;
   bool fast = false;
+  std::string screenshot;
   PictureOptions picture;
 };
 
@@ -26,6 +27,7 @@ RunFunction setupPlay(CLI::App& app) {
   app.add_option("--frames", o.frames, "Close by itself after showing N frames")->check(CLI::PositiveNumber);
   app.add_flag("--once", o.once, "Stop at the last frame instead of starting over");
   app.add_flag("--fast", o.fast, "Show a new frame on every redraw instead of at the run's frame rate");
+  app.add_option("--screenshot", o.screenshot, "Save the window's last picture as a PNG when it closes");
   o.picture.add(app);
   app.footer("Mouse: drag to orbit, wheel to zoom. Keys: space pause, left/right step, R reset view, Esc quit.\n"
              "Needs a display (run it under xvfb-run on a server); drape render works without one.");
@@ -40,6 +42,7 @@ RunFunction setupPlay(CLI::App& app) {
     options.view = o.picture.view();
     options.view.bounds = replay.bounds();
     options.overlay = o.picture.overlay();
+    options.screenshot = o.screenshot;
     const render::PlayerStats stats = render::Player(options).run(replay);
     std::cout << fmt::format("showed {} frames in {:.1f} s\n", stats.framesDrawn, stats.seconds);
     return 0;

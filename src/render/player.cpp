@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "drape/render/image.hpp"
 #include "gl_util.hpp"
 #include "hud.hpp"
 
@@ -70,6 +71,7 @@ void drawPanel(OverlaySettings& overlay, const std::vector<MeshInfo>& meshes, bo
   const ImGuiIO& io = ImGui::GetIO();
   ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 10.0f, 10.0f), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
   ImGui::SetNextWindowBgAlpha(0.75f);
+  ImGui::SetNextWindowCollapsed(io.DisplaySize.x < 800.0f, ImGuiCond_FirstUseEver);  // small windows: keep the picture clear
   ImGui::Begin("overlays", nullptr, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove);
   ImGui::Checkbox("paused (space)", &paused);
   ImGui::Checkbox("floor", &overlay.floor);
@@ -107,6 +109,22 @@ void drawPanel(OverlaySettings& overlay, const std::vector<MeshInfo>& meshes, bo
   }
   if (ImGui::Button("reset view (R)")) view = initialView;
   ImGui::End();
+}
+
+/// The picture just drawn into the window's back buffer, rows top to bottom.
+Image readBackBuffer(int width, int height) {
+  Image image;
+  image.width = width;
+  image.height = height;
+  std::vector<std::uint8_t> rows(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3);
+  glReadBuffer(GL_BACK);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width, height, GL_RGB, GL_UNSIGNED_BYTE, rows.data());
+  image.rgb.resize(rows.size());
+  const std::size_t stride = static_cast<std::size_t>(width) * 3;
+  for (int y = 0; y < height; ++y)
+    std::copy_n(rows.data() + static_cast<std::size_t>(height - 1 - y) * stride, stride, image.rgb.data() + static_cast<std::size_t>(y) * stride);
+  return image;
 }
 
 }  // namespace
@@ -221,6 +239,7 @@ PlayerStats Player::run(FrameSource& source) {
         imgui.drawHud(hud, width, height);
         drawPanel(overlay, source.meshes(), hasStates, paused, view, initialView);
         imgui.endFrame();
+        if (!options_.screenshot.empty() && glfwWindowShouldClose(window)) writePng(options_.screenshot, readBackBuffer(width, height));
         glfwSwapBuffers(window);
       }
       ++fpsFrames;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -307,6 +308,8 @@ struct Renderer::Impl {
   std::vector<std::vector<float>> normals;    ///< per mesh, xyz float, area-weighted, unit
   Frame frame;                                ///< the current frame (for the slice)
   Aabb frameBounds;
+  std::uint64_t generation = 0;               ///< counts setFrame calls
+  std::tuple<std::uint64_t, int, double, bool> sliceKey{~0ull, -1, 0.0, false};  ///< what the slice texture shows
   GLuint meshProgram = 0, gridProgram = 0, backgroundProgram = 0, markerProgram = 0, sliceProgram = 0;
   GLuint quadVao = 0, quadVbo = 0, emptyVao = 0, sliceTexture = 0;
 
@@ -554,18 +557,24 @@ struct Renderer::Impl {
     const double y = box.min.y() + std::clamp(overlay.sliceHeight, 0.0, 1.0) * box.size().y();
     const Vec3 lo(box.min.x() - margin, y, box.min.z() - margin);
     const Vec3 size(box.size().x() + 2 * margin, 0.0, box.size().z() + 2 * margin);
-    constexpr int kCells = 96;
-    std::vector<float> distance(kCells * kCells);
-    for (int j = 0; j < kCells; ++j) {
-      for (int i = 0; i < kCells; ++i) {
-        const Vec3 p(lo.x() + (i + 0.5) / kCells * size.x(), y, lo.z() + (j + 0.5) / kCells * size.z());
-        const double d = overlay.sliceDistance ? overlay.sliceDistance(p) : bruteForceDistance(static_cast<std::size_t>(part), p);
-        distance[static_cast<std::size_t>(j * kCells + i)] = static_cast<float>(d);
-      }
-    }
+    // Sample the distances only when the frame or the slice changed (the window redraws
+    // far more often than frames arrive).
+    const auto key = std::make_tuple(generation, part, overlay.sliceHeight, static_cast<bool>(overlay.sliceDistance));
     glBindTexture(GL_TEXTURE_2D, sliceTexture);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, kCells, kCells, 0, GL_RED, GL_FLOAT, distance.data());
+    if (key != sliceKey) {
+      sliceKey = key;
+      constexpr int kCells = 96;
+      std::vector<float> distance(kCells * kCells);
+      for (int j = 0; j < kCells; ++j) {
+        for (int i = 0; i < kCells; ++i) {
+          const Vec3 p(lo.x() + (i + 0.5) / kCells * size.x(), y, lo.z() + (j + 0.5) / kCells * size.z());
+          const double d = overlay.sliceDistance ? overlay.sliceDistance(p) : bruteForceDistance(static_cast<std::size_t>(part), p);
+          distance[static_cast<std::size_t>(j * kCells + i)] = static_cast<float>(d);
+        }
+      }
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, kCells, kCells, 0, GL_RED, GL_FLOAT, distance.data());
+    }
     glUseProgram(sliceProgram);
     glUniformMatrix4fv(glGetUniformLocation(sliceProgram, "uViewProj"), 1, GL_FALSE, viewProj.data());
     glUniform3f(glGetUniformLocation(sliceProgram, "uMin"), static_cast<float>(lo.x()), static_cast<float>(lo.y()),
@@ -623,6 +632,7 @@ void Renderer::setFrame(const Frame& frame) {
   }
   s.frame = frame;
   s.frameBounds = frameBounds(frame);
+  ++s.generation;
   for (std::size_t m = 0; m < s.meshes.size(); ++m) {
     const std::vector<Vec3>& x = frame.positions[m];
     if (x.size() != s.meshes[m].vertexCount) {

@@ -27,6 +27,7 @@ struct PlayerOptions {
   bool realTime = true;   ///< advance at the source's frame rate; false: one frame per redraw
   ViewSettings view;
   OverlaySettings overlay;
+  std::string screenshot;  ///< "": none; else the last picture the window showed, as PNG
 };
 
 struct PlayerStats {

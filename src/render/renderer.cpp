@@ -112,7 +112,7 @@ void main() {
   float d = length(vWorld.xz - uCentre.xz) / uRadius;
   float fade = 1.0 - smoothstep(0.15, 1.0, d);
   vec3 floorColour = vec3(0.60, 0.62, 0.65);
-  vec3 c = mix(floorColour, vec3(0.42, 0.44, 0.48), max(minor * 0.45, major * 0.85));
+  vec3 c = mix(floorColour, vec3(0.42, 0.44, 0.48), max(minor * 0.35, major * 0.8));
   fragColour = vec4(c, fade);
 }
 )";
@@ -411,7 +411,7 @@ struct Renderer::Impl {
   /// the stencil so shadows land on it only.
   void drawFloor(const Mat4& viewProj, const Aabb& bounds, float floorY) {
     const float extent = std::max(0.5f, static_cast<float>(bounds.size().maxCoeff()));
-    const float spacing = std::pow(10.0f, std::floor(std::log10(extent * 0.5f))) * (extent > 4.0f ? 1.0f : 0.5f);
+    const float spacing = std::pow(10.0f, std::floor(std::log10(extent))) / 10.0f;  // 10 cm lines for a person
     const V3 c = bounds.center().cast<float>();
     glUseProgram(gridProgram);
     glUniformMatrix4fv(glGetUniformLocation(gridProgram, "uViewProj"), 1, GL_FALSE, viewProj.data());

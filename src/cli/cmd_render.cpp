@@ -1,0 +1,62 @@
+// `drape render OUTDIR --png DIR [--video out.mp4] [--contact-sheet sheet.png] [--size WxH]`:
+// pictures of a finished run, rendered headless (EGL surfaceless; no display needed).
+
+#include <iostream>
+
+#include <fmt/format.h>
+
+#include "command.hpp"
+#include "drape/core/error.hpp"
+#include "drape/render/outputs.hpp"
+#include "render_options.hpp"
+
+namespace drape::cli {
+namespace {
+
+struct RenderOptions {
+  std::string run;
+  std::string png;
+  std::string video;
+  std::string sheet;
+  std::string sheetSize = "1920x1080";
+  bool noHud = false;
+  PictureOptions picture;
+};
+
+RunFunction setupRender(CLI::App& app) {
+  static RenderOptions o;
+  app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes")->required();
+  app.add_option("--png", o.png, "Write every frame as DIR/frame_00000.png ...");
+  app.add_option("--video", o.video, "Encode every frame as an H.264 MP4 (needs the ffmpeg command)");
+  app.add_option("--contact-sheet", o.sheet, "Write a 4x4 grid of evenly spaced frames with their time codes");
+  app.add_option("--sheet-size", o.sheetSize, "Contact sheet size WIDTHxHEIGHT")->capture_default_str();
+  app.add_flag("--no-hud", o.noHud, "No time code or frame number on PNG and video frames");
+  o.picture.add(app);
+  app.footer("Renders without a display (EGL surfaceless, Mesa llvmpipe). At least one of --png, --video,\n"
+             "--contact-sheet is needed.");
+  return [] {
+    if (o.png.empty() && o.video.empty() && o.sheet.empty()) {
+      throw Error("drape render: nothing to write: give --png DIR, --video FILE.mp4 or --contact-sheet FILE.png");
+    }
+    render::RenderJob job;
+    std::tie(job.width, job.height) = o.picture.parsedSize();
+    std::tie(job.sheetWidth, job.sheetHeight) = PictureOptions::parseSize(o.sheetSize, "--sheet-size");
+    job.pngDirectory = o.png;
+    job.videoPath = o.video;
+    job.contactSheet = o.sheet;
+    job.hud = !o.noHud;
+    job.view = o.picture.view();
+    job.overlay = o.picture.overlay();
+    const render::RenderSummary summary = render::renderRun(o.run, job);
+    if (!o.png.empty()) std::cout << fmt::format("wrote {} frames to {}/\n", summary.frames, o.png);
+    if (!o.video.empty()) std::cout << fmt::format("wrote {} ({} frames)\n", o.video, summary.frames);
+    if (!o.sheet.empty()) std::cout << fmt::format("wrote {} (frames {})\n", o.sheet, fmt::join(summary.sheetFrames, " "));
+    std::cerr << fmt::format("rendered in {:.1f} s with {}\n", summary.seconds, summary.glDescription);
+    return 0;
+  };
+}
+
+const bool registered = registerCommand({"render", "Render a run's frames to PNG, video and a contact sheet (headless)", "", 40, &setupRender});
+
+}  // namespace
+}  // namespace drape::cli

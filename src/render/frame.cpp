@@ -1,0 +1,22 @@
+#include "drape/render/frame.hpp"
+
+#include <fmt/format.h>
+
+#include "drape/core/error.hpp"
+
+namespace drape::render {
+
+MeshRole parseMeshRole(const std::string& role) {
+  if (role == "garment") return MeshRole::Garment;
+  if (role == "segment") return MeshRole::Segment;
+  throw Error(fmt::format("mesh role '{}' is not one of: garment, segment", role));
+}
+
+Aabb frameBounds(const Frame& frame) {
+  Aabb box;
+  for (const std::vector<Vec3>& mesh : frame.positions)
+    for (const Vec3& p : mesh) box.extend(p);
+  return box;
+}
+
+}  // namespace drape::render

@@ -1,0 +1,96 @@
+#include "drape/render/run_replay.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "drape/core/error.hpp"
+#include "drape/formats/obj.hpp"
+#include "drape/formats/pc2.hpp"
+#include "drape/formats/run_manifest.hpp"
+
+namespace drape::render {
+namespace {
+
+/// DIR/stats.json's "ms_per_stage" object ({"forces": 1.2, ...}), when the run wrote one.
+/// Anything else in the file is not the player's business; a malformed file is reported.
+std::vector<StageTime> readStageTimes(const std::filesystem::path& directory) {
+  const std::filesystem::path path = directory / "stats.json";
+  std::ifstream in(path);
+  if (!in) return {};
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw Error(fmt::format("{}: not valid JSON (byte {})", path.string(), e.byte));
+  }
+  std::vector<StageTime> stages;
+  if (!j.is_object() || !j.contains("ms_per_stage") || !j["ms_per_stage"].is_object()) return stages;
+  for (const auto& [stage, value] : j["ms_per_stage"].items()) {
+    if (value.is_number()) stages.push_back({stage, value.get<double>()});
+  }
+  return stages;
+}
+
+}  // namespace
+
+RunReplay::RunReplay(const std::string& directory) : directory_(directory) {
+  const formats::RunManifest manifest = formats::readRunManifest(directory);
+  const std::filesystem::path dir(directory);
+  if (manifest.frames <= 0) throw Error(fmt::format("{}: the run has no frames", (dir / "manifest.json").string()));
+  if (!(manifest.frameRate > 0.0) || !std::isfinite(manifest.frameRate)) {
+    throw Error(fmt::format("{}: frame_rate must be positive", (dir / "manifest.json").string()));
+  }
+  frameRate_ = manifest.frameRate;
+  frames_ = manifest.frames;
+  startFrame_ = manifest.startFrame;
+  for (const formats::RunMesh& m : manifest.meshes) {
+    const std::string objPath = (dir / m.topology).string();
+    const std::string pc2Path = (dir / m.cache).string();
+    mesh::TriMesh topology = formats::readObj(objPath);
+    formats::Pc2Cache cache = formats::readPc2(pc2Path);
+    if (cache.pointCount != topology.vertexCount()) {
+      throw Error(fmt::format("{}: {} points per sample, but {} has {} vertices", pc2Path, cache.pointCount, objPath,
+                              topology.vertexCount()));
+    }
+    if (static_cast<std::int64_t>(cache.frames.size()) < frames_) {
+      throw Error(fmt::format("{}: {} samples, the manifest says {} frames", pc2Path, cache.frames.size(), frames_));
+    }
+    cache.frames.resize(static_cast<std::size_t>(frames_));
+    for (const std::vector<Vec3>& f : cache.frames) {
+      for (const Vec3& p : f) {
+        if (!p.allFinite()) throw Error(fmt::format("{}: a position is not finite", pc2Path));
+        bounds_.extend(p);
+      }
+    }
+    MeshInfo info;
+    info.name = m.name;
+    try {
+      info.role = parseMeshRole(m.role);
+    } catch (const Error& e) {
+      throw Error(fmt::format("{}: {}", (dir / "manifest.json").string(), e.what()));
+    }
+    info.vertexCount = topology.vertexCount();
+    info.triangles = std::move(topology.triangles);
+    meshes_.push_back(std::move(info));
+    caches_.push_back(std::move(cache.frames));
+  }
+  if (meshes_.empty()) throw Error(fmt::format("{}: the run lists no meshes", (dir / "manifest.json").string()));
+  stages_ = readStageTimes(dir);
+}
+
+bool RunReplay::read(std::int64_t index, Frame& out) {
+  if (index < 0 || index >= frames_) return false;
+  out.index = index;
+  out.time = TimeCode{startFrame_ + index, frameRate_};
+  out.positions.resize(meshes_.size());
+  for (std::size_t m = 0; m < meshes_.size(); ++m) out.positions[m] = caches_[m][static_cast<std::size_t>(index)];
+  out.states.clear();
+  out.stages = stages_;
+  return true;
+}
+
+}  // namespace drape::render

@@ -1,0 +1,150 @@
+// The real drape command: render (PNG, video, contact sheet), play (a window under Xvfb
+// that closes by itself) and export, on the test run, plus their errors.
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+
+#include "../formats/test_run_fixture.hpp"
+#include "drape/render/image.hpp"
+
+namespace drape::render {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int status = -1;
+  std::string output;  ///< standard output and error
+};
+
+Result run(const std::string& command) {
+  Result r;
+  std::FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return r;
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) r.output += buffer.data();
+  const int status = ::pclose(pipe);
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+bool have(const std::string& tool) { return std::system(("command -v " + tool + " >/dev/null 2>&1").c_str()) == 0; }
+
+std::string drape() { return std::string(DRAPE_EXE); }
+
+TEST(RenderCli, PngFramesAtTheAskedSize) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_png"), 6);
+  const Result r = run(drape() + " render " + dir + " --png " + dir + "/png --size 200x150");
+  ASSERT_EQ(r.status, 0) << r.output;
+  for (int i = 0; i < 6; ++i) {
+    const Image image = readPng(dir + "/png/frame_0000" + std::to_string(i) + ".png");
+    EXPECT_EQ(image.width, 200);
+    EXPECT_EQ(image.height, 150);
+  }
+  EXPECT_FALSE(fs::exists(dir + "/png/frame_00006.png"));
+}
+
+TEST(RenderCli, VideoHasEveryFrame) {
+  if (!have("ffmpeg") || !have("ffprobe")) GTEST_SKIP() << "ffmpeg is not installed (scripts/install-deps installs it)";
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_video"), 17);
+  const Result r = run(drape() + " render " + dir + " --video " + dir + "/out.mp4 --size 161x121");  // odd: padded
+  ASSERT_EQ(r.status, 0) << r.output;
+  const Result probe = run("ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames,r_frame_rate "
+                           "-of csv=p=0 " + dir + "/out.mp4");
+  ASSERT_EQ(probe.status, 0) << probe.output;
+  EXPECT_NE(probe.output.find("24/1,17"), std::string::npos) << probe.output;
+}
+
+TEST(RenderCli, ContactSheetHas16TilesWithTimeCodes) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_sheet"), 40);
+  const Result r = run(drape() + " render " + dir + " --contact-sheet " + dir + "/sheet.png --sheet-size 960x540");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("frames 0 3 5 8 10 13 16 18 21 23 26 29 31 34 36 39"), std::string::npos) << r.output;
+  const Image sheet = readPng(dir + "/sheet.png");
+  ASSERT_EQ(sheet.width, 960);
+  ASSERT_EQ(sheet.height, 540);
+  // Layout: a gap of max(2, width / 320) pixels around 4x4 equal tiles, in the sheet colour.
+  const int gap = 3, tileW = (960 - 5 * gap) / 4, tileH = (540 - 5 * gap) / 4;
+  const auto isGap = [&](int x, int y) {
+    const std::uint8_t* p = sheet.pixel(x, y);
+    return p[0] == 18 && p[1] == 20 && p[2] == 26;
+  };
+  for (int k = 0; k <= 4; ++k) {
+    for (int y = 0; y < 540; y += 7) EXPECT_TRUE(isGap(k * (tileW + gap) + 1, y)) << "column gap " << k;
+    for (int x = 0; x < 960; x += 7) EXPECT_TRUE(isGap(x, k * (tileH + gap) + 1)) << "row gap " << k;
+  }
+  // Each tile carries a label of near-white text in its lower-left quarter, and no two
+  // labels are the same (16 different time codes).
+  std::set<std::vector<bool>> labels;
+  for (int t = 0; t < 16; ++t) {
+    const int x0 = gap + (t % 4) * (tileW + gap), y0 = gap + (t / 4) * (tileH + gap);
+    std::vector<bool> mask;
+    long white = 0;
+    for (int y = y0 + tileH * 3 / 4; y < y0 + tileH; ++y)
+      for (int x = x0; x < x0 + tileW / 2; ++x) {
+        const std::uint8_t* p = sheet.pixel(x, y);
+        const bool w = p[0] > 225 && p[1] > 225 && p[2] > 225;
+        mask.push_back(w);
+        white += w;
+      }
+    EXPECT_GT(white, 60) << "tile " << t << " has no time code";
+    labels.insert(mask);
+  }
+  EXPECT_EQ(labels.size(), 16u);
+}
+
+TEST(PlayCli, WindowUnderXvfbClosesByItselfAfterNFrames) {
+  if (!have("xvfb-run")) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps installs xvfb)";
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_play"), 24);
+  // Leak checking is off for this child only: the X and GLX stack leaks a few bytes at exit
+  // from a driver that is already unloaded, which LeakSanitizer cannot attribute.
+  const Result r = run("ASAN_OPTIONS=detect_leaks=0 timeout 300 xvfb-run -a " + drape() + " play " + dir +
+                       " --frames 8 --fast --size 320x240 --screenshot " + dir + "/shot.png");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("showed 8 frames"), std::string::npos) << r.output;
+  const Image shot = readPng(dir + "/shot.png");
+  EXPECT_EQ(shot.width, 320);
+  long red = 0;
+  for (int y = 0; y < shot.height; ++y)
+    for (int x = 0; x < shot.width; ++x) red += shot.pixel(x, y)[0] > shot.pixel(x, y)[1] + 40;
+  EXPECT_GT(red, 500) << "the window showed the garment";
+}
+
+TEST(PlayCli, NoDisplayIsAClearError) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_nodisplay"), 2);
+  const Result r = run("env -u DISPLAY -u WAYLAND_DISPLAY ASAN_OPTIONS=detect_leaks=0 " + drape() + " play " + dir + " --frames 1");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("needs a display"), std::string::npos) << r.output;
+}
+
+TEST(RenderCli, BadInputsExitWithTwoAndSayWhat) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_bad"), 2);
+  Result r = run(drape() + " render " + dir + "/nowhere --png " + dir + "/png");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("nowhere"), std::string::npos) << r.output;
+  r = run(drape() + " render " + dir + " --png " + dir + "/png --size 12x800");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("--size"), std::string::npos) << r.output;
+  r = run(drape() + " render " + dir + " --png " + dir + "/png --size big");
+  EXPECT_EQ(r.status, 2);
+  r = run(drape() + " render " + dir);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("nothing to write"), std::string::npos) << r.output;
+  r = run(drape() + " export " + dir + "/nowhere");
+  EXPECT_EQ(r.status, 2);
+}
+
+TEST(ExportCli, WritesResultGlbIntoTheRun) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_export"), 5);
+  const Result r = run(drape() + " export " + dir);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir + "/result.glb"));
+  EXPECT_NE(r.output.find("1 morph-target meshes, 1 rigid nodes"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace drape::render

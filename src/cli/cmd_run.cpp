@@ -1,0 +1,188 @@
+// `drape run`: simulate a garment hanging from pinned vertices (a VRML97 scene with an
+// avatar and motion comes later through the same RunSetup) and write frames, a PC2 cache,
+// stats.json and manifest.json into the output directory.
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "command.hpp"
+#include "drape/core/error.hpp"
+#include "drape/formats/obj.hpp"
+#include "drape/formats/units.hpp"
+#include "run_setup.hpp"
+
+namespace drape::cli {
+namespace {
+
+struct RunOptions {
+  std::string garment, units = "m", pinVertices, pinMask, out, substeps = "33", integrator = "symplectic-euler";
+  std::string wind, gravity;
+  std::vector<std::string> spheres;
+  double pinTolerance_m = 1e-4;
+  long frames = 0, every = 1;
+  cloth::Material material;
+  cloth::StepSettings settings;
+};
+
+/// "x,y,z" -> Vec3; throws naming `option`.
+Vec3 parseVec3(const std::string& text, const std::string& option) {
+  std::vector<double> v;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw Error(fmt::format("{}: '{}' is not a number", option, item));
+    }
+  }
+  if (v.size() != 3) throw Error(fmt::format("{}: expected three numbers x,y,z, got '{}'", option, text));
+  return {v[0], v[1], v[2]};
+}
+
+/// "0,5,17" -> sorted unique indices; throws naming --pin-vertices.
+std::vector<std::uint32_t> parseIndexList(const std::string& text) {
+  std::vector<std::uint32_t> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    std::size_t used = 0;
+    long long value = -1;
+    try {
+      value = std::stoll(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || value < 0 || value > 0xfffffffell)
+      throw Error(fmt::format("--pin-vertices: '{}' is not a vertex index (0-based, comma-separated)", item));
+    out.push_back(static_cast<std::uint32_t>(value));
+  }
+  if (out.empty()) throw Error("--pin-vertices: the list is empty");
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+/// Garment vertices within `tolerance` of a vertex of the mask mesh (paper 4.1: a constraint
+/// mask is a subset of the garment, matched within a tolerance). Brute force: masks and
+/// garments are small and this runs once.
+std::vector<std::uint32_t> matchMask(const mesh::TriMesh& garment, const mesh::TriMesh& mask, double tolerance) {
+  std::vector<std::uint32_t> out;
+  const double t2 = tolerance * tolerance;
+  for (std::size_t i = 0; i < garment.vertexCount(); ++i)
+    for (const Vec3& p : mask.positions)
+      if ((garment.positions[i] - p).squaredNorm() <= t2) {
+        out.push_back(static_cast<std::uint32_t>(i));
+        break;
+      }
+  if (out.empty())
+    throw Error(fmt::format("{}: no vertex of the mask lies within {} m of a garment vertex (--pin-tolerance)",
+                            mask.name, tolerance));
+  return out;
+}
+
+int substepsFrom(const std::string& text) {
+  if (text == "auto") return 0;
+  std::size_t used = 0;
+  long value = 0;
+  try {
+    value = std::stol(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || value < 1 || value > 100000)
+    throw Error(fmt::format("--substeps must be a whole number in [1, 100000] or 'auto', got '{}'", text));
+  return static_cast<int>(value);
+}
+
+int runCommand(RunOptions& o) {
+  RunSetup setup;
+  const double scale = formats::metresPerUnit(o.units, "--units");
+  formats::ObjReadOptions read;
+  read.metresPerUnit = scale;
+  GarmentSetup garment;
+  garment.mesh = formats::readObj(o.garment, read);
+  garment.name = std::filesystem::path(o.garment).stem().string();
+  garment.material = o.material;
+  if (!o.pinVertices.empty()) garment.pinned = parseIndexList(o.pinVertices);
+  if (!o.pinMask.empty()) {
+    if (!(o.pinTolerance_m > 0.0)) throw Error(fmt::format("--pin-tolerance must be > 0 m, got {}", o.pinTolerance_m));
+    garment.pinned = matchMask(garment.mesh, formats::readObj(o.pinMask, read), o.pinTolerance_m);
+  }
+
+  setup.settings = o.settings;
+  setup.settings.integrator = cloth::parseIntegrator(o.integrator, "--integrator");
+  if (!o.wind.empty()) setup.settings.wind_m_s = parseVec3(o.wind, "--wind");
+  if (!o.gravity.empty()) setup.settings.gravity_m_s2 = parseVec3(o.gravity, "--gravity");
+  for (const std::string& s : o.spheres) {
+    const auto comma = s.rfind(',');
+    if (comma == std::string::npos) throw Error(fmt::format("--sphere: expected x,y,z,radius (m), got '{}'", s));
+    const Vec3 c = parseVec3(s.substr(0, comma), "--sphere");
+    const Vec3 r = parseVec3("0,0," + s.substr(comma + 1), "--sphere");
+    setup.spheres.push_back({c, r.z()});
+  }
+  const int substeps = substepsFrom(o.substeps);
+  setup.settings.substepsPerFrame = substeps > 0 ? substeps : 1;
+  setup.garments.push_back(std::move(garment));
+  setup.frames = o.frames;
+  setup.objEvery = o.every;
+  setup.outDir = o.out;
+  if (substeps == 0) setup.settings.substepsPerFrame = stableSubsteps(setup);
+  return simulateRun(setup);
+}
+
+RunFunction setupRun(CLI::App& app) {
+  auto o = std::make_shared<RunOptions>();
+  app.footer(
+      "Writes DIR/frames/frame_NNNNN.obj (every --every frames), DIR/garment.pc2 (every frame), DIR/garment.obj "
+      "(rest topology), DIR/stats.json and DIR/manifest.json. Units are SI; Y is up.\n"
+      "Exit codes: 0 done, 2 bad input, 3 the simulation became unstable (files so far are kept).");
+  app.add_option("--garment", o->garment, "Garment mesh (OBJ)")->required();
+  app.add_option("--units", o->units, "Length unit of the OBJ files: m, dm, cm, mm, in")->capture_default_str();
+  auto* pins = app.add_option("--pin-vertices", o->pinVertices, "Vertices pinned in place, 0-based, e.g. 0,12,40");
+  auto* mask = app.add_option("--pin-mask", o->pinMask, "OBJ whose vertices mark the pinned garment vertices");
+  pins->excludes(mask);
+  mask->excludes(pins);
+  app.add_option("--pin-tolerance", o->pinTolerance_m, "Distance within which a mask vertex matches, m")
+      ->capture_default_str();
+  app.add_option("--frames", o->frames, "Frames to simulate")->required();
+  app.add_option("--out", o->out, "Output directory")->required();
+  app.add_option("--every", o->every, "Write an OBJ frame every K frames")->capture_default_str();
+
+  cloth::Material& m = o->material;
+  app.add_option("--density", m.density_kg_m3, "Fabric density, kg/m^3")->capture_default_str();
+  app.add_option("--thickness", m.thickness_m, "Fabric thickness, m")->capture_default_str();
+  app.add_option("--youngs-modulus", m.youngsModulus_Pa, "Young's modulus E, Pa")->capture_default_str();
+  app.add_option("--poisson-ratio", m.poissonRatio, "Poisson ratio, [0, 0.5)")->capture_default_str();
+  app.add_option("--bending-stiffness", m.bendingStiffness_Nm, "Bending modulus D, N m (default E t^3/(12(1-nu^2)))");
+  app.add_option("--damping", m.damping_s, "Internal (stiffness-proportional) damping time, s")->capture_default_str();
+  app.add_option("--static-friction", m.staticFriction, "Static friction coefficient")->capture_default_str();
+  app.add_option("--dynamic-friction", m.dynamicFriction, "Dynamic friction coefficient")->capture_default_str();
+  app.add_option("--compression-scale", m.compressionScale, "Factor on compressive stresses, (0, 1]")
+      ->capture_default_str();
+
+  cloth::StepSettings& s = o->settings;
+  app.add_option("--substeps", o->substeps, "Substeps per frame, or 'auto' (the estimated stable count)")
+      ->capture_default_str();
+  app.add_option("--frame-rate", s.frameRate_hz, "Frames per second")->capture_default_str();
+  app.add_option("--integrator", o->integrator, "symplectic-euler or forward-euler (the paper's)")
+      ->capture_default_str();
+  app.add_option("--air-viscosity", s.airViscosity_Ns_m3, "Linear air drag per area, N s/m^3")->capture_default_str();
+  app.add_option("--wind", o->wind, "Wind velocity x,y,z, m/s");
+  app.add_option("--gravity", o->gravity, "Gravity x,y,z, m/s^2 (default 0,-9.81,0)");
+  app.add_option("--max-speed", s.maxSpeed_m_s, "Stability bound on vertex speed, m/s")->capture_default_str();
+  app.add_option("--sphere", o->spheres, "A static sphere collider x,y,z,radius (m); repeatable");
+  return [o] { return runCommand(*o); };
+}
+
+const bool registered =
+    registerCommand({"run", "Simulate a garment and write OBJ frames, a PC2 cache and stats", "", 10, &setupRun});
+
+}  // namespace
+}  // namespace drape::cli

@@ -1,0 +1,135 @@
+// `drape run` end to end on the bundled example, every bad input of issue 2, and an
+// unstable run.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.hpp"
+#include "drape/formats/obj.hpp"
+#include "drape/formats/pc2.hpp"
+#include "drape/formats/run_manifest.hpp"
+
+namespace drape {
+namespace {
+
+using testing::CliResult;
+using testing::lineCount;
+using testing::runDrape;
+using testing::ScratchDir;
+using testing::slurp;
+
+const std::string kDress = std::string(DRAPE_SOURCE_DIR) + "/examples/hanging_dress/dress.obj";
+const std::string kMask = std::string(DRAPE_SOURCE_DIR) + "/examples/hanging_dress/shoulders_mask.obj";
+
+TEST(Run, BundledExampleWritesEverything) {
+  ScratchDir dir("run-example");
+  const std::string out = dir / "out";
+  const CliResult r = runDrape("run --garment '" + kDress + "' --units dm --pin-mask '" + kMask +
+                                   "' --substeps auto --frames 3 --every 2 --out '" + out + "'",
+                               dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+
+  // Frames 0, 2 and the last one as OBJ; every frame in the cache.
+  for (const char* f : {"frame_00000.obj", "frame_00002.obj", "frame_00003.obj"})
+    EXPECT_TRUE(std::filesystem::exists(out + "/frames/" + f)) << f;
+  EXPECT_FALSE(std::filesystem::exists(out + "/frames/frame_00001.obj"));
+  const mesh::TriMesh rest = formats::readObj(out + "/garment.obj");
+  EXPECT_EQ(rest.vertexCount(), 2205u);
+  EXPECT_EQ(rest.triangleCount(), 4192u);
+  const formats::Pc2Cache cache = formats::readPc2(out + "/garment.pc2");
+  ASSERT_EQ(cache.frames.size(), 4u);
+  ASSERT_EQ(cache.pointCount, 2205u);
+  // The rest topology is in metres (the file is in decimetres: 5.62 dm at the top).
+  EXPECT_NEAR(rest.bounds().max.y(), 0.56211, 1e-4);
+  // Pinned (top) vertices stay; the free ones fall.
+  double moved = 0.0;
+  for (std::size_t i = 0; i < cache.pointCount; ++i) {
+    const double dy = cache.frames.back()[i].y() - cache.frames.front()[i].y();
+    if (rest.positions[i].y() > 0.53) {
+      EXPECT_NEAR(dy, 0.0, 1e-6) << i;
+    }
+    moved = std::min(moved, dy);
+  }
+  EXPECT_LT(moved, -1e-4);
+
+  const nlohmann::json stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  for (const char* key : {"frames", "substeps_per_frame", "ms_per_frame", "ms_per_stage", "energy", "max_strain",
+                          "nan_detected"})
+    EXPECT_TRUE(stats.contains(key)) << key;
+  for (const char* stage : {"forces", "integrate", "collide", "fixtures", "output"})
+    EXPECT_TRUE(stats["ms_per_stage"].contains(stage)) << stage;
+  EXPECT_EQ(stats["frames"], 3);
+  EXPECT_GT(stats["substeps_per_frame"].get<int>(), 33);  // auto: the stable count for this mesh
+  EXPECT_GT(stats["ms_per_frame"].get<double>(), 0.0);
+  EXPECT_EQ(stats["energy"].size(), 4u);
+  EXPECT_LT(stats["energy"].back().get<double>(), stats["energy"].front().get<double>());  // falling, drag
+  EXPECT_GE(stats["max_strain"].get<double>(), 0.0);
+  EXPECT_LT(stats["max_strain"].get<double>(), 0.5);
+  EXPECT_FALSE(stats["nan_detected"].get<bool>());
+
+  const formats::RunManifest manifest = formats::readRunManifest(out);
+  EXPECT_EQ(manifest.frames, 4);
+  ASSERT_EQ(manifest.meshes.size(), 1u);
+  EXPECT_EQ(manifest.meshes[0].cache, "garment.pc2");
+  EXPECT_EQ(manifest.meshes[0].topology, "garment.obj");
+}
+
+void writeText(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
+
+struct BadCase {
+  const char* name;
+  std::string args;      // after "run"
+  const char* expected;  // part of the one-line message
+};
+
+TEST(Run, BadInputsGiveOneLineAndExitCode2) {
+  ScratchDir dir("run-bad");
+  const std::string nonManifold = dir / "nonmanifold.obj", degenerate = dir / "degenerate.obj";
+  writeText(nonManifold, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 2 5\n");
+  writeText(degenerate, "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n");
+  const std::string dress = "--garment '" + kDress + "' --units dm --frames 1 --out '" + (dir / "o") + "'";
+  const std::vector<BadCase> cases = {
+      {"missing file", "--garment /no/such/garment.obj --frames 1 --out '" + (dir / "o") + "'", "no such file"},
+      {"non-manifold", "--garment '" + nonManifold + "' --frames 1 --out '" + (dir / "o") + "'", "non-manifold edge"},
+      {"degenerate", "--garment '" + degenerate + "' --frames 1 --out '" + (dir / "o") + "'", "degenerate"},
+      {"negative thickness", dress + " --thickness -0.001", "--thickness must be > 0 m"},
+      {"negative density", dress + " --density -5", "--density must be > 0 kg/m^3"},
+      {"poisson 0.5", dress + " --poisson-ratio 0.5", "--poisson-ratio must be in [0, 0.5)"},
+      {"poisson negative", dress + " --poisson-ratio -0.1", "--poisson-ratio must be in [0, 0.5)"},
+      {"pin out of range", dress + " --pin-vertices 0,5000", "--pin-vertices: vertex 5000 is out of range"},
+      {"pin not a number", dress + " --pin-vertices 0,x", "--pin-vertices: 'x' is not a vertex index"},
+      {"unknown unit", "--garment '" + kDress + "' --units furlong --frames 1 --out '" + (dir / "o") + "'",
+       "--units"},
+      {"mask matches nothing", dress + " --pin-mask '" + nonManifold + "'", "no vertex of the mask"},
+      {"zero frames", "--garment '" + kDress + "' --units dm --frames 0 --out '" + (dir / "o") + "'",
+       "--frames must be >= 1"},
+      {"bad substeps", dress + " --substeps fast", "--substeps must be"},
+      {"bad integrator", dress + " --integrator rk4", "--integrator must be"},
+  };
+  for (const BadCase& c : cases) {
+    const CliResult r = runDrape("run " + c.args, dir);
+    EXPECT_EQ(r.code, 2) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_EQ(lineCount(r.err), 1) << c.name << ": " << r.err;
+  }
+}
+
+TEST(Run, UnstableRunExits3AndKeepsWhatItWrote) {
+  ScratchDir dir("run-unstable");
+  const std::string out = dir / "out";
+  // The dress at the default 33 substeps is far beyond its stable step.
+  const CliResult r = runDrape("run --garment '" + kDress + "' --units dm --pin-mask '" + kMask +
+                                   "' --frames 5 --out '" + out + "'",
+                               dir);
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find("garment 'dress': vertex"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("in frame 1"), std::string::npos) << r.err;
+  const nlohmann::json stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  EXPECT_TRUE(stats["unstable"].get<bool>());
+  EXPECT_EQ(stats["frames"], 0);
+  EXPECT_EQ(formats::readPc2(out + "/garment.pc2").frames.size(), 1u);
+  EXPECT_EQ(formats::readRunManifest(out).frames, 1);
+}
+
+}  // namespace
+}  // namespace drape

@@ -256,4 +256,18 @@ double maxJointSeparation(const AvatarAnimation& animation, const scene::Avatar&
   return largest;
 }
 
+AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& motionPath, const MotionOptions& options,
+                              ClipLoadReport* report, JointMap* chosenMap) {
+  const Clip clip = loadClip(motionPath, options.clip, report);
+  JointMap map;
+  if (!options.jointMapPath.empty()) {
+    map = readJointMap(options.jointMapPath);
+    checkJointMap(map, clip.skeleton, avatar);
+  } else {
+    map = chooseJointMap(readJointMapDirectory(options.jointMapDirectory), clip.skeleton, avatar);
+  }
+  if (chosenMap) *chosenMap = map;
+  return AvatarAnimation::build(avatar, clip, map, options.retarget);
+}
+
 }  // namespace drape::motion

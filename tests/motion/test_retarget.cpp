@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "drape/core/error.hpp"
 #include "drape/motion/animation.hpp"
 #include "drape/motion/clip_io.hpp"
 #include "drape/motion/jointmap.hpp"
@@ -119,6 +120,31 @@ TEST(Retarget, JointSeparationWithinAFrameIsSmall) {
 TEST(Retarget, CmuWalkDelfem2OnMakeHuman) { checkWalk("cmu_walk_delfem2.bvh"); }
 TEST(Retarget, CmuWalk12_03OnMakeHuman) { checkWalk("cmu_12_03_walk.bvh"); }
 TEST(Retarget, DazStyleWalkOnMakeHuman) { checkWalk("cmu_02_02_walk_dazstyle.bvh"); }
+
+TEST(Retarget, LoadAnimationWithTheShippedMaps) {
+  MotionOptions options;
+  options.jointMapDirectory = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";
+  ClipLoadReport report;
+  JointMap map;
+  const AvatarAnimation anim =
+      loadAnimation(makeHuman(), std::string(DRAPE_DATA_DIR) + "/mocap/cmu_02_02_walk_dazstyle.bvh", options, &report, &map);
+  EXPECT_EQ(map.name, "daz");
+  EXPECT_EQ(report.units.name, "cm");
+  EXPECT_DOUBLE_EQ(anim.rate(), 30.0);
+  EXPECT_EQ(anim.jointCount(), makeHuman().joints.size());
+}
+
+TEST(Retarget, UnknownJointInAUserMapIsAnErrorWithItsLine) {
+  MotionOptions options;
+  options.jointMapPath = std::string(DRAPE_TEST_DATA_DIR) + "/bad/motion/map_unknown_joint.json";
+  try {
+    (void)loadAnimation(makeHuman(), std::string(DRAPE_DATA_DIR) + "/mocap/cmu_walk_delfem2.bvh", options);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), options.jointMapPath + ":5: unknown motion joint 'LeftKnee' (not in the motion's skeleton)");
+    EXPECT_EQ(e.code(), ExitCode::BadInput);
+  }
+}
 
 }  // namespace
 }  // namespace drape::motion

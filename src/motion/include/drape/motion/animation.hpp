@@ -39,6 +39,7 @@
 
 #include "drape/core/math.hpp"
 #include "drape/core/timecode.hpp"
+#include "drape/motion/clip_io.hpp"
 #include "drape/motion/jointmap.hpp"
 #include "drape/motion/skeleton.hpp"
 #include "drape/scene/avatar.hpp"
@@ -108,6 +109,20 @@ class AvatarAnimation {
   std::vector<double> ground_;
   std::vector<int> driving_;
 };
+
+/// What `drape run --motion FILE` needs in one call.
+struct MotionOptions {
+  ClipLoadOptions clip;            ///< rate (default 30 Hz), --motion-scale, ASF path
+  std::string jointMapPath;        ///< --joint-map FILE (checked strictly); "" = choose
+  std::string jointMapDirectory;   ///< the shipped maps (share/drape/jointmaps)
+  RetargetOptions retarget;
+};
+
+/// Loads FILE.bvh / FILE.amc, picks or reads the joint map, and retargets onto `avatar`.
+/// Throws drape::Error (exit code 2) naming the file, line and problem.
+[[nodiscard]] AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& motionPath,
+                                            const MotionOptions& options, ClipLoadReport* report = nullptr,
+                                            JointMap* chosenMap = nullptr);
 
 /// The paper's caveat, measured: over every frame and `substeps` substeps, the largest
 /// distance (m) between an interpolated joint's origin and the point of its interpolated

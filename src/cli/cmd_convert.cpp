@@ -1,0 +1,55 @@
+// `drape convert AVATAR --to avatar.wrl`: writes any avatar drape loads (.glb, .gltf,
+// MakeHuman .mhskel) as a segmented H-Anim 1.1 VRML97 humanoid.
+
+#include <filesystem>
+
+#include <spdlog/spdlog.h>
+
+#include "command.hpp"
+#include "drape/core/error.hpp"
+#include "drape/formats/hanim_writer.hpp"
+#include "drape/scene/avatar_gltf.hpp"
+
+namespace drape::cli {
+namespace {
+
+// Segments are stored in their joint's frame; H-Anim 1.1's default pose puts every point
+// in humanoid coordinates.
+formats::HanimHumanoidData toHanim(const scene::Avatar& a) {
+  formats::HanimHumanoidData h;
+  h.name = a.name.empty() ? "avatar" : a.name;
+  h.info = {"authorName=drape convert", "source=" + std::filesystem::path(a.source).filename().string(),
+            "units=metres (1 unit = 1 m), Y up"};
+  for (const scene::Joint& j : a.joints) h.joints.push_back({j.name, j.parent, j.restCenter, {}});
+  for (const scene::Segment& s : a.segments) {
+    if (s.joint < 0 || static_cast<std::size_t>(s.joint) >= a.joints.size()) continue;
+    const RigidTransform rest = a.joints[static_cast<std::size_t>(s.joint)].restWorld();
+    formats::HanimSegmentData seg;
+    seg.name = s.name;
+    seg.triangles = s.mesh.triangles;
+    for (const Vec3& p : s.mesh.positions) seg.points.push_back(rest.apply(p));
+    h.joints[static_cast<std::size_t>(s.joint)].segments.push_back(std::move(seg));
+  }
+  return h;
+}
+
+RunFunction setupConvert(CLI::App& app) {
+  static std::string input, output;
+  app.add_option("avatar", input, "The avatar to convert: .glb, .gltf or MakeHuman .mhskel (mesh and weights beside it)")
+      ->required();
+  app.add_option("--to", output, "Output file: a segmented H-Anim 1.1 VRML97 humanoid (.wrl)")->required();
+  return [] {
+    const std::string ext = std::filesystem::path(output).extension().string();
+    if (ext != ".wrl") throw Error(fmt::format("--to {}: drape converts avatars to H-Anim VRML97 (.wrl) only", output));
+    const scene::Avatar avatar = scene::loadAvatarFile(input);
+    writeHanim(output, toHanim(avatar));
+    spdlog::info("{}: {} joints, {} segments written to {}", input, avatar.joints.size(), avatar.segments.size(), output);
+    return 0;
+  };
+}
+
+const bool registered =
+    registerCommand({"convert", "Convert an avatar to a segmented H-Anim VRML97 humanoid", "", 40, &setupConvert});
+
+}  // namespace
+}  // namespace drape::cli

@@ -1,0 +1,92 @@
+// `drape inspect FILE.bvh|.amc|.asf|.glb|.gltf|.mhskel`: skeleton, frame count, rate,
+// duration and the units guess of motion files; joints and segments of avatars.
+
+#include <filesystem>
+
+#include <fmt/ostream.h>
+
+#include "command.hpp"
+#include "drape/formats/asf_amc.hpp"
+#include "drape/formats/bvh.hpp"
+#include "drape/mesh/topology.hpp"
+#include "drape/motion/clip_io.hpp"
+#include "drape/scene/avatar_gltf.hpp"
+
+namespace drape::cli {
+namespace {
+
+void printSkeleton(std::ostream& out, const motion::Skeleton& s) {
+  fmt::print(out, "  skeleton   {} joints\n", s.size());
+  std::vector<int> depth(s.size(), 0);
+  for (std::size_t j = 0; j < s.size(); ++j) {
+    const int p = s.joints[j].parent;
+    depth[j] = p < 0 ? 0 : depth[static_cast<std::size_t>(p)] + 1;
+    fmt::print(out, "    {}{}\n", std::string(static_cast<std::size_t>(depth[j]) * 2, ' '), s.joints[j].name);
+  }
+}
+
+void printClip(std::ostream& out, const std::string& path, const char* kind, const motion::Clip& clip,
+               const motion::ClipLoadReport& r) {
+  fmt::print(out, "{}: {} motion\n", path, kind);
+  printSkeleton(out, clip.skeleton);
+  const double sourceDuration = r.sourceFrames > 1 ? static_cast<double>(r.sourceFrames - 1) / r.sourceRate : 0.0;
+  fmt::print(out, "  frames     {} at {:.4g} Hz in the file ({:.3f} s)\n", r.sourceFrames, r.sourceRate, sourceDuration);
+  fmt::print(out, "  T-pose     {}\n", r.referenceTPoseSkipped ? "frame 1 is a reference T-pose (not played)" : "no reference frame");
+  fmt::print(out, "  played     {} frames at {:.4g} Hz ({:.3f} s), starting {}\n", clip.frameCount(), clip.rate, clip.duration(),
+             clip.start.smpte());
+  fmt::print(out, "  units      {} guessed from a rest extent of {:.4g} units ({:.3f} m each)\n", r.units.name,
+             r.units.extentInUnits, r.units.metresPerUnit);
+  if (clip.frameCount() > 0) {
+    const Vec3 a = clip.rootTranslations.front(), b = clip.rootTranslations.back();
+    fmt::print(out, "  root path  [{:.3f} {:.3f} {:.3f}] -> [{:.3f} {:.3f} {:.3f}] m\n", a.x(), a.y(), a.z(), b.x(), b.y(), b.z());
+  }
+}
+
+void inspectBvh(const std::string& path, std::ostream& out) {
+  motion::ClipLoadReport report;
+  const motion::Clip clip = motion::loadClip(path, {}, &report);
+  printClip(out, path, "BVH", clip, report);
+}
+
+void inspectAcclaim(const std::string& path, std::ostream& out) {
+  if (std::filesystem::path(path).extension() == ".asf") {
+    const formats::AsfSkeleton asf = formats::readAsf(path);
+    fmt::print(out, "{}: Acclaim ASF skeleton '{}'\n  bones      {}\n", path, asf.name, asf.bones.size());
+    for (const formats::AsfBone& b : asf.bones)
+      fmt::print(out, "    {:<12} parent {:<12} length {:.4g}, {} dof\n", b.name,
+                 b.parent < 0 ? "root" : asf.bones[static_cast<std::size_t>(b.parent)].name, b.length, b.dofs.size());
+    return;
+  }
+  motion::ClipLoadReport report;
+  const motion::Clip clip = motion::loadClip(path, {}, &report);
+  printClip(out, path, "Acclaim AMC", clip, report);
+}
+
+void inspectAvatar(const std::string& path, std::ostream& out) {
+  const scene::Avatar a = scene::loadAvatarFile(path);
+  fmt::print(out, "{}: skinned avatar '{}'\n", path, a.name);
+  fmt::print(out, "  joints     {}\n", a.joints.size());
+  std::vector<int> depth(a.joints.size(), 0);
+  for (std::size_t j = 0; j < a.joints.size(); ++j) {
+    const int p = a.joints[j].parent;
+    depth[j] = p < 0 ? 0 : depth[static_cast<std::size_t>(p)] + 1;
+    const Vec3 c = a.joints[j].restCenter;
+    fmt::print(out, "    {}{} at [{:.3f} {:.3f} {:.3f}] m\n", std::string(static_cast<std::size_t>(depth[j]) * 2, ' '),
+               a.joints[j].name, c.x(), c.y(), c.z());
+  }
+  if (a.skin) {
+    const Aabb box = a.skin->mesh.bounds();
+    fmt::print(out, "  skin       {} vertices, {} triangles, height {:.3f} m\n", a.skin->mesh.vertexCount(),
+               a.skin->mesh.triangleCount(), box.size().y());
+  }
+  fmt::print(out, "  segments   {} (closed, by dominant skin weight)\n", a.segments.size());
+  for (const scene::Segment& s : a.segments)
+    fmt::print(out, "    {:<18} {:>6} triangles\n", s.name, s.mesh.triangleCount());
+}
+
+const bool bvh = registerInspector({".bvh"}, "BVH motion: skeleton, frames, rate, duration, units guess", &inspectBvh);
+const bool acclaim = registerInspector({".amc", ".asf"}, "Acclaim (CMU) ASF skeletons and AMC motion", &inspectAcclaim);
+const bool avatars = registerInspector({".glb", ".gltf", ".mhskel"}, "skinned avatars: joints, skin, segments", &inspectAvatar);
+
+}  // namespace
+}  // namespace drape::cli

@@ -1,0 +1,615 @@
+#include "drape/formats/gltf_avatar.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <map>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "drape/core/error.hpp"
+#include "motion_text.hpp"
+
+namespace drape::formats {
+namespace {
+
+constexpr std::size_t kMaxElements = 50'000'000;
+
+// ---- the glTF document, parsed by hand from its JSON ---------------------------------
+//
+// Only what a skinned character needs. Field names follow the glTF 2.0 schema.
+
+constexpr int kComponentByte = 5120, kComponentUnsignedByte = 5121, kComponentShort = 5122,
+              kComponentUnsignedShort = 5123, kComponentUnsignedInt = 5125, kComponentFloat = 5126;
+constexpr int kModeTriangles = 4;
+
+struct GBufferView {
+  int buffer = -1;
+  std::size_t byteOffset = 0, byteLength = 0, byteStride = 0;
+};
+struct GAccessor {
+  int bufferView = -1;
+  std::size_t byteOffset = 0, count = 0;
+  int componentType = 0, components = 0;
+  bool normalized = false, sparse = false;
+};
+struct GNode {
+  std::string name;
+  std::vector<int> children;
+  std::vector<double> matrix, translation, rotation, scale;
+  int mesh = -1, skin = -1;
+};
+struct GSkin {
+  std::vector<int> joints;
+  int inverseBindMatrices = -1;
+};
+struct GPrimitive {
+  std::map<std::string, int> attributes;
+  int indices = -1, mode = kModeTriangles;
+};
+struct GModel {
+  std::vector<std::vector<unsigned char>> buffers;
+  std::vector<GBufferView> bufferViews;
+  std::vector<GAccessor> accessors;
+  std::vector<GNode> nodes;
+  std::vector<GSkin> skins;
+  std::vector<std::vector<GPrimitive>> meshes;
+};
+
+bool insideFolder(const std::string& baseDir, const std::string& path) {
+  if (baseDir.empty()) return false;
+  std::error_code ec;
+  const auto base = std::filesystem::weakly_canonical(baseDir, ec);
+  if (ec) return false;
+  const auto full = std::filesystem::weakly_canonical(path, ec);
+  if (ec) return false;
+  const auto rel = full.lexically_relative(base);
+  return !rel.empty() && *rel.begin() != ".." && !rel.is_absolute();
+}
+
+std::vector<unsigned char> decodeBase64(std::string_view text, const std::string& name) {
+  auto value = [](char c) -> int {
+    if (c >= 'A' && c <= 'Z') return c - 'A';
+    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+    if (c >= '0' && c <= '9') return c - '0' + 52;
+    if (c == '+' || c == '-') return 62;
+    if (c == '/' || c == '_') return 63;
+    return -1;
+  };
+  std::vector<unsigned char> out;
+  out.reserve(text.size() / 4 * 3);
+  unsigned bits = 0;
+  int count = 0;
+  for (char c : text) {
+    if (c == '=') break;
+    const int v = value(c);
+    if (v < 0) throw Error(fmt::format("{}: a data: URI holds a character that is not base64", name));
+    bits = (bits << 6) | static_cast<unsigned>(v);
+    if (++count == 4) {
+      out.push_back(static_cast<unsigned char>(bits >> 16));
+      out.push_back(static_cast<unsigned char>(bits >> 8));
+      out.push_back(static_cast<unsigned char>(bits));
+      bits = 0;
+      count = 0;
+    }
+  }
+  if (count == 2) out.push_back(static_cast<unsigned char>(bits >> 4));
+  if (count == 3) {
+    out.push_back(static_cast<unsigned char>(bits >> 10));
+    out.push_back(static_cast<unsigned char>(bits >> 2));
+  }
+  return out;
+}
+
+// A buffer's bytes: a base64 data: URI, or a file inside the model's folder.
+std::vector<unsigned char> loadUri(const std::string& uri, const std::string& name, const std::string& baseDir) {
+  if (uri.rfind("data:", 0) == 0) {
+    const std::size_t comma = uri.find(',');
+    if (comma == std::string::npos || uri.substr(0, comma).find(";base64") == std::string::npos)
+      throw Error(fmt::format("{}: only base64 data: URIs are supported", name));
+    return decodeBase64(std::string_view(uri).substr(comma + 1), name);
+  }
+  const std::size_t colon = uri.find(':');
+  const std::string path = (std::filesystem::path(baseDir) / uri).string();
+  if ((colon != std::string::npos && colon < uri.find('/')) || std::filesystem::path(uri).is_absolute() ||
+      !insideFolder(baseDir, path))
+    throw Error(fmt::format("{}: refers to '{}', outside the model's folder (only data: URIs and files beside the model are read)",
+                            name, uri));
+  const std::string bytes = detail::readWholeFile(path, std::size_t{1} << 30);
+  return {bytes.begin(), bytes.end()};
+}
+
+using nlohmann::json;
+
+int intOr(const json& j, const char* key, int fallback) {
+  const auto it = j.find(key);
+  if (it == j.end()) return fallback;
+  if (!it->is_number_integer()) throw Error(fmt::format("\"{}\" must be a whole number", key));
+  const auto v = it->get<long long>();
+  if (v < -1 || v > 1'000'000'000) throw Error(fmt::format("\"{}\" is out of range", key));
+  return static_cast<int>(v);
+}
+
+std::size_t sizeOr(const json& j, const char* key, std::size_t fallback) {
+  const auto it = j.find(key);
+  if (it == j.end()) return fallback;
+  if (!it->is_number_unsigned()) throw Error(fmt::format("\"{}\" must be a whole number >= 0", key));
+  const auto v = it->get<unsigned long long>();
+  if (v > (1ull << 40)) throw Error(fmt::format("\"{}\" is out of range", key));
+  return static_cast<std::size_t>(v);
+}
+
+std::vector<double> numbers(const json& j, const char* key, std::size_t expected) {
+  std::vector<double> out;
+  const auto it = j.find(key);
+  if (it == j.end()) return out;
+  if (!it->is_array() || it->size() != expected) throw Error(fmt::format("\"{}\" must hold {} numbers", key, expected));
+  for (const json& v : *it) {
+    if (!v.is_number()) throw Error(fmt::format("\"{}\" must hold {} numbers", key, expected));
+    out.push_back(v.get<double>());
+  }
+  return out;
+}
+
+std::vector<int> indices(const json& j, const char* key) {
+  std::vector<int> out;
+  const auto it = j.find(key);
+  if (it == j.end()) return out;
+  if (!it->is_array()) throw Error(fmt::format("\"{}\" must be a list of indices", key));
+  for (const json& v : *it) {
+    if (!v.is_number_unsigned() || v.get<unsigned long long>() > 1'000'000'000) throw Error(fmt::format("\"{}\" must be a list of indices", key));
+    out.push_back(static_cast<int>(v.get<unsigned long long>()));
+  }
+  return out;
+}
+
+const json& arrayOf(const json& doc, const char* key) {
+  static const json empty = json::array();
+  const auto it = doc.find(key);
+  if (it == doc.end()) return empty;
+  if (!it->is_array()) throw Error(fmt::format("\"{}\" must be a list", key));
+  return *it;
+}
+
+int componentsOf(const std::string& type) {
+  if (type == "SCALAR") return 1;
+  if (type == "VEC2") return 2;
+  if (type == "VEC3") return 3;
+  if (type == "VEC4") return 4;
+  if (type == "MAT2") return 4;
+  if (type == "MAT3") return 9;
+  if (type == "MAT4") return 16;
+  return 0;
+}
+
+// Splits a GLB container into its JSON and BIN chunks (bounds checked).
+void splitGlb(std::string_view bytes, const std::string& name, std::string_view& jsonText, std::vector<unsigned char>& bin) {
+  auto u32 = [&](std::size_t at) {
+    std::uint32_t v;
+    std::memcpy(&v, bytes.data() + at, 4);
+    return v;
+  };
+  if (bytes.size() < 20) throw Error(fmt::format("{}: a GLB file needs at least 20 bytes", name));
+  if (u32(4) != 2) throw Error(fmt::format("{}: GLB version {} (drape reads glTF 2.0)", name, u32(4)));
+  const std::size_t total = std::min<std::size_t>(u32(8), bytes.size());
+  std::size_t at = 12;
+  bool sawJson = false;
+  while (at + 8 <= total) {
+    const std::size_t length = u32(at);
+    const std::uint32_t type = u32(at + 4);
+    if (length > total - at - 8) throw Error(fmt::format("{}: a GLB chunk runs past the end of the file", name));
+    const std::string_view chunk = bytes.substr(at + 8, length);
+    if (type == 0x4E4F534Au && !sawJson) {
+      jsonText = chunk;
+      sawJson = true;
+    } else if (type == 0x004E4942u && bin.empty()) {
+      bin.assign(chunk.begin(), chunk.end());
+    }
+    at += 8 + length;
+  }
+  if (!sawJson) throw Error(fmt::format("{}: the GLB file has no JSON chunk", name));
+}
+
+GModel parseDocument(std::string_view bytes, const std::string& name, const std::string& baseDir) {
+  std::string_view jsonText = bytes;
+  std::vector<unsigned char> bin;
+  const bool glb = bytes.size() >= 4 && bytes.substr(0, 4) == "glTF";
+  if (glb) splitGlb(bytes, name, jsonText, bin);
+  json doc;
+  try {
+    doc = json::parse(jsonText.begin(), jsonText.end());
+  } catch (const json::parse_error& e) {
+    std::string what = e.what();
+    if (const auto colon = what.rfind(": "); colon != std::string::npos) what = what.substr(colon + 2);
+    throw Error(fmt::format("{}: not a glTF 2.0 file ({})", name, what));
+  }
+  if (!doc.is_object() || !doc.contains("asset") || !doc["asset"].is_object())
+    throw Error(fmt::format("{}: not a glTF 2.0 file (no \"asset\" object)", name));
+  const std::string version = doc["asset"].value("version", std::string());
+  if (version.rfind("2.", 0) != 0) throw Error(fmt::format("{}: glTF version '{}' (drape reads 2.x)", name, version));
+  GModel m;
+  try {
+    for (const json& b : arrayOf(doc, "buffers")) {
+      const std::size_t length = sizeOr(b, "byteLength", 0);
+      std::vector<unsigned char> data;
+      if (b.contains("uri")) {
+        if (!b["uri"].is_string()) throw Error("\"uri\" must be a string");
+        data = loadUri(b["uri"].get<std::string>(), name, baseDir);
+      } else if (glb && m.buffers.empty()) {
+        data = bin;
+      }
+      if (data.size() < length) throw Error(fmt::format("buffer {} holds {} bytes, fewer than its byteLength {}", m.buffers.size(), data.size(), length));
+      m.buffers.push_back(std::move(data));
+    }
+    for (const json& v : arrayOf(doc, "bufferViews"))
+      m.bufferViews.push_back({intOr(v, "buffer", -1), sizeOr(v, "byteOffset", 0), sizeOr(v, "byteLength", 0), sizeOr(v, "byteStride", 0)});
+    for (const json& a : arrayOf(doc, "accessors")) {
+      GAccessor acc;
+      acc.bufferView = intOr(a, "bufferView", -1);
+      acc.byteOffset = sizeOr(a, "byteOffset", 0);
+      acc.count = sizeOr(a, "count", 0);
+      acc.componentType = intOr(a, "componentType", 0);
+      acc.components = componentsOf(a.value("type", std::string()));
+      acc.normalized = a.value("normalized", false);
+      acc.sparse = a.contains("sparse");
+      m.accessors.push_back(acc);
+    }
+    for (const json& n : arrayOf(doc, "nodes")) {
+      GNode node;
+      node.name = n.contains("name") && n["name"].is_string() ? n["name"].get<std::string>() : "";
+      node.children = indices(n, "children");
+      node.matrix = numbers(n, "matrix", 16);
+      node.translation = numbers(n, "translation", 3);
+      node.rotation = numbers(n, "rotation", 4);
+      node.scale = numbers(n, "scale", 3);
+      node.mesh = intOr(n, "mesh", -1);
+      node.skin = intOr(n, "skin", -1);
+      m.nodes.push_back(std::move(node));
+    }
+    for (const json& s : arrayOf(doc, "skins")) m.skins.push_back({indices(s, "joints"), intOr(s, "inverseBindMatrices", -1)});
+    for (const json& mesh : arrayOf(doc, "meshes")) {
+      std::vector<GPrimitive> prims;
+      for (const json& p : arrayOf(mesh, "primitives")) {
+        GPrimitive prim;
+        if (p.contains("attributes")) {
+          if (!p["attributes"].is_object()) throw Error("\"attributes\" must be an object");
+          for (const auto& [key, value] : p["attributes"].items()) {
+            if (!value.is_number_unsigned()) throw Error(fmt::format("attribute {} must name an accessor", key));
+            prim.attributes[key] = static_cast<int>(std::min<unsigned long long>(value.get<unsigned long long>(), 1'000'000'000));
+          }
+        }
+        prim.indices = intOr(p, "indices", -1);
+        prim.mode = intOr(p, "mode", kModeTriangles);
+        prims.push_back(std::move(prim));
+      }
+      m.meshes.push_back(std::move(prims));
+    }
+  } catch (const json::exception& e) {
+    throw Error(fmt::format("{}: bad glTF JSON ({})", name, e.what()));
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    if (what.rfind(name + ":", 0) == 0) throw;
+    throw Error(fmt::format("{}: {}", name, what));
+  }
+  return m;
+}
+
+// ---- accessors, bounds checked ------------------------------------------------------
+
+struct Reader {
+  const GModel& model;
+  std::string name;
+
+  [[noreturn]] void fail(const std::string& what) const { throw Error(fmt::format("{}: {}", name, what)); }
+
+  // Reads accessor `index` as `components` numbers per element (as doubles).
+  std::vector<double> read(int index, int components, const char* what) const {
+    if (index < 0 || static_cast<std::size_t>(index) >= model.accessors.size()) fail(fmt::format("{}: accessor {} does not exist", what, index));
+    const GAccessor& a = model.accessors[static_cast<std::size_t>(index)];
+    if (a.sparse) fail(fmt::format("{}: sparse accessors are not supported", what));
+    if (a.components != components) fail(fmt::format("{}: accessor {} has {} components, expected {}", what, index, a.components, components));
+    if (a.count > kMaxElements) fail(fmt::format("{}: accessor {} has too many elements ({})", what, index, a.count));
+    const int size = componentSize(a.componentType);
+    if (size <= 0) fail(fmt::format("{}: accessor {} has an unknown component type {}", what, index, a.componentType));
+    std::vector<double> out(a.count * static_cast<std::size_t>(components), 0.0);
+    if (a.bufferView < 0) return out;  // all zeros, as the spec says
+    if (static_cast<std::size_t>(a.bufferView) >= model.bufferViews.size()) fail(fmt::format("{}: buffer view {} does not exist", what, a.bufferView));
+    const GBufferView& view = model.bufferViews[static_cast<std::size_t>(a.bufferView)];
+    if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model.buffers.size()) fail(fmt::format("{}: buffer {} does not exist", what, view.buffer));
+    const std::vector<unsigned char>& data = model.buffers[static_cast<std::size_t>(view.buffer)];
+    const std::size_t element = static_cast<std::size_t>(size) * static_cast<std::size_t>(components);
+    const std::size_t stride = view.byteStride ? view.byteStride : element;
+    if (stride < element) fail(fmt::format("{}: byte stride {} is smaller than an element ({} bytes)", what, stride, element));
+    const std::size_t start = view.byteOffset + a.byteOffset;
+    if (a.count > 0) {
+      const std::size_t end = start + stride * (a.count - 1) + element;
+      if (view.byteOffset > data.size() || end > data.size() || end > view.byteOffset + view.byteLength || end < start)
+        fail(fmt::format("{}: accessor {} reads past the end of its buffer", what, index));
+    }
+    for (std::size_t i = 0; i < a.count; ++i) {
+      const unsigned char* p = data.data() + start + i * stride;
+      for (int c = 0; c < components; ++c) out[i * static_cast<std::size_t>(components) + static_cast<std::size_t>(c)] =
+          component(p + c * size, a.componentType, a.normalized);
+    }
+    return out;
+  }
+
+  static int componentSize(int type) {
+    switch (type) {
+      case kComponentByte: case kComponentUnsignedByte: return 1;
+      case kComponentShort: case kComponentUnsignedShort: return 2;
+      case kComponentUnsignedInt: case kComponentFloat: return 4;
+      default: return 0;
+    }
+  }
+
+  static double component(const unsigned char* p, int type, bool normalized) {
+    switch (type) {
+      case kComponentFloat: { float f; std::memcpy(&f, p, 4); return f; }
+      case kComponentUnsignedByte: return normalized ? *p / 255.0 : *p;
+      case kComponentByte: { const auto v = static_cast<std::int8_t>(*p); return normalized ? std::max(v / 127.0, -1.0) : v; }
+      case kComponentUnsignedShort: { std::uint16_t v; std::memcpy(&v, p, 2); return normalized ? v / 65535.0 : v; }
+      case kComponentShort: { std::int16_t v; std::memcpy(&v, p, 2); return normalized ? std::max(v / 32767.0, -1.0) : v; }
+      case kComponentUnsignedInt: { std::uint32_t v; std::memcpy(&v, p, 4); return v; }
+      default: return 0.0;
+    }
+  }
+};
+
+Eigen::Matrix4d localMatrix(const GNode& node) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  if (node.matrix.size() == 16) {
+    for (int i = 0; i < 16; ++i) m(i % 4, i / 4) = node.matrix[static_cast<std::size_t>(i)];  // column-major
+    return m;
+  }
+  Eigen::Affine3d t = Eigen::Affine3d::Identity();
+  if (node.translation.size() == 3) t.translate(Vec3(node.translation[0], node.translation[1], node.translation[2]));
+  if (node.rotation.size() == 4) {
+    const Quat q(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]);
+    if (q.norm() > 1e-12) t.rotate(q.normalized());
+  }
+  if (node.scale.size() == 3) t.scale(Vec3(node.scale[0], node.scale[1], node.scale[2]));
+  return t.matrix();
+}
+
+// World matrices of every node in the rest pose (the file's node transforms).
+std::vector<Eigen::Matrix4d> nodeWorlds(const GModel& model, std::vector<int>& parent, const Reader& r) {
+  const std::size_t n = model.nodes.size();
+  parent.assign(n, -1);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c : model.nodes[i].children) {
+      if (c < 0 || static_cast<std::size_t>(c) >= n) r.fail(fmt::format("node {} has a child {} that does not exist", i, c));
+      if (parent[static_cast<std::size_t>(c)] >= 0 || static_cast<std::size_t>(c) == i) r.fail(fmt::format("node {} has two parents", c));
+      parent[static_cast<std::size_t>(c)] = static_cast<int>(i);
+    }
+  std::vector<Eigen::Matrix4d> world(n, Eigen::Matrix4d::Identity());
+  std::vector<int> state(n, 0);  // 0 todo, 1 visiting, 2 done
+  std::function<void(std::size_t)> visit = [&](std::size_t i) {
+    std::vector<std::size_t> chain;  // iterative walk up to a finished ancestor (no deep recursion)
+    for (std::size_t k = i;;) {
+      if (state[k] == 2) break;
+      if (state[k] == 1) r.fail(fmt::format("the node hierarchy has a cycle at node {}", k));
+      state[k] = 1;
+      chain.push_back(k);
+      if (parent[k] < 0) break;
+      k = static_cast<std::size_t>(parent[k]);
+    }
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+      const int p = parent[*it];
+      world[*it] = (p < 0 ? Eigen::Matrix4d::Identity() : world[static_cast<std::size_t>(p)]) * localMatrix(model.nodes[*it]);
+      state[*it] = 2;
+    }
+  };
+  for (std::size_t i = 0; i < n; ++i) visit(i);
+  return world;
+}
+
+GltfSkinnedModel extract(const GModel& model, const std::string& name) {
+  const Reader r{model, name};
+  if (model.skins.empty()) r.fail("has no skin (a skinned character is needed)");
+  const GSkin& skin = model.skins.front();
+  if (skin.joints.empty()) r.fail("its skin has no joints");
+  if (skin.joints.size() > 65535) r.fail("its skin has too many joints");
+  std::vector<int> nodeParent;
+  const std::vector<Eigen::Matrix4d> world = nodeWorlds(model, nodeParent, r);
+
+  // Joints in parent-first order: sort by depth in the node tree.
+  const std::size_t jn = skin.joints.size();
+  std::vector<int> jointOfNode(model.nodes.size(), -1);
+  for (std::size_t j = 0; j < jn; ++j) {
+    const int node = skin.joints[j];
+    if (node < 0 || static_cast<std::size_t>(node) >= model.nodes.size()) r.fail(fmt::format("skin joint {} is not a node", node));
+    if (jointOfNode[static_cast<std::size_t>(node)] >= 0) r.fail(fmt::format("node {} is listed twice in the skin", node));
+    jointOfNode[static_cast<std::size_t>(node)] = static_cast<int>(j);
+  }
+  auto depth = [&](int node) {
+    int d = 0;
+    for (int k = nodeParent[static_cast<std::size_t>(node)]; k >= 0; k = nodeParent[static_cast<std::size_t>(k)]) ++d;
+    return d;
+  };
+  std::vector<std::size_t> order(jn);
+  for (std::size_t j = 0; j < jn; ++j) order[j] = j;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return depth(skin.joints[a]) < depth(skin.joints[b]); });
+  std::vector<int> newIndex(jn);
+  for (std::size_t k = 0; k < jn; ++k) newIndex[order[k]] = static_cast<int>(k);
+
+  GltfSkinnedModel out;
+  out.source = name;
+  for (std::size_t k = 0; k < jn; ++k) {
+    const int node = skin.joints[order[k]];
+    GltfJoint joint;
+    joint.name = model.nodes[static_cast<std::size_t>(node)].name.empty() ? fmt::format("joint{}", order[k])
+                                                                           : model.nodes[static_cast<std::size_t>(node)].name;
+    for (int a = nodeParent[static_cast<std::size_t>(node)]; a >= 0; a = nodeParent[static_cast<std::size_t>(a)])
+      if (jointOfNode[static_cast<std::size_t>(a)] >= 0) {
+        joint.parent = newIndex[static_cast<std::size_t>(jointOfNode[static_cast<std::size_t>(a)])];
+        break;
+      }
+    joint.restWorld = world[static_cast<std::size_t>(node)];
+    out.joints.push_back(joint);
+  }
+  // Inverse bind matrices; identity when absent, as the glTF spec says.
+  std::vector<Eigen::Matrix4d> inverseBind(jn, Eigen::Matrix4d::Identity());
+  if (skin.inverseBindMatrices >= 0) {
+    const std::vector<double> m = r.read(skin.inverseBindMatrices, 16, "inverseBindMatrices");
+    if (m.size() / 16 < jn) r.fail("inverseBindMatrices has fewer matrices than the skin has joints");
+    for (std::size_t j = 0; j < jn; ++j)
+      for (int i = 0; i < 16; ++i) inverseBind[j](i % 4, i / 4) = m[j * 16 + static_cast<std::size_t>(i)];
+  }
+  std::vector<Eigen::Matrix4d> skinMatrix(jn);
+  for (std::size_t j = 0; j < jn; ++j) skinMatrix[j] = world[static_cast<std::size_t>(skin.joints[j])] * inverseBind[j];
+
+  for (std::size_t ni = 0; ni < model.nodes.size(); ++ni) {
+    const GNode& node = model.nodes[ni];
+    if (node.skin != 0 || node.mesh < 0) continue;
+    if (static_cast<std::size_t>(node.mesh) >= model.meshes.size()) r.fail(fmt::format("node {} names mesh {}, which does not exist", ni, node.mesh));
+    for (const GPrimitive& prim : model.meshes[static_cast<std::size_t>(node.mesh)]) {
+      if (prim.mode != kModeTriangles) continue;
+      const auto pos = prim.attributes.find("POSITION");
+      const auto jts = prim.attributes.find("JOINTS_0");
+      const auto wts = prim.attributes.find("WEIGHTS_0");
+      if (pos == prim.attributes.end() || jts == prim.attributes.end() || wts == prim.attributes.end()) continue;
+      const std::vector<double> p = r.read(pos->second, 3, "POSITION");
+      const std::vector<double> ji = r.read(jts->second, 4, "JOINTS_0");
+      const std::vector<double> w = r.read(wts->second, 4, "WEIGHTS_0");
+      const std::size_t count = p.size() / 3;
+      if (ji.size() / 4 != count || w.size() / 4 != count) r.fail("JOINTS_0/WEIGHTS_0 and POSITION have different counts");
+      const auto base = static_cast<std::uint32_t>(out.positions.size());
+      if (out.positions.size() + count > kMaxElements) r.fail("too many vertices");
+      for (std::size_t v = 0; v < count; ++v) {
+        std::array<std::uint16_t, 4> joints{};
+        std::array<float, 4> weights{};
+        double total = 0.0;
+        Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
+        for (int k = 0; k < 4; ++k) {
+          const double jk = ji[v * 4 + static_cast<std::size_t>(k)];
+          const double wk = w[v * 4 + static_cast<std::size_t>(k)];
+          if (!(jk >= 0.0) || jk >= static_cast<double>(jn)) r.fail(fmt::format("vertex {} names joint {}, but the skin has {}", v, jk, jn));
+          if (!(wk >= 0.0) || !std::isfinite(wk)) r.fail(fmt::format("vertex {} has a bad weight {}", v, wk));
+          joints[static_cast<std::size_t>(k)] = static_cast<std::uint16_t>(newIndex[static_cast<std::size_t>(jk)]);
+          weights[static_cast<std::size_t>(k)] = static_cast<float>(wk);
+          total += wk;
+          m += wk * skinMatrix[static_cast<std::size_t>(jk)];
+        }
+        if (!(total > 1e-9)) r.fail(fmt::format("vertex {} has no skin weight", v));
+        // Non-normalised weights (CesiumMan has them) are normalised, as viewers do.
+        for (float& x : weights) x = static_cast<float>(x / total);
+        m /= total;
+        const Eigen::Vector4d h = m * Eigen::Vector4d(p[3 * v], p[3 * v + 1], p[3 * v + 2], 1.0);
+        if (!h.allFinite()) r.fail(fmt::format("vertex {} is not finite after skinning", v));
+        out.positions.emplace_back(h.x(), h.y(), h.z());
+        out.vertexJoints.push_back(joints);
+        out.vertexWeights.push_back(weights);
+      }
+      std::vector<double> idx;
+      if (prim.indices >= 0) {
+        idx = r.read(prim.indices, 1, "indices");
+      } else {
+        idx.resize(count);
+        for (std::size_t i = 0; i < count; ++i) idx[i] = static_cast<double>(i);
+      }
+      for (std::size_t t = 0; t + 2 < idx.size(); t += 3) {
+        mesh::Triangle tri;
+        for (int c = 0; c < 3; ++c) {
+          const double i = idx[t + static_cast<std::size_t>(c)];
+          if (!(i >= 0.0) || i >= static_cast<double>(count)) r.fail(fmt::format("index {} is out of range ({} vertices)", i, count));
+          tri[static_cast<std::size_t>(c)] = base + static_cast<std::uint32_t>(i);
+        }
+        if (tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2]) out.triangles.push_back(tri);
+      }
+    }
+  }
+  if (out.triangles.empty()) r.fail("no skinned triangle mesh uses its first skin");
+  return out;
+}
+
+// ---- plain-data serialisation across the process boundary --------------------------
+
+template <typename T>
+void put(std::string& s, const T& v) {
+  s.append(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+template <typename T>
+void putVector(std::string& s, const std::vector<T>& v) {
+  put<std::uint64_t>(s, v.size());
+  s.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+}
+
+struct Cursor {
+  std::string_view bytes;
+  std::size_t at = 0;
+  std::string name;
+  template <typename T>
+  T get() {
+    if (bytes.size() - at < sizeof(T)) throw Error(fmt::format("{}: the glTF reader returned truncated data", name));
+    T v;
+    std::memcpy(&v, bytes.data() + at, sizeof(T));
+    at += sizeof(T);
+    return v;
+  }
+  template <typename T>
+  std::vector<T> getVector() {
+    const auto n = get<std::uint64_t>();
+    if (n > (bytes.size() - at) / std::max<std::size_t>(sizeof(T), 1)) throw Error(fmt::format("{}: the glTF reader returned truncated data", name));
+    std::vector<T> v(n);
+    std::memcpy(v.data(), bytes.data() + at, n * sizeof(T));
+    at += n * sizeof(T);
+    return v;
+  }
+};
+
+}  // namespace
+
+std::string serialise(const GltfSkinnedModel& model) {
+  std::string s;
+  put<std::uint64_t>(s, model.joints.size());
+  for (const GltfJoint& j : model.joints) {
+    putVector(s, std::vector<char>(j.name.begin(), j.name.end()));
+    put<std::int32_t>(s, j.parent);
+    for (int i = 0; i < 16; ++i) put<double>(s, j.restWorld(i % 4, i / 4));
+  }
+  std::vector<double> xyz;
+  for (const Vec3& p : model.positions) xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
+  putVector(s, xyz);
+  putVector(s, model.triangles);
+  putVector(s, model.vertexJoints);
+  putVector(s, model.vertexWeights);
+  return s;
+}
+
+GltfSkinnedModel deserialiseGltfSkinnedModel(std::string_view bytes, const std::string& name) {
+  Cursor c{bytes, 0, name};
+  GltfSkinnedModel model;
+  model.source = name;
+  const auto joints = c.get<std::uint64_t>();
+  if (joints > 65535) throw Error(fmt::format("{}: the glTF reader returned bad data", name));
+  for (std::uint64_t k = 0; k < joints; ++k) {
+    GltfJoint j;
+    const std::vector<char> chars = c.getVector<char>();
+    j.name.assign(chars.begin(), chars.end());
+    j.parent = c.get<std::int32_t>();
+    for (int i = 0; i < 16; ++i) j.restWorld(i % 4, i / 4) = c.get<double>();
+    model.joints.push_back(std::move(j));
+  }
+  const std::vector<double> xyz = c.getVector<double>();
+  for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) model.positions.emplace_back(xyz[i], xyz[i + 1], xyz[i + 2]);
+  model.triangles = c.getVector<mesh::Triangle>();
+  model.vertexJoints = c.getVector<std::array<std::uint16_t, 4>>();
+  model.vertexWeights = c.getVector<std::array<float, 4>>();
+  return model;
+}
+
+GltfSkinnedModel parseGltfSkinnedModel(std::string_view bytes, const std::string& name, const std::string& baseDir) {
+  return extract(parseDocument(bytes, name, baseDir), name);
+}
+
+GltfSkinnedModel readGltfSkinnedModel(const std::string& path, const IsolationLimits& limits) {
+  const std::string bytes = detail::readWholeFile(path, std::size_t{1} << 30);
+  const std::string baseDir = std::filesystem::absolute(path).parent_path().string();
+  const std::string result = runIsolated(path, "glTF reader", [&] { return serialise(parseGltfSkinnedModel(bytes, path, baseDir)); }, limits);
+  return deserialiseGltfSkinnedModel(result, path);
+}
+
+}  // namespace drape::formats

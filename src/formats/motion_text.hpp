@@ -1,0 +1,61 @@
+#pragma once
+// Private helpers of the hand-written motion and rig readers (BVH, ASF/AMC, MakeHuman):
+// whole-file reading with a size limit, and a line/column tracking word scanner.
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+
+#include "drape/core/error.hpp"
+
+namespace drape::formats::detail {
+
+/// Reads a whole file; throws drape::Error "path: no such file" / "is a directory" /
+/// "is larger than N bytes".
+[[nodiscard]] std::string readWholeFile(const std::string& path, std::size_t maxBytes = std::size_t{1} << 30);
+
+/// Splits text into whitespace-separated words, tracking 1-based line and column.
+/// `{` and `}` are words of their own even when glued to a neighbour.
+class WordScanner {
+ public:
+  WordScanner(std::string_view text, std::string file) : text_(text), file_(std::move(file)) {}
+
+  struct Word {
+    std::string_view text;
+    int line = 0;
+    int column = 0;
+  };
+
+  /// The next word, or an empty word at end of input (line/column of the end).
+  Word next();
+  /// Peeks the next word without consuming it.
+  Word peek();
+  /// The rest of the current line after the last word read (trimmed), consumed.
+  Word restOfLine();
+  [[nodiscard]] bool atEnd();
+  [[nodiscard]] SourcePos pos(const Word& w) const { return {file_, w.line, w.column}; }
+  [[nodiscard]] SourcePos here() const { return {file_, line_, column_}; }
+  [[nodiscard]] const std::string& file() const { return file_; }
+  [[nodiscard]] std::size_t offset() const { return pos_; }
+  [[nodiscard]] int line() const { return line_; }
+
+ private:
+  void skipSpace();
+  void advance();
+
+  std::string_view text_;
+  std::string file_;
+  std::size_t pos_ = 0;
+  int line_ = 1;
+  int column_ = 1;
+};
+
+/// Parses a whole word as a finite double; throws "expected a number, found 'x'" at w.
+[[nodiscard]] double parseNumber(const WordScanner& s, const WordScanner::Word& w);
+/// Parses a whole word as a non-negative integer no larger than `max`.
+[[nodiscard]] std::size_t parseCount(const WordScanner& s, const WordScanner::Word& w, std::size_t max,
+                                     const char* what);
+/// Quotes a word for messages, shortened to 40 characters; "end of file" if empty.
+[[nodiscard]] std::string quoted(std::string_view word);
+
+}  // namespace drape::formats::detail

@@ -1,0 +1,273 @@
+#include "drape/motion/animation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "drape/core/error.hpp"
+#include "drape/motion/interpolate.hpp"
+
+namespace drape::motion {
+namespace {
+
+// For each avatar joint, the motion joint the map makes drive it (-1 if none).
+std::vector<int> drivingJoints(const scene::Avatar& avatar, const Skeleton& skeleton, const JointMap& map) {
+  std::vector<int> driving(avatar.joints.size(), -1);
+  for (const JointMapEntry& e : map.entries) {
+    const int a = avatar.findJoint(e.avatarJoint);
+    const int m = skeleton.find(e.motionJoint);
+    if (a >= 0 && m >= 0 && driving[static_cast<std::size_t>(a)] < 0) driving[static_cast<std::size_t>(a)] = m;
+  }
+  return driving;
+}
+
+// Rest-pose correction per avatar joint: the world rotation that turns the avatar's rest
+// bone directions (towards its driven children) onto the motion skeleton's rest bone
+// directions towards the same children. A T-pose motion then lifts an A-pose avatar's
+// arms at its reference frame, and both skeletons agree wherever the motion goes. Roots
+// keep identity (both stand upright facing +Z); joints with no usable child share their
+// parent's correction.
+std::vector<Quat> restCorrections(const scene::Avatar& avatar, const std::vector<int>& driving,
+                                  const std::vector<Vec3>& motionRest, const Skeleton& skeleton) {
+  const std::size_t n = avatar.joints.size();
+  std::vector<Vec3> avatarDir(n, Vec3::Zero()), motionDir(n, Vec3::Zero());
+  for (std::size_t c = 0; c < n; ++c) {
+    const int a = avatar.joints[c].parent;
+    if (a < 0 || driving[c] < 0 || driving[static_cast<std::size_t>(a)] < 0) continue;
+    const Vec3 da = avatar.joints[c].restCenter - avatar.joints[static_cast<std::size_t>(a)].restCenter;
+    const Vec3 dm = motionRest[static_cast<std::size_t>(driving[c])] -
+                    motionRest[static_cast<std::size_t>(driving[static_cast<std::size_t>(a)])];
+    if (da.norm() < 1e-9 || dm.norm() < 1e-9) continue;
+    avatarDir[static_cast<std::size_t>(a)] += da.normalized();
+    motionDir[static_cast<std::size_t>(a)] += dm.normalized();
+  }
+  // A driven joint with no driven child (a foot whose toes the motion lacks, a head):
+  // its motion end site against the avatar's directions to all its children.
+  for (std::size_t a = 0; a < n; ++a) {
+    if (driving[a] < 0 || avatarDir[a].norm() > 1e-9) continue;
+    const auto& endSite = skeleton.joints[static_cast<std::size_t>(driving[a])].endSite;
+    if (!endSite || endSite->norm() < 1e-9) continue;
+    Vec3 sum = Vec3::Zero();
+    for (std::size_t c = 0; c < n; ++c) {
+      if (avatar.joints[c].parent != static_cast<int>(a)) continue;
+      const Vec3 d = avatar.joints[c].restCenter - avatar.joints[a].restCenter;
+      if (d.norm() > 1e-9) sum += d.normalized();
+    }
+    if (sum.norm() < 1e-9) continue;
+    avatarDir[a] = sum;
+    motionDir[a] = endSite->normalized();
+  }
+  std::vector<Quat> correction(n, Quat::Identity());
+  for (std::size_t a = 0; a < n; ++a) {
+    const int parent = avatar.joints[a].parent;
+    if (parent < 0) continue;
+    if (avatarDir[a].norm() > 1e-9 && motionDir[a].norm() > 1e-9) {
+      correction[a] = Quat::FromTwoVectors(avatarDir[a], motionDir[a]);
+    } else {
+      correction[a] = correction[static_cast<std::size_t>(parent)];
+    }
+  }
+  return correction;
+}
+
+// Leg-length ratio avatar / motion over LeftUpLeg -> LeftLeg -> LeftFoot (or the right
+// leg); falls back to the ratio of overall extents.
+double legLengthRatio(const scene::Avatar& avatar, const std::vector<int>& driving, const std::vector<Vec3>& motionRest,
+                      const Skeleton& skeleton) {
+  for (const char* side : {"Left", "Right"}) {
+    const int up = avatar.findJoint(fmt::format("{}UpLeg", side));
+    const int knee = avatar.findJoint(fmt::format("{}Leg", side));
+    const int foot = avatar.findJoint(fmt::format("{}Foot", side));
+    if (up < 0 || knee < 0 || foot < 0) continue;
+    const int mu = driving[static_cast<std::size_t>(up)], mk = driving[static_cast<std::size_t>(knee)],
+              mf = driving[static_cast<std::size_t>(foot)];
+    if (mu < 0 || mk < 0 || mf < 0) continue;
+    auto centre = [&](int j) { return avatar.joints[static_cast<std::size_t>(j)].restCenter; };
+    auto rest = [&](int j) { return motionRest[static_cast<std::size_t>(j)]; };
+    const double a = (centre(knee) - centre(up)).norm() + (centre(foot) - centre(knee)).norm();
+    const double m = (rest(mk) - rest(mu)).norm() + (rest(mf) - rest(mk)).norm();
+    if (a > 1e-6 && m > 1e-6) return a / m;
+  }
+  Aabb box;
+  for (const scene::Joint& j : avatar.joints) box.extend(j.restCenter);
+  const double extent = skeleton.restExtent();
+  return extent > 1e-9 && !box.empty() && box.size().maxCoeff() > 1e-9 ? box.size().maxCoeff() / extent : 1.0;
+}
+
+// The avatar's floor: its lowest rest point (segments, else the skin, else joints).
+double avatarFloor(const scene::Avatar& avatar) {
+  double floor = std::numeric_limits<double>::infinity();
+  for (const scene::Segment& s : avatar.segments) {
+    const RigidTransform rest = avatar.joints[static_cast<std::size_t>(s.joint)].restWorld();
+    for (const Vec3& v : s.mesh.positions) floor = std::min(floor, rest.apply(v).y());
+  }
+  if (std::isinf(floor) && avatar.skin)
+    for (const Vec3& v : avatar.skin->mesh.positions) floor = std::min(floor, v.y());
+  if (std::isinf(floor))
+    for (const scene::Joint& j : avatar.joints) floor = std::min(floor, j.restCenter.y());
+  return std::isinf(floor) ? 0.0 : floor;
+}
+
+// The capture floor is seldom level over a take (the CMU walk in data/ rises about 7 cm
+// in 3 s), so a fixed root height leaves the feet floating or sinking as the clip goes on.
+// Grounding measures the avatar's own lowest point per frame, takes its minimum over each
+// window of about one gait cycle (1 s) and smooths that over the same window: the result
+// is the floor the motion walks on, subtracted from every joint's height.
+std::vector<double> measureGround(const scene::Avatar& avatar, const std::vector<RigidTransform>& world,
+                                     std::size_t frames, double rate, double floor) {
+  const std::size_t n = avatar.joints.size();
+  // Up to 256 points per segment are plenty to find its lowest point.
+  std::vector<std::pair<int, Vec3>> samples;
+  for (const scene::Segment& s : avatar.segments) {
+    const std::size_t stride = std::max<std::size_t>(1, s.mesh.positions.size() / 256);
+    for (std::size_t v = 0; v < s.mesh.positions.size(); v += stride) samples.emplace_back(s.joint, s.mesh.positions[v]);
+  }
+  std::vector<double> lowest(frames, 0.0), window(frames, 0.0), correction(frames, 0.0);
+  if (samples.empty()) return correction;
+  for (std::size_t f = 0; f < frames; ++f) {
+    double low = std::numeric_limits<double>::infinity();
+    for (const auto& [joint, p] : samples) low = std::min(low, world[f * n + static_cast<std::size_t>(joint)].apply(p).y());
+    lowest[f] = low - floor;
+  }
+  const auto half = static_cast<std::size_t>(std::max(1.0, std::round(rate * 0.5)));
+  auto range = [&](std::size_t f) {
+    return std::make_pair(f > half ? f - half : 0, std::min(frames - 1, f + half));
+  };
+  for (std::size_t f = 0; f < frames; ++f) {
+    const auto [lo, hi] = range(f);
+    window[f] = *std::min_element(lowest.begin() + static_cast<std::ptrdiff_t>(lo), lowest.begin() + static_cast<std::ptrdiff_t>(hi) + 1);
+  }
+  for (std::size_t f = 0; f < frames; ++f) {
+    const auto [lo, hi] = range(f);
+    double sum = 0.0;
+    for (std::size_t k = lo; k <= hi; ++k) sum += window[k];
+    correction[f] = sum / static_cast<double>(hi - lo + 1);
+  }
+  return correction;
+}
+
+}  // namespace
+
+AvatarAnimation AvatarAnimation::build(const scene::Avatar& avatar, const Clip& clip, const JointMap& map,
+                                       const RetargetOptions& options) {
+  const std::size_t n = avatar.joints.size();
+  if (n == 0) throw Error(fmt::format("{}: the avatar has no joints to animate", avatar.source));
+  if (clip.frameCount() == 0) throw Error(fmt::format("{}: the motion has no frames", clip.source));
+  AvatarAnimation anim;
+  anim.frames_ = clip.frameCount();
+  anim.joints_ = n;
+  anim.rate_ = clip.rate;
+  anim.start_ = clip.start;
+  anim.driving_ = drivingJoints(avatar, clip.skeleton, map);
+  for (std::size_t a = 0; a < n; ++a)
+    if (avatar.joints[a].parent < 0 && anim.driving_[a] < 0)
+      throw Error(fmt::format("{}: no joint of the motion {} drives the avatar's root joint '{}' (joint map '{}')",
+                              avatar.source.empty() ? avatar.name : avatar.source, clip.source, avatar.joints[a].name, map.name));
+
+  const std::vector<Vec3> motionRest = clip.skeleton.restPositions();
+  const std::vector<Quat> correction = restCorrections(avatar, anim.driving_, motionRest, clip.skeleton);
+  anim.rootScale_ = options.rootScale > 0.0 ? options.rootScale : legLengthRatio(avatar, anim.driving_, motionRest, clip.skeleton);
+  const double floor = avatarFloor(avatar);
+  anim.rootHeightOffset_ = floor;  // the motion's y = 0 on the avatar's floor, before grounding
+
+  std::vector<RigidTransform> motionWorld(clip.skeleton.size());
+  std::vector<Quat> delta(n);  // world rotation from the avatar's rest pose
+  std::vector<Vec3> position(n);
+  std::vector<Vec3> firstRoot(n, Vec3::Zero());
+  anim.world_.resize(anim.frames_ * n);
+  anim.inverse_.resize(anim.frames_ * n);
+  anim.rootPath_.resize(anim.frames_);
+  for (std::size_t f = 0; f < anim.frames_; ++f) {
+    forwardKinematics(clip.skeleton, clip.frameRotations(f), clip.rootTranslations[f], motionWorld);
+    for (std::size_t a = 0; a < n; ++a) {
+      const scene::Joint& joint = avatar.joints[a];
+      const int m = anim.driving_[a];
+      const auto parent = static_cast<std::size_t>(joint.parent);
+      if (joint.parent < 0) {
+        // Root: rotation from the motion, position along the scaled motion root path.
+        const Vec3 motionRoot = motionWorld[static_cast<std::size_t>(m)].translation;
+        if (f == 0) firstRoot[a] = motionRoot;
+        delta[a] = motionWorld[static_cast<std::size_t>(m)].rotation;
+        Vec3 p = anim.rootScale_ * motionRoot;
+        if (options.anchorRootAtRest) {
+          p.x() = joint.restCenter.x() + anim.rootScale_ * (motionRoot.x() - firstRoot[a].x());
+          p.z() = joint.restCenter.z() + anim.rootScale_ * (motionRoot.z() - firstRoot[a].z());
+        }
+        p.y() = anim.rootHeightOffset_ + anim.rootScale_ * motionRoot.y();
+        position[a] = p;
+        if (a == 0) anim.rootPath_[f] = p;
+      } else {
+        delta[a] = m >= 0 ? Quat((motionWorld[static_cast<std::size_t>(m)].rotation * correction[a]).normalized())
+                          : delta[parent];
+        position[a] = position[parent] + delta[parent] * (joint.restCenter - avatar.joints[parent].restCenter);
+      }
+      anim.world_[f * n + a] = {(delta[a] * joint.restOrientation).normalized(), position[a]};
+    }
+  }
+  anim.ground_.assign(anim.frames_, 0.0);
+  if (options.groundFeet) anim.ground_ = measureGround(avatar, anim.world_, anim.frames_, anim.rate_, floor);
+  for (std::size_t f = 0; f < anim.frames_; ++f) {
+    for (std::size_t a = 0; a < n; ++a) {
+      RigidTransform& t = anim.world_[f * n + a];
+      t.translation.y() -= anim.ground_[f];
+      anim.inverse_[f * n + a] = t.inverse();
+    }
+    anim.rootPath_[f] = anim.world_[f * n].translation;
+  }
+  return anim;
+}
+
+void AvatarAnimation::evaluate(std::size_t f, double s, std::span<RigidTransform> out) const {
+  const std::size_t f0 = std::min(f, frames_ - 1);
+  const std::size_t f1 = std::min(f0 + 1, frames_ - 1);
+  const RigidTransform* a = world_.data() + f0 * joints_;
+  const RigidTransform* b = world_.data() + f1 * joints_;
+  for (std::size_t j = 0; j < joints_; ++j) out[j] = interpolate(a[j], b[j], s);
+}
+
+void AvatarAnimation::evaluateInverse(std::size_t f, double s, std::span<RigidTransform> out) const {
+  const std::size_t f0 = std::min(f, frames_ - 1);
+  const std::size_t f1 = std::min(f0 + 1, frames_ - 1);
+  const RigidTransform* a = inverse_.data() + f0 * joints_;
+  const RigidTransform* b = inverse_.data() + f1 * joints_;
+  for (std::size_t j = 0; j < joints_; ++j) out[j] = interpolate(a[j], b[j], s);
+}
+
+double maxJointSeparation(const AvatarAnimation& animation, const scene::Avatar& avatar, int substeps) {
+  // Where each joint sits in its parent's frame (constant: bones are rigid).
+  std::vector<Vec3> attach(avatar.joints.size(), Vec3::Zero());
+  for (std::size_t a = 0; a < avatar.joints.size(); ++a) {
+    const int p = avatar.joints[a].parent;
+    if (p >= 0) attach[a] = avatar.joints[static_cast<std::size_t>(p)].restWorld().inverse().apply(avatar.joints[a].restCenter);
+  }
+  std::vector<RigidTransform> ltm(animation.jointCount());
+  double largest = 0.0;
+  for (std::size_t f = 0; f + 1 < animation.frameCount(); ++f) {
+    for (int k = 1; k < substeps; ++k) {
+      animation.evaluate(f, static_cast<double>(k) / substeps, ltm);
+      for (std::size_t a = 0; a < avatar.joints.size(); ++a) {
+        const int p = avatar.joints[a].parent;
+        if (p < 0) continue;
+        largest = std::max(largest, (ltm[a].translation - ltm[static_cast<std::size_t>(p)].apply(attach[a])).norm());
+      }
+    }
+  }
+  return largest;
+}
+
+AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& motionPath, const MotionOptions& options,
+                              ClipLoadReport* report, JointMap* chosenMap) {
+  const Clip clip = loadClip(motionPath, options.clip, report);
+  JointMap map;
+  if (!options.jointMapPath.empty()) {
+    map = readJointMap(options.jointMapPath);
+    checkJointMap(map, clip.skeleton, avatar);
+  } else {
+    map = chooseJointMap(readJointMapDirectory(options.jointMapDirectory), clip.skeleton, avatar);
+  }
+  if (chosenMap) *chosenMap = map;
+  return AvatarAnimation::build(avatar, clip, map, options.retarget);
+}
+
+}  // namespace drape::motion

@@ -1,0 +1,132 @@
+#pragma once
+// AvatarAnimation: a clip retargeted onto an avatar, ready for the simulation loop.
+//
+// THE INTERFACE sim/ consumes. Built once per (avatar, clip, map); then, for motion frame
+// f and substep fraction s in [0, 1], it writes each avatar joint's world rigid transform
+// (the paper's LTM, section 4.3.1) into a caller's span, allocating nothing:
+//
+//   motion::AvatarAnimation anim = motion::AvatarAnimation::build(avatar, clip, map);
+//   std::vector<RigidTransform> ltm(anim.jointCount()), ltmInv(anim.jointCount());
+//   for (std::size_t f = 0; f + 1 < anim.frameCount(); ++f)
+//     for (int k = 0; k <= substeps; ++k) {
+//       const double s = double(k) / substeps;
+//       anim.evaluate(f, s, ltm);          // joint frame -> world
+//       anim.evaluateInverse(f, s, ltmInv); // world -> joint frame
+//       // segment i moves with ltm[avatar.segments[i].joint]:
+//       //   world vertex = ltm[j].apply(segment vertex in its joint frame)
+//     }
+//
+// Micro-interpolation (section 4.3.1): every joint's world transform and its inverse are
+// stored per frame and interpolated separately per substep, translation linearly and
+// rotation by SLERP; no forward kinematics runs per substep. s = 0 and s = 1 give frames f
+// and f + 1 bit for bit. The paper's caveat holds: within a frame a child joint may drift
+// from the point of its parent it is attached to (measured by maxJointSeparation; see
+// docs/MOTION.md), and LTM(s) * LTMinv(s) is identity only at s = 0 and 1.
+//
+// Retargeting: each mapped avatar joint takes the world rotation of its motion joint,
+// composed with a constant rest-pose correction (the rotation that turns the avatar's rest
+// bone directions onto the motion skeleton's rest bone directions, so a T-pose motion
+// drives an A-pose avatar); unmapped joints follow their parent rigidly. Joint positions
+// come from the avatar's own bone lengths (forward kinematics at build time). The root
+// follows the motion's root path scaled by the ratio of leg lengths (avatar / motion),
+// with the motion's y = 0 on the avatar's floor (its lowest rest vertex); then, since
+// capture floors are seldom level, the body is grounded: each frame is lowered by the
+// smoothed per-gait-cycle minimum of the avatar's lowest point (groundCorrection()).
+
+#include <span>
+#include <string>
+#include <vector>
+
+#include "drape/core/math.hpp"
+#include "drape/core/timecode.hpp"
+#include "drape/motion/clip_io.hpp"
+#include "drape/motion/jointmap.hpp"
+#include "drape/motion/skeleton.hpp"
+#include "drape/scene/avatar.hpp"
+
+namespace drape::motion {
+
+struct RetargetOptions {
+  /// Start the root at the avatar's rest position on the floor plane (x, z), instead of
+  /// where the capture volume had it; heights always follow the motion.
+  bool anchorRootAtRest = true;
+  /// Multiplies the root path instead of the leg-length ratio, if > 0.
+  double rootScale = 0.0;
+  /// Follow the capture's floor: per frame, lower or raise the whole body so that its
+  /// lowest point over each one-second window (about a gait cycle) meets the avatar's
+  /// floor (see groundCorrection()).
+  bool groundFeet = true;
+};
+
+class AvatarAnimation {
+ public:
+  /// Retargets `clip` onto `avatar` through `map` (motion joint -> avatar joint).
+  /// Throws drape::Error if the avatar's root joint is driven by no motion joint.
+  [[nodiscard]] static AvatarAnimation build(const scene::Avatar& avatar, const Clip& clip, const JointMap& map,
+                                             const RetargetOptions& options = {});
+
+  [[nodiscard]] std::size_t frameCount() const { return frames_; }
+  [[nodiscard]] std::size_t jointCount() const { return joints_; }
+  [[nodiscard]] double rate() const { return rate_; }          ///< frames per second
+  [[nodiscard]] TimeCode start() const { return start_; }      ///< time code of frame 0
+  [[nodiscard]] double duration() const { return frames_ > 1 ? static_cast<double>(frames_ - 1) / rate_ : 0.0; }
+
+  /// Exact joint world transforms of frame f (< frameCount()).
+  [[nodiscard]] std::span<const RigidTransform> frame(std::size_t f) const {
+    return {world_.data() + f * joints_, joints_};
+  }
+  /// Joint world transforms at time (f + s) / rate(), s in [0, 1]; f + 1 is clamped to the
+  /// last frame. out.size() must be jointCount(). Allocates nothing.
+  void evaluate(std::size_t f, double s, std::span<RigidTransform> out) const;
+  /// The interpolated inverses (world -> joint frame), interpolated on their own as the
+  /// paper does. Allocates nothing.
+  void evaluateInverse(std::size_t f, double s, std::span<RigidTransform> out) const;
+
+  /// m, world position of the root joint per frame (the path the character travels).
+  [[nodiscard]] std::span<const Vec3> rootPath() const { return rootPath_; }
+  /// The ratio applied to the motion's root path (leg-length ratio unless overridden).
+  [[nodiscard]] double rootScale() const { return rootScale_; }
+  /// m, root height for a motion root height of 0 before grounding: the avatar's floor
+  /// (its lowest rest vertex); root y = rootHeightOffset() + rootScale() * motion root y
+  /// - groundCorrection()[f].
+  [[nodiscard]] double rootHeightOffset() const { return rootHeightOffset_; }
+  /// m per frame, how far the whole body was lowered to follow the capture's floor
+  /// (zeros when RetargetOptions::groundFeet is off).
+  [[nodiscard]] std::span<const double> groundCorrection() const { return ground_; }
+  /// For each avatar joint, the motion joint driving it (-1: follows its parent).
+  [[nodiscard]] std::span<const int> drivingJoint() const { return driving_; }
+
+ private:
+  std::size_t frames_ = 0;
+  std::size_t joints_ = 0;
+  double rate_ = 30.0;
+  TimeCode start_;
+  double rootScale_ = 1.0;
+  double rootHeightOffset_ = 0.0;
+  std::vector<RigidTransform> world_;     ///< frame-major frames_ x joints_
+  std::vector<RigidTransform> inverse_;   ///< same layout, world_[i].inverse()
+  std::vector<Vec3> rootPath_;
+  std::vector<double> ground_;
+  std::vector<int> driving_;
+};
+
+/// What `drape run --motion FILE` needs in one call.
+struct MotionOptions {
+  ClipLoadOptions clip;            ///< rate (default 30 Hz), --motion-scale, ASF path
+  std::string jointMapPath;        ///< --joint-map FILE (checked strictly); "" = choose
+  std::string jointMapDirectory;   ///< the shipped maps (share/drape/jointmaps)
+  RetargetOptions retarget;
+};
+
+/// Loads FILE.bvh / FILE.amc, picks or reads the joint map, and retargets onto `avatar`.
+/// Throws drape::Error (exit code 2) naming the file, line and problem.
+[[nodiscard]] AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& motionPath,
+                                            const MotionOptions& options, ClipLoadReport* report = nullptr,
+                                            JointMap* chosenMap = nullptr);
+
+/// The paper's caveat, measured: over every frame and `substeps` substeps, the largest
+/// distance (m) between an interpolated joint's origin and the point of its interpolated
+/// parent it is attached to.
+[[nodiscard]] double maxJointSeparation(const AvatarAnimation& animation, const scene::Avatar& avatar, int substeps);
+
+}  // namespace drape::motion

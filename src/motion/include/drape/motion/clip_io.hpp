@@ -1,0 +1,74 @@
+#pragma once
+// Motion files to Clips: BVH and ASF/AMC, converted to metres (units guessed from the
+// skeleton's size unless given), the CMU T-pose reference frame dropped, and resampled to
+// the motion rate.
+
+#include <optional>
+#include <string>
+
+#include "drape/formats/bvh.hpp"
+#include "drape/motion/skeleton.hpp"
+
+namespace drape::formats {
+struct AsfSkeleton;
+struct AmcMotion;
+}  // namespace drape::formats
+
+namespace drape::motion {
+
+/// CMU's ASF length unit as the cgspeed BVH conversions keep it: (1/0.45) inch = 0.0564 m.
+inline constexpr double kCmuMetresPerUnit = 2.54 / 0.45 / 100.0;
+
+struct UnitsGuess {
+  double metresPerUnit = 1.0;
+  std::string name;        ///< "m", "cm", "mm", "in" or "CMU units (0.0564 m)"
+  double extentInUnits = 0.0;  ///< the skeleton's rest extent in file units
+};
+
+/// Picks the unit that makes a human skeleton of `extentInUnits` closest to 1.7 m:
+/// m, cm, mm, inches, or CMU's 0.0564 m.
+[[nodiscard]] UnitsGuess guessUnits(double extentInUnits);
+
+struct ClipLoadOptions {
+  double rate = 30.0;                      ///< resample to this many frames per second (0: keep)
+  std::optional<double> metresPerUnit;     ///< overrides the units guess (--motion-scale)
+  bool skipReferenceTPose = true;          ///< drop a CMU-style T-pose first frame
+  std::string asfPath;                     ///< for .amc files: the skeleton (default: the .asf next to it)
+};
+
+/// What loading found, for `drape inspect` and logs.
+struct ClipLoadReport {
+  UnitsGuess units;
+  bool unitsOverridden = false;
+  double sourceRate = 0.0;                 ///< frames per second in the file
+  std::size_t sourceFrames = 0;            ///< frames in the file
+  bool referenceTPoseSkipped = false;
+};
+
+/// BVH channels to local rotations: the rotation channels in file order compose left to
+/// right (Z Y X = Rz * Ry * Rx); the root's position channels (plus its offset) give the
+/// root translation. Position channels of other joints are ignored.
+[[nodiscard]] Clip clipFromBvh(const formats::BvhFile& bvh, const ClipLoadOptions& options = {},
+                               ClipLoadReport* report = nullptr);
+
+/// ASF skeleton + AMC motion to a clip (see asf_amc.hpp for the conventions).
+[[nodiscard]] Clip clipFromAsfAmc(const formats::AsfSkeleton& asf, const formats::AmcMotion& amc,
+                                  const ClipLoadOptions& options = {}, ClipLoadReport* report = nullptr);
+
+/// Reads FILE.bvh or FILE.amc (with options.asfPath or FILE's .asf) into a clip.
+/// Throws drape::Error with "file:line:column: ..." on bad files.
+[[nodiscard]] Clip loadClip(const std::string& path, const ClipLoadOptions& options = {},
+                            ClipLoadReport* report = nullptr);
+
+/// True if frame 0 of the raw clip is a reference T-pose that is not part of the motion:
+/// its arms are near horizontal and far apart, and the pose jumps to frame 1 by more than
+/// 20 degrees at some joint while frame 1 to frame 2 changes much less.
+[[nodiscard]] bool firstFrameIsReferenceTPose(const Clip& clip);
+
+/// Resamples the clip to `rate` (SLERP of local rotations, linear root translation).
+[[nodiscard]] Clip resample(const Clip& clip, double rate);
+
+/// Drops the first `count` frames.
+void dropLeadingFrames(Clip& clip, std::size_t count);
+
+}  // namespace drape::motion

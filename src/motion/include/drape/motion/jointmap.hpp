@@ -1,0 +1,55 @@
+#pragma once
+// Joint name maps: which motion joint drives which avatar joint. drape's avatars use the
+// CMU MotionBuilder-style names of the cgspeed BVH conversions (Hips, LeftUpLeg, LeftLeg,
+// ...); maps for the MotionBuilder, 3ds Max and Daz/Poser naming styles ship as JSON in
+// share/drape/jointmaps/, and `--joint-map FILE` reads any other:
+//
+//   { "name": "daz", "description": "...", "joints": { "hip": "Hips", "lThigh": "LeftUpLeg" } }
+//
+// Keys are motion joints, values avatar joints.
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "drape/motion/skeleton.hpp"
+#include "drape/scene/avatar.hpp"
+
+namespace drape::motion {
+
+struct JointMapEntry {
+  std::string motionJoint;
+  std::string avatarJoint;
+  int line = 0;  ///< line of the entry in its file (0 if built in code)
+};
+
+struct JointMap {
+  std::string name;
+  std::string source;  ///< file it came from, for messages
+  std::vector<JointMapEntry> entries;
+
+  /// The avatar joint `motionJoint` drives, or nullptr.
+  [[nodiscard]] const std::string* avatarJointFor(std::string_view motionJoint) const;
+  /// A map that pairs every joint with the avatar joint of the same name.
+  [[nodiscard]] static JointMap identity(const Skeleton& skeleton);
+};
+
+/// Parses a map; throws drape::Error "name:line:column: ..." on bad JSON or structure.
+[[nodiscard]] JointMap parseJointMap(std::string_view json, const std::string& name);
+[[nodiscard]] JointMap readJointMap(const std::string& path);
+/// Every *.json map in `directory`, sorted by name (empty if the directory is missing).
+[[nodiscard]] std::vector<JointMap> readJointMapDirectory(const std::string& directory);
+
+/// Number of entries of `map` whose motion joint is in `skeleton` and avatar joint in `avatar`.
+[[nodiscard]] std::size_t matchedJointCount(const JointMap& map, const Skeleton& skeleton, const scene::Avatar& avatar);
+
+/// The candidate (or the identity map) that pairs the most joints of `skeleton` with `avatar`.
+[[nodiscard]] JointMap chooseJointMap(const std::vector<JointMap>& candidates, const Skeleton& skeleton,
+                                      const scene::Avatar& avatar);
+
+/// A user's map must name only joints that exist: throws "file:line: unknown motion joint
+/// 'X' ..." or "... unknown avatar joint 'Y' ...".
+void checkJointMap(const JointMap& map, const Skeleton& skeleton, const scene::Avatar& avatar);
+
+}  // namespace drape::motion

@@ -1,0 +1,155 @@
+#include "drape/scene/avatar_segment.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <unordered_map>
+
+namespace drape::scene {
+namespace {
+
+std::uint64_t undirectedKey(std::uint32_t a, std::uint32_t b) {
+  const std::uint32_t lo = std::min(a, b), hi = std::max(a, b);
+  return (static_cast<std::uint64_t>(lo) << 32) | hi;
+}
+
+std::unordered_map<std::uint64_t, int> edgeUseCounts(const mesh::TriMesh& mesh) {
+  std::unordered_map<std::uint64_t, int> count;
+  count.reserve(mesh.triangles.size() * 3);
+  for (const mesh::Triangle& t : mesh.triangles)
+    for (int c = 0; c < 3; ++c) ++count[undirectedKey(t[c], t[(c + 1) % 3])];
+  return count;
+}
+
+std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t v) {
+  while (parent[v] != v) v = parent[v] = parent[parent[v]];
+  return v;
+}
+
+}  // namespace
+
+std::vector<int> dominantJointPerTriangle(const SkinnedMesh& skin, std::size_t jointCount) {
+  std::vector<int> label(skin.mesh.triangles.size(), 0);
+  std::vector<double> sum(jointCount, 0.0);
+  for (std::size_t t = 0; t < skin.mesh.triangles.size(); ++t) {
+    for (std::uint32_t v : skin.mesh.triangles[t])
+      for (int k = 0; k < 4; ++k)
+        if (skin.joints[v][k] < jointCount) sum[skin.joints[v][k]] += skin.weights[v][k];
+    int best = 0;
+    for (std::size_t j = 1; j < jointCount; ++j)
+      if (sum[j] > sum[static_cast<std::size_t>(best)]) best = static_cast<int>(j);
+    label[t] = best;
+    for (std::uint32_t v : skin.mesh.triangles[t])
+      for (int k = 0; k < 4; ++k)
+        if (skin.joints[v][k] < jointCount) sum[skin.joints[v][k]] = 0.0;
+  }
+  return label;
+}
+
+std::vector<std::uint32_t> weldByPosition(const mesh::TriMesh& mesh, double tolerance) {
+  const std::size_t n = mesh.positions.size();
+  std::vector<std::uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  auto cell = [&](std::uint32_t v) {
+    const Vec3& p = mesh.positions[v];
+    return std::array<long long, 3>{std::llround(p.x() / tolerance), std::llround(p.y() / tolerance),
+                                    std::llround(p.z() / tolerance)};
+  };
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    const auto ca = cell(a), cb = cell(b);
+    return ca != cb ? ca < cb : a < b;
+  });
+  std::vector<std::uint32_t> map(n);
+  for (std::size_t i = 0; i < n;) {
+    std::size_t j = i;
+    const auto c = cell(order[i]);
+    while (j < n && cell(order[j]) == c) map[order[j++]] = order[i];
+    i = j;
+  }
+  return map;
+}
+
+std::size_t countBoundaryEdges(const mesh::TriMesh& mesh) {
+  std::size_t boundary = 0;
+  for (const auto& [key, count] : edgeUseCounts(mesh))
+    if (count == 1) ++boundary;
+  return boundary;
+}
+
+std::size_t capOpenings(mesh::TriMesh& mesh) {
+  const auto counts = edgeUseCounts(mesh);
+  // Boundary half-edges as they appear in their one face (u -> v).
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> boundary;
+  for (const mesh::Triangle& t : mesh.triangles)
+    for (int c = 0; c < 3; ++c)
+      if (counts.at(undirectedKey(t[c], t[(c + 1) % 3])) == 1) boundary.emplace_back(t[c], t[(c + 1) % 3]);
+  if (boundary.empty()) return 0;
+  // Openings = connected components of the boundary edges.
+  std::vector<std::uint32_t> parent(mesh.positions.size());
+  std::iota(parent.begin(), parent.end(), 0u);
+  for (const auto& [u, v] : boundary) parent[findRoot(parent, u)] = findRoot(parent, v);
+  std::unordered_map<std::uint32_t, std::uint32_t> centreOf;  // component root -> centre vertex
+  std::unordered_map<std::uint32_t, std::pair<Vec3, int>> sums;
+  for (const auto& [u, v] : boundary) {
+    auto& s = sums[findRoot(parent, u)];
+    if (s.second == 0) s.first = Vec3::Zero();
+    s.first += mesh.positions[u];
+    ++s.second;
+  }
+  for (auto& [root, s] : sums) {
+    centreOf[root] = static_cast<std::uint32_t>(mesh.positions.size());
+    mesh.positions.push_back(s.first / s.second);
+  }
+  for (const auto& [u, v] : boundary) mesh.triangles.push_back({v, u, centreOf[findRoot(parent, u)]});
+  return sums.size();
+}
+
+std::vector<int> segmentSkinnedAvatar(Avatar& avatar) {
+  avatar.segments.clear();
+  std::vector<int> segmentOfTriangle;
+  if (!avatar.skin) return segmentOfTriangle;
+  const SkinnedMesh& skin = *avatar.skin;
+  const std::vector<int> label = dominantJointPerTriangle(skin, avatar.joints.size());
+  const std::vector<std::uint32_t> weld = weldByPosition(skin.mesh);
+  segmentOfTriangle.assign(label.size(), -1);
+  std::vector<std::uint32_t> local(skin.mesh.positions.size(), mesh::kNoVertex);
+  for (std::size_t j = 0; j < avatar.joints.size(); ++j) {
+    Segment segment;
+    segment.name = avatar.joints[j].name;
+    segment.joint = static_cast<int>(j);
+    segment.mesh.name = avatar.joints[j].name;
+    const RigidTransform toJoint = avatar.joints[j].restWorld().inverse();
+    std::vector<std::uint32_t> used;
+    for (std::size_t t = 0; t < label.size(); ++t) {
+      if (label[t] != static_cast<int>(j)) continue;
+      mesh::Triangle tri;
+      for (int c = 0; c < 3; ++c) {
+        const std::uint32_t v = weld[skin.mesh.triangles[t][c]];
+        if (local[v] == mesh::kNoVertex) {
+          local[v] = static_cast<std::uint32_t>(segment.mesh.positions.size());
+          segment.mesh.positions.push_back(toJoint.apply(skin.mesh.positions[v]));
+          used.push_back(v);
+        }
+        tri[c] = local[v];
+      }
+      // Welding can collapse a sliver triangle to a repeated vertex: it has no area to keep.
+      if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
+        segmentOfTriangle[t] = static_cast<int>(avatar.segments.size());
+        continue;
+      }
+      segment.mesh.triangles.push_back(tri);
+      segmentOfTriangle[t] = static_cast<int>(avatar.segments.size());
+    }
+    for (std::uint32_t v : used) local[v] = mesh::kNoVertex;
+    if (segment.mesh.triangles.empty()) {
+      for (int& s : segmentOfTriangle)
+        if (s == static_cast<int>(avatar.segments.size())) s = -1;
+      continue;
+    }
+    capOpenings(segment.mesh);
+    avatar.segments.push_back(std::move(segment));
+  }
+  return segmentOfTriangle;
+}
+
+}  // namespace drape::scene

@@ -1,0 +1,36 @@
+#pragma once
+// Segmenting a skinned character (paper section 4.2, done by hand there): each joint's
+// segment is the set of triangles whose dominant skin weight is that joint; each
+// segment's openings are capped so it is closed, and its vertices are moved into the
+// joint's frame (unit scale, axes of the rest frame).
+
+#include <cstdint>
+#include <vector>
+
+#include "drape/mesh/trimesh.hpp"
+#include "drape/scene/avatar.hpp"
+
+namespace drape::scene {
+
+/// For each triangle, the joint with the largest summed weight over its three vertices
+/// (ties go to the lower joint index).
+[[nodiscard]] std::vector<int> dominantJointPerTriangle(const SkinnedMesh& skin, std::size_t jointCount);
+
+/// Vertex index map that merges vertices at the same position (within `tolerance` m):
+/// UV and normal seams split vertices that are one point of the surface.
+[[nodiscard]] std::vector<std::uint32_t> weldByPosition(const mesh::TriMesh& mesh, double tolerance = 1e-7);
+
+/// Closes every opening of `mesh`: each connected run of boundary edges gets a centre
+/// vertex (the mean of its vertices) and one triangle per boundary edge, wound against
+/// the edge's face. Returns the number of caps added.
+std::size_t capOpenings(mesh::TriMesh& mesh);
+
+/// Number of edges used by exactly one triangle.
+[[nodiscard]] std::size_t countBoundaryEdges(const mesh::TriMesh& mesh);
+
+/// Builds avatar.segments from avatar.skin (replacing any): one closed segment per joint
+/// that dominates at least one triangle, named after the joint, in the joint's frame.
+/// Returns, for each triangle of the skin, the index of the segment it went to.
+std::vector<int> segmentSkinnedAvatar(Avatar& avatar);
+
+}  // namespace drape::scene

@@ -1,0 +1,151 @@
+// BVH, ASF/AMC and MakeHuman rig readers: the real files in data/, and the malformed-file
+// corpus in tests/data/bad/motion with the exact message and position each must produce.
+
+#include <gtest/gtest.h>
+
+#include <functional>
+
+#include "drape/core/error.hpp"
+#include "drape/formats/asf_amc.hpp"
+#include "drape/formats/bvh.hpp"
+#include "drape/formats/mhskel.hpp"
+
+namespace drape::formats {
+namespace {
+
+std::string mocap(const std::string& f) { return std::string(DRAPE_DATA_DIR) + "/mocap/" + f; }
+std::string bad(const std::string& f) { return std::string(DRAPE_TEST_DATA_DIR) + "/bad/motion/" + f; }
+
+std::string errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ExitCode::BadInput);
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(Bvh, ReadsTheCmuWalk) {
+  const BvhFile f = readBvh(mocap("cmu_walk_delfem2.bvh"));
+  EXPECT_EQ(f.joints.size(), 31u);
+  EXPECT_EQ(f.channelCount, 96u);
+  EXPECT_EQ(f.frameCount, 344u);
+  EXPECT_NEAR(f.frameTime, 1.0 / 120.0, 1e-6);
+  EXPECT_EQ(f.values.size(), 344u * 96u);
+  EXPECT_EQ(f.joints[0].name, "Hips");
+  EXPECT_EQ(f.joints[2].name, "LeftUpLeg");
+  EXPECT_EQ(f.joints[2].parent, 1);
+  EXPECT_NEAR((f.joints[2].offset - Vec3(1.65674, -1.80282, 0.62477)).norm(), 0.0, 1e-12);
+  EXPECT_TRUE(f.joints[5].endSite.has_value());  // LeftToeBase
+  EXPECT_DOUBLE_EQ(f.values[0], 10.4194);
+  EXPECT_EQ(f.firstFrameLine, 188);
+}
+
+TEST(Bvh, ReadsTheDazWalkWithTabSeparators) {
+  const BvhFile f = readBvh(mocap("cmu_02_02_walk_dazstyle.bvh"));
+  EXPECT_EQ(f.joints.size(), 43u);
+  EXPECT_EQ(f.channelCount, 132u);
+  EXPECT_EQ(f.frameCount, 299u);
+}
+
+struct BadCase {
+  const char* file;
+  const char* expected;  ///< message after "path:"
+};
+
+TEST(Bvh, MalformedCorpus) {
+  const BadCase cases[] = {
+      // The 7.7 GB Assimp regression: rejected from the header, nothing allocated.
+      {"huge_frames.bvh", "8:9: Frames: 329490295 exceeds the limit of 1000000"},
+      {"frames_exceed_file.bvh", "20:1: the file ends after 1 of the 900000 frames declared"},
+      {"no_channels.bvh", "8:9: the skeleton has no channels, so frames cannot hold motion"},
+      {"zero_frame_time.bvh", "18:13: Frame Time must be > 0 s, found 0"},
+      {"wrong_channel_count.bvh", "20: frame 2 has 5 values, expected 6 (one per channel)"},
+      {"truncated.bvh", "21:1: the file ends after 2 of the 3 frames declared"},
+      {"extra_frames.bvh", "20:1: more values than the 1 frames declared"},
+      {"bad_number.bvh", "19:5: expected a number, found 'abc'"},
+      {"unknown_channel.bvh", "5:24: unknown channel 'Wrotation' (expected Xposition..Zrotation)"},
+      {"missing_brace.bvh", "3:3: expected '{', found 'OFFSET'"},
+      {"too_many_channels.bvh", "5:12: channel count 7 exceeds the limit of 6"},
+  };
+  for (const BadCase& c : cases) {
+    const std::string path = bad(c.file);
+    EXPECT_EQ(errorOf([&] { (void)readBvh(path); }), path + ":" + c.expected) << c.file;
+  }
+}
+
+TEST(Bvh, EmptyAndMissing) {
+  EXPECT_EQ(errorOf([] { (void)parseBvh("", "e.bvh"); }), "e.bvh:1:1: expected 'HIERARCHY', found end of file");
+  EXPECT_EQ(errorOf([] { (void)readBvh("/nonexistent/x.bvh"); }), "/nonexistent/x.bvh: no such file");
+}
+
+TEST(Bvh, DeepNestingIsAnErrorNotAStackOverflow) {
+  std::string text = "HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n";
+  for (int i = 1; i < 400; ++i) text += "JOINT j" + std::to_string(i) + "\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n";
+  EXPECT_NE(errorOf([&] { (void)parseBvh(text, "deep.bvh"); }).find("joints nested deeper than 256"), std::string::npos);
+}
+
+TEST(AsfAmc, ReadsTheCmuSoccerKick) {
+  const AsfSkeleton asf = readAsf(mocap("cmu_11.asf"));
+  EXPECT_EQ(asf.bones.size(), 30u);
+  EXPECT_DOUBLE_EQ(asf.lengthScale, 0.45);
+  EXPECT_TRUE(asf.degrees);
+  for (std::size_t b = 0; b < asf.bones.size(); ++b) EXPECT_LT(asf.bones[b].parent, static_cast<int>(b));
+  const int tibia = asf.find("ltibia");
+  ASSERT_GE(tibia, 0);
+  EXPECT_EQ(asf.bones[static_cast<std::size_t>(asf.bones[static_cast<std::size_t>(tibia)].parent)].name, "lfemur");
+  EXPECT_EQ(asf.bones[static_cast<std::size_t>(tibia)].dofs.size(), 1u);
+  const AmcMotion amc = readAmc(mocap("cmu_11_01.amc"), asf);
+  EXPECT_EQ(amc.frameCount, 597u);
+  EXPECT_DOUBLE_EQ(amc.frame(0)[0], 12.2047);  // root TX of frame 1
+}
+
+TEST(AsfAmc, MalformedCorpus) {
+  const AsfSkeleton asf = readAsf(bad("small.asf"));
+  const BadCase cases[] = {
+      {"amc_unknown_bone.amc", "8:1: unknown bone 'tibia' (not in the ASF skeleton)"},
+      {"amc_wrong_count.amc", "5:1: bone 'femur' has 2 values, expected 3 (its degrees of freedom)"},
+      {"amc_frame_gap.amc", "6:1: frame 3 follows frame 1"},
+  };
+  for (const BadCase& c : cases) {
+    const std::string path = bad(c.file);
+    EXPECT_EQ(errorOf([&] { (void)readAmc(path, asf); }), path + ":" + c.expected) << c.file;
+  }
+  const std::string asfPath = bad("asf_unknown_parent.asf");
+  EXPECT_EQ(errorOf([&] { (void)readAsf(asfPath); }), asfPath + ":26:5: unknown bone 'shin' in the hierarchy");
+}
+
+TEST(MhSkel, ReadsTheCmuMbRig) {
+  const MhSkeleton s = readMhskel(std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel");
+  EXPECT_EQ(s.bones.size(), 31u);
+  EXPECT_EQ(s.bones[0].name, "Hips");
+  EXPECT_EQ(s.joints.size(), 62u);
+  for (std::size_t b = 1; b < s.bones.size(); ++b) EXPECT_LT(s.find(s.bones[b].parent), static_cast<int>(b));
+  const MhSkeleton d = readMhskel(std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_default.mhskel");
+  EXPECT_EQ(d.bones.size(), 163u);
+  EXPECT_EQ(d.bones[0].name, "root");
+}
+
+TEST(MhSkel, ReadsTheDefaultWeights) {
+  const MhWeights w = readMhw(std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_default_weights.mhw");
+  EXPECT_EQ(w.weights.size(), 139u);
+  std::size_t pairs = 0;
+  for (const auto& [bone, list] : w.weights) pairs += list.size();
+  EXPECT_EQ(pairs, 57107u);
+  const auto fold = readMakeHumanWeightFold(std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_to_cmu_joint_map.json");
+  EXPECT_EQ(fold.size(), 139u);
+  EXPECT_EQ(fold.at("breast.L"), "Spine");
+  EXPECT_EQ(readMakeHumanWeightFold(std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_to_cmu_joint_map.json", true).at("neck01"), "Neck");
+}
+
+TEST(MhSkel, MalformedCorpus) {
+  const std::string badJson = bad("mhskel_bad_json.mhskel");
+  EXPECT_EQ(errorOf([&] { (void)readMhskel(badJson); }).rfind(badJson + ":5:3: ", 0), 0u)
+      << errorOf([&] { (void)readMhskel(badJson); });
+  const std::string twoRoots = bad("mhskel_two_roots.mhskel");
+  EXPECT_EQ(errorOf([&] { (void)readMhskel(twoRoots); }), twoRoots + ": two root bones ('a' and 'b')");
+}
+
+}  // namespace
+}  // namespace drape::formats

@@ -1,0 +1,98 @@
+// glTF skinned characters: CesiumMan segmented into 19 closed segments covering every
+// triangle; the Assimp failure cases of the motion issue as regressions.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "drape/core/error.hpp"
+#include "drape/scene/avatar_gltf.hpp"
+#include "drape/scene/avatar_segment.hpp"
+
+namespace drape::scene {
+namespace {
+
+std::string data(const std::string& file) { return std::string(DRAPE_DATA_DIR) + "/avatars/" + file; }
+std::string bad(const std::string& file) { return std::string(DRAPE_TEST_DATA_DIR) + "/bad/motion/" + file; }
+
+std::string errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(GltfAvatar, ReadsInProcessToo) {
+  // The same reader without the child process (what the fuzz target exercises).
+  std::ifstream in(data("CesiumMan.glb"), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const formats::GltfSkinnedModel m = formats::parseGltfSkinnedModel(bytes, "CesiumMan.glb", std::string(DRAPE_DATA_DIR) + "/avatars");
+  EXPECT_EQ(m.joints.size(), 19u);
+  EXPECT_EQ(m.triangles.size(), 4672u);
+  const formats::GltfSkinnedModel back = formats::deserialiseGltfSkinnedModel(formats::serialise(m), "x");
+  EXPECT_EQ(back.positions, m.positions);
+  EXPECT_EQ(back.vertexJoints, m.vertexJoints);
+}
+
+TEST(GltfAvatar, CesiumManHas19ClosedSegmentsCoveringEveryTriangle) {
+  const Avatar a = loadGltfAvatar(data("CesiumMan.glb"));
+  ASSERT_EQ(a.joints.size(), 19u);
+  ASSERT_TRUE(a.skin.has_value());
+  EXPECT_EQ(a.skin->mesh.triangles.size(), 4672u);
+  EXPECT_EQ(a.segments.size(), 19u);
+  for (const Segment& s : a.segments) EXPECT_EQ(countBoundaryEdges(s.mesh), 0u) << s.name;
+  Avatar copy = a;
+  const std::vector<int> segmentOf = segmentSkinnedAvatar(copy);
+  ASSERT_EQ(segmentOf.size(), 4672u);
+  for (std::size_t t = 0; t < segmentOf.size(); ++t) EXPECT_GE(segmentOf[t], 0) << "triangle " << t;
+  // Y up after the root node's rotation, about 1.5 m tall, standing on y = 0.
+  const Aabb box = a.skin->mesh.bounds();
+  EXPECT_NEAR(box.size().y(), 1.5, 0.05);
+  EXPECT_NEAR(box.min.y(), 0.0, 0.02);
+  // Segments sit in their joint's frame: moved back to the rest pose they match the skin.
+  for (const Segment& s : a.segments) {
+    const Vec3 c = a.joints[static_cast<std::size_t>(s.joint)].restCenter;
+    Aabb segBox;
+    for (const Vec3& v : s.mesh.positions) segBox.extend(v + c);
+    EXPECT_TRUE(box.contains(segBox.center())) << s.name;
+  }
+}
+
+TEST(GltfAvatar, RiggedSimpleIsTwoSegments) {
+  const Avatar a = loadGltfAvatar(data("RiggedSimple.glb"));
+  EXPECT_EQ(a.joints.size(), 2u);
+  EXPECT_EQ(a.segments.size(), 2u);
+  for (const Segment& s : a.segments) EXPECT_EQ(countBoundaryEdges(s.mesh), 0u) << s.name;
+}
+
+// Regression: a spec-valid skin without inverseBindMatrices crashed Assimp's glTF2 importer;
+// the glTF default (identity) applies.
+TEST(GltfAvatar, SkinWithoutInverseBindMatricesUsesIdentity) {
+  const Avatar a = loadGltfAvatar(bad("skin_without_inverse_bind.gltf"));
+  EXPECT_EQ(a.joints.size(), 2u);
+  EXPECT_EQ(a.segments.size(), 2u);
+}
+
+// Regression: bytes that are not glTF fell through to other Assimp importers.
+TEST(GltfAvatar, BytesThatAreNotGltfAreAnError) {
+  EXPECT_EQ(errorOf([] { (void)loadGltfAvatar(bad("not_gltf.glb")); }).rfind(bad("not_gltf.glb") + ": ", 0), 0u);
+  const std::string e = errorOf([] { (void)loadGltfAvatar(bad("not_gltf.glb")); });
+  EXPECT_NE(e, "(no error)");
+}
+
+// Regression: a buffer URI that is a plain path outside the model's folder was read from disk.
+TEST(GltfAvatar, BufferUriOutsideTheFolderIsRefused) {
+  const std::string e = errorOf([] { (void)loadGltfAvatar(bad("buffer_outside_folder.gltf")); });
+  EXPECT_NE(e.find("outside the model's folder"), std::string::npos) << e;
+}
+
+TEST(GltfAvatar, UnknownAvatarExtension) {
+  EXPECT_EQ(errorOf([] { (void)loadAvatarFile("x.fbx"); }),
+            "x.fbx: drape reads avatars from .glb, .gltf and MakeHuman .mhskel files, not '.fbx'");
+}
+
+}  // namespace
+}  // namespace drape::scene

@@ -1,0 +1,82 @@
+// The MakeHuman body as a segmented avatar: cmu_mb joints where SOURCES.md measured them,
+// closed segments covering every body triangle, weights folded as MakeHuman does.
+
+#include <gtest/gtest.h>
+
+#include "drape/scene/avatar_makehuman.hpp"
+#include "drape/scene/avatar_segment.hpp"
+
+namespace drape::scene {
+namespace {
+
+const Avatar& makeHuman() {
+  static const Avatar avatar = [] {
+    MakeHumanAvatarOptions options;
+    options.directory = std::string(DRAPE_DATA_DIR) + "/avatars";
+    return buildMakeHumanAvatar(options);
+  }();
+  return avatar;
+}
+
+TEST(MakeHumanAvatar, JointsWhereTheRigPutsThem) {
+  const Avatar& a = makeHuman();
+  ASSERT_EQ(a.joints.size(), 31u);
+  EXPECT_EQ(a.joints[0].name, "Hips");
+  EXPECT_EQ(a.joints[0].parent, -1);
+  for (std::size_t j = 1; j < a.joints.size(); ++j) EXPECT_LT(a.joints[j].parent, static_cast<int>(j));
+  // SOURCES.md, checked positions (dm there, m here).
+  EXPECT_NEAR((a.joints[static_cast<std::size_t>(a.findJoint("Hips"))].restCenter - Vec3(0, 0.0727, 0.0144)).norm(), 0.0, 1e-3);
+  EXPECT_NEAR((a.joints[static_cast<std::size_t>(a.findJoint("LeftUpLeg"))].restCenter - Vec3(0.1104, 0.0486, 0.0123)).norm(), 0.0, 1e-3);
+  EXPECT_NEAR((a.joints[static_cast<std::size_t>(a.findJoint("LeftLeg"))].restCenter - Vec3(0.1581, -0.3695, 0.0320)).norm(), 0.0, 1e-3);
+  EXPECT_NEAR((a.joints[static_cast<std::size_t>(a.findJoint("LeftArm"))].restCenter - Vec3(0.1677, 0.5246, 0.0146)).norm(), 0.0, 1e-3);
+  EXPECT_NEAR((a.joints[static_cast<std::size_t>(a.findJoint("Head"))].restCenter - Vec3(0, 0.6975, 0.0161)).norm(), 0.0, 1e-3);
+}
+
+TEST(MakeHumanAvatar, ClosedSegmentsCoverTheBody) {
+  const Avatar& a = makeHuman();
+  ASSERT_TRUE(a.skin.has_value());
+  EXPECT_EQ(a.skin->mesh.positions.size(), 13380u);
+  EXPECT_GE(a.segments.size(), 19u);
+  std::size_t covered = 0;
+  Avatar copy = a;
+  const std::vector<int> segmentOf = segmentSkinnedAvatar(copy);
+  for (int s : segmentOf) covered += s >= 0 ? 1 : 0;
+  EXPECT_EQ(covered, a.skin->mesh.triangles.size());
+  for (const Segment& s : a.segments) {
+    EXPECT_EQ(countBoundaryEdges(s.mesh), 0u) << s.name;
+    EXPECT_EQ(s.name, a.joints[static_cast<std::size_t>(s.joint)].name);
+  }
+  // SOURCES.md: after folding, LeftLeg's vertices lie between knee and ankle (y -0.728..-0.376 m).
+  const Segment& shin = a.segments[static_cast<std::size_t>(a.findSegment("LeftLeg"))];
+  const Vec3 knee = a.joints[static_cast<std::size_t>(shin.joint)].restCenter;
+  for (std::size_t v = 0; v < shin.mesh.positions.size(); ++v) {
+    const double y = shin.mesh.positions[v].y() + knee.y();
+    EXPECT_GT(y, -0.76);
+    EXPECT_LT(y, -0.35);
+  }
+}
+
+TEST(Segmentation, CapsAnOpenTube) {
+  // A square tube open at both ends: two caps, no boundary left, outward winding kept.
+  mesh::TriMesh tube;
+  for (int ring = 0; ring < 2; ++ring)
+    for (int k = 0; k < 4; ++k) tube.positions.emplace_back(std::cos(k * M_PI / 2), std::sin(k * M_PI / 2), ring);
+  for (std::uint32_t k = 0; k < 4; ++k) {
+    const std::uint32_t a = k, b = (k + 1) % 4, c = 4 + k, d = 4 + (k + 1) % 4;
+    tube.triangles.push_back({a, b, d});
+    tube.triangles.push_back({a, d, c});
+  }
+  EXPECT_EQ(countBoundaryEdges(tube), 8u);
+  EXPECT_EQ(capOpenings(tube), 2u);
+  EXPECT_EQ(countBoundaryEdges(tube), 0u);
+  // Closed and consistently wound: the signed volume is the prism's (2 x 1 = 2) in magnitude.
+  double volume = 0.0;
+  for (std::size_t t = 0; t < tube.triangles.size(); ++t) {
+    const auto& tri = tube.triangles[t];
+    volume += tube.positions[tri[0]].dot(tube.positions[tri[1]].cross(tube.positions[tri[2]])) / 6.0;
+  }
+  EXPECT_NEAR(std::abs(volume), 2.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace drape::scene

@@ -1,0 +1,161 @@
+#pragma once
+// The distance field of one body part (paper section 4.3.2): built once, in the part's
+// local unit-scale frame, then only read by the collision code (section 4.3.3).
+//
+// Layout: a grid of dims() voxels of voxelSize() metres; voxel (x, y, z) covers
+// origin() + voxelSize() * [x, x+1) x [y, y+1) x [z, z+1) and has linear index
+// x + nx * (y + ny * z). Continuous voxel coordinates put voxel centres at integers:
+// c = (p - origin) / voxelSize - 0.5. The outermost layer is tagged border (a trace that
+// reaches it has left the volume); the border is wide enough that the shell (T3) around
+// the body never reaches it.
+//
+// Storage per voxel (structure of arrays): signed distance as int16 in 1/64 voxel (2 bytes),
+// flags (1 byte), Voronoi normal octahedron-encoded in 2 x int8 (2 bytes); references to
+// the surface voxels of each Voronoi cell only for voxels within the shell.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "drape/core/math.hpp"
+#include "drape/field/grid.hpp"
+#include "drape/field/propagation.hpp"
+#include "drape/field/voxelize.hpp"
+#include "drape/mesh/trimesh.hpp"
+
+namespace drape::field {
+
+struct FieldSettings {
+  double voxelSize_m = 0.01;  ///< m, edge of a cubic voxel (ignored when dims is set)
+  double shell_m = 0.06;      ///< m, the outer offset surface T3: Voronoi references are kept within it
+  double shellVoxels = 0;     ///< if positive: the shell in voxels, overriding shell_m (the paper's T3 = 6)
+  /// Voxels of border around the part's bounding box, the tagged outermost layer included.
+  /// 0: automatic, ceil(shell / voxel) + 2.
+  int borderVoxels = 0;
+  /// If all three are positive: the grid has exactly these dimensions (border included) and
+  /// the voxel size follows from the part's bounding box (its largest extent per voxel).
+  std::array<int, 3> dims{0, 0, 0};
+  FieldMethod method = FieldMethod::Dvdp;
+};
+
+/// How the build went: counts, times (ms, wall clock, one thread) and memory.
+struct FieldStats {
+  std::size_t voxels = 0;
+  std::size_t surfaceVoxels = 0;
+  std::size_t insideVoxels = 0;  ///< voxels whose centre is inside the body (surface voxels included)
+  std::size_t shellVoxels = 0;   ///< voxels with Voronoi references
+  std::size_t references = 0;    ///< total references in the shell
+  double voxelizeMs = 0;
+  double propagateMs = 0;  ///< DVDP or the exact transform
+  double finishMs = 0;     ///< normals and compact storage
+  std::size_t bytes = 0;   ///< memory of the built field
+};
+
+/// The result of DistanceField::locate for a local point.
+struct PointLocation {
+  bool inVolume = false;      ///< inside the grid and not in the border layer
+  std::uint32_t voxel = 0;    ///< voxel containing the point (clamped to the grid)
+  double distance_m = 0;      ///< signed, trilinear; negative inside the body
+};
+
+class DistanceField {
+ public:
+  /// Builds the field of one body part. `part` is in the part's local frame, metres, closed,
+  /// triangles wound counter-clockwise seen from outside. Throws drape::Error on bad
+  /// settings (naming the setting) or an empty mesh.
+  [[nodiscard]] static DistanceField build(const mesh::TriMesh& part, const FieldSettings& settings);
+
+  // --- grid geometry -----------------------------------------------------------------
+  [[nodiscard]] const GridDims& dims() const { return dims_; }
+  [[nodiscard]] double voxelSize() const { return voxelSize_; }  ///< m
+  [[nodiscard]] const Vec3& origin() const { return origin_; }    ///< m, corner of voxel (0, 0, 0)
+  [[nodiscard]] std::size_t voxelCount() const { return dims_.count(); }
+  /// Linear index steps of +1 voxel along x, y, z (for a voxel walk).
+  [[nodiscard]] std::array<std::int64_t, 3> strides() const {
+    return {1, dims_.nx, static_cast<std::int64_t>(dims_.nx) * dims_.ny};
+  }
+  [[nodiscard]] std::uint32_t index(int x, int y, int z) const { return dims_.index(x, y, z); }
+  [[nodiscard]] Vec3i coordinates(std::uint32_t voxel) const {
+    return {dims_.xOf(voxel), dims_.yOf(voxel), dims_.zOf(voxel)};
+  }
+  /// Local point (m) -> continuous voxel coordinates (voxel centres at integers).
+  [[nodiscard]] Vec3 toVoxel(const Vec3& local_m) const { return (local_m - origin_) / voxelSize_ - Vec3::Constant(0.5); }
+  /// Continuous voxel coordinates -> local point (m).
+  [[nodiscard]] Vec3 toLocal(const Vec3& voxel) const { return origin_ + (voxel + Vec3::Constant(0.5)) * voxelSize_; }
+  /// Centre of a voxel in the local frame (m).
+  [[nodiscard]] Vec3 centre(std::uint32_t voxel) const { return toLocal(coordinates(voxel).cast<double>()); }
+  /// Whether a local point (m) lies in the grid (border layer included).
+  [[nodiscard]] bool containsPoint(const Vec3& local_m) const;
+  /// The voxel containing a local point (m), clamped to the grid.
+  [[nodiscard]] std::uint32_t voxelAt(const Vec3& local_m) const;
+  /// The grid's box in the local frame (m): cull with it.
+  [[nodiscard]] Aabb bounds() const;
+  /// The body part's own bounding box in the local frame (m).
+  [[nodiscard]] const Aabb& bodyBounds() const { return bodyBounds_; }
+
+  // --- per voxel -------------------------------------------------------------------------
+  /// The one-comparison exit test of a voxel walk: the outermost layer.
+  [[nodiscard]] bool isBorder(std::uint32_t voxel) const { return flags_[voxel] & kVoxelBorder; }
+  /// The voxel's centre is inside the body.
+  [[nodiscard]] bool inside(std::uint32_t voxel) const { return flags_[voxel] & kVoxelInside; }
+  [[nodiscard]] bool isSurface(std::uint32_t voxel) const { return flags_[voxel] & kVoxelSurface; }
+  /// The voxel is within the shell T3 (has Voronoi references).
+  [[nodiscard]] bool inShell(std::uint32_t voxel) const { return flags_[voxel] & kVoxelShell; }
+  /// Signed distance (m) from the voxel centre to the nearest surface voxel centre;
+  /// negative inside the body, 0 on surface voxels. Resolution 1/64 voxel.
+  [[nodiscard]] double distance(std::uint32_t voxel) const { return distance_[voxel] * metresPerUnit_; }
+  /// The same in voxel units.
+  [[nodiscard]] double distanceVoxels(std::uint32_t voxel) const { return distance_[voxel] * (1.0 / kUnitsPerVoxel); }
+  /// Offset-surface normal (unit, pointing away from the body): within the shell, the mean
+  /// of the normals of the Voronoi cell's surface voxels; beyond it, the distance gradient.
+  [[nodiscard]] Vec3 normal(std::uint32_t voxel) const { return decodeNormal(normal_[voxel]); }
+
+  // --- per local point (no allocation; reads 8 voxels) ---------------------------------------
+  /// Signed distance (m) at a local point (m), trilinear between voxel centres; clamped to
+  /// the grid for points outside it.
+  [[nodiscard]] double distanceAt(const Vec3& local_m) const;
+  /// Offset-surface normal at a local point: trilinear blend of the 8 voxel normals, unit.
+  [[nodiscard]] Vec3 normalAt(const Vec3& local_m) const;
+  /// Both, and whether the point is in the volume, in one call.
+  [[nodiscard]] PointLocation locate(const Vec3& local_m) const;
+
+  // --- Voronoi cells (cold: binary search) -----------------------------------------------------
+  /// Surface voxels whose Voronoi cell holds this voxel (empty beyond the shell).
+  [[nodiscard]] std::span<const std::uint32_t> references(std::uint32_t voxel) const;
+  /// Unit normals of the triangles overlapping a surface voxel (empty for other voxels).
+  [[nodiscard]] std::span<const Vec3f> surfaceNormals(std::uint32_t voxel) const;
+
+  [[nodiscard]] const FieldStats& stats() const { return stats_; }
+  [[nodiscard]] double shell_m() const { return shell_m_; }
+  [[nodiscard]] FieldMethod method() const { return method_; }
+  /// Memory held by the field (bytes).
+  [[nodiscard]] std::size_t memoryBytes() const;
+
+  static constexpr int kUnitsPerVoxel = 64;  ///< fixed-point scale of the stored distances
+
+  [[nodiscard]] static std::uint16_t encodeNormal(const Vec3& unit);
+  [[nodiscard]] static Vec3 decodeNormal(std::uint16_t code);
+
+ private:
+  GridDims dims_;
+  double voxelSize_ = 0;
+  double metresPerUnit_ = 0;  // voxelSize_ / kUnitsPerVoxel
+  Vec3 origin_ = Vec3::Zero();
+  Aabb bodyBounds_;
+  double shell_m_ = 0;
+  FieldMethod method_ = FieldMethod::Dvdp;
+  std::vector<std::int16_t> distance_;   ///< per voxel, 1/64 voxel, signed
+  std::vector<std::uint8_t> flags_;      ///< per voxel, VoxelFlag bits
+  std::vector<std::uint16_t> normal_;    ///< per voxel, octahedral code
+  std::vector<std::uint32_t> shellVoxels_, refStart_, refs_;          ///< shell only
+  std::vector<std::uint32_t> surfaceVoxels_, surfaceNormalStart_;    ///< surface voxels, sorted
+  std::vector<Vec3f> surfaceNormals_;
+  FieldStats stats_;
+};
+
+/// Grid placement for a part: its bounding box plus `border` voxels each side (cubic voxels
+/// of `voxelSize` m), or exactly `dims` voxels when they are given (voxel size from the box).
+[[nodiscard]] GridPlacement placeGrid(const Aabb& box, const FieldSettings& settings, int border);
+
+}  // namespace drape::field

@@ -1,0 +1,39 @@
+#pragma once
+// Force kernels (STYLE habit 6): one function per force type over the model's element
+// arrays, adding into the state's force accumulators. Each states its formula; the
+// derivations are in docs/PHYSICS.md. Energies are computed by matching functions so tests
+// can check force = -gradient(energy) and energy conservation.
+
+#include "drape/cloth/material.hpp"
+#include "drape/cloth/model.hpp"
+#include "drape/cloth/state.hpp"
+
+namespace drape::cloth {
+
+/// Sets every force accumulator to zero.
+void clearForces(ClothState& io);
+
+/// CST St Venant-Kirchhoff membrane in plane stress, per triangle of rest area A:
+///   E = (F^T F - I) / 2,  S = lambda_t tr(E) I + 2 mu_t E (+ damping_s * same of dE/dt),
+///   f_i = -A F S grad(N_i).
+/// Compressive principal stresses are scaled by material.compressionScale.
+void accumulateMembraneForces(const ClothModel& model, ClothState& io);
+
+/// Dihedral hinges: W = k / 2 (psi - psi0)^2 with psi = 2 sin(theta / 2), f = -dW/dx.
+void accumulateBendingForces(const ClothModel& model, ClothState& io);
+
+/// Viscous air drag relative to the wind, per vertex: f = -c A_v (v - wind).
+void accumulateDragForces(const ClothModel& model, const StepSettings& settings, ClothState& io);
+
+/// Elastic energies, J.
+[[nodiscard]] double membraneEnergy(const ClothModel& model, const ClothState& state);
+[[nodiscard]] double bendingEnergy(const ClothModel& model, const ClothState& state);
+/// Kinetic energy, J.
+[[nodiscard]] double kineticEnergy(const ClothModel& model, const ClothState& state);
+/// Gravitational potential -sum m g . x, J (zero at the origin).
+[[nodiscard]] double gravityEnergy(const ClothModel& model, const ClothState& state, const Vec3& gravity_m_s2);
+
+/// Largest |l - l0| / l0 over the model's edges.
+[[nodiscard]] double maxEdgeStrain(const ClothModel& model, const ClothState& state);
+
+}  // namespace drape::cloth

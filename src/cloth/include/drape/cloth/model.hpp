@@ -1,0 +1,120 @@
+#pragma once
+// ClothModel: what a garment is (STYLE habit 1). Built once from a mesh, its topology and a
+// Material by explicit Build passes (habit 4); immutable afterwards and shared by every
+// instance of the garment (several characters wearing the same dress share one model).
+//
+// Membrane: one constant-strain triangle (CST) per face, St Venant-Kirchhoff in plane
+// stress, so stiffness follows from E, nu, t and each triangle's own rest shape (no per-edge
+// spring constants). Bending: one hinge per interior edge, a dihedral-angle energy whose
+// stiffness follows from the bending modulus D and the rest geometry of the hinge. See
+// docs/PHYSICS.md for the derivations.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "drape/cloth/material.hpp"
+#include "drape/mesh/topology.hpp"
+#include "drape/mesh/trimesh.hpp"
+
+namespace drape::cloth {
+
+/// One membrane triangle (56 bytes). Filled by buildMembrane.
+///   F = (x1 - x0) (x) g1 + (x2 - x0) (x) g2   (3x2 deformation gradient)
+/// where g1, g2 are the rows of the inverse rest shape matrix in the triangle's rest plane.
+struct MembraneElement {
+  std::uint32_t v0, v1, v2;  ///< vertex indices
+  std::uint32_t pad = 0;
+  double g1u, g1v;           ///< gradient of the barycentric weight of v1 in rest-plane coords, 1/m
+  double g2u, g2v;           ///< gradient of the barycentric weight of v2, 1/m
+  double restArea_m2;        ///< rest area, m^2
+};
+
+/// One bending hinge (48 bytes). Filled by buildBending. The orientation is edge-local:
+///
+///          a                 N1 = (a - e0) x (a - e1)
+///         / \                N2 = (b - e1) x (b - e0)
+///       e0---e1              so the hinge is consistent however the two faces are wound.
+///         \ /
+///          b
+struct BendElement {
+  std::uint32_t e0, e1;  ///< the shared edge
+  std::uint32_t a, b;    ///< the vertices opposite it
+  double restPsi;        ///< rest value of psi = 2 sin(theta / 2) (theta: signed dihedral angle)
+  double stiffness_Nm;   ///< k in W = k / 2 (psi - restPsi)^2, N m
+};
+
+class ClothModel {
+ public:
+  /// Builds the model. Throws drape::Error naming mesh.name on an invalid material or a
+  /// mesh with no triangles. `topology` must be mesh::Topology::build(mesh).
+  [[nodiscard]] static std::shared_ptr<const ClothModel> build(const mesh::TriMesh& mesh,
+                                                               const mesh::Topology& topology,
+                                                               const Material& material);
+
+  [[nodiscard]] const std::string& name() const { return name_; }
+  [[nodiscard]] const Material& material() const { return material_; }
+  [[nodiscard]] std::size_t vertexCount() const { return restX_.size(); }
+  [[nodiscard]] std::size_t triangleCount() const { return triangles_.size(); }
+
+  // Rest positions (SoA), m.
+  [[nodiscard]] const std::vector<double>& restX() const { return restX_; }
+  [[nodiscard]] const std::vector<double>& restY() const { return restY_; }
+  [[nodiscard]] const std::vector<double>& restZ() const { return restZ_; }
+  /// Lumped vertex masses, kg (a third of each adjacent triangle's rho t A).
+  [[nodiscard]] const std::vector<double>& mass() const { return mass_; }
+  /// 1 / mass, 1/kg; 0 for vertices no triangle uses (they only feel gravity).
+  [[nodiscard]] const std::vector<double>& inverseMass() const { return inverseMass_; }
+  /// Vertex areas (a third of each adjacent triangle's area), m^2: the drag area.
+  [[nodiscard]] const std::vector<double>& vertexArea() const { return vertexArea_; }
+  [[nodiscard]] double totalMass_kg() const { return totalMass_; }
+
+  [[nodiscard]] const std::vector<MembraneElement>& membrane() const { return membrane_; }
+  [[nodiscard]] const std::vector<BendElement>& bending() const { return bending_; }
+  /// Plane-stress Lame constants times thickness (membrane stiffnesses), N/m.
+  [[nodiscard]] double lambdaT() const { return lambdaT_; }
+  [[nodiscard]] double muT() const { return muT_; }
+
+  /// Edges (for strain statistics): endpoints and rest lengths, m.
+  [[nodiscard]] const std::vector<std::uint32_t>& edgeV0() const { return edgeV0_; }
+  [[nodiscard]] const std::vector<std::uint32_t>& edgeV1() const { return edgeV1_; }
+  [[nodiscard]] const std::vector<double>& edgeRestLength() const { return edgeRest_; }
+  /// Triangles as loaded (for writing frames).
+  [[nodiscard]] const std::vector<mesh::Triangle>& triangles() const { return triangles_; }
+
+  /// Smallest altitude over all triangles, m: the length that limits the explicit step.
+  [[nodiscard]] double minAltitude_m() const { return minAltitude_; }
+  /// Membrane wave speed sqrt(E / (rho (1 - nu^2))), m/s.
+  [[nodiscard]] double membraneWaveSpeed_m_s() const;
+  /// A conservative estimate of the largest stable substep of the explicit integrators, s.
+  [[nodiscard]] double estimatedStableStep_s() const;
+
+ private:
+  void buildMasses(const mesh::TriMesh& mesh);
+  void buildMembrane(const mesh::TriMesh& mesh);
+  void buildBending(const mesh::TriMesh& mesh, const mesh::Topology& topology);
+  void buildEdges(const mesh::Topology& topology);
+  [[nodiscard]] double estimateBendingOmega(const mesh::TriMesh& mesh) const;
+
+  std::string name_;
+  Material material_;
+  std::vector<double> restX_, restY_, restZ_;
+  std::vector<double> mass_, inverseMass_, vertexArea_;
+  double totalMass_ = 0.0;
+  std::vector<MembraneElement> membrane_;
+  std::vector<BendElement> bending_;
+  double lambdaT_ = 0.0, muT_ = 0.0;
+  std::vector<std::uint32_t> edgeV0_, edgeV1_;
+  std::vector<double> edgeRest_;
+  std::vector<mesh::Triangle> triangles_;
+  double minAltitude_ = 0.0;
+  double bendingOmega_ = 0.0;  ///< highest bending frequency bound, rad/s (buildBending)
+};
+
+/// Bending hinge constant: W_e = kBendCoefficient * D * |e|^2 / (A1 + A2) * (psi - psi0)^2.
+/// Chosen (docs/PHYSICS.md) so that a regular grid bent into a cylinder of curvature kappa
+/// stores D kappa^2 / 2 per area, as plate theory says; irregular meshes store about 1.5
+/// times that (a known limit of hinge energies, measured by the calibration test).
+inline constexpr double kBendCoefficient = 0.5;
+
+}  // namespace drape::cloth

@@ -1,0 +1,172 @@
+#include "drape/cloth/model.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "drape/core/error.hpp"
+
+namespace drape::cloth {
+namespace {
+
+/// psi = 2 sin(theta / 2) of the hinge (see BendElement), with theta the signed dihedral
+/// angle, zero when flat; the same formula the bending kernel evaluates.
+double hingePsi(const Vec3& e0, const Vec3& e1, const Vec3& a, const Vec3& b) {
+  const Vec3 edge = e1 - e0;
+  const Vec3 n1 = (a - e0).cross(a - e1);
+  const Vec3 n2 = (b - e1).cross(b - e0);
+  const double denom = std::sqrt(n1.squaredNorm() * n2.squaredNorm());
+  if (denom <= 0.0) return 0.0;
+  const double c = std::clamp(n1.dot(n2) / denom, -1.0, 1.0);
+  const double s = n1.cross(n2).dot(edge);
+  const double psi = std::sqrt(2.0 * (1.0 - c));
+  return s < 0.0 ? -psi : psi;
+}
+
+}  // namespace
+
+std::shared_ptr<const ClothModel> ClothModel::build(const mesh::TriMesh& mesh, const mesh::Topology& topology,
+                                                    const Material& material) {
+  material.validate("--");
+  if (mesh.triangles.empty()) throw Error(fmt::format("{}: the garment has no triangles", mesh.name));
+  auto model = std::make_shared<ClothModel>(ClothModel());
+  model->name_ = mesh.name;
+  model->material_ = material;
+  model->triangles_ = mesh.triangles;
+  model->buildMasses(mesh);
+  model->buildMembrane(mesh);
+  model->buildBending(mesh, topology);
+  model->buildEdges(topology);
+  return model;
+}
+
+// Masses: each triangle's rho t A shared equally by its three corners (paper 4.1).
+void ClothModel::buildMasses(const mesh::TriMesh& mesh) {
+  const std::size_t n = mesh.vertexCount();
+  restX_.resize(n);
+  restY_.resize(n);
+  restZ_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    restX_[i] = mesh.positions[i].x();
+    restY_[i] = mesh.positions[i].y();
+    restZ_[i] = mesh.positions[i].z();
+  }
+  mass_.assign(n, 0.0);
+  vertexArea_.assign(n, 0.0);
+  const double areal = material_.arealDensity();
+  for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
+    const double third = mesh.triangleArea(t) / 3.0;
+    for (std::uint32_t v : mesh.triangles[t]) {
+      vertexArea_[v] += third;
+      mass_[v] += areal * third;
+    }
+  }
+  inverseMass_.resize(n);
+  totalMass_ = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    inverseMass_[i] = mass_[i] > 0.0 ? 1.0 / mass_[i] : 0.0;
+    totalMass_ += mass_[i];
+  }
+}
+
+// Membrane: rest shape of each triangle in its own plane (u along the first edge), and the
+// plane-stress Lame constants times thickness.
+void ClothModel::buildMembrane(const mesh::TriMesh& mesh) {
+  const double E = material_.youngsModulus_Pa, nu = material_.poissonRatio, t = material_.thickness_m;
+  lambdaT_ = E * nu / (1.0 - nu * nu) * t;
+  muT_ = E / (2.0 * (1.0 + nu)) * t;
+  membrane_.clear();
+  membrane_.reserve(mesh.triangleCount());
+  minAltitude_ = std::numeric_limits<double>::infinity();
+  for (std::size_t tri = 0; tri < mesh.triangleCount(); ++tri) {
+    const auto& [i0, i1, i2] = mesh.triangles[tri];
+    const Vec3 e1 = mesh.positions[i1] - mesh.positions[i0];
+    const Vec3 e2 = mesh.positions[i2] - mesh.positions[i0];
+    const Vec3 normal = e1.cross(e2);
+    const double twiceArea = normal.norm();
+    const double len1 = e1.norm();
+    if (!(twiceArea > 0.0) || !(len1 > 0.0))
+      throw Error(fmt::format("{}: triangle {} is degenerate (zero area)", mesh.name, tri + 1));
+    const Vec3 u = e1 / len1;
+    const Vec3 v = (normal / twiceArea).cross(u);
+    // Dm = [[a, b], [0, d]] with columns e1, e2 in (u, v) coordinates; g rows of Dm^-1.
+    const double a = len1, b = e2.dot(u), d = e2.dot(v);
+    // Dm^-1 = [[1/a, -b/(a d)], [0, 1/d]].
+    membrane_.push_back({i0, i1, i2, 0, 1.0 / a, -b / (a * d), 0.0, 1.0 / d, 0.5 * twiceArea});
+    const double longest = std::max({len1, e2.norm(), (e2 - e1).norm()});
+    minAltitude_ = std::min(minAltitude_, twiceArea / longest);
+  }
+}
+
+// Bending: one hinge per interior edge; k = 2 C D |e|^2 / (A1 + A2) from the rest geometry.
+void ClothModel::buildBending(const mesh::TriMesh& mesh, const mesh::Topology& topology) {
+  const double D = material_.bendingModulus();
+  bending_.clear();
+  bending_.reserve(topology.interiorEdgeCount());
+  for (const mesh::Edge& e : topology.edges) {
+    if (e.boundary()) continue;
+    const Vec3& x0 = mesh.positions[e.v0];
+    const Vec3& x1 = mesh.positions[e.v1];
+    const Vec3& xa = mesh.positions[e.opposite0];
+    const Vec3& xb = mesh.positions[e.opposite1];
+    const double areas = mesh.triangleArea(e.face0) + mesh.triangleArea(e.face1);
+    if (!(areas > 0.0)) continue;
+    const double k = 2.0 * kBendCoefficient * D * (x1 - x0).squaredNorm() / areas;
+    bending_.push_back({e.v0, e.v1, e.opposite0, e.opposite1, hingePsi(x0, x1, xa, xb), k});
+  }
+  bendingOmega_ = estimateBendingOmega(mesh);
+}
+
+// Highest bending frequency, from a Gershgorin bound on M^-1 K at rest: each hinge adds
+// k |g_i| |g_j| to row i (g = dtheta/dx at rest, the Bridson vectors).
+double ClothModel::estimateBendingOmega(const mesh::TriMesh& mesh) const {
+  std::vector<double> rowSum(vertexCount(), 0.0);
+  for (const BendElement& h : bending_) {
+    const Vec3 &x3 = mesh.positions[h.e0], &x4 = mesh.positions[h.e1];
+    const Vec3 &x1 = mesh.positions[h.a], &x2 = mesh.positions[h.b];
+    const Vec3 e = x4 - x3;
+    const Vec3 n1 = (x1 - x3).cross(x1 - x4), n2 = (x2 - x4).cross(x2 - x3);
+    const double el = e.norm();
+    if (!(n1.squaredNorm() > 0.0) || !(n2.squaredNorm() > 0.0) || !(el > 0.0)) continue;
+    const Vec3 a1 = n1 / n1.squaredNorm(), a2 = n2 / n2.squaredNorm();
+    const std::array<double, 4> g = {(a1 * el).norm(), (a2 * el).norm(),
+                                     (a1 * (x1 - x4).dot(e) / el + a2 * (x2 - x4).dot(e) / el).norm(),
+                                     (a1 * (x1 - x3).dot(e) / el + a2 * (x2 - x3).dot(e) / el).norm()};
+    const double total = g[0] + g[1] + g[2] + g[3];
+    const std::array<std::uint32_t, 4> v = {h.a, h.b, h.e0, h.e1};
+    for (int i = 0; i < 4; ++i) rowSum[v[i]] += h.stiffness_Nm * g[i] * total;
+  }
+  double omega2 = 0.0;
+  for (std::size_t i = 0; i < rowSum.size(); ++i) omega2 = std::max(omega2, rowSum[i] * inverseMass_[i]);
+  return std::sqrt(omega2);
+}
+
+void ClothModel::buildEdges(const mesh::Topology& topology) {
+  edgeV0_.clear();
+  edgeV1_.clear();
+  edgeRest_.clear();
+  for (const mesh::Edge& e : topology.edges) {
+    const Vec3 d(restX_[e.v1] - restX_[e.v0], restY_[e.v1] - restY_[e.v0], restZ_[e.v1] - restZ_[e.v0]);
+    edgeV0_.push_back(e.v0);
+    edgeV1_.push_back(e.v1);
+    edgeRest_.push_back(d.norm());
+  }
+}
+
+double ClothModel::membraneWaveSpeed_m_s() const {
+  const double nu = material_.poissonRatio;
+  return std::sqrt(material_.youngsModulus_Pa / (material_.density_kg_m3 * (1.0 - nu * nu)));
+}
+
+double ClothModel::estimatedStableStep_s() const {
+  // Membrane: explicit CFL bound for linear triangles (a wave may not cross the smallest
+  // altitude in one step; the factor 0.5 covers lumped-mass spectra of irregular meshes).
+  // Bending: symplectic Euler needs dt < 2 / omega_max; 0.9 of that.
+  const double membrane = 0.5 * minAltitude_ / membraneWaveSpeed_m_s();
+  const double bending = bendingOmega_ > 0.0 ? 1.8 / bendingOmega_ : membrane;
+  return std::min(membrane, bending);
+}
+
+}  // namespace drape::cloth

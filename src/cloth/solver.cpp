@@ -1,0 +1,136 @@
+#include "drape/cloth/solver.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "drape/cloth/forces.hpp"
+
+namespace drape::cloth {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+std::string Instability::describe(const std::string& garment, double bound) const {
+  if (nan)
+    return fmt::format("garment '{}': vertex {} became NaN or infinite in frame {}, substep {}", garment, vertex,
+                       frame, substep);
+  return fmt::format("garment '{}': vertex {} reached {:.4g} m/s (bound {:.4g} m/s) in frame {}, substep {}", garment,
+                     vertex, speed_m_s, bound, frame, substep);
+}
+
+ClothSolver::ClothSolver(std::shared_ptr<const ClothModel> model, const StepSettings& settings,
+                         std::vector<PinGroup> pins)
+    : model_(std::move(model)),
+      settings_(settings),
+      pins_(std::move(pins)),
+      integrator_(makeIntegrator(settings.integrator)),
+      state_(ClothState::atRest(*model_)) {
+  settings_.validate("--");
+}
+
+bool ClothSolver::stepFrame(long frame) {
+  const int n = settings_.substepsPerFrame;
+  const double dt = settings_.substep_s();
+  for (int s = 0; s < n; ++s) {
+    // Time from a substep counter, not an accumulated sum, so no drift over long takes.
+    const double t0 = static_cast<double>((frame - 1) * n + s) * dt;
+    if (!substep(t0, frame, s)) return false;
+  }
+  return true;
+}
+
+bool ClothSolver::substep(double t0, long frame, int substepIndex) {
+  const double dt = settings_.substep_s();
+  const double t1 = t0 + dt;
+  Clock::time_point start = Clock::now();
+  accumulateForces();  // membrane, bending, drag into state_.f*
+  times_.forces_s += secondsSince(start);
+
+  start = Clock::now();
+  integrate(dt);  // new velocities and positions
+  times_.integrate_s += secondsSince(start);
+
+  start = Clock::now();
+  collide(t0, t1);  // colliders correct the end-of-substep state
+  times_.collide_s += secondsSince(start);
+
+  start = Clock::now();
+  applyFixtures(t1, dt);  // pinned vertices follow their transforms
+  times_.fixtures_s += secondsSince(start);
+
+  start = Clock::now();
+  const bool stable = checkStability(frame, substepIndex);  // NaN or speed bound
+  times_.stability_s += secondsSince(start);
+  return stable;
+}
+
+void ClothSolver::accumulateForces() {
+  clearForces(state_);
+  accumulateMembraneForces(*model_, state_);
+  accumulateBendingForces(*model_, state_);
+  accumulateDragForces(*model_, settings_, state_);
+}
+
+void ClothSolver::integrate(double dt) { integrator_->advance(*model_, settings_.gravity_m_s2, dt, state_); }
+
+void ClothSolver::collide(double t0, double t1) {
+  for (Collider* c : colliders_) c->collide(*model_, t0, t1, state_);
+}
+
+void ClothSolver::applyFixtures(double t1, double dt) {
+  for (const PinGroup& g : pins_) {
+    const RigidTransform now = g.motion ? g.motion->poseAt(t1) : RigidTransform::identity();
+    const RigidTransform before = g.motion ? g.motion->poseAt(t1 - dt) : RigidTransform::identity();
+    const Mat3 r1 = now.rotation.toRotationMatrix(), r0 = before.rotation.toRotationMatrix();
+    const Vec3 p1 = now.translation, p0 = before.translation;
+    const double invDt = 1.0 / dt;
+    for (std::size_t k = 0; k < g.vertices.size(); ++k) {
+      const Vec3 local(g.localX[k], g.localY[k], g.localZ[k]);
+      const Vec3 at = r1 * local + p1;
+      const Vec3 was = r0 * local + p0;
+      const std::uint32_t v = g.vertices[k];
+      state_.setPosition(v, at);
+      state_.setVelocity(v, (at - was) * invDt);
+    }
+  }
+}
+
+bool ClothSolver::checkStability(long frame, int substepIndex) {
+  const double bound2 = settings_.maxSpeed_m_s * settings_.maxSpeed_m_s;
+  const std::size_t n = state_.size();
+  const double *x = state_.x.data(), *y = state_.y.data(), *z = state_.z.data();
+  const double *vx = state_.vx.data(), *vy = state_.vy.data(), *vz = state_.vz.data();
+  // Branch-free pass (vectorises); the slow search runs only when something is wrong.
+  int bad = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double s2 = vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i];
+    const double p = x[i] + y[i] + z[i];
+    bad |= static_cast<int>(!(s2 <= bound2)) | static_cast<int>(!(p - p == 0.0));
+  }
+  if (!bad) return true;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double s2 = vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i];
+    const double p = x[i] + y[i] + z[i];
+    const bool nan = !std::isfinite(s2) || !std::isfinite(p);
+    if (nan || s2 > bound2) {
+      instability_ = {true, nan, static_cast<std::uint32_t>(i), nan ? 0.0 : std::sqrt(s2), frame, substepIndex};
+      return false;
+    }
+  }
+  return true;
+}
+
+double ClothSolver::totalEnergy() const {
+  return kineticEnergy(*model_, state_) + gravityEnergy(*model_, state_, settings_.gravity_m_s2) +
+         membraneEnergy(*model_, state_) + bendingEnergy(*model_, state_);
+}
+
+}  // namespace drape::cloth

@@ -1,0 +1,50 @@
+#pragma once
+// Shared set-up for the cloth tests: a sheet, a model and a solver in a line or two.
+
+#include <memory>
+
+#include "drape/cloth/forces.hpp"
+#include "drape/cloth/model.hpp"
+#include "drape/cloth/sheets.hpp"
+#include "drape/cloth/solver.hpp"
+#include "drape/mesh/topology.hpp"
+
+namespace drape::cloth::testing {
+
+inline std::shared_ptr<const ClothModel> makeModel(const mesh::TriMesh& m, const Material& material) {
+  return ClothModel::build(m, mesh::Topology::build(m), material);
+}
+
+/// Vertices of a sheet's grid column i (all j) or row j (all i).
+inline std::vector<std::uint32_t> column(const SheetSpec& s, int i) {
+  std::vector<std::uint32_t> out;
+  for (int j = 0; j <= s.cellsV; ++j) out.push_back(sheetVertex(s, i, j));
+  return out;
+}
+inline std::vector<std::uint32_t> row(const SheetSpec& s, int j) {
+  std::vector<std::uint32_t> out;
+  for (int i = 0; i <= s.cellsU; ++i) out.push_back(sheetVertex(s, i, j));
+  return out;
+}
+
+/// Runs `steps` substeps; returns false on instability.
+inline bool run(ClothSolver& solver, long steps) {
+  const double dt = solver.settings().substep_s();
+  for (long k = 0; k < steps; ++k)
+    if (!solver.substep(static_cast<double>(k) * dt, k / solver.settings().substepsPerFrame + 1,
+                        static_cast<int>(k % solver.settings().substepsPerFrame)))
+      return false;
+  return true;
+}
+
+/// Settings with a given substep (frame rate 30, substeps chosen to give at most dt).
+inline StepSettings settingsWithStep(double dt, double air = 0.0, Vec3 gravity = Vec3(0, -9.81, 0)) {
+  StepSettings s;
+  s.frameRate_hz = 30.0;
+  s.substepsPerFrame = static_cast<int>(std::ceil(1.0 / (30.0 * dt)));
+  s.airViscosity_Ns_m3 = air;
+  s.gravity_m_s2 = gravity;
+  return s;
+}
+
+}  // namespace drape::cloth::testing

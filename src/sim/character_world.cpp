@@ -1,0 +1,210 @@
+#include "drape/sim/character_world.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "drape/core/error.hpp"
+#include "drape/core/log.hpp"
+#include "drape/mesh/topology.hpp"
+#include "drape/motion/interpolate.hpp"
+
+namespace drape::sim {
+namespace {
+
+double smoothstep(double u) {
+  u = std::clamp(u, 0.0, 1.0);
+  return u * u * (3.0 - 2.0 * u);
+}
+
+/// A body part's pose in the world at time t: its joint's world transform.
+class SegmentMotion final : public cloth::FixtureMotion {
+ public:
+  SegmentMotion(const AvatarPoses& poses, int joint) : poses_(poses), joint_(joint) {}
+  [[nodiscard]] RigidTransform poseAt(double t_s) const override { return poses_.jointAt(t_s, joint_); }
+
+ private:
+  const AvatarPoses& poses_;
+  int joint_;
+};
+
+}  // namespace
+
+AvatarPoses::AvatarPoses(const scene::Avatar& avatar, const motion::AvatarAnimation* animation, double leadIn_s)
+    : avatar_(avatar), animation_(animation), leadIn_s_(animation ? std::max(0.0, leadIn_s) : 0.0) {
+  for (int c = 0; c < 2; ++c) {
+    cacheTime_[c] = std::numeric_limits<double>::quiet_NaN();
+    cache_[c].resize(avatar.joints.size());
+  }
+}
+
+double AvatarPoses::end_s() const { return leadIn_s_ + (animation_ ? animation_->duration() : 0.0); }
+
+void AvatarPoses::evaluate(double t_s, std::span<RigidTransform> out) const {
+  const std::size_t joints = avatar_.joints.size();
+  if (!animation_) {
+    for (std::size_t j = 0; j < joints; ++j) out[j] = avatar_.joints[j].restWorld();
+    return;
+  }
+  if (t_s < leadIn_s_) {
+    // Lead-in: from the rest pose to the first frame, eased so the cloth is not jerked.
+    const double u = smoothstep(t_s / leadIn_s_);
+    const auto first = animation_->frame(0);
+    for (std::size_t j = 0; j < joints; ++j) out[j] = motion::interpolate(avatar_.joints[j].restWorld(), first[j], u);
+    return;
+  }
+  const double frames = (t_s - leadIn_s_) * animation_->rate();
+  const double last = static_cast<double>(animation_->frameCount() - 1);
+  const double clamped = std::clamp(frames, 0.0, last);
+  const auto f = static_cast<std::size_t>(std::min(std::floor(clamped), std::max(0.0, last - 1)));
+  animation_->evaluate(f, clamped - static_cast<double>(f), out);
+}
+
+const RigidTransform& AvatarPoses::jointAt(double t_s, int joint) const {
+  for (int c = 0; c < 2; ++c)
+    if (cacheTime_[c] == t_s) return cache_[c][static_cast<std::size_t>(joint)];
+  const int c = next_;
+  next_ = 1 - next_;
+  evaluate(t_s, cache_[c]);
+  cacheTime_[c] = t_s;
+  return cache_[c][static_cast<std::size_t>(joint)];
+}
+
+CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::AvatarAnimation* animation,
+                               std::vector<GarmentSpec> garments, const WorldSettings& settings)
+    : avatar_(avatar), settings_(settings) {
+  settings_.step.validate();
+  if (animation && animation->jointCount() != avatar.joints.size()) {
+    throw Error(fmt::format("{}: the motion drives {} joints, the avatar has {}", avatar.name,
+                            animation->jointCount(), avatar.joints.size()), ExitCode::Internal);
+  }
+  poses_ = std::make_unique<AvatarPoses>(avatar, animation, settings.leadIn_s);
+  for (GarmentSpec& g : garments)
+    if (!g.offsetsGiven) g.offsets = cloth::OffsetSurfaces::fromVoxelSize(settings.voxel_m);
+  buildFields(garments);
+
+  for (GarmentSpec& spec : garments) {
+    std::vector<int> parts;
+    for (const std::string& name : spec.collidesWith) {
+      const auto it = std::find_if(fields_.begin(), fields_.end(), [&](const PartField& p) { return p.segment == name; });
+      parts.push_back(static_cast<int>(it - fields_.begin()));
+    }
+    spec.material.validate("garment '" + spec.name + "': ");
+    auto model = std::make_shared<const cloth::ClothModel>(cloth::ClothModel::build(spec.mesh, spec.material));
+    std::vector<cloth::PinGroup> pins = bindMask(spec, parts);
+    if (!spec.pinned.empty()) {
+      const auto& m = *model;
+      pins.push_back(cloth::PinGroup::atRest(spec.pinned, m.restX(), m.restY(), m.restZ()));
+    }
+    GarmentRun run;
+    std::vector<cloth::CollisionPart> collisionParts;
+    for (int p : parts) collisionParts.push_back({fields_[p].segment, &fields_[p].field, partMotions_[p]});
+    run.collider = std::make_unique<cloth::FieldCollider>(spec.name, std::move(collisionParts), spec.offsets,
+                                                          spec.material.staticFriction, spec.material.dynamicFriction,
+                                                          spec.collisionEvery);
+    run.solver = std::make_unique<cloth::ClothSolver>(model, settings_.step, std::move(pins));
+    run.collider->initialise(run.solver->state(), 0.0);
+    run.solver->addCollider(*run.collider);
+    run.spec = std::move(spec);
+    garments_.push_back(std::move(run));
+  }
+}
+
+CharacterWorld::~CharacterWorld() = default;
+
+void CharacterWorld::buildFields(const std::vector<GarmentSpec>& garments) {
+  // One field per body segment any garment collides with, built once and shared.
+  std::vector<std::string> names;
+  double shell_m = 0;
+  for (const GarmentSpec& g : garments) {
+    shell_m = std::max(shell_m, g.offsets.t3_m);
+    for (const std::string& name : g.collidesWith) {
+      if (avatar_.findSegment(name) < 0) {
+        std::vector<std::string> known;
+        for (const auto& s : avatar_.segments) known.push_back(s.name);
+        throw Error(fmt::format("garment '{}': collidesWith names '{}', which avatar '{}' does not have (it has: {})",
+                                g.name, name, avatar_.name, fmt::join(known, ", ")));
+      }
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    }
+  }
+  field::FieldSettings fs;
+  fs.voxelSize_m = settings_.voxel_m;
+  fs.shell_m = shell_m;
+  fs.method = settings_.fieldMethod;
+  const auto start = std::chrono::steady_clock::now();
+  for (const std::string& name : names) {
+    const scene::Segment& segment = avatar_.segments[static_cast<std::size_t>(avatar_.findSegment(name))];
+    spdlog::debug("distance field for '{}' ({} triangles)", name, segment.mesh.triangleCount());
+    fields_.push_back({name, segment.joint, field::DistanceField::build(segment.mesh, fs)});
+    partMotions_.push_back(std::make_shared<SegmentMotion>(*poses_, segment.joint));
+  }
+  fieldBuild_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, const std::vector<int>& parts) const {
+  // Each mask vertex binds to the collidable part nearest to it (by its distance field),
+  // within the threshold, and from then on moves rigidly with that part (section 4.1).
+  std::vector<cloth::PinGroup> groups(parts.size());
+  std::size_t unbound = 0;
+  std::string firstUnbound;
+  for (std::uint32_t v : spec.bound) {
+    const Vec3 p = spec.mesh.positions[v];
+    double best = std::numeric_limits<double>::infinity();
+    int bestPart = -1;
+    Vec3 bestLocal = Vec3::Zero();
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      const PartField& pf = fields_[static_cast<std::size_t>(parts[k])];
+      const Vec3 local = partMotions_[static_cast<std::size_t>(parts[k])]->poseAt(0.0).inverse().apply(p);
+      if (!pf.field.containsPoint(local)) continue;
+      const double d = pf.field.distanceAt(local);
+      if (d < best) {
+        best = d;
+        bestPart = static_cast<int>(k);
+        bestLocal = local;
+      }
+    }
+    if (bestPart < 0 || best > spec.bindThreshold_m) {
+      if (unbound++ == 0) {
+        firstUnbound = bestPart < 0 ? fmt::format("vertex {} at ({:.3f}, {:.3f}, {:.3f}) m is near no collidable part", v,
+                                                  p.x(), p.y(), p.z())
+                                    : fmt::format("vertex {} at ({:.3f}, {:.3f}, {:.3f}) m is {:.3f} m from '{}'", v,
+                                                  p.x(), p.y(), p.z(), best, fields_[parts[bestPart]].segment);
+      }
+      continue;
+    }
+    cloth::PinGroup& g = groups[static_cast<std::size_t>(bestPart)];
+    g.vertices.push_back(v);
+    g.localX.push_back(bestLocal.x());
+    g.localY.push_back(bestLocal.y());
+    g.localZ.push_back(bestLocal.z());
+  }
+  if (unbound > 0) {
+    throw Error(fmt::format("garment '{}': {} of {} constraint-mask vertices cannot be bound within bindThreshold "
+                            "{:.3f} m of a collidable part ({}); {}",
+                            spec.name, unbound, spec.bound.size(), spec.bindThreshold_m,
+                            fmt::join(spec.collidesWith, ", "), firstUnbound));
+  }
+  std::vector<cloth::PinGroup> out;
+  for (std::size_t k = 0; k < groups.size(); ++k) {
+    if (groups[k].vertices.empty()) continue;
+    groups[k].motion = partMotions_[static_cast<std::size_t>(parts[k])];
+    out.push_back(std::move(groups[k]));
+  }
+  return out;
+}
+
+bool CharacterWorld::stepFrame(long frame) {
+  for (GarmentRun& g : garments_) {
+    if (!g.solver->stepFrame(frame)) {
+      instability_ = g.solver->instability().describe(g.spec.name, settings_.step.maxSpeed_m_s);
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace drape::sim

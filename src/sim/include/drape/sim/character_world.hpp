@@ -1,0 +1,125 @@
+#pragma once
+// One character's world, frame by frame: the core loop of the paper's cloth server
+// (section 4). Poses come from a retargeted motion (micro-interpolated per substep, section
+// 4.3.1); every collidable body part gets one distance field, built once (section 4.3.2);
+// every garment steps its cloth against those fields (section 4.3.3), with its constraint
+// mask bound to the nearest parts (section 4.1).
+//
+//   sim time 0 .. leadIn      the avatar blends from its rest pose (which the garments are
+//                             modelled on) into the motion's first frame, so the cloth is
+//                             not hit by a jump
+//   sim time leadIn ..        the motion plays; its last frame holds after the end
+//
+// Used alike by `drape run`, the benchmarks and (later) the cloth server role.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "drape/cloth/field_collider.hpp"
+#include "drape/cloth/material.hpp"
+#include "drape/cloth/solver.hpp"
+#include "drape/field/distance_field.hpp"
+#include "drape/mesh/trimesh.hpp"
+#include "drape/motion/animation.hpp"
+#include "drape/scene/avatar.hpp"
+
+namespace drape::sim {
+
+/// A garment as it enters the simulation: plain data from a scene file or the command line.
+struct GarmentSpec {
+  std::string name;
+  mesh::TriMesh mesh;                       ///< m, world, on the avatar's rest pose
+  cloth::Material material;
+  std::vector<std::uint32_t> pinned;        ///< vertices pinned in place in the world
+  std::vector<std::uint32_t> bound;         ///< constraint-mask vertices: follow the nearest part
+  double bindThreshold_m = 0.03;            ///< farthest a bound vertex may be from its part
+  std::vector<std::string> collidesWith;    ///< body segment names
+  cloth::OffsetSurfaces offsets;            ///< used when offsetsGiven, else from the voxel size
+  bool offsetsGiven = false;
+  int collisionEvery = 1;                   ///< collision tests every k substeps
+};
+
+struct WorldSettings {
+  cloth::StepSettings step;
+  double voxel_m = 0.005;                   ///< distance-field voxel size
+  field::FieldMethod fieldMethod = field::FieldMethod::Dvdp;
+  double leadIn_s = 1.0;                    ///< rest pose -> first motion frame blend
+};
+
+/// Joint world transforms of an animated avatar at any simulation time (with the lead-in),
+/// cached for the two most recent times so that every part and fixture asking for the
+/// start and end of a substep costs one evaluation each.
+class AvatarPoses {
+ public:
+  AvatarPoses(const scene::Avatar& avatar, const motion::AvatarAnimation* animation, double leadIn_s);
+  [[nodiscard]] const RigidTransform& jointAt(double t_s, int joint) const;
+  /// All joints at time t into out (size = joint count).
+  void evaluate(double t_s, std::span<RigidTransform> out) const;
+  [[nodiscard]] double leadIn_s() const { return leadIn_s_; }
+  /// Simulation time at which the motion ends (its last frame).
+  [[nodiscard]] double end_s() const;
+
+ private:
+  const scene::Avatar& avatar_;
+  const motion::AvatarAnimation* animation_;
+  double leadIn_s_;
+  mutable double cacheTime_[2];
+  mutable std::vector<RigidTransform> cache_[2];
+  mutable int next_ = 0;
+};
+
+struct PartField {
+  std::string segment;
+  int joint = -1;
+  field::DistanceField field;
+};
+
+class CharacterWorld {
+ public:
+  /// Builds the part fields, binds every garment's mask and establishes the initial
+  /// collision states. `animation` may be null (the avatar stands in its rest pose).
+  /// Throws drape::Error on unknown segment names or unbindable mask vertices.
+  CharacterWorld(const scene::Avatar& avatar, const motion::AvatarAnimation* animation,
+                 std::vector<GarmentSpec> garments, const WorldSettings& settings);
+  ~CharacterWorld();
+  CharacterWorld(const CharacterWorld&) = delete;
+  CharacterWorld& operator=(const CharacterWorld&) = delete;
+
+  /// Computes frame `frame` (1-based) of every garment. False when a garment went unstable
+  /// (see instability()).
+  bool stepFrame(long frame);
+
+  [[nodiscard]] std::size_t garmentCount() const { return garments_.size(); }
+  [[nodiscard]] const GarmentSpec& garment(std::size_t g) const { return garments_[g].spec; }
+  [[nodiscard]] const cloth::ClothSolver& solver(std::size_t g) const { return *garments_[g].solver; }
+  [[nodiscard]] const cloth::FieldCollider* collider(std::size_t g) const { return garments_[g].collider.get(); }
+  [[nodiscard]] const std::vector<PartField>& fields() const { return fields_; }
+  [[nodiscard]] const AvatarPoses& poses() const { return *poses_; }
+  /// The garment whose step failed and why, after stepFrame returned false.
+  [[nodiscard]] std::string instability() const { return instability_; }
+  /// Simulation time of the end of frame `frame`.
+  [[nodiscard]] double frameTime(long frame) const { return double(frame) / settings_.step.frameRate_hz; }
+  /// Seconds spent building the distance fields.
+  [[nodiscard]] double fieldBuild_s() const { return fieldBuild_s_; }
+
+ private:
+  struct GarmentRun {
+    GarmentSpec spec;
+    std::unique_ptr<cloth::FieldCollider> collider;
+    std::unique_ptr<cloth::ClothSolver> solver;
+  };
+  void buildFields(const std::vector<GarmentSpec>& garments);
+  [[nodiscard]] std::vector<cloth::PinGroup> bindMask(const GarmentSpec& spec, const std::vector<int>& parts) const;
+
+  const scene::Avatar& avatar_;
+  WorldSettings settings_;
+  std::unique_ptr<AvatarPoses> poses_;
+  std::vector<PartField> fields_;
+  std::vector<std::shared_ptr<const cloth::FixtureMotion>> partMotions_;  ///< per field
+  std::vector<GarmentRun> garments_;
+  std::string instability_;
+  double fieldBuild_s_ = 0;
+};
+
+}  // namespace drape::sim

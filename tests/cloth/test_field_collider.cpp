@@ -1,0 +1,217 @@
+// Distance-field collision (paper section 4.3.3): the response at T2, the last-resort
+// projection, friction, the backward entry trace and all nine state transitions.
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "drape/cloth/field_collider.hpp"
+#include "drape/cloth/model.hpp"
+#include "drape/field/shapes.hpp"
+#include "drape/mesh/topology.hpp"
+
+namespace drape::cloth {
+namespace {
+
+/// A body part moving with constant velocity from a start position.
+class LinearMotion final : public FixtureMotion {
+ public:
+  LinearMotion(const Vec3& start, const Vec3& velocity) : start_(start), velocity_(velocity) {}
+  [[nodiscard]] RigidTransform poseAt(double t) const override { return {Quat::Identity(), start_ + velocity_ * t}; }
+
+ private:
+  Vec3 start_, velocity_;
+};
+
+constexpr double kVoxel = 0.005;
+
+field::DistanceField buildField(const mesh::TriMesh& m) {
+  field::FieldSettings s;
+  s.voxelSize_m = kVoxel;
+  s.shell_m = 6 * kVoxel;
+  return field::DistanceField::build(m, s);
+}
+
+/// A tiny garment (one triangle) whose vertex 0 the tests drive; the others sit far away.
+struct Point {
+  std::shared_ptr<const ClothModel> model;
+  ClothState state;
+  explicit Point(const Vec3& p0) {
+    mesh::TriMesh m;
+    m.positions = {p0, Vec3(50, 50, 50), Vec3(50.1, 50, 50)};
+    m.triangles = {{0, 1, 2}};
+    model = ClothModel::build(m, mesh::Topology::build(m), Material{});
+    state = ClothState::atRest(*model);
+  }
+};
+
+struct BodySetup {
+  field::DistanceField field;
+  std::vector<CollisionPart> parts;
+  BodySetup(const mesh::TriMesh& body, std::shared_ptr<const FixtureMotion> motion) : field(buildField(body)) {
+    parts.push_back({"body", &field, std::move(motion)});
+  }
+};
+
+const OffsetSurfaces kOffsets = OffsetSurfaces::fromVoxelSize(kVoxel);
+
+TEST(FieldCollider, StopsOnT2AndNeverEndsBelowT0StaticField) {
+  BodySetup s(field::makeSphere(0.1, Vec3::Zero(), 64, 32), std::make_shared<StaticMotion>());
+  Point p(Vec3(0.3, 0.01, 0.0));
+  FieldCollider c("test", s.parts, kOffsets, 0.0, 0.0);
+  c.initialise(p.state, 0.0);
+  const double dt = 1e-3;
+  p.state.setVelocity(0, Vec3(-2.0, 0, 0));  // 2 mm per step towards the centre
+  bool touched = false;
+  for (int step = 0; step < 200; ++step) {
+    p.state.setPosition(0, p.state.position(0) + p.state.velocity(0) * dt);
+    c.collide(*p.model, step * dt, (step + 1) * dt, p.state);
+    const double d = s.field.distanceAt(p.state.position(0));
+    ASSERT_GE(d, kOffsets.t0_m) << "step " << step;
+    if (c.state(0, 0) == PointState::OnSurf) {
+      if (!touched) {
+        EXPECT_NEAR(d, kOffsets.t2_m, 0.3 * kVoxel) << "stops on T2";
+        const Vec3 n = s.field.normalAt(p.state.position(0));
+        EXPECT_GE(p.state.velocity(0).dot(n), -1e-9) << "no inward normal velocity left";
+      }
+      touched = true;
+    }
+  }
+  EXPECT_TRUE(touched);
+  EXPECT_EQ(c.fieldCounters().vertexSubstepsInsideBody, 0u);
+}
+
+TEST(FieldCollider, StopsOnT2AndNeverEndsBelowT0MovingField) {
+  // The sphere flies at a resting point at 3 m/s: both move in the world; the trace runs in
+  // the sphere's frame.
+  auto motion = std::make_shared<LinearMotion>(Vec3(-0.4, 0, 0), Vec3(3.0, 0, 0));
+  BodySetup s(field::makeSphere(0.1, Vec3::Zero(), 64, 32), motion);
+  Point p(Vec3(0.0, 0.02, 0.0));
+  FieldCollider c("test", s.parts, kOffsets, 0.0, 0.0);
+  c.initialise(p.state, 0.0);
+  const double dt = 1e-3;
+  bool touched = false;
+  for (int step = 0; step < 150; ++step) {
+    p.state.setPosition(0, p.state.position(0) + p.state.velocity(0) * dt);
+    c.collide(*p.model, step * dt, (step + 1) * dt, p.state);
+    const Vec3 local = motion->poseAt((step + 1) * dt).inverse().apply(p.state.position(0));
+    const double d = s.field.distanceAt(local);
+    ASSERT_GE(d, kOffsets.t0_m) << "step " << step;
+    if (!touched && c.state(0, 0) == PointState::OnSurf) {
+      touched = true;
+      EXPECT_NEAR(d, kOffsets.t2_m, 0.3 * kVoxel);
+      // Relative to the sphere, no inward normal velocity: the point is carried along.
+      const Vec3 n = s.field.normalAt(local);
+      EXPECT_GE((p.state.velocity(0) - Vec3(3.0, 0, 0)).dot(n), -1e-9);
+    }
+  }
+  EXPECT_TRUE(touched);
+}
+
+TEST(FieldCollider, SlidingFrictionDeceleratesAtMuG) {
+  // A large box whose top face is y = 0; the point slides on T2 at 1 m/s under gravity.
+  BodySetup s(field::makeBox(Vec3(-0.5, -0.1, -0.5), Vec3(0.5, 0.0, 0.5)), std::make_shared<StaticMotion>());
+  const double mu = 0.4, g = 9.81, dt = 1e-4;
+  Point p(Vec3(-0.3, kOffsets.t2_m, 0.0));
+  FieldCollider c("test", s.parts, kOffsets, mu, mu);
+  c.initialise(p.state, 0.0);
+  ASSERT_EQ(c.state(0, 0), PointState::OnSurf);
+  const double v0 = 1.0;
+  p.state.setVelocity(0, Vec3(v0, 0, 0));
+  const int steps = 1000;  // 0.1 s: expected speed loss mu g t = 0.392 m/s
+  for (int step = 0; step < steps; ++step) {
+    Vec3 v = p.state.velocity(0) + Vec3(0, -g, 0) * dt;
+    p.state.setVelocity(0, v);
+    p.state.setPosition(0, p.state.position(0) + v * dt);
+    c.collide(*p.model, step * dt, (step + 1) * dt, p.state);
+  }
+  const double deceleration = (v0 - p.state.velocity(0).x()) / (steps * dt);
+  EXPECT_NEAR(deceleration, mu * g, 0.05 * mu * g);
+  EXPECT_NEAR(p.state.position(0).y(), kOffsets.t2_m, 0.5 * kVoxel);
+}
+
+TEST(FieldCollider, BackwardTraceFindsTheFirstCrossing) {
+  const field::DistanceField f = buildField(field::makeSphere(0.05, Vec3::Zero(), 32, 16));
+  std::mt19937 rng(7);
+  const auto& d = f.dims();
+  std::uniform_int_distribution<int> ix(1, d.nx - 2), iy(1, d.ny - 2), iz(1, d.nz - 2);
+  std::uniform_int_distribution<int> far(-40, 40);
+  int checked = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Vec3i inside(ix(rng), iy(rng), iz(rng));
+    const Vec3i outside(inside.x() + far(rng) * 3, inside.y() + far(rng) * 3, inside.z() + far(rng) * 3);
+    if (walkable(f, outside) || !walkable(f, inside)) continue;
+    // Brute force: every voxel of the same discrete line, scanned from the outside end.
+    std::vector<Vec3i> line;
+    walkVoxels(inside, outside, [&](const Vec3i& p) {
+      line.push_back(p);
+      return true;
+    });
+    Vec3i first(-1, -1, -1);
+    for (auto it = line.rbegin(); it != line.rend(); ++it)
+      if (walkable(f, *it)) {
+        first = *it;
+        break;
+      }
+    EXPECT_EQ(entryVoxel(f, inside, outside), first);
+    ++checked;
+  }
+  EXPECT_GT(checked, 1000);
+}
+
+TEST(FieldCollider, BresenhamLinesAreConnectedAndEndWhereAsked) {
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> c(-20, 20);
+  for (int trial = 0; trial < 500; ++trial) {
+    const Vec3i a(c(rng), c(rng), c(rng)), b(c(rng), c(rng), c(rng));
+    Vec3i prev = a, last = a;
+    int count = 0;
+    const int visited = walkVoxels(a, b, [&](const Vec3i& p) {
+      if (count++ > 0) EXPECT_LE((p - prev).cwiseAbs().maxCoeff(), 1);
+      prev = p;
+      last = p;
+      return true;
+    });
+    EXPECT_EQ(last, b);
+    EXPECT_EQ(visited, (b - a).cwiseAbs().maxCoeff() + 1);
+  }
+}
+
+TEST(FieldCollider, ExercisesAllNineTransitions) {
+  BodySetup s(field::makeSphere(0.1, Vec3::Zero(), 48, 24), std::make_shared<StaticMotion>());
+  const double dt = 1e-3;
+  const double edge = s.field.bounds().max.x();  // the volume's edge along +x
+  // Scripted end positions along +x, one substep each; the names say what each should do.
+  struct Move {
+    double x;
+    PointState expected;
+  };
+  const std::vector<Move> moves = {
+      {edge + 0.10, PointState::OutsideVol},  // O -> O
+      {edge - 0.02, PointState::InsideVol},   // O -> I
+      {edge - 0.01, PointState::InsideVol},   // I -> I
+      {edge + 0.05, PointState::OutsideVol},  // I -> O
+      {0.05, PointState::OnSurf},             // O -> S (enters and hits T2)
+      {0.1 + kOffsets.t2_m, PointState::OnSurf},  // S -> S
+      {0.1 + kOffsets.t3_m + 0.003, PointState::InsideVol},  // S -> I (beyond T3, inside the grid)
+      {0.1 + kOffsets.t2_m - 0.002, PointState::OnSurf},    // I -> S
+      {edge + 0.10, PointState::OutsideVol},  // S -> O
+  };
+  Point p(Vec3(edge + 0.2, 0.003, 0.001));
+  FieldCollider c("test", s.parts, kOffsets, 0.0, 0.0);
+  c.initialise(p.state, 0.0);
+  for (std::size_t i = 0; i < moves.size(); ++i) {
+    const Vec3 target(moves[i].x, 0.003, 0.001);
+    p.state.setVelocity(0, (target - p.state.position(0)) / dt);
+    p.state.setPosition(0, target);
+    c.collide(*p.model, i * dt, (i + 1) * dt, p.state);
+    EXPECT_EQ(c.state(0, 0), moves[i].expected) << "move " << i;
+    p.state.setVelocity(0, Vec3::Zero());
+  }
+  const auto& t = c.fieldCounters().transitions;
+  for (int from = 0; from < 3; ++from)
+    for (int to = 0; to < 3; ++to) EXPECT_GT(t[from][to], 0u) << "transition " << from << " -> " << to;
+}
+
+}  // namespace
+}  // namespace drape::cloth

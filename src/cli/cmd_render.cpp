@@ -32,8 +32,9 @@ RunFunction setupRender(CLI::App& app) {
   app.add_option("--sheet-size", o.sheetSize, "Contact sheet size WIDTHxHEIGHT")->capture_default_str();
   app.add_flag("--no-hud", o.noHud, "No time code or frame number on PNG and video frames");
   o.picture.add(app);
-  app.footer("Renders without a display (EGL surfaceless, Mesa llvmpipe). At least one of --png, --video,\n"
-             "--contact-sheet is needed.");
+  app.footer(
+      "Renders without a display (EGL surfaceless, Mesa llvmpipe). At least one of --png, --video,\n"
+      "--contact-sheet is needed.");
   return [] {
     if (o.png.empty() && o.video.empty() && o.sheet.empty()) {
       throw Error("drape render: nothing to write: give --png DIR, --video FILE.mp4 or --contact-sheet FILE.png");
@@ -50,13 +51,15 @@ RunFunction setupRender(CLI::App& app) {
     const render::RenderSummary summary = render::renderRun(o.run, job);
     if (!o.png.empty()) std::cout << fmt::format("wrote {} frames to {}/\n", summary.frames, o.png);
     if (!o.video.empty()) std::cout << fmt::format("wrote {} ({} frames)\n", o.video, summary.frames);
-    if (!o.sheet.empty()) std::cout << fmt::format("wrote {} (frames {})\n", o.sheet, fmt::join(summary.sheetFrames, " "));
+    if (!o.sheet.empty())
+      std::cout << fmt::format("wrote {} (frames {})\n", o.sheet, fmt::join(summary.sheetFrames, " "));
     std::cerr << fmt::format("rendered in {:.1f} s with {}\n", summary.seconds, summary.glDescription);
     return 0;
   };
 }
 
-const bool registered = registerCommand({"render", "Render a run's frames to PNG, video and a contact sheet (headless)", "", 40, &setupRender});
+const bool registered = registerCommand(
+    {"render", "Render a run's frames to PNG, video and a contact sheet (headless)", "", 40, &setupRender});
 
 }  // namespace
 }  // namespace drape::cli

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 
 #include "../formats/test_run_fixture.hpp"
@@ -102,6 +103,27 @@ TEST(Hud, DrawsTextInTheTopLeftCornerOnly) {
       changed += c;
     }
   EXPECT_GT(changed, 400);
+}
+
+}  // namespace
+}  // namespace drape::render
+
+namespace drape::render {
+namespace {
+
+TEST(Preview, ContactSheetAndVideoInTheRunDirectory) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("preview"), 4);
+  const PreviewFiles files = renderPreview(dir);
+  EXPECT_EQ(files.contactSheet, dir + "/preview.png");
+  const Image sheet = readPng(files.contactSheet);
+  EXPECT_EQ(sheet.width, 1920);
+  EXPECT_EQ(sheet.height, 1080);
+  if (ffmpegAvailable()) {
+    EXPECT_EQ(files.video, dir + "/preview.mp4");
+    EXPECT_GT(std::filesystem::file_size(files.video), 1000u);
+  } else {
+    EXPECT_TRUE(files.video.empty());
+  }
 }
 
 }  // namespace

@@ -24,6 +24,10 @@ struct EglContext {
   EGLContext context = EGL_NO_CONTEXT;
 
   EglContext() {
+    // libepoxy aborts on the first EGL call when libEGL cannot be loaded: ask first.
+    if (!epoxy_has_egl()) {
+      throw Error("headless rendering: libEGL is not available (install libegl1 and libegl-mesa0)", ExitCode::Internal);
+    }
     const char* clientExtensions = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     if (clientExtensions == nullptr || std::strstr(clientExtensions, "EGL_MESA_platform_surfaceless") == nullptr) {
       throw Error("headless rendering: EGL has no surfaceless platform (install libegl1 and libegl-mesa0)",

@@ -20,6 +20,7 @@ struct RenderOptions {
   std::string sheet;
   std::string sheetSize = "1920x1080";
   bool noHud = false;
+  double orbit = 0.0;
   PictureOptions picture;
 };
 
@@ -31,6 +32,7 @@ RunFunction setupRender(CLI::App& app) {
   app.add_option("--contact-sheet", o.sheet, "Write a 4x4 grid of evenly spaced frames with their time codes");
   app.add_option("--sheet-size", o.sheetSize, "Contact sheet size WIDTHxHEIGHT")->capture_default_str();
   app.add_flag("--no-hud", o.noHud, "No time code or frame number on PNG and video frames");
+  app.add_option("--orbit", o.orbit, "Turn the camera this many degrees about the vertical over the run");
   o.picture.add(app);
   app.footer(
       "Renders without a display (EGL surfaceless, Mesa llvmpipe). At least one of --png, --video,\n"
@@ -46,6 +48,7 @@ RunFunction setupRender(CLI::App& app) {
     job.videoPath = o.video;
     job.contactSheet = o.sheet;
     job.hud = !o.noHud;
+    job.orbitDeg = o.orbit;
     job.view = o.picture.view();
     job.overlay = o.picture.overlay();
     const render::RenderSummary summary = render::renderRun(o.run, job);

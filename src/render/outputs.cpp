@@ -98,6 +98,13 @@ void paste(Image& sheet, const Image& tile, int x0, int y0) {
   }
 }
 
+/// The view at frame i of n: the job's camera, turned by its share of the orbit.
+ViewSettings viewAt(const ViewSettings& base, double orbitDeg, std::int64_t i, std::int64_t n) {
+  ViewSettings v = base;
+  if (n > 1) v.azimuthDeg += orbitDeg * static_cast<double>(i) / static_cast<double>(n - 1);
+  return v;
+}
+
 HudInfo hudFor(const Frame& frame, const RunReplay& replay) {
   HudInfo hud;
   hud.time = frame.time;
@@ -152,7 +159,7 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
       replay.read(i, frame);
       HudInfo hud = hudFor(frame, replay);
       hud.show = job.hud;
-      const Image image = renderer.render(frame, view, job.overlay, hud);
+      const Image image = renderer.render(frame, viewAt(view, job.orbitDeg, i, frames), job.overlay, hud);
       if (!job.pngDirectory.empty())
         writePng((fs::path(job.pngDirectory) / fmt::format("frame_{:05d}.png", i)).string(), image);
       if (video) video->write(image);
@@ -176,10 +183,11 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
     renderer.resize(tileW, tileH);
     summary.sheetFrames = contactSheetFrames(frames);
     for (int t = 0; t < kSheetTiles; ++t) {
-      replay.read(summary.sheetFrames[static_cast<std::size_t>(t)], frame);
+      const std::int64_t index = summary.sheetFrames[static_cast<std::size_t>(t)];
+      replay.read(index, frame);
       HudInfo hud = hudFor(frame, replay);
       hud.timeCodeOnly = true;
-      const Image tile = renderer.render(frame, view, job.overlay, hud);
+      const Image tile = renderer.render(frame, viewAt(view, job.orbitDeg, index, frames), job.overlay, hud);
       paste(sheet, tile, gap + (t % kSheetColumns) * (tileW + gap), gap + (t / kSheetColumns) * (tileH + gap));
     }
     writePng(job.contactSheet, sheet);

@@ -20,6 +20,7 @@ struct RenderJob {
   int sheetWidth = 1920;     ///< contact sheet size
   int sheetHeight = 1080;
   bool hud = true;  ///< time code and frame on PNG and video frames
+  double orbitDeg = 0.0;  ///< the camera turns this far about the vertical from first to last frame
   ViewSettings view;
   OverlaySettings overlay;
 };

@@ -20,12 +20,14 @@ RunFunction setupExport(CLI::App& app) {
   static ExportOptions o;
   app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes")->required();
   app.add_option("--glb", o.glb, "The binary glTF file to write (default: RUN/result.glb)");
-  app.footer("Garments become meshes with one morph target per frame and a weights animation; body parts\n"
-             "that move rigidly become nodes with translation and rotation animation.");
+  app.footer(
+      "Garments become meshes with one morph target per frame and a weights animation; body parts\n"
+      "that move rigidly become nodes with translation and rotation animation.");
   return [] {
     const std::string glb = o.glb.empty() ? (std::filesystem::path(o.run) / "result.glb").string() : o.glb;
     const formats::RunExportSummary s = formats::exportRunToGlb(o.run, glb);
-    std::cout << fmt::format("wrote {} ({} frames; {} morph-target meshes, {} rigid nodes)\n", glb, s.frames, s.deforming, s.rigid);
+    std::cout << fmt::format("wrote {} ({} frames; {} morph-target meshes, {} rigid nodes)\n", glb, s.frames,
+                             s.deforming, s.rigid);
     return 0;
   };
 }

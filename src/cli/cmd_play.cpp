@@ -29,8 +29,9 @@ RunFunction setupPlay(CLI::App& app) {
   app.add_flag("--fast", o.fast, "Show a new frame on every redraw instead of at the run's frame rate");
   app.add_option("--screenshot", o.screenshot, "Save the window's last picture as a PNG when it closes");
   o.picture.add(app);
-  app.footer("Mouse: drag to orbit, wheel to zoom. Keys: space pause, left/right step, R reset view, Esc quit.\n"
-             "Needs a display (run it under xvfb-run on a server); drape render works without one.");
+  app.footer(
+      "Mouse: drag to orbit, wheel to zoom. Keys: space pause, left/right step, R reset view, Esc quit.\n"
+      "Needs a display (run it under xvfb-run on a server); drape render works without one.");
   return [] {
     render::RunReplay replay(o.run);
     render::PlayerOptions options;
@@ -49,7 +50,8 @@ RunFunction setupPlay(CLI::App& app) {
   };
 }
 
-const bool registered = registerCommand({"play", "Replay a run in a window with time code and overlays", "", 41, &setupPlay});
+const bool registered =
+    registerCommand({"play", "Replay a run in a window with time code and overlays", "", 41, &setupPlay});
 
 }  // namespace
 }  // namespace drape::cli

@@ -20,6 +20,7 @@ struct RenderOptions {
   std::string sheet;
   std::string sheetSize = "1920x1080";
   bool noHud = false;
+  double orbit = 0.0;
   PictureOptions picture;
 };
 
@@ -31,9 +32,11 @@ RunFunction setupRender(CLI::App& app) {
   app.add_option("--contact-sheet", o.sheet, "Write a 4x4 grid of evenly spaced frames with their time codes");
   app.add_option("--sheet-size", o.sheetSize, "Contact sheet size WIDTHxHEIGHT")->capture_default_str();
   app.add_flag("--no-hud", o.noHud, "No time code or frame number on PNG and video frames");
+  app.add_option("--orbit", o.orbit, "Turn the camera this many degrees about the vertical over the run");
   o.picture.add(app);
-  app.footer("Renders without a display (EGL surfaceless, Mesa llvmpipe). At least one of --png, --video,\n"
-             "--contact-sheet is needed.");
+  app.footer(
+      "Renders without a display (EGL surfaceless, Mesa llvmpipe). At least one of --png, --video,\n"
+      "--contact-sheet is needed.");
   return [] {
     if (o.png.empty() && o.video.empty() && o.sheet.empty()) {
       throw Error("drape render: nothing to write: give --png DIR, --video FILE.mp4 or --contact-sheet FILE.png");
@@ -45,18 +48,21 @@ RunFunction setupRender(CLI::App& app) {
     job.videoPath = o.video;
     job.contactSheet = o.sheet;
     job.hud = !o.noHud;
+    job.orbitDeg = o.orbit;
     job.view = o.picture.view();
     job.overlay = o.picture.overlay();
     const render::RenderSummary summary = render::renderRun(o.run, job);
     if (!o.png.empty()) std::cout << fmt::format("wrote {} frames to {}/\n", summary.frames, o.png);
     if (!o.video.empty()) std::cout << fmt::format("wrote {} ({} frames)\n", o.video, summary.frames);
-    if (!o.sheet.empty()) std::cout << fmt::format("wrote {} (frames {})\n", o.sheet, fmt::join(summary.sheetFrames, " "));
+    if (!o.sheet.empty())
+      std::cout << fmt::format("wrote {} (frames {})\n", o.sheet, fmt::join(summary.sheetFrames, " "));
     std::cerr << fmt::format("rendered in {:.1f} s with {}\n", summary.seconds, summary.glDescription);
     return 0;
   };
 }
 
-const bool registered = registerCommand({"render", "Render a run's frames to PNG, video and a contact sheet (headless)", "", 40, &setupRender});
+const bool registered = registerCommand(
+    {"render", "Render a run's frames to PNG, video and a contact sheet (headless)", "", 40, &setupRender});
 
 }  // namespace
 }  // namespace drape::cli

@@ -26,7 +26,8 @@ struct PictureOptions {
 
   void add(CLI::App& app) {
     app.add_option("--size", size, "Picture size WIDTHxHEIGHT in pixels")->capture_default_str();
-    app.add_option("--azimuth", azimuthDeg, "Camera orbit angle about the vertical, degrees (0: from the front)")->capture_default_str();
+    app.add_option("--azimuth", azimuthDeg, "Camera orbit angle about the vertical, degrees (0: from the front)")
+        ->capture_default_str();
     app.add_option("--elevation", elevationDeg, "Camera angle above the horizon, degrees")->capture_default_str();
     app.add_option("--zoom", zoom, "Camera zoom (> 1 is closer)")->capture_default_str()->check(CLI::PositiveNumber);
     app.add_flag("--no-floor", noFloor, "Leave out the floor grid (and its shadows)");
@@ -43,10 +44,12 @@ struct PictureOptions {
   static std::pair<int, int> parseSize(const std::string& text, const char* option) {
     int w = 0, h = 0, used = 0;
     const bool digitsOnly = text.find_first_not_of("0123456789x") == std::string::npos;
-    if (!digitsOnly || std::sscanf(text.c_str(), "%5dx%5d%n", &w, &h, &used) != 2 || used != static_cast<int>(text.size())) {
+    if (!digitsOnly || std::sscanf(text.c_str(), "%5dx%5d%n", &w, &h, &used) != 2 ||
+        used != static_cast<int>(text.size())) {
       throw Error(fmt::format("{} '{}': expected WIDTHxHEIGHT, e.g. 1280x720", option, text));
     }
-    if (w < 16 || h < 16 || w > 8192 || h > 8192) throw Error(fmt::format("{} '{}': each side must be 16 to 8192 pixels", option, text));
+    if (w < 16 || h < 16 || w > 8192 || h > 8192)
+      throw Error(fmt::format("{} '{}': each side must be 16 to 8192 pixels", option, text));
     return {w, h};
   }
 

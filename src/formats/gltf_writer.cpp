@@ -56,7 +56,8 @@ class ModelBuilder {
   }
 
   int addIndices(const std::vector<mesh::Triangle>& triangles) {
-    const int view = addView(triangles.data(), triangles.size() * sizeof(mesh::Triangle), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    const int view =
+        addView(triangles.data(), triangles.size() * sizeof(mesh::Triangle), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
     tinygltf::Accessor a;
     a.bufferView = view;
     a.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
@@ -171,7 +172,8 @@ void addDeforming(ModelBuilder& b, const GltfDeformingMesh& m, int timeAccessor,
   prim.material = b.addMaterial(m.name, m.colour, m.doubleSided);
   for (std::size_t f = 1; f < frames; ++f) {
     if (m.frames[f].size() != base.size()) {
-      throw Error(fmt::format("{}: mesh '{}' has {} points at frame {}, {} at frame 0", path, m.name, m.frames[f].size(), f, base.size()));
+      throw Error(fmt::format("{}: mesh '{}' has {} points at frame {}, {} at frame 0", path, m.name,
+                              m.frames[f].size(), f, base.size()));
     }
     const std::vector<Vec3> normals = unitNormals(m.frames[f], m.triangles);
     std::vector<Vec3> dp(base.size()), dn(base.size());
@@ -215,7 +217,8 @@ void addRigid(ModelBuilder& b, const GltfRigidMesh& m, int timeAccessor, std::si
   tinygltf::Primitive prim;
   prim.mode = TINYGLTF_MODE_TRIANGLES;
   prim.attributes["POSITION"] = b.addVec3(toFloats(m.mesh.positions), true, TINYGLTF_TARGET_ARRAY_BUFFER);
-  prim.attributes["NORMAL"] = b.addVec3(toFloats(unitNormals(m.mesh.positions, m.mesh.triangles)), false, TINYGLTF_TARGET_ARRAY_BUFFER);
+  prim.attributes["NORMAL"] =
+      b.addVec3(toFloats(unitNormals(m.mesh.positions, m.mesh.triangles)), false, TINYGLTF_TARGET_ARRAY_BUFFER);
   prim.indices = b.addIndices(m.mesh.triangles);
   prim.material = b.addMaterial(m.name, m.colour, m.doubleSided);
   tinygltf::Mesh mesh;
@@ -263,14 +266,18 @@ constexpr std::array<float, 4> kSegmentColour = {0.61f, 0.51f, 0.43f, 1.0f};  //
 }  // namespace
 
 void writeGlb(const std::string& path, const GltfAnimation& animation) {
-  if (!(animation.frameRate > 0.0) || !std::isfinite(animation.frameRate)) throw Error(fmt::format("{}: frame rate must be positive", path));
+  if (!(animation.frameRate > 0.0) || !std::isfinite(animation.frameRate))
+    throw Error(fmt::format("{}: frame rate must be positive", path));
   if (animation.deforming.empty() && animation.rigid.empty()) throw Error(fmt::format("{}: nothing to export", path));
-  const std::size_t frames = !animation.deforming.empty() ? animation.deforming[0].frames.size() : animation.rigid[0].frames.size();
+  const std::size_t frames =
+      !animation.deforming.empty() ? animation.deforming[0].frames.size() : animation.rigid[0].frames.size();
   if (frames == 0) throw Error(fmt::format("{}: the animation has no frames", path));
   for (const GltfDeformingMesh& m : animation.deforming)
-    if (m.frames.size() != frames) throw Error(fmt::format("{}: mesh '{}' has {} frames, others {}", path, m.name, m.frames.size(), frames));
+    if (m.frames.size() != frames)
+      throw Error(fmt::format("{}: mesh '{}' has {} frames, others {}", path, m.name, m.frames.size(), frames));
   for (const GltfRigidMesh& m : animation.rigid)
-    if (m.frames.size() != frames) throw Error(fmt::format("{}: part '{}' has {} frames, others {}", path, m.name, m.frames.size(), frames));
+    if (m.frames.size() != frames)
+      throw Error(fmt::format("{}: part '{}' has {} frames, others {}", path, m.name, m.frames.size(), frames));
 
   ModelBuilder b;
   const int times = frames > 1 ? b.addFloats(frameTimes(frames, animation.frameRate), 1, true) : -1;
@@ -306,7 +313,8 @@ RigidFit fitRigid(const std::vector<Vec3>& from, const std::vector<Vec3>& to) {
   const Mat3 r = svd.matrixV() * d * svd.matrixU().transpose();
   fit.transform.rotation = Quat(r).normalized();
   fit.transform.translation = ct - r * cf;
-  for (std::size_t i = 0; i < from.size(); ++i) fit.maxError_m = std::max(fit.maxError_m, (fit.transform.apply(from[i]) - to[i]).norm());
+  for (std::size_t i = 0; i < from.size(); ++i)
+    fit.maxError_m = std::max(fit.maxError_m, (fit.transform.apply(from[i]) - to[i]).norm());
   return fit;
 }
 
@@ -324,14 +332,17 @@ RunExportSummary exportRunToGlb(const std::string& runDirectory, const std::stri
     mesh::TriMesh topology = readObj(objPath);
     Pc2Cache cache = readPc2(pc2Path);
     if (cache.pointCount != topology.vertexCount()) {
-      throw Error(fmt::format("{}: {} points per sample, but {} has {} vertices", pc2Path, cache.pointCount, objPath, topology.vertexCount()));
+      throw Error(fmt::format("{}: {} points per sample, but {} has {} vertices", pc2Path, cache.pointCount, objPath,
+                              topology.vertexCount()));
     }
     if (static_cast<long>(cache.frames.size()) < manifest.frames) {
-      throw Error(fmt::format("{}: {} samples, the manifest says {} frames", pc2Path, cache.frames.size(), manifest.frames));
+      throw Error(
+          fmt::format("{}: {} samples, the manifest says {} frames", pc2Path, cache.frames.size(), manifest.frames));
     }
     cache.frames.resize(static_cast<std::size_t>(manifest.frames));
     if (rm.role != "garment" && rm.role != "segment") {
-      throw Error(fmt::format("{}: mesh '{}' has role '{}' (expected garment or segment)", (dir / "manifest.json").string(), rm.name, rm.role));
+      throw Error(fmt::format("{}: mesh '{}' has role '{}' (expected garment or segment)",
+                              (dir / "manifest.json").string(), rm.name, rm.role));
     }
 
     // A segment whose every frame is a rigid motion of frame 0 becomes a TRS-animated node,

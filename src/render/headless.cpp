@@ -24,6 +24,10 @@ struct EglContext {
   EGLContext context = EGL_NO_CONTEXT;
 
   EglContext() {
+    // libepoxy aborts on the first EGL call when libEGL cannot be loaded: ask first.
+    if (!epoxy_has_egl()) {
+      throw Error("headless rendering: libEGL is not available (install libegl1 and libegl-mesa0)", ExitCode::Internal);
+    }
     const char* clientExtensions = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     if (clientExtensions == nullptr || std::strstr(clientExtensions, "EGL_MESA_platform_surfaceless") == nullptr) {
       throw Error("headless rendering: EGL has no surfaceless platform (install libegl1 and libegl-mesa0)",
@@ -35,9 +39,11 @@ struct EglContext {
       throw Error("headless rendering: cannot open the EGL surfaceless display (install libgl1-mesa-dri)",
                   ExitCode::Internal);
     }
-    if (eglBindAPI(EGL_OPENGL_API) != EGL_TRUE) throw Error("headless rendering: EGL cannot bind OpenGL", ExitCode::Internal);
-    const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
-                                 EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+    if (eglBindAPI(EGL_OPENGL_API) != EGL_TRUE)
+      throw Error("headless rendering: EGL cannot bind OpenGL", ExitCode::Internal);
+    const EGLint attributes[] = {
+        EGL_CONTEXT_MAJOR_VERSION,           3,       EGL_CONTEXT_MINOR_VERSION, 3, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+        EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
     context = eglCreateContext(display, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attributes);
     if (context == EGL_NO_CONTEXT) {
       throw Error(fmt::format("headless rendering: no OpenGL 3.3 core context (EGL error 0x{:x})", eglGetError()),
@@ -111,7 +117,8 @@ struct HeadlessRenderer::Impl {
   std::unique_ptr<ImGuiLayer> imgui;
 };
 
-HeadlessRenderer::HeadlessRenderer(std::vector<MeshInfo> meshes, int width, int height) : impl_(std::make_unique<Impl>()) {
+HeadlessRenderer::HeadlessRenderer(std::vector<MeshInfo> meshes, int width, int height)
+    : impl_(std::make_unique<Impl>()) {
   if (width < 16 || height < 16 || width > 8192 || height > 8192) {
     throw Error(fmt::format("image size {}x{} is outside 16x16 .. 8192x8192", width, height));
   }

@@ -23,7 +23,8 @@ ImFont* loadFont(ImGuiIO& io, const char* path, float pixels) {
   return io.Fonts->AddFontDefault(&config);
 }
 
-void boxedText(ImDrawList* list, ImFont* font, float size, ImVec2 pos, ImU32 colour, const std::string& text, float pad) {
+void boxedText(ImDrawList* list, ImFont* font, float size, ImVec2 pos, ImU32 colour, const std::string& text,
+               float pad) {
   const ImVec2 extent = font->CalcTextSizeA(size, 1e9f, 0.0f, text.c_str());
   list->AddRectFilled(ImVec2(pos.x - pad, pos.y - pad), ImVec2(pos.x + extent.x + pad, pos.y + extent.y + pad),
                       IM_COL32(10, 12, 18, 170), pad);
@@ -88,10 +89,12 @@ void ImGuiLayer::drawHud(const HudInfo& hud, int width, int height) {
   const float small = std::clamp(h / 42.0f, 11.0f, 24.0f);
   const float margin = big * 0.5f;
   boxedText(list, large_, big, ImVec2(margin, margin), white, hud.time.smpte(), big * 0.15f);
-  std::string lines = hud.frames ? fmt::format("frame {} / {}", hud.frame, *hud.frames) : fmt::format("frame {}", hud.frame);
+  std::string lines =
+      hud.frames ? fmt::format("frame {} / {}", hud.frame, *hud.frames) : fmt::format("frame {}", hud.frame);
   if (hud.fps > 0.0) lines += fmt::format("\n{:.1f} fps", hud.fps);
   for (const StageTime& s : hud.stages) lines += fmt::format("\n{:<10} {:7.3f} ms", s.stage, s.ms);
-  boxedText(list, small_, small, ImVec2(margin, margin + big * 1.5f), IM_COL32(225, 228, 235, 255), lines, small * 0.3f);
+  boxedText(list, small_, small, ImVec2(margin, margin + big * 1.5f), IM_COL32(225, 228, 235, 255), lines,
+            small * 0.3f);
   (void)width;
 }
 

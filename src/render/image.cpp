@@ -10,9 +10,13 @@
 namespace drape::render {
 
 void writePng(const std::string& path, const Image& image) {
-  if (image.width <= 0 || image.height <= 0 || image.rgb.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3) {
+  if (image.width <= 0 || image.height <= 0 ||
+      image.rgb.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3) {
     throw Error(fmt::format("{}: image to write is empty or inconsistent", path), ExitCode::Internal);
   }
+  // Level 4 instead of stb's default 8: a 1280x720 frame encodes in about 3/4 of the time
+  // (drape bench render); frames for a quick look favour speed over a few percent of size.
+  stbi_write_png_compression_level = 4;
   if (stbi_write_png(path.c_str(), image.width, image.height, 3, image.rgb.data(), image.width * 3) == 0) {
     throw Error(fmt::format("{}: cannot be written", path));
   }

@@ -37,9 +37,11 @@ std::string shellQuote(const std::string& text) {
 class VideoEncoder {
  public:
   VideoEncoder(const std::string& path, int width, int height, double frameRate) : path_(path) {
-    if (!ffmpegAvailable()) throw Error(fmt::format("{}: the ffmpeg command is needed for video (install ffmpeg)", path));
+    if (!ffmpegAvailable())
+      throw Error(fmt::format("{}: the ffmpeg command is needed for video (install ffmpeg)", path));
     const fs::path parent = fs::path(path).parent_path();
-    if (!parent.empty() && !fs::is_directory(parent)) throw Error(fmt::format("{}: directory {} does not exist", path, parent.string()));
+    if (!parent.empty() && !fs::is_directory(parent))
+      throw Error(fmt::format("{}: directory {} does not exist", path, parent.string()));
     log_ = (fs::temp_directory_path() / fmt::format("drape-ffmpeg-{}.log", static_cast<long>(::getpid()))).string();
     const std::string command = fmt::format(
         "ffmpeg -hide_banner -loglevel error -y -f rawvideo -pixel_format rgb24 -video_size {}x{} -framerate {} -i - "
@@ -59,7 +61,8 @@ class VideoEncoder {
   VideoEncoder& operator=(const VideoEncoder&) = delete;
 
   void write(const Image& image) {
-    if (std::fwrite(image.rgb.data(), 1, image.rgb.size(), pipe_) != image.rgb.size()) fail("ffmpeg stopped reading frames");
+    if (std::fwrite(image.rgb.data(), 1, image.rgb.size(), pipe_) != image.rgb.size())
+      fail("ffmpeg stopped reading frames");
   }
   void finish() {
     const int status = ::pclose(pipe_);
@@ -90,8 +93,16 @@ void checkSize(int width, int height, const char* what) {
 
 void paste(Image& sheet, const Image& tile, int x0, int y0) {
   for (int y = 0; y < tile.height; ++y) {
-    std::copy(tile.pixel(0, y), tile.pixel(0, y) + static_cast<std::ptrdiff_t>(tile.width) * 3, sheet.pixel(x0, y0 + y));
+    std::copy(tile.pixel(0, y), tile.pixel(0, y) + static_cast<std::ptrdiff_t>(tile.width) * 3,
+              sheet.pixel(x0, y0 + y));
   }
+}
+
+/// The view at frame i of n: the job's camera, turned by its share of the orbit.
+ViewSettings viewAt(const ViewSettings& base, double orbitDeg, std::int64_t i, std::int64_t n) {
+  ViewSettings v = base;
+  if (n > 1) v.azimuthDeg += orbitDeg * static_cast<double>(i) / static_cast<double>(n - 1);
+  return v;
 }
 
 HudInfo hudFor(const Frame& frame, const RunReplay& replay) {
@@ -109,7 +120,8 @@ std::vector<std::int64_t> contactSheetFrames(std::int64_t frames) {
   std::vector<std::int64_t> indices;
   if (frames <= 0) return indices;
   for (int i = 0; i < kSheetTiles; ++i) {
-    indices.push_back(static_cast<std::int64_t>(std::llround(static_cast<double>(i) * static_cast<double>(frames - 1) / (kSheetTiles - 1))));
+    indices.push_back(static_cast<std::int64_t>(
+        std::llround(static_cast<double>(i) * static_cast<double>(frames - 1) / (kSheetTiles - 1))));
   }
   return indices;
 }
@@ -128,10 +140,12 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
   if (!job.pngDirectory.empty()) {
     std::error_code ec;
     fs::create_directories(job.pngDirectory, ec);
-    if (ec || !fs::is_directory(job.pngDirectory)) throw Error(fmt::format("{}: cannot create the directory", job.pngDirectory));
+    if (ec || !fs::is_directory(job.pngDirectory))
+      throw Error(fmt::format("{}: cannot create the directory", job.pngDirectory));
   }
   std::unique_ptr<VideoEncoder> video;
-  if (!job.videoPath.empty()) video = std::make_unique<VideoEncoder>(job.videoPath, job.width, job.height, replay.frameRate());
+  if (!job.videoPath.empty())
+    video = std::make_unique<VideoEncoder>(job.videoPath, job.width, job.height, replay.frameRate());
 
   HeadlessRenderer renderer(replay.meshes(), job.width, job.height);
   RenderSummary summary;
@@ -145,8 +159,9 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
       replay.read(i, frame);
       HudInfo hud = hudFor(frame, replay);
       hud.show = job.hud;
-      const Image image = renderer.render(frame, view, job.overlay, hud);
-      if (!job.pngDirectory.empty()) writePng((fs::path(job.pngDirectory) / fmt::format("frame_{:05d}.png", i)).string(), image);
+      const Image image = renderer.render(frame, viewAt(view, job.orbitDeg, i, frames), job.overlay, hud);
+      if (!job.pngDirectory.empty())
+        writePng((fs::path(job.pngDirectory) / fmt::format("frame_{:05d}.png", i)).string(), image);
       if (video) video->write(image);
       ++summary.frames;
       progress.update(i + 1);
@@ -168,10 +183,11 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
     renderer.resize(tileW, tileH);
     summary.sheetFrames = contactSheetFrames(frames);
     for (int t = 0; t < kSheetTiles; ++t) {
-      replay.read(summary.sheetFrames[static_cast<std::size_t>(t)], frame);
+      const std::int64_t index = summary.sheetFrames[static_cast<std::size_t>(t)];
+      replay.read(index, frame);
       HudInfo hud = hudFor(frame, replay);
       hud.timeCodeOnly = true;
-      const Image tile = renderer.render(frame, view, job.overlay, hud);
+      const Image tile = renderer.render(frame, viewAt(view, job.orbitDeg, index, frames), job.overlay, hud);
       paste(sheet, tile, gap + (t % kSheetColumns) * (tileW + gap), gap + (t / kSheetColumns) * (tileH + gap));
     }
     writePng(job.contactSheet, sheet);

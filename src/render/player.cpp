@@ -71,7 +71,8 @@ void drawPanel(OverlaySettings& overlay, const std::vector<MeshInfo>& meshes, bo
   const ImGuiIO& io = ImGui::GetIO();
   ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 10.0f, 10.0f), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
   ImGui::SetNextWindowBgAlpha(0.75f);
-  ImGui::SetNextWindowCollapsed(io.DisplaySize.x < 800.0f, ImGuiCond_FirstUseEver);  // small windows: keep the picture clear
+  ImGui::SetNextWindowCollapsed(io.DisplaySize.x < 800.0f,
+                                ImGuiCond_FirstUseEver);  // small windows: keep the picture clear
   ImGui::Begin("overlays", nullptr, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove);
   ImGui::Checkbox("paused (space)", &paused);
   ImGui::Checkbox("floor", &overlay.floor);
@@ -82,7 +83,8 @@ void drawPanel(OverlaySettings& overlay, const std::vector<MeshInfo>& meshes, bo
   ImGui::Checkbox("pinned / bound markers", &overlay.markers);
   ImGui::Checkbox("offset surfaces T1-T3", &overlay.offsetSurfaces);
   if (overlay.offsetSurfaces || overlay.distanceSlice) {
-    std::array<float, 3> mm = {static_cast<float>(overlay.offsets_m[0] * 1000), static_cast<float>(overlay.offsets_m[1] * 1000),
+    std::array<float, 3> mm = {static_cast<float>(overlay.offsets_m[0] * 1000),
+                               static_cast<float>(overlay.offsets_m[1] * 1000),
                                static_cast<float>(overlay.offsets_m[2] * 1000)};
     if (ImGui::SliderFloat3("T1 T2 T3 (mm)", mm.data(), 0.0f, 50.0f, "%.1f")) {
       for (std::size_t i = 0; i < 3; ++i) overlay.offsets_m[i] = mm[i] / 1000.0;
@@ -100,7 +102,8 @@ void drawPanel(OverlaySettings& overlay, const std::vector<MeshInfo>& meshes, bo
       const std::string current = meshes[static_cast<std::size_t>(overlay.slicePart)].name;
       if (ImGui::BeginCombo("part", current.c_str())) {
         for (int m : segments)
-          if (ImGui::Selectable(meshes[static_cast<std::size_t>(m)].name.c_str(), m == overlay.slicePart)) overlay.slicePart = m;
+          if (ImGui::Selectable(meshes[static_cast<std::size_t>(m)].name.c_str(), m == overlay.slicePart))
+            overlay.slicePart = m;
         ImGui::EndCombo();
       }
       float height = static_cast<float>(overlay.sliceHeight);
@@ -123,7 +126,8 @@ Image readBackBuffer(int width, int height) {
   image.rgb.resize(rows.size());
   const std::size_t stride = static_cast<std::size_t>(width) * 3;
   for (int y = 0; y < height; ++y)
-    std::copy_n(rows.data() + static_cast<std::size_t>(height - 1 - y) * stride, stride, image.rgb.data() + static_cast<std::size_t>(y) * stride);
+    std::copy_n(rows.data() + static_cast<std::size_t>(height - 1 - y) * stride, stride,
+                image.rgb.data() + static_cast<std::size_t>(y) * stride);
   return image;
 }
 
@@ -137,7 +141,8 @@ PlayerStats Player::run(FrameSource& source) {
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
   glfwWindowHint(GLFW_SAMPLES, 4);
   GLFWwindow* window = glfwCreateWindow(options_.width, options_.height, options_.title.c_str(), nullptr, nullptr);
-  if (window == nullptr) throw Error(fmt::format("cannot open an OpenGL 3.3 core window ({})", glfwLastError()), ExitCode::Internal);
+  if (window == nullptr)
+    throw Error(fmt::format("cannot open an OpenGL 3.3 core window ({})", glfwLastError()), ExitCode::Internal);
   Input input;
   glfwSetWindowUserPointer(window, &input);
   glfwSetScrollCallback(window, &onScroll);  // before ImGui's backend, which chains to it
@@ -158,7 +163,8 @@ PlayerStats Player::run(FrameSource& source) {
     renderer.setFrame(frame);
     stats.framesDrawn = 1;
     Aabb seen = frameBounds(frame);
-    const bool hasStates = std::any_of(frame.states.begin(), frame.states.end(), [](const auto& s) { return !s.empty(); });
+    const bool hasStates =
+        std::any_of(frame.states.begin(), frame.states.end(), [](const auto& s) { return !s.empty(); });
 
     ViewSettings view = options_.view;
     const ViewSettings initialView = view;
@@ -210,7 +216,8 @@ PlayerStats Player::run(FrameSource& source) {
       }
       lastCursorX = cursorX;
       lastCursorY = cursorY;
-      if (!io.WantCaptureMouse && input.scroll != 0.0) view.zoom = std::clamp(view.zoom * std::pow(1.1, input.scroll), 0.2, 20.0);
+      if (!io.WantCaptureMouse && input.scroll != 0.0)
+        view.zoom = std::clamp(view.zoom * std::pow(1.1, input.scroll), 0.2, 20.0);
       input.scroll = 0.0;
 
       // Time: one new frame per frame period (or per redraw when not real-time).
@@ -239,7 +246,8 @@ PlayerStats Player::run(FrameSource& source) {
         imgui.drawHud(hud, width, height);
         drawPanel(overlay, source.meshes(), hasStates, paused, view, initialView);
         imgui.endFrame();
-        if (!options_.screenshot.empty() && glfwWindowShouldClose(window)) writePng(options_.screenshot, readBackBuffer(width, height));
+        if (!options_.screenshot.empty() && glfwWindowShouldClose(window))
+          writePng(options_.screenshot, readBackBuffer(width, height));
         glfwSwapBuffers(window);
       }
       ++fpsFrames;

@@ -17,9 +17,9 @@ using Mat4 = Eigen::Matrix4f;
 using V3 = Eigen::Vector3f;
 
 // Colours are given in sRGB (as a person picks them) and lit in linear space.
-constexpr std::array<float, 3> kGarmentSrgb = {0.80f, 0.22f, 0.25f};   // a warm red cloth
-constexpr std::array<float, 3> kSegmentSrgb = {0.80f, 0.74f, 0.68f};   // clay-coloured body
-constexpr std::array<float, 3> kBackgroundTop = {44.f, 50.f, 62.f};      // 0-255
+constexpr std::array<float, 3> kGarmentSrgb = {0.80f, 0.22f, 0.25f};  // a warm red cloth
+constexpr std::array<float, 3> kSegmentSrgb = {0.80f, 0.74f, 0.68f};  // clay-coloured body
+constexpr std::array<float, 3> kBackgroundTop = {44.f, 50.f, 62.f};   // 0-255
 constexpr std::array<float, 3> kBackgroundBottom = {120.f, 128.f, 140.f};
 
 // ---------------------------------------------------------------------------------------
@@ -274,7 +274,8 @@ struct GpuMesh {
 
 std::array<float, 3> backgroundColour(double v) {
   std::array<float, 3> c{};
-  for (int i = 0; i < 3; ++i) c[i] = static_cast<float>(kBackgroundBottom[i] + (kBackgroundTop[i] - kBackgroundBottom[i]) * v);
+  for (int i = 0; i < 3; ++i)
+    c[i] = static_cast<float>(kBackgroundBottom[i] + (kBackgroundTop[i] - kBackgroundBottom[i]) * v);
   return c;
 }
 
@@ -308,7 +309,7 @@ struct Renderer::Impl {
   std::vector<std::vector<float>> normals;    ///< per mesh, xyz float, area-weighted, unit
   Frame frame;                                ///< the current frame (for the slice)
   Aabb frameBounds;
-  std::uint64_t generation = 0;               ///< counts setFrame calls
+  std::uint64_t generation = 0;                                                  ///< counts setFrame calls
   std::tuple<std::uint64_t, int, double, bool> sliceKey{~0ull, -1, 0.0, false};  ///< what the slice texture shows
   GLuint meshProgram = 0, gridProgram = 0, backgroundProgram = 0, markerProgram = 0, sliceProgram = 0;
   GLuint quadVao = 0, quadVbo = 0, emptyVao = 0, sliceTexture = 0;
@@ -343,7 +344,8 @@ struct Renderer::Impl {
   void createMesh(const MeshInfo& info, GpuMesh& g) {
     for (const mesh::Triangle& t : info.triangles) {
       if (t[0] >= info.vertexCount || t[1] >= info.vertexCount || t[2] >= info.vertexCount) {
-        throw Error(fmt::format("mesh '{}': a triangle refers to a vertex beyond its {} vertices", info.name, info.vertexCount));
+        throw Error(fmt::format("mesh '{}': a triangle refers to a vertex beyond its {} vertices", info.name,
+                                info.vertexCount));
       }
     }
     const auto vertexBytes = static_cast<GLsizeiptr>(info.vertexCount * 3 * sizeof(float));
@@ -397,7 +399,8 @@ struct Renderer::Impl {
     glDisable(GL_DEPTH_TEST);
     glDepthMask(GL_FALSE);
     glUseProgram(backgroundProgram);
-    glUniform3f(glGetUniformLocation(backgroundProgram, "uTop"), kBackgroundTop[0], kBackgroundTop[1], kBackgroundTop[2]);
+    glUniform3f(glGetUniformLocation(backgroundProgram, "uTop"), kBackgroundTop[0], kBackgroundTop[1],
+                kBackgroundTop[2]);
     glUniform3f(glGetUniformLocation(backgroundProgram, "uBottom"), kBackgroundBottom[0], kBackgroundBottom[1],
                 kBackgroundBottom[2]);
     glUniform1f(glGetUniformLocation(backgroundProgram, "uHeight"), static_cast<float>(height));
@@ -482,8 +485,10 @@ struct Renderer::Impl {
 
   /// Offset surfaces T1-T3 of every segment: its mesh pushed out along the vertex normals,
   /// drawn as translucent shells, outermost first.
-  void drawOffsetSurfaces(const Mat4& viewProj, const CameraMatrices& cam, const V3& light, const OverlaySettings& overlay) {
-    static constexpr std::array<std::array<float, 3>, 3> kShellSrgb = {{{0.9f, 0.3f, 0.9f}, {0.3f, 0.9f, 0.3f}, {0.3f, 0.7f, 1.0f}}};
+  void drawOffsetSurfaces(const Mat4& viewProj, const CameraMatrices& cam, const V3& light,
+                          const OverlaySettings& overlay) {
+    static constexpr std::array<std::array<float, 3>, 3> kShellSrgb = {
+        {{0.9f, 0.3f, 0.9f}, {0.3f, 0.9f, 0.3f}, {0.3f, 0.7f, 1.0f}}};
     setMeshUniforms(viewProj, Mat4::Identity(), cam, light);
     glUniform1i(glGetUniformLocation(meshProgram, "uMode"), 2);
     glUniform1f(glGetUniformLocation(meshProgram, "uAlpha"), 0.18f);
@@ -495,7 +500,8 @@ struct Renderer::Impl {
     for (int shell = 2; shell >= 0; --shell) {
       const V3 colour = srgbToLinear(kShellSrgb[static_cast<std::size_t>(shell)]);
       glUniform3fv(glGetUniformLocation(meshProgram, "uColour"), 1, colour.data());
-      glUniform1f(glGetUniformLocation(meshProgram, "uInflate"), static_cast<float>(overlay.offsets_m[static_cast<std::size_t>(shell)]));
+      glUniform1f(glGetUniformLocation(meshProgram, "uInflate"),
+                  static_cast<float>(overlay.offsets_m[static_cast<std::size_t>(shell)]));
       for (std::size_t m = 0; m < gpu.size(); ++m) {
         if (meshes[m].role != MeshRole::Segment) continue;
         glBindVertexArray(gpu[m].vao);
@@ -568,7 +574,8 @@ struct Renderer::Impl {
       for (int j = 0; j < kCells; ++j) {
         for (int i = 0; i < kCells; ++i) {
           const Vec3 p(lo.x() + (i + 0.5) / kCells * size.x(), y, lo.z() + (j + 0.5) / kCells * size.z());
-          const double d = overlay.sliceDistance ? overlay.sliceDistance(p) : bruteForceDistance(static_cast<std::size_t>(part), p);
+          const double d =
+              overlay.sliceDistance ? overlay.sliceDistance(p) : bruteForceDistance(static_cast<std::size_t>(part), p);
           distance[static_cast<std::size_t>(j * kCells + i)] = static_cast<float>(d);
         }
       }
@@ -579,7 +586,8 @@ struct Renderer::Impl {
     glUniformMatrix4fv(glGetUniformLocation(sliceProgram, "uViewProj"), 1, GL_FALSE, viewProj.data());
     glUniform3f(glGetUniformLocation(sliceProgram, "uMin"), static_cast<float>(lo.x()), static_cast<float>(lo.y()),
                 static_cast<float>(lo.z()));
-    glUniform2f(glGetUniformLocation(sliceProgram, "uSize"), static_cast<float>(size.x()), static_cast<float>(size.z()));
+    glUniform2f(glGetUniformLocation(sliceProgram, "uSize"), static_cast<float>(size.x()),
+                static_cast<float>(size.z()));
     glUniform3f(glGetUniformLocation(sliceProgram, "uOffsets"), static_cast<float>(overlay.offsets_m[0]),
                 static_cast<float>(overlay.offsets_m[1]), static_cast<float>(overlay.offsets_m[2]));
     glUniform1f(glGetUniformLocation(sliceProgram, "uBand"), static_cast<float>(std::max(0.005, margin / 5.0)));
@@ -618,7 +626,8 @@ Renderer::~Renderer() {
   glDeleteVertexArrays(1, &impl_->quadVao);
   glDeleteVertexArrays(1, &impl_->emptyVao);
   glDeleteTextures(1, &impl_->sliceTexture);
-  for (GLuint p : {impl_->meshProgram, impl_->gridProgram, impl_->backgroundProgram, impl_->markerProgram, impl_->sliceProgram})
+  for (GLuint p :
+       {impl_->meshProgram, impl_->gridProgram, impl_->backgroundProgram, impl_->markerProgram, impl_->sliceProgram})
     glDeleteProgram(p);
 }
 
@@ -628,7 +637,8 @@ void Renderer::setFrame(const Frame& frame) {
   Impl& s = *impl_;
   if (frame.positions.size() != s.meshes.size()) {
     throw Error(fmt::format("frame {} has positions for {} meshes, the run has {}", frame.index, frame.positions.size(),
-                            s.meshes.size()), ExitCode::Internal);
+                            s.meshes.size()),
+                ExitCode::Internal);
   }
   s.frame = frame;
   s.frameBounds = frameBounds(frame);
@@ -637,7 +647,8 @@ void Renderer::setFrame(const Frame& frame) {
     const std::vector<Vec3>& x = frame.positions[m];
     if (x.size() != s.meshes[m].vertexCount) {
       throw Error(fmt::format("frame {}: mesh '{}' has {} positions, its topology {} vertices", frame.index,
-                              s.meshes[m].name, x.size(), s.meshes[m].vertexCount), ExitCode::Internal);
+                              s.meshes[m].name, x.size(), s.meshes[m].vertexCount),
+                  ExitCode::Internal);
     }
     std::vector<float>& p = s.positions[m];
     for (std::size_t v = 0; v < x.size(); ++v)
@@ -685,12 +696,12 @@ void Renderer::draw(int width, int height, const ViewSettings& view, const Overl
   glFrontFace(GL_CCW);
   glCullFace(GL_BACK);
 
-  s.drawBackground(height);                                                   // sky gradient
-  if (overlay.floor) s.drawFloor(viewProj, bounds, floorY);                   // grid, marks stencil
+  s.drawBackground(height);                                  // sky gradient
+  if (overlay.floor) s.drawFloor(viewProj, bounds, floorY);  // grid, marks stencil
   if (overlay.floor && overlay.shadows) s.drawShadows(viewProj, cam, light, floorY);
-  s.drawMeshes(viewProj, cam, light, overlay);                                // bodies and cloth
-  if (overlay.markers) s.drawMarkers(viewProj, height);                       // pinned / bound
-  if (overlay.distanceSlice) s.drawDistanceSlice(viewProj, overlay);          // field slice
+  s.drawMeshes(viewProj, cam, light, overlay);                                      // bodies and cloth
+  if (overlay.markers) s.drawMarkers(viewProj, height);                             // pinned / bound
+  if (overlay.distanceSlice) s.drawDistanceSlice(viewProj, overlay);                // field slice
   if (overlay.offsetSurfaces) s.drawOffsetSurfaces(viewProj, cam, light, overlay);  // T1-T3 shells
   glBindVertexArray(0);
   glUseProgram(0);

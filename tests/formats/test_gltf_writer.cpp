@@ -98,7 +98,8 @@ TEST(GltfWriter, RunExportReproducesEveryFrame) {
 
   // The torso: node TRS at key f applied to its rest mesh gives frame f.
   const tinygltf::Node& torsoNode = model.nodes[1];
-  const std::vector<float> rest = accessorData<float>(model, model.meshes[static_cast<std::size_t>(torsoNode.mesh)].primitives[0].attributes.at("POSITION"));
+  const std::vector<float> rest = accessorData<float>(
+      model, model.meshes[static_cast<std::size_t>(torsoNode.mesh)].primitives[0].attributes.at("POSITION"));
   const std::vector<float> tr = accessorData<float>(model, model.animations[0].samplers[1].output);
   const std::vector<float> rot = accessorData<float>(model, model.animations[0].samplers[2].output);
   for (std::size_t f = 0; f < 20; ++f) {
@@ -113,7 +114,8 @@ TEST(GltfWriter, RunExportReproducesEveryFrame) {
 
 TEST(GltfWriter, KhronosValidatorReportsNoErrors) {
   const std::string validator = std::string(DRAPE_SOURCE_DIR) + "/tools/gltf-validator/validate.js";
-  if (std::system("node --version >/dev/null 2>&1") != 0) GTEST_SKIP() << "node is not installed (scripts/install-deps installs it)";
+  if (std::system("node --version >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "node is not installed (scripts/install-deps installs it)";
   if (!std::filesystem::exists(std::string(DRAPE_SOURCE_DIR) + "/tools/gltf-validator/node_modules/gltf-validator")) {
     GTEST_SKIP() << "the gltf-validator npm package is not installed (scripts/install-deps runs npm ci)";
   }
@@ -122,7 +124,8 @@ TEST(GltfWriter, KhronosValidatorReportsNoErrors) {
   (void)exportRunToGlb(dir, glb);
   // A second file with a garment only, one frame: no animation at all.
   GltfAnimation still;
-  still.deforming.push_back({"square", {{0, 1, 2}, {0, 2, 3}}, {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)}}});
+  still.deforming.push_back(
+      {"square", {{0, 1, 2}, {0, 2, 3}}, {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)}}});
   writeGlb(dir + "/still.glb", still);
   for (const std::string& file : {glb, dir + "/still.glb"}) {
     const std::string command = "node " + validator + " " + file + " 2>&1";

@@ -53,8 +53,10 @@ TEST(RenderCli, VideoHasEveryFrame) {
   const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_video"), 17);
   const Result r = run(drape() + " render " + dir + " --video " + dir + "/out.mp4 --size 161x121");  // odd: padded
   ASSERT_EQ(r.status, 0) << r.output;
-  const Result probe = run("ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames,r_frame_rate "
-                           "-of csv=p=0 " + dir + "/out.mp4");
+  const Result probe =
+      run("ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames,r_frame_rate "
+          "-of csv=p=0 " +
+          dir + "/out.mp4");
   ASSERT_EQ(probe.status, 0) << probe.output;
   EXPECT_NE(probe.output.find("24/1,17"), std::string::npos) << probe.output;
 }
@@ -116,7 +118,8 @@ TEST(PlayCli, WindowUnderXvfbClosesByItselfAfterNFrames) {
 
 TEST(PlayCli, NoDisplayIsAClearError) {
   const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_nodisplay"), 2);
-  const Result r = run("env -u DISPLAY -u WAYLAND_DISPLAY ASAN_OPTIONS=detect_leaks=0 " + drape() + " play " + dir + " --frames 1");
+  const Result r =
+      run("env -u DISPLAY -u WAYLAND_DISPLAY ASAN_OPTIONS=detect_leaks=0 " + drape() + " play " + dir + " --frames 1");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("needs a display"), std::string::npos) << r.output;
 }

@@ -30,7 +30,8 @@ Box projectedBox(const CameraMatrices& cam, const std::vector<Vec3>& points) {
   Box box;
   const Eigen::Matrix4f vp = cam.viewProjection();
   for (const Vec3& p : points) {
-    const Eigen::Vector4f c = vp * Eigen::Vector4f(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()), 1.0f);
+    const Eigen::Vector4f c =
+        vp * Eigen::Vector4f(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()), 1.0f);
     const double x = (c.x() / c.w() * 0.5 + 0.5) * kW;
     const double y = (1.0 - (c.y() / c.w() * 0.5 + 0.5)) * kH;
     box.x0 = std::min(box.x0, static_cast<int>(std::floor(x)));
@@ -118,7 +119,8 @@ TEST_F(Headless, FramesDifferWhereTheClothMovedNotInEmptyCorners) {
   for (int corner = 0; corner < 4; ++corner) {
     const int cx = corner % 2 == 0 ? 0 : kW - 24, cy = corner / 2 == 0 ? 0 : kH - 24;
     for (int y = cy; y < cy + 24; ++y)
-      for (int x = cx; x < cx + 24; ++x) ASSERT_TRUE(std::equal(a.pixel(x, y), a.pixel(x, y) + 3, b.pixel(x, y))) << x << "," << y;
+      for (int x = cx; x < cx + 24; ++x)
+        ASSERT_TRUE(std::equal(a.pixel(x, y), a.pixel(x, y) + 3, b.pixel(x, y))) << x << "," << y;
   }
 }
 

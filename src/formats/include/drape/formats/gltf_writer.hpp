@@ -20,22 +20,22 @@ namespace drape::formats {
 struct GltfDeformingMesh {
   std::string name;
   std::vector<mesh::Triangle> triangles;
-  std::vector<std::vector<Vec3>> frames;        ///< world positions (m, Y up), per frame, all the same size
+  std::vector<std::vector<Vec3>> frames;                   ///< world positions (m, Y up), per frame, all the same size
   std::array<float, 4> colour = {0.8f, 0.8f, 0.8f, 1.0f};  ///< linear RGBA base colour
-  bool doubleSided = true;                      ///< cloth: both sides visible
+  bool doubleSided = true;                                 ///< cloth: both sides visible
 };
 
 /// A rigid part: its mesh in its own frame, moved by one rigid transform per frame.
 struct GltfRigidMesh {
   std::string name;
-  mesh::TriMesh mesh;                           ///< m, in the part's (joint's) frame
-  std::vector<RigidTransform> frames;           ///< part frame -> world, per frame
+  mesh::TriMesh mesh;                  ///< m, in the part's (joint's) frame
+  std::vector<RigidTransform> frames;  ///< part frame -> world, per frame
   std::array<float, 4> colour = {0.8f, 0.8f, 0.8f, 1.0f};
   bool doubleSided = false;
 };
 
 struct GltfAnimation {
-  double frameRate = 30.0;                      ///< frames per second of every `frames` list
+  double frameRate = 30.0;  ///< frames per second of every `frames` list
   std::vector<GltfDeformingMesh> deforming;
   std::vector<GltfRigidMesh> rigid;
 };

@@ -53,11 +53,11 @@ struct StageTime {
 
 /// One frame: world positions (m, Y up) of every mesh, in MeshInfo order.
 struct Frame {
-  std::int64_t index = 0;  ///< 0-based sample number within the run
-  TimeCode time;           ///< studio time code of the sample
-  std::vector<std::vector<Vec3>> positions;           ///< per mesh, MeshInfo::vertexCount entries
-  std::vector<std::vector<std::uint8_t>> states;      ///< per mesh: vertex_state bits, or empty
-  std::vector<StageTime> stages;                      ///< ms per stage for this frame (may be empty)
+  std::int64_t index = 0;                         ///< 0-based sample number within the run
+  TimeCode time;                                  ///< studio time code of the sample
+  std::vector<std::vector<Vec3>> positions;       ///< per mesh, MeshInfo::vertexCount entries
+  std::vector<std::vector<std::uint8_t>> states;  ///< per mesh: vertex_state bits, or empty
+  std::vector<StageTime> stages;                  ///< ms per stage for this frame (may be empty)
 };
 
 /// A stream of frames for the player. Replays allow any index; a live source only ever

@@ -14,21 +14,22 @@ namespace drape::render {
 struct RenderJob {
   int width = 1280;
   int height = 720;
-  std::string pngDirectory;   ///< "": no PNG frames; else DIR/frame_00000.png ...
-  std::string videoPath;      ///< "": no video; else an H.264 MP4 at the run's frame rate
-  std::string contactSheet;   ///< "": none; else a PNG of 16 tiles (4x4) with time codes
-  int sheetWidth = 1920;      ///< contact sheet size
+  std::string pngDirectory;  ///< "": no PNG frames; else DIR/frame_00000.png ...
+  std::string videoPath;     ///< "": no video; else an H.264 MP4 at the run's frame rate
+  std::string contactSheet;  ///< "": none; else a PNG of 16 tiles (4x4) with time codes
+  int sheetWidth = 1920;     ///< contact sheet size
   int sheetHeight = 1080;
-  bool hud = true;            ///< time code and frame on PNG and video frames
+  bool hud = true;  ///< time code and frame on PNG and video frames
+  double orbitDeg = 0.0;  ///< the camera turns this far about the vertical from first to last frame
   ViewSettings view;
   OverlaySettings overlay;
 };
 
 struct RenderSummary {
-  std::int64_t frames = 0;         ///< frames rendered for PNG/video
+  std::int64_t frames = 0;                ///< frames rendered for PNG/video
   std::vector<std::int64_t> sheetFrames;  ///< frame indices on the contact sheet
-  double seconds = 0.0;            ///< wall time
-  std::string glDescription;       ///< the OpenGL implementation that rendered
+  double seconds = 0.0;                   ///< wall time
+  std::string glDescription;              ///< the OpenGL implementation that rendered
 };
 
 /// Renders a run directory (see RunReplay) as the job asks. Throws drape::Error on a bad

@@ -23,8 +23,8 @@ struct PlayerOptions {
   int height = 720;
   std::string title = "drape";
   std::optional<std::int64_t> maxFrames;  ///< close by itself after drawing this many frames
-  bool loop = true;       ///< a replay starts over at its end (a live source ends the player)
-  bool realTime = true;   ///< advance at the source's frame rate; false: one frame per redraw
+  bool loop = true;                       ///< a replay starts over at its end (a live source ends the player)
+  bool realTime = true;                   ///< advance at the source's frame rate; false: one frame per redraw
   ViewSettings view;
   OverlaySettings overlay;
   std::string screenshot;  ///< "": none; else the last picture the window showed, as PNG

@@ -32,27 +32,27 @@ struct ViewSettings {
 using DistanceFunction = std::function<double(const Vec3& world)>;
 
 struct OverlaySettings {
-  bool floor = true;             ///< floor grid under the lowest point of the run
-  bool shadows = true;           ///< planar shadows of every mesh on the floor
-  bool collisionColours = false; ///< colour garment vertices by vertex_state collision bits
-  bool offsetSurfaces = false;   ///< draw the segments' offset surfaces T1-T3 (translucent shells)
+  bool floor = true;              ///< floor grid under the lowest point of the run
+  bool shadows = true;            ///< planar shadows of every mesh on the floor
+  bool collisionColours = false;  ///< colour garment vertices by vertex_state collision bits
+  bool offsetSurfaces = false;    ///< draw the segments' offset surfaces T1-T3 (translucent shells)
   std::array<double, 3> offsets_m = {0.004, 0.008, 0.016};  ///< T1, T2, T3 from the body surface
-  bool distanceSlice = false;    ///< a horizontal slice plane coloured by distance to one part
-  int slicePart = -1;            ///< mesh index (a segment) the slice measures; -1: the first segment
-  double sliceHeight = 0.5;      ///< 0 = bottom of the part, 1 = top
+  bool distanceSlice = false;      ///< a horizontal slice plane coloured by distance to one part
+  int slicePart = -1;              ///< mesh index (a segment) the slice measures; -1: the first segment
+  double sliceHeight = 0.5;        ///< 0 = bottom of the part, 1 = top
   DistanceFunction sliceDistance;  ///< optional real field for slicePart
-  bool markers = false;          ///< mark pinned (yellow) and bound (cyan) vertices
+  bool markers = false;            ///< mark pinned (yellow) and bound (cyan) vertices
 };
 
 /// Text drawn over the picture with Dear ImGui.
 struct HudInfo {
   bool show = true;
   TimeCode time;
-  std::int64_t frame = 0;           ///< 0-based sample
+  std::int64_t frame = 0;              ///< 0-based sample
   std::optional<std::int64_t> frames;  ///< total, when known
-  double fps = 0.0;                 ///< drawing rate; 0: not shown
+  double fps = 0.0;                    ///< drawing rate; 0: not shown
   std::vector<StageTime> stages;
-  bool timeCodeOnly = false;        ///< contact-sheet tiles: one large time code label
+  bool timeCodeOnly = false;  ///< contact-sheet tiles: one large time code label
 };
 
 /// Background colour (linear 0-255 RGB as written to images) at normalised height v

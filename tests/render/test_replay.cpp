@@ -1,0 +1,130 @@
+// RunReplay: what it reads from a run directory and what it refuses; contact sheet spacing.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "../formats/test_run_fixture.hpp"
+#include "drape/core/error.hpp"
+#include "drape/render/headless.hpp"
+#include "drape/render/outputs.hpp"
+#include "drape/render/run_replay.hpp"
+
+namespace drape::render {
+namespace {
+
+TEST(RunReplay, ReadsFramesTimeCodesAndStageTimes) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("replay"), 30);
+  std::ofstream(dir + "/stats.json") << R"({"frames": 30, "ms_per_stage": {"forces": 1.5, "collide": 0.25}})";
+  RunReplay replay(dir);
+  ASSERT_EQ(replay.meshes().size(), 2u);
+  EXPECT_EQ(replay.meshes()[0].role, MeshRole::Segment);
+  EXPECT_EQ(replay.meshes()[1].role, MeshRole::Garment);
+  EXPECT_EQ(replay.meshes()[1].vertexCount, static_cast<std::size_t>(testrun::kFlagColumns * testrun::kFlagRows));
+  EXPECT_EQ(replay.frameCount(), 30);
+  Frame f;
+  ASSERT_TRUE(replay.read(29, f));
+  EXPECT_EQ(f.time.smpte(), "00:00:01:05");  // 29 frames at 24 fps
+  const std::vector<Vec3> expected = testrun::flagPositions(29);
+  for (std::size_t v = 0; v < expected.size(); ++v) ASSERT_LT((f.positions[1][v] - expected[v]).norm(), 1e-6);
+  ASSERT_EQ(f.stages.size(), 2u);
+  EXPECT_EQ(f.stages[0].stage, "collide");  // JSON objects come back in key order
+  EXPECT_DOUBLE_EQ(f.stages[1].ms, 1.5);
+  EXPECT_FALSE(replay.read(30, f));
+  EXPECT_FALSE(replay.read(-1, f));
+  // The run's bounds hold every frame: the flag's wave reaches 12 cm in z.
+  EXPECT_GT(replay.bounds().max.z(), 0.1);
+  EXPECT_NEAR(replay.bounds().min.y(), 0.35, 1e-6);
+}
+
+TEST(RunReplay, RefusesInconsistentRuns) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("replay_bad"), 4);
+  // The manifest claims more frames than the caches hold.
+  formats::RunManifest m = formats::readRunManifest(dir);
+  m.frames = 5;
+  formats::writeRunManifest(dir, m);
+  try {
+    RunReplay replay(dir);
+    FAIL() << "accepted a cache that is too short";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("torso.pc2: 4 samples"), std::string::npos) << e.what();
+  }
+  // A cache whose point count does not match its topology.
+  m.frames = 4;
+  m.meshes[1].cache = "torso.pc2";
+  formats::writeRunManifest(dir, m);
+  EXPECT_THROW(RunReplay{dir}, Error);
+  // An unknown role.
+  m.meshes[1].cache = "flag.pc2";
+  m.meshes[1].role = "hat";
+  formats::writeRunManifest(dir, m);
+  try {
+    RunReplay replay(dir);
+    FAIL() << "accepted role 'hat'";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("hat"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ContactSheet, SixteenEvenlySpacedFramesFromFirstToLast) {
+  const std::vector<std::int64_t> f = contactSheetFrames(91);
+  ASSERT_EQ(f.size(), 16u);
+  EXPECT_EQ(f.front(), 0);
+  EXPECT_EQ(f.back(), 90);
+  for (std::size_t i = 1; i < f.size(); ++i) EXPECT_EQ(f[i] - f[i - 1], 6);
+  const std::vector<std::int64_t> few = contactSheetFrames(3);
+  ASSERT_EQ(few.size(), 16u);
+  EXPECT_EQ(few.front(), 0);
+  EXPECT_EQ(few.back(), 2);
+  EXPECT_TRUE(contactSheetFrames(0).empty());
+}
+
+TEST(Hud, DrawsTextInTheTopLeftCornerOnly) {
+  RunReplay replay(testrun::writeTestRun(testrun::freshDir("hud"), 3));
+  HeadlessRenderer renderer(replay.meshes(), 320, 240);
+  Frame f;
+  replay.read(2, f);
+  ViewSettings view;
+  view.bounds = replay.bounds();
+  const Image bare = renderer.render(f, view, OverlaySettings{});
+  HudInfo hud;
+  hud.time = f.time;
+  hud.frame = 2;
+  hud.frames = 3;
+  const Image text = renderer.render(f, view, OverlaySettings{}, hud);
+  long changed = 0;
+  for (int y = 0; y < 240; ++y)
+    for (int x = 0; x < 320; ++x) {
+      const bool c = !std::equal(bare.pixel(x, y), bare.pixel(x, y) + 3, text.pixel(x, y));
+      if (x > 160 || y > 120) {
+        ASSERT_FALSE(c) << "HUD pixel outside the top-left quarter at " << x << "," << y;
+      }
+      changed += c;
+    }
+  EXPECT_GT(changed, 400);
+}
+
+}  // namespace
+}  // namespace drape::render
+
+namespace drape::render {
+namespace {
+
+TEST(Preview, ContactSheetAndVideoInTheRunDirectory) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("preview"), 4);
+  const PreviewFiles files = renderPreview(dir);
+  EXPECT_EQ(files.contactSheet, dir + "/preview.png");
+  const Image sheet = readPng(files.contactSheet);
+  EXPECT_EQ(sheet.width, 1920);
+  EXPECT_EQ(sheet.height, 1080);
+  if (ffmpegAvailable()) {
+    EXPECT_EQ(files.video, dir + "/preview.mp4");
+    EXPECT_GT(std::filesystem::file_size(files.video), 1000u);
+  } else {
+    EXPECT_TRUE(files.video.empty());
+  }
+}
+
+}  // namespace
+}  // namespace drape::render

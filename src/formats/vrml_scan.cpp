@@ -199,6 +199,7 @@ class Scanner {
     const Token name = expectName("a PROTO name");
     ProtoInterface interface{std::string(name.text), {}, keyword.line, false};
     scopes_.emplace_back();
+    bodyTypes_.emplace_back();
     open(expect(Tok::OpenBracket, "'[' after the PROTO name"));
     while (current_.kind != Tok::CloseBracket) {
       const Token kind = expect(Tok::Id, "a field declaration or ']'");
@@ -220,7 +221,26 @@ class Scanner {
     take();
     close();
     scopes_.pop_back();
+    checkRecursion(name, std::move(bodyTypes_.back()));
+    bodyTypes_.pop_back();
     declare(std::move(interface));
+  }
+
+  /// A PROTO whose instances contain, directly or through other PROTOs, an instance of
+  /// itself: Coin expands it without end and overflows its stack.
+  void checkRecursion(const Token& name, std::set<std::string, std::less<>> used) {
+    std::vector<std::string> work(used.begin(), used.end());
+    while (!work.empty()) {
+      const std::string type = work.back();
+      work.pop_back();
+      const auto it = protoUses_.find(type);
+      if (it == protoUses_.end()) continue;
+      for (const std::string& t : it->second)
+        if (used.insert(t).second) work.push_back(t);
+    }
+    if (used.contains(name.text))
+      fail(name, fmt::format("PROTO {} contains an instance of itself (directly or through other PROTOs)", name.text));
+    protoUses_[std::string(name.text)] = std::move(used);
   }
 
   void externProto() {
@@ -288,6 +308,7 @@ class Scanner {
       def = std::string(expectName("a name after DEF").text);
     }
     const Token type = expectName("a node type");
+    for (auto& used : bodyTypes_) used.emplace(type.text);
     if (type.text == "DEF" || type.text == "USE" || type.text == "PROTO" || type.text == "ROUTE")
       fail(type, fmt::format("expected a node type, found {}", describe(type)));
     Scope& scope = scopes_.back();
@@ -435,6 +456,8 @@ class Scanner {
   int depth_ = 0;
   std::vector<Scope> scopes_;
   std::map<std::string, Known, std::less<>> protos_;
+  std::vector<std::set<std::string, std::less<>>> bodyTypes_;  ///< node types used in each open PROTO
+  std::map<std::string, std::set<std::string, std::less<>>, std::less<>> protoUses_;  ///< all types a PROTO's instance contains
   std::vector<std::pair<std::size_t, std::string>> insertions_;
   ScanResult result_;
 };

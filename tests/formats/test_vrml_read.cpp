@@ -147,6 +147,10 @@ TEST(VrmlRead, CoinsOwnCrashAndHangStayInTheChild) {
   const std::string crash = "#VRML V2.0 utf8\nDEF T Transform { children Shape { geometry USE T\n";
   const std::string crashMessage = errorOf([&] { (void)readText(crash, "crash.wrl", ".", raw); });
   EXPECT_EQ(crashMessage.rfind("crash.wrl: the VRML97 reader failed (signal ", 0), 0u) << crashMessage;
+  const std::string recursive = "#VRML V2.0 utf8\nPROTO P [ ] { Group { children P { } } }\nP { }\n";
+  const std::string recursiveMessage = errorOf([&] { (void)readText(recursive, "doll.wrl", ".", raw); });
+  // A stack overflow: signal 11, or the time limit when the sanitizers make it slow.
+  EXPECT_EQ(recursiveMessage.rfind("doll.wrl: the VRML97 reader failed (", 0), 0u) << recursiveMessage;
   const std::string hang("MM\x02\x00", 4);
   const std::string hangMessage = errorOf([&] { (void)readText(hang, "hang.wrl", ".", raw); });
   EXPECT_EQ(hangMessage.rfind("hang.wrl: the VRML97 reader failed (time limit", 0), 0u) << hangMessage;

@@ -73,6 +73,16 @@ TEST(VrmlScan, ChecksFieldsOfKnownProtosAndInjectsTags) {
   EXPECT_EQ(own.text.find("drapeNodeId"), std::string::npos);
 }
 
+// Found while fuzzing by hand: Coin expands a PROTO that contains itself until its stack
+// overflows (signal 11 in the reader's child).
+TEST(VrmlScan, RecursivePrototypesAreRejected) {
+  EXPECT_EQ(errorOf("#VRML V2.0 utf8\nPROTO P [ ] { Group { children P { } } }\nP { }\n"),
+            "t.wrl:2:7: PROTO P contains an instance of itself (directly or through other PROTOs)");
+  EXPECT_EQ(errorOf("#VRML V2.0 utf8\nPROTO A [ ] { Group { } }\nPROTO B [ ] { A { } }\nPROTO A [ ] { B { } }\n"),
+            "t.wrl:4:7: PROTO A contains an instance of itself (directly or through other PROTOs)");
+  EXPECT_EQ(errorOf("#VRML V2.0 utf8\nPROTO A [ ] { Group { } }\nPROTO B [ ] { A { } }\nB { }\n"), "(no error)");
+}
+
 TEST(VrmlScan, LimitsNesting) {
   std::string deep = "#VRML V2.0 utf8\n";
   for (int i = 0; i < 100; ++i) deep += "Group { children [ ";

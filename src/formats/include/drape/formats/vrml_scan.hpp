@@ -45,9 +45,9 @@ struct ScanOptions {
 };
 
 struct ScanResult {
-  std::string text;                       ///< the input, with drapeNodeId tags injected
-  std::vector<ProtoInterface> declared;   ///< PROTOs and EXTERNPROTOs the file declares
-  std::vector<NodeSite> sites;            ///< instances of tracked types, in file order
+  std::string text;                      ///< the input, with drapeNodeId tags injected
+  std::vector<ProtoInterface> declared;  ///< PROTOs and EXTERNPROTOs the file declares
+  std::vector<NodeSite> sites;           ///< instances of tracked types, in file order
 };
 
 /// Scans `text` read from `file` (used in messages). Throws drape::Error

@@ -20,7 +20,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     // Relative Inline/EXTERNPROTO URLs resolve against the real data, so inputs that
     // mutate GR001's Inlines reach the Inline path.
-    const auto document = drape::formats::vrml::readText(text, "fuzz.wrl", DRAPE_SOURCE_DIR "/data/vrml/choreonoid_GR001", options);
+    const auto document =
+        drape::formats::vrml::readText(text, "fuzz.wrl", DRAPE_SOURCE_DIR "/data/vrml/choreonoid_GR001", options);
     (void)drape::scene::buildScene(document);
   } catch (const drape::Error&) {
     // A clear message: the expected outcome for malformed input.

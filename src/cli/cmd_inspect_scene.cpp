@@ -20,7 +20,8 @@ void printJoint(std::ostream& out, const scene::Avatar& a, int joint, int depth)
       triangles += s.mesh.triangleCount();
       ++segments;
     }
-  fmt::print(out, "    {:{}}{}  at ({:.3f} {:.3f} {:.3f}) m", "", depth * 2, j.name, j.restCenter.x(), j.restCenter.y(), j.restCenter.z());
+  fmt::print(out, "    {:{}}{}  at ({:.3f} {:.3f} {:.3f}) m", "", depth * 2, j.name, j.restCenter.x(), j.restCenter.y(),
+             j.restCenter.z());
   if (segments > 0) fmt::print(out, "  [{} segment{}, {} triangles]", segments, segments == 1 ? "" : "s", triangles);
   fmt::print(out, "\n");
   for (std::size_t c = 0; c < a.joints.size(); ++c)
@@ -34,16 +35,21 @@ void printGarment(std::ostream& out, const scene::Scene& s, const scene::Garment
     fmt::print(out, ", {} non-manifold edges (cannot be simulated as cloth)\n", nonManifold);
   } else {
     const mesh::Topology t = mesh::Topology::build(g.mesh);
-    fmt::print(out, ", {} edges, {} boundary loop{}\n", t.edges.size(), t.boundaryLoops.size(), t.boundaryLoops.size() == 1 ? "" : "s");
+    fmt::print(out, ", {} edges, {} boundary loop{}\n", t.edges.size(), t.boundaryLoops.size(),
+               t.boundaryLoops.size() == 1 ? "" : "s");
   }
   const Aabb box = g.mesh.bounds();
-  fmt::print(out, "    bounds [{:.3f} {:.3f} {:.3f}] .. [{:.3f} {:.3f} {:.3f}] m\n", box.min.x(), box.min.y(), box.min.z(), box.max.x(),
-             box.max.y(), box.max.z());
+  fmt::print(out, "    bounds [{:.3f} {:.3f} {:.3f}] .. [{:.3f} {:.3f} {:.3f}] m\n", box.min.x(), box.min.y(),
+             box.min.z(), box.max.x(), box.max.y(), box.max.z());
   fmt::print(out, "    material {}, constraint mask {} vertices (tolerance {:g} m, bind threshold {:g} m)\n",
-             s.materials[static_cast<std::size_t>(g.material)].name, g.maskVertices.size(), g.maskTolerance, g.bindThreshold);
+             s.materials[static_cast<std::size_t>(g.material)].name, g.maskVertices.size(), g.maskTolerance,
+             g.bindThreshold);
   if (g.avatar >= 0) fmt::print(out, "    worn by {}\n", s.avatars[static_cast<std::size_t>(g.avatar)].name);
-  if (g.externalAvatar >= 0) fmt::print(out, "    worn by {}\n", s.externalAvatars[static_cast<std::size_t>(g.externalAvatar)].name);
-  fmt::print(out, "    collides with {}\n", g.collidesWith.empty() ? std::string("every segment") : fmt::format("{}", fmt::join(g.collidesWith, ", ")));
+  if (g.externalAvatar >= 0)
+    fmt::print(out, "    worn by {}\n", s.externalAvatars[static_cast<std::size_t>(g.externalAvatar)].name);
+  fmt::print(
+      out, "    collides with {}\n",
+      g.collidesWith.empty() ? std::string("every segment") : fmt::format("{}", fmt::join(g.collidesWith, ", ")));
 }
 
 void inspectScene(const std::string& path, std::ostream& out) {
@@ -53,39 +59,47 @@ void inspectScene(const std::string& path, std::ostream& out) {
   for (const scene::Avatar& a : s.avatars) {
     std::size_t triangles = 0;
     for (const scene::Segment& seg : a.segments) triangles += seg.mesh.triangleCount();
-    fmt::print(out, "  {} (H-Anim): {} joints, {} segments, {} triangles\n", a.name, a.joints.size(), a.segments.size(), triangles);
+    fmt::print(out, "  {} (H-Anim): {} joints, {} segments, {} triangles\n", a.name, a.joints.size(), a.segments.size(),
+               triangles);
     for (std::size_t j = 0; j < a.joints.size(); ++j)
       if (a.joints[j].parent < 0) printJoint(out, a, static_cast<int>(j), 0);
   }
   for (const scene::ExternalAvatar& a : s.externalAvatars)
-    fmt::print(out, "  {} (from {}){}\n", a.name, fmt::join(a.urls, ", "), a.jointMap.empty() ? "" : fmt::format(", joint map {}", fmt::join(a.jointMap, ", ")));
+    fmt::print(out, "  {} (from {}){}\n", a.name, fmt::join(a.urls, ", "),
+               a.jointMap.empty() ? "" : fmt::format(", joint map {}", fmt::join(a.jointMap, ", ")));
   fmt::print(out, "garments: {}\n", s.garments.size());
   for (const scene::Garment& g : s.garments) printGarment(out, s, g);
   fmt::print(out, "materials: {}\n", s.materials.size());
   for (const scene::ClothMaterial& m : s.materials) {
-    fmt::print(out, "  {}: density {:g} kg/m^3, thickness {:g} m ({:.4g} kg/m^2), Young's modulus {:g} Pa, Poisson ratio {:g}\n", m.name,
-               m.density, m.thickness, m.arealDensity(), m.youngsModulus, m.poissonRatio);
-    fmt::print(out, "    bending stiffness {:.4g} N m{}, damping {:g}, friction {:g} static / {:g} dynamic, compression scale {:g}\n",
-               m.bendingStiffnessOrDerived(), m.bendingStiffness < 0 ? " (from E, t, nu)" : "", m.damping, m.staticFriction,
-               m.dynamicFriction, m.compressionScale);
+    fmt::print(
+        out,
+        "  {}: density {:g} kg/m^3, thickness {:g} m ({:.4g} kg/m^2), Young's modulus {:g} Pa, Poisson ratio {:g}\n",
+        m.name, m.density, m.thickness, m.arealDensity(), m.youngsModulus, m.poissonRatio);
+    fmt::print(out,
+               "    bending stiffness {:.4g} N m{}, damping {:g}, friction {:g} static / {:g} dynamic, compression "
+               "scale {:g}\n",
+               m.bendingStiffnessOrDerived(), m.bendingStiffness < 0 ? " (from E, t, nu)" : "", m.damping,
+               m.staticFriction, m.dynamicFriction, m.compressionScale);
   }
   const scene::SimulationSettings& sim = s.simulation;
   fmt::print(out, "simulation{}:\n", s.hasSimulationNode ? "" : " (defaults: no Simulation node)");
-  fmt::print(out, "  gravity ({:g} {:g} {:g}) m/s^2, wind ({:g} {:g} {:g}) m/s, air viscosity {:g}\n", sim.gravity.x(), sim.gravity.y(),
-             sim.gravity.z(), sim.wind.x(), sim.wind.y(), sim.wind.z(), sim.airViscosity);
-  fmt::print(out, "  {:g} frames/s x {} steps/frame ({}), collisions every {} step{}\n", sim.frameRate, sim.stepsPerFrame, sim.integrator,
-             sim.collisionEvery, sim.collisionEvery == 1 ? "" : "s");
-  fmt::print(out, "  offsets T0..T3 {:g} {:g} {:g} {:g} m, voxel size {:g} m, unit scale {:g} m per file unit\n", sim.offsets[0],
-             sim.offsets[1], sim.offsets[2], sim.offsets[3], sim.voxelSize, sim.unitScale);
+  fmt::print(out, "  gravity ({:g} {:g} {:g}) m/s^2, wind ({:g} {:g} {:g}) m/s, air viscosity {:g}\n", sim.gravity.x(),
+             sim.gravity.y(), sim.gravity.z(), sim.wind.x(), sim.wind.y(), sim.wind.z(), sim.airViscosity);
+  fmt::print(out, "  {:g} frames/s x {} steps/frame ({}), collisions every {} step{}\n", sim.frameRate,
+             sim.stepsPerFrame, sim.integrator, sim.collisionEvery, sim.collisionEvery == 1 ? "" : "s");
+  fmt::print(out, "  offsets T0..T3 {:g} {:g} {:g} {:g} m, voxel size {:g} m, unit scale {:g} m per file unit\n",
+             sim.offsets[0], sim.offsets[1], sim.offsets[2], sim.offsets[3], sim.voxelSize, sim.unitScale);
   if (!s.scenery.empty()) {
     std::size_t triangles = 0;
     for (const scene::Scenery& m : s.scenery) triangles += m.mesh.triangleCount();
-    fmt::print(out, "scenery: {} shape{}, {} triangles\n", s.scenery.size(), s.scenery.size() == 1 ? "" : "s", triangles);
+    fmt::print(out, "scenery: {} shape{}, {} triangles\n", s.scenery.size(), s.scenery.size() == 1 ? "" : "s",
+               triangles);
   }
   for (const std::string& w : s.warnings) fmt::print(out, "warning: {}\n", w);
 }
 
-const bool registered = registerInspector({".wrl", ".vrml"}, "VRML97 scenes: avatars, garments, materials, simulation", &inspectScene);
+const bool registered =
+    registerInspector({".wrl", ".vrml"}, "VRML97 scenes: avatars, garments, materials, simulation", &inspectScene);
 
 }  // namespace
 }  // namespace drape::cli

@@ -12,7 +12,6 @@
 #include <Inventor/VRMLnodes/SoVRMLElevationGrid.h>
 #include <Inventor/VRMLnodes/SoVRMLExtrusion.h>
 #include <Inventor/VRMLnodes/SoVRMLGroup.h>
-#include <Inventor/VRMLnodes/SoVRMLImageTexture.h>
 #include <Inventor/VRMLnodes/SoVRMLIndexedFaceSet.h>
 #include <Inventor/VRMLnodes/SoVRMLInline.h>
 #include <Inventor/VRMLnodes/SoVRMLSphere.h>
@@ -86,12 +85,14 @@ void onReadError(const SoError* error, void*) {
   if (const std::size_t at = text.find(marker); at != std::string::npos) {
     std::size_t i = at + marker.size();
     while (i < text.size() && text[i] == ' ') ++i;
-    while (i < text.size() && text[i] >= '0' && text[i] <= '9' && line < 100'000'000) line = line * 10 + (text[i++] - '0');
+    while (i < text.size() && text[i] >= '0' && text[i] <= '9' && line < 100'000'000)
+      line = line * 10 + (text[i++] - '0');
   }
   std::string what = firstLine(text);
   const std::string prefix = "Coin read error: ";
   if (what.rfind(prefix, 0) == 0) what = what.substr(prefix.size());
-  for (std::size_t at = what.find("\"VRML"); at != std::string::npos; at = what.find("\"VRML", at)) what.erase(at + 1, 4);
+  for (std::size_t at = what.find("\"VRML"); at != std::string::npos; at = what.find("\"VRML", at))
+    what.erase(at + 1, 4);
   gMessages->readErrors.push_back(what);
   gMessages->readErrorLines.push_back(line);
 }
@@ -318,7 +319,8 @@ class Converter {
     container.getFields(list);
     // Coin leaves eventIns out of getFields(); the one drape follows (an interpolator's
     // set_fraction, fed by a TimeSensor) is looked up by name.
-    if (SoField* fraction = container.getField("set_fraction"); fraction != nullptr && list.find(fraction) < 0) list.append(fraction);
+    if (SoField* fraction = container.getField("set_fraction"); fraction != nullptr && list.find(fraction) < 0)
+      list.append(fraction);
     const NodeSite* site = nullptr;
     for (int i = 0; i < list.getLength(); ++i) {
       SoField* f = list[i];
@@ -326,7 +328,8 @@ class Converter {
       container.getFieldName(f, name);
       if (std::string(name.getString()) == "drapeNodeId") {
         const int id = static_cast<SoSFInt32*>(f)->getValue();
-        if (id >= 0 && static_cast<std::size_t>(id) < sites_.back()->size()) site = &(*sites_.back())[static_cast<std::size_t>(id)];
+        if (id >= 0 && static_cast<std::size_t>(id) < sites_.back()->size())
+          site = &(*sites_.back())[static_cast<std::size_t>(id)];
         continue;
       }
       Field field;
@@ -519,8 +522,10 @@ class Converter {
       const std::string path = resolveUrl(urls.back(), baseDir);
       if (path.empty()) continue;
       if (std::find(reader_.fileStack.begin(), reader_.fileStack.end(), path) != reader_.fileStack.end())
-        throw Error(fmt::format("{}: Inline '{}' includes itself (directly or through other Inlines)", files_.back(), urls.back()));
-      if (reader_.fileStack.size() > 16) throw Error(fmt::format("{}: Inline files nested deeper than 16", files_.back()));
+        throw Error(fmt::format("{}: Inline '{}' includes itself (directly or through other Inlines)", files_.back(),
+                                urls.back()));
+      if (reader_.fileStack.size() > 16)
+        throw Error(fmt::format("{}: Inline files nested deeper than 16", files_.back()));
       const std::string text = readBytes(path);
       const ScanResult scanned = scan(text, path, scanOptions());
       reader_.fileStack.push_back(path);

@@ -48,7 +48,8 @@ std::string readBytes(const std::string& path) {
   if (std::filesystem::is_directory(path, ec)) throw Error(fmt::format("{}: is a directory, not a VRML97 file", path));
   const std::uintmax_t size = std::filesystem::file_size(path, ec);
   if (ec) throw Error(fmt::format("{}: cannot read ({})", path, ec.message()));
-  if (size > kMaxBytes) throw Error(fmt::format("{}: {} bytes is more than drape reads as VRML97 (512 MiB)", path, size));
+  if (size > kMaxBytes)
+    throw Error(fmt::format("{}: {} bytes is more than drape reads as VRML97 (512 MiB)", path, size));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(fmt::format("{}: cannot open", path));
   std::ostringstream s;
@@ -81,7 +82,8 @@ bool isDrapeNodeType(std::string_view type) {
   return type == "ClothSet" || type == "ClothMaterial" || type == "Simulation" || type == "Avatar";
 }
 
-Document readText(std::string_view text, const std::string& name, const std::string& baseDir, const ReadOptions& options) {
+Document readText(std::string_view text, const std::string& name, const std::string& baseDir,
+                  const ReadOptions& options) {
   ScanResult scanned;
   if (options.prescan) {
     scanned = scan(text, name, detail::scanOptions());

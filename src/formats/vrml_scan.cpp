@@ -60,11 +60,20 @@ class Lexer {
     if (pos_ >= text_.size()) return t;
     const unsigned char c = static_cast<unsigned char>(text_[pos_]);
     switch (c) {
-      case '{': t.kind = Tok::OpenBrace; break;
-      case '}': t.kind = Tok::CloseBrace; break;
-      case '[': t.kind = Tok::OpenBracket; break;
-      case ']': t.kind = Tok::CloseBracket; break;
-      default: break;
+      case '{':
+        t.kind = Tok::OpenBrace;
+        break;
+      case '}':
+        t.kind = Tok::CloseBrace;
+        break;
+      case '[':
+        t.kind = Tok::OpenBracket;
+        break;
+      case ']':
+        t.kind = Tok::CloseBracket;
+        break;
+      default:
+        break;
     }
     if (t.kind != Tok::End) {
       t.text = text_.substr(pos_, 1);
@@ -197,8 +206,9 @@ class Scanner {
   void proto() {
     const Token keyword = take();
     const Token name = expectName("a PROTO name");
-    ProtoInterface interface{std::string(name.text), {}, keyword.line, false};
+    ProtoInterface interface { std::string(name.text), {}, keyword.line, false };
     scopes_.emplace_back();
+    bodyTypes_.emplace_back();
     open(expect(Tok::OpenBracket, "'[' after the PROTO name"));
     while (current_.kind != Tok::CloseBracket) {
       const Token kind = expect(Tok::Id, "a field declaration or ']'");
@@ -214,19 +224,39 @@ class Scanner {
     close();
     open(expect(Tok::OpenBrace, "'{' (the PROTO body)"));
     while (current_.kind != Tok::CloseBrace) {
-      if (current_.kind == Tok::End) fail(current_, fmt::format("unexpected end of file in PROTO {} (missing '}}')", name.text));
+      if (current_.kind == Tok::End)
+        fail(current_, fmt::format("unexpected end of file in PROTO {} (missing '}}')", name.text));
       statement();
     }
     take();
     close();
     scopes_.pop_back();
+    checkRecursion(name, std::move(bodyTypes_.back()));
+    bodyTypes_.pop_back();
     declare(std::move(interface));
+  }
+
+  /// A PROTO whose instances contain, directly or through other PROTOs, an instance of
+  /// itself: Coin expands it without end and overflows its stack.
+  void checkRecursion(const Token& name, std::set<std::string, std::less<>> used) {
+    std::vector<std::string> work(used.begin(), used.end());
+    while (!work.empty()) {
+      const std::string type = work.back();
+      work.pop_back();
+      const auto it = protoUses_.find(type);
+      if (it == protoUses_.end()) continue;
+      for (const std::string& t : it->second)
+        if (used.insert(t).second) work.push_back(t);
+    }
+    if (used.contains(name.text))
+      fail(name, fmt::format("PROTO {} contains an instance of itself (directly or through other PROTOs)", name.text));
+    protoUses_[std::string(name.text)] = std::move(used);
   }
 
   void externProto() {
     const Token keyword = take();
     const Token name = expectName("an EXTERNPROTO name");
-    ProtoInterface interface{std::string(name.text), {}, keyword.line, true};
+    ProtoInterface interface { std::string(name.text), {}, keyword.line, true };
     open(expect(Tok::OpenBracket, "'[' after the EXTERNPROTO name"));
     while (current_.kind != Tok::CloseBracket) {
       const Token kind = expect(Tok::Id, "a field declaration or ']'");
@@ -272,7 +302,8 @@ class Scanner {
     if (dot == std::string_view::npos || dot == 0 || dot + 1 == t.text.size())
       fail(t, fmt::format("expected 'node.event' in ROUTE, found {}", describe(t)));
     const std::string_view node = t.text.substr(0, dot);
-    if (!scopes_.back().defs.contains(node)) fail(t, fmt::format("ROUTE names '{}', which no DEF before it declares", node));
+    if (!scopes_.back().defs.contains(node))
+      fail(t, fmt::format("ROUTE names '{}', which no DEF before it declares", node));
   }
 
   // node: DEF name Type { body } | USE name | Type { body } | NULL
@@ -288,6 +319,7 @@ class Scanner {
       def = std::string(expectName("a name after DEF").text);
     }
     const Token type = expectName("a node type");
+    for (auto& used : bodyTypes_) used.emplace(type.text);
     if (type.text == "DEF" || type.text == "USE" || type.text == "PROTO" || type.text == "ROUTE")
       fail(type, fmt::format("expected a node type, found {}", describe(type)));
     Scope& scope = scopes_.back();
@@ -314,8 +346,8 @@ class Scanner {
   void body(const Token& type, const std::string& def, const Token& brace) {
     const std::string typeName(type.text);
     const auto known = protos_.find(typeName);
-    const bool tracked = std::find(options_.trackedTypes.begin(), options_.trackedTypes.end(), typeName) !=
-                         options_.trackedTypes.end();
+    const bool tracked =
+        std::find(options_.trackedTypes.begin(), options_.trackedTypes.end(), typeName) != options_.trackedTypes.end();
     int site = -1;
     if (tracked) {
       site = static_cast<int>(result_.sites.size());
@@ -325,7 +357,8 @@ class Scanner {
     }
     while (current_.kind != Tok::CloseBrace) {
       if (current_.kind == Tok::End)
-        fail(current_, fmt::format("unexpected end of file in {} (the '{{' at line {} is not closed)", typeName, brace.line));
+        fail(current_,
+             fmt::format("unexpected end of file in {} (the '{{' at line {} is not closed)", typeName, brace.line));
       if (isId("ROUTE")) {
         route();
         continue;
@@ -355,7 +388,8 @@ class Scanner {
     std::vector<std::string> visible;
     for (const std::string& name : f)
       if (name != "drapeNodeId") visible.push_back(name);
-    fail(field, fmt::format("unknown field '{}' in {} (its fields: {})", field.text, interface.name, fmt::join(visible, ", ")));
+    fail(field, fmt::format("unknown field '{}' in {} (its fields: {})", field.text, interface.name,
+                            fmt::join(visible, ", ")));
   }
 
   // value: [ elements ] | node | IS name | numbers | string | TRUE | FALSE
@@ -366,7 +400,8 @@ class Scanner {
         open(bracket);
         while (current_.kind != Tok::CloseBracket) {
           if (current_.kind == Tok::End)
-            fail(current_, fmt::format("unexpected end of file in the value of {} (the '[' at line {} is not closed)", field, bracket.line));
+            fail(current_, fmt::format("unexpected end of file in the value of {} (the '[' at line {} is not closed)",
+                                       field, bracket.line));
           element(field);
         }
         take();
@@ -435,6 +470,9 @@ class Scanner {
   int depth_ = 0;
   std::vector<Scope> scopes_;
   std::map<std::string, Known, std::less<>> protos_;
+  std::vector<std::set<std::string, std::less<>>> bodyTypes_;  ///< node types used in each open PROTO
+  std::map<std::string, std::set<std::string, std::less<>>, std::less<>>
+      protoUses_;  ///< all types a PROTO's instance contains
   std::vector<std::pair<std::size_t, std::string>> insertions_;
   ScanResult result_;
 };

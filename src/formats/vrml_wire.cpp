@@ -67,7 +67,8 @@ Document fromWire(std::string_view bytes, const std::string& what) {
     for (const fb::String* w : *in->warnings()) doc.warnings.push_back(str(w));
   const auto nodeCount = static_cast<std::int32_t>(in->nodes() == nullptr ? 0 : in->nodes()->size());
   const auto checkIndex = [&](std::int32_t i) {
-    if (i < -1 || i >= nodeCount) throw Error(fmt::format("{}: the VRML97 reader sent a node index out of range", what), ExitCode::Internal);
+    if (i < -1 || i >= nodeCount)
+      throw Error(fmt::format("{}: the VRML97 reader sent a node index out of range", what), ExitCode::Internal);
   };
   for (std::int32_t r : doc.roots) checkIndex(r);
   if (in->nodes() != nullptr) {
@@ -93,7 +94,8 @@ Document fromWire(std::string_view bytes, const std::string& what) {
         for (const wire::Field* f : *n->fields()) {
           Field field;
           field.name = str(f->name());
-          field.kind = static_cast<FieldKind>(std::min<std::uint8_t>(f->kind(), static_cast<std::uint8_t>(FieldKind::Other)));
+          field.kind =
+              static_cast<FieldKind>(std::min<std::uint8_t>(f->kind(), static_cast<std::uint8_t>(FieldKind::Other)));
           field.multiple = f->multiple();
           field.numbers = vec(f->numbers());
           if (f->strings() != nullptr)

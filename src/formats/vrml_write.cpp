@@ -38,7 +38,8 @@ struct File {
 
 void keys(File& out, std::size_t frames) {
   out.print("    key [");
-  for (std::size_t i = 0; i < frames; ++i) out.print(" {:.7g}", frames == 1 ? 0.0 : static_cast<double>(i) / static_cast<double>(frames - 1));
+  for (std::size_t i = 0; i < frames; ++i)
+    out.print(" {:.7g}", frames == 1 ? 0.0 : static_cast<double>(i) / static_cast<double>(frames - 1));
   out.print(" ]\n");
 }
 
@@ -50,9 +51,13 @@ void triangles(File& out, const std::vector<mesh::Triangle>& tris, const char* i
 
 void garment(File& out, const GarmentTrack& g, const std::string& def) {
   const std::size_t n = g.frames.front().size();
-  out.print("DEF {} Shape {{\n  appearance Appearance {{ material Material {{ diffuseColor {:.3g} {:.3g} {:.3g} }} }}\n", def, g.color.x(),
-            g.color.y(), g.color.z());
-  out.print("  geometry IndexedFaceSet {{\n    solid FALSE\n    creaseAngle 1.0\n    coord DEF {}_coord Coordinate {{\n      point [\n", def);
+  out.print(
+      "DEF {} Shape {{\n  appearance Appearance {{ material Material {{ diffuseColor {:.3g} {:.3g} {:.3g} }} }}\n", def,
+      g.color.x(), g.color.y(), g.color.z());
+  out.print(
+      "  geometry IndexedFaceSet {{\n    solid FALSE\n    creaseAngle 1.0\n    coord DEF {}_coord Coordinate {{\n      "
+      "point [\n",
+      def);
   for (const Vec3& p : g.frames.front()) out.print("        {:.7g} {:.7g} {:.7g}\n", p.x(), p.y(), p.z());
   out.print("      ]\n    }}\n");
   triangles(out, g.triangles, "    ");
@@ -61,7 +66,9 @@ void garment(File& out, const GarmentTrack& g, const std::string& def) {
   keys(out, g.frames.size());
   out.print("    keyValue [\n");
   for (const auto& frame : g.frames) {
-    if (frame.size() != n) throw Error(fmt::format("{}: garment {}: frames have different vertex counts ({} and {})", out.path, g.name, n, frame.size()));
+    if (frame.size() != n)
+      throw Error(fmt::format("{}: garment {}: frames have different vertex counts ({} and {})", out.path, g.name, n,
+                              frame.size()));
     for (const Vec3& p : frame) out.print("      {:.7g} {:.7g} {:.7g}\n", p.x(), p.y(), p.z());
   }
   out.print("    ]\n}}\n");
@@ -70,8 +77,10 @@ void garment(File& out, const GarmentTrack& g, const std::string& def) {
 void joint(File& out, const JointTrack& j, const std::string& def) {
   const RigidTransform& first = j.frames.front();
   const Eigen::AngleAxisd r0(first.rotation);
-  out.print("DEF {} Transform {{\n  translation {:.7g} {:.7g} {:.7g}\n  rotation {:.7g} {:.7g} {:.7g} {:.7g}\n  children [\n", def,
-            first.translation.x(), first.translation.y(), first.translation.z(), r0.axis().x(), r0.axis().y(), r0.axis().z(), r0.angle());
+  out.print(
+      "DEF {} Transform {{\n  translation {:.7g} {:.7g} {:.7g}\n  rotation {:.7g} {:.7g} {:.7g} {:.7g}\n  children [\n",
+      def, first.translation.x(), first.translation.y(), first.translation.z(), r0.axis().x(), r0.axis().y(),
+      r0.axis().z(), r0.angle());
   for (const mesh::TriMesh& m : j.segments) {
     out.print("    Shape {{\n      appearance Appearance {{ material Material {{ diffuseColor 0.75 0.7 0.65 }} }}\n");
     out.print("      geometry IndexedFaceSet {{\n        coord Coordinate {{\n          point [\n");
@@ -84,7 +93,8 @@ void joint(File& out, const JointTrack& j, const std::string& def) {
   out.print("DEF {}_position PositionInterpolator {{\n", def);
   keys(out, j.frames.size());
   out.print("    keyValue [\n");
-  for (const RigidTransform& t : j.frames) out.print("      {:.7g} {:.7g} {:.7g}\n", t.translation.x(), t.translation.y(), t.translation.z());
+  for (const RigidTransform& t : j.frames)
+    out.print("      {:.7g} {:.7g} {:.7g}\n", t.translation.x(), t.translation.y(), t.translation.z());
   out.print("    ]\n}}\n");
   out.print("DEF {}_orientation OrientationInterpolator {{\n", def);
   keys(out, j.frames.size());
@@ -104,16 +114,21 @@ void writeAnimation(const std::string& path, const Animation& animation) {
   for (const JointTrack& j : animation.joints) frames = std::max(frames, j.frames.size());
   if (frames == 0) throw Error(fmt::format("{}: nothing to write (no frames)", path));
   for (const GarmentTrack& g : animation.garments)
-    if (g.frames.size() != frames) throw Error(fmt::format("{}: garment {} has {} frames, others {}", path, g.name, g.frames.size(), frames));
+    if (g.frames.size() != frames)
+      throw Error(fmt::format("{}: garment {} has {} frames, others {}", path, g.name, g.frames.size(), frames));
   for (const JointTrack& j : animation.joints)
-    if (j.frames.size() != frames) throw Error(fmt::format("{}: joint {} has {} frames, others {}", path, j.name, j.frames.size(), frames));
-  if (!(animation.frameRate > 0.0)) throw Error(fmt::format("{}: frame rate {:g} must be positive", path, animation.frameRate));
+    if (j.frames.size() != frames)
+      throw Error(fmt::format("{}: joint {} has {} frames, others {}", path, j.name, j.frames.size(), frames));
+  if (!(animation.frameRate > 0.0))
+    throw Error(fmt::format("{}: frame rate {:g} must be positive", path, animation.frameRate));
 
   File out{{std::fopen(path.c_str(), "w"), &std::fclose}, path};
   if (!out.f) throw Error(fmt::format("{}: cannot write", path));
   const double cycle = frames > 1 ? static_cast<double>(frames - 1) / animation.frameRate : 1.0 / animation.frameRate;
-  out.print("#VRML V2.0 utf8\n# Written by drape: {} frames at {:g} frames/s. Positions in metres.\n\n", frames, animation.frameRate);
-  out.print("WorldInfo {{ title \"drape result\" info [ \"frames {}\" \"frameRate {:g}\" ] }}\n", frames, animation.frameRate);
+  out.print("#VRML V2.0 utf8\n# Written by drape: {} frames at {:g} frames/s. Positions in metres.\n\n", frames,
+            animation.frameRate);
+  out.print("WorldInfo {{ title \"drape result\" info [ \"frames {}\" \"frameRate {:g}\" ] }}\n", frames,
+            animation.frameRate);
   out.print("NavigationInfo {{ type [ \"EXAMINE\" \"ANY\" ] }}\n");
   out.print("DEF Clock TimeSensor {{ cycleInterval {:.9g} loop TRUE }}\n\n", cycle);
   std::vector<std::string> used{"Clock"};
@@ -131,17 +146,21 @@ void writeAnimation(const std::string& path, const Animation& animation) {
     joint(out, j, def);
     for (const char* kind : {"position", "orientation"}) {
       routes.push_back(fmt::format("ROUTE Clock.fraction_changed TO {}_{}.set_fraction", def, kind));
-      routes.push_back(fmt::format("ROUTE {}_{}.value_changed TO {}.set_{}", def, kind, def, kind[0] == 'p' ? "translation" : "rotation"));
+      routes.push_back(fmt::format("ROUTE {}_{}.value_changed TO {}.set_{}", def, kind, def,
+                                   kind[0] == 'p' ? "translation" : "rotation"));
     }
   }
   out.print("\n");
   for (const std::string& r : routes) out.print("{}\n", r);
-  if (std::fflush(out.f.get()) != 0 || std::ferror(out.f.get()) != 0) throw Error(fmt::format("{}: write failed", path));
+  if (std::fflush(out.f.get()) != 0 || std::ferror(out.f.get()) != 0)
+    throw Error(fmt::format("{}: write failed", path));
 }
 
-std::vector<double> sampleAnimatedField(const Document& document, std::int32_t node, const std::string& field, double time) {
+std::vector<double> sampleAnimatedField(const Document& document, std::int32_t node, const std::string& field,
+                                        double time) {
   const auto at = [&](std::int32_t i) -> const Node* {
-    return i >= 0 && static_cast<std::size_t>(i) < document.nodes.size() ? &document.nodes[static_cast<std::size_t>(i)] : nullptr;
+    return i >= 0 && static_cast<std::size_t>(i) < document.nodes.size() ? &document.nodes[static_cast<std::size_t>(i)]
+                                                                         : nullptr;
   };
   const Node* target = at(node);
   const Field* f = target != nullptr ? target->field(field) : nullptr;
@@ -157,7 +176,8 @@ std::vector<double> sampleAnimatedField(const Document& document, std::int32_t n
   // Time -> fraction through the TimeSensor (looping or not); no sensor: time is the fraction.
   double t = time;
   if (const Node* sensor = fraction != nullptr ? at(fraction->routeFromNode) : nullptr) {
-    const double cycle = sensor->field("cycleInterval") != nullptr ? sensor->field("cycleInterval")->numbers.at(0) : 1.0;
+    const double cycle =
+        sensor->field("cycleInterval") != nullptr ? sensor->field("cycleInterval")->numbers.at(0) : 1.0;
     const bool loop = sensor->field("loop") != nullptr && sensor->field("loop")->numbers.at(0) != 0.0;
     t = cycle > 0 ? time / cycle : 0.0;
     if (loop && t > 1.0) t -= std::floor(t);

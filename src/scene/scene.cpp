@@ -14,7 +14,9 @@ namespace {
   throw Error::at(at, fmt::format("{}: {}", node, what));
 }
 
-std::string label(const char* type, const std::string& name) { return name.empty() ? type : fmt::format("{} {}", type, name); }
+std::string label(const char* type, const std::string& name) {
+  return name.empty() ? type : fmt::format("{} {}", type, name);
+}
 
 }  // namespace
 
@@ -27,7 +29,9 @@ void validate(const ClothMaterial& m) {
   const std::string node = label("ClothMaterial", m.name);
   const auto positive = [&](double v, const char* field, const char* unit) {
     if (!std::isfinite(v) || v <= 0.0)
-      bad(m.source, node, fmt::format("{} {:g} {} is {} (it must be greater than 0)", field, v, unit, v < 0 ? "negative" : "not positive"));
+      bad(m.source, node,
+          fmt::format("{} {:g} {} is {} (it must be greater than 0)", field, v, unit,
+                      v < 0 ? "negative" : "not positive"));
   };
   positive(m.density, "density", "kg/m^3");
   positive(m.thickness, "thickness", "m");
@@ -35,7 +39,8 @@ void validate(const ClothMaterial& m) {
   if (!std::isfinite(m.poissonRatio) || m.poissonRatio < 0.0 || m.poissonRatio >= 0.5)
     bad(m.source, node, fmt::format("poissonRatio {:g} is outside [0, 0.5)", m.poissonRatio));
   const auto nonNegative = [&](double v, const char* field) {
-    if (!std::isfinite(v) || v < 0.0) bad(m.source, node, fmt::format("{} {:g} is negative (it must be >= 0)", field, v));
+    if (!std::isfinite(v) || v < 0.0)
+      bad(m.source, node, fmt::format("{} {:g} is negative (it must be >= 0)", field, v));
   };
   if (!std::isfinite(m.bendingStiffness)) bad(m.source, node, "bendingStiffness is not a number");
   nonNegative(m.damping, "damping");
@@ -62,7 +67,9 @@ void validate(const SimulationSettings& s) {
     if (!std::isfinite(s.offsets[i]) || s.offsets[i] < 0.0)
       bad(s.source, node, fmt::format("offsets: T{} = {:g} m is negative", i, s.offsets[i]));
     if (i > 0 && s.offsets[i] < s.offsets[i - 1])
-      bad(s.source, node, fmt::format("offsets must not decrease (T{} = {:g} m < T{} = {:g} m)", i, s.offsets[i], i - 1, s.offsets[i - 1]));
+      bad(s.source, node,
+          fmt::format("offsets must not decrease (T{} = {:g} m < T{} = {:g} m)", i, s.offsets[i], i - 1,
+                      s.offsets[i - 1]));
   }
   if (s.integrator.empty()) bad(s.source, node, "integrator is empty");
 }

@@ -158,7 +158,8 @@ class Builder {
       }
       if (n.type != "Simulation") continue;
       if (found != nullptr && found->file == n.file) {
-        throw Error::at(where(n), fmt::format("a second Simulation node (the first is at line {}); a scene has one", found->line));
+        throw Error::at(
+            where(n), fmt::format("a second Simulation node (the first is at line {}); a scene has one", found->line));
       }
       if (found == nullptr) found = &n;
     }
@@ -184,12 +185,15 @@ class Builder {
       take("offsets", [&] {
         const Field* f = n.field("offsets");
         if (f->numbers.size() != 4)
-          throw Error::at(where(n, "offsets"), fmt::format("Simulation: offsets needs 4 values (T0 T1 T2 T3 in m), found {}", f->numbers.size()));
+          throw Error::at(
+              where(n, "offsets"),
+              fmt::format("Simulation: offsets needs 4 values (T0 T1 T2 T3 in m), found {}", f->numbers.size()));
         std::copy(f->numbers.begin(), f->numbers.end(), s.offsets.begin());
       });
       take("voxelSize", [&] { s.voxelSize = number(n, "voxelSize", s.voxelSize); });
       take("integrator", [&] { s.integrator = string(n, "integrator"); });
-      take("collisionEvery", [&] { s.collisionEvery = static_cast<int>(number(n, "collisionEvery", s.collisionEvery)); });
+      take("collisionEvery",
+           [&] { s.collisionEvery = static_cast<int>(number(n, "collisionEvery", s.collisionEvery)); });
       if (const Field* f = n.field("unitScale"); f != nullptr && !f->isDefault)
         take("unitScale", [&] { s.unitScale = number(n, "unitScale", 1.0); });
       s.source = nodePos;
@@ -235,7 +239,8 @@ class Builder {
     if (n.type == "Switch") {
       const auto choice = nodes(n, "choice");
       const auto which = static_cast<std::int64_t>(number(n, "whichChoice", -1));
-      if (which >= 0 && which < static_cast<std::int64_t>(choice.size())) walk(choice[static_cast<std::size_t>(which)], world);
+      if (which >= 0 && which < static_cast<std::int64_t>(choice.size()))
+        walk(choice[static_cast<std::size_t>(which)], world);
       return;
     }
     if (n.type == "LOD") {
@@ -259,7 +264,8 @@ class Builder {
     const Affine rootWorld = world * transformOf(n);
     const Quat rootRotation(rootWorld.rotation());
     for (std::int32_t c : nodes(n, "humanoidBody")) joint(c, rootWorld, rootRotation, -1, avatar);
-    if (avatar.joints.empty()) scene_.warnings.push_back(fmt::format("{}: Humanoid {} has no Joint", where(n).str(), avatar.name));
+    if (avatar.joints.empty())
+      scene_.warnings.push_back(fmt::format("{}: Humanoid {} has no Joint", where(n).str(), avatar.name));
     humanoidIndex_[index] = static_cast<int>(scene_.avatars.size());
     scene_.avatars.push_back(std::move(avatar));
   }
@@ -290,7 +296,8 @@ class Builder {
       s.mesh.name = s.name;
       for (std::int32_t c : nodes(n, "children")) collectGeometry(c, world, s.mesh);
       if (parent < 0) {
-        scene_.warnings.push_back(fmt::format("{}: Segment {} is not inside a Joint (ignored)", where(n).str(), s.name));
+        scene_.warnings.push_back(
+            fmt::format("{}: Segment {} is not inside a Joint (ignored)", where(n).str(), s.name));
         return;
       }
       // Into the joint's frame: unit scale, aligned with the humanoid's root frame.
@@ -331,7 +338,9 @@ class Builder {
     a.urls = strings(n, "url");
     a.jointMap = strings(n, "jointMap");
     a.source = where(n);
-    if (a.urls.empty()) throw Error::at(where(n), fmt::format("Avatar {}: url is empty (a glTF, FBX, Collada or MakeHuman file)", a.name));
+    if (a.urls.empty())
+      throw Error::at(where(n),
+                      fmt::format("Avatar {}: url is empty (a glTF, FBX, Collada or MakeHuman file)", a.name));
     const Affine local = world * transformOf(n);
     a.placement.rotation = Quat(local.rotation()).normalized();
     a.placement.translation = local.translation();
@@ -347,7 +356,8 @@ class Builder {
     ClothMaterial m;
     if (index >= 0) {
       const Node& n = at(index);
-      if (n.type != "ClothMaterial") throw Error::at(where(n), fmt::format("ClothSet material must be a ClothMaterial, not {}", n.type));
+      if (n.type != "ClothMaterial")
+        throw Error::at(where(n), fmt::format("ClothSet material must be a ClothMaterial, not {}", n.type));
       m.name = nameOf(n);
       m.source = where(n);
       const auto get = [&](const char* field, double& value) {
@@ -389,7 +399,9 @@ class Builder {
     const Node* n = &at(index);
     if (n->type == "Shape" && node(*n, "geometry") >= 0) n = &at(node(*n, "geometry"));
     if (n->type != "IndexedFaceSet")
-      throw Error::at(where(clothSet, field), fmt::format("ClothSet {}: {} must be an IndexedFaceSet or a Shape holding one, not {}", nameOf(clothSet), field, n->type));
+      throw Error::at(where(clothSet, field),
+                      fmt::format("ClothSet {}: {} must be an IndexedFaceSet or a Shape holding one, not {}",
+                                  nameOf(clothSet), field, n->type));
     return *n;
   }
 
@@ -401,14 +413,21 @@ class Builder {
     g.source = where(n);
     g.mesh.name = g.name;
     const auto cloth = nodes(n, "cloth");
-    if (cloth.empty()) throw Error::at(where(n), fmt::format("ClothSet {} has no cloth (an IndexedFaceSet or a Shape holding one)", g.name));
+    if (cloth.empty())
+      throw Error::at(where(n),
+                      fmt::format("ClothSet {} has no cloth (an IndexedFaceSet or a Shape holding one)", g.name));
     for (std::int32_t c : cloth) append(g.mesh, transformed(faceSet(c, n, "cloth"), pending.world, g.name));
-    if (g.mesh.triangles.empty()) throw Error::at(where(n, "cloth"), fmt::format("ClothSet {}: the cloth has no faces", g.name));
+    if (g.mesh.triangles.empty())
+      throw Error::at(where(n, "cloth"), fmt::format("ClothSet {}: the cloth has no faces", g.name));
     g.material = material(node(n, "material"));
     g.maskTolerance = number(n, "maskTolerance", g.maskTolerance);
     g.bindThreshold = number(n, "bindThreshold", g.bindThreshold);
-    if (!(g.maskTolerance >= 0.0)) throw Error::at(where(n, "maskTolerance"), fmt::format("ClothSet {}: maskTolerance {:g} m is negative", g.name, g.maskTolerance));
-    if (!(g.bindThreshold >= 0.0)) throw Error::at(where(n, "bindThreshold"), fmt::format("ClothSet {}: bindThreshold {:g} m is negative", g.name, g.bindThreshold));
+    if (!(g.maskTolerance >= 0.0))
+      throw Error::at(where(n, "maskTolerance"),
+                      fmt::format("ClothSet {}: maskTolerance {:g} m is negative", g.name, g.maskTolerance));
+    if (!(g.bindThreshold >= 0.0))
+      throw Error::at(where(n, "bindThreshold"),
+                      fmt::format("ClothSet {}: bindThreshold {:g} m is negative", g.name, g.bindThreshold));
     g.collidesWith = strings(n, "collidesWith");
     avatarOf(n, g);
     if (const std::int32_t mask = node(n, "constraintMask"); mask >= 0)
@@ -426,15 +445,19 @@ class Builder {
       const Avatar& avatar = scene_.avatars[static_cast<std::size_t>(g.avatar)];
       for (const std::string& s : g.collidesWith)
         if (avatar.findSegment(s) < 0)
-          throw Error::at(where(n, "collidesWith"), fmt::format("ClothSet {}: collidesWith names '{}', which avatar {} has no segment called", g.name, s, avatar.name));
+          throw Error::at(where(n, "collidesWith"),
+                          fmt::format("ClothSet {}: collidesWith names '{}', which avatar {} has no segment called",
+                                      g.name, s, avatar.name));
       return;
     }
     if (target.type == "Avatar") {
-      if (!externalIndex_.contains(&target)) externalAvatar(target, Affine(Eigen::Scaling(scene_.simulation.unitScale)));
+      if (!externalIndex_.contains(&target))
+        externalAvatar(target, Affine(Eigen::Scaling(scene_.simulation.unitScale)));
       g.externalAvatar = externalIndex_.at(&target);
       return;
     }
-    throw Error::at(where(n, "avatar"), fmt::format("ClothSet {}: avatar must be a Humanoid or an Avatar, not {}", g.name, target.type));
+    throw Error::at(where(n, "avatar"),
+                    fmt::format("ClothSet {}: avatar must be a Humanoid or an Avatar, not {}", g.name, target.type));
   }
 
   /// Every garment vertex within maskTolerance of a mask vertex (paper 4.1: the mask is a
@@ -443,7 +466,8 @@ class Builder {
   std::vector<std::uint32_t> matchMask(const mesh::TriMesh& mask, const Garment& g, const Node& n) const {
     const double tol = std::max(g.maskTolerance, 1e-9);
     const auto cellOf = [tol](const Vec3& p) {
-      return std::array<long long, 3>{static_cast<long long>(std::floor(p.x() / tol)), static_cast<long long>(std::floor(p.y() / tol)),
+      return std::array<long long, 3>{static_cast<long long>(std::floor(p.x() / tol)),
+                                      static_cast<long long>(std::floor(p.y() / tol)),
                                       static_cast<long long>(std::floor(p.z() / tol))};
     };
     std::map<std::array<long long, 3>, std::vector<std::uint32_t>> grid;
@@ -468,7 +492,8 @@ class Builder {
         double nearest = std::numeric_limits<double>::infinity();
         for (const Vec3& q : g.mesh.positions) nearest = std::min(nearest, (q - p).norm());
         throw Error::at(where(n, "constraintMask"),
-                        fmt::format("ClothSet {}: constraintMask vertex {} at ({:.4g} {:.4g} {:.4g}) m matches no cloth vertex within maskTolerance {:g} m (the nearest is {:.3g} m away)",
+                        fmt::format("ClothSet {}: constraintMask vertex {} at ({:.4g} {:.4g} {:.4g}) m matches no "
+                                    "cloth vertex within maskTolerance {:g} m (the nearest is {:.3g} m away)",
                                     g.name, m, p.x(), p.y(), p.z(), g.maskTolerance, nearest));
       }
     }

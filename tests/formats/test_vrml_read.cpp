@@ -76,7 +76,9 @@ TEST(VrmlRead, TorusKeepsItsRoutesAndVaseItsFaceSet) {
     if (n.type != "IndexedFaceSet") continue;
     EXPECT_TRUE(n.hasMesh);
     EXPECT_EQ(n.triangles.size(), 2592u);
-    EXPECT_EQ(n.positions.size(), vase.nodes.at(static_cast<std::size_t>(n.field("coord")->nodes.at(0))).field("point")->numbers.size() / 3);
+    EXPECT_EQ(
+        n.positions.size(),
+        vase.nodes.at(static_cast<std::size_t>(n.field("coord")->nodes.at(0))).field("point")->numbers.size() / 3);
     ASSERT_NE(n.field("normal"), nullptr);
     EXPECT_GE(n.field("normal")->nodes.at(0), 0);
   }
@@ -119,7 +121,8 @@ TEST(VrmlRead, MalformedCorpusGivesTheExpectedMessageAndLine) {
     ++cases;
     const std::string message = errorOf([&] { (void)readFile(dir + file); });
     EXPECT_NE(message.find(text), std::string::npos) << file << ": " << message;
-    const std::string prefix = expectedLine > 0 ? dir + file + ":" + std::to_string(expectedLine) + ":" : dir + file + ": ";
+    const std::string prefix =
+        expectedLine > 0 ? dir + file + ":" + std::to_string(expectedLine) + ":" : dir + file + ": ";
     EXPECT_EQ(message.rfind(prefix, 0), 0u) << file << ": " << message;
   }
   EXPECT_GE(cases, 14);
@@ -135,7 +138,8 @@ TEST(VrmlRead, CoinNullDereferenceUseInsideOwnDefIsAScanError) {
 
 TEST(VrmlRead, CoinHangOn3dsBytesIsAScanError) {
   const std::string text("MM\x02\x00", 4);
-  EXPECT_NE(errorOf([&] { (void)readText(text, "hang.wrl", "."); }).find("hang.wrl:1:1: not a VRML97 file"), std::string::npos);
+  EXPECT_NE(errorOf([&] { (void)readText(text, "hang.wrl", "."); }).find("hang.wrl:1:1: not a VRML97 file"),
+            std::string::npos);
 }
 
 // Without the pre-scan the same inputs reach Coin: its null dereference and its hang stay
@@ -147,6 +151,10 @@ TEST(VrmlRead, CoinsOwnCrashAndHangStayInTheChild) {
   const std::string crash = "#VRML V2.0 utf8\nDEF T Transform { children Shape { geometry USE T\n";
   const std::string crashMessage = errorOf([&] { (void)readText(crash, "crash.wrl", ".", raw); });
   EXPECT_EQ(crashMessage.rfind("crash.wrl: the VRML97 reader failed (signal ", 0), 0u) << crashMessage;
+  const std::string recursive = "#VRML V2.0 utf8\nPROTO P [ ] { Group { children P { } } }\nP { }\n";
+  const std::string recursiveMessage = errorOf([&] { (void)readText(recursive, "doll.wrl", ".", raw); });
+  // A stack overflow: signal 11, or the time limit when the sanitizers make it slow.
+  EXPECT_EQ(recursiveMessage.rfind("doll.wrl: the VRML97 reader failed (", 0), 0u) << recursiveMessage;
   const std::string hang("MM\x02\x00", 4);
   const std::string hangMessage = errorOf([&] { (void)readText(hang, "hang.wrl", ".", raw); });
   EXPECT_EQ(hangMessage.rfind("hang.wrl: the VRML97 reader failed (time limit", 0), 0u) << hangMessage;
@@ -160,18 +168,19 @@ TEST(VrmlRead, PreludeIsTheShippedFile) {
   const ScanResult r = scan(prelude(), "drape-nodes.wrl");
   std::vector<std::string> names;
   for (const ProtoInterface& p : r.declared) names.push_back(p.name);
-  EXPECT_EQ(names, (std::vector<std::string>{"ClothSet", "ClothMaterial", "Simulation", "Avatar", "Humanoid", "Joint", "Segment",
-                                             "Site", "Displacer"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"ClothSet", "ClothMaterial", "Simulation", "Avatar", "Humanoid", "Joint",
+                                             "Segment", "Site", "Displacer"}));
 }
 
 TEST(VrmlRead, ExternProtoToThePreludeLoads) {
   const std::string dir = tempDir();
   std::filesystem::copy_file(std::string(DRAPE_SOURCE_DIR) + "/share/drape/drape-nodes.wrl", dir + "/drape-nodes.wrl",
                              std::filesystem::copy_options::overwrite_existing);
-  std::ofstream(dir + "/ext.wrl") << "#VRML V2.0 utf8\n"
-                                     "EXTERNPROTO ClothMaterial [ exposedField SFFloat density exposedField SFFloat thickness ]\n"
-                                     "  \"drape-nodes.wrl#ClothMaterial\"\n"
-                                     "DEF Silk ClothMaterial { density 1300 }\n";
+  std::ofstream(dir + "/ext.wrl")
+      << "#VRML V2.0 utf8\n"
+         "EXTERNPROTO ClothMaterial [ exposedField SFFloat density exposedField SFFloat thickness ]\n"
+         "  \"drape-nodes.wrl#ClothMaterial\"\n"
+         "DEF Silk ClothMaterial { density 1300 }\n";
   const Document d = readFile(dir + "/ext.wrl");
   ASSERT_EQ(count(d, "ClothMaterial"), 1);
   for (const Node& n : d.nodes)
@@ -184,7 +193,8 @@ TEST(VrmlRead, ExternProtoToThePreludeLoads) {
 
 TEST(VrmlRead, MissingTextureIsAWarning) {
   const std::string text =
-      "#VRML V2.0 utf8\nShape { appearance Appearance { texture ImageTexture { url \"nowhere.png\" } } geometry Box { } }\n";
+      "#VRML V2.0 utf8\nShape { appearance Appearance { texture ImageTexture { url \"nowhere.png\" } } geometry Box { "
+      "} }\n";
   const Document d = readText(text, "tex.wrl", ".");
   ASSERT_EQ(d.warnings.size(), 1u);
   EXPECT_NE(d.warnings[0].find("nowhere.png"), std::string::npos);
@@ -213,7 +223,8 @@ TEST(VrmlWrite, RoundTripPositionsAtSeveralTimes) {
   box.triangles = {{0, 1, 2}};
   j.segments.push_back(box);
   for (std::size_t f = 0; f < frames; ++f)
-    j.frames.push_back({Quat(Eigen::AngleAxisd(0.1 * static_cast<double>(f), Vec3::UnitY())), Vec3(0, 1, 0.01 * static_cast<double>(f))});
+    j.frames.push_back({Quat(Eigen::AngleAxisd(0.1 * static_cast<double>(f), Vec3::UnitY())),
+                        Vec3(0, 1, 0.01 * static_cast<double>(f))});
   a.joints.push_back(j);
   const std::string path = tempDir() + "/result.wrl";
   writeAnimation(path, a);
@@ -231,7 +242,8 @@ TEST(VrmlWrite, RoundTripPositionsAtSeveralTimes) {
     const std::vector<double> p = sampleAnimatedField(d, coord, "point", t);
     ASSERT_EQ(p.size(), 12u) << t;
     for (std::size_t v = 0; v < 4; ++v)
-      for (int c = 0; c < 3; ++c) EXPECT_NEAR(p[v * 3 + static_cast<std::size_t>(c)], positionAt(v, t)[c], 1e-5) << "t " << t;
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(p[v * 3 + static_cast<std::size_t>(c)], positionAt(v, t)[c], 1e-5) << "t " << t;
     const std::vector<double> translation = sampleAnimatedField(d, hip, "translation", t);
     ASSERT_EQ(translation.size(), 3u);
     EXPECT_NEAR(translation[2], 0.01 * static_cast<double>(f), 1e-6);

@@ -38,7 +38,8 @@ std::string tempDir() {
   return dir.string();
 }
 
-const std::string kTriangle = "IndexedFaceSet { coord Coordinate { point [ 0 0 0, 1 0 0, 0 1 0 ] } coordIndex [ 0 1 2 -1 ] }";
+const std::string kTriangle =
+    "IndexedFaceSet { coord Coordinate { point [ 0 0 0, 1 0 0, 0 1 0 ] } coordIndex [ 0 1 2 -1 ] }";
 
 TEST(VrmlScene, Sr1IsAnAvatarOfThirtyJoints) {
   const Scene s = loadScene(kData + "choreonoid_SR1.wrl");
@@ -47,7 +48,8 @@ TEST(VrmlScene, Sr1IsAnAvatarOfThirtyJoints) {
   EXPECT_EQ(a.name, "SR1");
   EXPECT_EQ(a.joints.size(), 30u);
   EXPECT_EQ(a.segments.size(), 30u);
-  for (std::size_t j = 0; j < a.joints.size(); ++j) EXPECT_LT(a.joints[j].parent, static_cast<int>(j));  // parents first
+  for (std::size_t j = 0; j < a.joints.size(); ++j)
+    EXPECT_LT(a.joints[j].parent, static_cast<int>(j));  // parents first
   const int waist = a.findJoint("WAIST");
   ASSERT_EQ(waist, 0);
   EXPECT_NEAR(a.joints[0].restCenter.z(), 0.7135, 1e-6);
@@ -100,10 +102,14 @@ TEST(VrmlScene, EveryFieldWithValues) {
       "  offsets [ 0.001 0.002 0.003 0.004 ] voxelSize 0.005 integrator \"euler\" collisionEvery 2 unitScale 0.01 }\n"
       "DEF Body Humanoid { humanoidBody DEF Root Joint { name \"root\" children [ DEF Hips Segment { name \"hips\" "
       "children Shape { geometry Box { } } } ] } }\n"
-      "DEF Silk ClothMaterial { name \"silk\" density 1300 thickness 0.0002 youngsModulus 2e6 poissonRatio 0.25 bendingStiffness 1e-6\n"
+      "DEF Silk ClothMaterial { name \"silk\" density 1300 thickness 0.0002 youngsModulus 2e6 poissonRatio 0.25 "
+      "bendingStiffness 1e-6\n"
       "  damping 0.1 staticFriction 0.4 dynamicFriction 0.2 compressionScale 0.5 }\n"
-      "DEF Scarf ClothSet { name \"scarf\" material USE Silk avatar USE Body collidesWith [ \"hips\" ] maskTolerance 0.002 "
-      "bindThreshold 0.03\n  cloth " + kTriangle + "\n  constraintMask " + kTriangle + " }\n"
+      "DEF Scarf ClothSet { name \"scarf\" material USE Silk avatar USE Body collidesWith [ \"hips\" ] maskTolerance "
+      "0.002 "
+      "bindThreshold 0.03\n  cloth " +
+      kTriangle + "\n  constraintMask " + kTriangle +
+      " }\n"
       "Avatar { name \"guest\" url [ \"guest.glb\" ] jointMap [ \"map.json\" ] translation 100 0 0 scale 2 }\n");
   const SimulationSettings& sim = s.simulation;
   EXPECT_TRUE(s.hasSimulationNode);
@@ -157,7 +163,8 @@ TEST(VrmlScene, EveryFieldWithValues) {
 }
 
 TEST(VrmlScene, EveryFieldDefaults) {
-  const Scene s = fromText("#VRML V2.0 utf8\nSimulation { }\nClothSet { cloth " + kTriangle + " material ClothMaterial { } }\n");
+  const Scene s =
+      fromText("#VRML V2.0 utf8\nSimulation { }\nClothSet { cloth " + kTriangle + " material ClothMaterial { } }\n");
   const SimulationSettings defaults;
   EXPECT_TRUE(s.simulation.gravity.isApprox(defaults.gravity, 1e-6));
   EXPECT_EQ(s.simulation.frameRate, defaults.frameRate);
@@ -194,10 +201,16 @@ TEST(VrmlScene, EveryFieldDefaults) {
 }
 
 TEST(VrmlScene, DefUseSharesOneMaterialBetweenTwoGarments) {
-  const Scene s = fromText("#VRML V2.0 utf8\nDEF Denim ClothMaterial { density 600 }\n"
-                           "DEF A ClothSet { material USE Denim cloth " + kTriangle + " }\n"
-                           "DEF B ClothSet { material USE Denim cloth " + kTriangle + " }\n"
-                           "DEF C ClothSet { cloth " + kTriangle + " }\n");
+  const Scene s = fromText(
+      "#VRML V2.0 utf8\nDEF Denim ClothMaterial { density 600 }\n"
+      "DEF A ClothSet { material USE Denim cloth " +
+      kTriangle +
+      " }\n"
+      "DEF B ClothSet { material USE Denim cloth " +
+      kTriangle +
+      " }\n"
+      "DEF C ClothSet { cloth " +
+      kTriangle + " }\n");
   ASSERT_EQ(s.garments.size(), 3u);
   ASSERT_EQ(s.materials.size(), 2u);  // Denim once, and the default for C
   EXPECT_EQ(s.garments[0].material, 0);
@@ -211,41 +224,50 @@ TEST(VrmlScene, FileDeclaredProtosLoadAndKeepLines) {
   const std::string protos =
       "#VRML V2.0 utf8\n"
       "PROTO ClothMaterial [ exposedField SFFloat density 100 exposedField SFFloat thickness 0.001 ] { Group { } }\n"
-      "PROTO ClothSet [ exposedField MFNode cloth [ ] exposedField SFNode material NULL ] { Group { children IS cloth } }\n";
-  const Scene s = fromText(protos + "DEF Wool ClothMaterial { density 250 }\nClothSet { material USE Wool cloth " + kTriangle + " }\n");
+      "PROTO ClothSet [ exposedField MFNode cloth [ ] exposedField SFNode material NULL ] { Group { children IS cloth "
+      "} }\n";
+  const Scene s = fromText(protos + "DEF Wool ClothMaterial { density 250 }\nClothSet { material USE Wool cloth " +
+                           kTriangle + " }\n");
   ASSERT_EQ(s.materials.size(), 1u);
   EXPECT_NEAR(s.materials[0].density, 250, 1e-6);
-  EXPECT_NEAR(s.materials[0].thickness, 0.001, 1e-9);  // the file's own default
+  EXPECT_NEAR(s.materials[0].thickness, 0.001, 1e-9);                              // the file's own default
   EXPECT_NEAR(s.materials[0].youngsModulus, ClothMaterial{}.youngsModulus, 1e-6);  // a field the file's PROTO lacks
   // Errors still point at the line of the value.
   const std::string message = errorOf([&] {
-    (void)fromText(protos + "ClothMaterial { density 10 }\nDEF Bad ClothMaterial {\n  thickness -1\n}\n"
-                   "ClothSet { material USE Bad cloth " + kTriangle + " }\n");
+    (void)fromText(protos +
+                   "ClothMaterial { density 10 }\nDEF Bad ClothMaterial {\n  thickness -1\n}\n"
+                   "ClothSet { material USE Bad cloth " +
+                   kTriangle + " }\n");
   });
   EXPECT_EQ(message.rfind("scene.wrl:6: ClothMaterial Bad: thickness -1 m is negative", 0), 0u) << message;
 }
 
 TEST(VrmlScene, GarmentsGetTheirWorldTransform) {
-  const Scene s = fromText("#VRML V2.0 utf8\nTransform { translation 0 2 0 rotation 0 0 1 1.5707963267948966 scale 2 2 2 children [\n"
-                           "  ClothSet { cloth Shape { geometry " + kTriangle + " } }\n] }\n");
+  const Scene s = fromText(
+      "#VRML V2.0 utf8\nTransform { translation 0 2 0 rotation 0 0 1 1.5707963267948966 scale 2 2 2 children [\n"
+      "  ClothSet { cloth Shape { geometry " +
+      kTriangle + " } }\n] }\n");
   ASSERT_EQ(s.garments.size(), 1u);
   const auto& p = s.garments[0].mesh.positions;
   EXPECT_NEAR((p[0] - Vec3(0, 2, 0)).norm(), 0.0, 1e-6);
-  EXPECT_NEAR((p[1] - Vec3(0, 4, 0)).norm(), 0.0, 1e-6);   // x axis turned onto y, doubled
+  EXPECT_NEAR((p[1] - Vec3(0, 4, 0)).norm(), 0.0, 1e-6);  // x axis turned onto y, doubled
   EXPECT_NEAR((p[2] - Vec3(-2, 2, 0)).norm(), 0.0, 1e-6);
 }
 
 TEST(VrmlScene, WorldInfoUnitScale) {
-  const Scene s = fromText("#VRML V2.0 utf8\nWorldInfo { info [ \"unitScale 0.001\" ] }\nClothSet { cloth " + kTriangle + " }\n");
+  const Scene s =
+      fromText("#VRML V2.0 utf8\nWorldInfo { info [ \"unitScale 0.001\" ] }\nClothSet { cloth " + kTriangle + " }\n");
   EXPECT_NEAR(s.simulation.unitScale, 0.001, 1e-12);
   EXPECT_NEAR(s.garments.at(0).mesh.positions[1].x(), 0.001, 1e-12);
 }
 
 TEST(VrmlScene, InlinedHumanoidBecomesAnAvatar) {
   const std::string dir = tempDir();
-  std::ofstream(dir + "/body.wrl") << "#VRML V2.0 utf8\nHumanoid { name \"inlined\" humanoidBody Joint { name \"root\" children "
-                                      "Segment { name \"trunk\" children Shape { geometry Sphere { } } } } }\n";
-  std::ofstream(dir + "/world.wrl") << "#VRML V2.0 utf8\nTransform { translation 0 1 0 children Inline { url \"body.wrl\" } }\n";
+  std::ofstream(dir + "/body.wrl")
+      << "#VRML V2.0 utf8\nHumanoid { name \"inlined\" humanoidBody Joint { name \"root\" children "
+         "Segment { name \"trunk\" children Shape { geometry Sphere { } } } } }\n";
+  std::ofstream(dir + "/world.wrl")
+      << "#VRML V2.0 utf8\nTransform { translation 0 1 0 children Inline { url \"body.wrl\" } }\n";
   const Scene s = loadScene(dir + "/world.wrl");
   ASSERT_EQ(s.avatars.size(), 1u);
   EXPECT_EQ(s.avatars[0].name, "inlined");
@@ -282,15 +304,20 @@ TEST(VrmlScene, DomainErrorsFromTheBadCorpus) {
 
 TEST(VrmlScene, MoreDomainErrors) {
   EXPECT_NE(errorOf([&] {
-              (void)fromText("#VRML V2.0 utf8\nDEF H Humanoid { humanoidBody Joint { children Segment { name \"hips\" } } }\n"
-                             "ClothSet { avatar USE H collidesWith [ \"elbow\" ] cloth " + kTriangle + " }\n");
+              (void)fromText(
+                  "#VRML V2.0 utf8\nDEF H Humanoid { humanoidBody Joint { children Segment { name \"hips\" } } }\n"
+                  "ClothSet { avatar USE H collidesWith [ \"elbow\" ] cloth " +
+                  kTriangle + " }\n");
             }).find("collidesWith names 'elbow', which avatar H has no segment called"),
             std::string::npos);
-  EXPECT_NE(errorOf([&] { (void)fromText("#VRML V2.0 utf8\nClothSet { cloth Shape { geometry Box { } } }\n"); })
-                .find("cloth must be an IndexedFaceSet or a Shape holding one, not Box"),
+  EXPECT_NE(errorOf([&] {
+              (void)fromText("#VRML V2.0 utf8\nClothSet { cloth Shape { geometry Box { } } }\n");
+            }).find("cloth must be an IndexedFaceSet or a Shape holding one, not Box"),
             std::string::npos);
-  EXPECT_NE(errorOf([&] { (void)fromText("#VRML V2.0 utf8\nClothSet { cloth " + kTriangle + " material ClothMaterial { poissonRatio -0.1 } }\n"); })
-                .find("scene.wrl:2: ClothMaterial: poissonRatio -0.1 is outside [0, 0.5)"),
+  EXPECT_NE(errorOf([&] {
+              (void)fromText("#VRML V2.0 utf8\nClothSet { cloth " + kTriangle +
+                             " material ClothMaterial { poissonRatio -0.1 } }\n");
+            }).find("scene.wrl:2: ClothMaterial: poissonRatio -0.1 is outside [0, 0.5)"),
             std::string::npos);
 }
 

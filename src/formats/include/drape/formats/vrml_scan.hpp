@@ -3,6 +3,7 @@
 // reader crashes or hangs on some malformed input (a USE inside its own still-open DEF,
 // bytes it takes for another format, very deep nesting), so every VRML97 text is scanned
 // first: the `#VRML V2.0 utf8` header, tokens, strings, balanced brackets, DEF before USE,
+// no PROTO that contains an instance of itself,
 // no USE inside its own DEF, nesting depth, and the field names of drape's own nodes.
 // Errors are `file:line:column: what`. The scan does not build a scene graph; Coin does.
 
@@ -44,9 +45,9 @@ struct ScanOptions {
 };
 
 struct ScanResult {
-  std::string text;                       ///< the input, with drapeNodeId tags injected
-  std::vector<ProtoInterface> declared;   ///< PROTOs and EXTERNPROTOs the file declares
-  std::vector<NodeSite> sites;            ///< instances of tracked types, in file order
+  std::string text;                      ///< the input, with drapeNodeId tags injected
+  std::vector<ProtoInterface> declared;  ///< PROTOs and EXTERNPROTOs the file declares
+  std::vector<NodeSite> sites;           ///< instances of tracked types, in file order
 };
 
 /// Scans `text` read from `file` (used in messages). Throws drape::Error

@@ -29,14 +29,14 @@ enum class FieldKind : std::uint8_t {
 struct Field {
   std::string name;
   FieldKind kind = FieldKind::Other;
-  bool multiple = false;              ///< an MF field
+  bool multiple = false;  ///< an MF field
   std::vector<double> numbers;
   std::vector<std::string> strings;
   std::vector<std::int32_t> nodes;
-  bool isDefault = true;              ///< not written in the file (the PROTO's or VRML97's default)
-  int line = 0;                       ///< line it was written on, when known (drape's nodes)
-  std::int32_t routeFromNode = -1;    ///< a ROUTE feeds this field from that node's ...
-  std::string routeFromField;         ///< ... eventOut
+  bool isDefault = true;            ///< not written in the file (the PROTO's or VRML97's default)
+  int line = 0;                     ///< line it was written on, when known (drape's nodes)
+  std::int32_t routeFromNode = -1;  ///< a ROUTE feeds this field from that node's ...
+  std::string routeFromField;       ///< ... eventOut
 };
 
 struct Node {

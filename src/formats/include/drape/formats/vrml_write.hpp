@@ -14,22 +14,22 @@
 namespace drape::formats::vrml {
 
 struct GarmentTrack {
-  std::string name;                          ///< becomes a DEF name (sanitised)
+  std::string name;  ///< becomes a DEF name (sanitised)
   std::vector<mesh::Triangle> triangles;
-  std::vector<std::vector<Vec3>> frames;     ///< m, world positions per frame (same count each)
-  Vec3 color{0.8, 0.25, 0.2};                ///< diffuse colour, 0..1
+  std::vector<std::vector<Vec3>> frames;  ///< m, world positions per frame (same count each)
+  Vec3 color{0.8, 0.25, 0.2};             ///< diffuse colour, 0..1
 };
 
 struct JointTrack {
   std::string name;
-  std::vector<mesh::TriMesh> segments;       ///< m, in the joint's frame
-  std::vector<RigidTransform> frames;        ///< joint world transform per frame
+  std::vector<mesh::TriMesh> segments;  ///< m, in the joint's frame
+  std::vector<RigidTransform> frames;   ///< joint world transform per frame
 };
 
 struct Animation {
-  double frameRate = 30.0;                   ///< frames per second
+  double frameRate = 30.0;  ///< frames per second
   std::vector<GarmentTrack> garments;
-  std::vector<JointTrack> joints;            ///< optional: the avatar
+  std::vector<JointTrack> joints;  ///< optional: the avatar
 };
 
 /// Writes `animation` to `path`. Throws drape::Error on inconsistent tracks (frame counts
@@ -39,7 +39,7 @@ void writeAnimation(const std::string& path, const Animation& animation);
 /// The values a ROUTE from an interpolator gives field `field` of node `node` at `time`
 /// seconds (the interpolator driven by a TimeSensor's fraction_changed; linear between
 /// keys). Empty when the field is not animated. Numbers as in Field::numbers.
-[[nodiscard]] std::vector<double> sampleAnimatedField(const Document& document, std::int32_t node, const std::string& field,
-                                                      double time);
+[[nodiscard]] std::vector<double> sampleAnimatedField(const Document& document, std::int32_t node,
+                                                      const std::string& field, double time);
 
 }  // namespace drape::formats::vrml

@@ -19,18 +19,18 @@ namespace drape::scene {
 
 /// Physical properties of a cloth (the ClothMaterial node). Defaults: a light cotton.
 struct ClothMaterial {
-  std::string name;                 ///< DEF name or `name`, for messages
-  double density = 300.0;           ///< kg/m^3 of the cloth itself
-  double thickness = 0.0005;        ///< m
-  double youngsModulus = 5.0e5;     ///< Pa, in-plane stiffness of the membrane
-  double poissonRatio = 0.3;        ///< in [0, 0.5)
+  std::string name;              ///< DEF name or `name`, for messages
+  double density = 300.0;        ///< kg/m^3 of the cloth itself
+  double thickness = 0.0005;     ///< m
+  double youngsModulus = 5.0e5;  ///< Pa, in-plane stiffness of the membrane
+  double poissonRatio = 0.3;     ///< in [0, 0.5)
   /// N m; < 0 means "derive from E t^3 / (12 (1 - nu^2))" (bendingStiffnessOrDerived()).
   double bendingStiffness = -1.0;
-  double damping = 0.02;            ///< internal damping ratio, dimensionless (>= 0)
-  double staticFriction = 0.5;      ///< coefficient against body surfaces
-  double dynamicFriction = 0.3;     ///< coefficient against body surfaces (<= static)
-  double compressionScale = 0.1;    ///< stiffness under compression relative to tension, in [0, 1]
-  SourcePos source;                 ///< where the node was written
+  double damping = 0.02;          ///< internal damping ratio, dimensionless (>= 0)
+  double staticFriction = 0.5;    ///< coefficient against body surfaces
+  double dynamicFriction = 0.3;   ///< coefficient against body surfaces (<= static)
+  double compressionScale = 0.1;  ///< stiffness under compression relative to tension, in [0, 1]
+  SourcePos source;               ///< where the node was written
 
   /// kg/m^2: density x thickness, the mass per unit area of cloth.
   [[nodiscard]] double arealDensity() const { return density * thickness; }
@@ -40,32 +40,32 @@ struct ClothMaterial {
 
 /// Environment and solver settings (the Simulation node).
 struct SimulationSettings {
-  Vec3 gravity{0.0, -9.81, 0.0};     ///< m/s^2
-  double frameRate = 30.0;          ///< frames per second of output and motion
-  int stepsPerFrame = 33;           ///< explicit substeps per frame
-  double airViscosity = 0.02;       ///< N s/m^2 per unit area: drag on velocity relative to wind
-  Vec3 wind{0.0, 0.0, 0.0};         ///< m/s
+  Vec3 gravity{0.0, -9.81, 0.0};  ///< m/s^2
+  double frameRate = 30.0;        ///< frames per second of output and motion
+  int stepsPerFrame = 33;         ///< explicit substeps per frame
+  double airViscosity = 0.02;     ///< N s/m^2 per unit area: drag on velocity relative to wind
+  Vec3 wind{0.0, 0.0, 0.0};       ///< m/s
   /// m: the collision offset surfaces T0 < T1 < T2 < T3 of paper section 4.3.3.
   std::array<double, 4> offsets{0.002, 0.004, 0.006, 0.008};
-  double voxelSize = 0.01;          ///< m, edge of a distance-field voxel
+  double voxelSize = 0.01;                      ///< m, edge of a distance-field voxel
   std::string integrator = "symplectic-euler";  ///< name the cloth solver resolves
-  int collisionEvery = 1;           ///< collide every N substeps
-  double unitScale = 1.0;           ///< metres per file unit (applied to all geometry on load)
-  SourcePos source;                 ///< where the node was written; empty when defaulted
+  int collisionEvery = 1;                       ///< collide every N substeps
+  double unitScale = 1.0;                       ///< metres per file unit (applied to all geometry on load)
+  SourcePos source;                             ///< where the node was written; empty when defaulted
 };
 
 /// A garment (a ClothSet): its mesh in world metres, the constraint mask matched onto it,
 /// the material and the avatar it is worn by.
 struct Garment {
   std::string name;
-  mesh::TriMesh mesh;                      ///< m, world, rest shape as modelled
-  int material = -1;                       ///< index into Scene::materials
-  std::vector<std::uint32_t> maskVertices; ///< garment vertices matched by the mask, sorted
-  double maskTolerance = 0.001;            ///< m
-  double bindThreshold = 0.02;             ///< m, farthest a mask vertex binds to a body part
-  std::vector<std::string> collidesWith;   ///< segment names; empty: every segment
-  int avatar = -1;                         ///< index into Scene::avatars (a Humanoid), or -1
-  int externalAvatar = -1;                 ///< index into Scene::externalAvatars, or -1
+  mesh::TriMesh mesh;                       ///< m, world, rest shape as modelled
+  int material = -1;                        ///< index into Scene::materials
+  std::vector<std::uint32_t> maskVertices;  ///< garment vertices matched by the mask, sorted
+  double maskTolerance = 0.001;             ///< m
+  double bindThreshold = 0.02;              ///< m, farthest a mask vertex binds to a body part
+  std::vector<std::string> collidesWith;    ///< segment names; empty: every segment
+  int avatar = -1;                          ///< index into Scene::avatars (a Humanoid), or -1
+  int externalAvatar = -1;                  ///< index into Scene::externalAvatars, or -1
   SourcePos source;
 };
 
@@ -86,15 +86,15 @@ struct Scenery {
 };
 
 struct Scene {
-  std::string source;                          ///< the scene file
-  std::vector<Avatar> avatars;                 ///< H-Anim humanoids, in file order
+  std::string source;           ///< the scene file
+  std::vector<Avatar> avatars;  ///< H-Anim humanoids, in file order
   std::vector<ExternalAvatar> externalAvatars;
   std::vector<Garment> garments;
-  std::vector<ClothMaterial> materials;        ///< each ClothMaterial node once (DEF/USE shares)
+  std::vector<ClothMaterial> materials;  ///< each ClothMaterial node once (DEF/USE shares)
   SimulationSettings simulation;
   bool hasSimulationNode = false;
   std::vector<Scenery> scenery;
-  std::vector<std::string> warnings;           ///< "file:line: what"
+  std::vector<std::string> warnings;  ///< "file:line: what"
 };
 
 /// Reads a VRML97 scene (through formats' isolated reader) and builds the scene. Throws

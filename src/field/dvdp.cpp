@@ -19,7 +19,10 @@
 namespace drape::field {
 namespace {
 
-constexpr std::int32_t kUnprocessed = std::numeric_limits<std::int32_t>::max();
+// Unprocessed voxels hold kUnprocessed or more: kUnprocessed + the best squared distance
+// offered to them so far (ShellExact), so one load answers both questions.
+constexpr std::int32_t kUnprocessed = 1 << 30;
+constexpr std::int32_t kNoOffer = kUnprocessed + 0xffff;
 constexpr std::int32_t kGuard = -1;
 
 std::uint32_t pack(int x, int y, int z) {
@@ -129,7 +132,7 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
             sets[0].refs.push_back(pack(x + 1, y + 1, z + 1));
           }
         } else {
-          work[prow + x] = kUnprocessed;
+          work[prow + x] = kNoOffer;
           ++remaining;
         }
       }
@@ -158,14 +161,13 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
   std::vector<RefPair> pairs;
 
   // ShellExact: references offered to the 26 neighbours of each completed shell set, queued
-  // at the iteration of their own distance; tentative[] holds the best distance offered so
-  // far to a voxel, so only improving offers are queued.
+  // at the iteration of their own distance; an unprocessed voxel's work[] value holds the
+  // best distance offered to it so far, so only improving offers are queued.
   int shellIterations = 0;
   while (exactShell && shellIterations < table->iterationCount() &&
          table->iterationLength2[shellIterations] <= options.shellDistance2)
     ++shellIterations;
   std::vector<std::vector<Deferred>> deferred(static_cast<std::size_t>(shellIterations));
-  std::vector<std::uint16_t> tentative(exactShell ? padded.count() : 0, 0xffff);
   const auto& all = neighbours[3];
   auto offer = [&](const VoxelSet& set) {
     for (std::size_t e = 0; e < set.voxels.size(); ++e) {
@@ -173,14 +175,15 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
       const std::uint32_t uc = set.coords[e];
       for (std::size_t k = 0; k < all.delta.size(); ++k) {
         const std::uint32_t v = static_cast<std::uint32_t>(u + all.delta[k]);
-        if (work[v] != kUnprocessed) continue;
+        std::int32_t& w = work[v];
+        if (w < kUnprocessed) continue;
         const int vx = px(uc) + all.offset[k][0], vy = py(uc) + all.offset[k][1], vz = pz(uc) + all.offset[k][2];
         for (std::uint32_t r = set.refStart[e]; r < set.refStart[e + 1]; ++r) {
           const std::uint32_t ref = set.refs[r];
           const int dx = vx - px(ref), dy = vy - py(ref), dz = vz - pz(ref);
           const int ref2 = dx * dx + dy * dy + dz * dz;
-          if (ref2 > options.shellDistance2 || ref2 > tentative[v]) continue;
-          tentative[v] = static_cast<std::uint16_t>(ref2);
+          if (ref2 > options.shellDistance2 || kUnprocessed + ref2 > w) continue;
+          w = kUnprocessed + ref2;
           deferred[table->iterationOfLength2[ref2]].push_back({v, pack(vx, vy, vz), ref});
         }
       }
@@ -203,7 +206,7 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
       for (const Deferred& e : deferred[i]) {
         std::int32_t& d = work[e.voxel];
         if (d < length2) continue;  // assigned at a smaller distance meanwhile
-        if (d == kUnprocessed) {
+        if (d >= kUnprocessed) {
           d = length2;
           slot[e.voxel] = static_cast<std::uint32_t>(out.voxels.size());
           out.voxels.push_back(e.voxel);
@@ -229,7 +232,7 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
               const std::uint32_t v = static_cast<std::uint32_t>(u + nb.delta[k]);
               const std::int32_t d = work[v];
               if (d < length2) continue;  // processed earlier, or the guard layer
-              if (d == kUnprocessed) {
+              if (d >= kUnprocessed) {
                 work[v] = length2;
                 slot[v] = static_cast<std::uint32_t>(out.voxels.size());
                 out.voxels.push_back(v);
@@ -247,7 +250,7 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
           for (const std::uint32_t u : source.voxels) {
             for (std::size_t k = 0; k < nn; ++k) {
               const std::uint32_t v = static_cast<std::uint32_t>(u + nb.delta[k]);
-              if (work[v] != kUnprocessed) continue;
+              if (work[v] < kUnprocessed) continue;
               work[v] = length2;
               out.voxels.push_back(v);
               --remaining;

@@ -59,6 +59,10 @@ struct VoxelSet {
   std::vector<std::uint32_t> coords;    // packed padded coordinates (sets with references)
   std::vector<std::uint32_t> refStart;  // sets with references: size voxels + 1
   std::vector<std::uint32_t> refs;      // packed padded coordinates of surface voxels
+  // Connectivities this set has been expanded by. An expansion assigns every unprocessed
+  // neighbour of that connectivity, so a second action with the same source set and
+  // connectivity can only find processed voxels: it is skipped (same result, less work).
+  std::uint8_t expanded = 0;
 
   void release() {
     std::vector<std::uint32_t>().swap(voxels);
@@ -169,10 +173,17 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
     ++shellIterations;
   std::vector<std::vector<Deferred>> deferred(static_cast<std::size_t>(shellIterations));
   const auto& all = neighbours[3];
+  std::array<std::int64_t, 9> rowsAround{};
+  for (int dz = -1, r = 0; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy) rowsAround[r++] = padded.nx * (dy + static_cast<std::int64_t>(padded.ny) * dz);
   auto offer = [&](const VoxelSet& set) {
     for (std::size_t e = 0; e < set.voxels.size(); ++e) {
       const std::uint32_t u = set.voxels[e];
       const std::uint32_t uc = set.coords[e];
+      if (e + 4 < set.voxels.size()) {  // the 9 rows of the 3x3x3 block a few voxels ahead
+        const std::int64_t ahead = set.voxels[e + 4] - 1;
+        for (const std::int64_t row : rowsAround) __builtin_prefetch(&work[ahead + row]);
+      }
       for (std::size_t k = 0; k < all.delta.size(); ++k) {
         const std::uint32_t v = static_cast<std::uint32_t>(u + all.delta[k]);
         std::int32_t& w = work[v];
@@ -203,7 +214,13 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
     pairs.clear();
     if (inShell && exactShell) {
       // The references queued for this distance: every voxel reached, every way.
-      for (const Deferred& e : deferred[i]) {
+      const std::vector<Deferred>& queue = deferred[i];
+      for (std::size_t q = 0; q < queue.size(); ++q) {
+        const Deferred& e = queue[q];
+        if (q + 8 < queue.size()) {  // the queue is in offer order, scattered over the grid
+          __builtin_prefetch(&work[queue[q + 8].voxel]);
+          __builtin_prefetch(&slot[queue[q + 8].voxel]);
+        }
         std::int32_t& d = work[e.voxel];
         if (d < length2) continue;  // assigned at a smaller distance meanwhile
         if (d >= kUnprocessed) {
@@ -221,7 +238,10 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
       // connectivity; unprocessed ones take this iteration's distance.
       for (int a = table->actionStart[i]; a < table->actionStart[i + 1]; ++a) {
         const TableAction action = table->actions[a];
-        const VoxelSet& source = sets[action.sourceIteration];
+        VoxelSet& source = sets[action.sourceIteration];
+        const std::uint8_t bit = static_cast<std::uint8_t>(1u << static_cast<int>(action.connectivity));
+        if (source.expanded & bit) continue;
+        source.expanded |= bit;
         const Neighbours& nb = neighbours[static_cast<int>(action.connectivity)];
         const std::size_t nn = nb.delta.size();
         if (inShell) {
@@ -247,7 +267,13 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
           }
         } else {
           // Beyond the shell: distance only.
-          for (const std::uint32_t u : source.voxels) {
+          const std::size_t count = source.voxels.size();
+          for (std::size_t e = 0; e < count; ++e) {
+            const std::uint32_t u = source.voxels[e];
+            if (e + 4 < count) {
+              const std::uint32_t ahead = source.voxels[e + 4];
+              for (std::size_t k = 0; k < nn; ++k) __builtin_prefetch(&work[ahead + nb.delta[k]]);
+            }
             for (std::size_t k = 0; k < nn; ++k) {
               const std::uint32_t v = static_cast<std::uint32_t>(u + nb.delta[k]);
               if (work[v] < kUnprocessed) continue;

@@ -288,7 +288,8 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
     if (inShell && withRefs) {
       collectReferences(pairs, out);
       emitShellSet(out);
-      if (exactShell) offer(out);
+      // The last shell set has nothing to offer: its neighbours lie beyond the shell.
+      if (exactShell && i + 1 < shellIterations) offer(out);
     }
     // Release the sets nothing later depends on.
     for (int a = table->actionStart[i]; a < table->actionStart[i + 1]; ++a) {

@@ -63,6 +63,9 @@ GridPlacement placeGrid(const Aabb& box, const FieldSettings& settings, int bord
   for (int a = 0; a < 3; ++a)
     if (n[a] > kMaxGridSide) throw Error("a grid side above " + std::to_string(kMaxGridSide) + " voxels");
   g.dims = {n[0], n[1], n[2]};
+  if (g.dims.count() > kMaxVoxels)
+    throw Error("the grid of " + std::to_string(n[0]) + "x" + std::to_string(n[1]) + "x" + std::to_string(n[2]) +
+                " voxels exceeds " + std::to_string(kMaxVoxels) + " voxels: choose a larger --voxel");
   const Vec3 span(n[0] * g.voxelSize, n[1] * g.voxelSize, n[2] * g.voxelSize);
   g.origin = box.center() - 0.5 * span;
   return g;

@@ -19,7 +19,10 @@
 namespace drape::field {
 namespace {
 
-constexpr std::int32_t kUnprocessed = std::numeric_limits<std::int32_t>::max();
+// Unprocessed voxels hold kUnprocessed or more: kUnprocessed + the best squared distance
+// offered to them so far (ShellExact), so one load answers both questions.
+constexpr std::int32_t kUnprocessed = 1 << 30;
+constexpr std::int32_t kNoOffer = kUnprocessed + 0xffff;
 constexpr std::int32_t kGuard = -1;
 
 std::uint32_t pack(int x, int y, int z) {
@@ -56,6 +59,10 @@ struct VoxelSet {
   std::vector<std::uint32_t> coords;    // packed padded coordinates (sets with references)
   std::vector<std::uint32_t> refStart;  // sets with references: size voxels + 1
   std::vector<std::uint32_t> refs;      // packed padded coordinates of surface voxels
+  // Connectivities this set has been expanded by. An expansion assigns every unprocessed
+  // neighbour of that connectivity, so a second action with the same source set and
+  // connectivity can only find processed voxels: it is skipped (same result, less work).
+  std::uint8_t expanded = 0;
 
   void release() {
     std::vector<std::uint32_t>().swap(voxels);
@@ -129,7 +136,7 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
             sets[0].refs.push_back(pack(x + 1, y + 1, z + 1));
           }
         } else {
-          work[prow + x] = kUnprocessed;
+          work[prow + x] = kNoOffer;
           ++remaining;
         }
       }
@@ -158,29 +165,36 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
   std::vector<RefPair> pairs;
 
   // ShellExact: references offered to the 26 neighbours of each completed shell set, queued
-  // at the iteration of their own distance; tentative[] holds the best distance offered so
-  // far to a voxel, so only improving offers are queued.
+  // at the iteration of their own distance; an unprocessed voxel's work[] value holds the
+  // best distance offered to it so far, so only improving offers are queued.
   int shellIterations = 0;
   while (exactShell && shellIterations < table->iterationCount() &&
          table->iterationLength2[shellIterations] <= options.shellDistance2)
     ++shellIterations;
   std::vector<std::vector<Deferred>> deferred(static_cast<std::size_t>(shellIterations));
-  std::vector<std::uint16_t> tentative(exactShell ? padded.count() : 0, 0xffff);
   const auto& all = neighbours[3];
+  std::array<std::int64_t, 9> rowsAround{};
+  for (int dz = -1, r = 0; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy) rowsAround[r++] = padded.nx * (dy + static_cast<std::int64_t>(padded.ny) * dz);
   auto offer = [&](const VoxelSet& set) {
     for (std::size_t e = 0; e < set.voxels.size(); ++e) {
       const std::uint32_t u = set.voxels[e];
       const std::uint32_t uc = set.coords[e];
+      if (e + 4 < set.voxels.size()) {  // the 9 rows of the 3x3x3 block a few voxels ahead
+        const std::int64_t ahead = set.voxels[e + 4] - 1;
+        for (const std::int64_t row : rowsAround) __builtin_prefetch(&work[ahead + row]);
+      }
       for (std::size_t k = 0; k < all.delta.size(); ++k) {
         const std::uint32_t v = static_cast<std::uint32_t>(u + all.delta[k]);
-        if (work[v] != kUnprocessed) continue;
+        std::int32_t& w = work[v];
+        if (w < kUnprocessed) continue;
         const int vx = px(uc) + all.offset[k][0], vy = py(uc) + all.offset[k][1], vz = pz(uc) + all.offset[k][2];
         for (std::uint32_t r = set.refStart[e]; r < set.refStart[e + 1]; ++r) {
           const std::uint32_t ref = set.refs[r];
           const int dx = vx - px(ref), dy = vy - py(ref), dz = vz - pz(ref);
           const int ref2 = dx * dx + dy * dy + dz * dz;
-          if (ref2 > options.shellDistance2 || ref2 > tentative[v]) continue;
-          tentative[v] = static_cast<std::uint16_t>(ref2);
+          if (ref2 > options.shellDistance2 || kUnprocessed + ref2 > w) continue;
+          w = kUnprocessed + ref2;
           deferred[table->iterationOfLength2[ref2]].push_back({v, pack(vx, vy, vz), ref});
         }
       }
@@ -200,10 +214,16 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
     pairs.clear();
     if (inShell && exactShell) {
       // The references queued for this distance: every voxel reached, every way.
-      for (const Deferred& e : deferred[i]) {
+      const std::vector<Deferred>& queue = deferred[i];
+      for (std::size_t q = 0; q < queue.size(); ++q) {
+        const Deferred& e = queue[q];
+        if (q + 8 < queue.size()) {  // the queue is in offer order, scattered over the grid
+          __builtin_prefetch(&work[queue[q + 8].voxel]);
+          __builtin_prefetch(&slot[queue[q + 8].voxel]);
+        }
         std::int32_t& d = work[e.voxel];
         if (d < length2) continue;  // assigned at a smaller distance meanwhile
-        if (d == kUnprocessed) {
+        if (d >= kUnprocessed) {
           d = length2;
           slot[e.voxel] = static_cast<std::uint32_t>(out.voxels.size());
           out.voxels.push_back(e.voxel);
@@ -218,7 +238,10 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
       // connectivity; unprocessed ones take this iteration's distance.
       for (int a = table->actionStart[i]; a < table->actionStart[i + 1]; ++a) {
         const TableAction action = table->actions[a];
-        const VoxelSet& source = sets[action.sourceIteration];
+        VoxelSet& source = sets[action.sourceIteration];
+        const std::uint8_t bit = static_cast<std::uint8_t>(1u << static_cast<int>(action.connectivity));
+        if (source.expanded & bit) continue;
+        source.expanded |= bit;
         const Neighbours& nb = neighbours[static_cast<int>(action.connectivity)];
         const std::size_t nn = nb.delta.size();
         if (inShell) {
@@ -229,7 +252,7 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
               const std::uint32_t v = static_cast<std::uint32_t>(u + nb.delta[k]);
               const std::int32_t d = work[v];
               if (d < length2) continue;  // processed earlier, or the guard layer
-              if (d == kUnprocessed) {
+              if (d >= kUnprocessed) {
                 work[v] = length2;
                 slot[v] = static_cast<std::uint32_t>(out.voxels.size());
                 out.voxels.push_back(v);
@@ -244,10 +267,16 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
           }
         } else {
           // Beyond the shell: distance only.
-          for (const std::uint32_t u : source.voxels) {
+          const std::size_t count = source.voxels.size();
+          for (std::size_t e = 0; e < count; ++e) {
+            const std::uint32_t u = source.voxels[e];
+            if (e + 4 < count) {
+              const std::uint32_t ahead = source.voxels[e + 4];
+              for (std::size_t k = 0; k < nn; ++k) __builtin_prefetch(&work[ahead + nb.delta[k]]);
+            }
             for (std::size_t k = 0; k < nn; ++k) {
               const std::uint32_t v = static_cast<std::uint32_t>(u + nb.delta[k]);
-              if (work[v] != kUnprocessed) continue;
+              if (work[v] < kUnprocessed) continue;
               work[v] = length2;
               out.voxels.push_back(v);
               --remaining;
@@ -259,7 +288,8 @@ Propagation propagateDvdp(const GridDims& dims, std::span<const std::uint8_t> su
     if (inShell && withRefs) {
       collectReferences(pairs, out);
       emitShellSet(out);
-      if (exactShell) offer(out);
+      // The last shell set has nothing to offer: its neighbours lie beyond the shell.
+      if (exactShell && i + 1 < shellIterations) offer(out);
     }
     // Release the sets nothing later depends on.
     for (int a = table->actionStart[i]; a < table->actionStart[i + 1]; ++a) {

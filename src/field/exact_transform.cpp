@@ -64,7 +64,12 @@ void checkDims(const GridDims& dims) {
                 std::to_string(dims.nz) + " is empty or has a side above " + std::to_string(kMaxGridSide));
 }
 
-// The three passes. `feature` (optional) receives the nearest surface voxel's index.
+int px(std::uint32_t p) { return static_cast<int>(p & 1023u); }
+int py(std::uint32_t p) { return static_cast<int>((p >> 10) & 1023u); }
+int pz(std::uint32_t p) { return static_cast<int>(p >> 20); }
+
+// The three passes. `feature` (optional) receives the nearest surface voxel's packed
+// coordinates (x | y << 10 | z << 20).
 std::vector<std::int32_t> transform(const GridDims& dims, std::span<const std::uint8_t> surface,
                                     std::vector<std::uint32_t>* feature) {
   checkDims(dims);
@@ -116,9 +121,8 @@ std::vector<std::int32_t> transform(const GridDims& dims, std::span<const std::u
           for (int q = 0; q < n; ++q) {
             if (arg[q] < 0) continue;
             const std::uint32_t f = featureColumn[arg[q]];
-            // After pass 2 a feature is "x + nx * y" within the slice; pass 3 completes it.
-            fx[base + q * stride] = pass == 0 ? f + static_cast<std::uint32_t>(nx * arg[q])
-                                              : f + static_cast<std::uint32_t>(nx * ny) * static_cast<std::uint32_t>(arg[q]);
+            // After pass 2 a feature is x | y << 10; pass 3 adds z << 20.
+            fx[base + q * stride] = f | (static_cast<std::uint32_t>(arg[q]) << (pass == 0 ? 10 : 20));
           }
         }
         for (int q = 0; q < n; ++q) g[base + q * stride] = result[q];
@@ -147,6 +151,7 @@ Propagation exactFeatureTransform(const GridDims& dims, std::span<const std::uin
   }
   // References in the shell: the voxel's feature and the equally near features of its neighbours.
   std::uint32_t candidates[27];
+  const std::int64_t sy = dims.nx, sz = static_cast<std::int64_t>(dims.nx) * dims.ny;
   for (int z = 0; z < dims.nz; ++z)
     for (int y = 0; y < dims.ny; ++y)
       for (int x = 0; x < dims.nx; ++x) {
@@ -154,18 +159,21 @@ Propagation exactFeatureTransform(const GridDims& dims, std::span<const std::uin
         const std::int32_t d2 = result.distance2[v];
         if (d2 > options.shellDistance2) continue;
         int count = 0;
+        const bool interior = x > 0 && y > 0 && z > 0 && x < dims.nx - 1 && y < dims.ny - 1 && z < dims.nz - 1;
         for (int dz = -1; dz <= 1; ++dz)
           for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
-              if (!dims.contains(x + dx, y + dy, z + dz)) continue;
-              const std::uint32_t f = feature[dims.index(x + dx, y + dy, z + dz)];
-              if (dims.distance2(v, f) == d2) candidates[count++] = f;
+              if (!interior && !dims.contains(x + dx, y + dy, z + dz)) continue;
+              const std::uint32_t f = feature[v + dx + dy * sy + dz * sz];
+              const int ex = x - px(f), ey = y - py(f), ez = z - pz(f);
+              if (ex * ex + ey * ey + ez * ez == d2) candidates[count++] = f;
             }
         std::sort(candidates, candidates + count);
         result.shellVoxels.push_back(v);
         result.refStart.push_back(static_cast<std::uint32_t>(result.refs.size()));
         for (int c = 0; c < count; ++c)
-          if (c == 0 || candidates[c] != candidates[c - 1]) result.refs.push_back(candidates[c]);
+          if (c == 0 || candidates[c] != candidates[c - 1])
+            result.refs.push_back(dims.index(px(candidates[c]), py(candidates[c]), pz(candidates[c])));
       }
   result.refStart.push_back(static_cast<std::uint32_t>(result.refs.size()));
   return result;

@@ -30,8 +30,8 @@ struct FieldSettings {
   double voxelSize_m = 0.01;  ///< m, edge of a cubic voxel (ignored when dims is set)
   double shell_m = 0.06;      ///< m, the outer offset surface T3: Voronoi references are kept within it
   double shellVoxels = 0;     ///< if positive: the shell in voxels, overriding shell_m (the paper's T3 = 6)
-  /// Voxels of border around the part's bounding box, the tagged outermost layer included.
-  /// 0: automatic, ceil(shell / voxel) + 2.
+  /// Voxels of border around the part's bounding box, the tagged outermost layer included;
+  /// must hold the shell plus that layer. 0: automatic, ceil(shell / voxel) + 2 (8 with dims).
   int borderVoxels = 0;
   /// If all three are positive: the grid has exactly these dimensions (border included) and
   /// the voxel size follows from the part's bounding box (its largest extent per voxel).

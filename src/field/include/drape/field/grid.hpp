@@ -38,5 +38,7 @@ struct GridDims {
 
 /// Largest grid side drape builds (coordinates are packed in 10 bits during propagation).
 inline constexpr int kMaxGridSide = 1000;
+/// Largest grid drape builds (about 1.3 GB while building, 0.5-1 GB once built).
+inline constexpr std::size_t kMaxVoxels = 100'000'000;
 
 }  // namespace drape::field

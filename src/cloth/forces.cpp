@@ -108,24 +108,25 @@ void membraneKernel(const ClothModel& model, ClothState& io) {
       s.c += beta * 2.0 * mu * r12;
     }
 
-    // First Piola stress P = F S (columns Pu, Pv); f_i = -A P g_i.
-    const V3 pu = mul(add(mul(fu, s.a), mul(fv, s.c)), -area[t]);
-    const V3 pv = mul(add(mul(fu, s.c), mul(fv, s.b)), -area[t]);
-    const V3 f1 = add(mul(pu, g1u[t]), mul(pv, g1v[t]));
-    const V3 f2 = add(mul(pu, g2u[t]), mul(pv, g2v[t]));
-    w[t] = f1.x;
-    w[n + t] = f1.y;
-    w[2 * n + t] = f1.z;
-    w[3 * n + t] = f2.x;
-    w[4 * n + t] = f2.y;
-    w[5 * n + t] = f2.z;
+    // First Piola stress P = F S; f_i = -A P g_i = c_i1 Fu + c_i2 Fv. Only the four
+    // coefficients are stored (see the bending kernel); pass 2 rebuilds Fu, Fv.
+    const double A = area[t];
+    w[t] = -A * (s.a * g1u[t] + s.c * g1v[t]);          // f1 = w0 Fu + w1 Fv
+    w[n + t] = -A * (s.c * g1u[t] + s.b * g1v[t]);
+    w[2 * n + t] = -A * (s.a * g2u[t] + s.c * g2v[t]);  // f2 = w2 Fu + w3 Fv
+    w[3 * n + t] = -A * (s.c * g2u[t] + s.b * g2v[t]);
   }
   double* fx = io.fx.data();
   double* fy = io.fy.data();
   double* fz = io.fz.data();
   for (std::size_t t = 0; t < n; ++t) {
-    const V3 f1{w[t], w[n + t], w[2 * n + t]};
-    const V3 f2{w[3 * n + t], w[4 * n + t], w[5 * n + t]};
+    const V3 p0 = load(x, y, z, i0[t]);
+    const V3 d1 = sub(load(x, y, z, i1[t]), p0);
+    const V3 d2 = sub(load(x, y, z, i2[t]), p0);
+    const V3 fu = add(mul(d1, g1u[t]), mul(d2, g2u[t]));
+    const V3 fv = add(mul(d1, g1v[t]), mul(d2, g2v[t]));
+    const V3 f1 = add(mul(fu, w[t]), mul(fv, w[n + t]));
+    const V3 f2 = add(mul(fu, w[2 * n + t]), mul(fv, w[3 * n + t]));
     addTo(fx, fy, fz, i1[t], f1);
     addTo(fx, fy, fz, i2[t], f2);
     addTo(fx, fy, fz, i0[t], mul(add(f1, f2), -1.0));
@@ -174,37 +175,34 @@ void accumulateBendingForces(const ClothModel& model, ClothState& io) {
     const double psi = dot(cross(n1, n2), e) < 0.0 ? -psiAbs : psiAbs;
     const double cosHalf = std::sqrt(0.5 * (1.0 + c));
 
-    // dtheta/dx_i = -u_i with Bridson et al. (2003)'s u_i (they sum to zero exactly).
-    const double elen = std::sqrt(es), invE = 1.0 / elen;
-    const V3 a1 = mul(n1, 1.0 / n1s), a2 = mul(n2, 1.0 / n2s);
-    const V3 u1 = mul(a1, elen);
-    const V3 u2 = mul(a2, elen);
-    const V3 u3 = add(mul(a1, dot(sub(x1, x4), e) * invE), mul(a2, dot(sub(x2, x4), e) * invE));
-    const V3 u4 = mul(add(mul(a1, dot(sub(x1, x3), e) * invE), mul(a2, dot(sub(x2, x3), e) * invE)), -1.0);
-
-    // f_i = -k (psi - psi0) dpsi/dx_i = k (psi - psi0) cos(theta/2) u_i.
+    // dtheta/dx_i = -u_i with Bridson et al. (2003)'s u_i, which sum to zero exactly:
+    //   u_a = |e| N1 / |N1|^2, u_b = |e| N2 / |N2|^2,
+    //   u_e0 = ((a - e1).e N1 / |N1|^2 + (b - e1).e N2 / |N2|^2) / |e|, u_e1 = -(u_a + u_b + u_e0).
+    // f_i = -k (psi - psi0) dpsi/dx_i = k (psi - psi0) cos(theta/2) u_i. Every force is a
+    // combination of N1 and N2, so only four coefficients are stored (GCC 12 stops
+    // vectorising this loop beyond about four output streams).
     const double m = ok ? k[i] * (psi - restPsi[i]) * cosHalf : 0.0;
-    w[i] = u1.x * m;
-    w[n + i] = u1.y * m;
-    w[2 * n + i] = u1.z * m;
-    w[3 * n + i] = u2.x * m;
-    w[4 * n + i] = u2.y * m;
-    w[5 * n + i] = u2.z * m;
-    w[6 * n + i] = u3.x * m;
-    w[7 * n + i] = u3.y * m;
-    w[8 * n + i] = u3.z * m;
-    w[9 * n + i] = u4.x * m;
-    w[10 * n + i] = u4.y * m;
-    w[11 * n + i] = u4.z * m;
+    const double elen = std::sqrt(es), invE = 1.0 / elen;
+    const double r1 = m / n1s, r2 = m / n2s;
+    w[i] = r1 * elen;                                   // f_a = w0 N1
+    w[n + i] = r2 * elen;                               // f_b = w1 N2
+    w[2 * n + i] = r1 * dot(sub(x1, x4), e) * invE;     // f_e0 = w2 N1 + w3 N2
+    w[3 * n + i] = r2 * dot(sub(x2, x4), e) * invE;
   }
   double* fx = io.fx.data();
   double* fy = io.fy.data();
   double* fz = io.fz.data();
   for (std::size_t i = 0; i < n; ++i) {
-    addTo(fx, fy, fz, ia[i], {w[i], w[n + i], w[2 * n + i]});
-    addTo(fx, fy, fz, ib[i], {w[3 * n + i], w[4 * n + i], w[5 * n + i]});
-    addTo(fx, fy, fz, ie0[i], {w[6 * n + i], w[7 * n + i], w[8 * n + i]});
-    addTo(fx, fy, fz, ie1[i], {w[9 * n + i], w[10 * n + i], w[11 * n + i]});
+    const V3 x3 = load(x, y, z, ie0[i]), x4 = load(x, y, z, ie1[i]);
+    const V3 x1 = load(x, y, z, ia[i]), x2 = load(x, y, z, ib[i]);
+    const V3 n1 = cross(sub(x1, x3), sub(x1, x4));
+    const V3 n2 = cross(sub(x2, x4), sub(x2, x3));
+    const V3 fa = mul(n1, w[i]), fb = mul(n2, w[n + i]);
+    const V3 fe0 = add(mul(n1, w[2 * n + i]), mul(n2, w[3 * n + i]));
+    addTo(fx, fy, fz, ia[i], fa);
+    addTo(fx, fy, fz, ib[i], fb);
+    addTo(fx, fy, fz, ie0[i], fe0);
+    addTo(fx, fy, fz, ie1[i], mul(add(add(fa, fb), fe0), -1.0));
   }
 }
 

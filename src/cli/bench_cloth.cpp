@@ -97,7 +97,7 @@ double median(std::vector<double> v) {
 
 struct RunOutcome {
   double seconds = 0.0;  ///< CPU time of the frames run
-  long frames = 0;       ///< frames run (fewer than asked when it diverged)
+  double frames = 0.0;   ///< frames run, fractional when it diverged inside a frame
   bool diverged = false;
   double finalStrain = 0.0;
   std::string why;
@@ -126,8 +126,11 @@ RunOutcome runDrape(const SheetSize& size, int substeps, long frames) {
       r.why = solver.instability().describe("sheet", kSpeedBound_m_s);
       break;
     }
-  r.frames = std::min(f, frames);
   r.seconds = threadSeconds() - start;
+  // Frames' worth of substeps actually run (a diverged run stops inside its first frames).
+  r.frames = r.diverged ? static_cast<double>((solver.instability().frame - 1) * substeps + solver.instability().substep + 1) /
+                              substeps
+                        : static_cast<double>(frames);
   r.finalStrain = cloth::maxEdgeStrain(*model, solver.state());
   return r;
 }
@@ -143,7 +146,7 @@ CaseResult measureDrape(const std::string& name, const SheetSize& size, int subs
   RunOutcome last;
   for (int k = 0; k < repeats; ++k) {
     last = runDrape(size, substeps, frames);
-    ms.push_back(1e3 * last.seconds / static_cast<double>(last.frames));
+    ms.push_back(1e3 * last.seconds / last.frames);
     if (last.diverged) break;
   }
   c.runs = static_cast<int>(ms.size());

@@ -31,6 +31,8 @@ std::shared_ptr<const ClothModel> ClothModel::build(const mesh::TriMesh& mesh, c
                                                     const Material& material) {
   material.validate("--");
   if (mesh.triangles.empty()) throw Error(fmt::format("{}: the garment has no triangles", mesh.name));
+  if (mesh.vertexCount() >= (std::size_t{1} << 31))
+    throw Error(fmt::format("{}: more than 2^31 vertices", mesh.name));
   auto model = std::make_shared<ClothModel>(ClothModel());
   model->name_ = mesh.name;
   model->material_ = material;
@@ -39,6 +41,7 @@ std::shared_ptr<const ClothModel> ClothModel::build(const mesh::TriMesh& mesh, c
   model->buildMembrane(mesh);
   model->buildBending(mesh, topology);
   model->buildEdges(topology);
+  model->buildKernelData();
   return model;
 }
 
@@ -152,6 +155,30 @@ void ClothModel::buildEdges(const mesh::Topology& topology) {
     edgeV0_.push_back(e.v0);
     edgeV1_.push_back(e.v1);
     edgeRest_.push_back(d.norm());
+  }
+}
+
+// The element lists as structure of arrays for the kernels (gathers vectorise; AoS would not).
+void ClothModel::buildKernelData() {
+  MembraneArrays& m = membraneArrays_;
+  for (const MembraneElement& el : membrane_) {
+    m.v0.push_back(static_cast<std::int32_t>(el.v0));
+    m.v1.push_back(static_cast<std::int32_t>(el.v1));
+    m.v2.push_back(static_cast<std::int32_t>(el.v2));
+    m.g1u.push_back(el.g1u);
+    m.g1v.push_back(el.g1v);
+    m.g2u.push_back(el.g2u);
+    m.g2v.push_back(el.g2v);
+    m.area.push_back(el.restArea_m2);
+  }
+  BendArrays& b = bendArrays_;
+  for (const BendElement& h : bending_) {
+    b.e0.push_back(static_cast<std::int32_t>(h.e0));
+    b.e1.push_back(static_cast<std::int32_t>(h.e1));
+    b.a.push_back(static_cast<std::int32_t>(h.a));
+    b.b.push_back(static_cast<std::int32_t>(h.b));
+    b.restPsi.push_back(h.restPsi);
+    b.stiffness.push_back(h.stiffness_Nm);
   }
 }
 

@@ -1,5 +1,6 @@
 #include "drape/cloth/state.hpp"
 
+#include <algorithm>
 #include <cstring>
 
 #include "drape/cloth/model.hpp"
@@ -18,6 +19,7 @@ ClothState ClothState::atRest(const ClothModel& model) {
   s.fx.assign(n, 0.0);
   s.fy.assign(n, 0.0);
   s.fz.assign(n, 0.0);
+  s.work.assign(4 * std::max(model.membrane().size(), model.bending().size()), 0.0);
   return s;
 }
 

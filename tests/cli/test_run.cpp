@@ -133,3 +133,26 @@ TEST(Run, UnstableRunExits3AndKeepsWhatItWrote) {
 
 }  // namespace
 }  // namespace drape
+
+namespace drape {
+namespace {
+
+// The benchmark's smoke test: `drape bench cloth --quick --no-peers` prints one JSON object
+// with the keys for the three sheet sizes.
+TEST(BenchCloth, QuickPrintsTheCases) {
+  testing::ScratchDir dir("bench-cloth");
+  const testing::CliResult r = testing::runDrape("bench cloth --quick --no-peers --json", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_GE(j["cases"].size(), 3u);
+  for (const auto& c : j["cases"])
+    for (const char* key : {"name", "triangles", "vertices", "substeps_per_frame", "ms_per_frame",
+                            "vertex_substeps_per_s", "stable", "max_strain"})
+      EXPECT_TRUE(c.contains(key)) << key;
+  EXPECT_EQ(j["cases"][0]["triangles"], 480);
+  EXPECT_EQ(j["cases"][0]["substeps_per_frame"], 33);
+  EXPECT_TRUE(j.contains("peers"));
+}
+
+}  // namespace
+}  // namespace drape

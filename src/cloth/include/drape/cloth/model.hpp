@@ -44,6 +44,20 @@ struct BendElement {
   double stiffness_Nm;   ///< k in W = k / 2 (psi - restPsi)^2, N m
 };
 
+/// The membrane elements again as structure of arrays, what the vectorised kernel reads
+/// (filled by buildKernelData from the MembraneElement list; same order).
+/// Indices are signed 32-bit because that is what vector gather instructions take.
+struct MembraneArrays {
+  std::vector<std::int32_t> v0, v1, v2;
+  std::vector<double> g1u, g1v, g2u, g2v, area;
+};
+
+/// The bending hinges as structure of arrays (buildKernelData; same order as bending()).
+struct BendArrays {
+  std::vector<std::int32_t> e0, e1, a, b;
+  std::vector<double> restPsi, stiffness;
+};
+
 class ClothModel {
  public:
   /// Builds the model. Throws drape::Error naming mesh.name on an invalid material or a
@@ -71,6 +85,8 @@ class ClothModel {
 
   [[nodiscard]] const std::vector<MembraneElement>& membrane() const { return membrane_; }
   [[nodiscard]] const std::vector<BendElement>& bending() const { return bending_; }
+  [[nodiscard]] const MembraneArrays& membraneArrays() const { return membraneArrays_; }
+  [[nodiscard]] const BendArrays& bendArrays() const { return bendArrays_; }
   /// Plane-stress Lame constants times thickness (membrane stiffnesses), N/m.
   [[nodiscard]] double lambdaT() const { return lambdaT_; }
   [[nodiscard]] double muT() const { return muT_; }
@@ -94,6 +110,7 @@ class ClothModel {
   void buildMembrane(const mesh::TriMesh& mesh);
   void buildBending(const mesh::TriMesh& mesh, const mesh::Topology& topology);
   void buildEdges(const mesh::Topology& topology);
+  void buildKernelData();
   [[nodiscard]] double estimateBendingOmega(const mesh::TriMesh& mesh) const;
 
   std::string name_;
@@ -103,6 +120,8 @@ class ClothModel {
   double totalMass_ = 0.0;
   std::vector<MembraneElement> membrane_;
   std::vector<BendElement> bending_;
+  MembraneArrays membraneArrays_;
+  BendArrays bendArrays_;
   double lambdaT_ = 0.0, muT_ = 0.0;
   std::vector<std::uint32_t> edgeV0_, edgeV1_;
   std::vector<double> edgeRest_;

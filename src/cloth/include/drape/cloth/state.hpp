@@ -18,8 +18,11 @@ struct ClothState {
   std::vector<double> x, y, z;     ///< positions, m
   std::vector<double> vx, vy, vz;  ///< velocities, m/s
   std::vector<double> fx, fy, fz;  ///< force accumulators of the current substep, N
+  /// Workspace of the force kernels (per-element forces before they are scattered to the
+  /// vertices); sized by atRest, not part of the state proper (hash() ignores it).
+  std::vector<double> work;
 
-  /// Rest positions, zero velocity.
+  /// Rest positions, zero velocity; sizes the workspace for the model's elements.
   [[nodiscard]] static ClothState atRest(const ClothModel& model);
   [[nodiscard]] std::size_t size() const { return x.size(); }
   [[nodiscard]] Vec3 position(std::size_t i) const { return {x[i], y[i], z[i]}; }

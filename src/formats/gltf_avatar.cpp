@@ -222,7 +222,8 @@ GModel parseDocument(std::string_view bytes, const std::string& name, const std:
     doc = json::parse(jsonText.begin(), jsonText.end());
   } catch (const json::exception& e) {  // parse_error, and out_of_range for numbers that overflow
     std::string what = e.what();
-    if (const auto colon = what.rfind(": "); colon != std::string::npos) what = what.substr(colon + 2);
+    if (what.rfind("[json.exception", 0) == 0 && what.find("] ") != std::string::npos) what = what.substr(what.find("] ") + 2);
+    if (const auto colon = what.find(": "); colon != std::string::npos) what = what.substr(colon + 2);
     throw Error(fmt::format("{}: not a glTF 2.0 file ({})", name, what));
   }
   if (!doc.is_object() || !doc.contains("asset") || !doc["asset"].is_object())

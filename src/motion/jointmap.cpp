@@ -57,7 +57,7 @@ JointMap parseJointMap(std::string_view json, const std::string& name) {
     doc = nlohmann::json::parse(json.begin(), json.end());
   } catch (const nlohmann::json::parse_error& e) {
     std::string what = e.what();
-    if (const auto colon = what.rfind(": "); colon != std::string::npos) what = what.substr(colon + 2);
+    if (const auto colon = what.find(": "); colon != std::string::npos) what = what.substr(colon + 2);
     throw Error::at(positionOf(json, e.byte > 0 ? e.byte - 1 : 0, name), what);
   } catch (const nlohmann::json::exception& e) {  // out_of_range: a number too large for a double
     throw Error(fmt::format("{}: bad JSON ({})", name, e.what()));

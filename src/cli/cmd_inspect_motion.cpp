@@ -1,6 +1,7 @@
 // `drape inspect FILE.bvh|.amc|.asf|.glb|.gltf|.mhskel`: skeleton, frame count, rate,
 // duration and the units guess of motion files; joints and segments of avatars.
 
+#include <cctype>
 #include <filesystem>
 
 #include <fmt/ostream.h>
@@ -49,7 +50,9 @@ void inspectBvh(const std::string& path, std::ostream& out) {
 }
 
 void inspectAcclaim(const std::string& path, std::ostream& out) {
-  if (std::filesystem::path(path).extension() == ".asf") {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".asf") {
     const formats::AsfSkeleton asf = formats::readAsf(path);
     fmt::print(out, "{}: Acclaim ASF skeleton '{}'\n  bones      {}\n", path, asf.name, asf.bones.size());
     for (const formats::AsfBone& b : asf.bones)

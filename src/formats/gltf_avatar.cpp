@@ -220,14 +220,16 @@ GModel parseDocument(std::string_view bytes, const std::string& name, const std:
   json doc;
   try {
     doc = json::parse(jsonText.begin(), jsonText.end());
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, and out_of_range for numbers that overflow
     std::string what = e.what();
-    if (const auto colon = what.rfind(": "); colon != std::string::npos) what = what.substr(colon + 2);
+    if (what.rfind("[json.exception", 0) == 0 && what.find("] ") != std::string::npos) what = what.substr(what.find("] ") + 2);
+    if (const auto colon = what.find(": "); colon != std::string::npos) what = what.substr(colon + 2);
     throw Error(fmt::format("{}: not a glTF 2.0 file ({})", name, what));
   }
   if (!doc.is_object() || !doc.contains("asset") || !doc["asset"].is_object())
     throw Error(fmt::format("{}: not a glTF 2.0 file (no \"asset\" object)", name));
-  const std::string version = doc["asset"].value("version", std::string());
+  const auto versionIt = doc["asset"].find("version");
+  const std::string version = versionIt != doc["asset"].end() && versionIt->is_string() ? versionIt->get<std::string>() : "";
   if (version.rfind("2.", 0) != 0) throw Error(fmt::format("{}: glTF version '{}' (drape reads 2.x)", name, version));
   GModel m;
   try {

@@ -31,8 +31,10 @@ json parseJson(std::string_view text, const std::string& name) {
       }
     }
     std::string what = e.what();
-    if (const auto colon = what.rfind(": "); colon != std::string::npos) what = what.substr(colon + 2);
+    if (const auto colon = what.find(": "); colon != std::string::npos) what = what.substr(colon + 2);
     throw Error::at(pos, what);
+  } catch (const json::exception& e) {  // out_of_range: a number too large for a double
+    throw Error(fmt::format("{}: bad JSON ({})", name, e.what()));
   }
 }
 

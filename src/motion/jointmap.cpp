@@ -57,14 +57,17 @@ JointMap parseJointMap(std::string_view json, const std::string& name) {
     doc = nlohmann::json::parse(json.begin(), json.end());
   } catch (const nlohmann::json::parse_error& e) {
     std::string what = e.what();
-    if (const auto colon = what.rfind(": "); colon != std::string::npos) what = what.substr(colon + 2);
+    if (const auto colon = what.find(": "); colon != std::string::npos) what = what.substr(colon + 2);
     throw Error::at(positionOf(json, e.byte > 0 ? e.byte - 1 : 0, name), what);
+  } catch (const nlohmann::json::exception& e) {  // out_of_range: a number too large for a double
+    throw Error(fmt::format("{}: bad JSON ({})", name, e.what()));
   }
   if (!doc.is_object() || !doc.contains("joints") || !doc["joints"].is_object())
     throw Error(fmt::format("{}: expected a JSON object with a \"joints\" object of motion joint -> avatar joint", name));
   JointMap map;
   map.source = name;
-  map.name = doc.value("name", std::filesystem::path(name).stem().string());
+  map.name = doc.contains("name") && doc["name"].is_string() ? doc["name"].get<std::string>()
+                                                             : std::filesystem::path(name).stem().string();
   std::string text(json);
   for (const auto& [motionJoint, avatarJoint] : doc["joints"].items()) {
     const int line = lineOfKey(text, motionJoint);

@@ -141,8 +141,8 @@ TEST(MhSkel, ReadsTheDefaultWeights) {
 
 TEST(MhSkel, MalformedCorpus) {
   const std::string badJson = bad("mhskel_bad_json.mhskel");
-  EXPECT_EQ(errorOf([&] { (void)readMhskel(badJson); }).rfind(badJson + ":5:3: ", 0), 0u)
-      << errorOf([&] { (void)readMhskel(badJson); });
+  EXPECT_EQ(errorOf([&] { (void)readMhskel(badJson); }),
+            badJson + ":5:3: syntax error while parsing object key - unexpected '}'; expected string literal");
   const std::string twoRoots = bad("mhskel_two_roots.mhskel");
   EXPECT_EQ(errorOf([&] { (void)readMhskel(twoRoots); }), twoRoots + ": two root bones ('a' and 'b')");
 }

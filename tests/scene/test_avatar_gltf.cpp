@@ -89,6 +89,13 @@ TEST(GltfAvatar, BufferUriOutsideTheFolderIsRefused) {
   EXPECT_NE(e.find("outside the model's folder"), std::string::npos) << e;
 }
 
+// Found by fuzz/fuzz_gltf.cpp: a number too large for a double made nlohmann_json throw
+// out_of_range, which escaped as an uncaught exception.
+TEST(GltfAvatar, NumberOverflowIsAnError) {
+  const std::string e = errorOf([] { (void)loadGltfAvatar(bad("number_overflow.gltf")); });
+  EXPECT_NE(e.find("not a glTF 2.0 file (number overflow"), std::string::npos) << e;
+}
+
 TEST(GltfAvatar, UnknownAvatarExtension) {
   EXPECT_EQ(errorOf([] { (void)loadAvatarFile("x.fbx"); }),
             "x.fbx: drape reads avatars from .glb, .gltf and MakeHuman .mhskel files, not '.fbx'");

@@ -11,7 +11,7 @@ RELEASE_DIR := build/release
 ASAN_DIR := build/asan
 FUZZ_DIR := build/fuzz
 FUZZ_SECONDS ?= 60
-DEMO_OUT ?= out/demo
+DEMO_OUT ?= out/walking_skirt
 
 .PHONY: deps build demo test fuzz bench clean
 
@@ -38,7 +38,7 @@ fuzz: deps
 	@scripts/run-fuzzers $(FUZZ_DIR) $(FUZZ_SECONDS)
 
 bench: build
-	@for b in $$($(RELEASE_DIR)/drape bench --help | awk '/^SUBCOMMANDS:/{s=1;next} s && NF {print $$1}'); do \
+	@for b in $$($(RELEASE_DIR)/drape bench --help | awk '/^Subcommands:/{s=1;next} s && NF {print $$1}'); do \
 		echo "== drape bench $$b --json" >&2; $(RELEASE_DIR)/drape bench $$b --json; done
 
 clean:

@@ -1,6 +1,7 @@
-// `drape run`: simulate a garment hanging from pinned vertices (a VRML97 scene with an
-// avatar and motion comes later through the same RunSetup) and write frames, a PC2 cache,
-// stats.json and manifest.json into the output directory.
+// `drape run`: simulate garments and write frames, PC2 caches, result.wrl, result.glb,
+// stats.json and manifest.json into the output directory. The garments come from a VRML97
+// scene (with its avatar, materials and settings) or from --garment; a character moves with
+// --motion (BVH, ASF/AMC) and its body parts collide through distance fields.
 
 #include <algorithm>
 #include <cmath>
@@ -9,16 +10,25 @@
 
 #include <fmt/format.h>
 
+#include "drape/core/log.hpp"
+
 #include "command.hpp"
 #include "drape/core/error.hpp"
 #include "drape/formats/obj.hpp"
 #include "drape/formats/units.hpp"
+#include "drape/motion/animation.hpp"
+#include "drape/scene/avatar_gltf.hpp"
+#include "drape/scene/scene.hpp"
+#include "drape/sim/scene_setup.hpp"
 #include "run_setup.hpp"
 
 namespace drape::cli {
 namespace {
 
 struct RunOptions {
+  std::string scene, avatar, motion, jointMap, fieldMethod = "dvdp";
+  double motionScale = 0.0, voxel_m = 0.0, leadIn_s = 1.0;
+  bool preview = false;
   std::string garment, units = "m", pinVertices, pinMask, out, substeps = "33", integrator = "symplectic-euler";
   std::string wind, gravity;
   std::vector<std::string> spheres;
@@ -101,8 +111,42 @@ int substepsFrom(const std::string& text) {
   return static_cast<int>(value);
 }
 
-int runCommand(RunOptions& o) {
-  RunSetup setup;
+/// Command-line values that override the scene's (only those the user gave).
+void applyOverrides(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
+  cloth::StepSettings& s = setup.settings;
+  if (app.count("--frame-rate")) s.frameRate_hz = o.settings.frameRate_hz;
+  if (app.count("--air-viscosity")) s.airViscosity_Ns_m3 = o.settings.airViscosity_Ns_m3;
+  if (app.count("--max-speed")) s.maxSpeed_m_s = o.settings.maxSpeed_m_s;
+  if (app.count("--integrator")) s.integrator = cloth::parseIntegrator(o.integrator, "--integrator");
+  if (app.count("--wind")) s.wind_m_s = parseVec3(o.wind, "--wind");
+  if (app.count("--gravity")) s.gravity_m_s2 = parseVec3(o.gravity, "--gravity");
+  for (GarmentSetup& g : setup.garments) {
+    cloth::Material& m = g.material;
+    if (app.count("--density")) m.density_kg_m3 = o.material.density_kg_m3;
+    if (app.count("--thickness")) m.thickness_m = o.material.thickness_m;
+    if (app.count("--youngs-modulus")) m.youngsModulus_Pa = o.material.youngsModulus_Pa;
+    if (app.count("--poisson-ratio")) m.poissonRatio = o.material.poissonRatio;
+    if (app.count("--bending-stiffness")) m.bendingStiffness_Nm = o.material.bendingStiffness_Nm;
+    if (app.count("--damping")) m.damping_s = o.material.damping_s;
+    if (app.count("--static-friction")) m.staticFriction = o.material.staticFriction;
+    if (app.count("--dynamic-friction")) m.dynamicFriction = o.material.dynamicFriction;
+    if (app.count("--compression-scale")) m.compressionScale = o.material.compressionScale;
+  }
+}
+
+/// Garments, materials, settings and the avatar from a VRML97 scene.
+void setupFromScene(const RunOptions& o, RunSetup& setup, std::shared_ptr<const scene::Avatar>& avatar) {
+  const scene::Scene sc = scene::loadScene(o.scene);
+  for (const std::string& w : sc.warnings) spdlog::warn("{}", w);
+  if (sc.garments.empty()) throw Error(fmt::format("{}: the scene has no ClothSet to simulate", o.scene));
+  avatar = sim::sceneAvatar(sc);
+  setup.settings = sim::toStepSettings(sc.simulation);
+  setup.garments = sim::garmentSpecs(sc, avatar.get());
+  if (avatar) setup.character = CharacterSetup{avatar, nullptr, sc.simulation.voxelSize};
+}
+
+/// A garment from --garment (OBJ) with its pins or mask.
+void setupFromGarment(const RunOptions& o, RunSetup& setup, bool onAvatar) {
   const double scale = formats::metresPerUnit(o.units, "--units");
   formats::ObjReadOptions read;
   read.metresPerUnit = scale;
@@ -115,26 +159,77 @@ int runCommand(RunOptions& o) {
     if (!(o.pinTolerance_m > 0.0)) throw Error(fmt::format("--pin-tolerance must be > 0 m, got {}", o.pinTolerance_m));
     garment.pinned = matchMask(garment.mesh, formats::readObj(o.pinMask, read), o.pinTolerance_m);
   }
-
+  if (onAvatar) std::swap(garment.bound, garment.pinned);  // a mask on a body binds to it
   setup.settings = o.settings;
   setup.settings.integrator = cloth::parseIntegrator(o.integrator, "--integrator");
   if (!o.wind.empty()) setup.settings.wind_m_s = parseVec3(o.wind, "--wind");
   if (!o.gravity.empty()) setup.settings.gravity_m_s2 = parseVec3(o.gravity, "--gravity");
-  for (const std::string& s : o.spheres) {
-    const auto comma = s.rfind(',');
-    if (comma == std::string::npos) throw Error(fmt::format("--sphere: expected x,y,z,radius (m), got '{}'", s));
-    const Vec3 c = parseVec3(s.substr(0, comma), "--sphere");
-    const Vec3 r = parseVec3("0,0," + s.substr(comma + 1), "--sphere");
+  setup.garments.push_back(std::move(garment));
+}
+
+int runCommand(const CLI::App& app, RunOptions& o) {
+  if (o.scene.empty() == o.garment.empty())
+    throw Error("drape run: give either a scene file (drape run SCENE.wrl) or --garment FILE.obj");
+  RunSetup setup;
+  std::shared_ptr<const scene::Avatar> avatar;
+  if (!o.scene.empty()) {
+    setupFromScene(o, setup, avatar);
+    applyOverrides(app, o, setup);
+  } else {
+    if (!o.avatar.empty()) avatar = std::make_shared<const scene::Avatar>(scene::loadAvatarFile(o.avatar));
+    setupFromGarment(o, setup, avatar != nullptr);
+    if (avatar) {
+      setup.character = CharacterSetup{avatar, nullptr, 0.005};
+      for (GarmentSetup& g : setup.garments)
+        for (const scene::Segment& seg : avatar->segments) g.collidesWith.push_back(seg.name);
+    }
+  }
+  if (!o.motion.empty() && !avatar)
+    throw Error("--motion: there is no avatar to move (the scene has none; without a scene, give --avatar FILE)");
+  for (const std::string& sphere : o.spheres) {
+    const auto comma = sphere.rfind(',');
+    if (comma == std::string::npos) throw Error(fmt::format("--sphere: expected x,y,z,radius (m), got '{}'", sphere));
+    const Vec3 c = parseVec3(sphere.substr(0, comma), "--sphere");
+    const Vec3 r = parseVec3("0,0," + sphere.substr(comma + 1), "--sphere");
     setup.spheres.push_back({c, r.z()});
   }
-  const int substeps = substepsFrom(o.substeps);
-  setup.settings.substepsPerFrame = substeps > 0 ? substeps : 1;
-  setup.garments.push_back(std::move(garment));
+
+  if (setup.character) {
+    CharacterSetup& ch = *setup.character;
+    if (o.voxel_m > 0) ch.voxel_m = o.voxel_m;
+    ch.fieldMethod = o.fieldMethod == "exact" ? field::FieldMethod::Exact : field::FieldMethod::Dvdp;
+    if (!(o.leadIn_s >= 0)) throw Error(fmt::format("--lead-in must be >= 0 s, got {}", o.leadIn_s));
+    ch.leadIn_s = o.leadIn_s;
+    if (!o.motion.empty()) {
+      motion::MotionOptions mo;
+      mo.clip.rate = setup.settings.frameRate_hz;
+      if (o.motionScale > 0) mo.clip.metresPerUnit = o.motionScale;
+      mo.jointMapPath = o.jointMap;
+      mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
+      ch.animation = std::make_shared<const motion::AvatarAnimation>(motion::loadAnimation(*avatar, o.motion, mo));
+    }
+  }
+
+  if (app.count("--substeps") || o.scene.empty()) {
+    const int substeps = substepsFrom(o.substeps);
+    setup.settings.substepsPerFrame = substeps > 0 ? substeps : 1;
+    if (substeps == 0) setup.settings.substepsPerFrame = stableSubsteps(setup);
+  }
+  // Frames: as asked, or the lead-in plus the whole motion.
   setup.frames = o.frames;
+  if (!app.count("--frames")) {
+    if (!setup.character || !setup.character->animation)
+      throw Error("--frames is required (it defaults to the motion's length only with --motion)");
+    const double seconds = setup.character->leadIn_s + setup.character->animation->duration();
+    setup.frames = static_cast<long>(std::ceil(seconds * setup.settings.frameRate_hz));
+  }
   setup.objEvery = o.every;
   setup.outDir = o.out;
-  if (substeps == 0) setup.settings.substepsPerFrame = stableSubsteps(setup);
-  return simulateRun(setup);
+  setup.preview = o.preview;
+  const int code = simulateRun(setup);
+  fmt::print("results in {}/: garment caches (.pc2), frames/, result.wrl, result.glb, stats.json{}\n", o.out,
+             o.preview ? ", preview.png" : "");
+  return code;
 }
 
 RunFunction setupRun(CLI::App& app) {
@@ -143,7 +238,18 @@ RunFunction setupRun(CLI::App& app) {
       "Writes DIR/frames/frame_NNNNN.obj (every --every frames), DIR/garment.pc2 (every frame), DIR/garment.obj "
       "(rest topology), DIR/stats.json and DIR/manifest.json. Units are SI; Y is up.\n"
       "Exit codes: 0 done, 2 bad input, 3 the simulation became unstable (files so far are kept).");
-  app.add_option("--garment", o->garment, "Garment mesh (OBJ)")->required();
+  app.add_option("scene", o->scene, "VRML97 scene with ClothSet garments (and an avatar)");
+  app.add_option("--garment", o->garment, "Garment mesh (OBJ), instead of a scene");
+  app.add_option("--avatar", o->avatar, "Avatar to wear --garment (.glb, .gltf, MakeHuman .mhskel)");
+  app.add_option("--motion", o->motion, "Motion for the avatar (.bvh, .amc)");
+  app.add_option("--joint-map", o->jointMap, "JSON map from the motion's joint names to the avatar's");
+  app.add_option("--motion-scale", o->motionScale, "Metres per motion-file unit (default: guessed from the skeleton)");
+  app.add_option("--voxel", o->voxel_m, "Distance-field voxel size, m (default: the scene's, or 0.005)");
+  app.add_option("--field-method", o->fieldMethod, "dvdp (the paper's) or exact")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"dvdp", "exact"}));
+  app.add_option("--lead-in", o->leadIn_s, "Seconds to blend from the rest pose into the motion")->capture_default_str();
+  app.add_flag("--preview", o->preview, "Also render a contact sheet and, with ffmpeg, an MP4 into the output directory");
   app.add_option("--units", o->units, "Length unit of the OBJ files: m, dm, cm, mm, in")->capture_default_str();
   auto* pins = app.add_option("--pin-vertices", o->pinVertices, "Vertices pinned in place, 0-based, e.g. 0,12,40");
   auto* mask = app.add_option("--pin-mask", o->pinMask, "OBJ whose vertices mark the pinned garment vertices");
@@ -151,7 +257,7 @@ RunFunction setupRun(CLI::App& app) {
   mask->excludes(pins);
   app.add_option("--pin-tolerance", o->pinTolerance_m, "Distance within which a mask vertex matches, m")
       ->capture_default_str();
-  app.add_option("--frames", o->frames, "Frames to simulate")->required();
+  app.add_option("--frames", o->frames, "Frames to simulate (default with --motion: the lead-in and the whole motion)");
   app.add_option("--out", o->out, "Output directory")->required();
   app.add_option("--every", o->every, "Write an OBJ frame every K frames")->capture_default_str();
 
@@ -178,11 +284,11 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--gravity", o->gravity, "Gravity x,y,z, m/s^2 (default 0,-9.81,0)");
   app.add_option("--max-speed", s.maxSpeed_m_s, "Stability bound on vertex speed, m/s")->capture_default_str();
   app.add_option("--sphere", o->spheres, "A static sphere collider x,y,z,radius (m); repeatable");
-  return [o] { return runCommand(*o); };
+  return [o, &app] { return runCommand(app, *o); };
 }
 
 const bool registered =
-    registerCommand({"run", "Simulate a garment and write OBJ frames, a PC2 cache and stats", "", 10, &setupRun});
+    registerCommand({"run", "Simulate garments (on a moving avatar) and write frames, caches, VRML97, glTF and stats", "", 10, &setupRun});
 
 }  // namespace
 }  // namespace drape::cli

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <array>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -18,7 +19,10 @@
 #include "drape/formats/obj.hpp"
 #include "drape/formats/pc2.hpp"
 #include "drape/formats/run_manifest.hpp"
+#include "drape/formats/gltf_writer.hpp"
+#include "drape/formats/vrml_write.hpp"
 #include "drape/mesh/topology.hpp"
+#include "drape/render/outputs.hpp"
 
 namespace drape::cli {
 namespace {
@@ -32,10 +36,29 @@ constexpr double kMinTriangleArea_m2 = 1e-12;
 /// One garment being simulated: its model, solver and output streams.
 struct GarmentRun {
   std::string fileStem;  ///< "garment" alone, "garment-<name>" when there are several
-  std::shared_ptr<const cloth::ClothModel> model;
-  std::unique_ptr<cloth::ClothSolver> solver;
+  const cloth::ClothModel* model = nullptr;
+  std::unique_ptr<cloth::ClothSolver> ownedSolver;  ///< without a character
+  cloth::ClothSolver* solver = nullptr;             ///< owned here or by the character world
+  const cloth::FieldCollider* collider = nullptr;   ///< on a character
+  std::unique_ptr<formats::Pc2Writer> cache;
+  std::vector<std::vector<Vec3>> frames;            ///< every frame, for result.wrl
+};
+
+/// One avatar body part written as a deforming mesh: rest topology and a cache of world
+/// positions per frame (role "segment" in the manifest).
+struct SegmentRun {
+  std::string name;
+  int joint = -1;
+  std::string fileStem;
+  const mesh::TriMesh* mesh = nullptr;  ///< in the joint's frame
   std::unique_ptr<formats::Pc2Writer> cache;
 };
+
+std::string sanitise(const std::string& name) {
+  std::string out;
+  for (char c : name) out += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
+  return out.empty() ? std::string("part") : out;
+}
 
 double medianOf(std::vector<double> v) {
   if (v.empty()) return 0.0;
@@ -55,10 +78,93 @@ std::vector<cloth::PinGroup> pinsOf(const GarmentSetup& g, const cloth::ClothMod
   return {cloth::PinGroup::atRest(g.pinned, model.restX(), model.restY(), model.restZ())};
 }
 
+/// The paper's Table 3 figures and ours: how much time went to collisions, how far points
+/// were traced, where they are, and how deep anything got.
+void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& runs, const cloth::StageTimes& total,
+                       const sim::CharacterWorld* world) {
+  const double simulated = total.forces_s + total.integrate_s + total.collide_s + total.fixtures_s;
+  stats["collision_time_share"] = simulated > 0 ? total.collide_s / simulated : 0.0;
+  cloth::FieldCollisionCounters sum;
+  std::array<std::size_t, 3> states{};
+  for (const GarmentRun& r : runs) {
+    if (!r.collider) continue;
+    const cloth::FieldCollisionCounters& c = r.collider->fieldCounters();
+    sum.tests += c.tests;
+    sum.traceVoxels += c.traceVoxels;
+    sum.collisions += c.collisions;
+    sum.projections += c.projections;
+    sum.vertexSubstepsBelowT1 += c.vertexSubstepsBelowT1;
+    sum.vertexSubstepsBelowT0 += c.vertexSubstepsBelowT0;
+    sum.vertexSubstepsInsideBody += c.vertexSubstepsInsideBody;
+    sum.vertexSubsteps += c.vertexSubsteps;
+    sum.maxPenetration_m = std::max(sum.maxPenetration_m, c.maxPenetration_m);
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) sum.transitions[a][b] += c.transitions[a][b];
+    const auto now = r.collider->pointsPerState();
+    for (int k = 0; k < 3; ++k) states[k] += now[k];
+  }
+  stats["mean_collision_path_voxels"] = sum.meanPathVoxels();
+  stats["points_per_state"] = {{"outside_vol", states[0]}, {"inside_vol", states[1]}, {"on_surf", states[2]}};
+  stats["vertex_substeps"] = sum.vertexSubsteps;
+  stats["vertex_substeps_below_T1"] = sum.vertexSubstepsBelowT1;
+  stats["vertex_substeps_below_T0"] = sum.vertexSubstepsBelowT0;
+  stats["vertex_substeps_inside_body"] = sum.vertexSubstepsInsideBody;
+  stats["max_penetration_m"] = sum.maxPenetration_m;
+  stats["collisions_registered"] = sum.collisions;
+  stats["last_resort_projections"] = sum.projections;
+  nlohmann::json transitions;
+  const char* names[3] = {"outside_vol", "inside_vol", "on_surf"};
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) transitions[std::string(names[a]) + "->" + names[b]] = sum.transitions[a][b];
+  stats["state_transitions"] = transitions;
+  if (world) {
+    nlohmann::json fields = nlohmann::json::array();
+    for (const sim::PartField& f : world->fields()) {
+      const auto& d = f.field.dims();
+      fields.push_back({{"segment", f.segment},
+                        {"dims", {d.nx, d.ny, d.nz}},
+                        {"bytes", f.field.memoryBytes()},
+                        {"build_ms", f.field.stats().voxelizeMs + f.field.stats().propagateMs + f.field.stats().finishMs}});
+    }
+    stats["distance_fields"] = fields;
+    stats["distance_field_build_s"] = world->fieldBuild_s();
+  }
+}
+
+/// result.wrl (any VRML97 browser, and drape's reader) and result.glb (glTF viewers, DCC
+/// tools): the garments and, on a character, the animated avatar.
+void writeResultFiles(const RunSetup& setup, const std::vector<GarmentRun>& runs,
+                      const std::vector<SegmentRun>& segments,
+                      const std::vector<std::vector<RigidTransform>>& jointFrames) {
+  const fs::path out(setup.outDir);
+  formats::vrml::Animation animation;
+  animation.frameRate = setup.settings.frameRate_hz;
+  for (std::size_t g = 0; g < runs.size(); ++g)
+    animation.garments.push_back({setup.garments[g].name, runs[g].model->triangles(), runs[g].frames, Vec3(0.8, 0.25, 0.2)});
+  if (setup.character) {
+    const scene::Avatar& avatar = *setup.character->avatar;
+    for (std::size_t j = 0; j < avatar.joints.size(); ++j) {
+      formats::vrml::JointTrack track;
+      track.name = avatar.joints[j].name;
+      for (const SegmentRun& sr : segments)
+        if (sr.joint == static_cast<int>(j)) track.segments.push_back(*sr.mesh);
+      track.frames = jointFrames[j];
+      animation.joints.push_back(std::move(track));
+    }
+  }
+  formats::vrml::writeAnimation((out / "result.wrl").string(), animation);
+  (void)formats::exportRunToGlb(setup.outDir, (out / "result.glb").string());
+  if (setup.preview) {
+    const render::PreviewFiles preview = render::renderPreview(setup.outDir);
+    spdlog::info("preview: {}{}", preview.contactSheet, preview.video.empty() ? " (no ffmpeg: no video)" : ", " + preview.video);
+  }
+}
+
 }  // namespace
 
 void validateRunSetup(const RunSetup& setup) {
   if (setup.garments.empty()) throw Error("drape run: no garment to simulate");
+  if (setup.character && !setup.character->avatar) throw Error("drape run: the character has no avatar", ExitCode::Internal);
   setup.settings.validate("--");
   if (setup.frames < 1) throw Error(fmt::format("--frames must be >= 1, got {}", setup.frames));
   if (setup.objEvery < 1) throw Error(fmt::format("--every must be >= 1, got {}", setup.objEvery));
@@ -89,18 +195,40 @@ int simulateRun(const RunSetup& setup) {
   const fs::path out(setup.outDir);
   const cloth::StepSettings& settings = setup.settings;
 
-  // Build every garment (topology checks happen here: non-manifold, degenerate).
+  // Build every garment (topology checks happen here: non-manifold, degenerate). On a
+  // character, the world builds the part fields, binds the masks and owns the solvers.
   std::vector<cloth::SphereCollider> spheres;
   for (const SphereSetup& s : setup.spheres) spheres.emplace_back(s.centre_m, s.radius_m);
+  for (const GarmentSetup& g : setup.garments) (void)mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
+  std::unique_ptr<sim::CharacterWorld> world;
+  if (setup.character) {
+    sim::WorldSettings ws;
+    ws.step = settings;
+    ws.voxel_m = setup.character->voxel_m;
+    ws.fieldMethod = setup.character->fieldMethod;
+    ws.leadIn_s = setup.character->leadIn_s;
+    spdlog::info("building distance fields ({} m voxels) and binding constraint masks", ws.voxel_m);
+    world = std::make_unique<sim::CharacterWorld>(*setup.character->avatar, setup.character->animation.get(),
+                                                  setup.garments, ws);
+    spdlog::info("{} distance fields in {:.2f} s", world->fields().size(), world->fieldBuild_s());
+  }
   std::vector<GarmentRun> runs;
   formats::RunManifest manifest;
   manifest.frameRate = settings.frameRate_hz;
-  for (const GarmentSetup& g : setup.garments) {
+  for (std::size_t gi = 0; gi < setup.garments.size(); ++gi) {
+    const GarmentSetup& g = setup.garments[gi];
     GarmentRun r;
-    r.fileStem = setup.garments.size() == 1 ? "garment" : "garment-" + g.name;
-    const mesh::Topology topology = mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
-    r.model = cloth::ClothModel::build(g.mesh, topology, g.material);
-    r.solver = std::make_unique<cloth::ClothSolver>(r.model, settings, pinsOf(g, *r.model));
+    r.fileStem = setup.garments.size() == 1 ? "garment" : "garment-" + sanitise(g.name);
+    if (world) {
+      r.solver = &world->mutableSolver(gi);
+      r.collider = world->collider(gi);
+    } else {
+      const mesh::Topology topology = mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
+      auto model = cloth::ClothModel::build(g.mesh, topology, g.material);
+      r.ownedSolver = std::make_unique<cloth::ClothSolver>(model, settings, pinsOf(g, *model));
+      r.solver = r.ownedSolver.get();
+    }
+    r.model = &r.solver->model();
     for (cloth::SphereCollider& s : spheres) r.solver->addCollider(s);
     const double stable = r.model->estimatedStableStep_s();
     if (settings.substep_s() > stable)
@@ -114,6 +242,33 @@ int simulateRun(const RunSetup& setup) {
                                                    1.0);
     manifest.meshes.push_back({g.name, "garment", r.fileStem + ".obj", r.fileStem + ".pc2"});
     runs.push_back(std::move(r));
+  }
+
+  // The avatar's body parts, written as deforming meshes for players and exporters.
+  std::vector<SegmentRun> segments;
+  std::vector<RigidTransform> joints;
+  std::vector<std::vector<RigidTransform>> jointFrames;  // per joint, per frame (result.wrl)
+  if (setup.character) {
+    const scene::Avatar& avatar = *setup.character->avatar;
+    joints.resize(avatar.joints.size());
+    jointFrames.resize(avatar.joints.size());
+    world->poses().evaluate(0.0, joints);
+    std::error_code ec;
+    fs::create_directories(out / "segments", ec);
+    for (const scene::Segment& seg : avatar.segments) {
+      SegmentRun sr;
+      sr.name = seg.name;
+      sr.joint = seg.joint;
+      sr.mesh = &seg.mesh;
+      sr.fileStem = "segments/" + sanitise(seg.name);
+      std::vector<Vec3> rest;
+      for (const Vec3& p : seg.mesh.positions) rest.push_back(joints[static_cast<std::size_t>(seg.joint)].apply(p));
+      formats::writeObj((out / (sr.fileStem + ".obj")).string(), rest, seg.mesh.triangles,
+                        "drape run: body part " + seg.name + " (m)");
+      sr.cache = std::make_unique<formats::Pc2Writer>((out / (sr.fileStem + ".pc2")).string(), rest.size(), 0.0, 1.0);
+      manifest.meshes.push_back({seg.name, "segment", sr.fileStem + ".obj", sr.fileStem + ".pc2"});
+      segments.push_back(std::move(sr));
+    }
   }
 
   // Per-frame records for stats.json.
@@ -130,6 +285,7 @@ int simulateRun(const RunSetup& setup) {
       const cloth::ClothState& s = r.solver->state();
       s.copyPositions(positions);
       r.cache->writeFrame(positions);
+      r.frames.push_back(positions);
       if (frame % setup.objEvery == 0 || frame == setup.frames) {
         const std::string name =
             runs.size() == 1 ? fmt::format("frame_{:05d}.obj", frame) : fmt::format("{}_{:05d}.obj", r.fileStem, frame);
@@ -140,6 +296,16 @@ int simulateRun(const RunSetup& setup) {
       maxStrain = std::max(maxStrain, cloth::maxEdgeStrain(*r.model, s));
     }
     energy.push_back(e);
+    if (world) {
+      world->poses().evaluate(world->frameTime(frame), joints);
+      for (std::size_t j = 0; j < joints.size(); ++j) jointFrames[j].push_back(joints[j]);
+      for (SegmentRun& sr : segments) {
+        positions.clear();
+        const RigidTransform& pose = joints[static_cast<std::size_t>(sr.joint)];
+        for (const Vec3& p : sr.mesh->positions) positions.push_back(pose.apply(p));
+        sr.cache->writeFrame(positions);
+      }
+    }
     outputSeconds += std::chrono::duration<double>(Clock::now() - start).count();
   };
 
@@ -164,8 +330,10 @@ int simulateRun(const RunSetup& setup) {
 
   // Close the caches and write stats and manifest (also after an instability).
   for (GarmentRun& r : runs) r.cache->close();
+  for (SegmentRun& sr : segments) sr.cache->close();
   manifest.frames = done + 1;
   formats::writeRunManifest(setup.outDir, manifest);
+  writeResultFiles(setup, runs, segments, jointFrames);
 
   cloth::StageTimes total;
   for (const GarmentRun& r : runs) {
@@ -204,6 +372,7 @@ int simulateRun(const RunSetup& setup) {
                         {"estimated_stable_substep_s", m.estimatedStableStep_s()}});
   }
   stats["garments"] = garments;
+  addCollisionStats(stats, runs, total, world.get());
   const std::string statsPath = (out / "stats.json").string();
   std::ofstream statsFile(statsPath);
   statsFile << stats.dump(2) << "\n";

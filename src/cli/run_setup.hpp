@@ -6,20 +6,30 @@
 // DIR/stats.json and DIR/manifest.json.
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "drape/cloth/collider.hpp"
 #include "drape/cloth/material.hpp"
 #include "drape/mesh/trimesh.hpp"
+#include "drape/motion/animation.hpp"
+#include "drape/scene/avatar.hpp"
+#include "drape/sim/character_world.hpp"
 
 namespace drape::cli {
 
-struct GarmentSetup {
-  std::string name;                    ///< for messages and file names ("dress")
-  mesh::TriMesh mesh;                  ///< rest shape, m
-  cloth::Material material;
-  std::vector<std::uint32_t> pinned;   ///< vertices pinned in place (sorted, unique)
+/// A garment: name, rest mesh (m), material, pinned vertices, and, on a character, its
+/// constraint mask (bound vertices), collision candidates and offsets.
+using GarmentSetup = sim::GarmentSpec;
+
+/// The character garments are worn by: a segmented avatar and, optionally, its motion.
+struct CharacterSetup {
+  std::shared_ptr<const scene::Avatar> avatar;
+  std::shared_ptr<const motion::AvatarAnimation> animation;  ///< null: the avatar stands at rest
+  double voxel_m = 0.005;                                     ///< distance-field voxel size
+  field::FieldMethod fieldMethod = field::FieldMethod::Dvdp;
+  double leadIn_s = 1.0;                                      ///< rest pose -> first motion frame
 };
 
 struct SphereSetup {
@@ -31,9 +41,11 @@ struct RunSetup {
   std::vector<GarmentSetup> garments;
   cloth::StepSettings settings;
   std::vector<SphereSetup> spheres;    ///< analytic sphere colliders (every garment collides)
+  std::optional<CharacterSetup> character;  ///< garments on an avatar, colliding with its parts
   long frames = 0;                     ///< frames to simulate after the initial one
   long objEvery = 1;                   ///< write an OBJ frame every K frames
   std::string outDir;
+  bool preview = false;                ///< also a contact sheet and (with ffmpeg) an MP4
 };
 
 /// Checks the setup (garment topology, materials, settings, pins) and throws drape::Error

@@ -217,10 +217,15 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
     if (d > offsets_.t3_m) {
       state = PointState::InsideVol;  // carried away by forces
     } else if (d < offsets_.t0_m) {
-      local += (offsets_.t1_m - d) * f.normalAt(local);  // last resort
+      local += (offsets_.t2_m - d) * f.normalAt(local);  // last resort
       moved = true;
       ++field_.projections;
       ++counters_.contacts;
+    } else if (d < offsets_.t2_m) {
+      // Sliding: the point stays on T2 while the part moves into it; the envelope down to
+      // T1 absorbs what one substep's normal cannot (the penalty below).
+      local += (offsets_.t2_m - d) * f.normalAt(local);
+      moved = true;
     }
   } else {
     state = PointState::InsideVol;

@@ -31,12 +31,14 @@ Skirt makeSkirt(const SkirtShape& s) {
   for (int r = 0; r <= s.rings; ++r) {
     const double f = double(r) / s.rings;
     const double flare = 1.0 + (s.hemFlare - 1.0) * f;
+    const bool profiled = s.ringRadiusX.size() == std::size_t(s.rings + 1) && s.ringRadiusZ.size() == std::size_t(s.rings + 1);
+    const double rx = profiled ? s.ringRadiusX[r] : s.waistRadiusX * flare;
+    const double rz = profiled ? s.ringRadiusZ[r] : s.waistRadiusZ * flare;
     // Stagger alternate rings by half a segment: near-equilateral triangles.
     const double phase = (r % 2) * 0.5;
     for (int k = 0; k < s.segments; ++k) {
       const double a = 2.0 * std::numbers::pi * (k + phase) / s.segments;
-      out.mesh.positions.push_back(s.waistCentre + Vec3(s.waistRadiusX * flare * std::sin(a), -s.length * f,
-                                                        s.waistRadiusZ * flare * std::cos(a)));
+      out.mesh.positions.push_back(s.waistCentre + Vec3(rx * std::sin(a), -s.length * f, rz * std::cos(a)));
     }
   }
   auto id = [&](int r, int k) { return static_cast<std::uint32_t>(r * s.segments + (k % s.segments)); };
@@ -52,10 +54,13 @@ Skirt makeSkirt(const SkirtShape& s) {
       }
     }
   }
+  // The mask is the waist ring itself, as a polygon over the opening (a mask only has to
+  // carry the vertices it marks).
   out.waistband.name = "waistband";
-  out.waistband.positions = out.mesh.positions;
-  out.waistband.positions.resize(static_cast<std::size_t>(2 * s.segments));
-  out.waistband.triangles.assign(out.mesh.triangles.begin(), out.mesh.triangles.begin() + 2 * s.segments);
+  out.waistband.positions.assign(out.mesh.positions.begin(), out.mesh.positions.begin() + s.segments);
+  std::vector<std::uint32_t> ring(static_cast<std::size_t>(s.segments));
+  for (int k = 0; k < s.segments; ++k) ring[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(k);
+  triangulatePolygon(ring, out.waistband.triangles);
   return out;
 }
 

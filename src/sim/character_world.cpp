@@ -93,7 +93,7 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
       parts.push_back(static_cast<int>(it - fields_.begin()));
     }
     spec.material.validate("garment '" + spec.name + "': ");
-    auto model = std::make_shared<const cloth::ClothModel>(cloth::ClothModel::build(spec.mesh, spec.material));
+    auto model = cloth::ClothModel::build(spec.mesh, mesh::Topology::build(spec.mesh), spec.material);
     std::vector<cloth::PinGroup> pins = bindMask(spec, parts);
     if (!spec.pinned.empty()) {
       const auto& m = *model;
@@ -146,51 +146,68 @@ void CharacterWorld::buildFields(const std::vector<GarmentSpec>& garments) {
 }
 
 std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, const std::vector<int>& parts) const {
-  // Each mask vertex binds to the collidable part nearest to it (by its distance field),
-  // within the threshold, and from then on moves rigidly with that part (section 4.1).
-  std::vector<cloth::PinGroup> groups(parts.size());
+  // Each mask vertex binds to a collidable part within the threshold (measured with the
+  // distance fields) and from then on moves rigidly with it (section 4.1). The paper binds
+  // to the nearest part; where an automatic segmentation puts a few waist vertices nearer a
+  // thigh than the pelvis, that tears the waistband apart as the leg swings. So the part
+  // most mask vertices are nearest to takes every vertex within the threshold of it, and
+  // only the others go to their own nearest part.
+  const std::size_t n = spec.bound.size();
+  const std::size_t np = parts.size();
+  std::vector<double> distance(n * np, std::numeric_limits<double>::infinity());
+  std::vector<Vec3> local(n * np, Vec3::Zero());
+  std::vector<int> nearest(n, -1), votes(np, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 p = spec.mesh.positions[spec.bound[i]];
+    for (std::size_t k = 0; k < np; ++k) {
+      const PartField& pf = fields_[static_cast<std::size_t>(parts[k])];
+      const Vec3 l = partMotions_[static_cast<std::size_t>(parts[k])]->poseAt(0.0).inverse().apply(p);
+      if (!pf.field.containsPoint(l)) continue;
+      distance[i * np + k] = pf.field.distanceAt(l);
+      local[i * np + k] = l;
+      if (nearest[i] < 0 || distance[i * np + k] < distance[i * np + static_cast<std::size_t>(nearest[i])])
+        nearest[i] = static_cast<int>(k);
+    }
+    if (nearest[i] >= 0 && distance[i * np + static_cast<std::size_t>(nearest[i])] <= spec.bindThreshold_m)
+      ++votes[static_cast<std::size_t>(nearest[i])];
+  }
+  const auto majority = static_cast<std::size_t>(std::max_element(votes.begin(), votes.end()) - votes.begin());
+
+  std::vector<cloth::PinGroup> groups(np);
   std::size_t unbound = 0;
   std::string firstUnbound;
-  for (std::uint32_t v : spec.bound) {
-    const Vec3 p = spec.mesh.positions[v];
-    double best = std::numeric_limits<double>::infinity();
-    int bestPart = -1;
-    Vec3 bestLocal = Vec3::Zero();
-    for (std::size_t k = 0; k < parts.size(); ++k) {
-      const PartField& pf = fields_[static_cast<std::size_t>(parts[k])];
-      const Vec3 local = partMotions_[static_cast<std::size_t>(parts[k])]->poseAt(0.0).inverse().apply(p);
-      if (!pf.field.containsPoint(local)) continue;
-      const double d = pf.field.distanceAt(local);
-      if (d < best) {
-        best = d;
-        bestPart = static_cast<int>(k);
-        bestLocal = local;
-      }
-    }
-    if (bestPart < 0 || best > spec.bindThreshold_m) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t v = spec.bound[i];
+    int k = np > 0 && distance[i * np + majority] <= spec.bindThreshold_m ? static_cast<int>(majority) : nearest[i];
+    if (k < 0 || distance[i * np + static_cast<std::size_t>(k)] > spec.bindThreshold_m) {
+      const Vec3& p = spec.mesh.positions[v];
       if (unbound++ == 0) {
-        firstUnbound = bestPart < 0 ? fmt::format("vertex {} at ({:.3f}, {:.3f}, {:.3f}) m is near no collidable part", v,
-                                                  p.x(), p.y(), p.z())
-                                    : fmt::format("vertex {} at ({:.3f}, {:.3f}, {:.3f}) m is {:.3f} m from '{}'", v,
-                                                  p.x(), p.y(), p.z(), best, fields_[parts[bestPart]].segment);
+        firstUnbound = k < 0 ? fmt::format("vertex {} at ({:.3f}, {:.3f}, {:.3f}) m is near no collidable part", v,
+                                           p.x(), p.y(), p.z())
+                             : fmt::format("vertex {} at ({:.3f}, {:.3f}, {:.3f}) m is {:.3f} m from '{}'", v, p.x(),
+                                           p.y(), p.z(), distance[i * np + static_cast<std::size_t>(k)],
+                                           fields_[static_cast<std::size_t>(parts[static_cast<std::size_t>(k)])].segment);
       }
       continue;
     }
-    cloth::PinGroup& g = groups[static_cast<std::size_t>(bestPart)];
+    cloth::PinGroup& g = groups[static_cast<std::size_t>(k)];
+    const Vec3& l = local[i * np + static_cast<std::size_t>(k)];
     g.vertices.push_back(v);
-    g.localX.push_back(bestLocal.x());
-    g.localY.push_back(bestLocal.y());
-    g.localZ.push_back(bestLocal.z());
+    g.localX.push_back(l.x());
+    g.localY.push_back(l.y());
+    g.localZ.push_back(l.z());
   }
   if (unbound > 0) {
     throw Error(fmt::format("garment '{}': {} of {} constraint-mask vertices cannot be bound within bindThreshold "
                             "{:.3f} m of a collidable part ({}); {}",
-                            spec.name, unbound, spec.bound.size(), spec.bindThreshold_m,
-                            fmt::join(spec.collidesWith, ", "), firstUnbound));
+                            spec.name, unbound, n, spec.bindThreshold_m, fmt::join(spec.collidesWith, ", "),
+                            firstUnbound));
   }
   std::vector<cloth::PinGroup> out;
   for (std::size_t k = 0; k < groups.size(); ++k) {
     if (groups[k].vertices.empty()) continue;
+    spdlog::debug("garment '{}': {} mask vertices bound to '{}'", spec.name, groups[k].vertices.size(),
+                  fields_[static_cast<std::size_t>(parts[k])].segment);
     groups[k].motion = partMotions_[static_cast<std::size_t>(parts[k])];
     out.push_back(std::move(groups[k]));
   }

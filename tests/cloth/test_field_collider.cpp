@@ -148,11 +148,12 @@ TEST(FieldCollider, BackwardTraceFindsTheFirstCrossing) {
       return true;
     });
     Vec3i first(-1, -1, -1);
-    for (auto it = line.rbegin(); it != line.rend(); ++it)
+    for (auto it = line.rbegin(); it != line.rend(); ++it) {
       if (walkable(f, *it)) {
         first = *it;
         break;
       }
+    }
     EXPECT_EQ(entryVoxel(f, inside, outside), first);
     ++checked;
   }

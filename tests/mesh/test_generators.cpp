@@ -27,8 +27,8 @@ TEST(Generators, SkirtIsATubeWithOutwardNormals) {
     radial.y() = 0;
     EXPECT_GT(s.mesh.triangleNormalArea(f).dot(radial), 0.0) << "triangle " << f;
   }
-  // The waistband mask is the top band: its vertices are the first two rings.
-  EXPECT_EQ(s.waistband.positions.size(), static_cast<std::size_t>(2 * shape.segments));
+  // The waistband mask is the waist ring: the first ring's vertices.
+  EXPECT_EQ(s.waistband.positions.size(), static_cast<std::size_t>(shape.segments));
   for (std::size_t i = 0; i < s.waistband.positions.size(); ++i) EXPECT_EQ(s.waistband.positions[i], s.mesh.positions[i]);
 }
 

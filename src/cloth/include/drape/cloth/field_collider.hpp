@@ -12,7 +12,7 @@
 //        T3 ............................  outer envelope: sliding zone ends, point released
 //        T2 ----------------------------  collision surface: an inward crossing stops here
 //        T1 ............................  inner envelope: penalty pushes outwards below it
-//        T0 ............................  last resort: projected back out to T1
+//        T0 ............................  last resort: projected back out to T2
 //      ~~~~~~ body surface ~~~~~~~~~~~~~
 //
 // Per mass point and part the collider keeps a state (OutsideVol, InsideVol, OnSurf) and the
@@ -25,8 +25,10 @@
 //                              point stops on T2, loses its inward normal velocity (relative
 //                              to the moving part), keeps its tangential velocity reduced by
 //                              Coulomb friction, and becomes OnSurf
-//   OnSurf     -> OnSurf       sliding: inward velocity removed with friction while below T2;
-//                              below T1 a penalty impulse outwards; below T0 projected to T1
+//   OnSurf     -> OnSurf       sliding on T2: a point the part has pushed below T2 is moved
+//                              back onto it, its inward velocity removed with friction;
+//                              below T1 a penalty impulse outwards as well; below T0 the
+//                              last-resort projection is counted
 //   OnSurf     -> InsideVol    when forces carry it beyond T3
 
 #include <array>

@@ -1,6 +1,8 @@
 #pragma once
 // Procedural garments and test meshes, shared by tests, examples and benchmarks.
 
+#include <vector>
+
 #include "drape/mesh/trimesh.hpp"
 
 namespace drape::mesh {
@@ -19,11 +21,14 @@ struct SkirtShape {
   double length = 0.55;             ///< m, waist to hem
   int segments = 24;                ///< vertices around
   int rings = 10;                   ///< bands of quads from waist to hem
+  /// Optional profile: if both have rings + 1 entries, ring r has these radii (m) instead
+  /// of the linear flare.
+  std::vector<double> ringRadiusX, ringRadiusZ;
 };
 
 struct Skirt {
   TriMesh mesh;   ///< (segments x rings x 2) triangles, normals outward
-  TriMesh waistband;  ///< the constraint mask: the top band's triangles, same vertex positions
+  TriMesh waistband;  ///< the constraint mask: the waist ring (the mesh's first `segments` vertices)
 };
 
 [[nodiscard]] Skirt makeSkirt(const SkirtShape& shape);

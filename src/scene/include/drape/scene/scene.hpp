@@ -26,7 +26,7 @@ struct ClothMaterial {
   double poissonRatio = 0.3;     ///< in [0, 0.5)
   /// N m; < 0 means "derive from E t^3 / (12 (1 - nu^2))" (bendingStiffnessOrDerived()).
   double bendingStiffness = -1.0;
-  double damping = 0.02;          ///< internal damping ratio, dimensionless (>= 0)
+  double damping = 0.0;           ///< s, stiffness-proportional (Rayleigh) damping time (>= 0)
   double staticFriction = 0.5;    ///< coefficient against body surfaces
   double dynamicFriction = 0.3;   ///< coefficient against body surfaces (<= static)
   double compressionScale = 0.1;  ///< stiffness under compression relative to tension, in [0, 1]

@@ -93,6 +93,8 @@ class CharacterWorld {
   [[nodiscard]] std::size_t garmentCount() const { return garments_.size(); }
   [[nodiscard]] const GarmentSpec& garment(std::size_t g) const { return garments_[g].spec; }
   [[nodiscard]] const cloth::ClothSolver& solver(std::size_t g) const { return *garments_[g].solver; }
+  /// For adding extra colliders and stepping garments one by one.
+  [[nodiscard]] cloth::ClothSolver& mutableSolver(std::size_t g) { return *garments_[g].solver; }
   [[nodiscard]] const cloth::FieldCollider* collider(std::size_t g) const { return garments_[g].collider.get(); }
   [[nodiscard]] const std::vector<PartField>& fields() const { return fields_; }
   [[nodiscard]] const AvatarPoses& poses() const { return *poses_; }

@@ -1,0 +1,29 @@
+#pragma once
+// Garments fitted to an avatar's rest pose: the skirt of the paper's walking scenario.
+
+#include <string>
+#include <vector>
+
+#include "drape/mesh/generators.hpp"
+#include "drape/scene/avatar.hpp"
+
+namespace drape::scene {
+
+struct SkirtFit {
+  std::string waistSegment = "LowerBack";  ///< the waist is at this segment's joint
+  std::vector<std::string> hipSegments = {"Hips"};  ///< also cleared, also collidable
+  std::vector<std::string> legSegments = {"LeftUpLeg", "RightUpLeg", "LeftLeg", "RightLeg"};
+  double length_m = 0.0;       ///< waist to hem; 0: down to just above the knees' lower third
+  double clearance_m = 0.02;   ///< gap between the body's outline and the skirt at rest
+  double flare = 0.12;         ///< extra hem radius per metre of length (an A-line)
+  int segments = 24;           ///< vertices around
+  int rings = 10;              ///< bands from waist to hem (segments x rings x 2 triangles)
+};
+
+/// Fits a skirt to the avatar at rest: the waist ring wraps the waist segment at its
+/// joint's height with half the clearance (the constraint mask binds it there), every lower ring clears the outline of the hips and legs at its
+/// height (growing monotonically: cloth hangs, it does not hug), plus the flare. Throws
+/// drape::Error naming the avatar if it has no such segments.
+[[nodiscard]] mesh::Skirt fitSkirt(const Avatar& avatar, const SkirtFit& fit = {});
+
+}  // namespace drape::scene

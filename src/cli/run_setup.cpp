@@ -207,7 +207,7 @@ int simulateRun(const RunSetup& setup) {
     ws.voxel_m = setup.character->voxel_m;
     ws.fieldMethod = setup.character->fieldMethod;
     ws.leadIn_s = setup.character->leadIn_s;
-    spdlog::info("building distance fields ({} m voxels) and binding constraint masks", ws.voxel_m);
+    spdlog::info("building distance fields ({:.4g} m voxels) and binding constraint masks", ws.voxel_m);
     world = std::make_unique<sim::CharacterWorld>(*setup.character->avatar, setup.character->animation.get(),
                                                   setup.garments, ws);
     spdlog::info("{} distance fields in {:.2f} s", world->fields().size(), world->fieldBuild_s());

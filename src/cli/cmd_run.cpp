@@ -235,8 +235,12 @@ int runCommand(const CLI::App& app, RunOptions& o) {
 RunFunction setupRun(CLI::App& app) {
   auto o = std::make_shared<RunOptions>();
   app.footer(
-      "Writes DIR/frames/frame_NNNNN.obj (every --every frames), DIR/garment.pc2 (every frame), DIR/garment.obj "
-      "(rest topology), DIR/stats.json and DIR/manifest.json. Units are SI; Y is up.\n"
+      "Examples:\n"
+      "  drape run examples/walking_skirt/scene.wrl --motion examples/walking_skirt/walk.bvh --out out/ws --preview\n"
+      "  drape run --garment dress.obj --units dm --pin-mask mask.obj --substeps auto --frames 90 --out out/dress\n"
+      "Writes DIR/frames/frame_NNNNN.obj (every --every frames), DIR/garment.pc2 and DIR/garment.obj, the avatar's "
+      "parts as DIR/segments/NAME.{obj,pc2}, DIR/result.wrl (VRML97), DIR/result.glb (glTF 2.0), DIR/stats.json and "
+      "DIR/manifest.json. Units are SI; Y is up.\n"
       "Exit codes: 0 done, 2 bad input, 3 the simulation became unstable (files so far are kept).");
   app.add_option("scene", o->scene, "VRML97 scene with ClothSet garments (and an avatar)");
   app.add_option("--garment", o->garment, "Garment mesh (OBJ), instead of a scene");

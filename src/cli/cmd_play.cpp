@@ -1,12 +1,21 @@
 // `drape play OUTDIR [--frames N]`: replays a finished run in a window with the overlays.
+// `drape play SCENE.wrl [--motion FILE]`: simulates the scene live in the window, the
+// garments coloured by collision state when that overlay is on.
 
+#include <filesystem>
 #include <iostream>
 
 #include <fmt/format.h>
 
 #include "command.hpp"
+#include "drape/core/error.hpp"
+#include "drape/core/log.hpp"
+#include "drape/motion/animation.hpp"
 #include "drape/render/player.hpp"
 #include "drape/render/run_replay.hpp"
+#include "drape/scene/scene.hpp"
+#include "drape/sim/character_world.hpp"
+#include "drape/sim/scene_setup.hpp"
 #include "render_options.hpp"
 
 namespace drape::cli {
@@ -14,6 +23,7 @@ namespace {
 
 struct PlayOptions {
   std::string run;
+  std::string motion;
   long frames = 0;
   bool once = false;
   bool fast = false;
@@ -21,9 +31,66 @@ struct PlayOptions {
   PictureOptions picture;
 };
 
+/// The live source: each frame steps the character's world once and hands the player the
+/// garments (with their collision states) and the body parts where they are.
+int playScene(const PlayOptions& o, render::PlayerOptions options) {
+  const scene::Scene sc = scene::loadScene(o.run);
+  for (const std::string& w : sc.warnings) spdlog::warn("{}", w);
+  const std::unique_ptr<scene::Avatar> avatar = sim::sceneAvatar(sc);
+  if (!avatar) throw Error(fmt::format("{}: drape play simulates scenes with an avatar (replay a run directory otherwise)", o.run));
+  std::unique_ptr<motion::AvatarAnimation> animation;
+  if (!o.motion.empty()) {
+    motion::MotionOptions mo;
+    mo.clip.rate = sc.simulation.frameRate;
+    mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
+    animation = std::make_unique<motion::AvatarAnimation>(motion::loadAnimation(*avatar, o.motion, mo));
+  }
+  const sim::WorldSettings ws = sim::toWorldSettings(sc.simulation);
+  sim::CharacterWorld world(*avatar, animation.get(), sim::garmentSpecs(sc, avatar.get()), ws);
+
+  std::vector<render::MeshInfo> meshes;
+  for (std::size_t g = 0; g < world.garmentCount(); ++g) {
+    const mesh::TriMesh& m = world.garment(g).mesh;
+    meshes.push_back({world.garment(g).name, render::MeshRole::Garment, m.vertexCount(), m.triangles});
+  }
+  for (const scene::Segment& seg : avatar->segments)
+    meshes.push_back({seg.name, render::MeshRole::Segment, seg.mesh.vertexCount(), seg.mesh.triangles});
+
+  std::vector<RigidTransform> joints(avatar->joints.size());
+  long frame = 0;
+  render::CallbackSource source(meshes, ws.step.frameRate_hz, [&](render::Frame& out) {
+    if (frame > 0 && !world.stepFrame(frame)) {
+      spdlog::error("{}", world.instability());
+      return false;
+    }
+    out.time = TimeCode{frame, ws.step.frameRate_hz};
+    out.positions.resize(meshes.size());
+    out.states.resize(meshes.size());
+    for (std::size_t g = 0; g < world.garmentCount(); ++g) {
+      world.solver(g).state().copyPositions(out.positions[g]);
+      world.collider(g)->vertexDisplayStates(out.states[g]);
+    }
+    world.poses().evaluate(world.frameTime(frame), joints);
+    for (std::size_t s = 0; s < avatar->segments.size(); ++s) {
+      const scene::Segment& seg = avatar->segments[s];
+      std::vector<Vec3>& p = out.positions[world.garmentCount() + s];
+      p.clear();
+      for (const Vec3& v : seg.mesh.positions) p.push_back(joints[static_cast<std::size_t>(seg.joint)].apply(v));
+    }
+    ++frame;
+    return true;
+  });
+  options.loop = false;
+  const render::PlayerStats stats = render::Player(options).run(source);
+  std::cout << fmt::format("simulated and showed {} frames in {:.1f} s\n", stats.framesDrawn, stats.seconds);
+  return 0;
+}
+
 RunFunction setupPlay(CLI::App& app) {
   static PlayOptions o;
-  app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes")->required();
+  app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes, or a scene to simulate live")
+      ->required();
+  app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc)");
   app.add_option("--frames", o.frames, "Close by itself after showing N frames")->check(CLI::PositiveNumber);
   app.add_flag("--once", o.once, "Stop at the last frame instead of starting over");
   app.add_flag("--fast", o.fast, "Show a new frame on every redraw instead of at the run's frame rate");
@@ -33,8 +100,19 @@ RunFunction setupPlay(CLI::App& app) {
       "Mouse: drag to orbit, wheel to zoom. Keys: space pause, left/right step, R reset view, Esc quit.\n"
       "Needs a display (run it under xvfb-run on a server); drape render works without one.");
   return [] {
-    render::RunReplay replay(o.run);
     render::PlayerOptions options;
+    if (std::filesystem::is_regular_file(o.run)) {
+      std::tie(options.width, options.height) = o.picture.parsedSize();
+      options.title = fmt::format("drape play {}", o.run);
+      if (o.frames > 0) options.maxFrames = o.frames;
+      options.realTime = !o.fast;
+      options.view = o.picture.view();
+      options.overlay = o.picture.overlay();
+      options.screenshot = o.screenshot;
+      return playScene(o, options);
+    }
+    if (!o.motion.empty()) throw Error("--motion: drape play takes a motion only with a scene file, not a run directory");
+    render::RunReplay replay(o.run);
     std::tie(options.width, options.height) = o.picture.parsedSize();
     options.title = fmt::format("drape play {}", o.run);
     if (o.frames > 0) options.maxFrames = o.frames;
@@ -51,7 +129,7 @@ RunFunction setupPlay(CLI::App& app) {
 }
 
 const bool registered =
-    registerCommand({"play", "Replay a run in a window with time code and overlays", "", 41, &setupPlay});
+    registerCommand({"play", "Replay a run, or simulate a scene live, in a window with time code and overlays", "", 41, &setupPlay});
 
 }  // namespace
 }  // namespace drape::cli

@@ -89,3 +89,24 @@ TEST(RunScene, MotionWithoutAvatarIsABadInput) {
 
 }  // namespace
 }  // namespace drape
+
+namespace drape {
+namespace {
+
+TEST(PlayScene, SimulatesTheWalkingSkirtLiveUnderXvfb) {
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps installs xvfb)";
+  ScratchDir dir("play-walking-skirt");
+  const std::string shot = dir / "live.png";
+  const std::string cmd = std::string("ASAN_OPTIONS=detect_leaks=0 xvfb-run -a '") + DRAPE_EXE + "' play '" + kSkirtDir +
+                          "/scene.wrl' --motion '" + kSkirtDir + "/walk.bvh' --frames 4 --fast --collision-states " +
+                          "--screenshot '" + shot + "' >'" + (dir / "out.txt") + "' 2>&1";
+  const int status = std::system(cmd.c_str());
+  const std::string out = slurp(dir / "out.txt");
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << out;
+  EXPECT_NE(out.find("simulated and showed 4 frames"), std::string::npos) << out;
+  EXPECT_TRUE(std::filesystem::exists(shot));
+}
+
+}  // namespace
+}  // namespace drape

@@ -1,7 +1,10 @@
 // `drape render OUTDIR --png DIR [--video out.mp4] [--contact-sheet sheet.png] [--size WxH]`:
 // pictures of a finished run, rendered headless (EGL surfaceless; no display needed).
 
+#include <filesystem>
 #include <iostream>
+
+#include <unistd.h>
 
 #include <fmt/format.h>
 
@@ -9,12 +12,16 @@
 #include "drape/core/error.hpp"
 #include "drape/render/outputs.hpp"
 #include "render_options.hpp"
+#include "run_setup.hpp"
 
 namespace drape::cli {
 namespace {
 
 struct RenderOptions {
   std::string run;
+  std::string motion;
+  std::string runOut;
+  long frames = 0;
   std::string png;
   std::string video;
   std::string sheet;
@@ -26,7 +33,11 @@ struct RenderOptions {
 
 RunFunction setupRender(CLI::App& app) {
   static RenderOptions o;
-  app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes")->required();
+  app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes, or a scene to simulate")
+      ->required();
+  app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc)");
+  app.add_option("--frames", o.frames, "With a scene: frames to simulate (default: the lead-in and the whole motion)");
+  app.add_option("--run-out", o.runOut, "With a scene: keep the simulated run in this directory (default: a temporary one)");
   app.add_option("--png", o.png, "Write every frame as DIR/frame_00000.png ...");
   app.add_option("--video", o.video, "Encode every frame as an H.264 MP4 (needs the ffmpeg command)");
   app.add_option("--contact-sheet", o.sheet, "Write a 4x4 grid of evenly spaced frames with their time codes");
@@ -41,6 +52,25 @@ RunFunction setupRender(CLI::App& app) {
     if (o.png.empty() && o.video.empty() && o.sheet.empty()) {
       throw Error("drape render: nothing to write: give --png DIR, --video FILE.mp4 or --contact-sheet FILE.png");
     }
+    // A scene is simulated first, exactly as `drape run` does, into a run directory.
+    std::string runDir = o.run;
+    std::filesystem::path scratch;
+    if (std::filesystem::is_regular_file(o.run)) {
+      RunSetup setup = runSetupFromScene(o.run);
+      if (!o.motion.empty()) addMotion(setup, o.motion);
+      setup.frames = o.frames > 0 ? o.frames : defaultFrames(setup);
+      if (o.runOut.empty()) {
+        scratch = std::filesystem::temp_directory_path() / fmt::format("drape-render-{}", ::getpid());
+        runDir = scratch.string();
+      } else {
+        runDir = o.runOut;
+      }
+      setup.outDir = runDir;
+      setup.objEvery = setup.frames;
+      (void)simulateRun(setup);
+    } else if (!o.motion.empty()) {
+      throw Error("--motion: drape render takes a motion only with a scene file, not a run directory");
+    }
     render::RenderJob job;
     std::tie(job.width, job.height) = o.picture.parsedSize();
     std::tie(job.sheetWidth, job.sheetHeight) = PictureOptions::parseSize(o.sheetSize, "--sheet-size");
@@ -51,7 +81,11 @@ RunFunction setupRender(CLI::App& app) {
     job.orbitDeg = o.orbit;
     job.view = o.picture.view();
     job.overlay = o.picture.overlay();
-    const render::RenderSummary summary = render::renderRun(o.run, job);
+    const render::RenderSummary summary = render::renderRun(runDir, job);
+    if (!scratch.empty()) {
+      std::error_code ec;
+      std::filesystem::remove_all(scratch, ec);
+    }
     if (!o.png.empty()) std::cout << fmt::format("wrote {} frames to {}/\n", summary.frames, o.png);
     if (!o.video.empty()) std::cout << fmt::format("wrote {} ({} frames)\n", o.video, summary.frames);
     if (!o.sheet.empty())
@@ -62,7 +96,7 @@ RunFunction setupRender(CLI::App& app) {
 }
 
 const bool registered = registerCommand(
-    {"render", "Render a run's frames to PNG, video and a contact sheet (headless)", "", 40, &setupRender});
+    {"render", "Render a run (or simulate a scene and render it) to PNG, video and a contact sheet (headless)", "", 40, &setupRender});
 
 }  // namespace
 }  // namespace drape::cli

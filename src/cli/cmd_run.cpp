@@ -134,17 +134,6 @@ void applyOverrides(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   }
 }
 
-/// Garments, materials, settings and the avatar from a VRML97 scene.
-void setupFromScene(const RunOptions& o, RunSetup& setup, std::shared_ptr<const scene::Avatar>& avatar) {
-  const scene::Scene sc = scene::loadScene(o.scene);
-  for (const std::string& w : sc.warnings) spdlog::warn("{}", w);
-  if (sc.garments.empty()) throw Error(fmt::format("{}: the scene has no ClothSet to simulate", o.scene));
-  avatar = sim::sceneAvatar(sc);
-  setup.settings = sim::toStepSettings(sc.simulation);
-  setup.garments = sim::garmentSpecs(sc, avatar.get());
-  if (avatar) setup.character = CharacterSetup{avatar, nullptr, sc.simulation.voxelSize};
-}
-
 /// A garment from --garment (OBJ) with its pins or mask.
 void setupFromGarment(const RunOptions& o, RunSetup& setup, bool onAvatar) {
   const double scale = formats::metresPerUnit(o.units, "--units");
@@ -173,7 +162,8 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   RunSetup setup;
   std::shared_ptr<const scene::Avatar> avatar;
   if (!o.scene.empty()) {
-    setupFromScene(o, setup, avatar);
+    setup = runSetupFromScene(o.scene);
+    if (setup.character) avatar = setup.character->avatar;
     applyOverrides(app, o, setup);
   } else {
     if (!o.avatar.empty()) avatar = std::make_shared<const scene::Avatar>(scene::loadAvatarFile(o.avatar));
@@ -200,14 +190,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     ch.fieldMethod = o.fieldMethod == "exact" ? field::FieldMethod::Exact : field::FieldMethod::Dvdp;
     if (!(o.leadIn_s >= 0)) throw Error(fmt::format("--lead-in must be >= 0 s, got {}", o.leadIn_s));
     ch.leadIn_s = o.leadIn_s;
-    if (!o.motion.empty()) {
-      motion::MotionOptions mo;
-      mo.clip.rate = setup.settings.frameRate_hz;
-      if (o.motionScale > 0) mo.clip.metresPerUnit = o.motionScale;
-      mo.jointMapPath = o.jointMap;
-      mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
-      ch.animation = std::make_shared<const motion::AvatarAnimation>(motion::loadAnimation(*avatar, o.motion, mo));
-    }
+    if (!o.motion.empty()) addMotion(setup, o.motion, o.motionScale, o.jointMap);
   }
 
   if (app.count("--substeps") || o.scene.empty()) {
@@ -217,12 +200,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   }
   // Frames: as asked, or the lead-in plus the whole motion.
   setup.frames = o.frames;
-  if (!app.count("--frames")) {
-    if (!setup.character || !setup.character->animation)
-      throw Error("--frames is required (it defaults to the motion's length only with --motion)");
-    const double seconds = setup.character->leadIn_s + setup.character->animation->duration();
-    setup.frames = static_cast<long>(std::ceil(seconds * setup.settings.frameRate_hz));
-  }
+  if (!app.count("--frames")) setup.frames = defaultFrames(setup);
   setup.objEvery = o.every;
   setup.outDir = o.out;
   setup.preview = o.preview;

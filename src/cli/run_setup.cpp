@@ -23,6 +23,8 @@
 #include "drape/formats/vrml_write.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/render/outputs.hpp"
+#include "drape/scene/scene.hpp"
+#include "drape/sim/scene_setup.hpp"
 
 namespace drape::cli {
 namespace {
@@ -161,6 +163,37 @@ void writeResultFiles(const RunSetup& setup, const std::vector<GarmentRun>& runs
 }
 
 }  // namespace
+
+RunSetup runSetupFromScene(const std::string& scenePath) {
+  const scene::Scene sc = scene::loadScene(scenePath);
+  for (const std::string& w : sc.warnings) spdlog::warn("{}", w);
+  if (sc.garments.empty()) throw Error(fmt::format("{}: the scene has no ClothSet to simulate", scenePath));
+  RunSetup setup;
+  const std::shared_ptr<const scene::Avatar> avatar = sim::sceneAvatar(sc);
+  setup.settings = sim::toStepSettings(sc.simulation);
+  setup.garments = sim::garmentSpecs(sc, avatar.get());
+  if (avatar) setup.character = CharacterSetup{avatar, nullptr, sc.simulation.voxelSize};
+  return setup;
+}
+
+void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerUnit, const std::string& jointMap) {
+  if (!setup.character)
+    throw Error("--motion: there is no avatar to move (the scene has none; without a scene, give --avatar FILE)");
+  motion::MotionOptions mo;
+  mo.clip.rate = setup.settings.frameRate_hz;
+  if (metresPerUnit > 0) mo.clip.metresPerUnit = metresPerUnit;
+  mo.jointMapPath = jointMap;
+  mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
+  setup.character->animation =
+      std::make_shared<const motion::AvatarAnimation>(motion::loadAnimation(*setup.character->avatar, motionPath, mo));
+}
+
+long defaultFrames(const RunSetup& setup) {
+  if (!setup.character || !setup.character->animation)
+    throw Error("--frames is required (it defaults to the motion's length only with --motion)");
+  const double seconds = setup.character->leadIn_s + setup.character->animation->duration();
+  return static_cast<long>(std::ceil(seconds * setup.settings.frameRate_hz));
+}
 
 void validateRunSetup(const RunSetup& setup) {
   if (setup.garments.empty()) throw Error("drape run: no garment to simulate");

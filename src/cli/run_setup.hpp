@@ -48,6 +48,19 @@ struct RunSetup {
   bool preview = false;                ///< also a contact sheet and (with ffmpeg) an MP4
 };
 
+/// Garments, materials, settings and the avatar (as the setup's character, without motion)
+/// from a VRML97 scene. Throws drape::Error on a bad scene or one with no ClothSet.
+[[nodiscard]] RunSetup runSetupFromScene(const std::string& scenePath);
+
+/// Loads a motion file onto the setup's avatar (rate = the setup's frame rate). `metresPerUnit`
+/// > 0 overrides the units guess; `jointMap` "" picks one of the shipped maps.
+void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerUnit = 0.0,
+               const std::string& jointMap = "");
+
+/// Frames to simulate when none are asked for: the lead-in plus the whole motion. Throws
+/// naming --frames when there is no motion.
+[[nodiscard]] long defaultFrames(const RunSetup& setup);
+
 /// Checks the setup (garment topology, materials, settings, pins) and throws drape::Error
 /// (BadInput) with one line naming what is wrong.
 void validateRunSetup(const RunSetup& setup);

@@ -110,3 +110,20 @@ TEST(PlayScene, SimulatesTheWalkingSkirtLiveUnderXvfb) {
 
 }  // namespace
 }  // namespace drape
+
+namespace drape {
+namespace {
+
+TEST(RenderScene, SimulatesThenRendersAContactSheet) {
+  ScratchDir dir("render-walking-skirt");
+  const std::string sheet = dir / "sheet.png", run = dir / "run";
+  const CliResult r = runDrape("render '" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir +
+                                   "/walk.bvh' --frames 6 --run-out '" + run + "' --contact-sheet '" + sheet + "'",
+                               dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(sheet));
+  EXPECT_EQ(formats::readRunManifest(run).frames, 7);
+}
+
+}  // namespace
+}  // namespace drape

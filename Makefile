@@ -38,7 +38,7 @@ fuzz: deps
 	@scripts/run-fuzzers $(FUZZ_DIR) $(FUZZ_SECONDS)
 
 bench: build
-	@for b in $$($(RELEASE_DIR)/drape bench --help | awk '/^Subcommands:/{s=1;next} s && NF {print $$1}'); do \
+	@for b in $$($(RELEASE_DIR)/drape bench --help | awk '/^Subcommands:/{s=1;next} s && !NF {exit} s {print $$1}'); do \
 		echo "== drape bench $$b --json" >&2; $(RELEASE_DIR)/drape bench $$b --json; done
 
 clean:

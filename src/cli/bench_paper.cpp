@@ -17,6 +17,7 @@
 #include "drape/scene/scene.hpp"
 #include "drape/sim/character_world.hpp"
 #include "drape/sim/scene_setup.hpp"
+#include "run_setup.hpp"
 
 namespace drape::cli {
 namespace {
@@ -39,22 +40,17 @@ struct PaperRun {
 };
 
 PaperRun runOnce(const PaperBenchOptions& o) {
-  const scene::Scene sc = scene::loadScene(o.scene);
-  const std::unique_ptr<scene::Avatar> avatar = sim::sceneAvatar(sc);
-  if (!avatar) throw Error(fmt::format("{}: the scene has no avatar", o.scene));
-  motion::MotionOptions mo;
-  mo.clip.rate = sc.simulation.frameRate;
-  mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
-  const motion::AvatarAnimation animation = motion::loadAnimation(*avatar, o.motion, mo);
-  sim::WorldSettings ws = sim::toWorldSettings(sc.simulation);
-  sim::CharacterWorld world(*avatar, &animation, sim::garmentSpecs(sc, avatar.get()), ws);
+  RunSetup setup = runSetupFromScene(o.scene);
+  if (!setup.character) throw Error(fmt::format("{}: the scene has no avatar", o.scene));
+  addMotion(setup, o.motion);
+  const std::unique_ptr<sim::CharacterWorld> worldPtr = buildWorld(setup);
+  sim::CharacterWorld& world = *worldPtr;
 
   PaperRun r;
-  r.substeps = ws.step.substepsPerFrame;
+  r.substeps = setup.settings.substepsPerFrame;
   r.fieldBuildSeconds = world.fieldBuild_s();
   for (std::size_t g = 0; g < world.garmentCount(); ++g) r.triangles += world.garment(g).mesh.triangleCount();
-  const double seconds = ws.leadIn_s + animation.duration();
-  r.frames = o.frames > 0 ? o.frames : static_cast<long>(std::ceil(seconds * ws.step.frameRate_hz));
+  r.frames = o.frames > 0 ? o.frames : defaultFrames(setup);
   // Animation and interpolation are inside the step: every part's pose is evaluated per
   // substep by the fixtures and colliders that ask for it.
   const auto start = std::chrono::steady_clock::now();

@@ -10,13 +10,11 @@
 #include "command.hpp"
 #include "drape/core/error.hpp"
 #include "drape/core/log.hpp"
-#include "drape/motion/animation.hpp"
 #include "drape/render/player.hpp"
 #include "drape/render/run_replay.hpp"
-#include "drape/scene/scene.hpp"
 #include "drape/sim/character_world.hpp"
-#include "drape/sim/scene_setup.hpp"
 #include "render_options.hpp"
+#include "run_setup.hpp"
 
 namespace drape::cli {
 namespace {
@@ -34,19 +32,14 @@ struct PlayOptions {
 /// The live source: each frame steps the character's world once and hands the player the
 /// garments (with their collision states) and the body parts where they are.
 int playScene(const PlayOptions& o, render::PlayerOptions options) {
-  const scene::Scene sc = scene::loadScene(o.run);
-  for (const std::string& w : sc.warnings) spdlog::warn("{}", w);
-  const std::unique_ptr<scene::Avatar> avatar = sim::sceneAvatar(sc);
-  if (!avatar) throw Error(fmt::format("{}: drape play simulates scenes with an avatar (replay a run directory otherwise)", o.run));
-  std::unique_ptr<motion::AvatarAnimation> animation;
-  if (!o.motion.empty()) {
-    motion::MotionOptions mo;
-    mo.clip.rate = sc.simulation.frameRate;
-    mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
-    animation = std::make_unique<motion::AvatarAnimation>(motion::loadAnimation(*avatar, o.motion, mo));
-  }
-  const sim::WorldSettings ws = sim::toWorldSettings(sc.simulation);
-  sim::CharacterWorld world(*avatar, animation.get(), sim::garmentSpecs(sc, avatar.get()), ws);
+  RunSetup setup = runSetupFromScene(o.run);
+  if (!setup.character)
+    throw Error(fmt::format("{}: drape play simulates scenes with an avatar (replay a run directory otherwise)", o.run));
+  if (!o.motion.empty()) addMotion(setup, o.motion);
+  const std::unique_ptr<sim::CharacterWorld> worldPtr = buildWorld(setup);
+  sim::CharacterWorld& world = *worldPtr;
+  const scene::Avatar* avatar = setup.character->avatar.get();
+  const cloth::StepSettings& step = setup.settings;
 
   std::vector<render::MeshInfo> meshes;
   for (std::size_t g = 0; g < world.garmentCount(); ++g) {
@@ -58,12 +51,12 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
 
   std::vector<RigidTransform> joints(avatar->joints.size());
   long frame = 0;
-  render::CallbackSource source(meshes, ws.step.frameRate_hz, [&](render::Frame& out) {
+  render::CallbackSource source(meshes, step.frameRate_hz, [&](render::Frame& out) {
     if (frame > 0 && !world.stepFrame(frame)) {
       spdlog::error("{}", world.instability());
       return false;
     }
-    out.time = TimeCode{frame, ws.step.frameRate_hz};
+    out.time = TimeCode{frame, step.frameRate_hz};
     out.positions.resize(meshes.size());
     out.states.resize(meshes.size());
     for (std::size_t g = 0; g < world.garmentCount(); ++g) {

@@ -188,6 +188,20 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
       std::make_shared<const motion::AvatarAnimation>(motion::loadAnimation(*setup.character->avatar, motionPath, mo));
 }
 
+std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup) {
+  if (!setup.character) throw Error("drape: the scene has no avatar to simulate on");
+  sim::WorldSettings ws;
+  ws.step = setup.settings;
+  ws.voxel_m = setup.character->voxel_m;
+  ws.fieldMethod = setup.character->fieldMethod;
+  ws.leadIn_s = setup.character->leadIn_s;
+  spdlog::info("building distance fields ({:.4g} m voxels) and binding constraint masks", ws.voxel_m);
+  auto world = std::make_unique<sim::CharacterWorld>(*setup.character->avatar, setup.character->animation.get(),
+                                                     setup.garments, ws);
+  spdlog::info("{} distance fields in {:.2f} s", world->fields().size(), world->fieldBuild_s());
+  return world;
+}
+
 long defaultFrames(const RunSetup& setup) {
   if (!setup.character || !setup.character->animation)
     throw Error("--frames is required (it defaults to the motion's length only with --motion)");
@@ -233,18 +247,7 @@ int simulateRun(const RunSetup& setup) {
   std::vector<cloth::SphereCollider> spheres;
   for (const SphereSetup& s : setup.spheres) spheres.emplace_back(s.centre_m, s.radius_m);
   for (const GarmentSetup& g : setup.garments) (void)mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
-  std::unique_ptr<sim::CharacterWorld> world;
-  if (setup.character) {
-    sim::WorldSettings ws;
-    ws.step = settings;
-    ws.voxel_m = setup.character->voxel_m;
-    ws.fieldMethod = setup.character->fieldMethod;
-    ws.leadIn_s = setup.character->leadIn_s;
-    spdlog::info("building distance fields ({:.4g} m voxels) and binding constraint masks", ws.voxel_m);
-    world = std::make_unique<sim::CharacterWorld>(*setup.character->avatar, setup.character->animation.get(),
-                                                  setup.garments, ws);
-    spdlog::info("{} distance fields in {:.2f} s", world->fields().size(), world->fieldBuild_s());
-  }
+  std::unique_ptr<sim::CharacterWorld> world = setup.character ? buildWorld(setup) : nullptr;
   std::vector<GarmentRun> runs;
   formats::RunManifest manifest;
   manifest.frameRate = settings.frameRate_hz;

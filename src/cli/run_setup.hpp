@@ -57,6 +57,10 @@ struct RunSetup {
 void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerUnit = 0.0,
                const std::string& jointMap = "");
 
+/// The character's world of a setup with an avatar: fields built, masks bound, solvers
+/// ready. Used by `drape run`, `drape play SCENE` and `drape bench paper` alike.
+[[nodiscard]] std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup);
+
 /// Frames to simulate when none are asked for: the lead-in plus the whole motion. Throws
 /// naming --frames when there is no motion.
 [[nodiscard]] long defaultFrames(const RunSetup& setup);

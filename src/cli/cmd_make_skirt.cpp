@@ -10,6 +10,7 @@
 #include <fmt/ostream.h>
 
 #include "command.hpp"
+#include "scene_text.hpp"
 #include "drape/core/error.hpp"
 #include "drape/formats/obj.hpp"
 #include "drape/scene/avatar_gltf.hpp"
@@ -25,14 +26,6 @@ struct MakeSkirtOptions {
   scene::SkirtFit fit;
   double bindThreshold_m = 0.04;
 };
-
-void writeIndexedFaceSet(std::ostream& os, const mesh::TriMesh& m, const std::string& indent) {
-  fmt::print(os, "{}coord Coordinate {{ point [\n", indent);
-  for (const Vec3& p : m.positions) fmt::print(os, "{}  {:.5f} {:.5f} {:.5f},\n", indent, p.x(), p.y(), p.z());
-  fmt::print(os, "{}] }}\n{}coordIndex [\n", indent, indent);
-  for (const auto& t : m.triangles) fmt::print(os, "{}  {} {} {} -1,\n", indent, t[0], t[1], t[2]);
-  fmt::print(os, "{}]\n", indent);
-}
 
 void writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::Skirt& skirt) {
   std::ofstream os(path);

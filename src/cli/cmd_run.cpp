@@ -117,6 +117,7 @@ void applyOverrides(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   if (app.count("--frame-rate")) s.frameRate_hz = o.settings.frameRate_hz;
   if (app.count("--air-viscosity")) s.airViscosity_Ns_m3 = o.settings.airViscosity_Ns_m3;
   if (app.count("--max-speed")) s.maxSpeed_m_s = o.settings.maxSpeed_m_s;
+  if (app.count("--max-added-mass")) s.maxAddedMass = o.settings.maxAddedMass;
   if (app.count("--integrator")) s.integrator = cloth::parseIntegrator(o.integrator, "--integrator");
   if (app.count("--wind")) s.wind_m_s = parseVec3(o.wind, "--wind");
   if (app.count("--gravity")) s.gravity_m_s2 = parseVec3(o.gravity, "--gravity");
@@ -265,6 +266,10 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--wind", o->wind, "Wind velocity x,y,z, m/s");
   app.add_option("--gravity", o->gravity, "Gravity x,y,z, m/s^2 (default 0,-9.81,0)");
   app.add_option("--max-speed", s.maxSpeed_m_s, "Stability bound on vertex speed, m/s")->capture_default_str();
+  app.add_option("--max-added-mass", s.maxAddedMass,
+                 "Mass scaling: mass that may be added to sliver triangles so the substep stays stable, as a "
+                 "fraction of the garment's mass (0: none)")
+      ->capture_default_str();
   app.add_option("--sphere", o->spheres, "A static sphere collider x,y,z,radius (m); repeatable");
   return [o, &app] { return runCommand(app, *o); };
 }

@@ -100,6 +100,7 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
     sum.vertexSubstepsInsideBody += c.vertexSubstepsInsideBody;
     sum.vertexSubsteps += c.vertexSubsteps;
     sum.maxPenetration_m = std::max(sum.maxPenetration_m, c.maxPenetration_m);
+    sum.embeddedAtStart += c.embeddedAtStart;
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) sum.transitions[a][b] += c.transitions[a][b];
     const auto now = r.collider->pointsPerState();
@@ -114,6 +115,7 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
   stats["max_penetration_m"] = sum.maxPenetration_m;
   stats["collisions_registered"] = sum.collisions;
   stats["last_resort_projections"] = sum.projections;
+  stats["pairs_embedded_at_start"] = sum.embeddedAtStart;
   nlohmann::json transitions;
   const char* names[3] = {"outside_vol", "inside_vol", "on_surf"};
   for (int a = 0; a < 3; ++a)
@@ -260,13 +262,19 @@ int simulateRun(const RunSetup& setup) {
       r.collider = world->collider(gi);
     } else {
       const mesh::Topology topology = mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
-      auto model = cloth::ClothModel::build(g.mesh, topology, g.material);
+      auto model = cloth::ClothModel::build(g.mesh, topology, g.material, settings.massScaling());
       r.ownedSolver = std::make_unique<cloth::ClothSolver>(model, settings, pinsOf(g, *model));
       r.solver = r.ownedSolver.get();
     }
     r.model = &r.solver->model();
     for (cloth::SphereCollider& s : spheres) r.solver->addCollider(s);
     const double stable = r.model->estimatedStableStep_s();
+    if (r.model->addedMass_kg() > 0.0)
+      spdlog::info("{}: mass scaling added {:.2f} % of its mass ({:.1f} g) on {} of {} vertices to keep the "
+                   "{:.3g} ms substep stable",
+                   g.name, 100.0 * r.model->addedMass_kg() / (r.model->totalMass_kg() - r.model->addedMass_kg()),
+                   1e3 * r.model->addedMass_kg(), r.model->massScaledVertexCount(), r.model->vertexCount(),
+                   1e3 * settings.substep_s());
     if (settings.substep_s() > stable)
       spdlog::warn("{}: the substep {:.3g} s is longer than the estimated stable step {:.3g} s; "
                    "the run may diverge (try --substeps {} or more)",
@@ -405,6 +413,8 @@ int simulateRun(const RunSetup& setup) {
                         {"triangles", m.triangleCount()},
                         {"pinned", setup.garments[g].pinned.size()},
                         {"mass_kg", m.totalMass_kg()},
+                        {"added_mass_kg", m.addedMass_kg()},
+                        {"mass_scaled_vertices", m.massScaledVertexCount()},
                         {"estimated_stable_substep_s", m.estimatedStableStep_s()}});
   }
   stats["garments"] = garments;

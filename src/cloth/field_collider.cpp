@@ -15,6 +15,8 @@ namespace {
 // per interval: strong enough to lift a point out within a few substeps, weak enough to
 // stay well inside the explicit step's stability limit (a rate of 1 would be a projection).
 constexpr double kPenaltyRate = 0.25;
+/// How fast a point that started below T2 is eased out (releaseEmbedded), m/s.
+constexpr double kEmbeddedSpeed_m_s = 0.1;
 
 int toIndex(PointState s) { return static_cast<int>(s); }
 
@@ -80,6 +82,8 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   states_.assign(parts_.size(), std::vector<PointState>(n, PointState::OutsideVol));
   lastLocal_.assign(parts_.size(), std::vector<Vec3>(n, Vec3::Zero()));
   penalty_.assign(n, 0);
+  embedded_.assign(parts_.size(), std::vector<std::uint8_t>(n, 0));
+  field_.embeddedAtStart = 0;
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     const field::DistanceField& f = *parts_[k].field;
     const RigidTransform inverse = parts_[k].motion->poseAt(t_s).inverse();
@@ -87,7 +91,13 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
       const Vec3 local = inverse.apply(state.position(i));
       lastLocal_[k][i] = local;
       if (!walkable(f, roundVoxel(f.toVoxel(local)))) continue;
-      states_[k][i] = f.distanceAt(local) < offsets_.t2_m ? PointState::OnSurf : PointState::InsideVol;
+      const double d = f.distanceAt(local);
+      states_[k][i] = d < offsets_.t2_m ? PointState::OnSurf : PointState::InsideVol;
+      if (d < offsets_.t2_m) {
+        states_[k][i] = PointState::InsideVol;
+        embedded_[k][i] = 1;
+        ++field_.embeddedAtStart;
+      }
     }
   }
   lastTime_s_ = t_s;
@@ -121,7 +131,7 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
   for (std::size_t i = 0; i < n; ++i) {
     double nearest = std::numeric_limits<double>::infinity();
     for (std::size_t k = 0; k < parts_.size(); ++k) {
-      if (states_[k][i] == PointState::OutsideVol) continue;
+      if (states_[k][i] == PointState::OutsideVol || embedded_[k][i]) continue;
       const Vec3 local = lastLocal_[k][i];
       nearest = std::min(nearest, parts_[k].field->distanceAt(local));
     }
@@ -148,6 +158,11 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   ++counters_.pointsTested;
 
   const Vec3 world1 = io.position(i);
+  if (embedded_[k][i]) {
+    releaseEmbedded(k, frame, i, dt_s, io);
+    ++field_.transitions[toIndex(from)][toIndex(state)];
+    return;
+  }
   // OutsideVol -> OutsideVol: culled by the part's box, no trace.
   if (state == PointState::OutsideVol && !frame.worldBox1.contains(world1)) {
     ++field_.transitions[0][0];
@@ -260,6 +275,38 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   }
   last = local;
   ++field_.transitions[toIndex(from)][toIndex(state)];
+}
+
+// A point that started below T2 of the part (a garment modelled tight on a smooth body lies
+// inside a rigid segment's offset surfaces, or its capped volume, near the joints) is eased
+// out along the normal at most kEmbeddedSpeed, losing its inward velocity relative to the
+// part, instead of being thrown onto T2 in one substep; once on T2 it collides like any other.
+void FieldCollider::releaseEmbedded(std::size_t k, const PartFrame& frame, std::size_t i, double dt_s,
+                                    ClothState& io) {
+  const field::DistanceField& f = *parts_[k].field;
+  Vec3 local = frame.inverse1.apply(io.position(i));
+  lastLocal_[k][i] = local;
+  if (!walkable(f, roundVoxel(f.toVoxel(local)))) {
+    embedded_[k][i] = 0;
+    states_[k][i] = PointState::OutsideVol;
+    return;
+  }
+  const double d = f.distanceAt(local);
+  if (d >= offsets_.t2_m) {
+    embedded_[k][i] = 0;
+    states_[k][i] = d > offsets_.t3_m ? PointState::InsideVol : PointState::OnSurf;
+    return;
+  }
+  const Vec3 normal = f.normalAt(local);
+  local += std::min(offsets_.t2_m - d, kEmbeddedSpeed_m_s * dt_s) * normal;
+  lastLocal_[k][i] = local;
+  const Vec3 n = frame.pose1.applyVector(normal);
+  const Vec3 world = frame.pose1.apply(local);
+  const Vec3 partVelocity = (world - frame.pose0.apply(local)) / dt_s;
+  const Vec3 v = io.velocity(i);
+  const double vn = (v - partVelocity).dot(n);
+  if (vn < 0) io.setVelocity(i, v - vn * n);
+  io.setPosition(i, world);
 }
 
 std::array<std::size_t, 3> FieldCollider::pointsPerState() const {

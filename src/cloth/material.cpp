@@ -61,6 +61,8 @@ void StepSettings::validate(const std::string& prefix) const {
   require(airViscosity_Ns_m3 >= 0.0 && std::isfinite(airViscosity_Ns_m3), prefix, "air-viscosity",
           ">= 0 N s/m^3", airViscosity_Ns_m3);
   require(maxSpeed_m_s > 0.0, prefix, "max-speed", "> 0 m/s", maxSpeed_m_s);
+  require(maxAddedMass >= 0.0 && maxAddedMass <= 10.0, prefix, "max-added-mass", "in [0, 10] (a fraction)",
+          maxAddedMass);
   if (!finite(gravity_m_s2)) throw Error(fmt::format("{}gravity must be finite", prefix));
   if (!finite(wind_m_s)) throw Error(fmt::format("{}wind must be finite", prefix));
 }

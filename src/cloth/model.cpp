@@ -28,7 +28,7 @@ double hingePsi(const Vec3& e0, const Vec3& e1, const Vec3& a, const Vec3& b) {
 }  // namespace
 
 std::shared_ptr<const ClothModel> ClothModel::build(const mesh::TriMesh& mesh, const mesh::Topology& topology,
-                                                    const Material& material) {
+                                                    const Material& material, const MassScaling& scaling) {
   material.validate("--");
   if (mesh.triangles.empty()) throw Error(fmt::format("{}: the garment has no triangles", mesh.name));
   if (mesh.vertexCount() >= (std::size_t{1} << 31))
@@ -40,6 +40,7 @@ std::shared_ptr<const ClothModel> ClothModel::build(const mesh::TriMesh& mesh, c
   model->buildMasses(mesh);
   model->buildMembrane(mesh);
   model->buildBending(mesh, topology);
+  model->applyMassScaling(mesh, scaling);
   model->buildEdges(topology);
   model->buildKernelData();
   return model;
@@ -66,9 +67,13 @@ void ClothModel::buildMasses(const mesh::TriMesh& mesh) {
       mass_[v] += areal * third;
     }
   }
-  inverseMass_.resize(n);
+  updateInverseMasses();
+}
+
+void ClothModel::updateInverseMasses() {
+  inverseMass_.resize(mass_.size());
   totalMass_ = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < mass_.size(); ++i) {
     inverseMass_[i] = mass_[i] > 0.0 ? 1.0 / mass_[i] : 0.0;
     totalMass_ += mass_[i];
   }
@@ -101,6 +106,61 @@ void ClothModel::buildMembrane(const mesh::TriMesh& mesh) {
     const double longest = std::max({len1, e2.norm(), (e2 - e1).norm()});
     minAltitude_ = std::min(minAltitude_, twiceArea / longest);
   }
+  membraneStep_ = 0.5 * minAltitude_ / membraneWaveSpeed_m_s();
+}
+
+// Membrane: explicit CFL bound for one linear triangle (a wave may not cross its smallest
+// altitude in one step; the factor 0.5 covers lumped-mass spectra of irregular meshes).
+double ClothModel::membraneStableStep(const mesh::TriMesh& mesh, std::size_t tri) const {
+  const auto& [i0, i1, i2] = mesh.triangles[tri];
+  const Vec3 e1 = mesh.positions[i1] - mesh.positions[i0];
+  const Vec3 e2 = mesh.positions[i2] - mesh.positions[i0];
+  const double longest = std::max({e1.norm(), e2.norm(), (e2 - e1).norm()});
+  return 0.5 * (e1.cross(e2).norm() / longest) / membraneWaveSpeed_m_s();
+}
+
+// Mass scaling, element by element as explicit finite-element codes do it: a triangle whose
+// own stable step dt is below the target gets its density scaled by (target / dt)^2, which
+// slows its membrane wave by target / dt; a vertex whose bending frequency bound is still too
+// high for the target then gets the mass that brings it down. Garments modelled for drawing
+// have a few sliver triangles (seams, darts) that would otherwise set the step of the whole
+// garment; scaling them adds little mass where it changes nothing visible.
+void ClothModel::applyMassScaling(const mesh::TriMesh& mesh, const MassScaling& scaling) {
+  if (!(scaling.targetStep_s > 0.0)) return;
+  const double target = scaling.targetStep_s;
+  const double baseMass = totalMass_;
+  const std::vector<double> before = mass_;
+  const double areal = material_.arealDensity();
+  membraneStep_ = std::numeric_limits<double>::infinity();
+  for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
+    const double dt = membraneStableStep(mesh, t);
+    if (dt < target) {
+      const double added = areal * mesh.triangleArea(t) / 3.0 * ((target / dt) * (target / dt) - 1.0);
+      for (std::uint32_t v : mesh.triangles[t]) mass_[v] += added;
+    }
+    membraneStep_ = std::min(membraneStep_, std::max(dt, target));
+  }
+  const double omegaMax = 1.8 / target;  // bending: symplectic Euler's 2 / omega, with 0.9 of it
+  const std::vector<double> rowSum = bendingRowSums(mesh);
+  for (std::size_t i = 0; i < mass_.size(); ++i) mass_[i] = std::max(mass_[i], rowSum[i] / (omegaMax * omegaMax));
+  updateInverseMasses();
+  bendingOmega_ = estimateBendingOmega(mesh);
+  addedMass_ = totalMass_ - baseMass;
+  massScaledVertices_ = 0;
+  for (std::size_t i = 0; i < mass_.size(); ++i) massScaledVertices_ += mass_[i] > before[i] ? 1 : 0;
+  if (addedMass_ > scaling.maxAddedFraction * baseMass) {
+    const double unscaled = std::min(0.5 * minAltitude_ / membraneWaveSpeed_m_s(),
+                                     bendingOmegaUnscaled_ > 0.0 ? 1.8 / bendingOmegaUnscaled_ : 1e9);
+    const std::string stableAt =
+        scaling.frameRate_hz > 0.0
+            ? fmt::format("{} substeps per frame", static_cast<long>(std::ceil(1.0 / (scaling.frameRate_hz * unscaled))))
+            : fmt::format("a substep of {:.3g} ms", 1e3 * unscaled);
+    throw Error(fmt::format("{}: keeping the substep of {:.3g} ms stable needs {:.1f} % more mass on {} of {} "
+                            "vertices, more than maxAddedMass {:g} allows; use more substeps per frame (the "
+                            "garment is stable without mass scaling at {}) or allow more added mass",
+                            name_, 1e3 * target, 100.0 * addedMass_ / baseMass, massScaledVertices_, mass_.size(),
+                            scaling.maxAddedFraction, stableAt));
+  }
 }
 
 // Bending: one hinge per interior edge; k = 2 C D |e|^2 / (A1 + A2) from the rest geometry.
@@ -120,11 +180,19 @@ void ClothModel::buildBending(const mesh::TriMesh& mesh, const mesh::Topology& t
     bending_.push_back({e.v0, e.v1, e.opposite0, e.opposite1, hingePsi(x0, x1, xa, xb), k});
   }
   bendingOmega_ = estimateBendingOmega(mesh);
+  bendingOmegaUnscaled_ = bendingOmega_;
 }
 
 // Highest bending frequency, from a Gershgorin bound on M^-1 K at rest: each hinge adds
 // k |g_i| |g_j| to row i (g = dtheta/dx at rest, the Bridson vectors).
 double ClothModel::estimateBendingOmega(const mesh::TriMesh& mesh) const {
+  const std::vector<double> rowSum = bendingRowSums(mesh);
+  double omega2 = 0.0;
+  for (std::size_t i = 0; i < rowSum.size(); ++i) omega2 = std::max(omega2, rowSum[i] * inverseMass_[i]);
+  return std::sqrt(omega2);
+}
+
+std::vector<double> ClothModel::bendingRowSums(const mesh::TriMesh& mesh) const {
   std::vector<double> rowSum(vertexCount(), 0.0);
   for (const BendElement& h : bending_) {
     const Vec3 &x3 = mesh.positions[h.e0], &x4 = mesh.positions[h.e1];
@@ -141,9 +209,7 @@ double ClothModel::estimateBendingOmega(const mesh::TriMesh& mesh) const {
     const std::array<std::uint32_t, 4> v = {h.a, h.b, h.e0, h.e1};
     for (int i = 0; i < 4; ++i) rowSum[v[i]] += h.stiffness_Nm * g[i] * total;
   }
-  double omega2 = 0.0;
-  for (std::size_t i = 0; i < rowSum.size(); ++i) omega2 = std::max(omega2, rowSum[i] * inverseMass_[i]);
-  return std::sqrt(omega2);
+  return rowSum;
 }
 
 void ClothModel::buildEdges(const mesh::Topology& topology) {
@@ -188,10 +254,9 @@ double ClothModel::membraneWaveSpeed_m_s() const {
 }
 
 double ClothModel::estimatedStableStep_s() const {
-  // Membrane: explicit CFL bound for linear triangles (a wave may not cross the smallest
-  // altitude in one step; the factor 0.5 covers lumped-mass spectra of irregular meshes).
-  // Bending: symplectic Euler needs dt < 2 / omega_max; 0.9 of that.
-  const double membrane = 0.5 * minAltitude_ / membraneWaveSpeed_m_s();
+  // Membrane: see membraneStableStep. Bending: symplectic Euler needs dt < 2 / omega_max;
+  // 0.9 of that.
+  const double membrane = membraneStep_;
   const double bending = bendingOmega_ > 0.0 ? 1.8 / bendingOmega_ : membrane;
   return std::min(membrane, bending);
 }

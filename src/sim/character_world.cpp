@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numeric>
+#include <unordered_map>
 
 #include <fmt/format.h>
 
@@ -93,7 +95,8 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
       parts.push_back(static_cast<int>(it - fields_.begin()));
     }
     spec.material.validate("garment '" + spec.name + "': ");
-    auto model = cloth::ClothModel::build(spec.mesh, mesh::Topology::build(spec.mesh), spec.material);
+    auto model = cloth::ClothModel::build(spec.mesh, mesh::Topology::build(spec.mesh), spec.material,
+                                          settings_.step.massScaling());
     std::vector<cloth::PinGroup> pins = bindMask(spec, parts);
     if (!spec.pinned.empty()) {
       const auto& m = *model;
@@ -145,18 +148,46 @@ void CharacterWorld::buildFields(const std::vector<GarmentSpec>& garments) {
   fieldBuild_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+namespace {
+
+/// Connected pieces of the constraint mask: mask vertices joined by a garment edge whose two
+/// ends are both in the mask. Returns each mask entry's piece index.
+std::vector<std::size_t> maskPieces(const mesh::TriMesh& mesh, const std::vector<std::uint32_t>& bound) {
+  std::vector<std::size_t> parent(bound.size());
+  std::iota(parent.begin(), parent.end(), std::size_t{0});
+  const auto find = [&](std::size_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  std::unordered_map<std::uint32_t, std::size_t> entry;
+  for (std::size_t i = 0; i < bound.size(); ++i) entry.emplace(bound[i], i);
+  for (const mesh::Triangle& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const auto a = entry.find(t[static_cast<std::size_t>(k)]);
+      const auto b = entry.find(t[static_cast<std::size_t>((k + 1) % 3)]);
+      if (a != entry.end() && b != entry.end()) parent[find(a->second)] = find(b->second);
+    }
+  }
+  std::vector<std::size_t> piece(bound.size());
+  for (std::size_t i = 0; i < bound.size(); ++i) piece[i] = find(i);
+  return piece;
+}
+
+}  // namespace
+
 std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, const std::vector<int>& parts) const {
   // Each mask vertex binds to a collidable part within the threshold (measured with the
   // distance fields) and from then on moves rigidly with it (section 4.1). The paper binds
   // to the nearest part; where an automatic segmentation puts a few waist vertices nearer a
-  // thigh than the pelvis, that tears the waistband apart as the leg swings. So the part
-  // most mask vertices are nearest to takes every vertex within the threshold of it, and
-  // only the others go to their own nearest part.
+  // thigh than the pelvis, that tears the waistband apart as the leg swings. So within each
+  // connected piece of the mask (a waistband, a shoulder, a cuff) the part most of the
+  // piece's vertices are nearest to takes every vertex within the threshold of it, and only
+  // the others go to their own nearest part.
   const std::size_t n = spec.bound.size();
   const std::size_t np = parts.size();
   std::vector<double> distance(n * np, std::numeric_limits<double>::infinity());
   std::vector<Vec3> local(n * np, Vec3::Zero());
-  std::vector<int> nearest(n, -1), votes(np, 0);
+  std::vector<int> nearest(n, -1);
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 p = spec.mesh.positions[spec.bound[i]];
     for (std::size_t k = 0; k < np; ++k) {
@@ -168,17 +199,25 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
       if (nearest[i] < 0 || distance[i * np + k] < distance[i * np + static_cast<std::size_t>(nearest[i])])
         nearest[i] = static_cast<int>(k);
     }
-    if (nearest[i] >= 0 && distance[i * np + static_cast<std::size_t>(nearest[i])] <= spec.bindThreshold_m)
-      ++votes[static_cast<std::size_t>(nearest[i])];
   }
-  const auto majority = static_cast<std::size_t>(std::max_element(votes.begin(), votes.end()) - votes.begin());
+  const std::vector<std::size_t> piece = maskPieces(spec.mesh, spec.bound);
+  std::unordered_map<std::size_t, std::vector<int>> votes;  // piece -> votes per part
+  for (std::size_t i = 0; i < n; ++i) {
+    std::vector<int>& v = votes.try_emplace(piece[i], std::vector<int>(np, 0)).first->second;
+    if (nearest[i] >= 0 && distance[i * np + static_cast<std::size_t>(nearest[i])] <= spec.bindThreshold_m)
+      ++v[static_cast<std::size_t>(nearest[i])];
+  }
+  std::unordered_map<std::size_t, std::size_t> majority;  // piece -> part
+  for (const auto& [p, v] : votes)
+    majority[p] = static_cast<std::size_t>(std::max_element(v.begin(), v.end()) - v.begin());
 
   std::vector<cloth::PinGroup> groups(np);
   std::size_t unbound = 0;
   std::string firstUnbound;
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t v = spec.bound[i];
-    int k = np > 0 && distance[i * np + majority] <= spec.bindThreshold_m ? static_cast<int>(majority) : nearest[i];
+    const std::size_t m = majority[piece[i]];
+    int k = np > 0 && distance[i * np + m] <= spec.bindThreshold_m ? static_cast<int>(m) : nearest[i];
     if (k < 0 || distance[i * np + static_cast<std::size_t>(k)] > spec.bindThreshold_m) {
       const Vec3& p = spec.mesh.positions[v];
       if (unbound++ == 0) {

@@ -214,5 +214,33 @@ TEST(FieldCollider, ExercisesAllNineTransitions) {
     for (int to = 0; to < 3; ++to) EXPECT_GT(t[from][to], 0u) << "transition " << from << " -> " << to;
 }
 
+TEST(FieldCollider, PointsStartingBelowT2AreEasedOutNotThrown) {
+  // A garment modelled tight on the body starts below T2 (here 1 mm from a sphere whose T2
+  // is 15 mm): it rises at the easing speed, never in one jump, and then slides on T2.
+  BodySetup s(field::makeSphere(0.1, Vec3::Zero(), 64, 32), std::make_shared<StaticMotion>());
+  Point p(Vec3(0.101, 0.0, 0.0));
+  FieldCollider c("test", s.parts, kOffsets, 0.0, 0.0);
+  c.initialise(p.state, 0.0);
+  EXPECT_EQ(c.fieldCounters().embeddedAtStart, 1u);
+  const double dt = 1e-3;
+  const double easing_m_s = 0.1;
+  double previous = s.field.distanceAt(p.state.position(0));
+  int steps = 0;
+  for (; steps < 1000 && c.state(0, 0) != PointState::OnSurf; ++steps) {
+    p.state.setVelocity(0, Vec3(-0.5, 0, 0));  // pressed inwards every substep
+    c.collide(*p.model, steps * dt, (steps + 1) * dt, p.state);
+    const double d = s.field.distanceAt(p.state.position(0));
+    EXPECT_LE(d - previous, easing_m_s * dt * 1.05 + 1e-9) << "step " << steps << ": no jump";
+    EXPECT_GE(d, previous - 1e-9) << "step " << steps << ": never deeper";
+    EXPECT_GE(p.state.velocity(0).dot(s.field.normalAt(p.state.position(0))), -1e-9) << "no inward velocity";
+    previous = d;
+  }
+  EXPECT_EQ(c.state(0, 0), PointState::OnSurf);
+  EXPECT_NEAR(previous, kOffsets.t2_m, 0.2 * kVoxel);
+  // 14 mm at 0.1 m/s: about 140 substeps of 1 ms.
+  EXPECT_NEAR(steps, (kOffsets.t2_m - 0.001) / (easing_m_s * dt), 20);
+  EXPECT_EQ(c.fieldCounters().vertexSubstepsInsideBody, 0u);
+}
+
 }  // namespace
 }  // namespace drape::cloth

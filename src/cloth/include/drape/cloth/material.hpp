@@ -43,6 +43,15 @@ enum class IntegratorKind {
 /// Parses the names above; throws drape::Error naming `option` otherwise.
 [[nodiscard]] IntegratorKind parseIntegrator(const std::string& text, const std::string& option = "--integrator");
 
+/// Mass scaling (explicit finite elements' standard remedy for a few tiny elements): mass is
+/// added to the triangles and hinges whose own stable step is shorter than targetStep_s,
+/// until it is not; the rest of the garment is untouched. Off when targetStep_s is 0.
+struct MassScaling {
+  double targetStep_s = 0.0;      ///< the substep the model must stay stable at, s
+  double maxAddedFraction = 0.0;  ///< largest added mass, as a fraction of the garment's mass
+  double frameRate_hz = 0.0;      ///< for messages: substeps per frame instead of seconds
+};
+
 /// Environment and time stepping (the paper's Simulation node).
 struct StepSettings {
   Vec3 gravity_m_s2 = Vec3(0.0, -9.81, 0.0);  ///< Y up, as the run manifest says
@@ -52,8 +61,15 @@ struct StepSettings {
   Vec3 wind_m_s = Vec3::Zero();               ///< constant wind velocity, m/s
   IntegratorKind integrator = IntegratorKind::SymplecticEuler;
   double maxSpeed_m_s = 50.0;                 ///< stability guard: faster vertices mean divergence
+  /// Mass scaling allowed to keep substep_s() stable, as a fraction of each garment's mass;
+  /// 0: none (a substep above the stable step is only warned about).
+  double maxAddedMass = 0.0;
 
   [[nodiscard]] double substep_s() const { return 1.0 / (frameRate_hz * substepsPerFrame); }
+  /// What ClothModel::build needs to honour maxAddedMass.
+  [[nodiscard]] MassScaling massScaling() const {
+    return maxAddedMass > 0.0 ? MassScaling{substep_s(), maxAddedMass, frameRate_hz} : MassScaling{};
+  }
   void validate(const std::string& prefix = "--") const;
 };
 

@@ -64,7 +64,8 @@ class ClothModel {
   /// mesh with no triangles. `topology` must be mesh::Topology::build(mesh).
   [[nodiscard]] static std::shared_ptr<const ClothModel> build(const mesh::TriMesh& mesh,
                                                                const mesh::Topology& topology,
-                                                               const Material& material);
+                                                               const Material& material,
+                                                               const MassScaling& scaling = {});
 
   [[nodiscard]] const std::string& name() const { return name_; }
   [[nodiscard]] const Material& material() const { return material_; }
@@ -102,8 +103,12 @@ class ClothModel {
   [[nodiscard]] double minAltitude_m() const { return minAltitude_; }
   /// Membrane wave speed sqrt(E / (rho (1 - nu^2))), m/s.
   [[nodiscard]] double membraneWaveSpeed_m_s() const;
-  /// A conservative estimate of the largest stable substep of the explicit integrators, s.
+  /// A conservative estimate of the largest stable substep of the explicit integrators, s
+  /// (with the masses as scaled).
   [[nodiscard]] double estimatedStableStep_s() const;
+  /// Mass added by mass scaling, kg, and the number of vertices that received some.
+  [[nodiscard]] double addedMass_kg() const { return addedMass_; }
+  [[nodiscard]] std::size_t massScaledVertexCount() const { return massScaledVertices_; }
 
  private:
   void buildMasses(const mesh::TriMesh& mesh);
@@ -111,7 +116,11 @@ class ClothModel {
   void buildBending(const mesh::TriMesh& mesh, const mesh::Topology& topology);
   void buildEdges(const mesh::Topology& topology);
   void buildKernelData();
+  void applyMassScaling(const mesh::TriMesh& mesh, const MassScaling& scaling);
+  void updateInverseMasses();
+  [[nodiscard]] std::vector<double> bendingRowSums(const mesh::TriMesh& mesh) const;
   [[nodiscard]] double estimateBendingOmega(const mesh::TriMesh& mesh) const;
+  [[nodiscard]] double membraneStableStep(const mesh::TriMesh& mesh, std::size_t tri) const;
 
   std::string name_;
   Material material_;
@@ -128,6 +137,10 @@ class ClothModel {
   std::vector<mesh::Triangle> triangles_;
   double minAltitude_ = 0.0;
   double bendingOmega_ = 0.0;  ///< highest bending frequency bound, rad/s (buildBending)
+  double bendingOmegaUnscaled_ = 0.0;
+  double membraneStep_ = 0.0;  ///< stable step of the stiffest triangle after mass scaling, s
+  double addedMass_ = 0.0;
+  std::size_t massScaledVertices_ = 0;
 };
 
 /// Bending hinge constant: W_e = kBendCoefficient * D * |e|^2 / (A1 + A2) * (psi - psi0)^2.

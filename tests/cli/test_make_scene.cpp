@@ -1,0 +1,74 @@
+// `drape make-scene`: the MakeHuman dress on the MakeHuman body becomes a scene that drape
+// reads, binds and simulates on the walk; the substeps come from mass scaling.
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.hpp"
+#include "drape/scene/scene.hpp"
+
+namespace drape {
+namespace {
+
+using testing::CliResult;
+using testing::runDrape;
+using testing::ScratchDir;
+using testing::slurp;
+
+const std::string kSource = DRAPE_SOURCE_DIR;
+
+TEST(MakeScene, DressOnTheWalkingBody) {
+  ScratchDir dir("make-scene-dress");
+  const std::string sceneDir = dir / "dress";
+  const CliResult made = runDrape(
+      "make-scene '" + kSource + "/data/avatars/makehuman_rig_cmu_mb.mhskel' --garment '" + kSource +
+          "/data/garments/makehuman_female_elegantsuit01_dress.obj' --units dm --mask '" + kSource +
+          "/examples/hanging_dress/shoulders_mask.obj' --name dress --offsets 0.002,0.004,0.006,0.016 "
+          "--collides-with Hips,LowerBack,Spine,Spine1,Neck,LeftShoulder,RightShoulder,LeftArm,RightArm,"
+          "LeftUpLeg,RightUpLeg --out '" + sceneDir + "'",
+      dir);
+  ASSERT_EQ(made.code, 0) << made.err;
+  EXPECT_NE(made.out.find("substeps per frame"), std::string::npos) << made.out;
+
+  const scene::Scene sc = scene::loadScene(sceneDir + "/scene.wrl");
+  ASSERT_EQ(sc.garments.size(), 1u);
+  EXPECT_EQ(sc.garments[0].mesh.triangleCount(), 4192u);
+  EXPECT_EQ(sc.garments[0].maskVertices.size(), 222u);
+  EXPECT_GT(sc.simulation.stepsPerFrame, 33) << "the dress's slivers need more substeps than the skirt";
+  EXPECT_GT(sc.simulation.maxAddedMass, 0.0);
+
+  const std::string out = dir / "out";
+  const CliResult ran = runDrape("run '" + sceneDir + "/scene.wrl' --motion '" + kSource +
+                                     "/examples/walking_skirt/walk.bvh' --lead-in 0.2 --frames 3 --out '" + out + "'",
+                                 dir);
+  ASSERT_EQ(ran.code, 0) << ran.err;
+  const nlohmann::json stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  EXPECT_EQ(stats["frames"].get<int>(), 3);
+  EXPECT_EQ(stats["vertex_substeps_inside_body"].get<long>(), 0);
+  EXPECT_GT(stats["pairs_embedded_at_start"].get<long>(), 0) << "the dress is modelled tight on the body";
+  const nlohmann::json& g = stats["garments"][0];
+  EXPECT_GT(g["added_mass_kg"].get<double>(), 0.0);
+  EXPECT_LT(g["added_mass_kg"].get<double>(), 0.02 * g["mass_kg"].get<double>());
+}
+
+TEST(MakeScene, TooFewSubstepsForTheAddedMassIsAClearError) {
+  ScratchDir dir("make-scene-substeps");
+  const std::string sceneDir = dir / "dress";
+  const CliResult made = runDrape(
+      "make-scene '" + kSource + "/data/avatars/makehuman_rig_cmu_mb.mhskel' --garment '" + kSource +
+          "/data/garments/makehuman_female_elegantsuit01_dress.obj' --units dm --mask '" + kSource +
+          "/examples/hanging_dress/shoulders_mask.obj' --substeps 33 --collides-with Hips,Spine1 --out '" + sceneDir +
+          "'",
+      dir);
+  ASSERT_EQ(made.code, 0) << made.err;
+  const CliResult ran = runDrape("run '" + sceneDir + "/scene.wrl' --motion '" + kSource +
+                                     "/examples/walking_skirt/walk.bvh' --frames 1 --out '" + (dir / "out") + "'",
+                                 dir);
+  EXPECT_EQ(ran.code, 2) << ran.err;
+  EXPECT_NE(ran.err.find("more than maxAddedMass"), std::string::npos) << ran.err;
+  EXPECT_NE(ran.err.find("substeps per frame"), std::string::npos) << ran.err;
+}
+
+}  // namespace
+}  // namespace drape

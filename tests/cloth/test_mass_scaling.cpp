@@ -1,0 +1,104 @@
+// Mass scaling: sliver triangles get the mass that makes them stable at the target substep,
+// element by element, and nothing else changes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cloth_fixture.hpp"
+#include "drape/core/error.hpp"
+
+namespace drape::cloth {
+namespace {
+
+using testing::row;
+using testing::run;
+
+Material knit() {
+  Material m;
+  m.youngsModulus_Pa = 5e4;
+  m.thickness_m = 5e-4;
+  m.density_kg_m3 = 300;
+  return m;
+}
+
+/// A 0.5 m sheet of 10 x 10 cells whose vertex (4, 5) is moved 45 % of a cell towards
+/// (5, 5): the triangles around it become slivers, as in garments modelled for drawing.
+struct SliverSheet {
+  SheetSpec spec{0.5, 0.5, 10, 10, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), "sliver"};
+  mesh::TriMesh mesh;
+  SliverSheet() {
+    mesh = gridSheet(spec);
+    mesh.positions[sheetVertex(spec, 4, 5)].x() += 0.45 * 0.05;
+  }
+};
+
+/// The membrane step of one triangle as the model defines it: 0.5 altitude / wave speed.
+double triangleStep(const mesh::TriMesh& m, std::size_t t, double waveSpeed) {
+  const auto& [a, b, c] = m.triangles[t];
+  const Vec3 e1 = m.positions[b] - m.positions[a], e2 = m.positions[c] - m.positions[a];
+  const double longest = std::max({e1.norm(), e2.norm(), (e2 - e1).norm()});
+  return 0.5 * e1.cross(e2).norm() / longest / waveSpeed;
+}
+
+TEST(MassScaling, ReachesTheTargetStepAddingOnlyWhatTheSliversNeed) {
+  const SliverSheet s;
+  const auto plain = testing::makeModel(s.mesh, knit());
+  const double target = 1.8 * plain->estimatedStableStep_s();
+  const auto scaled = ClothModel::build(s.mesh, mesh::Topology::build(s.mesh), knit(), MassScaling{target, 1.0});
+  EXPECT_GE(scaled->estimatedStableStep_s(), target * (1 - 1e-9));
+  EXPECT_LT(plain->estimatedStableStep_s(), target);
+
+  // Brute force over the triangles: the membrane part of the added mass.
+  const double c = plain->membraneWaveSpeed_m_s();
+  std::vector<double> expected = plain->mass();
+  for (std::size_t t = 0; t < s.mesh.triangleCount(); ++t) {
+    const double dt = triangleStep(s.mesh, t, c);
+    if (dt >= target) continue;
+    const double added = knit().arealDensity() * s.mesh.triangleArea(t) / 3.0 * ((target / dt) * (target / dt) - 1);
+    for (std::uint32_t v : s.mesh.triangles[t]) expected[v] += added;
+  }
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_GE(scaled->mass()[i], expected[i] * (1 - 1e-12)) << "vertex " << i;
+    if (expected[i] == plain->mass()[i] && scaled->mass()[i] == plain->mass()[i]) continue;
+    ++changed;
+  }
+  EXPECT_GT(changed, 0u);
+  EXPECT_LT(changed, 20u) << "only the slivers' corners gain mass";
+  EXPECT_EQ(changed, scaled->massScaledVertexCount());
+  EXPECT_NEAR(scaled->totalMass_kg(), plain->totalMass_kg() + scaled->addedMass_kg(), 1e-15);
+  EXPECT_LT(scaled->addedMass_kg(), 0.05 * plain->totalMass_kg());
+}
+
+TEST(MassScaling, TooMuchAddedMassIsAnErrorThatNamesTheSubsteps) {
+  const SliverSheet s;
+  const auto plain = testing::makeModel(s.mesh, knit());
+  const double target = 3.0 * plain->estimatedStableStep_s();
+  try {
+    (void)ClothModel::build(s.mesh, mesh::Topology::build(s.mesh), knit(), MassScaling{target, 1e-4, 30.0});
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("sliver: keeping the substep"), std::string::npos) << what;
+    EXPECT_NE(what.find("substeps per frame"), std::string::npos) << what;
+  }
+}
+
+TEST(MassScaling, AScaledSheetHangsStablyAtTheTargetStep) {
+  // Four times the unscaled estimate: the scaled sheet hangs from its top row for 1 s
+  // without the stability guard firing and comes to rest.
+  const SliverSheet s;
+  const auto plain = testing::makeModel(s.mesh, knit());
+  StepSettings settings = testing::settingsWithStep(4.0 * plain->estimatedStableStep_s());
+  settings.maxAddedMass = 0.5;
+  const auto scaled = ClothModel::build(s.mesh, mesh::Topology::build(s.mesh), knit(), settings.massScaling());
+  ClothSolver solver(scaled, settings,
+                     {PinGroup::atRest(row(s.spec, s.spec.cellsV), scaled->restX(), scaled->restY(), scaled->restZ())});
+  ASSERT_TRUE(run(solver, 30L * settings.substepsPerFrame)) << solver.instability().describe("sliver", 30);
+  double speed = 0;
+  for (std::size_t i = 0; i < solver.state().size(); ++i) speed = std::max(speed, solver.state().velocity(i).norm());
+  EXPECT_LT(speed, 1.0);
+}
+
+}  // namespace
+}  // namespace drape::cloth

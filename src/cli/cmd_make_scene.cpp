@@ -21,6 +21,7 @@
 #include "drape/formats/units.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/scene/avatar_gltf.hpp"
+#include "drape/scene/garment_fit.hpp"
 #include "scene_text.hpp"
 
 namespace drape::cli {
@@ -79,6 +80,32 @@ std::vector<std::string> segmentsNear(const scene::Avatar& avatar, const mesh::T
     if (touches) near.push_back(seg.name);
   }
   return near;
+}
+
+/// The mask moved with the garment's fit: each mask vertex is matched to the garment vertex
+/// it sits on as modelled (within 1 mm) and takes that vertex's fitted position.
+mesh::TriMesh fitMask(const mesh::TriMesh& mask, const scene::MakeHumanGarment& g, const std::string& maskPath) {
+  constexpr double kTolerance_m = 1e-3;
+  mesh::TriMesh fitted = mask;
+  std::size_t unmatched = 0;
+  for (std::size_t i = 0; i < mask.positions.size(); ++i) {
+    std::size_t best = 0;
+    double bestDistance = std::numeric_limits<double>::infinity();
+    for (std::size_t v = 0; v < g.modelled.positions.size(); ++v) {
+      const double d = (g.modelled.positions[v] - mask.positions[i]).norm();
+      if (d < bestDistance) {
+        bestDistance = d;
+        best = v;
+      }
+    }
+    if (bestDistance > kTolerance_m) ++unmatched;
+    fitted.positions[i] = g.fitted.positions[best];
+  }
+  if (unmatched > 0)
+    throw Error(fmt::format("{}: {} of {} mask vertices are more than 1 mm from every vertex of the garment as "
+                            "modelled; is --units right?",
+                            maskPath, unmatched, mask.positions.size()));
+  return fitted;
 }
 
 /// The fewest substeps per frame (at least the paper's 33) at which mass scaling keeps the
@@ -145,8 +172,18 @@ int makeScene(MakeSceneOptions& o) {
   const scene::Avatar avatar = scene::loadAvatarFile(o.avatar);
   formats::ObjReadOptions read;
   read.metresPerUnit = formats::metresPerUnit(o.units, "--units");
-  const mesh::TriMesh garment = formats::readObj(o.garment, read);
-  const mesh::TriMesh mask = formats::readObj(o.mask, read);
+  mesh::TriMesh garment, mask = formats::readObj(o.mask, read);
+  if (std::filesystem::path(o.garment).extension() == ".mhclo") {
+    // A MakeHuman garment: refitted to the body this avatar is built from.
+    if (std::filesystem::path(o.avatar).extension() != ".mhskel")
+      throw Error(fmt::format("{}: a MakeHuman garment (.mhclo) fits the MakeHuman body; give a .mhskel avatar, "
+                              "not {}", o.garment, o.avatar));
+    const scene::MakeHumanGarment fit = scene::fitMakeHumanGarment(o.garment, o.avatar);
+    garment = fit.fitted;
+    mask = fitMask(mask, fit, o.mask);
+  } else {
+    garment = formats::readObj(o.garment, read);
+  }
   if (o.name.empty()) o.name = std::filesystem::path(o.garment).stem().string();
   if (o.title.empty()) o.title = o.name;
   if (o.collidesWith.empty()) o.collidesWith = segmentsNear(avatar, garment, o.reach_m);
@@ -164,13 +201,18 @@ int makeScene(MakeSceneOptions& o) {
   if (ec) throw Error(fmt::format("--out {}: cannot create the directory ({})", o.out, ec.message()));
   if (o.avatarUrl.empty())
     o.avatarUrl = std::filesystem::relative(std::filesystem::absolute(o.avatar), std::filesystem::absolute(o.out)).string();
-  writeScene((std::filesystem::path(o.out) / "scene.wrl").string(), o, garment, mask);
+  const std::filesystem::path dir(o.out);
+  writeScene((dir / "scene.wrl").string(), o, garment, mask);
+  formats::writeObj((dir / (o.name + ".obj")).string(), garment.positions, garment.triangles,
+                    "drape make-scene: " + o.name + " on the avatar at rest (m)");
+  formats::writeObj((dir / (o.name + "_mask.obj")).string(), mask.positions, mask.triangles,
+                    "drape make-scene: constraint mask of " + o.name + " (m)");
   fmt::print("{}: {} vertices, {} triangles; mask {} vertices\n", o.name, garment.vertexCount(),
              garment.triangleCount(), mask.vertexCount());
   fmt::print("collides with {}\n", fmt::join(o.collidesWith, ", "));
   fmt::print("{} substeps per frame at {:g} frames/s (mass scaling adds {:.2f} % of the mass)\n", o.stepsPerFrame,
              o.frameRate, 100.0 * added);
-  fmt::print("wrote {}/scene.wrl\n", o.out);
+  fmt::print("wrote {}/scene.wrl, {}.obj, {}_mask.obj\n", o.out, o.name, o.name);
   return 0;
 }
 
@@ -178,8 +220,12 @@ RunFunction setupMakeScene(CLI::App& app) {
   static MakeSceneOptions o;
   app.add_option("avatar", o.avatar, "Avatar file the garment was modelled on (.glb, .gltf, MakeHuman .mhskel)")
       ->required();
-  app.add_option("--garment", o.garment, "Garment OBJ, in the avatar's rest pose")->required();
-  app.add_option("--mask", o.mask, "Constraint mask OBJ: the garment vertices bound to the body")->required();
+  app.add_option("--garment", o.garment,
+                 "Garment OBJ in the avatar's rest pose, or a MakeHuman .mhclo (refitted to the MakeHuman body)")
+      ->required();
+  app.add_option("--mask", o.mask,
+                 "Constraint mask OBJ: the garment vertices bound to the body (for a .mhclo: on its OBJ as modelled)")
+      ->required();
   app.add_option("--out", o.out, "Directory for scene.wrl")->required();
   app.add_option("--units", o.units, "Length unit of both OBJ files: m, dm, cm, mm, in")->capture_default_str();
   app.add_option("--name", o.name, "Garment name (default: the OBJ's file name)");

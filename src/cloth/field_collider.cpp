@@ -269,7 +269,14 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
       }
     }
     const double belowT1 = offsets_.t1_m - f.distanceAt(local);
-    if (belowT1 > 0) v += n * (kPenaltyRate * belowT1 / dt_s);  // penalty impulse outwards
+    if (belowT1 > 0) {
+      // Penalty: separate from the part at least at the rate that removes kPenaltyRate of
+      // the depth per substep. A floor on the relative normal velocity, not an added impulse,
+      // so that two parts meeting in a corner, or many substeps below T1, cannot pump energy.
+      const double wanted = kPenaltyRate * belowT1 / dt_s;
+      const double vn = (v - partVelocity).dot(n);
+      if (vn < wanted) v += n * (wanted - vn);
+    }
     io.setVelocity(i, v);
     if (moved) io.setPosition(i, world);
   }

@@ -130,4 +130,14 @@ Avatar loadMakeHumanAvatar(const std::string& mhskelPath) {
   return buildMakeHumanAvatar(options);
 }
 
+std::vector<Vec3> loadMakeHumanBaseVertices(const std::string& mhskelPath) {
+  const MakeHumanAvatarOptions options;
+  formats::ObjReadOptions objOptions;
+  objOptions.metresPerUnit = options.metresPerUnit;
+  objOptions.groups = {options.meshGroup};
+  objOptions.keepUnusedVertices = true;
+  return formats::readObj(join(std::filesystem::path(mhskelPath).parent_path().string(), options.meshFile), objOptions)
+      .positions;
+}
+
 }  // namespace drape::scene

@@ -2,10 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "drape/formats/mhclo.hpp"
+#include "drape/formats/obj.hpp"
+#include "drape/scene/avatar_makehuman.hpp"
 
 namespace drape::scene {
 namespace {
@@ -78,6 +82,61 @@ mesh::Skirt fitSkirt(const Avatar& avatar, const SkirtFit& fit) {
   mesh::Skirt skirt = mesh::makeSkirt(shape);
   skirt.mesh.name = "skirt";
   return skirt;
+}
+
+namespace {
+
+std::string garmentObjPath(const formats::Mhclo& clo) {
+  const std::filesystem::path dir = std::filesystem::path(clo.source).parent_path();
+  if (!clo.objFile.empty() && std::filesystem::exists(dir / clo.objFile)) return (dir / clo.objFile).string();
+  std::filesystem::path beside(clo.source);
+  beside.replace_extension(".obj");
+  if (std::filesystem::exists(beside)) return beside.string();
+  throw Error(fmt::format("{}: its mesh is neither '{}' nor '{}' beside it", clo.source, clo.objFile,
+                          beside.filename().string()));
+}
+
+/// MakeHuman's per-axis offset scale: how far apart two base vertices are on this body
+/// relative to the body the offsets were made on (base units; the ratio carries the units).
+Vec3 offsetScale(const formats::Mhclo& clo, const std::vector<Vec3>& base, double metresPerBaseUnit) {
+  Vec3 s = Vec3::Constant(metresPerBaseUnit);
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!clo.hasScale[axis]) continue;
+    const formats::MhcloScale& r = clo.scale[static_cast<std::size_t>(axis)];
+    s[axis] = std::abs(base[r.a][axis] - base[r.b][axis]) / r.reference;
+  }
+  return s;
+}
+
+}  // namespace
+
+MakeHumanGarment fitMakeHumanGarment(const std::string& mhcloPath, const std::string& mhskelPath) {
+  const formats::Mhclo clo = formats::readMhclo(mhcloPath);
+  const std::vector<Vec3> base = loadMakeHumanBaseVertices(mhskelPath);
+  const double metresPerBaseUnit = MakeHumanAvatarOptions{}.metresPerUnit;
+  formats::ObjReadOptions read;
+  read.metresPerUnit = metresPerBaseUnit;  // MakeHuman garments share the base mesh's units
+  read.keepUnusedVertices = true;
+  MakeHumanGarment g;
+  g.modelled = formats::readObj(garmentObjPath(clo), read);
+  if (g.modelled.vertexCount() != clo.vertices.size())
+    throw Error(fmt::format("{}: fits {} vertices, but its mesh has {}", mhcloPath, clo.vertices.size(),
+                            g.modelled.vertexCount()));
+  if (clo.largestBaseIndex >= base.size())
+    throw Error(fmt::format("{}: uses base-mesh vertex {}, but the base mesh beside {} has {} vertices", mhcloPath,
+                            clo.largestBaseIndex, mhskelPath, base.size()));
+  for (const formats::MhcloScale& r : clo.scale)
+    if (r.a >= base.size() || r.b >= base.size())
+      throw Error(fmt::format("{}: a scale line uses a vertex beyond the base mesh's {}", mhcloPath, base.size()));
+  const Vec3 scale = offsetScale(clo, base, metresPerBaseUnit);
+  g.fitted = g.modelled;
+  for (std::size_t i = 0; i < clo.vertices.size(); ++i) {
+    const formats::MhcloVertex& v = clo.vertices[i];
+    Vec3 p = v.offset.cwiseProduct(scale);
+    for (std::size_t k = 0; k < 3; ++k) p += v.weight[k] * base[v.base[k]];
+    g.fitted.positions[i] = p;
+  }
+  return g;
 }
 
 }  // namespace drape::scene

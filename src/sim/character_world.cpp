@@ -176,13 +176,13 @@ std::vector<std::size_t> maskPieces(const mesh::TriMesh& mesh, const std::vector
 }  // namespace
 
 std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, const std::vector<int>& parts) const {
-  // Each mask vertex binds to a collidable part within the threshold (measured with the
-  // distance fields) and from then on moves rigidly with it (section 4.1). The paper binds
-  // to the nearest part; where an automatic segmentation puts a few waist vertices nearer a
-  // thigh than the pelvis, that tears the waistband apart as the leg swings. So within each
-  // connected piece of the mask (a waistband, a shoulder, a cuff) the part most of the
-  // piece's vertices are nearest to takes every vertex within the threshold of it, and only
-  // the others go to their own nearest part.
+  // Each mask vertex must lie within the threshold of a collidable part (measured with the
+  // distance fields) and from then on moves rigidly with a part (section 4.1). The paper
+  // binds each vertex to its nearest part; where an automatic segmentation puts a few waist
+  // vertices nearer a thigh than the pelvis, or a shoulder seam's ends nearer the clavicles
+  // than the chest, that tears the cloth between them as the parts move apart. So each
+  // connected piece of the mask (a waistband, a shoulder yoke, a cuff) moves as one, with
+  // the part most of its vertices are nearest to.
   const std::size_t n = spec.bound.size();
   const std::size_t np = parts.size();
   std::vector<double> distance(n * np, std::numeric_limits<double>::infinity());
@@ -193,9 +193,9 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
     for (std::size_t k = 0; k < np; ++k) {
       const PartField& pf = fields_[static_cast<std::size_t>(parts[k])];
       const Vec3 l = partMotions_[static_cast<std::size_t>(parts[k])]->poseAt(0.0).inverse().apply(p);
+      local[i * np + k] = l;
       if (!pf.field.containsPoint(l)) continue;
       distance[i * np + k] = pf.field.distanceAt(l);
-      local[i * np + k] = l;
       if (nearest[i] < 0 || distance[i * np + k] < distance[i * np + static_cast<std::size_t>(nearest[i])])
         nearest[i] = static_cast<int>(k);
     }
@@ -216,8 +216,7 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
   std::string firstUnbound;
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t v = spec.bound[i];
-    const std::size_t m = majority[piece[i]];
-    int k = np > 0 && distance[i * np + m] <= spec.bindThreshold_m ? static_cast<int>(m) : nearest[i];
+    const int k = nearest[i];
     if (k < 0 || distance[i * np + static_cast<std::size_t>(k)] > spec.bindThreshold_m) {
       const Vec3& p = spec.mesh.positions[v];
       if (unbound++ == 0) {
@@ -229,8 +228,9 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
       }
       continue;
     }
-    cloth::PinGroup& g = groups[static_cast<std::size_t>(k)];
-    const Vec3& l = local[i * np + static_cast<std::size_t>(k)];
+    const std::size_t m = majority[piece[i]];
+    cloth::PinGroup& g = groups[m];
+    const Vec3& l = local[i * np + m];
     g.vertices.push_back(v);
     g.localX.push_back(l.x());
     g.localY.push_back(l.y());

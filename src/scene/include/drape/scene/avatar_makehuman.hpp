@@ -7,6 +7,7 @@
 // space the MakeHuman garments are modelled in (so a dress fits it with the same scale).
 
 #include <string>
+#include <vector>
 
 #include "drape/scene/avatar.hpp"
 
@@ -30,5 +31,9 @@ struct MakeHumanAvatarOptions {
 /// skeleton other than cmu_mb still uses the default weights folded by bone name through
 /// its bones' "reference" lists).
 [[nodiscard]] Avatar loadMakeHumanAvatar(const std::string& mhskelPath);
+
+/// Every vertex of the base mesh next to a .mhskel (body, helpers and joint cubes, in file
+/// order, as the rig and .mhclo files index them), in metres.
+[[nodiscard]] std::vector<Vec3> loadMakeHumanBaseVertices(const std::string& mhskelPath);
 
 }  // namespace drape::scene

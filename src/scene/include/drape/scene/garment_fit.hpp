@@ -27,3 +27,21 @@ struct SkirtFit {
 [[nodiscard]] mesh::Skirt fitSkirt(const Avatar& avatar, const SkirtFit& fit = {});
 
 }  // namespace drape::scene
+
+namespace drape::scene {
+
+/// A MakeHuman garment refitted to the MakeHuman body drape builds (the hm08 base mesh as
+/// the avatar's .mhskel finds it): each vertex placed by its .mhclo weights on the base mesh
+/// plus its offset, scaled per axis as MakeHuman does. `modelled` is the garment's own OBJ
+/// (its shape on whichever body it was exported on), `fitted` the same mesh on drape's body.
+struct MakeHumanGarment {
+  mesh::TriMesh modelled;  ///< m, as in the OBJ
+  mesh::TriMesh fitted;    ///< m, on the avatar's rest pose
+};
+
+/// Reads MHCLO and its OBJ (the .mhclo's obj_file beside it, else the .obj of the same
+/// name) and fits it to the base mesh next to `mhskelPath`. Throws drape::Error naming the
+/// file when the two do not belong together (vertex counts, indices beyond the base mesh).
+[[nodiscard]] MakeHumanGarment fitMakeHumanGarment(const std::string& mhcloPath, const std::string& mhskelPath);
+
+}  // namespace drape::scene

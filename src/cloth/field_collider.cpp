@@ -15,7 +15,7 @@ namespace {
 // per interval: strong enough to lift a point out within a few substeps, weak enough to
 // stay well inside the explicit step's stability limit (a rate of 1 would be a projection).
 constexpr double kPenaltyRate = 0.25;
-/// How fast a point that started below T2 is eased out (releaseEmbedded), m/s.
+/// How fast a point that started below T1 is eased out (releaseEmbedded), m/s.
 constexpr double kEmbeddedSpeed_m_s = 0.1;
 
 int toIndex(PointState s) { return static_cast<int>(s); }
@@ -93,7 +93,7 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
       if (!walkable(f, roundVoxel(f.toVoxel(local)))) continue;
       const double d = f.distanceAt(local);
       states_[k][i] = d < offsets_.t2_m ? PointState::OnSurf : PointState::InsideVol;
-      if (d < offsets_.t2_m) {
+      if (d < offsets_.t1_m) {
         states_[k][i] = PointState::InsideVol;
         embedded_[k][i] = 1;
         ++field_.embeddedAtStart;
@@ -284,7 +284,7 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   ++field_.transitions[toIndex(from)][toIndex(state)];
 }
 
-// A point that started below T2 of the part (a garment modelled tight on a smooth body lies
+// A point that started below T1 of the part (a garment modelled tight on a smooth body lies
 // inside a rigid segment's offset surfaces, or its capped volume, near the joints) is eased
 // out along the normal at most kEmbeddedSpeed, losing its inward velocity relative to the
 // part, instead of being thrown onto T2 in one substep; once on T2 it collides like any other.
@@ -305,8 +305,14 @@ void FieldCollider::releaseEmbedded(std::size_t k, const PartFrame& frame, std::
     return;
   }
   const Vec3 normal = f.normalAt(local);
-  local += std::min(offsets_.t2_m - d, kEmbeddedSpeed_m_s * dt_s) * normal;
+  const double rest = offsets_.t2_m - d;
+  const double step = std::min(rest, kEmbeddedSpeed_m_s * dt_s);
+  local += step * normal;
   lastLocal_[k][i] = local;
+  if (step == rest) {  // on T2 now (to the field's accuracy): slide from here
+    embedded_[k][i] = 0;
+    states_[k][i] = PointState::OnSurf;
+  }
   const Vec3 n = frame.pose1.applyVector(normal);
   const Vec3 world = frame.pose1.apply(local);
   const Vec3 partVelocity = (world - frame.pose0.apply(local)) / dt_s;

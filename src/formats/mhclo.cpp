@@ -97,7 +97,7 @@ Mhclo parseMhclo(std::string_view text, const std::string& name) {
     }
     const LineReader r(name, lineNo, words);
     const std::string_view key = words[0].text;
-    const bool numeric = (key.front() >= '0' && key.front() <= '9');
+    const bool numeric = (key.front() >= '0' && key.front() <= '9') || key.front() == '-' || key.front() == '+';
     if (inVertices && numeric) {
       m.vertices.push_back(parseVertex(r, words.size()));
       for (std::uint32_t b : m.vertices.back().base) m.largestBaseIndex = std::max(m.largestBaseIndex, b);

@@ -53,6 +53,7 @@ TEST(Mhclo, MalformedLinesNameLineAndColumn) {
   expectError("verts 0\n0 1 2 0.5 0.25 x 0 0 0\n", "bad.mhclo:2:16:", "expected a number, found 'x'");
   expectError("verts 0\n0 1 2 0.5\n", "bad.mhclo:2:1:", "expected 1 or 9 values");
   expectError("verts 0\n-3\n", "bad.mhclo:2:1:", "expected a base-mesh vertex index");
+  expectError("verts 0\n3x\n", "bad.mhclo:2:1:", "expected a base-mesh vertex index");
   expectError("x_scale 1 2\nverts 0\n1\n", "bad.mhclo:1:1:", "expected 'x_scale A B DISTANCE'");
   expectError("x_scale 1 2 0\nverts 0\n1\n", "bad.mhclo:1:13:", "reference distance > 0");
   expectError("name nothing\n", "bad.mhclo:", "no 'verts' list");

@@ -75,7 +75,7 @@ struct FieldCollisionCounters {
   std::uint64_t vertexSubstepsInsideBody = 0;  ///< signed distance < 0 after the response
   std::uint64_t vertexSubsteps = 0;            ///< vertices x collision substeps
   double maxPenetration_m = 0;      ///< deepest point below the body surface after the response
-  std::uint64_t embeddedAtStart = 0;  ///< (vertex, part) pairs below T2 at the start, eased out onto T2
+  std::uint64_t embeddedAtStart = 0;  ///< (vertex, part) pairs below T1 at the start, eased out onto T2
   std::array<std::array<std::uint64_t, 3>, 3> transitions{};  ///< [from][to] PointState counts
 
   /// Mean voxel path per tested (vertex, part) pair: the paper's "average collision path
@@ -126,7 +126,7 @@ class FieldCollider final : public Collider {
   std::vector<std::vector<PointState>> states_;   ///< [part][vertex]
   std::vector<std::vector<Vec3>> lastLocal_;      ///< [part][vertex], m, part frame at lastTime
   std::vector<std::uint8_t> penalty_;             ///< per vertex: below T1 of some part now
-  /// [part][vertex]: the point started below T2 of the part and is being eased out onto T2
+  /// [part][vertex]: the point started below T1 of the part and is being eased out onto T2
   /// (releaseEmbedded) rather than thrown there in one substep.
   std::vector<std::vector<std::uint8_t>> embedded_;
   ColliderCounters counters_;

@@ -160,6 +160,18 @@ TEST(FieldCollider, BackwardTraceFindsTheFirstCrossing) {
   EXPECT_GT(checked, 1000);
 }
 
+TEST(FieldCollider, WalkableIsExactlyNotBorder) {
+  // walkable() is a range test standing in for the border flag: they must agree everywhere.
+  const field::DistanceField f = buildField(field::makeBox(Vec3(-0.03, -0.05, -0.02), Vec3(0.03, 0.05, 0.02)));
+  const auto& d = f.dims();
+  for (int z = -1; z <= d.nz; ++z)
+    for (int y = -1; y <= d.ny; ++y)
+      for (int x = -1; x <= d.nx; ++x) {
+        const bool inGrid = d.contains(x, y, z);
+        ASSERT_EQ(walkable(f, Vec3i(x, y, z)), inGrid && !f.isBorder(f.index(x, y, z))) << x << " " << y << " " << z;
+      }
+}
+
 TEST(FieldCollider, BresenhamLinesAreConnectedAndEndWhereAsked) {
   std::mt19937 rng(3);
   std::uniform_int_distribution<int> c(-20, 20);

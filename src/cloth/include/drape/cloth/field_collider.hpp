@@ -191,9 +191,12 @@ int walkVoxels(const Vec3i& from, const Vec3i& to, Visit&& visit) {
 /// volume. Exposed for tests.
 [[nodiscard]] Vec3i entryVoxel(const field::DistanceField& field, const Vec3i& inside, const Vec3i& outside);
 
-/// Whether a walk may stand on voxel p: in the grid and not in its tagged border layer.
+/// Whether a walk may stand on voxel p: in the grid and not in its tagged border layer. The
+/// border is exactly the outermost layer (voxelize tags it so), so this is a range test and
+/// reads no voxel data: one cache miss less per pair. Tested against the flags.
 [[nodiscard]] inline bool walkable(const field::DistanceField& field, const Vec3i& p) {
-  return field.dims().contains(p.x(), p.y(), p.z()) && !field.isBorder(field.index(p.x(), p.y(), p.z()));
+  const field::GridDims& d = field.dims();
+  return p.x() >= 1 && p.y() >= 1 && p.z() >= 1 && p.x() < d.nx - 1 && p.y() < d.ny - 1 && p.z() < d.nz - 1;
 }
 
 }  // namespace drape::cloth

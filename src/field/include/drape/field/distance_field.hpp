@@ -197,15 +197,22 @@ inline DistanceField::Gather DistanceField::gatherAt(const Vec3& c) const {
   return g;
 }
 
+/// a0 + ... + a7 as a balanced tree: a fixed order, and no serial chain of eight adds.
+template <typename T>
+inline T sumOfEight(const T (&a)[8]) {
+  return ((a[0] + a[1]) + (a[2] + a[3])) + ((a[4] + a[5]) + (a[6] + a[7]));
+}
+
 inline double DistanceField::blendDistance(const Gather& g) const {
-  double d = 0;
-  for (int k = 0; k < 8; ++k) d += g.weight[k] * distance_[g.voxel[k]];
-  return d * metresPerUnit_;
+  double terms[8];
+  for (int k = 0; k < 8; ++k) terms[k] = g.weight[k] * distance_[g.voxel[k]];
+  return sumOfEight(terms) * metresPerUnit_;
 }
 
 inline Vec3 DistanceField::blendNormal(const Gather& g, const Vec3& c) const {
-  // Decoded in float (the codes hold 8 bits per component); blended and normalised in double.
-  double sx = 0, sy = 0, sz = 0;
+  // Decoded in float (the codes hold 8 bits per component), eight lanes at once; blended and
+  // normalised in double.
+  float tx[8], ty[8], tz[8];
   for (int k = 0; k < 8; ++k) {
     const std::uint16_t code = normal_[g.voxel[k]];
     const float u = static_cast<float>(static_cast<std::int8_t>(code & 0xff)) * (1.0f / 127.0f);
@@ -214,10 +221,11 @@ inline Vec3 DistanceField::blendNormal(const Gather& g, const Vec3& c) const {
     const float nx = w < 0 ? (1.0f - std::abs(v)) * (u >= 0 ? 1.0f : -1.0f) : u;
     const float ny = w < 0 ? (1.0f - std::abs(u)) * (v >= 0 ? 1.0f : -1.0f) : v;
     const float scale = static_cast<float>(g.weight[k]) / std::sqrt(nx * nx + ny * ny + w * w);
-    sx += nx * scale;
-    sy += ny * scale;
-    sz += w * scale;
+    tx[k] = nx * scale;
+    ty[k] = ny * scale;
+    tz[k] = w * scale;
   }
+  const double sx = sumOfEight(tx), sy = sumOfEight(ty), sz = sumOfEight(tz);
   const Vec3 sum(sx, sy, sz);
   const double len = sum.norm();
   if (len > 1e-9) return sum / len;

@@ -172,6 +172,7 @@ DistanceField DistanceField::build(const mesh::TriMesh& part, const FieldSetting
   f.shellVoxels_ = std::move(prop.shellVoxels);
   f.refStart_ = std::move(prop.refStart);
   f.refs_ = std::move(prop.refs);
+  (void)decodedNormals();  // built here, not in the first collision step that reads a normal
   f.stats_.finishMs = msSince(start);
 
   for (auto* v : {&f.shellVoxels_, &f.refStart_, &f.refs_, &f.surfaceVoxels_, &f.surfaceNormalStart_})
@@ -259,6 +260,15 @@ Vec3 DistanceField::decodeNormal(std::uint16_t code) {
     n.y() = (1 - std::abs(u)) * (v >= 0 ? 1 : -1);
   }
   return n.normalized();
+}
+
+const Vec3f* DistanceField::decodedNormals() {
+  static const std::vector<Vec3f> table = [] {
+    std::vector<Vec3f> t(65536);
+    for (std::size_t code = 0; code < t.size(); ++code) t[code] = decodeNormal(static_cast<std::uint16_t>(code)).cast<float>();
+    return t;
+  }();
+  return table.data();
 }
 
 }  // namespace drape::field

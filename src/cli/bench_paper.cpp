@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <iostream>
 
 #include <fmt/format.h>
@@ -30,9 +31,17 @@ struct PaperBenchOptions {
   bool json = false;
 };
 
+/// This thread's CPU time, s: on a shared machine other processes inflate the wall clock,
+/// not this (the run is single-threaded).
+double threadSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 struct PaperRun {
   long frames = 0;
-  double simSeconds = 0, collideSeconds = 0, stepSeconds = 0;
+  double simSeconds = 0, simCpuSeconds = 0, collideSeconds = 0, forcesSeconds = 0, stepSeconds = 0;
   cloth::FieldCollisionCounters counters;
   std::size_t triangles = 0;
   int substeps = 0;
@@ -54,12 +63,15 @@ PaperRun runOnce(const PaperBenchOptions& o) {
   // Animation and interpolation are inside the step: every part's pose is evaluated per
   // substep by the fixtures and colliders that ask for it.
   const auto start = std::chrono::steady_clock::now();
+  const double cpuStart = threadSeconds();
   for (long f = 1; f <= r.frames; ++f)
     if (!world.stepFrame(f)) throw Error(world.instability(), ExitCode::Unstable);
+  r.simCpuSeconds = threadSeconds() - cpuStart;
   r.simSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (std::size_t g = 0; g < world.garmentCount(); ++g) {
     const cloth::StageTimes& t = world.solver(g).stageTimes();
     r.collideSeconds += t.collide_s;
+    r.forcesSeconds += t.forces_s;
     r.stepSeconds += t.forces_s + t.integrate_s + t.collide_s + t.fixtures_s + t.stability_s;
     const cloth::FieldCollisionCounters& c = world.collider(g)->fieldCounters();
     r.counters.tests += c.tests;
@@ -94,6 +106,9 @@ RunFunction setupPaperBench(CLI::App& app) {
     j["substeps_per_frame"] = r.substeps;
     j["sim_fps"] = r.frames / r.simSeconds;
     j["ms_per_frame"] = 1e3 * r.simSeconds / r.frames;
+    j["cpu_ms_per_frame"] = 1e3 * r.simCpuSeconds / r.frames;
+    j["collide_ms_per_frame"] = 1e3 * r.collideSeconds / r.frames;
+    j["forces_ms_per_frame"] = 1e3 * r.forcesSeconds / r.frames;
     j["collision_time_share"] = r.stepSeconds > 0 ? r.collideSeconds / r.stepSeconds : 0.0;
     j["mean_collision_path_voxels"] = r.counters.meanPathVoxels();
     j["vertex_substeps_inside_body"] = r.counters.vertexSubstepsInsideBody;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include <fmt/format.h>
@@ -20,26 +21,65 @@ constexpr double kEmbeddedSpeed_m_s = 0.1;
 
 int toIndex(PointState s) { return static_cast<int>(s); }
 
+/// The voxel whose cell holds continuous voxel coordinates c (centres at integers).
 Vec3i roundVoxel(const Vec3& c) {
-  return Vec3i(static_cast<int>(std::lround(c.x())), static_cast<int>(std::lround(c.y())),
-               static_cast<int>(std::lround(c.z())));
+  return Vec3i(static_cast<int>(std::floor(c.x() + 0.5)), static_cast<int>(std::floor(c.y() + 0.5)),
+               static_cast<int>(std::floor(c.z() + 0.5)));
 }
 
-Aabb transformedBox(const Aabb& box, const RigidTransform& pose) {
-  Aabb out;
-  for (int corner = 0; corner < 8; ++corner) {
-    const Vec3 p((corner & 1) ? box.max.x() : box.min.x(), (corner & 2) ? box.max.y() : box.min.y(),
-                 (corner & 4) ? box.max.z() : box.min.z());
-    out.extend(pose.apply(p));
+/// x -> linear x + offset.
+struct Affine {
+  Mat3 linear = Mat3::Identity();
+  Vec3 offset = Vec3::Zero();
+  [[nodiscard]] Vec3 apply(const Vec3& x) const { return linear * x + offset; }
+};
+
+/// World point -> the part's continuous voxel coordinates, the part being at `pose`:
+/// c = (R^T (p - t) - origin) / h - 1/2.
+Affine worldToVoxel(const field::DistanceField& f, const RigidTransform& pose) {
+  const Mat3 rt = pose.rotation.conjugate().toRotationMatrix();
+  const double h = f.voxelSize();
+  return {rt / h, -(rt * pose.translation + f.origin()) / h - Vec3::Constant(0.5)};
+}
+
+/// The inverse: p = R (origin + (c + 1/2) h) + t.
+Affine voxelToWorld(const field::DistanceField& f, const RigidTransform& pose) {
+  const Mat3 r = pose.rotation.toRotationMatrix();
+  const double h = f.voxelSize();
+  return {r * h, r * (f.origin() + Vec3::Constant(0.5 * h)) + pose.translation};
+}
+
+// The two passes of the per-part cull take their arrays as restrict parameters: GCC 12
+// vectorises them so, and not with the same pointers as locals of the member function.
+
+/// c = m x for every point (SoA).
+void mapPoints(const Affine& m, std::size_t n, const double* __restrict x, const double* __restrict y,
+               const double* __restrict z, double* __restrict cx, double* __restrict cy, double* __restrict cz) {
+  const double a00 = m.linear(0, 0), a01 = m.linear(0, 1), a02 = m.linear(0, 2);
+  const double a10 = m.linear(1, 0), a11 = m.linear(1, 1), a12 = m.linear(1, 2);
+  const double a20 = m.linear(2, 0), a21 = m.linear(2, 1), a22 = m.linear(2, 2);
+  const double b0 = m.offset.x(), b1 = m.offset.y(), b2 = m.offset.z();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double px = x[i], py = y[i], pz = z[i];
+    cx[i] = a00 * px + a01 * py + a02 * pz + b0;
+    cy[i] = a10 * px + a11 * py + a12 * pz + b1;
+    cz[i] = a20 * px + a21 * py + a22 * pz + b2;
   }
-  return out;
+}
+
+/// keep[i]: the point ends in the box [0.5, boxMax) of voxel coordinates, or its state is
+/// not OutsideVol, or `all`.
+void markCandidates(std::size_t n, const double* __restrict cx, const double* __restrict cy,
+                    const double* __restrict cz, const Vec3& boxMax, const std::uint8_t* __restrict state, bool all,
+                    std::uint8_t* __restrict keep) {
+  const double hx = boxMax.x(), hy = boxMax.y(), hz = boxMax.z();
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool inBox = (cx[i] >= 0.5) & (cx[i] < hx) & (cy[i] >= 0.5) & (cy[i] < hy) & (cz[i] >= 0.5) & (cz[i] < hz);
+    keep[i] = static_cast<std::uint8_t>(inBox | (state[i] != 0) | all);
+  }
 }
 
 }  // namespace
-
-bool walkable(const field::DistanceField& f, const Vec3i& p) {
-  return f.dims().contains(p.x(), p.y(), p.z()) && !f.isBorder(f.index(p.x(), p.y(), p.z()));
-}
 
 Vec3i entryVoxel(const field::DistanceField& f, const Vec3i& inside, const Vec3i& outside) {
   Vec3i entry = inside;
@@ -77,21 +117,33 @@ FieldCollider::FieldCollider(std::string garmentName, std::vector<CollisionPart>
   }
 }
 
+/// One part's transforms over a collision interval, built once per part and substep so
+/// that no pair transforms or inverts anything.
+struct FieldCollider::PartFrame {
+  Affine toVoxel0, toVoxel1;  ///< world -> voxel coordinates at the interval's start and end
+  Affine toWorld0, toWorld1;  ///< voxel coordinates -> world
+  Mat3 rotation1;             ///< the part's directions -> world at the end (normals)
+  double t2Voxels = 0;        ///< the collision surface T2 in voxels (the walk's test)
+};
+
 void FieldCollider::initialise(const ClothState& state, double t_s) {
   const std::size_t n = state.size();
   states_.assign(parts_.size(), std::vector<PointState>(n, PointState::OutsideVol));
-  lastLocal_.assign(parts_.size(), std::vector<Vec3>(n, Vec3::Zero()));
+  lastVoxel_.assign(parts_.size(), std::vector<Vec3>(n, Vec3::Zero()));
   penalty_.assign(n, 0);
   embedded_.assign(parts_.size(), std::vector<std::uint8_t>(n, 0));
   field_.embeddedAtStart = 0;
+  for (std::vector<double>* v : {&endVoxelX_, &endVoxelY_, &endVoxelZ_, &nearest_}) v->assign(n, 0.0);
+  keep_.assign(n + 8, 0);  // padded: the candidate scan reads eight flags at a time
+  candidates_.assign(n, 0);
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     const field::DistanceField& f = *parts_[k].field;
-    const RigidTransform inverse = parts_[k].motion->poseAt(t_s).inverse();
+    const Affine toVoxel = worldToVoxel(f, parts_[k].motion->poseAt(t_s));
     for (std::size_t i = 0; i < n; ++i) {
-      const Vec3 local = inverse.apply(state.position(i));
-      lastLocal_[k][i] = local;
-      if (!walkable(f, roundVoxel(f.toVoxel(local)))) continue;
-      const double d = f.distanceAt(local);
+      const Vec3 c = toVoxel.apply(state.position(i));
+      lastVoxel_[k][i] = c;
+      if (!walkable(f, roundVoxel(c))) continue;
+      const double d = f.distanceAtVoxel(c);
       states_[k][i] = d < offsets_.t2_m ? PointState::OnSurf : PointState::InsideVol;
       if (d < offsets_.t1_m) {
         states_[k][i] = PointState::InsideVol;
@@ -104,11 +156,15 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
 }
 
 FieldCollider::PartFrame FieldCollider::framePart(const CollisionPart& part, double t0_s, double t1_s) const {
+  const field::DistanceField& f = *part.field;
+  const RigidTransform pose0 = part.motion->poseAt(t0_s), pose1 = part.motion->poseAt(t1_s);
   PartFrame frame;
-  frame.pose0 = part.motion->poseAt(t0_s);
-  frame.pose1 = part.motion->poseAt(t1_s);
-  frame.inverse1 = frame.pose1.inverse();
-  frame.worldBox1 = transformedBox(part.field->bounds(), frame.pose1);
+  frame.toVoxel0 = worldToVoxel(f, pose0);
+  frame.toVoxel1 = worldToVoxel(f, pose1);
+  frame.toWorld0 = voxelToWorld(f, pose0);
+  frame.toWorld1 = voxelToWorld(f, pose1);
+  frame.rotation1 = pose1.rotation.toRotationMatrix();
+  frame.t2Voxels = offsets_.t2_m / f.voxelSize();
   return frame;
 }
 
@@ -119,26 +175,54 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
   const double interval_s = t1_s - lastTime_s_;
   if (!(interval_s > 0)) return;
 
-  std::fill(penalty_.begin(), penalty_.end(), 0);
+  const std::size_t n = io.size();
+  std::fill(nearest_.begin(), nearest_.end(), std::numeric_limits<double>::infinity());
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     const PartFrame frame = framePart(parts_[k], lastTime_s_, t1_s);
-    for (std::size_t i = 0; i < io.size(); ++i) collidePoint(k, frame, i, interval_s, io);
+    const std::size_t kept = selectCandidates(k, frame, io);
+    // The culled pairs are OutsideVol -> OutsideVol without a trace.
+    field_.tests += n;
+    counters_.pointsTested += n;
+    field_.transitions[0][0] += n - kept;
+    for (std::size_t j = 0; j < kept; ++j) {
+      const std::uint32_t i = candidates_[j];
+      collidePoint(k, frame, i, Vec3(endVoxelX_[i], endVoxelY_[i], endVoxelZ_[i]), interval_s, io);
+    }
   }
+  countPenetration();
+  lastTime_s_ = t1_s;
+}
 
-  // Penetration after the response, against the nearest part.
+std::size_t FieldCollider::selectCandidates(std::size_t k, const PartFrame& frame, const ClothState& io) {
   const std::size_t n = io.size();
-  field_.vertexSubsteps += n;
-  for (std::size_t i = 0; i < n; ++i) {
-    double nearest = std::numeric_limits<double>::infinity();
-    for (std::size_t k = 0; k < parts_.size(); ++k) {
-      if (states_[k][i] == PointState::OutsideVol || embedded_[k][i]) continue;
-      const Vec3 local = lastLocal_[k][i];
-      nearest = std::min(nearest, parts_[k].field->distanceAt(local));
+  mapPoints(frame.toVoxel1, n, io.x.data(), io.y.data(), io.z.data(), endVoxelX_.data(), endVoxelY_.data(),
+            endVoxelZ_.data());
+  // The walkable box: voxels 1 .. n-2 along each axis (the border layer is the outermost).
+  const field::GridDims& d = parts_[k].field->dims();
+  const Vec3 boxMax(d.nx - 1.5, d.ny - 1.5, d.nz - 1.5);
+  markCandidates(n, endVoxelX_.data(), endVoxelY_.data(), endVoxelZ_.data(), boxMax,
+                 reinterpret_cast<const std::uint8_t*>(states_[k].data()), !boxCulling_, keep_.data());
+  const std::uint8_t* keep = keep_.data();
+  // Most flags are zero: skip them eight at a time.
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < n; i += 8) {
+    std::uint64_t word;
+    std::memcpy(&word, keep + i, sizeof word);
+    if (word == 0) continue;
+    for (std::size_t j = i; j < std::min(n, i + 8); ++j) {
+      candidates_[kept] = static_cast<std::uint32_t>(j);
+      kept += keep[j];
     }
-    if (nearest < offsets_.t1_m) {
-      ++field_.vertexSubstepsBelowT1;
-      penalty_[i] = 1;
-    }
+  }
+  return kept;
+}
+
+void FieldCollider::countPenetration() {
+  field_.vertexSubsteps += nearest_.size();
+  for (std::size_t i = 0; i < nearest_.size(); ++i) {
+    const double nearest = nearest_[i];
+    penalty_[i] = nearest < offsets_.t1_m;
+    field_.vertexSubstepsBelowT1 += penalty_[i];
     if (nearest < offsets_.t0_m) ++field_.vertexSubstepsBelowT0;
     if (nearest < 0) {
       ++field_.vertexSubstepsInsideBody;
@@ -146,54 +230,44 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
     }
   }
   counters_.maxPenetration_m = field_.maxPenetration_m;
-  lastTime_s_ = t1_s;
 }
 
-void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::size_t i, double dt_s, ClothState& io) {
+void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::size_t i, const Vec3& c1, double dt_s,
+                                 ClothState& io) {
   const field::DistanceField& f = *parts_[k].field;
   PointState& state = states_[k][i];
-  Vec3& last = lastLocal_[k][i];
+  Vec3& last = lastVoxel_[k][i];
   const PointState from = state;
-  ++field_.tests;
-  ++counters_.pointsTested;
-
-  const Vec3 world1 = io.position(i);
   if (embedded_[k][i]) {
-    releaseEmbedded(k, frame, i, dt_s, io);
+    releaseEmbedded(k, frame, i, c1, dt_s, io);
     ++field_.transitions[toIndex(from)][toIndex(state)];
     return;
   }
-  // OutsideVol -> OutsideVol: culled by the part's box, no trace.
-  if (state == PointState::OutsideVol && !frame.worldBox1.contains(world1)) {
-    ++field_.transitions[0][0];
-    return;
-  }
-  const Vec3 local1 = frame.inverse1.apply(world1);
-  // A point outside the volume has no cached local position: where it was at the start of
-  // the interval follows from its velocity (x1 = x0 + v dt after the integrator).
-  const Vec3 local0 = state == PointState::OutsideVol
-                          ? frame.pose0.inverse().apply(world1 - io.velocity(i) * dt_s)
-                          : last;
-  const Vec3 c0 = f.toVoxel(local0), c1 = f.toVoxel(local1);
-  const Vec3i v0 = roundVoxel(c0), v1 = roundVoxel(c1);
+
+  const Vec3i v1 = roundVoxel(c1);
   const bool in1 = walkable(f, v1);
   if (state == PointState::OutsideVol && !in1) {
     ++field_.transitions[0][0];
-    last = local1;
+    last = c1;
     return;
   }
+  // A point outside the volume has no cached position: where it was at the start of the
+  // interval follows from its velocity (x1 = x0 + v dt after the integrator).
+  const Vec3 c0 = state == PointState::OutsideVol
+                      ? frame.toVoxel0.apply(io.position(i) - io.velocity(i) * dt_s)
+                      : last;
+  const Vec3i v0 = roundVoxel(c0);
 
   // Where the walk starts: the start voxel, or, entering from outside, the entry voxel
   // found by walking backwards from the end until the walk leaves the volume.
   const Vec3i start = state == PointState::OutsideVol ? entryVoxel(f, v1, v0) : v0;
   // Forward walk: stop where it leaves the volume (it cannot re-enter a box) or, unless the
   // point already slides on the surface, at the first voxel below T2.
-  const double t2Voxels = offsets_.t2_m / f.voxelSize();
   bool hit = false;
   Vec3i hitVoxel = start;
   const int walked = walkVoxels(start, v1, [&](const Vec3i& p) {
     if (!walkable(f, p)) return false;
-    if (state != PointState::OnSurf && f.distanceVoxels(f.index(p.x(), p.y(), p.z())) < t2Voxels) {
+    if (state != PointState::OnSurf && f.distanceVoxels(f.index(p.x(), p.y(), p.z())) < frame.t2Voxels) {
       hit = true;
       hitVoxel = p;
       return false;
@@ -205,121 +279,132 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
 
   if (!in1 && !hit) {  // left the volume
     state = PointState::OutsideVol;
-    last = local1;
+    last = c1;
     ++field_.transitions[toIndex(from)][toIndex(state)];
     return;
   }
 
-  Vec3 local = local1;
+  const double h = f.voxelSize();
+  Vec3 c = c1;
   bool moved = false;
-  double d = f.distanceAt(local);
-  if (state != PointState::OnSurf && (hit || d < offsets_.t2_m)) {
+  // Most pairs are InsideVol far from the body: they need the distance only. The normal
+  // comes with it (one gather) where a response will read it.
+  const bool needNormal = state == PointState::OnSurf || hit;
+  field::FieldSample at = needNormal ? f.sampleAtVoxel(c) : field::FieldSample{f.distanceAtVoxel(c), Vec3::Zero()};
+  if (state != PointState::OnSurf && (hit || at.distance_m < offsets_.t2_m)) {
     // Collision: stop where the path meets T2. The contact point is the path point nearest
     // the first voxel below T2, moved along the offset-surface normal onto T2.
     if (hit) {
       const Vec3 seg = c1 - c0;
       const double len2 = seg.squaredNorm();
       const double s = len2 > 0 ? std::clamp((hitVoxel.cast<double>() - c0).dot(seg) / len2, 0.0, 1.0) : 1.0;
-      local = f.toLocal(c0 + s * seg);
-      d = f.distanceAt(local);
+      c = c0 + s * seg;
     }
-    local += (offsets_.t2_m - d) * f.normalAt(local);
+    at = f.sampleAtVoxel(c);
+    c += (offsets_.t2_m - at.distance_m) / h * at.normal;
     moved = true;
     state = PointState::OnSurf;
     ++field_.collisions;
     ++counters_.contacts;
   } else if (state == PointState::OnSurf) {
-    if (d > offsets_.t3_m) {
+    if (at.distance_m > offsets_.t3_m) {
       state = PointState::InsideVol;  // carried away by forces
-    } else if (d < offsets_.t0_m) {
-      local += (offsets_.t2_m - d) * f.normalAt(local);  // last resort
+    } else if (at.distance_m < offsets_.t0_m) {
+      c += (offsets_.t2_m - at.distance_m) / h * at.normal;  // last resort
       moved = true;
       ++field_.projections;
       ++counters_.contacts;
-    } else if (d < offsets_.t2_m) {
+    } else if (at.distance_m < offsets_.t2_m) {
       // Sliding: the point stays on T2 while the part moves into it; the envelope down to
       // T1 absorbs what one substep's normal cannot (the penalty below).
-      local += (offsets_.t2_m - d) * f.normalAt(local);
+      c += (offsets_.t2_m - at.distance_m) / h * at.normal;
       moved = true;
     }
   } else {
     state = PointState::InsideVol;
   }
 
-  if (state == PointState::OnSurf) {
-    const Vec3 n = frame.pose1.applyVector(f.normalAt(local));
-    const Vec3 world = frame.pose1.apply(local);
-    const Vec3 partVelocity = (world - frame.pose0.apply(local)) / dt_s;
-    Vec3 v = io.velocity(i);
-    const double depth = offsets_.t2_m - f.distanceAt(local);
-    if (depth > -1e-12) {
-      // In contact: remove the inward normal velocity relative to the part, with Coulomb
-      // friction on the tangential part (stick below the static coefficient).
-      const Vec3 rel = v - partVelocity;
-      const double vn = rel.dot(n);
-      if (vn < 0) {
-        Vec3 vt = rel - vn * n;
-        const double speed = vt.norm();
-        if (speed <= staticFriction_ * -vn) {
-          vt.setZero();
-        } else {
-          vt *= 1.0 - dynamicFriction_ * -vn / speed;
-        }
-        v = partVelocity + vt;
-      }
-    }
-    const double belowT1 = offsets_.t1_m - f.distanceAt(local);
-    if (belowT1 > 0) {
-      // Penalty: separate from the part at least at the rate that removes kPenaltyRate of
-      // the depth per substep. A floor on the relative normal velocity, not an added impulse,
-      // so that two parts meeting in a corner, or many substeps below T1, cannot pump energy.
-      const double wanted = kPenaltyRate * belowT1 / dt_s;
-      const double vn = (v - partVelocity).dot(n);
-      if (vn < wanted) v += n * (wanted - vn);
-    }
-    io.setVelocity(i, v);
-    if (moved) io.setPosition(i, world);
-  }
-  last = local;
+  if (moved) at = f.sampleAtVoxel(c);  // the response reads the field where the point is now
+  if (state == PointState::OnSurf) respondOnSurface(frame, c, at, i, moved, dt_s, io);
+  last = c;
+  nearest_[i] = std::min(nearest_[i], at.distance_m);
   ++field_.transitions[toIndex(from)][toIndex(state)];
+}
+
+void FieldCollider::respondOnSurface(const PartFrame& frame, const Vec3& c, const field::FieldSample& at,
+                                     std::size_t i, bool moved, double dt_s, ClothState& io) const {
+  const Vec3 n = frame.rotation1 * at.normal;
+  const Vec3 world = frame.toWorld1.apply(c);
+  const Vec3 partVelocity = (world - frame.toWorld0.apply(c)) / dt_s;
+  Vec3 v = io.velocity(i);
+  const double depth = offsets_.t2_m - at.distance_m;
+  if (depth > -1e-12) {
+    // In contact: remove the inward normal velocity relative to the part, with Coulomb
+    // friction on the tangential part (stick below the static coefficient).
+    const Vec3 rel = v - partVelocity;
+    const double vn = rel.dot(n);
+    if (vn < 0) {
+      Vec3 vt = rel - vn * n;
+      const double speed = vt.norm();
+      if (speed <= staticFriction_ * -vn) {
+        vt.setZero();
+      } else {
+        vt *= 1.0 - dynamicFriction_ * -vn / speed;
+      }
+      v = partVelocity + vt;
+    }
+  }
+  const double belowT1 = offsets_.t1_m - at.distance_m;
+  if (belowT1 > 0) {
+    // Penalty: separate from the part at least at the rate that removes kPenaltyRate of
+    // the depth per substep. A floor on the relative normal velocity, not an added impulse,
+    // so that two parts meeting in a corner, or many substeps below T1, cannot pump energy.
+    const double wanted = kPenaltyRate * belowT1 / dt_s;
+    const double vn = (v - partVelocity).dot(n);
+    if (vn < wanted) v += n * (wanted - vn);
+  }
+  io.setVelocity(i, v);
+  if (moved) io.setPosition(i, world);
 }
 
 // A point that started below T1 of the part (a garment modelled tight on a smooth body lies
 // inside a rigid segment's offset surfaces, or its capped volume, near the joints) is eased
 // out along the normal at most kEmbeddedSpeed, losing its inward velocity relative to the
 // part, instead of being thrown onto T2 in one substep; once on T2 it collides like any other.
-void FieldCollider::releaseEmbedded(std::size_t k, const PartFrame& frame, std::size_t i, double dt_s,
+// Eased pairs stay out of the penetration counts: they are reported as pairs_embedded_at_start.
+void FieldCollider::releaseEmbedded(std::size_t k, const PartFrame& frame, std::size_t i, const Vec3& c1, double dt_s,
                                     ClothState& io) {
   const field::DistanceField& f = *parts_[k].field;
-  Vec3 local = frame.inverse1.apply(io.position(i));
-  lastLocal_[k][i] = local;
-  if (!walkable(f, roundVoxel(f.toVoxel(local)))) {
+  PointState& state = states_[k][i];
+  Vec3& last = lastVoxel_[k][i];
+  Vec3 c = c1;
+  last = c;
+  if (!walkable(f, roundVoxel(c))) {
     embedded_[k][i] = 0;
-    states_[k][i] = PointState::OutsideVol;
+    state = PointState::OutsideVol;
     return;
   }
-  const double d = f.distanceAt(local);
-  if (d >= offsets_.t2_m) {
+  const field::FieldSample at = f.sampleAtVoxel(c);
+  const double rest = offsets_.t2_m - at.distance_m;
+  if (rest <= 0) {
     embedded_[k][i] = 0;
-    states_[k][i] = d > offsets_.t3_m ? PointState::InsideVol : PointState::OnSurf;
+    state = at.distance_m > offsets_.t3_m ? PointState::InsideVol : PointState::OnSurf;
     return;
   }
-  const Vec3 normal = f.normalAt(local);
-  const double rest = offsets_.t2_m - d;
   const double step = std::min(rest, kEmbeddedSpeed_m_s * dt_s);
-  local += step * normal;
-  lastLocal_[k][i] = local;
-  if (step == rest) {  // on T2 now (to the field's accuracy): slide from here
-    embedded_[k][i] = 0;
-    states_[k][i] = PointState::OnSurf;
-  }
-  const Vec3 n = frame.pose1.applyVector(normal);
-  const Vec3 world = frame.pose1.apply(local);
-  const Vec3 partVelocity = (world - frame.pose0.apply(local)) / dt_s;
+  c += step / f.voxelSize() * at.normal;
+  last = c;
+  const Vec3 n = frame.rotation1 * at.normal;
+  const Vec3 world = frame.toWorld1.apply(c);
+  const Vec3 partVelocity = (world - frame.toWorld0.apply(c)) / dt_s;
   const Vec3 v = io.velocity(i);
   const double vn = (v - partVelocity).dot(n);
   if (vn < 0) io.setVelocity(i, v - vn * n);
   io.setPosition(i, world);
+  if (step == rest) {  // on T2 now (to the field's accuracy): slide from here
+    embedded_[k][i] = 0;
+    state = PointState::OnSurf;
+  }
 }
 
 std::array<std::size_t, 3> FieldCollider::pointsPerState() const {

@@ -27,59 +27,48 @@ struct Sym2 {
 };
 
 /// Scales the compressive principal part of the stress S by `scale` (S and the strain share
-/// principal directions, so a tension direction keeps its full stress).
+/// principal directions, so a tension direction keeps its full stress). Branch-free (every
+/// case computed, one selected) so that the membrane loop vectorises.
 inline Sym2 softenCompression(Sym2 s, double scale) {
   const double mean = 0.5 * (s.a + s.b);
   const double half = 0.5 * (s.a - s.b);
   const double radius = std::sqrt(half * half + s.c * s.c);
   const double s1 = mean + radius, s2 = mean - radius;
-  if (s2 >= 0.0) return s;
-  if (s1 <= 0.0) return {s.a * scale, s.b * scale, s.c * scale};
   // Unit eigenvector of s2: (s.c, s2 - s.a) or (s2 - s.b, s.c), whichever is longer.
-  double nx = s.c, ny = s2 - s.a;
-  if (nx * nx + ny * ny < 1e-300) {
-    nx = s2 - s.b;
-    ny = s.c;
-  }
-  const double inv = 1.0 / std::sqrt(nx * nx + ny * ny);
-  nx *= inv;
-  ny *= inv;
+  const double ax = s.c, ay = s2 - s.a;
+  const bool first = ax * ax + ay * ay >= 1e-300;
+  const double nx = first ? ax : s2 - s.b, ny = first ? ay : s.c;
+  const double inv = 1.0 / std::sqrt(std::max(nx * nx + ny * ny, 1e-300));
+  const double ux = nx * inv, uy = ny * inv;
   const double k = (scale - 1.0) * s2;
-  return {s.a + k * nx * nx, s.b + k * ny * ny, s.c + k * nx * ny};
+  const Sym2 mixed{s.a + k * ux * ux, s.b + k * uy * uy, s.c + k * ux * uy};
+  const Sym2 both{s.a * scale, s.b * scale, s.c * scale};
+  const bool tension = s2 >= 0.0, compression = s1 <= 0.0;
+  return {tension ? s.a : compression ? both.a : mixed.a, tension ? s.b : compression ? both.b : mixed.b,
+          tension ? s.c : compression ? both.c : mixed.c};
 }
 
-}  // namespace
+struct MembraneConstants {
+  double lambda, mu, beta, softScale;
+};
 
-void clearForces(ClothState& io) {
-  std::fill(io.fx.begin(), io.fx.end(), 0.0);
-  std::fill(io.fy.begin(), io.fy.end(), 0.0);
-  std::fill(io.fz.begin(), io.fz.end(), 0.0);
-}
+// The kernels run in two passes. Pass 1 (per element, gathers only, no scatter) computes
+// every element's corner forces into the workspace, one column per component; pass 2
+// (scalar) adds them to the vertices. Pass 1 takes its arrays as restrict parameters: GCC 12
+// vectorises it so (gathers included), and not with the same pointers as function locals.
 
-// Membrane, pass 1 (per triangle, no scatter, vectorises): f1 and f2 into the workspace.
-// Pass 2 (scalar) scatters f1, f2 and f0 = -(f1 + f2) to the vertices.
+/// Membrane pass 1: f1 and f2 of every triangle into w (columns f1x f1y f1z f2x f2y f2z);
+/// f0 = -(f1 + f2).
 template <bool kDamp, bool kSoften>
-void membraneKernel(const ClothModel& model, ClothState& io) {
-  const MembraneArrays& el = model.membraneArrays();
-  const std::size_t n = el.area.size();
-  const double lambda = model.lambdaT(), mu = model.muT();
-  const double beta = model.material().damping_s;
-  const double softScale = model.material().compressionScale;
-  const double* __restrict x = io.x.data();
-  const double* __restrict y = io.y.data();
-  const double* __restrict z = io.z.data();
-  const double* __restrict vx = io.vx.data();
-  const double* __restrict vy = io.vy.data();
-  const double* __restrict vz = io.vz.data();
-  const std::int32_t* __restrict i0 = el.v0.data();
-  const std::int32_t* __restrict i1 = el.v1.data();
-  const std::int32_t* __restrict i2 = el.v2.data();
-  const double* __restrict g1u = el.g1u.data();
-  const double* __restrict g1v = el.g1v.data();
-  const double* __restrict g2u = el.g2u.data();
-  const double* __restrict g2v = el.g2v.data();
-  const double* __restrict area = el.area.data();
-  double* __restrict w = io.work.data();
+void membraneCornerForces(std::size_t n, const MembraneConstants& k, const double* __restrict x,
+                          const double* __restrict y, const double* __restrict z, const double* __restrict vx,
+                          const double* __restrict vy, const double* __restrict vz, const std::int32_t* __restrict i0,
+                          const std::int32_t* __restrict i1, const std::int32_t* __restrict i2,
+                          const double* __restrict g1u, const double* __restrict g1v, const double* __restrict g2u,
+                          const double* __restrict g2v, const double* __restrict area, double* __restrict f1x,
+                          double* __restrict f1y, double* __restrict f1z, double* __restrict f2x,
+                          double* __restrict f2y, double* __restrict f2z) {
+  const double lambda = k.lambda, mu = k.mu, beta = k.beta, softScale = k.softScale;
   for (std::size_t t = 0; t < n; ++t) {
     // Deformation gradient columns Fu, Fv (F = d1 (x) g1 + d2 (x) g2).
     const V3 p0 = load(x, y, z, i0[t]);
@@ -108,55 +97,58 @@ void membraneKernel(const ClothModel& model, ClothState& io) {
       s.c += beta * 2.0 * mu * r12;
     }
 
-    // First Piola stress P = F S; f_i = -A P g_i = c_i1 Fu + c_i2 Fv. Only the four
-    // coefficients are stored (see the bending kernel); pass 2 rebuilds Fu, Fv.
+    // First Piola stress P = F S; f_i = -A P g_i = c_i1 Fu + c_i2 Fv.
     const double A = area[t];
-    w[t] = -A * (s.a * g1u[t] + s.c * g1v[t]);          // f1 = w0 Fu + w1 Fv
-    w[n + t] = -A * (s.c * g1u[t] + s.b * g1v[t]);
-    w[2 * n + t] = -A * (s.a * g2u[t] + s.c * g2v[t]);  // f2 = w2 Fu + w3 Fv
-    w[3 * n + t] = -A * (s.c * g2u[t] + s.b * g2v[t]);
+    const double c11 = -A * (s.a * g1u[t] + s.c * g1v[t]), c12 = -A * (s.c * g1u[t] + s.b * g1v[t]);
+    const double c21 = -A * (s.a * g2u[t] + s.c * g2v[t]), c22 = -A * (s.c * g2u[t] + s.b * g2v[t]);
+    const V3 f1 = add(mul(fu, c11), mul(fv, c12));
+    const V3 f2 = add(mul(fu, c21), mul(fv, c22));
+    f1x[t] = f1.x;
+    f1y[t] = f1.y;
+    f1z[t] = f1.z;
+    f2x[t] = f2.x;
+    f2y[t] = f2.y;
+    f2z[t] = f2.z;
   }
-  double* fx = io.fx.data();
-  double* fy = io.fy.data();
-  double* fz = io.fz.data();
+}
+
+/// Membrane pass 2: the corner forces to the vertices.
+void scatterMembrane(std::size_t n, const std::int32_t* i0, const std::int32_t* i1, const std::int32_t* i2,
+                     const double* w, double* fx, double* fy, double* fz) {
   for (std::size_t t = 0; t < n; ++t) {
-    const V3 p0 = load(x, y, z, i0[t]);
-    const V3 d1 = sub(load(x, y, z, i1[t]), p0);
-    const V3 d2 = sub(load(x, y, z, i2[t]), p0);
-    const V3 fu = add(mul(d1, g1u[t]), mul(d2, g2u[t]));
-    const V3 fv = add(mul(d1, g1v[t]), mul(d2, g2v[t]));
-    const V3 f1 = add(mul(fu, w[t]), mul(fv, w[n + t]));
-    const V3 f2 = add(mul(fu, w[2 * n + t]), mul(fv, w[3 * n + t]));
+    const V3 f1{w[t], w[n + t], w[2 * n + t]};
+    const V3 f2{w[3 * n + t], w[4 * n + t], w[5 * n + t]};
     addTo(fx, fy, fz, i1[t], f1);
     addTo(fx, fy, fz, i2[t], f2);
     addTo(fx, fy, fz, i0[t], mul(add(f1, f2), -1.0));
   }
 }
 
-void accumulateMembraneForces(const ClothModel& model, ClothState& io) {
-  const bool damp = model.material().damping_s > 0.0;
-  const bool soften = model.material().compressionScale < 1.0;
-  if (damp && soften) membraneKernel<true, true>(model, io);
-  else if (damp) membraneKernel<true, false>(model, io);
-  else if (soften) membraneKernel<false, true>(model, io);
-  else membraneKernel<false, false>(model, io);
+template <bool kDamp, bool kSoften>
+void membraneKernel(const ClothModel& model, ClothState& io) {
+  const MembraneArrays& el = model.membraneArrays();
+  const std::size_t n = el.area.size();
+  const MembraneConstants k{model.lambdaT(), model.muT(), model.material().damping_s,
+                            model.material().compressionScale};
+  double* w = io.work.data();  // six columns of n
+  membraneCornerForces<kDamp, kSoften>(n, k, io.x.data(), io.y.data(), io.z.data(), io.vx.data(), io.vy.data(),
+                                       io.vz.data(), el.v0.data(), el.v1.data(), el.v2.data(), el.g1u.data(),
+                                       el.g1v.data(), el.g2u.data(), el.g2v.data(), el.area.data(), w, w + n, w + 2 * n,
+                                       w + 3 * n, w + 4 * n, w + 5 * n);
+  scatterMembrane(n, el.v0.data(), el.v1.data(), el.v2.data(), io.work.data(), io.fx.data(), io.fy.data(),
+                  io.fz.data());
 }
 
-// Bending, pass 1 (per hinge, no scatter, vectorises): the four hinge forces into the
-// workspace. Pass 2 (scalar) scatters them.
-void accumulateBendingForces(const ClothModel& model, ClothState& io) {
-  const BendArrays& h = model.bendArrays();
-  const std::size_t n = h.stiffness.size();
-  const double* __restrict x = io.x.data();
-  const double* __restrict y = io.y.data();
-  const double* __restrict z = io.z.data();
-  const std::int32_t* __restrict ie0 = h.e0.data();
-  const std::int32_t* __restrict ie1 = h.e1.data();
-  const std::int32_t* __restrict ia = h.a.data();
-  const std::int32_t* __restrict ib = h.b.data();
-  const double* __restrict restPsi = h.restPsi.data();
-  const double* __restrict k = h.stiffness.data();
-  double* __restrict w = io.work.data();
+/// Bending pass 1: the forces on a, b and e0 of every hinge into w (columns fa, fb, fe0, x y z
+/// each); f_e1 = -(fa + fb + fe0).
+void hingeCornerForces(std::size_t n, const double* __restrict x, const double* __restrict y,
+                       const double* __restrict z, const std::int32_t* __restrict ie0,
+                       const std::int32_t* __restrict ie1, const std::int32_t* __restrict ia,
+                       const std::int32_t* __restrict ib, const double* __restrict restPsi,
+                       const double* __restrict k, double* __restrict fax, double* __restrict fay,
+                       double* __restrict faz, double* __restrict fbx, double* __restrict fby,
+                       double* __restrict fbz, double* __restrict fex, double* __restrict fey,
+                       double* __restrict fez) {
   for (std::size_t i = 0; i < n; ++i) {
     // Hinge normals with edge-local orientation (see BendElement) and the edge vector.
     const V3 x3 = load(x, y, z, ie0[i]), x4 = load(x, y, z, ie1[i]);
@@ -178,32 +170,65 @@ void accumulateBendingForces(const ClothModel& model, ClothState& io) {
     // dtheta/dx_i = -u_i with Bridson et al. (2003)'s u_i, which sum to zero exactly:
     //   u_a = |e| N1 / |N1|^2, u_b = |e| N2 / |N2|^2,
     //   u_e0 = ((a - e1).e N1 / |N1|^2 + (b - e1).e N2 / |N2|^2) / |e|, u_e1 = -(u_a + u_b + u_e0).
-    // f_i = -k (psi - psi0) dpsi/dx_i = k (psi - psi0) cos(theta/2) u_i. Every force is a
-    // combination of N1 and N2, so only four coefficients are stored (GCC 12 stops
-    // vectorising this loop beyond about four output streams).
-    const double m = ok ? k[i] * (psi - restPsi[i]) * cosHalf : 0.0;
+    // f_i = -k (psi - psi0) dpsi/dx_i = k (psi - psi0) cos(theta/2) u_i.
+    const double stiffness = k[i], rest = restPsi[i];  // loaded unconditionally: a select, not a masked load
+    const double m = ok ? stiffness * (psi - rest) * cosHalf : 0.0;
     const double elen = std::sqrt(es), invE = 1.0 / elen;
     const double r1 = m / n1s, r2 = m / n2s;
-    w[i] = r1 * elen;                                   // f_a = w0 N1
-    w[n + i] = r2 * elen;                               // f_b = w1 N2
-    w[2 * n + i] = r1 * dot(sub(x1, x4), e) * invE;     // f_e0 = w2 N1 + w3 N2
-    w[3 * n + i] = r2 * dot(sub(x2, x4), e) * invE;
+    const V3 fa = mul(n1, r1 * elen), fb = mul(n2, r2 * elen);
+    const V3 fe0 = add(mul(n1, r1 * dot(sub(x1, x4), e) * invE), mul(n2, r2 * dot(sub(x2, x4), e) * invE));
+    fax[i] = fa.x;
+    fay[i] = fa.y;
+    faz[i] = fa.z;
+    fbx[i] = fb.x;
+    fby[i] = fb.y;
+    fbz[i] = fb.z;
+    fex[i] = fe0.x;
+    fey[i] = fe0.y;
+    fez[i] = fe0.z;
   }
-  double* fx = io.fx.data();
-  double* fy = io.fy.data();
-  double* fz = io.fz.data();
+}
+
+/// Bending pass 2: the hinge forces to the vertices.
+void scatterHinges(std::size_t n, const std::int32_t* ie0, const std::int32_t* ie1, const std::int32_t* ia,
+                   const std::int32_t* ib, const double* w, double* fx, double* fy, double* fz) {
   for (std::size_t i = 0; i < n; ++i) {
-    const V3 x3 = load(x, y, z, ie0[i]), x4 = load(x, y, z, ie1[i]);
-    const V3 x1 = load(x, y, z, ia[i]), x2 = load(x, y, z, ib[i]);
-    const V3 n1 = cross(sub(x1, x3), sub(x1, x4));
-    const V3 n2 = cross(sub(x2, x4), sub(x2, x3));
-    const V3 fa = mul(n1, w[i]), fb = mul(n2, w[n + i]);
-    const V3 fe0 = add(mul(n1, w[2 * n + i]), mul(n2, w[3 * n + i]));
+    const V3 fa{w[i], w[n + i], w[2 * n + i]};
+    const V3 fb{w[3 * n + i], w[4 * n + i], w[5 * n + i]};
+    const V3 fe0{w[6 * n + i], w[7 * n + i], w[8 * n + i]};
     addTo(fx, fy, fz, ia[i], fa);
     addTo(fx, fy, fz, ib[i], fb);
     addTo(fx, fy, fz, ie0[i], fe0);
     addTo(fx, fy, fz, ie1[i], mul(add(add(fa, fb), fe0), -1.0));
   }
+}
+
+}  // namespace
+
+void clearForces(ClothState& io) {
+  std::fill(io.fx.begin(), io.fx.end(), 0.0);
+  std::fill(io.fy.begin(), io.fy.end(), 0.0);
+  std::fill(io.fz.begin(), io.fz.end(), 0.0);
+}
+
+void accumulateMembraneForces(const ClothModel& model, ClothState& io) {
+  const bool damp = model.material().damping_s > 0.0;
+  const bool soften = model.material().compressionScale < 1.0;
+  if (damp && soften) membraneKernel<true, true>(model, io);
+  else if (damp) membraneKernel<true, false>(model, io);
+  else if (soften) membraneKernel<false, true>(model, io);
+  else membraneKernel<false, false>(model, io);
+}
+
+void accumulateBendingForces(const ClothModel& model, ClothState& io) {
+  const BendArrays& h = model.bendArrays();
+  const std::size_t n = h.stiffness.size();
+  double* w = io.work.data();  // nine columns of n
+  hingeCornerForces(n, io.x.data(), io.y.data(), io.z.data(), h.e0.data(), h.e1.data(), h.a.data(), h.b.data(),
+                    h.restPsi.data(), h.stiffness.data(), w, w + n, w + 2 * n, w + 3 * n, w + 4 * n, w + 5 * n,
+                    w + 6 * n, w + 7 * n, w + 8 * n);
+  scatterHinges(n, h.e0.data(), h.e1.data(), h.a.data(), h.b.data(), io.work.data(), io.fx.data(), io.fy.data(),
+                io.fz.data());
 }
 
 void accumulateDragForces(const ClothModel& model, const StepSettings& settings, ClothState& io) {

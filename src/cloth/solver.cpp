@@ -40,16 +40,22 @@ bool ClothSolver::stepFrame(long frame) {
   const int n = settings_.substepsPerFrame;
   const double dt = settings_.substep_s();
   for (int s = 0; s < n; ++s) {
-    // Time from a substep counter, not an accumulated sum, so no drift over long takes.
+    // Times from a substep counter, not an accumulated sum, so no drift over long takes;
+    // both ends from the counter, so this substep's t1 is the next one's t0 exactly (the
+    // poses of the body parts are cached by time).
     const double t0 = static_cast<double>((frame - 1) * n + s) * dt;
-    if (!substep(t0, frame, s)) return false;
+    const double t1 = static_cast<double>((frame - 1) * n + s + 1) * dt;
+    if (!substep(t0, t1, frame, s)) return false;
   }
   return true;
 }
 
 bool ClothSolver::substep(double t0, long frame, int substepIndex) {
+  return substep(t0, t0 + settings_.substep_s(), frame, substepIndex);
+}
+
+bool ClothSolver::substep(double t0, double t1, long frame, int substepIndex) {
   const double dt = settings_.substep_s();
-  const double t1 = t0 + dt;
   Clock::time_point start = Clock::now();
   accumulateForces();  // membrane, bending, drag into state_.f*
   times_.forces_s += secondsSince(start);
@@ -63,7 +69,7 @@ bool ClothSolver::substep(double t0, long frame, int substepIndex) {
   times_.collide_s += secondsSince(start);
 
   start = Clock::now();
-  applyFixtures(t1, dt);  // pinned vertices follow their transforms
+  applyFixtures(t0, t1, dt);  // pinned vertices follow their transforms
   times_.fixtures_s += secondsSince(start);
 
   start = Clock::now();
@@ -85,10 +91,10 @@ void ClothSolver::collide(double t0, double t1) {
   for (Collider* c : colliders_) c->collide(*model_, t0, t1, state_);
 }
 
-void ClothSolver::applyFixtures(double t1, double dt) {
+void ClothSolver::applyFixtures(double t0, double t1, double dt) {
   for (const PinGroup& g : pins_) {
     const RigidTransform now = g.motion ? g.motion->poseAt(t1) : RigidTransform::identity();
-    const RigidTransform before = g.motion ? g.motion->poseAt(t1 - dt) : RigidTransform::identity();
+    const RigidTransform before = g.motion ? g.motion->poseAt(t0) : RigidTransform::identity();
     const Mat3 r1 = now.rotation.toRotationMatrix(), r0 = before.rotation.toRotationMatrix();
     const Vec3 p1 = now.translation, p0 = before.translation;
     const double invDt = 1.0 / dt;

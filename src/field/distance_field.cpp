@@ -172,6 +172,7 @@ DistanceField DistanceField::build(const mesh::TriMesh& part, const FieldSetting
   f.shellVoxels_ = std::move(prop.shellVoxels);
   f.refStart_ = std::move(prop.refStart);
   f.refs_ = std::move(prop.refs);
+  (void)decodedNormals();  // built here, not in the first collision step that reads a normal
   f.stats_.finishMs = msSince(start);
 
   for (auto* v : {&f.shellVoxels_, &f.refStart_, &f.refs_, &f.surfaceVoxels_, &f.surfaceNormalStart_})
@@ -205,55 +206,9 @@ Aabb DistanceField::bounds() const {
   return box;
 }
 
-namespace {
+double DistanceField::distanceAt(const Vec3& p) const { return distanceAtVoxel(toVoxel(p)); }
 
-// The lower corner voxel and weights of a trilinear lookup at continuous voxel coordinates.
-struct Cell {
-  std::uint32_t base;
-  double fx, fy, fz;
-};
-
-Cell cellAt(const GridDims& d, const Vec3& c) {
-  const auto axis = [](double v, int n, int& i) {
-    v = std::clamp(v, 0.0, static_cast<double>(n - 1));
-    i = std::min(static_cast<int>(v), n - 2);
-    return v - i;
-  };
-  int x, y, z;
-  Cell cell;
-  cell.fx = axis(c.x(), d.nx, x);
-  cell.fy = axis(c.y(), d.ny, y);
-  cell.fz = axis(c.z(), d.nz, z);
-  cell.base = d.index(x, y, z);
-  return cell;
-}
-
-}  // namespace
-
-double DistanceField::distanceAt(const Vec3& p) const {
-  const Cell c = cellAt(dims_, toVoxel(p));
-  const std::size_t sy = static_cast<std::size_t>(dims_.nx), sz = sy * static_cast<std::size_t>(dims_.ny);
-  const std::int16_t* q = distance_.data() + c.base;
-  const double x00 = q[0] + c.fx * (q[1] - q[0]);
-  const double x10 = q[sy] + c.fx * (q[sy + 1] - q[sy]);
-  const double x01 = q[sz] + c.fx * (q[sz + 1] - q[sz]);
-  const double x11 = q[sz + sy] + c.fx * (q[sz + sy + 1] - q[sz + sy]);
-  const double y0 = x00 + c.fy * (x10 - x00), y1 = x01 + c.fy * (x11 - x01);
-  return (y0 + c.fz * (y1 - y0)) * metresPerUnit_;
-}
-
-Vec3 DistanceField::normalAt(const Vec3& p) const {
-  const Cell c = cellAt(dims_, toVoxel(p));
-  const std::size_t sy = static_cast<std::size_t>(dims_.nx), sz = sy * static_cast<std::size_t>(dims_.ny);
-  Vec3 sum = Vec3::Zero();
-  for (int k = 0; k < 8; ++k) {
-    const double w = ((k & 1) ? c.fx : 1 - c.fx) * ((k & 2) ? c.fy : 1 - c.fy) * ((k & 4) ? c.fz : 1 - c.fz);
-    const std::size_t v = c.base + ((k & 1) ? 1 : 0) + ((k & 2) ? sy : 0) + ((k & 4) ? sz : 0);
-    sum += w * decodeNormal(normal_[v]);
-  }
-  const double len = sum.norm();
-  return len > 1e-9 ? Vec3(sum / len) : normal(voxelAt(p));
-}
+Vec3 DistanceField::normalAt(const Vec3& p) const { return sampleAtVoxel(toVoxel(p)).normal; }
 
 PointLocation DistanceField::locate(const Vec3& p) const {
   PointLocation l;
@@ -305,6 +260,15 @@ Vec3 DistanceField::decodeNormal(std::uint16_t code) {
     n.y() = (1 - std::abs(u)) * (v >= 0 ? 1 : -1);
   }
   return n.normalized();
+}
+
+const Vec3f* DistanceField::decodedNormals() {
+  static const std::vector<Vec3f> table = [] {
+    std::vector<Vec3f> t(65536);
+    for (std::size_t code = 0; code < t.size(); ++code) t[code] = decodeNormal(static_cast<std::uint16_t>(code)).cast<float>();
+    return t;
+  }();
+  return table.data();
 }
 
 }  // namespace drape::field

@@ -16,8 +16,9 @@
 //      ~~~~~~ body surface ~~~~~~~~~~~~~
 //
 // Per mass point and part the collider keeps a state (OutsideVol, InsideVol, OnSurf) and the
-// point's last position in the part's local frame. Transitions:
-//   OutsideVol -> OutsideVol   no trace (both ends outside the part's box)
+// point's last position in the part's continuous voxel coordinates. Transitions:
+//   OutsideVol -> OutsideVol   no trace: the point ends the interval outside the part's
+//                              walkable box (culled per part and substep, see below)
 //   OutsideVol -> In/OnSurf    trace backwards from the end until it exits: the entry voxel;
 //                              then forwards from the entry
 //   In/OnSurf  -> OutsideVol   the trace stops where it leaves the volume (convex box)
@@ -30,6 +31,13 @@
 //                              below T1 a penalty impulse outwards as well; below T0 the
 //                              last-resort projection is counted
 //   OnSurf     -> InsideVol    when forces carry it beyond T3
+//
+// Culling (the paper's non-hierarchical boxes): once per part and collision substep, one
+// vectorised pass maps every point's end position into the part's voxel coordinates (the
+// part's rigid transform at t1 and the grid placement folded into one affine map) and keeps
+// only the points that end inside the part's walkable box or are not OutsideVol. The others
+// are exactly the OutsideVol -> OutsideVol pairs of the per-pair test, counted in bulk, so
+// culling changes no state, counter or position (tested against the unculled path).
 
 #include <array>
 #include <cstdint>
@@ -93,6 +101,10 @@ class FieldCollider final : public Collider {
   /// first step).
   void initialise(const ClothState& state, double t_s);
 
+  /// Off: every (point, part) pair goes through the full per-pair test (the reference the
+  /// culled path is tested against). On by default.
+  void setBoxCulling(bool on) { boxCulling_ = on; }
+
   [[nodiscard]] std::string name() const override { return "distance fields"; }
   void collide(const ClothModel& model, double t0_s, double t1_s, ClothState& io) override;
   [[nodiscard]] ColliderCounters counters() const override { return counters_; }
@@ -108,27 +120,39 @@ class FieldCollider final : public Collider {
   void vertexDisplayStates(std::vector<std::uint8_t>& out) const;
 
  private:
-  struct PartFrame {
-    RigidTransform pose0, pose1, inverse1;
-    Aabb worldBox1;  // the part's grid box at the end of the interval, world frame
-  };
+  struct PartFrame;  // one part's transforms over the interval (field_collider.cpp)
   PartFrame framePart(const CollisionPart& part, double t0_s, double t1_s) const;
-  void releaseEmbedded(std::size_t k, const PartFrame& frame, std::size_t i, double dt_s, ClothState& io);
-  void collidePoint(std::size_t part, const PartFrame& frame, std::size_t vertex, double dt_s, ClothState& io);
+  /// Fills endVoxel* with every point's end position in part k's voxel coordinates and
+  /// candidates_ with the points the per-pair test must see; returns their number.
+  std::size_t selectCandidates(std::size_t k, const PartFrame& frame, const ClothState& io);
+  void releaseEmbedded(std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& endVoxel, double dt_s,
+                       ClothState& io);
+  void collidePoint(std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& endVoxel, double dt_s,
+                    ClothState& io);
+  void respondOnSurface(const PartFrame& frame, const Vec3& voxel, const field::FieldSample& at, std::size_t vertex,
+                        bool moved, double dt_s, ClothState& io) const;
+  /// Penetration after the response, against the nearest part (the counters of Table 3).
+  void countPenetration();
 
   std::string garment_;
   std::vector<CollisionPart> parts_;
   OffsetSurfaces offsets_;
   double staticFriction_, dynamicFriction_;
   int every_;
+  bool boxCulling_ = true;
   long calls_ = 0;
   double lastTime_s_ = 0;
   std::vector<std::vector<PointState>> states_;   ///< [part][vertex]
-  std::vector<std::vector<Vec3>> lastLocal_;      ///< [part][vertex], m, part frame at lastTime
+  std::vector<std::vector<Vec3>> lastVoxel_;      ///< [part][vertex], part's voxel coordinates at lastTime
   std::vector<std::uint8_t> penalty_;             ///< per vertex: below T1 of some part now
   /// [part][vertex]: the point started below T1 of the part and is being eased out onto T2
   /// (releaseEmbedded) rather than thrown there in one substep.
   std::vector<std::vector<std::uint8_t>> embedded_;
+  // Per-substep scratch, sized by initialise (the step does not allocate).
+  std::vector<double> endVoxelX_, endVoxelY_, endVoxelZ_;  ///< per vertex, the current part's voxel coordinates
+  std::vector<std::uint8_t> keep_;                ///< per vertex: the current part must test it
+  std::vector<std::uint32_t> candidates_;         ///< the vertices kept, ascending
+  std::vector<double> nearest_;                   ///< per vertex, m: distance to the nearest part after the response
   ColliderCounters counters_;
   FieldCollisionCounters field_;
 };
@@ -173,7 +197,12 @@ int walkVoxels(const Vec3i& from, const Vec3i& to, Visit&& visit) {
 /// volume. Exposed for tests.
 [[nodiscard]] Vec3i entryVoxel(const field::DistanceField& field, const Vec3i& inside, const Vec3i& outside);
 
-/// Whether a walk may stand on voxel p: in the grid and not in its tagged border layer.
-[[nodiscard]] bool walkable(const field::DistanceField& field, const Vec3i& p);
+/// Whether a walk may stand on voxel p: in the grid and not in its tagged border layer. The
+/// border is exactly the outermost layer (voxelize tags it so), so this is a range test and
+/// reads no voxel data: one cache miss less per pair. Tested against the flags.
+[[nodiscard]] inline bool walkable(const field::DistanceField& field, const Vec3i& p) {
+  const field::GridDims& d = field.dims();
+  return p.x() >= 1 && p.y() >= 1 && p.z() >= 1 && p.x() < d.nx - 1 && p.y() < d.ny - 1 && p.z() < d.nz - 1;
+}
 
 }  // namespace drape::cloth

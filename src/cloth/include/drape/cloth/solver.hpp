@@ -59,6 +59,10 @@ class ClothSolver {
 
   /// One substep over [t0, t0 + dt] (exposed for tests); returns false on instability.
   bool substep(double t0_s, long frame, int substepIndex);
+  /// The same over [t0, t1] with t1 given (t1 - t0 is the substep up to rounding), so that
+  /// consecutive substeps share their boundary times bit for bit and every pose is
+  /// evaluated once per time.
+  bool substep(double t0_s, double t1_s, long frame, int substepIndex);
 
   [[nodiscard]] const ClothModel& model() const { return *model_; }
   [[nodiscard]] const StepSettings& settings() const { return settings_; }
@@ -75,7 +79,7 @@ class ClothSolver {
   void accumulateForces();
   void integrate(double dt_s);
   void collide(double t0_s, double t1_s);
-  void applyFixtures(double t1_s, double dt_s);
+  void applyFixtures(double t0_s, double t1_s, double dt_s);
   bool checkStability(long frame, int substepIndex);
 
   std::shared_ptr<const ClothModel> model_;

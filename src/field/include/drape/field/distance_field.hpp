@@ -13,7 +13,9 @@
 // flags (1 byte), Voronoi normal octahedron-encoded in 2 x int8 (2 bytes); references to
 // the surface voxels of each Voronoi cell only for voxels within the shell.
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -50,6 +52,12 @@ struct FieldStats {
   double propagateMs = 0;  ///< DVDP or the exact transform
   double finishMs = 0;     ///< normals and compact storage
   std::size_t bytes = 0;   ///< memory of the built field
+};
+
+/// Distance and offset-surface normal at one point, from one trilinear gather.
+struct FieldSample {
+  double distance_m = 0;   ///< signed, trilinear; negative inside the body
+  Vec3 normal = Vec3::UnitZ();  ///< unit, pointing away from the body (local frame)
 };
 
 /// The result of DistanceField::locate for a local point.
@@ -120,6 +128,12 @@ class DistanceField {
   /// Both, and whether the point is in the volume, in one call.
   [[nodiscard]] PointLocation locate(const Vec3& local_m) const;
 
+  // --- per point in continuous voxel coordinates (the collision's hot path) ------------------
+  // The same trilinear reads as distanceAt and normalAt, without the metre conversion, and
+  // both from the one gather of 8 voxels when both are needed.
+  [[nodiscard]] double distanceAtVoxel(const Vec3& voxel) const;
+  [[nodiscard]] FieldSample sampleAtVoxel(const Vec3& voxel) const;
+
   // --- Voronoi cells (cold: binary search) -----------------------------------------------------
   /// Surface voxels whose Voronoi cell holds this voxel (empty beyond the shell).
   [[nodiscard]] std::span<const std::uint32_t> references(std::uint32_t voxel) const;
@@ -136,8 +150,22 @@ class DistanceField {
 
   [[nodiscard]] static std::uint16_t encodeNormal(const Vec3& unit);
   [[nodiscard]] static Vec3 decodeNormal(std::uint16_t code);
+  /// decodeNormal of every code, in float (built on first use, shared, 768 KB): the
+  /// collision's normal reads look codes up instead of decoding them.
+  [[nodiscard]] static const Vec3f* decodedNormals();
 
  private:
+  /// The 8 voxels around continuous voxel coordinates (clamped to the grid) and their
+  /// trilinear weights, in the order x fastest.
+  struct Gather {
+    std::array<std::size_t, 8> voxel;
+    std::array<double, 8> weight;
+  };
+  [[nodiscard]] Gather gatherAt(const Vec3& voxel) const;
+  [[nodiscard]] double blendDistance(const Gather& g) const;
+  /// Unit blend of the 8 decoded normals; the nearest voxel's normal where they cancel.
+  [[nodiscard]] Vec3 blendNormal(const Gather& g, const Vec3& voxel) const;
+
   GridDims dims_;
   double voxelSize_ = 0;
   double metresPerUnit_ = 0;  // voxelSize_ / kUnitsPerVoxel
@@ -153,6 +181,65 @@ class DistanceField {
   std::vector<Vec3f> surfaceNormals_;
   FieldStats stats_;
 };
+
+inline DistanceField::Gather DistanceField::gatherAt(const Vec3& c) const {
+  const auto axis = [](double v, int n, int& i) {
+    v = std::clamp(v, 0.0, static_cast<double>(n - 1));
+    i = std::min(static_cast<int>(v), n - 2);
+    return v - i;
+  };
+  int x, y, z;
+  const double fx = axis(c.x(), dims_.nx, x), fy = axis(c.y(), dims_.ny, y), fz = axis(c.z(), dims_.nz, z);
+  const std::size_t base = dims_.index(x, y, z);
+  const std::size_t sy = static_cast<std::size_t>(dims_.nx), sz = sy * static_cast<std::size_t>(dims_.ny);
+  Gather g;
+  for (int k = 0; k < 8; ++k) {
+    g.voxel[k] = base + ((k & 1) ? 1 : 0) + ((k & 2) ? sy : 0) + ((k & 4) ? sz : 0);
+    g.weight[k] = ((k & 1) ? fx : 1 - fx) * ((k & 2) ? fy : 1 - fy) * ((k & 4) ? fz : 1 - fz);
+  }
+  return g;
+}
+
+/// a0 + ... + a7 as a balanced tree: a fixed order, and no serial chain of eight adds.
+template <typename T>
+inline T sumOfEight(const T (&a)[8]) {
+  return ((a[0] + a[1]) + (a[2] + a[3])) + ((a[4] + a[5]) + (a[6] + a[7]));
+}
+
+inline double DistanceField::blendDistance(const Gather& g) const {
+  double terms[8];
+  for (int k = 0; k < 8; ++k) terms[k] = g.weight[k] * distance_[g.voxel[k]];
+  return sumOfEight(terms) * metresPerUnit_;
+}
+
+inline Vec3 DistanceField::blendNormal(const Gather& g, const Vec3& c) const {
+  // Unit normals from the decode table (one load per voxel instead of a square root and a
+  // division), blended and normalised in double.
+  const Vec3f* table = decodedNormals();
+  float tx[8], ty[8], tz[8];
+  for (int k = 0; k < 8; ++k) {
+    const Vec3f& n = table[normal_[g.voxel[k]]];
+    const float w = static_cast<float>(g.weight[k]);
+    tx[k] = n.x() * w;
+    ty[k] = n.y() * w;
+    tz[k] = n.z() * w;
+  }
+  const double sx = sumOfEight(tx), sy = sumOfEight(ty), sz = sumOfEight(tz);
+  const Vec3 sum(sx, sy, sz);
+  const double len = sum.norm();
+  if (len > 1e-9) return sum / len;
+  const int x = std::clamp(static_cast<int>(std::floor(c.x() + 0.5)), 0, dims_.nx - 1);
+  const int y = std::clamp(static_cast<int>(std::floor(c.y() + 0.5)), 0, dims_.ny - 1);
+  const int z = std::clamp(static_cast<int>(std::floor(c.z() + 0.5)), 0, dims_.nz - 1);
+  return normal(dims_.index(x, y, z));
+}
+
+inline double DistanceField::distanceAtVoxel(const Vec3& c) const { return blendDistance(gatherAt(c)); }
+
+inline FieldSample DistanceField::sampleAtVoxel(const Vec3& c) const {
+  const Gather g = gatherAt(c);
+  return {blendDistance(g), blendNormal(g, c)};
+}
 
 /// Grid placement for a part: its bounding box plus `border` voxels each side (cubic voxels
 /// of `voxelSize` m), or exactly `dims` voxels when they are given (voxel size from the box).

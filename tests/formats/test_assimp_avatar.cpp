@@ -105,6 +105,12 @@ TEST(AssimpAvatar, ParsesInProcessToo) {
   EXPECT_EQ(back.vertexJoints, m.vertexJoints);
 }
 
+// tests/data/avatars/tube_two_joints.fbx is the tube written by `drape convert` (ASCII
+// FBX, centimetres): a committed FBX file, and the FBX fuzz target's seed.
+TEST(AssimpAvatar, AsciiFbxTube) {
+  expectTheTube(readAssimpSkinnedModel(std::string(DRAPE_TEST_DATA_DIR) + "/avatars/tube_two_joints.fbx"));
+}
+
 struct ScratchDir {
   std::filesystem::path path = std::filesystem::temp_directory_path() / ("drape-assimp-" + std::to_string(::getpid()));
   ScratchDir() { std::filesystem::create_directories(path); }
@@ -123,6 +129,30 @@ TEST_P(AssimpWriter, WritesTheTubeSoItReadsBack) {
 
 INSTANTIATE_TEST_SUITE_P(Formats, AssimpWriter, ::testing::Values(".dae", ".fbx"),
                          [](const auto& info) { return std::string(info.param + 1); });
+
+void replaceOnce(std::string& text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  ASSERT_NE(at, std::string::npos) << from;
+  text.replace(at, from.size(), to);
+}
+
+// Assimp's FBX importer leaves GlobalSettings' units and axes to drape: a file in units of
+// 2 cm with Z up reads back scaled by 2 and turned Y up.
+TEST(AssimpAvatar, FbxUnitScaleFactorAndUpAxisAreApplied) {
+  const ScratchDir dir;
+  const std::string plain = (dir.path / "tube.fbx").string(), zUp = (dir.path / "tube_z_up.fbx").string();
+  writeAssimpSkinnedModel(plain, readAssimpSkinnedModel(tube()));
+  std::string text = slurp(plain);
+  replaceOnce(text, "\"UnitScaleFactor\", \"double\", \"Number\", \"\", 1", "\"UnitScaleFactor\", \"double\", \"Number\", \"\", 2");
+  replaceOnce(text, "\"UpAxis\", \"int\", \"Integer\", \"\", 1", "\"UpAxis\", \"int\", \"Integer\", \"\", 2");
+  std::ofstream(zUp, std::ios::binary) << text;
+  const SkinnedModel a = readAssimpSkinnedModel(plain), b = readAssimpSkinnedModel(zUp);
+  ASSERT_EQ(a.positions.size(), b.positions.size());
+  for (std::size_t v = 0; v < a.positions.size(); ++v) {
+    const Vec3& p = a.positions[v];
+    EXPECT_LT((b.positions[v] - 2.0 * Vec3(p.x(), p.z(), -p.y())).norm(), 1e-6) << v;
+  }
+}
 
 TEST(AssimpAvatar, WriterRefusesOtherExtensions) {
   const std::string e = errorOf([] { writeAssimpSkinnedModel("x.obj", readAssimpSkinnedModel(tube())); });

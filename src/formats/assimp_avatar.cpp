@@ -73,6 +73,43 @@ bool hasColladaRoot(std::string_view s) {
   return s.size() > 8 && (std::isspace(static_cast<unsigned char>(s[8])) || s[8] == '>');
 }
 
+int lineAt(std::string_view bytes, std::size_t offset) {
+  return 1 + static_cast<int>(std::count(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(offset), '\n'));
+}
+
+// Assimp's Collada parser allocates without bound on a word that is not a number in an
+// index list (fuzzing: "abc" in <p> took over 4 GB) and reserves whatever a count
+// attribute says, so drape checks both before Assimp sees the bytes.
+void checkColladaNumbers(std::string_view bytes, const std::string& name) {
+  constexpr std::string_view kCount = "count=\"";
+  for (std::size_t at = bytes.find(kCount); at != std::string_view::npos; at = bytes.find(kCount, at + 1)) {
+    std::size_t end = at + kCount.size();
+    double value = 0.0;
+    for (; end < bytes.size() && std::isdigit(static_cast<unsigned char>(bytes[end])); ++end) value = value * 10.0 + (bytes[end] - '0');
+    // Every counted item takes at least one byte of the file.
+    if (value > static_cast<double>(bytes.size()))
+      throw Error(fmt::format("{}:{}: count=\"{:.0f}\" is more than a {}-byte file can hold", name, lineAt(bytes, at), value, bytes.size()));
+  }
+  // Lists of indices and counts: whole numbers only.
+  for (const std::string_view tag : {"p", "v", "vcount", "h", "int_array"}) {
+    const std::string open = "<" + std::string(tag);
+    for (std::size_t at = bytes.find(open); at != std::string_view::npos; at = bytes.find(open, at + 1)) {
+      const std::size_t after = at + open.size();
+      if (after >= bytes.size() || (bytes[after] != '>' && !std::isspace(static_cast<unsigned char>(bytes[after])))) continue;
+      const std::size_t start = bytes.find('>', after);
+      if (start == std::string_view::npos) break;
+      const std::size_t stop = std::min(bytes.find('<', start), bytes.size());
+      for (std::size_t i = start + 1; i < stop; ++i) {
+        const char c = bytes[i];
+        if (std::isdigit(static_cast<unsigned char>(c)) || std::isspace(static_cast<unsigned char>(c)) || (c == '-' && tag == "int_array")) continue;
+        const std::size_t wordEnd = std::min(bytes.find_first_of(" \t\r\n<", i), stop);
+        throw Error(fmt::format("{}:{}: <{}> holds '{}', not a whole number", name, lineAt(bytes, i), tag,
+                                bytes.substr(i, std::min<std::size_t>(wordEnd - i, 40))));
+      }
+    }
+  }
+}
+
 void checkSignature(std::string_view bytes, Format format, const std::string& name) {
   if (format == Format::Collada) {
     if (!hasColladaRoot(bytes)) throw Error(fmt::format("{}: not a Collada file (no XML root element <COLLADA>)", name));
@@ -514,6 +551,7 @@ bool isAssimpAvatarPath(const std::string& path) {
 SkinnedModel parseAssimpSkinnedModel(std::string_view bytes, const std::string& name) {
   const Format format = formatOf(name);
   checkSignature(bytes, format, name);
+  if (format == Format::Collada) checkColladaNumbers(bytes, name);
   Assimp::Importer importer;
   keepOnlyImporterFor(importer, extensionOf(format));
   configure(importer);

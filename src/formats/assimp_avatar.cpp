@@ -77,10 +77,28 @@ int lineAt(std::string_view bytes, std::size_t offset) {
   return 1 + static_cast<int>(std::count(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(offset), '\n'));
 }
 
-// Assimp's Collada parser allocates without bound on a word that is not a number in an
-// index list (fuzzing: "abc" in <p> took over 4 GB) and reserves whatever a count
-// attribute says, so drape checks both before Assimp sees the bytes.
+// Position of the next start tag `<tag ...>` or `<tag>` at or after `from` (not `<tagx`).
+std::size_t findStartTag(std::string_view bytes, std::string_view tag, std::size_t from) {
+  const std::string open = "<" + std::string(tag);
+  for (std::size_t at = bytes.find(open, from); at != std::string_view::npos; at = bytes.find(open, at + 1)) {
+    const std::size_t after = at + open.size();
+    if (after < bytes.size() && (bytes[after] == '>' || std::isspace(static_cast<unsigned char>(bytes[after])))) return at;
+  }
+  return std::string_view::npos;
+}
+
+// Assimp's Collada parser dereferences a null pointer on an array without its (required)
+// count attribute (found by fuzzing), allocates without bound on a word that is not a
+// number in an index list ("abc" in <p> took over 4 GB) and reserves whatever a count
+// attribute says; drape checks all three before Assimp sees the bytes.
 void checkColladaNumbers(std::string_view bytes, const std::string& name) {
+  for (const std::string_view tag : {"float_array", "int_array", "Name_array", "IDREF_array", "SIDREF_array", "bool_array", "token_array"})
+    for (std::size_t at = findStartTag(bytes, tag, 0); at != std::string_view::npos; at = findStartTag(bytes, tag, at + 1)) {
+      const std::string_view startTag = bytes.substr(at, bytes.find('>', at) - at);
+      const std::size_t count = startTag.find("count=");
+      if (count == std::string_view::npos || !std::isspace(static_cast<unsigned char>(startTag[count - 1])))
+        throw Error(fmt::format("{}:{}: <{}> has no count attribute", name, lineAt(bytes, at), tag));
+    }
   constexpr std::string_view kCount = "count=\"";
   for (std::size_t at = bytes.find(kCount); at != std::string_view::npos; at = bytes.find(kCount, at + 1)) {
     std::size_t end = at + kCount.size();
@@ -92,11 +110,8 @@ void checkColladaNumbers(std::string_view bytes, const std::string& name) {
   }
   // Lists of indices and counts: whole numbers only.
   for (const std::string_view tag : {"p", "v", "vcount", "h", "int_array"}) {
-    const std::string open = "<" + std::string(tag);
-    for (std::size_t at = bytes.find(open); at != std::string_view::npos; at = bytes.find(open, at + 1)) {
-      const std::size_t after = at + open.size();
-      if (after >= bytes.size() || (bytes[after] != '>' && !std::isspace(static_cast<unsigned char>(bytes[after])))) continue;
-      const std::size_t start = bytes.find('>', after);
+    for (std::size_t at = findStartTag(bytes, tag, 0); at != std::string_view::npos; at = findStartTag(bytes, tag, at + 1)) {
+      const std::size_t start = bytes.find('>', at);
       if (start == std::string_view::npos) break;
       const std::size_t stop = std::min(bytes.find('<', start), bytes.size());
       for (std::size_t i = start + 1; i < stop; ++i) {

@@ -195,6 +195,12 @@ TEST(AssimpAvatarBad, IndexThatIsNotANumber) {
   expectError("index_not_a_number.dae", ":29: <p> holds 'abc', not a whole number");
 }
 
+// Found by fuzz/fuzz_dae.cpp: Assimp dereferences a null pointer on an array without
+// its count attribute.
+TEST(AssimpAvatarBad, ArrayWithoutCount) {
+  expectError("array_without_count.dae", ":17: <float_array> has no count attribute");
+}
+
 // Assimp reserves what a count attribute says before reading the values.
 TEST(AssimpAvatarBad, CountLargerThanTheFile) {
   expectError("count_too_large.dae", ":17: count=\"3600000000\" is more than a");

@@ -91,7 +91,7 @@ std::size_t findStartTag(std::string_view bytes, std::string_view tag, std::size
 // count attribute (found by fuzzing), allocates without bound on a word that is not a
 // number in an index list ("abc" in <p> took over 4 GB) and reserves whatever a count
 // attribute says; drape checks all three before Assimp sees the bytes.
-void checkColladaNumbers(std::string_view bytes, const std::string& name) {
+void checkColladaArrays(std::string_view bytes, const std::string& name) {
   for (const std::string_view tag : {"float_array", "int_array", "Name_array", "IDREF_array", "SIDREF_array", "bool_array", "token_array"})
     for (std::size_t at = findStartTag(bytes, tag, 0); at != std::string_view::npos; at = findStartTag(bytes, tag, at + 1)) {
       const std::string_view startTag = bytes.substr(at, bytes.find('>', at) - at);
@@ -566,7 +566,7 @@ bool isAssimpAvatarPath(const std::string& path) {
 SkinnedModel parseAssimpSkinnedModel(std::string_view bytes, const std::string& name) {
   const Format format = formatOf(name);
   checkSignature(bytes, format, name);
-  if (format == Format::Collada) checkColladaNumbers(bytes, name);
+  if (format == Format::Collada) checkColladaArrays(bytes, name);
   Assimp::Importer importer;
   keepOnlyImporterFor(importer, extensionOf(format));
   configure(importer);

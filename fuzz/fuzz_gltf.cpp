@@ -15,7 +15,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const drape::formats::GltfSkinnedModel model =
         drape::formats::parseGltfSkinnedModel(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.glb", "");
     (void)drape::scene::buildAvatarFromSkinnedModel(model);
-    (void)drape::formats::deserialiseGltfSkinnedModel(drape::formats::serialise(model), "fuzz.glb");
+    (void)drape::formats::deserialiseSkinnedModel(drape::formats::serialise(model), "fuzz.glb");
   } catch (const drape::Error&) {
   }
   return 0;

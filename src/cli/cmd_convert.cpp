@@ -1,5 +1,6 @@
-// `drape convert AVATAR --to avatar.wrl`: writes any avatar drape loads (.glb, .gltf,
-// MakeHuman .mhskel) as a segmented H-Anim 1.1 VRML97 humanoid.
+// `drape convert AVATAR --to avatar.wrl|.dae|.fbx`: writes any avatar drape loads (.glb,
+// .gltf, .dae, .fbx, MakeHuman .mhskel) as a segmented H-Anim 1.1 VRML97 humanoid, or its
+// skinned mesh and skeleton as Collada or (ASCII) FBX through Assimp.
 
 #include <filesystem>
 
@@ -7,6 +8,7 @@
 
 #include "command.hpp"
 #include "drape/core/error.hpp"
+#include "drape/formats/assimp_avatar.hpp"
 #include "drape/formats/hanim_writer.hpp"
 #include "drape/scene/avatar_gltf.hpp"
 
@@ -35,13 +37,25 @@ formats::HanimHumanoidData toHanim(const scene::Avatar& a) {
 
 RunFunction setupConvert(CLI::App& app) {
   static std::string input, output;
-  app.add_option("avatar", input, "The avatar to convert: .glb, .gltf or MakeHuman .mhskel (mesh and weights beside it)")
+  app.add_option("avatar", input,
+                 "The avatar to convert: .glb, .gltf, .dae, .fbx or MakeHuman .mhskel (mesh and weights beside it)")
       ->required();
-  app.add_option("--to", output, "Output file: a segmented H-Anim 1.1 VRML97 humanoid (.wrl)")->required();
+  app.add_option("--to", output,
+                 "Output file: a segmented H-Anim 1.1 VRML97 humanoid (.wrl), or the skinned mesh and skeleton as "
+                 "Collada (.dae, metres) or ASCII FBX (.fbx, centimetres)")
+      ->required();
   return [] {
     const std::string ext = std::filesystem::path(output).extension().string();
-    if (ext != ".wrl") throw Error(fmt::format("--to {}: drape converts avatars to H-Anim VRML97 (.wrl) only", output));
+    const bool skinned = formats::isAssimpAvatarPath(output);
+    if (ext != ".wrl" && !skinned)
+      throw Error(fmt::format("--to {}: drape converts avatars to H-Anim VRML97 (.wrl), Collada (.dae) or FBX (.fbx)", output));
     const scene::Avatar avatar = scene::loadAvatarFile(input);
+    if (skinned) {
+      formats::writeAssimpSkinnedModel(output, scene::skinnedModelOf(avatar));
+      spdlog::info("{}: {} joints, {} skinned vertices written to {}", input, avatar.joints.size(),
+                   avatar.skin->mesh.vertexCount(), output);
+      return 0;
+    }
     writeHanim(output, toHanim(avatar));
     spdlog::info("{}: {} joints, {} segments written to {}", input, avatar.joints.size(), avatar.segments.size(), output);
     return 0;
@@ -49,7 +63,7 @@ RunFunction setupConvert(CLI::App& app) {
 }
 
 const bool registered =
-    registerCommand({"convert", "Convert an avatar to a segmented H-Anim VRML97 humanoid", "", 40, &setupConvert});
+    registerCommand({"convert", "Convert an avatar to a segmented H-Anim VRML97 humanoid, Collada or FBX", "", 40, &setupConvert});
 
 }  // namespace
 }  // namespace drape::cli

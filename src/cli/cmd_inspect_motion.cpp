@@ -1,4 +1,4 @@
-// `drape inspect FILE.bvh|.amc|.asf|.glb|.gltf|.mhskel`: skeleton, frame count, rate,
+// `drape inspect FILE.bvh|.amc|.asf|.glb|.gltf|.dae|.fbx|.mhskel`: skeleton, frame count, rate,
 // duration and the units guess of motion files; joints and segments of avatars.
 
 #include <cctype>
@@ -89,7 +89,7 @@ void inspectAvatar(const std::string& path, std::ostream& out) {
 
 const bool bvh = registerInspector({".bvh"}, "BVH motion: skeleton, frames, rate, duration, units guess", &inspectBvh);
 const bool acclaim = registerInspector({".amc", ".asf"}, "Acclaim (CMU) ASF skeletons and AMC motion", &inspectAcclaim);
-const bool avatars = registerInspector({".glb", ".gltf", ".mhskel"}, "skinned avatars: joints, skin, segments", &inspectAvatar);
+const bool avatars = registerInspector({".glb", ".gltf", ".dae", ".fbx", ".mhskel"}, "skinned avatars: joints, skin, segments", &inspectAvatar);
 
 }  // namespace
 }  // namespace drape::cli

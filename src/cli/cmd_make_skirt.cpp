@@ -58,7 +58,7 @@ void writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::
 
 RunFunction setupMakeSkirt(CLI::App& app) {
   static MakeSkirtOptions o;
-  app.add_option("avatar", o.avatar, "Avatar file to fit the skirt to (.glb, .gltf, MakeHuman .mhskel)")->required();
+  app.add_option("avatar", o.avatar, "Avatar file to fit the skirt to (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel)")->required();
   app.add_option("--out", o.out, "Directory for scene.wrl, skirt.obj and waistband.obj")->required();
   app.add_option("--avatar-url", o.avatarUrl, "The Avatar url written into scene.wrl (default: the avatar's path relative to --out)");
   app.add_option("--length", o.fit.length_m, "Waist to hem, m (default: a little above the knees)");

@@ -223,7 +223,7 @@ RunFunction setupRun(CLI::App& app) {
       "Exit codes: 0 done, 2 bad input, 3 the simulation became unstable (files so far are kept).");
   app.add_option("scene", o->scene, "VRML97 scene with ClothSet garments (and an avatar)");
   app.add_option("--garment", o->garment, "Garment mesh (OBJ), instead of a scene");
-  app.add_option("--avatar", o->avatar, "Avatar to wear --garment (.glb, .gltf, MakeHuman .mhskel)");
+  app.add_option("--avatar", o->avatar, "Avatar to wear --garment (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel)");
   app.add_option("--motion", o->motion, "Motion for the avatar (.bvh, .amc)");
   app.add_option("--joint-map", o->jointMap, "JSON map from the motion's joint names to the avatar's");
   app.add_option("--motion-scale", o->motionScale, "Metres per motion-file unit (default: guessed from the skeleton)");

@@ -408,7 +408,7 @@ std::vector<Eigen::Matrix4d> nodeWorlds(const GModel& model, std::vector<int>& p
   return world;
 }
 
-GltfSkinnedModel extract(const GModel& model, const std::string& name) {
+SkinnedModel extract(const GModel& model, const std::string& name) {
   const Reader r{model, name};
   if (model.skins.empty()) r.fail("has no skin (a skinned character is needed)");
   const GSkin& skin = model.skins.front();
@@ -437,11 +437,11 @@ GltfSkinnedModel extract(const GModel& model, const std::string& name) {
   std::vector<int> newIndex(jn);
   for (std::size_t k = 0; k < jn; ++k) newIndex[order[k]] = static_cast<int>(k);
 
-  GltfSkinnedModel out;
+  SkinnedModel out;
   out.source = name;
   for (std::size_t k = 0; k < jn; ++k) {
     const int node = skin.joints[order[k]];
-    GltfJoint joint;
+    SkinnedJoint joint;
     joint.name = model.nodes[static_cast<std::size_t>(node)].name.empty() ? fmt::format("joint{}", order[k])
                                                                            : model.nodes[static_cast<std::size_t>(node)].name;
     for (int a = nodeParent[static_cast<std::size_t>(node)]; a >= 0; a = nodeParent[static_cast<std::size_t>(a)])
@@ -527,91 +527,17 @@ GltfSkinnedModel extract(const GModel& model, const std::string& name) {
   return out;
 }
 
-// ---- plain-data serialisation across the process boundary --------------------------
-
-template <typename T>
-void put(std::string& s, const T& v) {
-  s.append(reinterpret_cast<const char*>(&v), sizeof(T));
-}
-template <typename T>
-void putVector(std::string& s, const std::vector<T>& v) {
-  put<std::uint64_t>(s, v.size());
-  s.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
-}
-
-struct Cursor {
-  std::string_view bytes;
-  std::size_t at = 0;
-  std::string name;
-  template <typename T>
-  T get() {
-    if (bytes.size() - at < sizeof(T)) throw Error(fmt::format("{}: the glTF reader returned truncated data", name));
-    T v;
-    std::memcpy(&v, bytes.data() + at, sizeof(T));
-    at += sizeof(T);
-    return v;
-  }
-  template <typename T>
-  std::vector<T> getVector() {
-    const auto n = get<std::uint64_t>();
-    if (n > (bytes.size() - at) / std::max<std::size_t>(sizeof(T), 1)) throw Error(fmt::format("{}: the glTF reader returned truncated data", name));
-    std::vector<T> v(n);
-    std::memcpy(v.data(), bytes.data() + at, n * sizeof(T));
-    at += n * sizeof(T);
-    return v;
-  }
-};
-
 }  // namespace
 
-std::string serialise(const GltfSkinnedModel& model) {
-  std::string s;
-  put<std::uint64_t>(s, model.joints.size());
-  for (const GltfJoint& j : model.joints) {
-    putVector(s, std::vector<char>(j.name.begin(), j.name.end()));
-    put<std::int32_t>(s, j.parent);
-    for (int i = 0; i < 16; ++i) put<double>(s, j.restWorld(i % 4, i / 4));
-  }
-  std::vector<double> xyz;
-  for (const Vec3& p : model.positions) xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
-  putVector(s, xyz);
-  putVector(s, model.triangles);
-  putVector(s, model.vertexJoints);
-  putVector(s, model.vertexWeights);
-  return s;
-}
-
-GltfSkinnedModel deserialiseGltfSkinnedModel(std::string_view bytes, const std::string& name) {
-  Cursor c{bytes, 0, name};
-  GltfSkinnedModel model;
-  model.source = name;
-  const auto joints = c.get<std::uint64_t>();
-  if (joints > 65535) throw Error(fmt::format("{}: the glTF reader returned bad data", name));
-  for (std::uint64_t k = 0; k < joints; ++k) {
-    GltfJoint j;
-    const std::vector<char> chars = c.getVector<char>();
-    j.name.assign(chars.begin(), chars.end());
-    j.parent = c.get<std::int32_t>();
-    for (int i = 0; i < 16; ++i) j.restWorld(i % 4, i / 4) = c.get<double>();
-    model.joints.push_back(std::move(j));
-  }
-  const std::vector<double> xyz = c.getVector<double>();
-  for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) model.positions.emplace_back(xyz[i], xyz[i + 1], xyz[i + 2]);
-  model.triangles = c.getVector<mesh::Triangle>();
-  model.vertexJoints = c.getVector<std::array<std::uint16_t, 4>>();
-  model.vertexWeights = c.getVector<std::array<float, 4>>();
-  return model;
-}
-
-GltfSkinnedModel parseGltfSkinnedModel(std::string_view bytes, const std::string& name, const std::string& baseDir) {
+SkinnedModel parseGltfSkinnedModel(std::string_view bytes, const std::string& name, const std::string& baseDir) {
   return extract(parseDocument(bytes, name, baseDir), name);
 }
 
-GltfSkinnedModel readGltfSkinnedModel(const std::string& path, const IsolationLimits& limits) {
+SkinnedModel readGltfSkinnedModel(const std::string& path, const IsolationLimits& limits) {
   const std::string bytes = detail::readWholeFile(path, std::size_t{1} << 30);
   const std::string baseDir = std::filesystem::absolute(path).parent_path().string();
   const std::string result = runIsolated(path, "glTF reader", [&] { return serialise(parseGltfSkinnedModel(bytes, path, baseDir)); }, limits);
-  return deserialiseGltfSkinnedModel(result, path);
+  return deserialiseSkinnedModel(result, path);
 }
 
 }  // namespace drape::formats

@@ -6,16 +6,17 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "drape/formats/assimp_avatar.hpp"
 #include "drape/scene/avatar_makehuman.hpp"
 #include "drape/scene/avatar_segment.hpp"
 
 namespace drape::scene {
 
-Avatar buildAvatarFromSkinnedModel(const formats::GltfSkinnedModel& model) {
+Avatar buildAvatarFromSkinnedModel(const formats::SkinnedModel& model) {
   Avatar avatar;
   avatar.source = model.source;
   avatar.name = std::filesystem::path(model.source).stem().string();
-  for (const formats::GltfJoint& j : model.joints) {
+  for (const formats::SkinnedJoint& j : model.joints) {
     Joint joint;
     joint.name = j.name;
     joint.parent = j.parent;
@@ -38,12 +39,37 @@ Avatar buildAvatarFromSkinnedModel(const formats::GltfSkinnedModel& model) {
 
 Avatar loadGltfAvatar(const std::string& path) { return buildAvatarFromSkinnedModel(formats::readGltfSkinnedModel(path)); }
 
+Avatar loadAssimpAvatar(const std::string& path) {
+  return buildAvatarFromSkinnedModel(formats::readAssimpSkinnedModel(path));
+}
+
+formats::SkinnedModel skinnedModelOf(const Avatar& avatar) {
+  if (!avatar.skin) throw Error(fmt::format("{}: the avatar has no skinned mesh to write", avatar.source));
+  formats::SkinnedModel model;
+  model.source = avatar.source;
+  for (const Joint& j : avatar.joints) {
+    formats::SkinnedJoint joint;
+    joint.name = j.name;
+    joint.parent = j.parent;
+    const RigidTransform rest = j.restWorld();
+    joint.restWorld.topLeftCorner<3, 3>() = rest.rotation.toRotationMatrix();
+    joint.restWorld.block<3, 1>(0, 3) = rest.translation;
+    model.joints.push_back(std::move(joint));
+  }
+  model.positions = avatar.skin->mesh.positions;
+  model.triangles = avatar.skin->mesh.triangles;
+  model.vertexJoints = avatar.skin->joints;
+  model.vertexWeights = avatar.skin->weights;
+  return model;
+}
+
 Avatar loadAvatarFile(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (ext == ".glb" || ext == ".gltf") return loadGltfAvatar(path);
+  if (ext == ".dae" || ext == ".fbx") return loadAssimpAvatar(path);
   if (ext == ".mhskel") return loadMakeHumanAvatar(path);
-  throw Error(fmt::format("{}: drape reads avatars from .glb, .gltf and MakeHuman .mhskel files, not '{}'", path, ext));
+  throw Error(fmt::format("{}: drape reads avatars from .glb, .gltf, .dae, .fbx and MakeHuman .mhskel files, not '{}'", path, ext));
 }
 
 }  // namespace drape::scene

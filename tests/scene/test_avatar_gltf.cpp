@@ -32,7 +32,7 @@ TEST(GltfAvatar, ReadsInProcessToo) {
   const formats::GltfSkinnedModel m = formats::parseGltfSkinnedModel(bytes, "CesiumMan.glb", std::string(DRAPE_DATA_DIR) + "/avatars");
   EXPECT_EQ(m.joints.size(), 19u);
   EXPECT_EQ(m.triangles.size(), 4672u);
-  const formats::GltfSkinnedModel back = formats::deserialiseGltfSkinnedModel(formats::serialise(m), "x");
+  const formats::GltfSkinnedModel back = formats::deserialiseSkinnedModel(formats::serialise(m), "x");
   EXPECT_EQ(back.positions, m.positions);
   EXPECT_EQ(back.vertexJoints, m.vertexJoints);
 }
@@ -97,8 +97,8 @@ TEST(GltfAvatar, NumberOverflowIsAnError) {
 }
 
 TEST(GltfAvatar, UnknownAvatarExtension) {
-  EXPECT_EQ(errorOf([] { (void)loadAvatarFile("x.fbx"); }),
-            "x.fbx: drape reads avatars from .glb, .gltf and MakeHuman .mhskel files, not '.fbx'");
+  EXPECT_EQ(errorOf([] { (void)loadAvatarFile("x.obj"); }),
+            "x.obj: drape reads avatars from .glb, .gltf, .dae, .fbx and MakeHuman .mhskel files, not '.obj'");
 }
 
 }  // namespace

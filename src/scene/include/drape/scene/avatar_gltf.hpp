@@ -1,25 +1,36 @@
 #pragma once
-// glTF 2.0 skinned characters (.gltf, .glb) as segmented avatars: one joint per skin
-// joint (rest centre = the joint node's rest position, frame aligned with the root
-// coordinate system), the skinned mesh kept for drawing, and one closed segment per joint
-// that dominates any triangle (avatar_segment.hpp). The file is read in a limited child
-// process (formats/gltf_avatar.hpp).
+// Skinned characters (glTF 2.0 .gltf/.glb through drape's own reader, Collada .dae and
+// FBX .fbx through Assimp) as segmented avatars: one joint per skeleton joint (rest
+// centre = the joint node's rest position, frame aligned with the root coordinate
+// system), the skinned mesh kept for drawing, and one closed segment per joint that
+// dominates any triangle (avatar_segment.hpp). Files are read in a limited child process
+// (formats/gltf_avatar.hpp, formats/assimp_avatar.hpp).
 
 #include <string>
 
 #include "drape/formats/gltf_avatar.hpp"
+#include "drape/formats/skinned_model.hpp"
 #include "drape/scene/avatar.hpp"
 
 namespace drape::scene {
 
-/// Builds the avatar from already-read glTF data (positions in metres).
-[[nodiscard]] Avatar buildAvatarFromSkinnedModel(const formats::GltfSkinnedModel& model);
+/// Builds the avatar from an already-read skinned model (positions in metres, Y up).
+[[nodiscard]] Avatar buildAvatarFromSkinnedModel(const formats::SkinnedModel& model);
 
 /// Reads and builds; throws drape::Error naming the file.
 [[nodiscard]] Avatar loadGltfAvatar(const std::string& path);
 
-/// Any avatar file drape reads: .glb/.gltf, or a MakeHuman .mhskel (the mesh and weights
-/// beside it). Throws drape::Error for other extensions.
+/// Reads a Collada (.dae) or FBX (.fbx) skinned character through Assimp and builds it;
+/// throws drape::Error naming the file.
+[[nodiscard]] Avatar loadAssimpAvatar(const std::string& path);
+
+/// The avatar's skinned mesh and skeleton as plain data, for the skinned-model writers
+/// (joint frames are the avatar's: rest centre, root-aligned axes). Throws drape::Error if
+/// the avatar has no skinned mesh.
+[[nodiscard]] formats::SkinnedModel skinnedModelOf(const Avatar& avatar);
+
+/// Any avatar file drape reads: .glb/.gltf, .dae/.fbx, or a MakeHuman .mhskel (the mesh
+/// and weights beside it). Throws drape::Error for other extensions.
 [[nodiscard]] Avatar loadAvatarFile(const std::string& path);
 
 }  // namespace drape::scene

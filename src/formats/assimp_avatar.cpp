@@ -1,0 +1,615 @@
+#include "drape/formats/assimp_avatar.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <unordered_map>
+#include <unordered_set>
+
+#include <assimp/BaseImporter.h>
+#include <assimp/Exporter.hpp>
+#include <assimp/IOSystem.hpp>
+#include <assimp/Importer.hpp>
+#include <assimp/MemoryIOWrapper.h>
+#include <assimp/config.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <fmt/format.h>
+
+#include "drape/core/error.hpp"
+#include "motion_text.hpp"
+
+namespace drape::formats {
+namespace {
+
+constexpr std::size_t kMaxVertices = 10'000'000;
+constexpr std::size_t kMaxJoints = 1024;
+constexpr std::size_t kMaxFileBytes = std::size_t{1} << 30;
+
+enum class Format { Collada, Fbx };
+
+std::string lowerExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+Format formatOf(const std::string& name) {
+  const std::string ext = lowerExtension(name);
+  if (ext == ".dae") return Format::Collada;
+  if (ext == ".fbx") return Format::Fbx;
+  throw Error(fmt::format("{}: drape reads Collada (.dae) and FBX (.fbx) through Assimp, not '{}'", name, ext));
+}
+
+const char* formatName(Format f) { return f == Format::Collada ? "Collada" : "FBX"; }
+const char* extensionOf(Format f) { return f == Format::Collada ? ".dae" : ".fbx"; }
+
+// ---- the bytes must be what the extension says --------------------------------------
+
+std::string_view skipSpaceAndBom(std::string_view s) {
+  if (s.substr(0, 3) == "\xEF\xBB\xBF") s.remove_prefix(3);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
+  return s;
+}
+
+// The XML root element must be <COLLADA>: skip the declaration, comments and a DOCTYPE.
+bool hasColladaRoot(std::string_view s) {
+  for (;;) {
+    s = skipSpaceAndBom(s);
+    std::string_view close;
+    if (s.substr(0, 4) == "<!--") close = "-->";
+    else if (s.substr(0, 2) == "<?") close = "?>";
+    else if (s.substr(0, 2) == "<!") close = ">";
+    else break;
+    const std::size_t end = s.find(close);
+    if (end == std::string_view::npos) return false;
+    s.remove_prefix(end + close.size());
+  }
+  if (s.substr(0, 8) != "<COLLADA") return false;
+  return s.size() > 8 && (std::isspace(static_cast<unsigned char>(s[8])) || s[8] == '>');
+}
+
+int lineAt(std::string_view bytes, std::size_t offset) {
+  return 1 + static_cast<int>(std::count(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(offset), '\n'));
+}
+
+// Position of the next start tag `<tag ...>` or `<tag>` at or after `from` (not `<tagx`).
+std::size_t findStartTag(std::string_view bytes, std::string_view tag, std::size_t from) {
+  const std::string open = "<" + std::string(tag);
+  for (std::size_t at = bytes.find(open, from); at != std::string_view::npos; at = bytes.find(open, at + 1)) {
+    const std::size_t after = at + open.size();
+    if (after < bytes.size() && (bytes[after] == '>' || std::isspace(static_cast<unsigned char>(bytes[after])))) return at;
+  }
+  return std::string_view::npos;
+}
+
+// Assimp's Collada parser dereferences a null pointer on an array without its (required)
+// count attribute (found by fuzzing), allocates without bound on a word that is not a
+// number in an index list ("abc" in <p> took over 4 GB) and reserves whatever a count
+// attribute says; drape checks all three before Assimp sees the bytes.
+void checkColladaArrays(std::string_view bytes, const std::string& name) {
+  for (const std::string_view tag : {"float_array", "int_array", "Name_array", "IDREF_array", "SIDREF_array", "bool_array", "token_array"})
+    for (std::size_t at = findStartTag(bytes, tag, 0); at != std::string_view::npos; at = findStartTag(bytes, tag, at + 1)) {
+      const std::string_view startTag = bytes.substr(at, bytes.find('>', at) - at);
+      const std::size_t count = startTag.find("count=");
+      if (count == std::string_view::npos || !std::isspace(static_cast<unsigned char>(startTag[count - 1])))
+        throw Error(fmt::format("{}:{}: <{}> has no count attribute", name, lineAt(bytes, at), tag));
+    }
+  constexpr std::string_view kCount = "count=\"";
+  for (std::size_t at = bytes.find(kCount); at != std::string_view::npos; at = bytes.find(kCount, at + 1)) {
+    std::size_t end = at + kCount.size();
+    double value = 0.0;
+    for (; end < bytes.size() && std::isdigit(static_cast<unsigned char>(bytes[end])); ++end) value = value * 10.0 + (bytes[end] - '0');
+    // Every counted item takes at least one byte of the file.
+    if (value > static_cast<double>(bytes.size()))
+      throw Error(fmt::format("{}:{}: count=\"{:.0f}\" is more than a {}-byte file can hold", name, lineAt(bytes, at), value, bytes.size()));
+  }
+  // Lists of indices and counts: whole numbers only.
+  for (const std::string_view tag : {"p", "v", "vcount", "h", "int_array"}) {
+    for (std::size_t at = findStartTag(bytes, tag, 0); at != std::string_view::npos; at = findStartTag(bytes, tag, at + 1)) {
+      const std::size_t start = bytes.find('>', at);
+      if (start == std::string_view::npos) break;
+      const std::size_t stop = std::min(bytes.find('<', start), bytes.size());
+      for (std::size_t i = start + 1; i < stop; ++i) {
+        const char c = bytes[i];
+        if (std::isdigit(static_cast<unsigned char>(c)) || std::isspace(static_cast<unsigned char>(c)) || (c == '-' && tag == "int_array")) continue;
+        const std::size_t wordEnd = std::min(bytes.find_first_of(" \t\r\n<", i), stop);
+        throw Error(fmt::format("{}:{}: <{}> holds '{}', not a whole number", name, lineAt(bytes, i), tag,
+                                bytes.substr(i, std::min<std::size_t>(wordEnd - i, 40))));
+      }
+    }
+  }
+}
+
+void checkSignature(std::string_view bytes, Format format, const std::string& name) {
+  if (format == Format::Collada) {
+    if (!hasColladaRoot(bytes)) throw Error(fmt::format("{}: not a Collada file (no XML root element <COLLADA>)", name));
+    return;
+  }
+  if (bytes.substr(0, 18) == "Kaydara FBX Binary") return;
+  if (skipSpaceAndBom(bytes).substr(0, 5) == "; FBX") return;
+  throw Error(fmt::format("{}: not an FBX file (neither binary FBX, starting \"Kaydara FBX Binary\", nor ASCII FBX, starting \"; FBX\")", name));
+}
+
+// ---- Assimp, restricted to one importer and one file ---------------------------------
+
+// Serves the avatar's own bytes under one internal name and refuses every other path:
+// Collada and FBX may name textures or other files, and drape reads none of them.
+class OwnBytesOnly final : public Assimp::IOSystem {
+ public:
+  OwnBytesOnly(std::string_view bytes, std::string internalName) : bytes_(bytes), name_(std::move(internalName)) {}
+
+  bool Exists(const char* path) const override { return path != nullptr && name_ == path; }
+  char getOsSeparator() const override { return '/'; }
+
+  Assimp::IOStream* Open(const char* path, const char* mode) override {
+    const bool writing = mode != nullptr && (std::strchr(mode, 'w') || std::strchr(mode, 'a') || std::strchr(mode, '+'));
+    if (path == nullptr || name_ != path || writing) {
+      refused_.emplace_back(path == nullptr ? "" : path);
+      return nullptr;
+    }
+    return new Assimp::MemoryIOStream(reinterpret_cast<const std::uint8_t*>(bytes_.data()), bytes_.size(), false);
+  }
+  void Close(Assimp::IOStream* stream) override { delete stream; }
+
+  [[nodiscard]] const std::vector<std::string>& refused() const { return refused_; }
+
+ private:
+  std::string_view bytes_;
+  std::string name_;
+  std::vector<std::string> refused_;
+};
+
+// Unregisters (and frees) every importer but the one for `extension`, so a file the
+// importer rejects cannot fall through to another format's reader.
+void keepOnlyImporterFor(Assimp::Importer& importer, const char* extension) {
+  Assimp::BaseImporter* const keep = importer.GetImporter(extension);
+  if (keep == nullptr) throw Error(fmt::format("this Assimp has no importer for {}", extension), ExitCode::Internal);
+  std::vector<Assimp::BaseImporter*> others;
+  for (std::size_t i = 0; i < importer.GetImporterCount(); ++i)
+    if (importer.GetImporter(i) != keep) others.push_back(importer.GetImporter(i));
+  for (Assimp::BaseImporter* other : others) {
+    importer.UnregisterLoader(other);
+    delete other;  // UnregisterLoader hands ownership back
+  }
+  if (importer.GetImporterCount() != 1) throw Error("could not restrict Assimp to one importer", ExitCode::Internal);
+}
+
+void configure(Assimp::Importer& importer) {
+  importer.SetPropertyInteger(AI_CONFIG_PP_LBW_MAX_WEIGHTS, 4);
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
+  // Helper nodes for FBX pivots would sit between bones and become joints of their own.
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
+  // Less to parse from untrusted bytes: nothing of these is used.
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_TEXTURES, false);
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_CAMERAS, false);
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_LIGHTS, false);
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_ANIMATIONS, false);
+}
+
+constexpr unsigned kPostProcess = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                  aiProcess_LimitBoneWeights | aiProcess_ValidateDataStructure;
+
+std::string refusalNote(const OwnBytesOnly& io) {
+  if (io.refused().empty()) return "";
+  return fmt::format(" (it asked for '{}', which drape does not open: only the avatar file itself is read)", io.refused().front());
+}
+
+// ---- the scene as drape's plain data --------------------------------------------------
+
+Eigen::Matrix4d toEigen(const aiMatrix4x4& m) {
+  Eigen::Matrix4d e;
+  e << m.a1, m.a2, m.a3, m.a4, m.b1, m.b2, m.b3, m.b4, m.c1, m.c2, m.c3, m.c4, m.d1, m.d2, m.d3, m.d4;
+  return e;
+}
+
+aiMatrix4x4 toAssimp(const Eigen::Matrix4d& e) {
+  aiMatrix4x4 m;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) m[static_cast<unsigned>(r)][static_cast<unsigned>(c)] = static_cast<ai_real>(e(r, c));
+  return m;
+}
+
+// A number from the scene metadata, whatever numeric type the importer stored it as.
+std::optional<double> metadataNumber(const aiScene& scene, const char* key) {
+  const aiMetadata* meta = scene.mMetaData;
+  if (meta == nullptr) return std::nullopt;
+  for (unsigned i = 0; i < meta->mNumProperties; ++i) {
+    if (std::strcmp(meta->mKeys[i].C_Str(), key) != 0 || meta->mValues[i].mData == nullptr) continue;
+    const void* data = meta->mValues[i].mData;
+    switch (meta->mValues[i].mType) {
+      case AI_INT32: return *static_cast<const std::int32_t*>(data);
+      case AI_UINT64: return static_cast<double>(*static_cast<const std::uint64_t*>(data));
+      case AI_FLOAT: return *static_cast<const float*>(data);
+      case AI_DOUBLE: return *static_cast<const double*>(data);
+      default: return std::nullopt;
+    }
+  }
+  return std::nullopt;
+}
+
+// FBX: the importer leaves units and axes to the caller. UnitScaleFactor is centimetres
+// per file unit; CoordAxis and UpAxis (with signs) name the file's right and up axes, and
+// front follows from right-handedness (tools disagree on FrontAxisSign's meaning).
+Eigen::Matrix4d fbxToMetresYUp(const aiScene& scene, const std::string& name) {
+  const double unitCm = metadataNumber(scene, "UnitScaleFactor").value_or(1.0);
+  if (!std::isfinite(unitCm) || unitCm < 1e-6 || unitCm > 1e6)
+    throw Error(fmt::format("{}: FBX UnitScaleFactor {} is not a usable unit", name, unitCm));
+  const double up = metadataNumber(scene, "UpAxis").value_or(1.0);
+  const double upSign = metadataNumber(scene, "UpAxisSign").value_or(1.0);
+  const double right = metadataNumber(scene, "CoordAxis").value_or(0.0);
+  const double rightSign = metadataNumber(scene, "CoordAxisSign").value_or(1.0);
+  auto valid = [](double axis) { return axis == 0.0 || axis == 1.0 || axis == 2.0; };
+  if (!valid(up) || !valid(right) || up == right || std::abs(upSign) != 1.0 || std::abs(rightSign) != 1.0)
+    throw Error(fmt::format("{}: FBX axes UpAxis {} / CoordAxis {} (with signs {}, {}) are not two different axes", name,
+                            up, right, upSign, rightSign));
+  const Vec3 rightRow = rightSign * Vec3::Unit(static_cast<int>(right));
+  const Vec3 upRow = upSign * Vec3::Unit(static_cast<int>(up));
+  Eigen::Matrix3d axes;
+  axes.row(0) = rightRow.transpose();
+  axes.row(1) = upRow.transpose();
+  axes.row(2) = rightRow.cross(upRow).transpose();
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.topLeftCorner<3, 3>() = axes * (unitCm * 0.01);
+  return m;
+}
+
+struct SceneReader {
+  const aiScene& scene;
+  const std::string& name;
+  Eigen::Matrix4d toMetres;  // applied on the left of every world matrix
+  std::unordered_map<const aiNode*, Eigen::Matrix4d> world;
+
+  [[noreturn]] void fail(const std::string& what) const { throw Error(fmt::format("{}: {}", name, what)); }
+
+  // World matrices of every node, iteratively (a deep malformed tree must not recurse).
+  void computeWorlds() {
+    std::vector<const aiNode*> stack{scene.mRootNode};
+    world[scene.mRootNode] = toMetres * toEigen(scene.mRootNode->mTransformation);
+    while (!stack.empty()) {
+      const aiNode* node = stack.back();
+      stack.pop_back();
+      for (unsigned i = 0; i < node->mNumChildren; ++i) {
+        const aiNode* child = node->mChildren[i];
+        if (child == nullptr || world.count(child) != 0) fail("its node tree is not a tree");
+        world[child] = world[node] * toEigen(child->mTransformation);
+        stack.push_back(child);
+      }
+    }
+  }
+
+  // Meshes with bones and triangles, each with the first node that places it.
+  std::vector<std::pair<const aiMesh*, const aiNode*>> skinnedMeshes() const {
+    std::vector<std::pair<const aiMesh*, const aiNode*>> out;
+    std::vector<bool> seen(scene.mNumMeshes, false);
+    std::vector<const aiNode*> stack{scene.mRootNode};
+    while (!stack.empty()) {
+      const aiNode* node = stack.back();
+      stack.pop_back();
+      for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+        const unsigned m = node->mMeshes[i];
+        if (m >= scene.mNumMeshes || seen[m]) continue;
+        seen[m] = true;
+        const aiMesh* mesh = scene.mMeshes[m];
+        if (mesh->HasBones() && (mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) != 0) out.emplace_back(mesh, node);
+      }
+      for (unsigned i = node->mNumChildren; i-- > 0;) stack.push_back(node->mChildren[i]);
+    }
+    return out;
+  }
+
+  const aiNode* boneNode(const aiBone& bone) const {
+    const aiNode* node = scene.mRootNode->FindNode(bone.mName);
+    if (node == nullptr) fail(fmt::format("bone '{}' names no node of the scene", bone.mName.C_Str()));
+    return node;
+  }
+
+  static int depth(const aiNode* node) {
+    int d = 0;
+    for (const aiNode* p = node->mParent; p != nullptr; p = p->mParent) ++d;
+    return d;
+  }
+
+  // The skeleton root: the deepest node that is an ancestor of (or is) every bone node.
+  static const aiNode* commonAncestor(const aiNode* a, const aiNode* b) {
+    int da = depth(a), db = depth(b);
+    for (; da > db; --da) a = a->mParent;
+    for (; db > da; --db) b = b->mParent;
+    while (a != b) {
+      a = a->mParent;
+      b = b->mParent;
+    }
+    return a;
+  }
+};
+
+// Joints: every bone's node and the nodes between it and the skeleton root, in the
+// node tree's depth-first order (parents first).
+std::vector<const aiNode*> skeletonNodes(const SceneReader& r, const std::vector<const aiNode*>& bones) {
+  const aiNode* root = bones.front();
+  for (const aiNode* b : bones) root = SceneReader::commonAncestor(root, b);
+  std::unordered_set<const aiNode*> member{root};
+  for (const aiNode* b : bones)
+    for (const aiNode* n = b; n != root && member.insert(n).second; n = n->mParent)
+      if (member.size() > kMaxJoints) r.fail(fmt::format("its skeleton has more than {} joints", kMaxJoints));
+  std::vector<const aiNode*> order;
+  std::vector<const aiNode*> stack{root};
+  while (!stack.empty()) {
+    const aiNode* node = stack.back();
+    stack.pop_back();
+    order.push_back(node);
+    for (unsigned i = node->mNumChildren; i-- > 0;)
+      if (member.count(node->mChildren[i]) != 0) stack.push_back(node->mChildren[i]);
+  }
+  return order;
+}
+
+struct Influence {
+  std::uint16_t bone = 0;  // index into the mesh's bones
+  float weight = 0.0f;
+};
+
+// Appends one mesh: positions skinned with the rest-pose nodes (as glTF viewers do), at
+// most four influences per vertex, normalised. A vertex no bone weighs follows the
+// skeleton root and stays where its mesh node puts it.
+void appendMesh(const SceneReader& r, const aiMesh& mesh, const aiNode& meshNode,
+                const std::unordered_map<const aiNode*, std::uint16_t>& jointOf, SkinnedModel& out) {
+  const std::size_t count = mesh.mNumVertices;
+  if (out.positions.size() + count > kMaxVertices) r.fail(fmt::format("it has more than {} vertices", kMaxVertices));
+  if (mesh.mNumBones > 65535) r.fail("a mesh has more than 65535 bones");
+  std::vector<std::vector<Influence>> influences(count);
+  std::vector<Eigen::Matrix4d> skinMatrix(mesh.mNumBones);
+  std::vector<std::uint16_t> boneJoint(mesh.mNumBones);
+  for (unsigned b = 0; b < mesh.mNumBones; ++b) {
+    const aiBone& bone = *mesh.mBones[b];
+    const aiNode* node = r.boneNode(bone);
+    skinMatrix[b] = r.world.at(node) * toEigen(bone.mOffsetMatrix);
+    boneJoint[b] = jointOf.at(node);
+    for (unsigned k = 0; k < bone.mNumWeights; ++k) {
+      const aiVertexWeight& w = bone.mWeights[k];
+      if (w.mVertexId >= count) r.fail(fmt::format("bone '{}' weighs vertex {}, but the mesh has {}", bone.mName.C_Str(), w.mVertexId, count));
+      if (!std::isfinite(w.mWeight) || w.mWeight < 0.0f) r.fail(fmt::format("bone '{}' has a bad weight {}", bone.mName.C_Str(), w.mWeight));
+      if (w.mWeight > 0.0f) influences[w.mVertexId].push_back({static_cast<std::uint16_t>(b), w.mWeight});
+    }
+  }
+  const Eigen::Matrix4d meshWorld = r.world.at(&meshNode);
+  const auto base = static_cast<std::uint32_t>(out.positions.size());
+  for (std::size_t v = 0; v < count; ++v) {
+    std::vector<Influence>& in = influences[v];
+    std::sort(in.begin(), in.end(), [](const Influence& a, const Influence& b) { return a.weight > b.weight; });
+    if (in.size() > 4) in.resize(4);
+    double total = 0.0;
+    for (const Influence& i : in) total += i.weight;
+    std::array<std::uint16_t, 4> joints{};
+    std::array<float, 4> weights{};
+    Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
+    if (total > 1e-9) {
+      for (std::size_t k = 0; k < in.size(); ++k) {
+        joints[k] = boneJoint[in[k].bone];
+        weights[k] = static_cast<float>(in[k].weight / total);
+        m += (in[k].weight / total) * skinMatrix[in[k].bone];
+      }
+    } else {
+      weights[0] = 1.0f;
+      m = meshWorld;
+    }
+    const aiVector3D& p = mesh.mVertices[v];
+    const Eigen::Vector4d h = m * Eigen::Vector4d(p.x, p.y, p.z, 1.0);
+    if (!h.allFinite()) r.fail(fmt::format("vertex {} is not finite after skinning", v));
+    out.positions.emplace_back(h.x(), h.y(), h.z());
+    out.vertexJoints.push_back(joints);
+    out.vertexWeights.push_back(weights);
+  }
+  for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+    const aiFace& face = mesh.mFaces[f];
+    if (face.mNumIndices != 3) continue;  // points and lines left by triangulation
+    mesh::Triangle tri;
+    for (unsigned c = 0; c < 3; ++c) {
+      if (face.mIndices[c] >= count) r.fail(fmt::format("face {} names vertex {}, but the mesh has {}", f, face.mIndices[c], count));
+      tri[c] = base + face.mIndices[c];
+    }
+    if (tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2]) out.triangles.push_back(tri);
+  }
+}
+
+SkinnedModel extract(const aiScene& scene, Format format, const std::string& name) {
+  const Eigen::Matrix4d toMetres = format == Format::Fbx ? fbxToMetresYUp(scene, name) : Eigen::Matrix4d::Identity();
+  SceneReader r{scene, name, toMetres, {}};
+  if (scene.mRootNode == nullptr) r.fail("has no node tree");
+  r.computeWorlds();
+  const auto meshes = r.skinnedMeshes();
+  if (meshes.empty()) r.fail("has no skinned triangle mesh (a mesh with bones is needed)");
+  std::vector<const aiNode*> bones;
+  for (const auto& [mesh, node] : meshes)
+    for (unsigned b = 0; b < mesh->mNumBones; ++b) bones.push_back(r.boneNode(*mesh->mBones[b]));
+  const std::vector<const aiNode*> skeleton = skeletonNodes(r, bones);
+
+  SkinnedModel out;
+  out.source = name;
+  std::unordered_map<const aiNode*, std::uint16_t> jointOf;
+  for (std::size_t j = 0; j < skeleton.size(); ++j) {
+    const aiNode* node = skeleton[j];
+    jointOf[node] = static_cast<std::uint16_t>(j);
+    SkinnedJoint joint;
+    joint.name = node->mName.length > 0 ? node->mName.C_Str() : fmt::format("joint{}", j);
+    joint.parent = j == 0 ? -1 : jointOf.at(node->mParent);
+    joint.restWorld = r.world.at(node);
+    out.joints.push_back(std::move(joint));
+  }
+  for (const auto& [mesh, node] : meshes) appendMesh(r, *mesh, *node, jointOf, out);
+  if (out.triangles.empty()) r.fail("its skinned meshes have no triangles");
+  return out;
+}
+
+// ---- writing ----------------------------------------------------------------------------
+
+void checkWritable(const SkinnedModel& model, const std::string& path) {
+  const std::size_t n = model.positions.size();
+  if (model.joints.empty()) throw Error(fmt::format("{}: an avatar without joints cannot be written as a skinned model", path));
+  if (model.joints.size() > kMaxJoints) throw Error(fmt::format("{}: more than {} joints", path, kMaxJoints));
+  if (model.vertexJoints.size() != n || model.vertexWeights.size() != n)
+    throw Error(fmt::format("{}: the skin has weights for {} of {} vertices", path, model.vertexWeights.size(), n));
+  for (std::size_t j = 0; j < model.joints.size(); ++j)
+    if (model.joints[j].parent >= static_cast<int>(j)) throw Error(fmt::format("{}: joint '{}' comes before its parent", path, model.joints[j].name));
+  for (const mesh::Triangle& t : model.triangles)
+    for (std::uint32_t i : t)
+      if (i >= n) throw Error(fmt::format("{}: a triangle names vertex {} of {}", path, i, n));
+  for (const auto& joints : model.vertexJoints)
+    for (std::uint16_t j : joints)
+      if (j >= model.joints.size()) throw Error(fmt::format("{}: a vertex names joint {} of {}", path, j, model.joints.size()));
+}
+
+aiMesh* buildMesh(const SkinnedModel& model, const std::vector<Eigen::Matrix4d>& jointWorld, double unitsPerMetre) {
+  auto mesh = std::make_unique<aiMesh>();
+  mesh->mName = aiString(model.source.empty() ? std::string("skin") : std::filesystem::path(model.source).stem().string());
+  mesh->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+  mesh->mMaterialIndex = 0;
+  mesh->mNumVertices = static_cast<unsigned>(model.positions.size());
+  mesh->mVertices = new aiVector3D[mesh->mNumVertices];
+  for (std::size_t v = 0; v < model.positions.size(); ++v) {
+    const Vec3 p = model.positions[v] * unitsPerMetre;
+    mesh->mVertices[v] = aiVector3D(static_cast<ai_real>(p.x()), static_cast<ai_real>(p.y()), static_cast<ai_real>(p.z()));
+  }
+  mesh->mNumFaces = static_cast<unsigned>(model.triangles.size());
+  mesh->mFaces = new aiFace[mesh->mNumFaces];
+  for (std::size_t t = 0; t < model.triangles.size(); ++t) {
+    aiFace& face = mesh->mFaces[t];
+    face.mNumIndices = 3;
+    face.mIndices = new unsigned[3]{model.triangles[t][0], model.triangles[t][1], model.triangles[t][2]};
+  }
+  std::vector<std::vector<aiVertexWeight>> weightsOf(model.joints.size());
+  for (std::size_t v = 0; v < model.positions.size(); ++v)
+    for (std::size_t k = 0; k < 4; ++k)
+      if (model.vertexWeights[v][k] > 0.0f)
+        weightsOf[model.vertexJoints[v][k]].emplace_back(static_cast<unsigned>(v), model.vertexWeights[v][k]);
+  std::vector<aiBone*> bones;
+  for (std::size_t j = 0; j < model.joints.size(); ++j) {
+    if (weightsOf[j].empty()) continue;  // exporters write a bone per influence, not per joint
+    auto* bone = new aiBone();
+    bone->mName = aiString(model.joints[j].name);
+    bone->mOffsetMatrix = toAssimp(jointWorld[j].inverse());  // the mesh node is the identity
+    bone->mNumWeights = static_cast<unsigned>(weightsOf[j].size());
+    bone->mWeights = new aiVertexWeight[bone->mNumWeights];
+    std::copy(weightsOf[j].begin(), weightsOf[j].end(), bone->mWeights);
+    bones.push_back(bone);
+  }
+  mesh->mNumBones = static_cast<unsigned>(bones.size());
+  mesh->mBones = new aiBone*[bones.size()];
+  std::copy(bones.begin(), bones.end(), mesh->mBones);
+  return mesh.release();
+}
+
+void addChildren(aiNode* parent, const std::vector<aiNode*>& children) {
+  if (children.empty()) return;
+  parent->mNumChildren = static_cast<unsigned>(children.size());
+  parent->mChildren = new aiNode*[children.size()];
+  for (std::size_t i = 0; i < children.size(); ++i) {
+    parent->mChildren[i] = children[i];
+    children[i]->mParent = parent;
+  }
+}
+
+// The skeleton as nodes with local transforms, plus one node carrying the skinned mesh.
+aiNode* buildNodes(const SkinnedModel& model, const std::vector<Eigen::Matrix4d>& jointWorld, const std::string& meshName) {
+  auto* root = new aiNode("drape_avatar");
+  std::vector<aiNode*> nodes;
+  std::vector<std::vector<aiNode*>> children(model.joints.size());
+  std::vector<aiNode*> top;
+  for (std::size_t j = 0; j < model.joints.size(); ++j) {
+    auto* node = new aiNode(model.joints[j].name);
+    const int p = model.joints[j].parent;
+    const Eigen::Matrix4d local = p < 0 ? jointWorld[j] : Eigen::Matrix4d(jointWorld[static_cast<std::size_t>(p)].inverse() * jointWorld[j]);
+    node->mTransformation = toAssimp(local);
+    (p < 0 ? top : children[static_cast<std::size_t>(p)]).push_back(node);
+    nodes.push_back(node);
+  }
+  for (std::size_t j = 0; j < nodes.size(); ++j) addChildren(nodes[j], children[j]);
+  auto* meshNode = new aiNode(meshName);
+  meshNode->mNumMeshes = 1;
+  meshNode->mMeshes = new unsigned[1]{0};
+  top.push_back(meshNode);
+  addChildren(root, top);
+  return root;
+}
+
+std::unique_ptr<aiScene> buildScene(const SkinnedModel& model, double unitsPerMetre) {
+  // Joint frames in the written units: the same rotation, translations scaled.
+  Eigen::Matrix4d scale = Eigen::Matrix4d::Identity();
+  scale.topLeftCorner<3, 3>() *= unitsPerMetre;
+  std::vector<Eigen::Matrix4d> jointWorld;
+  for (const SkinnedJoint& j : model.joints) jointWorld.push_back(scale * j.restWorld * scale.inverse());
+
+  auto scene = std::make_unique<aiScene>();
+  scene->mNumMaterials = 1;
+  scene->mMaterials = new aiMaterial*[1];
+  scene->mMaterials[0] = new aiMaterial();
+  const aiString materialName("skin");
+  scene->mMaterials[0]->AddProperty(&materialName, AI_MATKEY_NAME);
+  scene->mNumMeshes = 1;
+  scene->mMeshes = new aiMesh*[1];
+  scene->mMeshes[0] = buildMesh(model, jointWorld, unitsPerMetre);
+  scene->mRootNode = buildNodes(model, jointWorld, std::string(scene->mMeshes[0]->mName.C_Str()) + "_mesh");
+  return scene;
+}
+
+}  // namespace
+
+bool isAssimpAvatarPath(const std::string& path) {
+  const std::string ext = lowerExtension(path);
+  return ext == ".dae" || ext == ".fbx";
+}
+
+SkinnedModel parseAssimpSkinnedModel(std::string_view bytes, const std::string& name) {
+  const Format format = formatOf(name);
+  checkSignature(bytes, format, name);
+  if (format == Format::Collada) checkColladaArrays(bytes, name);
+  Assimp::Importer importer;
+  keepOnlyImporterFor(importer, extensionOf(format));
+  configure(importer);
+  const std::string internalName = std::string("avatar") + extensionOf(format);
+  auto* io = new OwnBytesOnly(bytes, internalName);
+  importer.SetIOHandler(io);  // the importer owns and deletes it
+  const aiScene* scene = nullptr;
+  try {
+    scene = importer.ReadFile(internalName, kPostProcess);
+  } catch (const std::exception& e) {
+    throw Error(fmt::format("{}: Assimp's {} importer failed: {}{}", name, formatName(format), e.what(), refusalNote(*io)));
+  }
+  if (scene == nullptr)
+    throw Error(fmt::format("{}: Assimp's {} importer failed: {}{}", name, formatName(format), importer.GetErrorString(), refusalNote(*io)));
+  if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0)
+    throw Error(fmt::format("{}: has no mesh (Assimp reports the {} scene as incomplete)", name, formatName(format)));
+  return extract(*scene, format, name);
+}
+
+SkinnedModel readAssimpSkinnedModel(const std::string& path, const IsolationLimits& limits) {
+  const Format format = formatOf(path);
+  const std::string bytes = detail::readWholeFile(path, kMaxFileBytes);
+  const std::string reader = fmt::format("{} reader (Assimp)", formatName(format));
+  const std::string result = runIsolated(path, reader, [&] { return serialise(parseAssimpSkinnedModel(bytes, path)); }, limits);
+  return deserialiseSkinnedModel(result, path);
+}
+
+void writeAssimpSkinnedModel(const std::string& path, const SkinnedModel& model) {
+  const std::string ext = lowerExtension(path);
+  if (ext != ".dae" && ext != ".fbx")
+    throw Error(fmt::format("{}: drape writes skinned avatars as Collada (.dae) or FBX (.fbx), not '{}'", path, ext));
+  checkWritable(model, path);
+  const bool fbx = ext == ".fbx";
+  // FBX is written in centimetres: Assimp's FBX exporter declares UnitScaleFactor 1.
+  const std::unique_ptr<aiScene> scene = buildScene(model, fbx ? 100.0 : 1.0);
+  const char* formatId = fbx ? "fbxa" : "collada";
+  // In the limited child too: the exporter is Assimp code, and a crash there must not end drape.
+  (void)runIsolated(path, fmt::format("{} writer (Assimp)", fbx ? "FBX" : "Collada"), [&] {
+    Assimp::Exporter exporter;
+    if (exporter.Export(scene.get(), formatId, path) != AI_SUCCESS)
+      throw Error(fmt::format("{}: Assimp's {} exporter failed: {}", path, fbx ? "FBX" : "Collada", exporter.GetErrorString()));
+    return std::string();
+  });
+}
+
+}  // namespace drape::formats

@@ -1,0 +1,47 @@
+#pragma once
+// Skinned characters in Collada (.dae) and FBX (.fbx), read and written through Assimp.
+// (glTF stays on drape's own reader, gltf_avatar.hpp: Assimp's glTF2 importer crashed on
+// CesiumMan.)
+//
+// Safety rules for files from outside (Assimp is not safe on malformed input):
+//   - the bytes must look like the format the extension names (Collada: XML whose root
+//     element is <COLLADA>; FBX: "Kaydara FBX Binary" or a text file starting "; FBX");
+//   - only the importer for that extension is registered, so nothing falls through to
+//     another of Assimp's ~50 readers;
+//   - Assimp sees the avatar's own bytes and nothing else: every other file it asks for
+//     (textures, external references) is refused, so images are never read and nothing
+//     outside the avatar's folder is ever opened;
+//   - every import runs in a limited child process (core/isolate.hpp), so a crash, a hang
+//     or a memory blow-up is an error message naming the file.
+//
+// Units and axes: Assimp applies Collada's <unit meter> and <up_axis> to the root node.
+// Its FBX importer applies neither: it reports GlobalSettings' UnitScaleFactor
+// (centimetres per unit, 1 by default) and UpAxis/CoordAxis in the scene metadata, and
+// drape applies them. The result is in metres, Y up.
+
+#include <string>
+#include <string_view>
+
+#include "drape/core/isolate.hpp"
+#include "drape/formats/skinned_model.hpp"
+
+namespace drape::formats {
+
+/// True for the extensions read and written here (".dae", ".fbx"; any case).
+[[nodiscard]] bool isAssimpAvatarPath(const std::string& path);
+
+/// Parses Collada or FBX bytes in this process (for the fuzz target and the child). The
+/// extension of `name` picks the format; `name` is also what messages call the file.
+[[nodiscard]] SkinnedModel parseAssimpSkinnedModel(std::string_view bytes, const std::string& name);
+
+/// Reads a .dae/.fbx file in a limited child process. Throws drape::Error naming the file.
+[[nodiscard]] SkinnedModel readAssimpSkinnedModel(const std::string& path, const IsolationLimits& limits = {});
+
+/// Writes `model` (metres, Y up) as Collada 1.4 (.dae, in metres) or as ASCII FBX 7.5
+/// (.fbx, in centimetres as its UnitScaleFactor 1 says): the skeleton as a node tree, one
+/// skinned mesh, one bone per weighted joint. Binary FBX is not written: what Assimp
+/// 5.2's binary FBX exporter writes, its own FBX importer cannot read back. Throws
+/// drape::Error naming the path.
+void writeAssimpSkinnedModel(const std::string& path, const SkinnedModel& model);
+
+}  // namespace drape::formats

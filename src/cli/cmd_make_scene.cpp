@@ -218,7 +218,7 @@ int makeScene(MakeSceneOptions& o) {
 
 RunFunction setupMakeScene(CLI::App& app) {
   static MakeSceneOptions o;
-  app.add_option("avatar", o.avatar, "Avatar file the garment was modelled on (.glb, .gltf, MakeHuman .mhskel)")
+  app.add_option("avatar", o.avatar, "Avatar file the garment was modelled on (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel)")
       ->required();
   app.add_option("--garment", o.garment,
                  "Garment OBJ in the avatar's rest pose, or a MakeHuman .mhclo (refitted to the MakeHuman body)")

@@ -196,11 +196,7 @@ int makeScene(MakeSceneOptions& o) {
   double added = 0.0;
   if (o.stepsPerFrame == 0) o.stepsPerFrame = fewestStableSubsteps(garment, o, added);
 
-  std::error_code ec;
-  std::filesystem::create_directories(o.out, ec);
-  if (ec) throw Error(fmt::format("--out {}: cannot create the directory ({})", o.out, ec.message()));
-  if (o.avatarUrl.empty())
-    o.avatarUrl = std::filesystem::relative(std::filesystem::absolute(o.avatar), std::filesystem::absolute(o.out)).string();
+  o.avatarUrl = prepareSceneDir(o.out, o.avatar, o.avatarUrl);
   const std::filesystem::path dir(o.out);
   writeScene((dir / "scene.wrl").string(), o, garment, mask);
   formats::writeObj((dir / (o.name + ".obj")).string(), garment.positions, garment.triangles,

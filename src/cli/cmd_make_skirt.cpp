@@ -71,11 +71,7 @@ RunFunction setupMakeSkirt(CLI::App& app) {
   return [] {
     const scene::Avatar avatar = scene::loadAvatarFile(o.avatar);
     const mesh::Skirt skirt = scene::fitSkirt(avatar, o.fit);
-    std::error_code ec;
-    std::filesystem::create_directories(o.out, ec);
-    if (ec) throw Error(fmt::format("--out {}: cannot create the directory ({})", o.out, ec.message()));
-    if (o.avatarUrl.empty())
-      o.avatarUrl = std::filesystem::relative(std::filesystem::absolute(o.avatar), std::filesystem::absolute(o.out)).string();
+    o.avatarUrl = prepareSceneDir(o.out, o.avatar, o.avatarUrl);
     const std::filesystem::path dir(o.out);
     formats::writeObj((dir / "skirt.obj").string(), skirt.mesh.positions, skirt.mesh.triangles, "drape make-skirt (m)");
     formats::writeObj((dir / "waistband.obj").string(), skirt.waistband.positions, skirt.waistband.triangles,

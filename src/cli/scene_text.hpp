@@ -1,11 +1,14 @@
 #pragma once
 // Pieces of the VRML97 scene files that `drape make-skirt` and `drape make-scene` write.
 
+#include <filesystem>
 #include <ostream>
 #include <string>
 
+#include <fmt/format.h>
 #include <fmt/ostream.h>
 
+#include "drape/core/error.hpp"
 #include "drape/mesh/trimesh.hpp"
 
 namespace drape::cli {
@@ -17,6 +20,16 @@ inline void writeIndexedFaceSet(std::ostream& os, const mesh::TriMesh& m, const 
   fmt::print(os, "{}] }}\n{}coordIndex [\n", indent, indent);
   for (const auto& t : m.triangles) fmt::print(os, "{}  {} {} {} -1,\n", indent, t[0], t[1], t[2]);
   fmt::print(os, "{}]\n", indent);
+}
+
+/// Creates the scene's directory (`--out`) and returns the Avatar url to write: `avatarUrl`
+/// if given, else the avatar's path relative to that directory.
+inline std::string prepareSceneDir(const std::string& out, const std::string& avatar, const std::string& avatarUrl) {
+  std::error_code ec;
+  std::filesystem::create_directories(out, ec);
+  if (ec) throw Error(fmt::format("--out {}: cannot create the directory ({})", out, ec.message()));
+  if (!avatarUrl.empty()) return avatarUrl;
+  return std::filesystem::relative(std::filesystem::absolute(avatar), std::filesystem::absolute(out)).string();
 }
 
 }  // namespace drape::cli

@@ -79,6 +79,42 @@ void markCandidates(std::size_t n, const double* __restrict cx, const double* __
   }
 }
 
+/// b[i] = min(a[i - stride], a[i], a[i + stride]) along the axis of index step `stride` and
+/// n voxels; the grid's ends take the minimum of the voxels that exist.
+void minOfThree(const std::vector<std::int32_t>& a, std::vector<std::int32_t>& b, std::size_t stride, int n) {
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const int along = static_cast<int>((i / stride) % static_cast<std::size_t>(n));
+    const std::int32_t below = along > 0 ? a[i - stride] : a[i];
+    const std::int32_t above = along < n - 1 ? a[i + stride] : a[i];
+    b[i] = std::min({below, a[i], above});
+  }
+}
+
+/// The clearance bits of a part (FieldCollider::clearOfT2_): a 3x3x3 minimum filter of the
+/// stored distances, as three passes of three, against T2 plus one distance unit, so that
+/// the rounding of a trilinear blend cannot bring a value of the neighbourhood below T2.
+std::vector<std::uint64_t> clearanceBits(const field::DistanceField& f, double t2Voxels) {
+  const field::GridDims& d = f.dims();
+  const std::size_t n = f.voxelCount();
+  std::vector<std::int32_t> a(n), b(n);
+  for (std::size_t i = 0; i < n; ++i)
+    a[i] = static_cast<std::int32_t>(std::lround(f.distanceVoxels(static_cast<std::uint32_t>(i)) *
+                                                 field::DistanceField::kUnitsPerVoxel));
+  const std::size_t sy = static_cast<std::size_t>(d.nx), sz = sy * static_cast<std::size_t>(d.ny);
+  minOfThree(a, b, 1, d.nx);
+  minOfThree(b, a, sy, d.ny);
+  minOfThree(a, b, sz, d.nz);
+  const auto limit = static_cast<std::int32_t>(std::ceil(t2Voxels * field::DistanceField::kUnitsPerVoxel));
+  std::vector<std::uint64_t> bits((n + 63) / 64, 0);
+  for (int z = 1; z < d.nz - 1; ++z)
+    for (int y = 1; y < d.ny - 1; ++y)
+      for (int x = 1; x < d.nx - 1; ++x) {
+        const std::uint32_t v = d.index(x, y, z);
+        if (b[v] > limit) bits[v >> 6] |= std::uint64_t{1} << (v & 63);
+      }
+  return bits;
+}
+
 }  // namespace
 
 Vec3i entryVoxel(const field::DistanceField& f, const Vec3i& inside, const Vec3i& outside) {
@@ -114,6 +150,7 @@ FieldCollider::FieldCollider(std::string garmentName, std::vector<CollisionPart>
                               "less than the outer offset T3 = {:.4f} m",
                               garment_, p.name, p.field->shell_m(), offsets_.t3_m));
     }
+    clearOfT2_.push_back(clearanceBits(*p.field, offsets_.t2_m / p.field->voxelSize()));
   }
 }
 
@@ -267,7 +304,9 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   Vec3i hitVoxel = start;
   const int walked = walkVoxels(start, v1, [&](const Vec3i& p) {
     if (!walkable(f, p)) return false;
-    if (state != PointState::OnSurf && f.distanceVoxels(f.index(p.x(), p.y(), p.z())) < frame.t2Voxels) {
+    if (state == PointState::OnSurf) return true;
+    const std::uint32_t voxel = f.index(p.x(), p.y(), p.z());
+    if (!clearOfT2(k, voxel) && f.distanceVoxels(voxel) < frame.t2Voxels) {
       hit = true;
       hitVoxel = p;
       return false;
@@ -280,6 +319,15 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   if (!in1 && !hit) {  // left the volume
     state = PointState::OutsideVol;
     last = c1;
+    ++field_.transitions[toIndex(from)][toIndex(state)];
+    return;
+  }
+  if (state != PointState::OnSurf && !hit && clearOfT2(k, f.index(v1.x(), v1.y(), v1.z()))) {
+    // Far above T2 wherever the point is in its voxel: what the trilinear distance below
+    // would decide. Its penetration figure is left out: it cannot be below T1.
+    state = PointState::InsideVol;
+    last = c1;
+    ++field_.clearanceSkips;
     ++field_.transitions[toIndex(from)][toIndex(state)];
     return;
   }

@@ -79,14 +79,17 @@ void markCandidates(std::size_t n, const double* __restrict cx, const double* __
   }
 }
 
-/// b[i] = min(a[i - stride], a[i], a[i + stride]) along the axis of index step `stride` and
-/// n voxels; the grid's ends take the minimum of the voxels that exist.
+/// b = min(a[i - stride], a[i], a[i + stride]) for every voxel, along the axis whose index
+/// step is `stride` and which has n voxels; a voxel at either end of it takes the minimum
+/// of the voxels that exist.
 void minOfThree(const std::vector<std::int32_t>& a, std::vector<std::int32_t>& b, std::size_t stride, int n) {
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const int along = static_cast<int>((i / stride) % static_cast<std::size_t>(n));
-    const std::int32_t below = along > 0 ? a[i - stride] : a[i];
-    const std::int32_t above = along < n - 1 ? a[i + stride] : a[i];
-    b[i] = std::min({below, a[i], above});
+  const std::size_t line = stride * static_cast<std::size_t>(n);  // one run of the axis, all lower axes inside
+  for (std::size_t start = 0; start < a.size(); start += line) {
+    const std::int32_t* in = a.data() + start;
+    std::int32_t* out = b.data() + start;
+    for (std::size_t i = 0; i < stride; ++i) out[i] = std::min(in[i], in[i + stride]);
+    for (std::size_t i = stride; i < line - stride; ++i) out[i] = std::min({in[i - stride], in[i], in[i + stride]});
+    for (std::size_t i = line - stride; i < line; ++i) out[i] = std::min(in[i - stride], in[i]);
   }
 }
 
@@ -96,16 +99,17 @@ void minOfThree(const std::vector<std::int32_t>& a, std::vector<std::int32_t>& b
 std::vector<std::uint64_t> clearanceBits(const field::DistanceField& f, double t2Voxels) {
   const field::GridDims& d = f.dims();
   const std::size_t n = f.voxelCount();
+  std::vector<std::uint64_t> bits((n + 63) / 64, 0);
+  if (d.nx < 3 || d.ny < 3 || d.nz < 3) return bits;  // no walkable voxel
   std::vector<std::int32_t> a(n), b(n);
   for (std::size_t i = 0; i < n; ++i)
-    a[i] = static_cast<std::int32_t>(std::lround(f.distanceVoxels(static_cast<std::uint32_t>(i)) *
-                                                 field::DistanceField::kUnitsPerVoxel));
+    a[i] = static_cast<std::int32_t>(f.distanceVoxels(static_cast<std::uint32_t>(i)) *
+                                     field::DistanceField::kUnitsPerVoxel);  // exact: whole units
   const std::size_t sy = static_cast<std::size_t>(d.nx), sz = sy * static_cast<std::size_t>(d.ny);
   minOfThree(a, b, 1, d.nx);
   minOfThree(b, a, sy, d.ny);
   minOfThree(a, b, sz, d.nz);
   const auto limit = static_cast<std::int32_t>(std::ceil(t2Voxels * field::DistanceField::kUnitsPerVoxel));
-  std::vector<std::uint64_t> bits((n + 63) / 64, 0);
   for (int z = 1; z < d.nz - 1; ++z)
     for (int y = 1; y < d.ny - 1; ++y)
       for (int x = 1; x < d.nx - 1; ++x) {

@@ -322,6 +322,32 @@ TEST(FieldCollider, BoxCullingChangesNothing) {
   EXPECT_GT(c.transitions[0][0], c.tests / 4);  // culled pairs
 }
 
+TEST(FieldCollider, ClearanceBitsBoundTheTrilinearDistance) {
+  // Anywhere in a voxel marked clear, the trilinear distance and the voxel's own are above
+  // T2; and the marks reach down to within two voxels of T2 (the 3x3x3 neighbourhood).
+  const BodySetup s(field::makeRoundedTube(0.04, 0.03, 0.15, 24), std::make_shared<StaticMotion>());
+  const field::DistanceField& f = s.field;
+  const FieldCollider c("test", s.parts, kOffsets, 0.5, 0.3);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> within(-0.5, 0.4999);
+  const double t2Voxels = kOffsets.t2_m / kVoxel;
+  std::size_t clear = 0;
+  double lowestClear = 1e9;
+  for (std::uint32_t v = 0; v < f.voxelCount(); ++v) {
+    if (!c.clearOfT2(0, v)) continue;
+    ++clear;
+    ASSERT_TRUE(walkable(f, f.coordinates(v)));
+    EXPECT_GT(f.distanceVoxels(v), t2Voxels);
+    lowestClear = std::min(lowestClear, f.distanceVoxels(v));
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 p = f.coordinates(v).cast<double>() + Vec3(within(rng), within(rng), within(rng));
+      ASSERT_GT(f.distanceAtVoxel(p), kOffsets.t2_m) << "voxel " << v;
+    }
+  }
+  EXPECT_GT(clear, 1000u);
+  EXPECT_LT(lowestClear, t2Voxels + 2);
+}
+
 TEST(FieldCollider, ClearanceSkipChangesNothing) {
   const FieldCollisionCounters c = expectSameAsReference([](FieldCollider& full) { full.setClearanceSkip(false); });
   EXPECT_GT(c.clearanceSkips, c.transitions[1][1] / 4);  // pairs that stayed InsideVol unread

@@ -117,6 +117,11 @@ class FieldCollider final : public Collider {
   /// Off: no pair skips its distance reads through the clearance bits (the reference the
   /// skip is tested against). On by default.
   void setClearanceSkip(bool on) { clearanceSkip_ = on; }
+  /// Whether every voxel of the 3x3x3 neighbourhood of part k's voxel lies above T2, so that
+  /// no trilinear distance nearest to it can be below T2 (false with the skip off).
+  [[nodiscard]] bool clearOfT2(std::size_t k, std::uint32_t voxel) const {
+    return clearanceSkip_ && ((clearOfT2_[k][voxel >> 6] >> (voxel & 63)) & 1);
+  }
 
   [[nodiscard]] std::string name() const override { return "distance fields"; }
   void collide(const ClothModel& model, double t0_s, double t1_s, ClothState& io) override;
@@ -165,9 +170,6 @@ class FieldCollider final : public Collider {
   /// [part][voxel / 64], bit voxel % 64: the voxel's whole 3x3x3 neighbourhood lies above
   /// T2 (walkable voxels only). Built with the collider: the fields are fixed, and so is T2.
   std::vector<std::vector<std::uint64_t>> clearOfT2_;
-  [[nodiscard]] bool clearOfT2(std::size_t k, std::uint32_t voxel) const {
-    return clearanceSkip_ && ((clearOfT2_[k][voxel >> 6] >> (voxel & 63)) & 1);
-  }
   // Per-substep scratch, sized by initialise (the step does not allocate).
   std::vector<double> endVoxelX_, endVoxelY_, endVoxelZ_;  ///< per vertex, the current part's voxel coordinates
   std::vector<std::uint8_t> keep_;                ///< per vertex: the current part must test it

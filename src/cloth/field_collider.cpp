@@ -298,6 +298,13 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
                       ? frame.toVoxel0.apply(io.position(i) - io.velocity(i) * dt_s)
                       : last;
   const Vec3i v0 = roundVoxel(c0);
+  if (state == PointState::InsideVol && in1 && v0 == v1 && clearOfT2(k, f.index(v1.x(), v1.y(), v1.z()))) {
+    // The commonest pair: still in its voxel, far above T2. The walk would be that one
+    // voxel, found clear, and would add no voxel step to the path.
+    ++field_.traces;
+    stayInside(k, i, c1);
+    return;
+  }
 
   // Where the walk starts: the start voxel, or, entering from outside, the entry voxel
   // found by walking backwards from the end until the walk leaves the volume.
@@ -327,12 +334,7 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
     return;
   }
   if (state != PointState::OnSurf && !hit && clearOfT2(k, f.index(v1.x(), v1.y(), v1.z()))) {
-    // Far above T2 wherever the point is in its voxel: what the trilinear distance below
-    // would decide. Its penetration figure is left out: it cannot be below T1.
-    state = PointState::InsideVol;
-    last = c1;
-    ++field_.clearanceSkips;
-    ++field_.transitions[toIndex(from)][toIndex(state)];
+    stayInside(k, i, c1);
     return;
   }
 
@@ -381,6 +383,17 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   last = c;
   nearest_[i] = std::min(nearest_[i], at.distance_m);
   ++field_.transitions[toIndex(from)][toIndex(state)];
+}
+
+// A point that ends in a voxel marked clear of T2, without a collision on its way, is where
+// the trilinear distance would find it: above T2, so InsideVol. Its penetration figure is
+// left out: it cannot be below T1.
+void FieldCollider::stayInside(std::size_t k, std::size_t i, const Vec3& c1) {
+  PointState& state = states_[k][i];
+  ++field_.transitions[toIndex(state)][toIndex(PointState::InsideVol)];
+  state = PointState::InsideVol;
+  lastVoxel_[k][i] = c1;
+  ++field_.clearanceSkips;
 }
 
 void FieldCollider::respondOnSurface(const PartFrame& frame, const Vec3& c, const field::FieldSample& at,

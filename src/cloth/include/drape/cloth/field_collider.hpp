@@ -147,6 +147,8 @@ class FieldCollider final : public Collider {
                        ClothState& io);
   void collidePoint(std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& endVoxel, double dt_s,
                     ClothState& io);
+  /// Pair (k, vertex) ends at voxel coordinates c1 in a voxel clear of T2: InsideVol.
+  void stayInside(std::size_t k, std::size_t vertex, const Vec3& c1);
   void respondOnSurface(const PartFrame& frame, const Vec3& voxel, const field::FieldSample& at, std::size_t vertex,
                         bool moved, double dt_s, ClothState& io) const;
   /// Penetration after the response, against the nearest part (the counters of Table 3).

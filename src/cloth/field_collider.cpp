@@ -79,6 +79,46 @@ void markCandidates(std::size_t n, const double* __restrict cx, const double* __
   }
 }
 
+/// b = min(a[i - stride], a[i], a[i + stride]) for every voxel, along the axis whose index
+/// step is `stride` and which has n voxels; a voxel at either end of it takes the minimum
+/// of the voxels that exist.
+void minOfThree(const std::vector<std::int32_t>& a, std::vector<std::int32_t>& b, std::size_t stride, int n) {
+  const std::size_t line = stride * static_cast<std::size_t>(n);  // one run of the axis, all lower axes inside
+  for (std::size_t start = 0; start < a.size(); start += line) {
+    const std::int32_t* in = a.data() + start;
+    std::int32_t* out = b.data() + start;
+    for (std::size_t i = 0; i < stride; ++i) out[i] = std::min(in[i], in[i + stride]);
+    for (std::size_t i = stride; i < line - stride; ++i) out[i] = std::min({in[i - stride], in[i], in[i + stride]});
+    for (std::size_t i = line - stride; i < line; ++i) out[i] = std::min(in[i - stride], in[i]);
+  }
+}
+
+/// The clearance bits of a part (FieldCollider::clearOfT2_): a 3x3x3 minimum filter of the
+/// stored distances, as three passes of three, against T2 plus one distance unit, so that
+/// the rounding of a trilinear blend cannot bring a value of the neighbourhood below T2.
+std::vector<std::uint64_t> clearanceBits(const field::DistanceField& f, double t2Voxels) {
+  const field::GridDims& d = f.dims();
+  const std::size_t n = f.voxelCount();
+  std::vector<std::uint64_t> bits((n + 63) / 64, 0);
+  if (d.nx < 3 || d.ny < 3 || d.nz < 3) return bits;  // no walkable voxel
+  std::vector<std::int32_t> a(n), b(n);
+  for (std::size_t i = 0; i < n; ++i)
+    a[i] = static_cast<std::int32_t>(f.distanceVoxels(static_cast<std::uint32_t>(i)) *
+                                     field::DistanceField::kUnitsPerVoxel);  // exact: whole units
+  const std::size_t sy = static_cast<std::size_t>(d.nx), sz = sy * static_cast<std::size_t>(d.ny);
+  minOfThree(a, b, 1, d.nx);
+  minOfThree(b, a, sy, d.ny);
+  minOfThree(a, b, sz, d.nz);
+  const auto limit = static_cast<std::int32_t>(std::ceil(t2Voxels * field::DistanceField::kUnitsPerVoxel));
+  for (int z = 1; z < d.nz - 1; ++z)
+    for (int y = 1; y < d.ny - 1; ++y)
+      for (int x = 1; x < d.nx - 1; ++x) {
+        const std::uint32_t v = d.index(x, y, z);
+        if (b[v] > limit) bits[v >> 6] |= std::uint64_t{1} << (v & 63);
+      }
+  return bits;
+}
+
 }  // namespace
 
 Vec3i entryVoxel(const field::DistanceField& f, const Vec3i& inside, const Vec3i& outside) {
@@ -114,6 +154,7 @@ FieldCollider::FieldCollider(std::string garmentName, std::vector<CollisionPart>
                               "less than the outer offset T3 = {:.4f} m",
                               garment_, p.name, p.field->shell_m(), offsets_.t3_m));
     }
+    clearOfT2_.push_back(clearanceBits(*p.field, offsets_.t2_m / p.field->voxelSize()));
   }
 }
 
@@ -257,6 +298,13 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
                       ? frame.toVoxel0.apply(io.position(i) - io.velocity(i) * dt_s)
                       : last;
   const Vec3i v0 = roundVoxel(c0);
+  if (state == PointState::InsideVol && in1 && v0 == v1 && clearOfT2(k, f.index(v1.x(), v1.y(), v1.z()))) {
+    // The commonest pair: still in its voxel, far above T2. The walk would be that one
+    // voxel, found clear, and would add no voxel step to the path.
+    ++field_.traces;
+    stayInside(k, i, c1);
+    return;
+  }
 
   // Where the walk starts: the start voxel, or, entering from outside, the entry voxel
   // found by walking backwards from the end until the walk leaves the volume.
@@ -267,7 +315,9 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   Vec3i hitVoxel = start;
   const int walked = walkVoxels(start, v1, [&](const Vec3i& p) {
     if (!walkable(f, p)) return false;
-    if (state != PointState::OnSurf && f.distanceVoxels(f.index(p.x(), p.y(), p.z())) < frame.t2Voxels) {
+    if (state == PointState::OnSurf) return true;
+    const std::uint32_t voxel = f.index(p.x(), p.y(), p.z());
+    if (!clearOfT2(k, voxel) && f.distanceVoxels(voxel) < frame.t2Voxels) {
       hit = true;
       hitVoxel = p;
       return false;
@@ -281,6 +331,10 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
     state = PointState::OutsideVol;
     last = c1;
     ++field_.transitions[toIndex(from)][toIndex(state)];
+    return;
+  }
+  if (state != PointState::OnSurf && !hit && clearOfT2(k, f.index(v1.x(), v1.y(), v1.z()))) {
+    stayInside(k, i, c1);
     return;
   }
 
@@ -329,6 +383,17 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   last = c;
   nearest_[i] = std::min(nearest_[i], at.distance_m);
   ++field_.transitions[toIndex(from)][toIndex(state)];
+}
+
+// A point that ends in a voxel marked clear of T2, without a collision on its way, is where
+// the trilinear distance would find it: above T2, so InsideVol. Its penetration figure is
+// left out: it cannot be below T1.
+void FieldCollider::stayInside(std::size_t k, std::size_t i, const Vec3& c1) {
+  PointState& state = states_[k][i];
+  ++field_.transitions[toIndex(state)][toIndex(PointState::InsideVol)];
+  state = PointState::InsideVol;
+  lastVoxel_[k][i] = c1;
+  ++field_.clearanceSkips;
 }
 
 void FieldCollider::respondOnSurface(const PartFrame& frame, const Vec3& c, const field::FieldSample& at,

@@ -254,9 +254,11 @@ ClothState cloudState(std::size_t n, std::mt19937& rng) {
   return s;
 }
 
-TEST(FieldCollider, BoxCullingChangesNothing) {
-  // Culled and unculled colliders see the same random points against three tumbling parts;
-  // every state, counter, position and velocity must agree exactly after every substep.
+/// Runs two colliders over the same random points against three tumbling parts, the second
+/// with `reference` applied (a shortcut switched off); every state, counter, position and
+/// velocity must agree exactly after every substep. Returns the first's counters.
+template <typename Configure>
+FieldCollisionCounters expectSameAsReference(Configure&& reference) {
   const field::DistanceField sphere = buildField(field::makeSphere(0.06, Vec3::Zero(), 32, 16));
   const field::DistanceField box = buildField(field::makeBox(Vec3(-0.04, -0.1, -0.03), Vec3(0.04, 0.1, 0.03)));
   const field::DistanceField tube = buildField(field::makeRoundedTube(0.04, 0.03, 0.15, 24));
@@ -267,12 +269,12 @@ TEST(FieldCollider, BoxCullingChangesNothing) {
   const Point anchor(Vec3::Zero());  // a model for the collide() signature; the collider ignores it
   std::mt19937 rng(11);
   const std::size_t n = 600;
-  ClothState culledState = cloudState(n, rng);
-  ClothState fullState = culledState;
-  FieldCollider culled("test", parts, kOffsets, 0.5, 0.3);
+  ClothState fastState = cloudState(n, rng);
+  ClothState fullState = fastState;
+  FieldCollider fast("test", parts, kOffsets, 0.5, 0.3);
   FieldCollider full("test", parts, kOffsets, 0.5, 0.3);
-  full.setBoxCulling(false);
-  culled.initialise(culledState, 0.0);
+  reference(full);
+  fast.initialise(fastState, 0.0);
   full.initialise(fullState, 0.0);
   std::normal_distribution<double> kick(0.0, 0.5);
   const double dt = 1e-3;
@@ -280,20 +282,23 @@ TEST(FieldCollider, BoxCullingChangesNothing) {
     // The same random velocity change for both clouds, pulled back towards the origin.
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3 dv(kick(rng), kick(rng), kick(rng));
-      for (ClothState* s : {&culledState, &fullState}) {
+      for (ClothState* s : {&fastState, &fullState}) {
         const Vec3 v = s->velocity(i) + dv - 2.0 * s->position(i) * dt * 100;
         s->setVelocity(i, v);
         s->setPosition(i, s->position(i) + v * dt);
       }
     }
-    culled.collide(*anchor.model, step * dt, (step + 1) * dt, culledState);
+    fast.collide(*anchor.model, step * dt, (step + 1) * dt, fastState);
     full.collide(*anchor.model, step * dt, (step + 1) * dt, fullState);
     for (std::size_t k = 0; k < parts.size(); ++k)
-      for (std::size_t i = 0; i < n; ++i)
-        ASSERT_EQ(culled.state(k, i), full.state(k, i)) << "step " << step << " part " << k << " vertex " << i;
-    ASSERT_EQ(culledState.hash(), fullState.hash()) << "step " << step;
+      for (std::size_t i = 0; i < n; ++i) {
+        EXPECT_EQ(fast.state(k, i), full.state(k, i)) << "step " << step << " part " << k << " vertex " << i;
+        if (fast.state(k, i) != full.state(k, i)) return fast.fieldCounters();
+      }
+    EXPECT_EQ(fastState.hash(), fullState.hash()) << "step " << step;
+    if (fastState.hash() != fullState.hash()) return fast.fieldCounters();
   }
-  const FieldCollisionCounters& a = culled.fieldCounters();
+  const FieldCollisionCounters& a = fast.fieldCounters();
   const FieldCollisionCounters& b = full.fieldCounters();
   EXPECT_EQ(a.tests, b.tests);
   EXPECT_EQ(a.traces, b.traces);
@@ -303,12 +308,49 @@ TEST(FieldCollider, BoxCullingChangesNothing) {
   EXPECT_EQ(a.vertexSubstepsBelowT1, b.vertexSubstepsBelowT1);
   EXPECT_EQ(a.vertexSubstepsBelowT0, b.vertexSubstepsBelowT0);
   EXPECT_EQ(a.vertexSubstepsInsideBody, b.vertexSubstepsInsideBody);
+  EXPECT_EQ(a.maxPenetration_m, b.maxPenetration_m);
   EXPECT_EQ(a.transitions, b.transitions);
-  // The scenario must exercise what it compares: culled pairs, entries, collisions.
-  EXPECT_GT(a.transitions[0][0], a.tests / 4);
+  // The scenario must exercise what it compares: entries, collisions, sliding.
   EXPECT_GT(a.transitions[0][1] + a.transitions[0][2], 100u);
   EXPECT_GT(a.collisions, 100u);
   EXPECT_GT(a.transitions[2][2], 100u);
+  return a;
+}
+
+TEST(FieldCollider, BoxCullingChangesNothing) {
+  const FieldCollisionCounters c = expectSameAsReference([](FieldCollider& full) { full.setBoxCulling(false); });
+  EXPECT_GT(c.transitions[0][0], c.tests / 4);  // culled pairs
+}
+
+TEST(FieldCollider, ClearanceBitsBoundTheTrilinearDistance) {
+  // Anywhere in a voxel marked clear, the trilinear distance and the voxel's own are above
+  // T2; and the marks reach down to within two voxels of T2 (the 3x3x3 neighbourhood).
+  const BodySetup s(field::makeRoundedTube(0.04, 0.03, 0.15, 24), std::make_shared<StaticMotion>());
+  const field::DistanceField& f = s.field;
+  const FieldCollider c("test", s.parts, kOffsets, 0.5, 0.3);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> within(-0.5, 0.4999);
+  const double t2Voxels = kOffsets.t2_m / kVoxel;
+  std::size_t clear = 0;
+  double lowestClear = 1e9;
+  for (std::uint32_t v = 0; v < f.voxelCount(); ++v) {
+    if (!c.clearOfT2(0, v)) continue;
+    ++clear;
+    ASSERT_TRUE(walkable(f, f.coordinates(v)));
+    EXPECT_GT(f.distanceVoxels(v), t2Voxels);
+    lowestClear = std::min(lowestClear, f.distanceVoxels(v));
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 p = f.coordinates(v).cast<double>() + Vec3(within(rng), within(rng), within(rng));
+      ASSERT_GT(f.distanceAtVoxel(p), kOffsets.t2_m) << "voxel " << v;
+    }
+  }
+  EXPECT_GT(clear, 1000u);
+  EXPECT_LT(lowestClear, t2Voxels + 2);
+}
+
+TEST(FieldCollider, ClearanceSkipChangesNothing) {
+  const FieldCollisionCounters c = expectSameAsReference([](FieldCollider& full) { full.setClearanceSkip(false); });
+  EXPECT_GT(c.clearanceSkips, c.transitions[1][1] / 4);  // pairs that stayed InsideVol unread
 }
 
 TEST(FieldCollider, PointsStartingBelowT2AreEasedOutNotThrown) {

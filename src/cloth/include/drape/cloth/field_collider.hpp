@@ -38,6 +38,15 @@
 // only the points that end inside the part's walkable box or are not OutsideVol. The others
 // are exactly the OutsideVol -> OutsideVol pairs of the per-pair test, counted in bulk, so
 // culling changes no state, counter or position (tested against the unculled path).
+//
+// Clearance (most kept pairs are InsideVol points far from the body): per part, one bit per
+// voxel says that every voxel of its 3x3x3 neighbourhood lies above T2 (by at least one
+// distance unit). A trilinear distance at a point whose nearest voxel is v blends only voxels
+// of v's neighbourhood, so it is a convex combination of values above T2: a point whose walk
+// ends in such a voxel without meeting T2 stays InsideVol without the 8-voxel read, and the
+// walk itself skips the distance read of such voxels. States, positions and the collision
+// counters are those of the full test (tested against it); the penetration statistics only
+// miss distances above T2, which no threshold below T2 can see.
 
 #include <array>
 #include <cstdint>
@@ -83,6 +92,7 @@ struct FieldCollisionCounters {
   std::uint64_t vertexSubstepsInsideBody = 0;  ///< signed distance < 0 after the response
   std::uint64_t vertexSubsteps = 0;            ///< vertices x collision substeps
   double maxPenetration_m = 0;      ///< deepest point below the body surface after the response
+  std::uint64_t clearanceSkips = 0;  ///< pairs that stayed InsideVol without a trilinear read
   std::uint64_t embeddedAtStart = 0;  ///< (vertex, part) pairs below T1 at the start, eased out onto T2
   std::array<std::array<std::uint64_t, 3>, 3> transitions{};  ///< [from][to] PointState counts
 
@@ -104,6 +114,14 @@ class FieldCollider final : public Collider {
   /// Off: every (point, part) pair goes through the full per-pair test (the reference the
   /// culled path is tested against). On by default.
   void setBoxCulling(bool on) { boxCulling_ = on; }
+  /// Off: no pair skips its distance reads through the clearance bits (the reference the
+  /// skip is tested against). On by default.
+  void setClearanceSkip(bool on) { clearanceSkip_ = on; }
+  /// Whether every voxel of the 3x3x3 neighbourhood of part k's voxel lies above T2, so that
+  /// no trilinear distance nearest to it can be below T2 (false with the skip off).
+  [[nodiscard]] bool clearOfT2(std::size_t k, std::uint32_t voxel) const {
+    return clearanceSkip_ && ((clearOfT2_[k][voxel >> 6] >> (voxel & 63)) & 1);
+  }
 
   [[nodiscard]] std::string name() const override { return "distance fields"; }
   void collide(const ClothModel& model, double t0_s, double t1_s, ClothState& io) override;
@@ -129,6 +147,8 @@ class FieldCollider final : public Collider {
                        ClothState& io);
   void collidePoint(std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& endVoxel, double dt_s,
                     ClothState& io);
+  /// Pair (k, vertex) ends at voxel coordinates c1 in a voxel clear of T2: InsideVol.
+  void stayInside(std::size_t k, std::size_t vertex, const Vec3& c1);
   void respondOnSurface(const PartFrame& frame, const Vec3& voxel, const field::FieldSample& at, std::size_t vertex,
                         bool moved, double dt_s, ClothState& io) const;
   /// Penetration after the response, against the nearest part (the counters of Table 3).
@@ -140,6 +160,7 @@ class FieldCollider final : public Collider {
   double staticFriction_, dynamicFriction_;
   int every_;
   bool boxCulling_ = true;
+  bool clearanceSkip_ = true;
   long calls_ = 0;
   double lastTime_s_ = 0;
   std::vector<std::vector<PointState>> states_;   ///< [part][vertex]
@@ -148,6 +169,9 @@ class FieldCollider final : public Collider {
   /// [part][vertex]: the point started below T1 of the part and is being eased out onto T2
   /// (releaseEmbedded) rather than thrown there in one substep.
   std::vector<std::vector<std::uint8_t>> embedded_;
+  /// [part][voxel / 64], bit voxel % 64: the voxel's whole 3x3x3 neighbourhood lies above
+  /// T2 (walkable voxels only). Built with the collider: the fields are fixed, and so is T2.
+  std::vector<std::vector<std::uint64_t>> clearOfT2_;
   // Per-substep scratch, sized by initialise (the step does not allocate).
   std::vector<double> endVoxelX_, endVoxelY_, endVoxelZ_;  ///< per vertex, the current part's voxel coordinates
   std::vector<std::uint8_t> keep_;                ///< per vertex: the current part must test it

@@ -231,7 +231,7 @@ RunFunction setupMakeScene(CLI::App& app) {
                  "Collidable segments (default: every segment the garment comes within --reach of at rest)")
       ->delimiter(',');
   app.add_option("--reach", o.reach_m, "Distance from a segment's box that makes it collidable, m")->capture_default_str();
-  app.add_option("--voxel", o.voxel_m, "Distance-field voxel, m; the offsets T0..T3 are 1, 2, 3, 6 voxels")
+  app.add_option("--voxel", o.voxel_m, "Distance-field voxel, m; without --offsets, T0..T3 are 1, 2, 3 and 6 voxels")
       ->capture_default_str();
   app.add_option("--offsets", o.offsets, "The offset surfaces T0,T1,T2,T3 in m (a garment modelled tight on the body "
                  "needs T2 below its clearance)")

@@ -173,6 +173,7 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   lastVoxel_.assign(parts_.size(), std::vector<Vec3>(n, Vec3::Zero()));
   penalty_.assign(n, 0);
   embedded_.assign(parts_.size(), std::vector<std::uint8_t>(n, 0));
+  projected_.assign(n, 0);
   field_.embeddedAtStart = 0;
   for (std::vector<double>* v : {&endVoxelX_, &endVoxelY_, &endVoxelZ_, &nearest_}) v->assign(n, 0.0);
   keep_.assign(n + 8, 0);  // padded: the candidate scan reads eight flags at a time
@@ -218,6 +219,7 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
 
   const std::size_t n = io.size();
   std::fill(nearest_.begin(), nearest_.end(), std::numeric_limits<double>::infinity());
+  std::fill(projected_.begin(), projected_.end(), std::uint8_t{0});
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     const PartFrame frame = framePart(parts_[k], lastTime_s_, t1_s);
     const std::size_t kept = selectCandidates(k, frame, io);
@@ -363,14 +365,17 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   } else if (state == PointState::OnSurf) {
     if (at.distance_m > offsets_.t3_m) {
       state = PointState::InsideVol;  // carried away by forces
-    } else if (at.distance_m < offsets_.t0_m) {
+    } else if (at.distance_m < offsets_.t0_m && !projected_[i]) {
       c += (offsets_.t2_m - at.distance_m) / h * at.normal;  // last resort
       moved = true;
       ++field_.projections;
       ++counters_.contacts;
-    } else if (at.distance_m < offsets_.t2_m) {
+    } else if (at.distance_m < offsets_.t2_m && !projected_[i]) {
       // Sliding: the point stays on T2 while the part moves into it; the envelope down to
-      // T1 absorbs what one substep's normal cannot (the penalty below).
+      // T1 absorbs what one substep's normal cannot (the penalty below). One part moves a
+      // sliding point per substep: where two parts' offset surfaces overlap (cloth pinched
+      // between arm and chest) their projections would otherwise push it back and forth,
+      // and each jump kicks the cloth around it; the second part answers with velocity only.
       c += (offsets_.t2_m - at.distance_m) / h * at.normal;
       moved = true;
     }
@@ -378,7 +383,10 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
     state = PointState::InsideVol;
   }
 
-  if (moved) at = f.sampleAtVoxel(c);  // the response reads the field where the point is now
+  if (moved) {
+    at = f.sampleAtVoxel(c);  // the response reads the field where the point is now
+    projected_[i] = 1;
+  }
   if (state == PointState::OnSurf) respondOnSurface(frame, c, at, i, moved, dt_s, io);
   last = c;
   nearest_[i] = std::min(nearest_[i], at.distance_m);

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
@@ -50,6 +53,37 @@ TEST(MakeScene, DressOnTheWalkingBody) {
   const nlohmann::json& g = stats["garments"][0];
   EXPECT_GT(g["added_mass_kg"].get<double>(), 0.0);
   EXPECT_LT(g["added_mass_kg"].get<double>(), 0.02 * g["mass_kg"].get<double>());
+}
+
+TEST(MakeScene, AMakeHumanGarmentIsRefittedWithItsMask) {
+  // The .mhclo route: the dress refitted to drape's MakeHuman body; the mask, given on the
+  // OBJ as modelled, moves with the fit, so the scene still matches all of it.
+  ScratchDir dir("make-scene-mhclo");
+  const std::string sceneDir = dir / "dress";
+  const CliResult made = runDrape(
+      "make-scene '" + kSource + "/data/avatars/makehuman_rig_cmu_mb.mhskel' --garment '" + kSource +
+          "/data/garments/makehuman_female_elegantsuit01_dress.mhclo' --units dm --mask '" + kSource +
+          "/examples/hanging_dress/shoulders_mask.obj' --substeps 155 --collides-with Hips,Spine1 --out '" + sceneDir +
+          "'",
+      dir);
+  ASSERT_EQ(made.code, 0) << made.err;
+  const scene::Scene sc = scene::loadScene(sceneDir + "/scene.wrl");
+  ASSERT_EQ(sc.garments.size(), 1u);
+  EXPECT_EQ(sc.garments[0].mesh.triangleCount(), 4192u);
+  EXPECT_EQ(sc.garments[0].maskVertices.size(), 222u);
+  EXPECT_EQ(sc.simulation.stepsPerFrame, 155);
+  // Refitted: the sleeves' cuffs rise to the body's wrists (about 0.2-0.3 m up, not 0.14-0.19).
+  double highestCuff = -1;
+  for (const Vec3& p : sc.garments[0].mesh.positions)
+    if (std::abs(p.x()) > 0.39) highestCuff = std::max(highestCuff, p.y());
+  EXPECT_GT(highestCuff, 0.25);
+
+  const CliResult wrong = runDrape("make-scene '" + kSource + "/data/avatars/CesiumMan.glb' --garment '" + kSource +
+                                       "/data/garments/makehuman_female_elegantsuit01_dress.mhclo' --mask '" + kSource +
+                                       "/examples/hanging_dress/shoulders_mask.obj' --out '" + (dir / "x") + "'",
+                                   dir);
+  EXPECT_EQ(wrong.code, 2);
+  EXPECT_NE(wrong.err.find("give a .mhskel avatar"), std::string::npos) << wrong.err;
 }
 
 TEST(MakeScene, TooFewSubstepsForTheAddedMassIsAClearError) {

@@ -169,6 +169,7 @@ class FieldCollider final : public Collider {
   /// [part][vertex]: the point started below T1 of the part and is being eased out onto T2
   /// (releaseEmbedded) rather than thrown there in one substep.
   std::vector<std::vector<std::uint8_t>> embedded_;
+  std::vector<std::uint8_t> projected_;  ///< per vertex: a part has moved it this substep
   /// [part][voxel / 64], bit voxel % 64: the voxel's whole 3x3x3 neighbourhood lies above
   /// T2 (walkable voxels only). Built with the collider: the fields are fixed, and so is T2.
   std::vector<std::vector<std::uint64_t>> clearOfT2_;

@@ -21,16 +21,23 @@ using testing::slurp;
 
 const std::string kSource = DRAPE_SOURCE_DIR;
 
+/// `drape make-scene` on the MakeHuman body with the dress (`garment`: its .obj or .mhclo)
+/// and the hanging-dress mask, plus `options`, writing to `out`.
+std::string makeDressScene(const std::string& garment, const std::string& options, const std::string& out) {
+  return "make-scene '" + kSource + "/data/avatars/makehuman_rig_cmu_mb.mhskel' --garment '" + kSource +
+         "/data/garments/makehuman_female_elegantsuit01_dress." + garment + "' --units dm --mask '" + kSource +
+         "/examples/hanging_dress/shoulders_mask.obj' " + options + " --out '" + out + "'";
+}
+
 TEST(MakeScene, DressOnTheWalkingBody) {
   ScratchDir dir("make-scene-dress");
   const std::string sceneDir = dir / "dress";
-  const CliResult made = runDrape(
-      "make-scene '" + kSource + "/data/avatars/makehuman_rig_cmu_mb.mhskel' --garment '" + kSource +
-          "/data/garments/makehuman_female_elegantsuit01_dress.obj' --units dm --mask '" + kSource +
-          "/examples/hanging_dress/shoulders_mask.obj' --name dress --offsets 0.002,0.004,0.006,0.016 "
-          "--collides-with Hips,LowerBack,Spine,Spine1,Neck,LeftShoulder,RightShoulder,LeftArm,RightArm,"
-          "LeftUpLeg,RightUpLeg --out '" + sceneDir + "'",
-      dir);
+  const CliResult made = runDrape(makeDressScene("obj",
+                                                  "--name dress --offsets 0.002,0.004,0.006,0.016 --collides-with "
+                                                  "Hips,LowerBack,Spine,Spine1,Neck,LeftShoulder,RightShoulder,"
+                                                  "LeftArm,RightArm,LeftUpLeg,RightUpLeg",
+                                                  sceneDir),
+                                   dir);
   ASSERT_EQ(made.code, 0) << made.err;
   EXPECT_NE(made.out.find("substeps per frame"), std::string::npos) << made.out;
 
@@ -60,12 +67,7 @@ TEST(MakeScene, AMakeHumanGarmentIsRefittedWithItsMask) {
   // OBJ as modelled, moves with the fit, so the scene still matches all of it.
   ScratchDir dir("make-scene-mhclo");
   const std::string sceneDir = dir / "dress";
-  const CliResult made = runDrape(
-      "make-scene '" + kSource + "/data/avatars/makehuman_rig_cmu_mb.mhskel' --garment '" + kSource +
-          "/data/garments/makehuman_female_elegantsuit01_dress.mhclo' --units dm --mask '" + kSource +
-          "/examples/hanging_dress/shoulders_mask.obj' --substeps 155 --collides-with Hips,Spine1 --out '" + sceneDir +
-          "'",
-      dir);
+  const CliResult made = runDrape(makeDressScene("mhclo", "--substeps 155 --collides-with Hips,Spine1", sceneDir), dir);
   ASSERT_EQ(made.code, 0) << made.err;
   const scene::Scene sc = scene::loadScene(sceneDir + "/scene.wrl");
   ASSERT_EQ(sc.garments.size(), 1u);
@@ -89,12 +91,7 @@ TEST(MakeScene, AMakeHumanGarmentIsRefittedWithItsMask) {
 TEST(MakeScene, TooFewSubstepsForTheAddedMassIsAClearError) {
   ScratchDir dir("make-scene-substeps");
   const std::string sceneDir = dir / "dress";
-  const CliResult made = runDrape(
-      "make-scene '" + kSource + "/data/avatars/makehuman_rig_cmu_mb.mhskel' --garment '" + kSource +
-          "/data/garments/makehuman_female_elegantsuit01_dress.obj' --units dm --mask '" + kSource +
-          "/examples/hanging_dress/shoulders_mask.obj' --substeps 33 --collides-with Hips,Spine1 --out '" + sceneDir +
-          "'",
-      dir);
+  const CliResult made = runDrape(makeDressScene("obj", "--substeps 33 --collides-with Hips,Spine1", sceneDir), dir);
   ASSERT_EQ(made.code, 0) << made.err;
   const CliResult ran = runDrape("run '" + sceneDir + "/scene.wrl' --motion '" + kSource +
                                      "/examples/walking_skirt/walk.bvh' --frames 1 --out '" + (dir / "out") + "'",

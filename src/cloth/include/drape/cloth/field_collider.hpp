@@ -27,10 +27,12 @@
 //                              to the moving part), keeps its tangential velocity reduced by
 //                              Coulomb friction, and becomes OnSurf
 //   OnSurf     -> OnSurf       sliding on T2: a point the part has pushed below T2 is moved
-//                              back onto it, its inward velocity removed with friction;
-//                              below T1 a penalty impulse outwards as well; below T0 the
-//                              last-resort projection is counted
+//                              back onto it (by one part per substep; other parts answer
+//                              with velocity only), its inward velocity removed with
+//                              friction; below T1 the outward relative velocity gets a
+//                              penalty floor; below T0 the last-resort projection is counted
 //   OnSurf     -> InsideVol    when forces carry it beyond T3
+// A point that starts below T1 of a part is eased out onto T2 at a bounded speed first.
 //
 // Culling (the paper's non-hierarchical boxes): once per part and collision substep, one
 // vectorised pass maps every point's end position into the part's voxel coordinates (the

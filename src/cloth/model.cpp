@@ -128,6 +128,7 @@ double ClothModel::membraneStableStep(const mesh::TriMesh& mesh, std::size_t tri
 void ClothModel::applyMassScaling(const mesh::TriMesh& mesh, const MassScaling& scaling) {
   if (!(scaling.targetStep_s > 0.0)) return;
   const double target = scaling.targetStep_s;
+  const double unscaledStep = estimatedStableStep_s();  // for the error message
   const double baseMass = totalMass_;
   const std::vector<double> before = mass_;
   const double areal = material_.arealDensity();
@@ -149,12 +150,11 @@ void ClothModel::applyMassScaling(const mesh::TriMesh& mesh, const MassScaling& 
   massScaledVertices_ = 0;
   for (std::size_t i = 0; i < mass_.size(); ++i) massScaledVertices_ += mass_[i] > before[i] ? 1 : 0;
   if (addedMass_ > scaling.maxAddedFraction * baseMass) {
-    const double unscaled = std::min(0.5 * minAltitude_ / membraneWaveSpeed_m_s(),
-                                     bendingOmegaUnscaled_ > 0.0 ? 1.8 / bendingOmegaUnscaled_ : 1e9);
     const std::string stableAt =
         scaling.frameRate_hz > 0.0
-            ? fmt::format("{} substeps per frame", static_cast<long>(std::ceil(1.0 / (scaling.frameRate_hz * unscaled))))
-            : fmt::format("a substep of {:.3g} ms", 1e3 * unscaled);
+            ? fmt::format("{} substeps per frame",
+                          static_cast<long>(std::ceil(1.0 / (scaling.frameRate_hz * unscaledStep))))
+            : fmt::format("a substep of {:.3g} ms", 1e3 * unscaledStep);
     throw Error(fmt::format("{}: keeping the substep of {:.3g} ms stable needs {:.1f} % more mass on {} of {} "
                             "vertices, more than maxAddedMass {:g} allows; use more substeps per frame (the "
                             "garment is stable without mass scaling at {}) or allow more added mass",
@@ -180,7 +180,6 @@ void ClothModel::buildBending(const mesh::TriMesh& mesh, const mesh::Topology& t
     bending_.push_back({e.v0, e.v1, e.opposite0, e.opposite1, hingePsi(x0, x1, xa, xb), k});
   }
   bendingOmega_ = estimateBendingOmega(mesh);
-  bendingOmegaUnscaled_ = bendingOmega_;
 }
 
 // Highest bending frequency, from a Gershgorin bound on M^-1 K at rest: each hinge adds

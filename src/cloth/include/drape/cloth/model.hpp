@@ -137,7 +137,6 @@ class ClothModel {
   std::vector<mesh::Triangle> triangles_;
   double minAltitude_ = 0.0;
   double bendingOmega_ = 0.0;  ///< highest bending frequency bound, rad/s (buildBending)
-  double bendingOmegaUnscaled_ = 0.0;
   double membraneStep_ = 0.0;  ///< stable step of the stiffest triangle after mass scaling, s
   double addedMass_ = 0.0;
   std::size_t massScaledVertices_ = 0;

@@ -109,19 +109,13 @@ mesh::TriMesh fitMask(const mesh::TriMesh& mask, const scene::MakeHumanGarment& 
   return fitted;
 }
 
-/// The fewest substeps per frame (at least the paper's 33) at which mass scaling keeps the
-/// garment stable while adding at most maxAddedMass of its mass.
-int fewestStableSubsteps(const mesh::TriMesh& garment, const MakeSceneOptions& o, double& addedFraction) {
-  const mesh::Topology topology = mesh::Topology::build(garment);
-  // Unbounded allowance: the model reports what it needs instead of refusing.
-  const double unbounded = std::numeric_limits<double>::infinity();
-  for (int n = 33; n <= 100000; n = std::max(n + 1, static_cast<int>(std::ceil(n * 1.05)))) {
-    const auto model =
-        cloth::ClothModel::build(garment, topology, o.material, cloth::MassScaling{1.0 / (o.frameRate * n), unbounded});
-    addedFraction = model->addedMass_kg() / (model->totalMass_kg() - model->addedMass_kg());
-    if (addedFraction <= o.maxAddedMass) return n;
-  }
-  throw Error(fmt::format("{}: no substep count up to 100000 is stable", o.garment));
+/// The fraction of the garment's mass that mass scaling adds at `substeps` per frame.
+double addedMassAt(const mesh::TriMesh& garment, const mesh::Topology& topology, const MakeSceneOptions& o,
+                   int substeps) {
+  const auto model = cloth::ClothModel::build(
+      garment, topology, o.material,
+      cloth::MassScaling{1.0 / (o.frameRate * substeps), std::numeric_limits<double>::infinity()});
+  return model->addedMass_kg() / (model->totalMass_kg() - model->addedMass_kg());
 }
 
 void writeMaterial(std::ostream& os, const cloth::Material& m) {
@@ -192,8 +186,18 @@ int makeScene(MakeSceneOptions& o) {
   if (o.collidesWith.empty())
     throw Error(fmt::format("{}: the garment is not within {} m of any segment of {}; is --units right?", o.garment,
                             o.reach_m, o.avatar));
-  double added = 0.0;
-  if (o.stepsPerFrame == 0) o.stepsPerFrame = fewestStableSubsteps(garment, o, added);
+  // The fewest substeps per frame, at least the paper's 33, that mass scaling keeps stable
+  // within the allowance; or the count asked for, and what it needs.
+  const mesh::Topology topology = mesh::Topology::build(garment);
+  const cloth::SubstepChoice choice =
+      cloth::fewestStableSubsteps(garment, topology, o.material, o.frameRate, o.maxAddedMass, std::max(33, o.stepsPerFrame));
+  if (o.stepsPerFrame == 0) o.stepsPerFrame = choice.substepsPerFrame;
+  const double added = o.stepsPerFrame == choice.substepsPerFrame ? choice.addedMassFraction
+                                                                    : addedMassAt(garment, topology, o, o.stepsPerFrame);
+  if (added > o.maxAddedMass)
+    throw Error(fmt::format("--substeps {}: mass scaling would add {:.2f} % of the garment's mass, more than "
+                            "--max-added-mass {:g}; {} substeps per frame need no more than that",
+                            o.stepsPerFrame, 100.0 * added, o.maxAddedMass, choice.substepsPerFrame));
 
   o.avatarUrl = prepareSceneDir(o.out, o.avatar, o.avatarUrl);
   const std::filesystem::path dir(o.out);

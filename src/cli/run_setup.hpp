@@ -70,7 +70,8 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
 void validateRunSetup(const RunSetup& setup);
 
 /// The smallest substep count per frame that the explicit integrators are estimated to
-/// keep stable for every garment (ClothModel::estimatedStableStep_s), at least 1.
+/// keep stable for every garment, with mass scaling adding at most the settings'
+/// maxAddedMass of each (cloth::fewestStableSubsteps), at least 1.
 [[nodiscard]] int stableSubsteps(const RunSetup& setup);
 
 /// Simulates and writes every output. Returns 0; on instability it finishes the files

@@ -1,6 +1,7 @@
 #include "drape/cloth/field_collider.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -67,15 +68,15 @@ void mapPoints(const Affine& m, std::size_t n, const double* __restrict x, const
   }
 }
 
-/// keep[i]: the point ends in the box [0.5, boxMax) of voxel coordinates, or its state is
-/// not OutsideVol, or `all`.
+/// keep[i]: the point is free and ends in the box [0.5, boxMax) of voxel coordinates, or
+/// its state is not OutsideVol, or `all` (a fixed point is always OutsideVol).
 void markCandidates(std::size_t n, const double* __restrict cx, const double* __restrict cy,
                     const double* __restrict cz, const Vec3& boxMax, const std::uint8_t* __restrict state, bool all,
-                    std::uint8_t* __restrict keep) {
+                    const std::uint8_t* __restrict free, std::uint8_t* __restrict keep) {
   const double hx = boxMax.x(), hy = boxMax.y(), hz = boxMax.z();
   for (std::size_t i = 0; i < n; ++i) {
     const bool inBox = (cx[i] >= 0.5) & (cx[i] < hx) & (cy[i] >= 0.5) & (cy[i] < hy) & (cz[i] >= 0.5) & (cz[i] < hz);
-    keep[i] = static_cast<std::uint8_t>(inBox | (state[i] != 0) | all);
+    keep[i] = static_cast<std::uint8_t>((inBox | (state[i] != 0) | all) & (free[i] != 0));
   }
 }
 
@@ -138,6 +139,15 @@ void OffsetSurfaces::validate(const std::string& prefix) const {
   }
 }
 
+/// One part's transforms over a collision interval, built once per part and substep so
+/// that no pair transforms or inverts anything.
+struct FieldCollider::PartFrame {
+  Affine toVoxel0, toVoxel1;  ///< world -> voxel coordinates at the interval's start and end
+  Affine toWorld0, toWorld1;  ///< voxel coordinates -> world
+  Mat3 rotation1;             ///< the part's directions -> world at the end (normals)
+  double t2Voxels = 0;        ///< the collision surface T2 in voxels (the walk's test)
+};
+
 FieldCollider::FieldCollider(std::string garmentName, std::vector<CollisionPart> parts, const OffsetSurfaces& offsets,
                              double staticFriction, double dynamicFriction, int every)
     : garment_(std::move(garmentName)),
@@ -156,19 +166,26 @@ FieldCollider::FieldCollider(std::string garmentName, std::vector<CollisionPart>
     }
     clearOfT2_.push_back(clearanceBits(*p.field, offsets_.t2_m / p.field->voxelSize()));
   }
+  frames_.resize(parts_.size());
 }
 
-/// One part's transforms over a collision interval, built once per part and substep so
-/// that no pair transforms or inverts anything.
-struct FieldCollider::PartFrame {
-  Affine toVoxel0, toVoxel1;  ///< world -> voxel coordinates at the interval's start and end
-  Affine toWorld0, toWorld1;  ///< voxel coordinates -> world
-  Mat3 rotation1;             ///< the part's directions -> world at the end (normals)
-  double t2Voxels = 0;        ///< the collision surface T2 in voxels (the walk's test)
-};
+FieldCollider::~FieldCollider() = default;
+
+
+void FieldCollider::setFixedVertices(const std::vector<std::uint32_t>& vertices, std::size_t vertexCount) {
+  free_.assign(vertexCount, 1);
+  for (std::uint32_t v : vertices) {
+    if (v >= vertexCount)
+      throw Error(fmt::format("garment '{}': fixed vertex {} is out of range ({} vertices)", garment_, v, vertexCount),
+                  ExitCode::Internal);
+    free_[v] = 0;
+  }
+  freeCount_ = static_cast<std::size_t>(std::count(free_.begin(), free_.end(), std::uint8_t{1}));
+}
 
 void FieldCollider::initialise(const ClothState& state, double t_s) {
   const std::size_t n = state.size();
+  if (free_.size() != n) setFixedVertices({}, n);
   states_.assign(parts_.size(), std::vector<PointState>(n, PointState::OutsideVol));
   lastVoxel_.assign(parts_.size(), std::vector<Vec3>(n, Vec3::Zero()));
   penalty_.assign(n, 0);
@@ -184,7 +201,7 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3 c = toVoxel.apply(state.position(i));
       lastVoxel_[k][i] = c;
-      if (!walkable(f, roundVoxel(c))) continue;
+      if (!free_[i] || !walkable(f, roundVoxel(c))) continue;
       const double d = f.distanceAtVoxel(c);
       states_[k][i] = d < offsets_.t2_m ? PointState::OnSurf : PointState::InsideVol;
       if (d < offsets_.t1_m) {
@@ -217,16 +234,18 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
   const double interval_s = t1_s - lastTime_s_;
   if (!(interval_s > 0)) return;
 
-  const std::size_t n = io.size();
   std::fill(nearest_.begin(), nearest_.end(), std::numeric_limits<double>::infinity());
   std::fill(projected_.begin(), projected_.end(), std::uint8_t{0});
+  const auto poseStart = std::chrono::steady_clock::now();
+  for (std::size_t k = 0; k < parts_.size(); ++k) frames_[k] = framePart(parts_[k], lastTime_s_, t1_s);
+  poseSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - poseStart).count();
   for (std::size_t k = 0; k < parts_.size(); ++k) {
-    const PartFrame frame = framePart(parts_[k], lastTime_s_, t1_s);
+    const PartFrame& frame = frames_[k];
     const std::size_t kept = selectCandidates(k, frame, io);
     // The culled pairs are OutsideVol -> OutsideVol without a trace.
-    field_.tests += n;
-    counters_.pointsTested += n;
-    field_.transitions[0][0] += n - kept;
+    field_.tests += freeCount_;
+    counters_.pointsTested += freeCount_;
+    field_.transitions[0][0] += freeCount_ - kept;
     for (std::size_t j = 0; j < kept; ++j) {
       const std::uint32_t i = candidates_[j];
       collidePoint(k, frame, i, Vec3(endVoxelX_[i], endVoxelY_[i], endVoxelZ_[i]), interval_s, io);
@@ -244,7 +263,7 @@ std::size_t FieldCollider::selectCandidates(std::size_t k, const PartFrame& fram
   const field::GridDims& d = parts_[k].field->dims();
   const Vec3 boxMax(d.nx - 1.5, d.ny - 1.5, d.nz - 1.5);
   markCandidates(n, endVoxelX_.data(), endVoxelY_.data(), endVoxelZ_.data(), boxMax,
-                 reinterpret_cast<const std::uint8_t*>(states_[k].data()), !boxCulling_, keep_.data());
+                 reinterpret_cast<const std::uint8_t*>(states_[k].data()), !boxCulling_, free_.data(), keep_.data());
   const std::uint8_t* keep = keep_.data();
   // Most flags are zero: skip them eight at a time.
   std::size_t kept = 0;
@@ -261,7 +280,7 @@ std::size_t FieldCollider::selectCandidates(std::size_t k, const PartFrame& fram
 }
 
 void FieldCollider::countPenetration() {
-  field_.vertexSubsteps += nearest_.size();
+  field_.vertexSubsteps += freeCount_;
   for (std::size_t i = 0; i < nearest_.size(); ++i) {
     const double nearest = nearest_[i];
     penalty_[i] = nearest < offsets_.t1_m;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -258,6 +259,28 @@ double ClothModel::estimatedStableStep_s() const {
   const double membrane = membraneStep_;
   const double bending = bendingOmega_ > 0.0 ? 1.8 / bendingOmega_ : membrane;
   return std::min(membrane, bending);
+}
+
+SubstepChoice fewestStableSubsteps(const mesh::TriMesh& mesh, const mesh::Topology& topology,
+                                   const Material& material, double frameRate_hz, double maxAddedFraction,
+                                   int least) {
+  constexpr int kMost = 100000;
+  const double unscaledStep = ClothModel::build(mesh, topology, material)->estimatedStableStep_s();
+  const double unscaled = std::ceil(1.0 / (frameRate_hz * unscaledStep));
+  if (!(unscaled <= kMost))
+    throw Error(fmt::format("garment '{}': no substep count up to {} is stable at {:g} frames/s", mesh.name, kMost,
+                            frameRate_hz));
+  const int none = std::max(least, static_cast<int>(unscaled));  // needs no mass scaling
+  if (maxAddedFraction > 0.0) {
+    // An unbounded allowance: the model reports the mass it needs instead of refusing.
+    const double unbounded = std::numeric_limits<double>::infinity();
+    for (int n = std::max(1, least); n < none; n = std::max(n + 1, static_cast<int>(std::ceil(n * 1.05)))) {
+      const auto model = ClothModel::build(mesh, topology, material, MassScaling{1.0 / (frameRate_hz * n), unbounded});
+      const double added = model->addedMass_kg() / (model->totalMass_kg() - model->addedMass_kg());
+      if (added <= maxAddedFraction) return {n, added};
+    }
+  }
+  return {none, 0.0};
 }
 
 }  // namespace drape::cloth

@@ -108,6 +108,9 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
     run.collider = std::make_unique<cloth::FieldCollider>(spec.name, std::move(collisionParts), spec.offsets,
                                                           spec.material.staticFriction, spec.material.dynamicFriction,
                                                           spec.collisionEvery);
+    std::vector<std::uint32_t> fixed;  // the fixtures move these after the collider: it leaves them out
+    for (const cloth::PinGroup& g : pins) fixed.insert(fixed.end(), g.vertices.begin(), g.vertices.end());
+    run.collider->setFixedVertices(fixed, model->vertexCount());
     run.solver = std::make_unique<cloth::ClothSolver>(model, settings_.step, std::move(pins));
     run.collider->initialise(run.solver->state(), 0.0);
     run.solver->addCollider(*run.collider);

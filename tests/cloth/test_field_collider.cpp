@@ -180,7 +180,9 @@ TEST(FieldCollider, BresenhamLinesAreConnectedAndEndWhereAsked) {
     Vec3i prev = a, last = a;
     int count = 0;
     const int visited = walkVoxels(a, b, [&](const Vec3i& p) {
-      if (count++ > 0) EXPECT_LE((p - prev).cwiseAbs().maxCoeff(), 1);
+      if (count++ > 0) {
+        EXPECT_LE((p - prev).cwiseAbs().maxCoeff(), 1);
+      }
       prev = p;
       last = p;
       return true;
@@ -346,6 +348,48 @@ TEST(FieldCollider, ClearanceBitsBoundTheTrilinearDistance) {
   }
   EXPECT_GT(clear, 1000u);
   EXPECT_LT(lowestClear, t2Voxels + 2);
+}
+
+TEST(FieldCollider, FixedVerticesAreLeftOut) {
+  // Fixtures move some vertices after the collider: it neither moves nor counts them, and
+  // the free vertices come out exactly as without any fixed vertex (the collider treats
+  // vertices independently).
+  const BodySetup s(field::makeSphere(0.06, Vec3::Zero(), 32, 16),
+                    std::make_shared<LinearMotion>(Vec3(-0.2, 0, 0), Vec3(2.0, 0, 0)));
+  std::mt19937 rng(3);
+  const std::size_t n = 400;
+  ClothState withFixed = cloudState(n, rng);
+  ClothState allFree = withFixed;
+  std::vector<std::uint32_t> fixed;
+  for (std::uint32_t i = 0; i < n; i += 3) fixed.push_back(i);
+  FieldCollider a("test", s.parts, kOffsets, 0.5, 0.3);
+  FieldCollider b("test", s.parts, kOffsets, 0.5, 0.3);
+  a.setFixedVertices(fixed, n);
+  a.initialise(withFixed, 0.0);
+  b.initialise(allFree, 0.0);
+  const Point anchor(Vec3::Zero());
+  const double dt = 1e-3;
+  for (int step = 0; step < 200; ++step) {
+    const ClothState before = withFixed;
+    a.collide(*anchor.model, step * dt, (step + 1) * dt, withFixed);
+    b.collide(*anchor.model, step * dt, (step + 1) * dt, allFree);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (i % 3 == 0) {
+        ASSERT_EQ(withFixed.position(i), before.position(i)) << "fixed vertex " << i << " moved";
+        ASSERT_EQ(withFixed.velocity(i), before.velocity(i));
+        ASSERT_EQ(a.state(0, i), PointState::OutsideVol);
+        // Keep the fixed vertices where the free run has them, so that both clouds agree.
+        withFixed.setPosition(i, allFree.position(i));
+        withFixed.setVelocity(i, allFree.velocity(i));
+      } else {
+        ASSERT_EQ(withFixed.position(i), allFree.position(i)) << "vertex " << i << " step " << step;
+        ASSERT_EQ(a.state(0, i), b.state(0, i));
+      }
+    }
+  }
+  EXPECT_GT(b.fieldCounters().collisions, 20u) << "the sphere must sweep through the cloud";
+  EXPECT_EQ(a.fieldCounters().vertexSubsteps, 200u * (n - fixed.size()));
+  EXPECT_LT(a.fieldCounters().collisions, b.fieldCounters().collisions);
 }
 
 TEST(FieldCollider, ClearanceSkipChangesNothing) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "cloth_fixture.hpp"
 #include "drape/core/error.hpp"
@@ -100,6 +101,43 @@ TEST(MassScaling, AScaledSheetHangsStablyAtTheTargetStep) {
   double speed = 0;
   for (std::size_t i = 0; i < solver.state().size(); ++i) speed = std::max(speed, solver.state().velocity(i).norm());
   EXPECT_LT(speed, 1.0);
+}
+
+/// Fraction of the mass that scaling adds at `substeps` per frame of `rate`.
+double addedFraction(const mesh::TriMesh& m, const Material& material, double rate, int substeps) {
+  const auto model = ClothModel::build(m, mesh::Topology::build(m), material,
+                                       MassScaling{1.0 / (rate * substeps), std::numeric_limits<double>::infinity()});
+  return model->addedMass_kg() / (model->totalMass_kg() - model->addedMass_kg());
+}
+
+TEST(MassScaling, FewestStableSubstepsWithinTheAllowance) {
+  const SliverSheet s;
+  const mesh::Topology topology = mesh::Topology::build(s.mesh);
+  const double rate = 30.0;
+  const int unscaled =
+      static_cast<int>(std::ceil(1.0 / (rate * testing::makeModel(s.mesh, knit())->estimatedStableStep_s())));
+  ASSERT_GT(unscaled, 4);
+
+  // No allowance: the unscaled estimate, as before mass scaling existed.
+  const SubstepChoice none = fewestStableSubsteps(s.mesh, topology, knit(), rate, 0.0);
+  EXPECT_EQ(none.substepsPerFrame, unscaled);
+  EXPECT_EQ(none.addedMassFraction, 0.0);
+  EXPECT_EQ(fewestStableSubsteps(s.mesh, topology, knit(), rate, 0.0, unscaled + 7).substepsPerFrame, unscaled + 7);
+
+  // With an allowance: fewer substeps, within it, and one substep fewer (every count below
+  // 20 is tried) needs more than the allowance.
+  for (const double allowance : {0.001, 0.01, 0.05}) {
+    const SubstepChoice c = fewestStableSubsteps(s.mesh, topology, knit(), rate, allowance);
+    EXPECT_LT(c.substepsPerFrame, unscaled) << allowance;
+    EXPECT_LE(c.addedMassFraction, allowance);
+    EXPECT_DOUBLE_EQ(c.addedMassFraction, addedFraction(s.mesh, knit(), rate, c.substepsPerFrame));
+    if (c.substepsPerFrame > 1 && c.substepsPerFrame <= 20) {
+      EXPECT_GT(addedFraction(s.mesh, knit(), rate, c.substepsPerFrame - 1), allowance) << allowance;
+    }
+    // The model builds at that count within the allowance (no refusal).
+    EXPECT_NO_THROW((void)ClothModel::build(s.mesh, topology, knit(),
+                                            MassScaling{1.0 / (rate * c.substepsPerFrame), allowance}));
+  }
 }
 
 }  // namespace

@@ -108,6 +108,12 @@ class FieldCollider final : public Collider {
   /// `every`: run the collision test every k-th call (the paper's reduced frequency).
   FieldCollider(std::string garmentName, std::vector<CollisionPart> parts, const OffsetSurfaces& offsets,
                 double staticFriction, double dynamicFriction, int every = 1);
+  ~FieldCollider() override;
+
+  /// Vertices that fixtures move (constraint masks, pins): the collider leaves them out,
+  /// since the fixtures set their positions and velocities after it in every substep. They
+  /// count in no test, state or penetration figure. Call before initialise.
+  void setFixedVertices(const std::vector<std::uint32_t>& vertices, std::size_t vertexCount);
 
   /// Establishes every point's initial state against every part at time t (before the
   /// first step).
@@ -129,6 +135,10 @@ class FieldCollider final : public Collider {
   void collide(const ClothModel& model, double t0_s, double t1_s, ClothState& io) override;
   [[nodiscard]] ColliderCounters counters() const override { return counters_; }
   [[nodiscard]] const FieldCollisionCounters& fieldCounters() const { return field_; }
+  /// Time spent fetching the parts' poses at the ends of each collision interval, s: the
+  /// animation and its micro-interpolation when the collider is the first to ask for a time.
+  /// Part of collide()'s time; the paper's collision share leaves it out.
+  [[nodiscard]] double poseSeconds() const { return poseSeconds_; }
 
   [[nodiscard]] const std::vector<CollisionPart>& parts() const { return parts_; }
   [[nodiscard]] const OffsetSurfaces& offsets() const { return offsets_; }
@@ -164,6 +174,8 @@ class FieldCollider final : public Collider {
   bool boxCulling_ = true;
   bool clearanceSkip_ = true;
   long calls_ = 0;
+  double poseSeconds_ = 0;
+  std::vector<PartFrame> frames_;  ///< per part, this interval's transforms (collide)
   double lastTime_s_ = 0;
   std::vector<std::vector<PointState>> states_;   ///< [part][vertex]
   std::vector<std::vector<Vec3>> lastVoxel_;      ///< [part][vertex], part's voxel coordinates at lastTime
@@ -172,6 +184,8 @@ class FieldCollider final : public Collider {
   /// (releaseEmbedded) rather than thrown there in one substep.
   std::vector<std::vector<std::uint8_t>> embedded_;
   std::vector<std::uint8_t> projected_;  ///< per vertex: a part has moved it this substep
+  std::vector<std::uint8_t> free_;       ///< per vertex: 1 unless a fixture moves it (setFixedVertices)
+  std::size_t freeCount_ = 0;            ///< vertices the collider tests
   /// [part][voxel / 64], bit voxel % 64: the voxel's whole 3x3x3 neighbourhood lies above
   /// T2 (walkable voxels only). Built with the collider: the fields are fixed, and so is T2.
   std::vector<std::vector<std::uint64_t>> clearOfT2_;

@@ -142,6 +142,21 @@ class ClothModel {
   std::size_t massScaledVertices_ = 0;
 };
 
+/// A substep count and the mass scaling it needs.
+struct SubstepChoice {
+  int substepsPerFrame = 0;
+  double addedMassFraction = 0.0;  ///< mass scaling adds this fraction of the garment's mass
+};
+
+/// The fewest substeps per frame, from `least` up, at which the garment is stable when mass
+/// scaling may add at most `maxAddedFraction` of its mass (0: no scaling: the estimated
+/// stable count). Counts below the unscaled stable count are tried on a ladder of 5 % steps
+/// (every count up to 20), each by building the model; at most 100000. Throws drape::Error
+/// naming the garment when none is stable.
+[[nodiscard]] SubstepChoice fewestStableSubsteps(const mesh::TriMesh& mesh, const mesh::Topology& topology,
+                                                 const Material& material, double frameRate_hz,
+                                                 double maxAddedFraction, int least = 1);
+
 /// Bending hinge constant: W_e = kBendCoefficient * D * |e|^2 / (A1 + A2) * (psi - psi0)^2.
 /// Chosen (docs/PHYSICS.md) so that a regular grid bent into a cylinder of curvature kappa
 /// stores D kappa^2 / 2 per area, as plate theory says; irregular meshes store about 1.5

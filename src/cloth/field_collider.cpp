@@ -190,7 +190,10 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   lastVoxel_.assign(parts_.size(), std::vector<Vec3>(n, Vec3::Zero()));
   penalty_.assign(n, 0);
   embedded_.assign(parts_.size(), std::vector<std::uint8_t>(n, 0));
-  projected_.assign(n, 0);
+  for (std::vector<double>* v : {&correctionX_, &correctionY_, &correctionZ_}) v->assign(n, 0.0);
+  corrections_.assign(n, 0);
+  corrected_.clear();
+  corrected_.reserve(n * parts_.size());  // the step does not allocate
   field_.embeddedAtStart = 0;
   for (std::vector<double>* v : {&endVoxelX_, &endVoxelY_, &endVoxelZ_, &nearest_}) v->assign(n, 0.0);
   keep_.assign(n + 8, 0);  // padded: the candidate scan reads eight flags at a time
@@ -235,7 +238,9 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
   if (!(interval_s > 0)) return;
 
   std::fill(nearest_.begin(), nearest_.end(), std::numeric_limits<double>::infinity());
-  std::fill(projected_.begin(), projected_.end(), std::uint8_t{0});
+  for (std::vector<double>* v : {&correctionX_, &correctionY_, &correctionZ_}) std::fill(v->begin(), v->end(), 0.0);
+  std::fill(corrections_.begin(), corrections_.end(), std::uint8_t{0});
+  corrected_.clear();
   const auto poseStart = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < parts_.size(); ++k) frames_[k] = framePart(parts_[k], lastTime_s_, t1_s);
   poseSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - poseStart).count();
@@ -251,6 +256,7 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
       collidePoint(k, frame, i, Vec3(endVoxelX_[i], endVoxelY_[i], endVoxelZ_[i]), interval_s, io);
     }
   }
+  applyCorrections(io);
   countPenetration();
   lastTime_s_ = t1_s;
 }
@@ -384,17 +390,14 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   } else if (state == PointState::OnSurf) {
     if (at.distance_m > offsets_.t3_m) {
       state = PointState::InsideVol;  // carried away by forces
-    } else if (at.distance_m < offsets_.t0_m && !projected_[i]) {
+    } else if (at.distance_m < offsets_.t0_m) {
       c += (offsets_.t2_m - at.distance_m) / h * at.normal;  // last resort
       moved = true;
       ++field_.projections;
       ++counters_.contacts;
-    } else if (at.distance_m < offsets_.t2_m && !projected_[i]) {
+    } else if (at.distance_m < offsets_.t2_m) {
       // Sliding: the point stays on T2 while the part moves into it; the envelope down to
-      // T1 absorbs what one substep's normal cannot (the penalty below). One part moves a
-      // sliding point per substep: where two parts' offset surfaces overlap (cloth pinched
-      // between arm and chest) their projections would otherwise push it back and forth,
-      // and each jump kicks the cloth around it; the second part answers with velocity only.
+      // T1 absorbs what one substep's normal cannot (the penalty below).
       c += (offsets_.t2_m - at.distance_m) / h * at.normal;
       moved = true;
     }
@@ -403,12 +406,14 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   }
 
   if (moved) {
-    at = f.sampleAtVoxel(c);  // the response reads the field where the point is now
-    projected_[i] = 1;
+    at = f.sampleAtVoxel(c);  // the response reads the field where the point is to be
+    addCorrection(i, frame.toWorld1.apply(c) - io.position(i));
+    corrected_.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(i)});
+  } else {
+    nearest_[i] = std::min(nearest_[i], at.distance_m);  // corrected pairs: applyCorrections
   }
-  if (state == PointState::OnSurf) respondOnSurface(frame, c, at, i, moved, dt_s, io);
+  if (state == PointState::OnSurf) respondOnSurface(frame, c, at, i, dt_s, io);
   last = c;
-  nearest_[i] = std::min(nearest_[i], at.distance_m);
   ++field_.transitions[toIndex(from)][toIndex(state)];
 }
 
@@ -424,7 +429,7 @@ void FieldCollider::stayInside(std::size_t k, std::size_t i, const Vec3& c1) {
 }
 
 void FieldCollider::respondOnSurface(const PartFrame& frame, const Vec3& c, const field::FieldSample& at,
-                                     std::size_t i, bool moved, double dt_s, ClothState& io) const {
+                                     std::size_t i, double dt_s, ClothState& io) const {
   const Vec3 n = frame.rotation1 * at.normal;
   const Vec3 world = frame.toWorld1.apply(c);
   const Vec3 partVelocity = (world - frame.toWorld0.apply(c)) / dt_s;
@@ -456,7 +461,28 @@ void FieldCollider::respondOnSurface(const PartFrame& frame, const Vec3& c, cons
     if (vn < wanted) v += n * (wanted - vn);
   }
   io.setVelocity(i, v);
-  if (moved) io.setPosition(i, world);
+}
+
+void FieldCollider::addCorrection(std::size_t i, const Vec3& displacement) {
+  correctionX_[i] += displacement.x();
+  correctionY_[i] += displacement.y();
+  correctionZ_[i] += displacement.z();
+  ++corrections_[i];
+}
+
+void FieldCollider::applyCorrections(ClothState& io) {
+  for (std::size_t i = 0; i < corrections_.size(); ++i) {
+    if (!corrections_[i]) continue;
+    const double share = 1.0 / corrections_[i];
+    io.x[i] += share * correctionX_[i];
+    io.y[i] += share * correctionY_[i];
+    io.z[i] += share * correctionZ_[i];
+  }
+  // The penetration figures of corrected pairs: where the points ended.
+  for (const auto& [k, i] : corrected_) {
+    const double d = parts_[k].field->distanceAtVoxel(frames_[k].toVoxel1.apply(io.position(i)));
+    nearest_[i] = std::min(nearest_[i], d);
+  }
 }
 
 // A point that started below T1 of the part (a garment modelled tight on a smooth body lies
@@ -492,7 +518,7 @@ void FieldCollider::releaseEmbedded(std::size_t k, const PartFrame& frame, std::
   const Vec3 v = io.velocity(i);
   const double vn = (v - partVelocity).dot(n);
   if (vn < 0) io.setVelocity(i, v - vn * n);
-  io.setPosition(i, world);
+  addCorrection(i, world - io.position(i));
   if (step == rest) {  // on T2 now (to the field's accuracy): slide from here
     embedded_[k][i] = 0;
     state = PointState::OnSurf;

@@ -27,12 +27,18 @@
 //                              to the moving part), keeps its tangential velocity reduced by
 //                              Coulomb friction, and becomes OnSurf
 //   OnSurf     -> OnSurf       sliding on T2: a point the part has pushed below T2 is moved
-//                              back onto it (by one part per substep; other parts answer
-//                              with velocity only), its inward velocity removed with
-//                              friction; below T1 the outward relative velocity gets a
-//                              penalty floor; below T0 the last-resort projection is counted
+//                              back onto it, its inward velocity removed with friction;
+//                              below T1 the outward relative velocity gets a penalty floor;
+//                              below T0 the last-resort projection is counted
 //   OnSurf     -> InsideVol    when forces carry it beyond T3
 // A point that starts below T1 of a part is eased out onto T2 at a bounded speed first.
+//
+// Position corrections are gathered over all parts and applied together at the end of the
+// collision step, each point moved by the mean of the displacements its parts asked for
+// (Jacobi averaging): where two parts' offset surfaces overlap (cloth pinched between arm and
+// chest, thigh and hips) the point settles between them instead of being pushed back and
+// forth, and a point one part touches moves exactly as that part asks. Velocity responses
+// apply part by part.
 //
 // Culling (the paper's non-hierarchical boxes): once per part and collision substep, one
 // vectorised pass maps every point's end position into the part's voxel coordinates (the
@@ -54,6 +60,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "drape/cloth/collider.hpp"
@@ -161,8 +168,14 @@ class FieldCollider final : public Collider {
                     ClothState& io);
   /// Pair (k, vertex) ends at voxel coordinates c1 in a voxel clear of T2: InsideVol.
   void stayInside(std::size_t k, std::size_t vertex, const Vec3& c1);
+  /// The velocity response of a point in contact with a part (friction, penalty floor).
   void respondOnSurface(const PartFrame& frame, const Vec3& voxel, const field::FieldSample& at, std::size_t vertex,
-                        bool moved, double dt_s, ClothState& io) const;
+                        double dt_s, ClothState& io) const;
+  /// A part asks to move the point by `displacement` (world, m) this collision step.
+  void addCorrection(std::size_t vertex, const Vec3& displacement);
+  /// Moves every point by the mean of its parts' displacements; then the penetration
+  /// figures of the corrected pairs, where the points ended.
+  void applyCorrections(ClothState& io);
   /// Penetration after the response, against the nearest part (the counters of Table 3).
   void countPenetration();
 
@@ -183,7 +196,11 @@ class FieldCollider final : public Collider {
   /// [part][vertex]: the point started below T1 of the part and is being eased out onto T2
   /// (releaseEmbedded) rather than thrown there in one substep.
   std::vector<std::vector<std::uint8_t>> embedded_;
-  std::vector<std::uint8_t> projected_;  ///< per vertex: a part has moved it this substep
+  /// Per vertex, this collision step: the sum of the displacements parts asked for (m) and
+  /// their number (addCorrection); the (part, vertex) pairs that asked.
+  std::vector<double> correctionX_, correctionY_, correctionZ_;
+  std::vector<std::uint8_t> corrections_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> corrected_;
   std::vector<std::uint8_t> free_;       ///< per vertex: 1 unless a fixture moves it (setFixedVertices)
   std::size_t freeCount_ = 0;            ///< vertices the collider tests
   /// [part][voxel / 64], bit voxel % 64: the voxel's whole 3x3x3 neighbourhood lies above

@@ -392,6 +392,39 @@ TEST(FieldCollider, FixedVerticesAreLeftOut) {
   EXPECT_LT(a.fieldCounters().collisions, b.fieldCounters().collisions);
 }
 
+TEST(FieldCollider, APointPinchedBetweenTwoPartsSettlesBetweenThem) {
+  // Two boxes close on a resting point from either side until their faces are 10 mm apart,
+  // closer than twice T2 (15 mm): no place is on both offset surfaces. Each part's correction
+  // alone would put the point 5 mm inside the other box; their mean keeps it in the middle,
+  // outside both.
+  const field::DistanceField boxField = buildField(field::makeBox(Vec3(-0.1, -0.05, -0.05), Vec3(0.0, 0.05, 0.05)));
+  const field::DistanceField mirrored = buildField(field::makeBox(Vec3(0.0, -0.05, -0.05), Vec3(0.1, 0.05, 0.05)));
+  auto left = std::make_shared<LinearMotion>(Vec3(-0.03, 0, 0), Vec3(0.1, 0, 0));
+  auto right = std::make_shared<LinearMotion>(Vec3(0.03, 0, 0), Vec3(-0.1, 0, 0));
+  const std::vector<CollisionPart> parts = {{"left", &boxField, left}, {"right", &mirrored, right}};
+  Point p(Vec3::Zero());
+  FieldCollider c("test", parts, kOffsets, 0.0, 0.0);
+  c.initialise(p.state, 0.0);
+  const double dt = 1e-3;
+  bool pinched = false;
+  for (int step = 0; step < 250; ++step) {
+    p.state.setPosition(0, p.state.position(0) + p.state.velocity(0) * dt);
+    c.collide(*p.model, step * dt, (step + 1) * dt, p.state);
+    const double t = (step + 1) * dt;
+    const double x = p.state.position(0).x();
+    const double leftFace = -0.03 + 0.1 * t, rightFace = 0.03 - 0.1 * t;
+    ASSERT_GT(x, leftFace) << "inside the left box at step " << step;
+    ASSERT_LT(x, rightFace) << "inside the right box at step " << step;
+    if (rightFace - leftFace < 2 * kOffsets.t2_m) {
+      pinched = true;
+      EXPECT_NEAR(x, 0.5 * (leftFace + rightFace), 0.25 * (rightFace - leftFace)) << "step " << step;
+    }
+  }
+  EXPECT_TRUE(pinched);
+  EXPECT_EQ(c.state(0, 0), PointState::OnSurf);
+  EXPECT_EQ(c.state(1, 0), PointState::OnSurf);
+}
+
 TEST(FieldCollider, ClearanceSkipChangesNothing) {
   const FieldCollisionCounters c = expectSameAsReference([](FieldCollider& full) { full.setClearanceSkip(false); });
   EXPECT_GT(c.clearanceSkips, c.transitions[1][1] / 4);  // pairs that stayed InsideVol unread

@@ -33,10 +33,12 @@ TEST(WalkingDress, WalksStablyWithFewPointsInsideTheBody) {
   EXPECT_LT(g["added_mass_kg"].get<double>(), 0.02 * (g["mass_kg"].get<double>() - g["added_mass_kg"].get<double>()));
   const double substeps = stats["vertex_substeps"].get<double>();
   ASSERT_GT(substeps, 0);
-  // The whole walk ends 0.46 % of vertex-substeps inside the body (examples/walking_dress);
-  // the arms coming down from the rest pose must not make that worse.
-  EXPECT_LT(stats["vertex_substeps_inside_body"].get<double>() / substeps, 0.01);
-  EXPECT_LT(stats["max_penetration_m"].get<double>(), 0.03);
+  // These frames end about 0.02 % of the free vertex-substeps inside the body, 0.8 mm deep at
+  // most, with the parts' corrections averaged; with one part moving a point per substep
+  // they ended about 0.4 %, 15 mm deep (examples/walking_dress).
+  EXPECT_LT(stats["vertex_substeps_inside_body"].get<double>() / substeps, 0.001);
+  EXPECT_LT(stats["max_penetration_m"].get<double>(), 0.005);
+  EXPECT_LT(stats["max_strain"].get<double>(), 1.6);
 }
 
 }  // namespace

@@ -167,6 +167,7 @@ FieldCollider::FieldCollider(std::string garmentName, std::vector<CollisionPart>
     clearOfT2_.push_back(clearanceBits(*p.field, offsets_.t2_m / p.field->voxelSize()));
   }
   frames_.resize(parts_.size());
+  poses_.resize(2 * parts_.size());
 }
 
 FieldCollider::~FieldCollider() = default;
@@ -217,9 +218,9 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   lastTime_s_ = t_s;
 }
 
-FieldCollider::PartFrame FieldCollider::framePart(const CollisionPart& part, double t0_s, double t1_s) const {
+FieldCollider::PartFrame FieldCollider::framePart(const CollisionPart& part, const RigidTransform& pose0,
+                                                  const RigidTransform& pose1) const {
   const field::DistanceField& f = *part.field;
-  const RigidTransform pose0 = part.motion->poseAt(t0_s), pose1 = part.motion->poseAt(t1_s);
   PartFrame frame;
   frame.toVoxel0 = worldToVoxel(f, pose0);
   frame.toVoxel1 = worldToVoxel(f, pose1);
@@ -242,8 +243,12 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
   std::fill(corrections_.begin(), corrections_.end(), std::uint8_t{0});
   corrected_.clear();
   const auto poseStart = std::chrono::steady_clock::now();
-  for (std::size_t k = 0; k < parts_.size(); ++k) frames_[k] = framePart(parts_[k], lastTime_s_, t1_s);
+  for (std::size_t k = 0; k < parts_.size(); ++k) {
+    poses_[2 * k] = parts_[k].motion->poseAt(lastTime_s_);
+    poses_[2 * k + 1] = parts_[k].motion->poseAt(t1_s);
+  }
   poseSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - poseStart).count();
+  for (std::size_t k = 0; k < parts_.size(); ++k) frames_[k] = framePart(parts_[k], poses_[2 * k], poses_[2 * k + 1]);
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     const PartFrame& frame = frames_[k];
     const std::size_t kept = selectCandidates(k, frame, io);

@@ -226,6 +226,12 @@ void AvatarAnimation::evaluate(std::size_t f, double s, std::span<RigidTransform
   for (std::size_t j = 0; j < joints_; ++j) out[j] = interpolate(a[j], b[j], s);
 }
 
+RigidTransform AvatarAnimation::evaluateJoint(std::size_t f, double s, std::size_t joint) const {
+  const std::size_t f0 = std::min(f, frames_ - 1);
+  const std::size_t f1 = std::min(f0 + 1, frames_ - 1);
+  return interpolate(world_[f0 * joints_ + joint], world_[f1 * joints_ + joint], s);
+}
+
 void AvatarAnimation::evaluateInverse(std::size_t f, double s, std::span<RigidTransform> out) const {
   const std::size_t f0 = std::min(f, frames_ - 1);
   const std::size_t f1 = std::min(f0 + 1, frames_ - 1);

@@ -40,39 +40,55 @@ AvatarPoses::AvatarPoses(const scene::Avatar& avatar, const motion::AvatarAnimat
   for (int c = 0; c < 2; ++c) {
     cacheTime_[c] = std::numeric_limits<double>::quiet_NaN();
     cache_[c].resize(avatar.joints.size());
+    cached_[c].assign(avatar.joints.size(), 0);
   }
 }
 
 double AvatarPoses::end_s() const { return leadIn_s_ + (animation_ ? animation_->duration() : 0.0); }
 
-void AvatarPoses::evaluate(double t_s, std::span<RigidTransform> out) const {
-  const std::size_t joints = avatar_.joints.size();
-  if (!animation_) {
-    for (std::size_t j = 0; j < joints; ++j) out[j] = avatar_.joints[j].restWorld();
-    return;
-  }
+AvatarPoses::When AvatarPoses::when(double t_s) const {
+  When w;
+  if (!animation_) return w;
   if (t_s < leadIn_s_) {
     // Lead-in: from the rest pose to the first frame, eased so the cloth is not jerked.
-    const double u = smoothstep(t_s / leadIn_s_);
-    const auto first = animation_->frame(0);
-    for (std::size_t j = 0; j < joints; ++j) out[j] = motion::interpolate(avatar_.joints[j].restWorld(), first[j], u);
-    return;
+    w.leadIn = true;
+    w.u = smoothstep(t_s / leadIn_s_);
+    return w;
   }
   const double frames = (t_s - leadIn_s_) * animation_->rate();
   const double last = static_cast<double>(animation_->frameCount() - 1);
   const double clamped = std::clamp(frames, 0.0, last);
-  const auto f = static_cast<std::size_t>(std::min(std::floor(clamped), std::max(0.0, last - 1)));
-  animation_->evaluate(f, clamped - static_cast<double>(f), out);
+  w.f = static_cast<std::size_t>(std::min(std::floor(clamped), std::max(0.0, last - 1)));
+  w.s = clamped - static_cast<double>(w.f);
+  return w;
 }
 
-const RigidTransform& AvatarPoses::jointAt(double t_s, int joint) const {
-  for (int c = 0; c < 2; ++c)
-    if (cacheTime_[c] == t_s) return cache_[c][static_cast<std::size_t>(joint)];
-  const int c = next_;
-  next_ = 1 - next_;
-  evaluate(t_s, cache_[c]);
-  cacheTime_[c] = t_s;
-  return cache_[c][static_cast<std::size_t>(joint)];
+RigidTransform AvatarPoses::joint(const When& w, std::size_t j) const {
+  if (!animation_) return avatar_.joints[j].restWorld();
+  if (w.leadIn) return motion::interpolate(avatar_.joints[j].restWorld(), animation_->frame(0)[j], w.u);
+  return animation_->evaluateJoint(w.f, w.s, j);
+}
+
+void AvatarPoses::evaluate(double t_s, std::span<RigidTransform> out) const {
+  const When w = when(t_s);
+  for (std::size_t j = 0; j < avatar_.joints.size(); ++j) out[j] = joint(w, j);
+}
+
+const RigidTransform& AvatarPoses::jointAt(double t_s, int jointIndex) const {
+  const auto j = static_cast<std::size_t>(jointIndex);
+  int c = cacheTime_[0] == t_s ? 0 : cacheTime_[1] == t_s ? 1 : -1;
+  if (c < 0) {  // a new time: the older slot takes it
+    c = next_;
+    next_ = 1 - next_;
+    cacheTime_[c] = t_s;
+    cacheWhen_[c] = when(t_s);
+    std::fill(cached_[c].begin(), cached_[c].end(), std::uint8_t{0});
+  }
+  if (!cached_[c][j]) {
+    cache_[c][j] = joint(cacheWhen_[c], j);
+    cached_[c][j] = 1;
+  }
+  return cache_[c][j];
 }
 
 CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::AvatarAnimation* animation,

@@ -143,7 +143,8 @@ class FieldCollider final : public Collider {
   [[nodiscard]] ColliderCounters counters() const override { return counters_; }
   [[nodiscard]] const FieldCollisionCounters& fieldCounters() const { return field_; }
   /// Time spent fetching the parts' poses at the ends of each collision interval, s: the
-  /// animation and its micro-interpolation when the collider is the first to ask for a time.
+  /// animation and its micro-interpolation when the collider is the first to ask for a time
+  /// (the transforms built from the poses count as collision).
   /// Part of collide()'s time; the paper's collision share leaves it out.
   [[nodiscard]] double poseSeconds() const { return poseSeconds_; }
 
@@ -158,7 +159,7 @@ class FieldCollider final : public Collider {
 
  private:
   struct PartFrame;  // one part's transforms over the interval (field_collider.cpp)
-  PartFrame framePart(const CollisionPart& part, double t0_s, double t1_s) const;
+  PartFrame framePart(const CollisionPart& part, const RigidTransform& pose0, const RigidTransform& pose1) const;
   /// Fills endVoxel* with every point's end position in part k's voxel coordinates and
   /// candidates_ with the points the per-pair test must see; returns their number.
   std::size_t selectCandidates(std::size_t k, const PartFrame& frame, const ClothState& io);
@@ -189,6 +190,7 @@ class FieldCollider final : public Collider {
   long calls_ = 0;
   double poseSeconds_ = 0;
   std::vector<PartFrame> frames_;  ///< per part, this interval's transforms (collide)
+  std::vector<RigidTransform> poses_;  ///< per part, its poses at the interval's start and end
   double lastTime_s_ = 0;
   std::vector<std::vector<PointState>> states_;   ///< [part][vertex]
   std::vector<std::vector<Vec3>> lastVoxel_;      ///< [part][vertex], part's voxel coordinates at lastTime

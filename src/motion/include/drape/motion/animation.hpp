@@ -78,6 +78,9 @@ class AvatarAnimation {
   /// Joint world transforms at time (f + s) / rate(), s in [0, 1]; f + 1 is clamped to the
   /// last frame. out.size() must be jointCount(). Allocates nothing.
   void evaluate(std::size_t f, double s, std::span<RigidTransform> out) const;
+  /// One joint of evaluate(): each joint is interpolated on its own (section 4.3.1), so a
+  /// caller that needs a few joints per substep pays for those only.
+  [[nodiscard]] RigidTransform evaluateJoint(std::size_t f, double s, std::size_t joint) const;
   /// The interpolated inverses (world -> joint frame), interpolated on their own as the
   /// paper does. Allocates nothing.
   void evaluateInverse(std::size_t f, double s, std::span<RigidTransform> out) const;

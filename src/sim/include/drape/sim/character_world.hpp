@@ -53,6 +53,8 @@ struct WorldSettings {
 class AvatarPoses {
  public:
   AvatarPoses(const scene::Avatar& avatar, const motion::AvatarAnimation* animation, double leadIn_s);
+  /// One joint's world transform at time t. The last two times asked for are cached joint by
+  /// joint: a substep evaluates only the joints its colliders and fixtures follow.
   [[nodiscard]] const RigidTransform& jointAt(double t_s, int joint) const;
   /// All joints at time t into out (size = joint count).
   void evaluate(double t_s, std::span<RigidTransform> out) const;
@@ -61,11 +63,24 @@ class AvatarPoses {
   [[nodiscard]] double end_s() const;
 
  private:
+  /// Where time t falls: the lead-in's eased blend u from the rest pose, or frame f and the
+  /// fraction s towards f + 1.
+  struct When {
+    bool leadIn = false;
+    double u = 0.0;
+    std::size_t f = 0;
+    double s = 0.0;
+  };
+  [[nodiscard]] When when(double t_s) const;
+  [[nodiscard]] RigidTransform joint(const When& w, std::size_t j) const;
+
   const scene::Avatar& avatar_;
   const motion::AvatarAnimation* animation_;
   double leadIn_s_;
   mutable double cacheTime_[2];
+  mutable When cacheWhen_[2];
   mutable std::vector<RigidTransform> cache_[2];
+  mutable std::vector<std::uint8_t> cached_[2];  ///< per joint: cache_ holds it for cacheTime_
   mutable int next_ = 0;
 };
 

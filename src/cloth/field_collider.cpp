@@ -240,7 +240,7 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
 
   std::fill(nearest_.begin(), nearest_.end(), std::numeric_limits<double>::infinity());
   for (std::vector<double>* v : {&correctionX_, &correctionY_, &correctionZ_}) std::fill(v->begin(), v->end(), 0.0);
-  std::fill(corrections_.begin(), corrections_.end(), std::uint8_t{0});
+  std::fill(corrections_.begin(), corrections_.end(), std::uint16_t{0});
   corrected_.clear();
   const auto poseStart = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < parts_.size(); ++k) {

@@ -201,7 +201,7 @@ class FieldCollider final : public Collider {
   /// Per vertex, this collision step: the sum of the displacements parts asked for (m) and
   /// their number (addCorrection); the (part, vertex) pairs that asked.
   std::vector<double> correctionX_, correctionY_, correctionZ_;
-  std::vector<std::uint8_t> corrections_;
+  std::vector<std::uint16_t> corrections_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> corrected_;
   std::vector<std::uint8_t> free_;       ///< per vertex: 1 unless a fixture moves it (setFixedVertices)
   std::size_t freeCount_ = 0;            ///< vertices the collider tests

@@ -172,7 +172,6 @@ FieldCollider::FieldCollider(std::string garmentName, std::vector<CollisionPart>
 
 FieldCollider::~FieldCollider() = default;
 
-
 void FieldCollider::setFixedVertices(const std::vector<std::uint32_t>& vertices, std::size_t vertexCount) {
   free_.assign(vertexCount, 1);
   for (std::uint32_t v : vertices) {

@@ -178,5 +178,36 @@ TEST(BenchCloth, QuickPrintsTheCases) {
   EXPECT_TRUE(j.contains("peers"));
 }
 
+// `drape bench paper` on the first frames of the walking skirt, with the collision tests
+// every substep and every third: the keys, the paper's Table 3 beside them, and the
+// reduced frequency seen in the counters.
+TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
+  testing::ScratchDir dir("bench-paper");
+  const auto bench = [&](const std::string& extra) {
+    const testing::CliResult r = testing::runDrape("bench paper --json --runs 1 --frames 40 " + extra, dir);
+    EXPECT_EQ(r.code, 0) << r.err;
+    return nlohmann::json::parse(r.out);
+  };
+  const nlohmann::json every = bench("");
+  const nlohmann::json third = bench("--collision-every 3");
+  for (const char* key : {"frames", "sim_fps", "ms_per_frame", "collision_time_share", "mean_collision_path_voxels",
+                          "vertex_substeps_inside_body", "animation_ms_per_frame", "collision_every"})
+    EXPECT_TRUE(every.contains(key)) << key;
+  EXPECT_EQ(every["frames"], 40);
+  EXPECT_EQ(every["paper_table3"]["sim_fps"], 30.2);
+  EXPECT_EQ(every["collision_every"], 1);
+  EXPECT_EQ(third["collision_every"], 3);
+  for (const nlohmann::json* j : {&every, &third}) {
+    EXPECT_GT((*j)["collision_time_share"].get<double>(), 0.0);
+    EXPECT_LT((*j)["collision_time_share"].get<double>(), 1.0);
+    EXPECT_GE((*j)["animation_ms_per_frame"].get<double>(), 0.0);
+    EXPECT_EQ((*j)["vertex_substeps_inside_body"], 0);
+  }
+  // A third of the tests, each over three substeps' motion: longer paths per test.
+  EXPECT_GT(third["mean_collision_path_voxels"].get<double>(), every["mean_collision_path_voxels"].get<double>());
+  const testing::CliResult bad = testing::runDrape("bench paper --json --collision-every 0", dir);
+  EXPECT_NE(bad.code, 0);
+}
+
 }  // namespace
 }  // namespace drape

@@ -197,7 +197,12 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   if (app.count("--substeps") || o.scene.empty()) {
     const int substeps = substepsFrom(o.substeps);
     setup.settings.substepsPerFrame = substeps > 0 ? substeps : 1;
-    if (substeps == 0) setup.settings.substepsPerFrame = stableSubsteps(setup);
+    if (substeps == 0) {
+      setup.settings.substepsPerFrame = stableSubsteps(setup);
+      spdlog::info("--substeps auto: {} substeps per frame ({:.3f} ms){}", setup.settings.substepsPerFrame,
+                   1e3 * setup.settings.substep_s(),
+                   setup.settings.maxAddedMass > 0.0 ? ", with mass scaling within --max-added-mass" : "");
+    }
   }
   // Frames: as asked, or the lead-in plus the whole motion.
   setup.frames = o.frames;

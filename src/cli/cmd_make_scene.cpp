@@ -109,15 +109,6 @@ mesh::TriMesh fitMask(const mesh::TriMesh& mask, const scene::MakeHumanGarment& 
   return fitted;
 }
 
-/// The fraction of the garment's mass that mass scaling adds at `substeps` per frame.
-double addedMassAt(const mesh::TriMesh& garment, const mesh::Topology& topology, const MakeSceneOptions& o,
-                   int substeps) {
-  const auto model = cloth::ClothModel::build(
-      garment, topology, o.material,
-      cloth::MassScaling{1.0 / (o.frameRate * substeps), std::numeric_limits<double>::infinity()});
-  return model->addedMass_kg() / (model->totalMass_kg() - model->addedMass_kg());
-}
-
 void writeMaterial(std::ostream& os, const cloth::Material& m) {
   fmt::print(os,
              "DEF Knit ClothMaterial {{\n  density {:g}\n  thickness {:g}\n  youngsModulus {:g}\n"
@@ -193,7 +184,8 @@ int makeScene(MakeSceneOptions& o) {
       cloth::fewestStableSubsteps(garment, topology, o.material, o.frameRate, o.maxAddedMass, std::max(33, o.stepsPerFrame));
   if (o.stepsPerFrame == 0) o.stepsPerFrame = choice.substepsPerFrame;
   const double added = o.stepsPerFrame == choice.substepsPerFrame ? choice.addedMassFraction
-                                                                    : addedMassAt(garment, topology, o, o.stepsPerFrame);
+                                                                    : cloth::addedMassFractionAt(garment, topology, o.material,
+                                                                                                 o.frameRate, o.stepsPerFrame);
   if (added > o.maxAddedMass)
     throw Error(fmt::format("--substeps {}: mass scaling would add {:.2f} % of the garment's mass, more than "
                             "--max-added-mass {:g}; {} substeps per frame need no more than that",

@@ -83,7 +83,7 @@ std::vector<cloth::PinGroup> pinsOf(const GarmentSetup& g, const cloth::ClothMod
 /// The paper's Table 3 figures and ours: how much time went to collisions, how far points
 /// were traced, where they are, and how deep anything got.
 void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& runs, const cloth::StageTimes& total,
-                       const sim::CharacterWorld* world) {
+                       long frames, const sim::CharacterWorld* world) {
   // As in the paper's Table 3, the share leaves out the animation and its interpolation: the
   // pose fetches the collider makes, timed inside its stage.
   double poses_s = 0;
@@ -91,7 +91,7 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
     if (r.collider) poses_s += r.collider->poseSeconds();
   const double simulated = total.forces_s + total.integrate_s + total.collide_s + total.fixtures_s - poses_s;
   stats["collision_time_share"] = simulated > 0 ? (total.collide_s - poses_s) / simulated : 0.0;
-  stats["animation_ms_per_frame"] = 1e3 * poses_s / std::max(1.0, static_cast<double>(stats["frames"].get<long>()));
+  stats["animation_ms_per_frame"] = 1e3 * poses_s / static_cast<double>(std::max(1L, frames));
   cloth::FieldCollisionCounters sum;
   std::array<std::size_t, 3> states{};
   for (const GarmentRun& r : runs) {
@@ -280,7 +280,7 @@ int simulateRun(const RunSetup& setup) {
     if (r.model->addedMass_kg() > 0.0)
       spdlog::info("{}: mass scaling added {:.2f} % of its mass ({:.1f} g) on {} of {} vertices to keep the "
                    "{:.3g} ms substep stable",
-                   g.name, 100.0 * r.model->addedMass_kg() / (r.model->totalMass_kg() - r.model->addedMass_kg()),
+                   g.name, 100.0 * r.model->addedMassFraction(),
                    1e3 * r.model->addedMass_kg(), r.model->massScaledVertexCount(), r.model->vertexCount(),
                    1e3 * settings.substep_s());
     if (settings.substep_s() > stable)
@@ -426,7 +426,7 @@ int simulateRun(const RunSetup& setup) {
                         {"estimated_stable_substep_s", m.estimatedStableStep_s()}});
   }
   stats["garments"] = garments;
-  addCollisionStats(stats, runs, total, world.get());
+  addCollisionStats(stats, runs, total, done, world.get());
   const std::string statsPath = (out / "stats.json").string();
   std::ofstream statsFile(statsPath);
   statsFile << stats.dump(2) << "\n";

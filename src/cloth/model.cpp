@@ -261,6 +261,13 @@ double ClothModel::estimatedStableStep_s() const {
   return std::min(membrane, bending);
 }
 
+double addedMassFractionAt(const mesh::TriMesh& mesh, const mesh::Topology& topology, const Material& material,
+                           double frameRate_hz, int substepsPerFrame) {
+  // An unbounded allowance: the model reports the mass it needs instead of refusing.
+  const MassScaling scaling{1.0 / (frameRate_hz * substepsPerFrame), std::numeric_limits<double>::infinity()};
+  return ClothModel::build(mesh, topology, material, scaling)->addedMassFraction();
+}
+
 SubstepChoice fewestStableSubsteps(const mesh::TriMesh& mesh, const mesh::Topology& topology,
                                    const Material& material, double frameRate_hz, double maxAddedFraction,
                                    int least) {
@@ -272,11 +279,8 @@ SubstepChoice fewestStableSubsteps(const mesh::TriMesh& mesh, const mesh::Topolo
                             frameRate_hz));
   const int none = std::max(least, static_cast<int>(unscaled));  // needs no mass scaling
   if (maxAddedFraction > 0.0) {
-    // An unbounded allowance: the model reports the mass it needs instead of refusing.
-    const double unbounded = std::numeric_limits<double>::infinity();
     for (int n = std::max(1, least); n < none; n = std::max(n + 1, static_cast<int>(std::ceil(n * 1.05)))) {
-      const auto model = ClothModel::build(mesh, topology, material, MassScaling{1.0 / (frameRate_hz * n), unbounded});
-      const double added = model->addedMass_kg() / (model->totalMass_kg() - model->addedMass_kg());
+      const double added = addedMassFractionAt(mesh, topology, material, frameRate_hz, n);
       if (added <= maxAddedFraction) return {n, added};
     }
   }

@@ -108,6 +108,8 @@ class ClothModel {
   [[nodiscard]] double estimatedStableStep_s() const;
   /// Mass added by mass scaling, kg, and the number of vertices that received some.
   [[nodiscard]] double addedMass_kg() const { return addedMass_; }
+  /// The added mass as a fraction of the garment's own (unscaled) mass.
+  [[nodiscard]] double addedMassFraction() const { return addedMass_ / (totalMass_ - addedMass_); }
   [[nodiscard]] std::size_t massScaledVertexCount() const { return massScaledVertices_; }
 
  private:
@@ -147,6 +149,11 @@ struct SubstepChoice {
   int substepsPerFrame = 0;
   double addedMassFraction = 0.0;  ///< mass scaling adds this fraction of the garment's mass
 };
+
+/// The fraction of the garment's mass that mass scaling adds to keep it stable at
+/// `substepsPerFrame` per frame of `frameRate_hz` (builds the model once).
+[[nodiscard]] double addedMassFractionAt(const mesh::TriMesh& mesh, const mesh::Topology& topology,
+                                         const Material& material, double frameRate_hz, int substepsPerFrame);
 
 /// The fewest substeps per frame, from `least` up, at which the garment is stable when mass
 /// scaling may add at most `maxAddedFraction` of its mass (0: no scaling: the estimated

@@ -235,7 +235,8 @@ RunFunction setupMakeScene(CLI::App& app) {
   app.add_option("--damping", o.material.damping_s, "The knit's stiffness-proportional damping time, s")
       ->capture_default_str();
   app.add_option("--frame-rate", o.frameRate, "Frames per second")->capture_default_str();
-  app.add_option("--substeps", o.stepsPerFrame, "Substeps per frame (default: the fewest that are stable, with mass scaling within --max-added-mass)");
+  app.add_option("--substeps", o.stepsPerFrame,
+                 "Substeps per frame (default: the fewest that are stable, with mass scaling within --max-added-mass)");
   app.add_option("--max-added-mass", o.maxAddedMass, "Mass scaling allowed, a fraction of the garment's mass")
       ->capture_default_str();
   app.add_option("--youngs-modulus", o.material.youngsModulus_Pa, "The knit's Young's modulus, Pa")->capture_default_str();

@@ -44,6 +44,7 @@ struct MakeSceneOptions {
   double frameRate = 30.0;
   int stepsPerFrame = 0;
   double maxAddedMass = 0.02;
+  int bendEvery = 1;  ///< chosen by makeScene from the garment
   double bindThreshold_m = 0.04;
   cloth::Material material = knit();
 
@@ -134,8 +135,8 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
   fmt::print(os,
              "DEF Simulation Simulation {{\n  gravity 0 -9.81 0\n  frameRate {:g}\n  stepsPerFrame {}\n"
              "  maxAddedMass {:g}\n  airViscosity 0.5\n  offsets [ {:g} {:g} {:g} {:g} ]\n  voxelSize {:g}\n"
-             "  integrator \"symplectic-euler\"\n  collisionEvery 1\n}}\n\n",
-             o.frameRate, o.stepsPerFrame, o.maxAddedMass, t[0], t[1], t[2], t[3], v);
+             "  integrator \"symplectic-euler\"\n  collisionEvery 1\n  bendEvery {}\n}}\n\n",
+             o.frameRate, o.stepsPerFrame, o.maxAddedMass, t[0], t[1], t[2], t[3], v, o.bendEvery);
   writeMaterial(os, o.material);
   fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n}}\n\n", o.avatarUrl);
   fmt::print(os,
@@ -190,6 +191,10 @@ int makeScene(MakeSceneOptions& o) {
     throw Error(fmt::format("--substeps {}: mass scaling would add {:.2f} % of the garment's mass, more than "
                             "--max-added-mass {:g}; {} substeps per frame need no more than that",
                             o.stepsPerFrame, 100.0 * added, o.maxAddedMass, choice.substepsPerFrame));
+
+  // Unscaled masses: scaling only adds mass, which slows bending, so this is the cautious rhythm.
+  o.bendEvery = cloth::suggestedBendEvery(*cloth::ClothModel::build(garment, topology, o.material),
+                                          1.0 / (o.frameRate * o.stepsPerFrame));
 
   o.avatarUrl = prepareSceneDir(o.out, o.avatar, o.avatarUrl);
   const std::filesystem::path dir(o.out);

@@ -11,8 +11,10 @@
 
 #include "command.hpp"
 #include "scene_text.hpp"
+#include "drape/cloth/model.hpp"
 #include "drape/core/error.hpp"
 #include "drape/formats/obj.hpp"
+#include "drape/mesh/topology.hpp"
 #include "drape/scene/avatar_gltf.hpp"
 #include "drape/scene/garment_fit.hpp"
 
@@ -27,7 +29,26 @@ struct MakeSkirtOptions {
   double bindThreshold_m = 0.04;
 };
 
+/// The knit the scene gives the skirt (written below as the Knit material).
+cloth::Material knit() {
+  cloth::Material m;
+  m.density_kg_m3 = 300;
+  m.thickness_m = 0.0005;
+  m.youngsModulus_Pa = 50000;
+  m.poissonRatio = 0.3;
+  m.damping_s = 0.002;
+  m.staticFriction = 0.5;
+  m.dynamicFriction = 0.3;
+  m.compressionScale = 0.2;
+  return m;
+}
+
 void writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::Skirt& skirt) {
+  constexpr double kFrameRate = 30.0;
+  constexpr int kSubsteps = 33;
+  const cloth::Material m = knit();
+  const int bendEvery = cloth::suggestedBendEvery(
+      *cloth::ClothModel::build(skirt.mesh, mesh::Topology::build(skirt.mesh), m), 1.0 / (kFrameRate * kSubsteps));
   std::ofstream os(path);
   fmt::print(os, "#VRML V2.0 utf8\n");
   fmt::print(os, "# The paper's walking scenario: a skirt of {} triangles bound at the waist, on a segmented\n"
@@ -36,12 +57,15 @@ void writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::
                  "# Units: metres, kilograms, seconds; y is up.\n\n",
              skirt.mesh.triangleCount(), path);
   fmt::print(os, "WorldInfo {{ title \"drape: walking skirt\" }}\n\n");
-  fmt::print(os, "DEF Simulation Simulation {{\n  gravity 0 -9.81 0\n  frameRate 30\n  stepsPerFrame 33\n"
+  fmt::print(os, "DEF Simulation Simulation {{\n  gravity 0 -9.81 0\n  frameRate {:g}\n  stepsPerFrame {}\n"
                  "  airViscosity 0.5\n  offsets [ 0.005 0.010 0.015 0.030 ]\n  voxelSize 0.005\n"
-                 "  integrator \"symplectic-euler\"\n  collisionEvery 1\n}}\n\n");
-  fmt::print(os, "DEF Knit ClothMaterial {{\n  density 300\n  thickness 0.0005\n  youngsModulus 50000\n"
-                 "  poissonRatio 0.3\n  damping 0.002\n  staticFriction 0.5\n  dynamicFriction 0.3\n"
-                 "  compressionScale 0.2\n}}\n\n");
+                 "  integrator \"symplectic-euler\"\n  collisionEvery 1\n  bendEvery {}\n}}\n\n",
+             kFrameRate, kSubsteps, bendEvery);
+  fmt::print(os, "DEF Knit ClothMaterial {{\n  density {:g}\n  thickness {:g}\n  youngsModulus {:g}\n"
+                 "  poissonRatio {:g}\n  damping {:g}\n  staticFriction {:g}\n  dynamicFriction {:g}\n"
+                 "  compressionScale {:g}\n}}\n\n",
+             m.density_kg_m3, m.thickness_m, m.youngsModulus_Pa, m.poissonRatio, m.damping_s, m.staticFriction,
+             m.dynamicFriction, m.compressionScale);
   fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n}}\n\n", o.avatarUrl);
   fmt::print(os, "DEF Skirt ClothSet {{\n  cloth Shape {{\n    appearance Appearance {{ material Material {{ diffuseColor 0.7 0.15 0.2 }} }}\n"
                  "    geometry DEF SkirtMesh IndexedFaceSet {{\n      solid FALSE\n");

@@ -233,7 +233,10 @@ FieldCollider::PartFrame FieldCollider::framePart(const CollisionPart& part, con
 void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_s, ClothState& io) {
   ++counters_.calls;
   if (states_.empty() || states_.front().size() != io.size()) initialise(io, t0_s);
-  if ((calls_++ % every_) != 0) return;  // reduced-frequency collision tests
+  if ((calls_++ % every_) != 0) {  // reduced-frequency collision tests
+    if (countEverySubstep_) countUntested(io, t1_s);
+    return;
+  }
   const double interval_s = t1_s - lastTime_s_;
   if (!(interval_s > 0)) return;
 
@@ -296,6 +299,30 @@ void FieldCollider::countPenetration() {
     penalty_[i] = nearest < offsets_.t1_m;
     field_.vertexSubstepsBelowT1 += penalty_[i];
     if (nearest < offsets_.t0_m) ++field_.vertexSubstepsBelowT0;
+    if (nearest < 0) {
+      ++field_.vertexSubstepsInsideBody;
+      field_.maxPenetration_m = std::max(field_.maxPenetration_m, -nearest);
+    }
+  }
+  counters_.maxPenetration_m = field_.maxPenetration_m;
+}
+
+void FieldCollider::countUntested(const ClothState& io, double t_s) {
+  std::fill(nearest_.begin(), nearest_.end(), std::numeric_limits<double>::infinity());
+  for (std::size_t k = 0; k < parts_.size(); ++k) {
+    const field::DistanceField& f = *parts_[k].field;
+    const Affine toVoxel = worldToVoxel(f, parts_[k].motion->poseAt(t_s));
+    for (std::size_t i = 0; i < io.size(); ++i) {
+      if (!free_[i] || embedded_[k][i]) continue;  // as the tests count: eased pairs stay out
+      const Vec3 c = toVoxel.apply(io.position(i));
+      if (walkable(f, roundVoxel(c))) nearest_[i] = std::min(nearest_[i], f.distanceAtVoxel(c));
+    }
+  }
+  // countPenetration without its penalty flags: those belong to the tests' responses.
+  field_.vertexSubsteps += freeCount_;
+  for (const double nearest : nearest_) {
+    field_.vertexSubstepsBelowT1 += nearest < offsets_.t1_m;
+    field_.vertexSubstepsBelowT0 += nearest < offsets_.t0_m;
     if (nearest < 0) {
       ++field_.vertexSubstepsInsideBody;
       field_.maxPenetration_m = std::max(field_.maxPenetration_m, -nearest);

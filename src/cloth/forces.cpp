@@ -145,7 +145,7 @@ void hingeCornerForces(std::size_t n, const double* __restrict x, const double* 
                        const double* __restrict z, const std::int32_t* __restrict ie0,
                        const std::int32_t* __restrict ie1, const std::int32_t* __restrict ia,
                        const std::int32_t* __restrict ib, const double* __restrict restPsi,
-                       const double* __restrict k, double* __restrict fax, double* __restrict fay,
+                       const double* __restrict k, double scale, double* __restrict fax, double* __restrict fay,
                        double* __restrict faz, double* __restrict fbx, double* __restrict fby,
                        double* __restrict fbz, double* __restrict fex, double* __restrict fey,
                        double* __restrict fez) {
@@ -171,7 +171,7 @@ void hingeCornerForces(std::size_t n, const double* __restrict x, const double* 
     //   u_a = |e| N1 / |N1|^2, u_b = |e| N2 / |N2|^2,
     //   u_e0 = ((a - e1).e N1 / |N1|^2 + (b - e1).e N2 / |N2|^2) / |e|, u_e1 = -(u_a + u_b + u_e0).
     // f_i = -k (psi - psi0) dpsi/dx_i = k (psi - psi0) cos(theta/2) u_i.
-    const double stiffness = k[i], rest = restPsi[i];  // loaded unconditionally: a select, not a masked load
+    const double stiffness = k[i] * scale, rest = restPsi[i];  // loaded unconditionally: a select, not a masked load
     const double m = ok ? stiffness * (psi - rest) * cosHalf : 0.0;
     const double elen = std::sqrt(es), invE = 1.0 / elen;
     const double r1 = m / n1s, r2 = m / n2s;
@@ -220,12 +220,12 @@ void accumulateMembraneForces(const ClothModel& model, ClothState& io) {
   else membraneKernel<false, false>(model, io);
 }
 
-void accumulateBendingForces(const ClothModel& model, ClothState& io) {
+void accumulateBendingForces(const ClothModel& model, ClothState& io, double scale) {
   const BendArrays& h = model.bendArrays();
   const std::size_t n = h.stiffness.size();
   double* w = io.work.data();  // nine columns of n
   hingeCornerForces(n, io.x.data(), io.y.data(), io.z.data(), h.e0.data(), h.e1.data(), h.a.data(), h.b.data(),
-                    h.restPsi.data(), h.stiffness.data(), w, w + n, w + 2 * n, w + 3 * n, w + 4 * n, w + 5 * n,
+                    h.restPsi.data(), h.stiffness.data(), scale, w, w + n, w + 2 * n, w + 3 * n, w + 4 * n, w + 5 * n,
                     w + 6 * n, w + 7 * n, w + 8 * n);
   scatterHinges(n, h.e0.data(), h.e1.data(), h.a.data(), h.b.data(), io.work.data(), io.fx.data(), io.fy.data(),
                 io.fz.data());

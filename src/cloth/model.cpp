@@ -261,6 +261,15 @@ double ClothModel::estimatedStableStep_s() const {
   return std::min(membrane, bending);
 }
 
+double ClothModel::bendingStableStep_s() const {
+  return bendingOmega_ > 0.0 ? 1.8 / bendingOmega_ : std::numeric_limits<double>::infinity();
+}
+
+int suggestedBendEvery(const ClothModel& model, double substep_s) {
+  const double span = 0.1 * model.bendingStableStep_s() / substep_s;
+  return std::clamp(static_cast<int>(std::min(span, 8.0)), 1, 8);
+}
+
 double addedMassFractionAt(const mesh::TriMesh& mesh, const mesh::Topology& topology, const Material& material,
                            double frameRate_hz, int substepsPerFrame) {
   // An unbounded allowance: the model reports the mass it needs instead of refusing.

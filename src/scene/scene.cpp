@@ -60,6 +60,8 @@ void validate(const SimulationSettings& s) {
   positive(s.unitScale, "unitScale");
   if (s.stepsPerFrame < 1) bad(s.source, node, fmt::format("stepsPerFrame {} must be at least 1", s.stepsPerFrame));
   if (s.collisionEvery < 1) bad(s.source, node, fmt::format("collisionEvery {} must be at least 1", s.collisionEvery));
+  if (s.bendEvery < 1 || s.bendEvery > s.stepsPerFrame)
+    bad(s.source, node, fmt::format("bendEvery {} must be in [1, stepsPerFrame {}]", s.bendEvery, s.stepsPerFrame));
   if (!std::isfinite(s.maxAddedMass) || s.maxAddedMass < 0.0 || s.maxAddedMass > 10.0)
     bad(s.source, node, fmt::format("maxAddedMass {:g} must be a fraction in [0, 10]", s.maxAddedMass));
   if (!std::isfinite(s.airViscosity) || s.airViscosity < 0.0)

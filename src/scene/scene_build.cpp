@@ -194,6 +194,7 @@ class Builder {
       take("integrator", [&] { s.integrator = string(n, "integrator"); });
       take("collisionEvery",
            [&] { s.collisionEvery = static_cast<int>(number(n, "collisionEvery", s.collisionEvery)); });
+      take("bendEvery", [&] { s.bendEvery = static_cast<int>(number(n, "bendEvery", s.bendEvery)); });
       take("maxAddedMass", [&] { s.maxAddedMass = number(n, "maxAddedMass", s.maxAddedMass); });
       if (const Field* f = n.field("unitScale"); f != nullptr && !f->isDefault)
         take("unitScale", [&] { s.unitScale = number(n, "unitScale", 1.0); });

@@ -47,6 +47,7 @@ cloth::StepSettings toStepSettings(const scene::SimulationSettings& s) {
   c.airViscosity_Ns_m3 = s.airViscosity;
   c.wind_m_s = s.wind;
   c.maxAddedMass = s.maxAddedMass;
+  c.bendEvery = s.bendEvery;
   c.integrator = cloth::parseIntegrator(s.integrator, "Simulation.integrator");
   return c;
 }

@@ -179,8 +179,9 @@ TEST(BenchCloth, QuickPrintsTheCases) {
 }
 
 // `drape bench paper` on the first frames of the walking skirt, with the collision tests
-// every substep and every third: the keys, the paper's Table 3 beside them, and the
-// reduced frequency seen in the counters.
+// every substep and every third (and bending every fourth): the keys, the paper's
+// Table 3 beside them, the reduced frequency seen in the counters, and the penetration
+// figures still over every substep.
 TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
   testing::ScratchDir dir("bench-paper");
   const auto bench = [&](const std::string& extra) {
@@ -189,7 +190,7 @@ TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
     return nlohmann::json::parse(r.out);
   };
   const nlohmann::json every = bench("");
-  const nlohmann::json third = bench("--collision-every 3");
+  const nlohmann::json third = bench("--collision-every 3 --bend-every 4");
   for (const char* key : {"frames", "sim_fps", "ms_per_frame", "collision_time_share", "mean_collision_path_voxels",
                           "vertex_substeps_inside_body", "animation_ms_per_frame", "collision_every"})
     EXPECT_TRUE(every.contains(key)) << key;
@@ -197,6 +198,10 @@ TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
   EXPECT_EQ(every["paper_table3"]["sim_fps"], 30.2);
   EXPECT_EQ(every["collision_every"], 1);
   EXPECT_EQ(third["collision_every"], 3);
+  EXPECT_EQ(every["bend_every"], 8);  // the scene's
+  EXPECT_EQ(third["bend_every"], 4);
+  EXPECT_GT(every["vertex_substeps"].get<long>(), 0);
+  EXPECT_EQ(third["vertex_substeps"], every["vertex_substeps"]);
   for (const nlohmann::json* j : {&every, &third}) {
     EXPECT_GT((*j)["collision_time_share"].get<double>(), 0.0);
     EXPECT_LT((*j)["collision_time_share"].get<double>(), 1.0);
@@ -205,8 +210,10 @@ TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
   }
   // A third of the tests, each over three substeps' motion: longer paths per test.
   EXPECT_GT(third["mean_collision_path_voxels"].get<double>(), every["mean_collision_path_voxels"].get<double>());
-  const testing::CliResult bad = testing::runDrape("bench paper --json --collision-every 0", dir);
-  EXPECT_NE(bad.code, 0);
+  for (const char* option : {"--collision-every 0", "--bend-every 0"}) {
+    const testing::CliResult bad = testing::runDrape(std::string("bench paper --json ") + option, dir);
+    EXPECT_NE(bad.code, 0) << option;
+  }
 }
 
 }  // namespace

@@ -392,6 +392,53 @@ TEST(FieldCollider, FixedVerticesAreLeftOut) {
   EXPECT_LT(a.fieldCounters().collisions, b.fieldCounters().collisions);
 }
 
+TEST(FieldCollider, CountingEverySubstepReadsTheUntestedOnesAndMovesNothing) {
+  // With tests every third substep, counting every substep adds, on the two substeps between
+  // tests, exactly the points a brute-force location finds inside the body, and changes no
+  // point, state or test figure.
+  // Fast enough (12 mm per substep) to overrun T2 between two tests.
+  const auto motion = std::make_shared<LinearMotion>(Vec3(-0.4, 0, 0), Vec3(12.0, 0, 0));
+  const BodySetup s(field::makeSphere(0.06, Vec3::Zero(), 32, 16), motion);
+  std::mt19937 rng(5);
+  const std::size_t n = 400;
+  ClothState counted = cloudState(n, rng);
+  ClothState plain = counted;
+  FieldCollider a("test", s.parts, kOffsets, 0.5, 0.3, 3);
+  FieldCollider b("test", s.parts, kOffsets, 0.5, 0.3, 3);
+  a.setCountEverySubstep(true);
+  a.initialise(counted, 0.0);
+  b.initialise(plain, 0.0);
+  const Point anchor(Vec3::Zero());
+  const double dt = 1e-3;
+  std::uint64_t untestedInside = 0, bruteForceInside = 0;
+  for (int step = 0; step < 75; ++step) {
+    const std::uint64_t before = a.fieldCounters().vertexSubstepsInsideBody;
+    a.collide(*anchor.model, step * dt, (step + 1) * dt, counted);
+    b.collide(*anchor.model, step * dt, (step + 1) * dt, plain);
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(counted.position(i), plain.position(i)) << "vertex " << i << " step " << step;
+      ASSERT_EQ(counted.velocity(i), plain.velocity(i));
+      ASSERT_EQ(a.state(0, i), b.state(0, i));
+    }
+    if (step % 3 == 0) continue;  // a tested substep: both count it the same way
+    untestedInside += a.fieldCounters().vertexSubstepsInsideBody - before;
+    const Vec3 centre = motion->poseAt((step + 1) * dt).translation;
+    for (std::size_t i = 0; i < n; ++i) {
+      const field::PointLocation l = s.field.locate(counted.position(i) - centre);
+      bruteForceInside += l.inVolume && l.distance_m < 0;
+    }
+  }
+  const FieldCollisionCounters &ca = a.fieldCounters(), &cb = b.fieldCounters();
+  EXPECT_EQ(ca.vertexSubsteps, 75u * n);
+  EXPECT_EQ(cb.vertexSubsteps, 25u * n);
+  EXPECT_EQ(ca.collisions, cb.collisions);
+  EXPECT_EQ(ca.tests, cb.tests);
+  EXPECT_GT(bruteForceInside, 20u) << "the sphere must overrun points between the tests";
+  EXPECT_EQ(untestedInside, bruteForceInside);
+  EXPECT_EQ(ca.vertexSubstepsInsideBody - cb.vertexSubstepsInsideBody, untestedInside);
+  EXPECT_GE(ca.maxPenetration_m, cb.maxPenetration_m);
+}
+
 TEST(FieldCollider, APointPinchedBetweenTwoPartsSettlesBetweenThem) {
   // Two boxes close on a resting point from either side until their faces are 10 mm apart,
   // closer than twice T2 (15 mm): no place is on both offset surfaces. Each part's correction

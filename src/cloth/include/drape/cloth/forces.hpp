@@ -19,8 +19,9 @@ void clearForces(ClothState& io);
 /// Compressive principal stresses are scaled by material.compressionScale.
 void accumulateMembraneForces(const ClothModel& model, ClothState& io);
 
-/// Dihedral hinges: W = k / 2 (psi - psi0)^2 with psi = 2 sin(theta / 2), f = -dW/dx.
-void accumulateBendingForces(const ClothModel& model, ClothState& io);
+/// Dihedral hinges: W = k / 2 (psi - psi0)^2 with psi = 2 sin(theta / 2), f = -dW/dx,
+/// times `scale` (the multiple-time-stepping impulse: bendEvery substeps' worth at once).
+void accumulateBendingForces(const ClothModel& model, ClothState& io, double scale = 1.0);
 
 /// Viscous air drag relative to the wind, per vertex: f = -c A_v (v - wind).
 void accumulateDragForces(const ClothModel& model, const StepSettings& settings, ClothState& io);

@@ -64,6 +64,9 @@ struct StepSettings {
   /// Mass scaling allowed to keep substep_s() stable, as a fraction of each garment's mass;
   /// 0: none (a substep above the stable step is only warned about).
   double maxAddedMass = 0.0;
+  /// Multiple time stepping: bending, the slow force, is evaluated every bendEvery-th substep
+  /// and applied there as an impulse over the bendEvery substeps (r-RESPA); 1: every substep.
+  int bendEvery = 1;
 
   [[nodiscard]] double substep_s() const { return 1.0 / (frameRate_hz * substepsPerFrame); }
   /// What ClothModel::build needs to honour maxAddedMass.

@@ -81,6 +81,8 @@ class ClothSolver {
   void collide(double t0_s, double t1_s);
   void applyFixtures(double t0_s, double t1_s, double dt_s);
   bool checkStability(long frame, int substepIndex);
+  /// Throws drape::Error when bendEvery substeps exceed the bending forces' stable step.
+  void checkBendingStep() const;
 
   std::shared_ptr<const ClothModel> model_;
   StepSettings settings_;
@@ -90,6 +92,7 @@ class ClothSolver {
   ClothState state_;
   StageTimes times_;
   Instability instability_;
+  long substepCount_ = 0;  ///< substeps taken, for the bending rhythm
 };
 
 }  // namespace drape::cloth

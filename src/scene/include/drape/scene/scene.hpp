@@ -50,6 +50,7 @@ struct SimulationSettings {
   double voxelSize = 0.01;                      ///< m, edge of a distance-field voxel
   std::string integrator = "symplectic-euler";  ///< name the cloth solver resolves
   int collisionEvery = 1;                       ///< collide every N substeps
+  int bendEvery = 1;                            ///< bending forces every N substeps, as an impulse
   double maxAddedMass = 0.0;                    ///< mass scaling allowed, fraction of a garment's mass
   double unitScale = 1.0;                       ///< metres per file unit (applied to all geometry on load)
   SourcePos source;                             ///< where the node was written; empty when defaulted

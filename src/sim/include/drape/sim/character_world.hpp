@@ -111,6 +111,7 @@ class CharacterWorld {
   /// For adding extra colliders and stepping garments one by one.
   [[nodiscard]] cloth::ClothSolver& mutableSolver(std::size_t g) { return *garments_[g].solver; }
   [[nodiscard]] const cloth::FieldCollider* collider(std::size_t g) const { return garments_[g].collider.get(); }
+  [[nodiscard]] cloth::FieldCollider* collider(std::size_t g) { return garments_[g].collider.get(); }
   [[nodiscard]] const std::vector<PartField>& fields() const { return fields_; }
   [[nodiscard]] const AvatarPoses& poses() const { return *poses_; }
   /// The garment whose step failed and why, after stepFrame returned false.

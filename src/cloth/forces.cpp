@@ -54,18 +54,21 @@ struct MembraneConstants {
 
 // The kernels run in two passes. Pass 1 (per element, gathers only, no scatter) computes
 // every element's corner forces into the workspace, one column per component; pass 2
-// (scalar) adds them to the vertices. Pass 1 takes its arrays as restrict parameters: GCC 12
+// (scalar) adds them to the vertices: the membrane, every substep, per vertex over its
+// corners (CSR, measured 17 % faster than scattering per triangle); the hinges, every
+// bendEvery substeps, by a scatter. Pass 1 takes its arrays as restrict parameters: GCC 12
 // vectorises it so (gathers included), and not with the same pointers as function locals.
 
-/// Membrane pass 1: f1 and f2 of every triangle into w (columns f1x f1y f1z f2x f2y f2z);
-/// f0 = -(f1 + f2).
+/// Membrane pass 1: the corner forces of every triangle into w (columns f0x f0y f0z f1x f1y
+/// f1z f2x f2y f2z; f0 = -(f1 + f2)).
 template <bool kDamp, bool kSoften>
 void membraneCornerForces(std::size_t n, const MembraneConstants& k, const double* __restrict x,
                           const double* __restrict y, const double* __restrict z, const double* __restrict vx,
                           const double* __restrict vy, const double* __restrict vz, const std::int32_t* __restrict i0,
                           const std::int32_t* __restrict i1, const std::int32_t* __restrict i2,
                           const double* __restrict g1u, const double* __restrict g1v, const double* __restrict g2u,
-                          const double* __restrict g2v, const double* __restrict area, double* __restrict f1x,
+                          const double* __restrict g2v, const double* __restrict area, double* __restrict f0x,
+                          double* __restrict f0y, double* __restrict f0z, double* __restrict f1x,
                           double* __restrict f1y, double* __restrict f1z, double* __restrict f2x,
                           double* __restrict f2y, double* __restrict f2z) {
   const double lambda = k.lambda, mu = k.mu, beta = k.beta, softScale = k.softScale;
@@ -103,6 +106,9 @@ void membraneCornerForces(std::size_t n, const MembraneConstants& k, const doubl
     const double c21 = -A * (s.a * g2u[t] + s.c * g2v[t]), c22 = -A * (s.c * g2u[t] + s.b * g2v[t]);
     const V3 f1 = add(mul(fu, c11), mul(fv, c12));
     const V3 f2 = add(mul(fu, c21), mul(fv, c22));
+    f0x[t] = -(f1.x + f2.x);
+    f0y[t] = -(f1.y + f2.y);
+    f0z[t] = -(f1.z + f2.z);
     f1x[t] = f1.x;
     f1y[t] = f1.y;
     f1z[t] = f1.z;
@@ -112,15 +118,22 @@ void membraneCornerForces(std::size_t n, const MembraneConstants& k, const doubl
   }
 }
 
-/// Membrane pass 2: the corner forces to the vertices.
-void scatterMembrane(std::size_t n, const std::int32_t* i0, const std::int32_t* i1, const std::int32_t* i2,
-                     const double* w, double* fx, double* fy, double* fz) {
-  for (std::size_t t = 0; t < n; ++t) {
-    const V3 f1{w[t], w[n + t], w[2 * n + t]};
-    const V3 f2{w[3 * n + t], w[4 * n + t], w[5 * n + t]};
-    addTo(fx, fy, fz, i1[t], f1);
-    addTo(fx, fy, fz, i2[t], f2);
-    addTo(fx, fy, fz, i0[t], mul(add(f1, f2), -1.0));
+/// Membrane pass 2: each vertex sums its corners' forces (loads only: a scatter's
+/// read-modify-writes would chain through store forwarding where triangles share vertices).
+void gatherMembrane(std::size_t vertices, std::size_t n, const std::int32_t* __restrict start,
+                    const std::int32_t* __restrict offset, const double* __restrict w, double* __restrict fx,
+                    double* __restrict fy, double* __restrict fz) {
+  for (std::size_t v = 0; v < vertices; ++v) {
+    double sx = 0.0, sy = 0.0, sz = 0.0;
+    for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
+      const double* c = w + offset[k];
+      sx += c[0];
+      sy += c[n];
+      sz += c[2 * n];
+    }
+    fx[v] += sx;
+    fy[v] += sy;
+    fz[v] += sz;
   }
 }
 
@@ -130,13 +143,13 @@ void membraneKernel(const ClothModel& model, ClothState& io) {
   const std::size_t n = el.area.size();
   const MembraneConstants k{model.lambdaT(), model.muT(), model.material().damping_s,
                             model.material().compressionScale};
-  double* w = io.work.data();  // six columns of n
+  double* w = io.work.data();  // nine columns of n
   membraneCornerForces<kDamp, kSoften>(n, k, io.x.data(), io.y.data(), io.z.data(), io.vx.data(), io.vy.data(),
                                        io.vz.data(), el.v0.data(), el.v1.data(), el.v2.data(), el.g1u.data(),
                                        el.g1v.data(), el.g2u.data(), el.g2v.data(), el.area.data(), w, w + n, w + 2 * n,
-                                       w + 3 * n, w + 4 * n, w + 5 * n);
-  scatterMembrane(n, el.v0.data(), el.v1.data(), el.v2.data(), io.work.data(), io.fx.data(), io.fy.data(),
-                  io.fz.data());
+                                       w + 3 * n, w + 4 * n, w + 5 * n, w + 6 * n, w + 7 * n, w + 8 * n);
+  gatherMembrane(io.size(), n, el.cornerStart.data(), el.cornerOffset.data(), w, io.fx.data(), io.fy.data(),
+                 io.fz.data());
 }
 
 /// Bending pass 1: the forces on a, b and e0 of every hinge into w (columns fa, fb, fe0, x y z

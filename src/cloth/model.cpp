@@ -237,6 +237,18 @@ void ClothModel::buildKernelData() {
     m.g2v.push_back(el.g2v);
     m.area.push_back(el.restArea_m2);
   }
+  // Corner incidences per vertex, in triangle order (a fixed summation order).
+  const std::size_t n = membrane_.size();
+  m.cornerStart.assign(vertexCount() + 1, 0);
+  for (const MembraneElement& el : membrane_)
+    for (const std::uint32_t v : {el.v0, el.v1, el.v2}) ++m.cornerStart[v + 1];
+  for (std::size_t v = 0; v < vertexCount(); ++v) m.cornerStart[v + 1] += m.cornerStart[v];
+  m.cornerOffset.assign(3 * n, 0);
+  std::vector<std::int32_t> next(m.cornerStart.begin(), m.cornerStart.end() - 1);
+  for (std::size_t t = 0; t < n; ++t) {
+    const std::array<std::uint32_t, 3> corners = {membrane_[t].v0, membrane_[t].v1, membrane_[t].v2};
+    for (std::size_t c = 0; c < 3; ++c) m.cornerOffset[next[corners[c]]++] = static_cast<std::int32_t>(3 * c * n + t);
+  }
   BendArrays& b = bendArrays_;
   for (const BendElement& h : bending_) {
     b.e0.push_back(static_cast<std::int32_t>(h.e0));

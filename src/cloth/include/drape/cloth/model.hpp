@@ -50,6 +50,10 @@ struct BendElement {
 struct MembraneArrays {
   std::vector<std::int32_t> v0, v1, v2;
   std::vector<double> g1u, g1v, g2u, g2v, area;
+  /// Per vertex (CSR: cornerStart[v] .. cornerStart[v + 1]) the offsets of its corner
+  /// forces in the kernel workspace (corner c of triangle t at 3 c n + t, x; y and z n and
+  /// 2 n further): the forces are summed per vertex, loads only, instead of scattered.
+  std::vector<std::int32_t> cornerStart, cornerOffset;
 };
 
 /// The bending hinges as structure of arrays (buildKernelData; same order as bending()).

@@ -10,6 +10,7 @@
 #include <ctime>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include <BulletSoftBody/btSoftBodyHelpers.h>
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
@@ -136,7 +137,8 @@ RunOutcome runDrape(const SheetSize& size, int substeps, long frames) {
 }
 
 /// Runs a case `repeats` times (once if it diverges); ms per frame is the median.
-CaseResult measureDrape(const std::string& name, const SheetSize& size, int substeps, long frames, int repeats) {
+CaseResult measureDrape(const std::string& name, const SheetSize& size, int substeps, long frames, int repeats,
+                        double strainBound = kStrainBound) {
   CaseResult c;
   c.name = name;
   c.substeps = substeps;
@@ -152,9 +154,9 @@ CaseResult measureDrape(const std::string& name, const SheetSize& size, int subs
   c.runs = static_cast<int>(ms.size());
   c.msPerFrame = median(ms);
   c.maxStrain = last.diverged ? std::numeric_limits<double>::quiet_NaN() : last.finalStrain;
-  c.stable = !last.diverged && last.finalStrain <= kStrainBound;
+  c.stable = !last.diverged && last.finalStrain <= strainBound;
   if (last.diverged) c.note = last.why;
-  else if (!c.stable) c.note = fmt::format("final max edge strain {:.3f} above {}", last.finalStrain, kStrainBound);
+  else if (!c.stable) c.note = fmt::format("final max edge strain {:.3f} above {}", last.finalStrain, strainBound);
   return c;
 }
 
@@ -182,7 +184,8 @@ int smallestStableSubsteps(const SheetSize& size, long frames) {
 // ---------------------------------------------------------------------------------------
 // Bullet (btSoftBody, default solver: position-based links, two iterations per substep)
 
-CaseResult measureBullet(const std::string& name, const SheetSize& size, long frames, int repeats) {
+CaseResult measureBullet(const std::string& name, const SheetSize& size, long frames, int repeats,
+                         double strainBound = kStrainBound) {
   CaseResult c;
   c.name = name;
   c.substeps = kSubsteps;
@@ -255,9 +258,9 @@ CaseResult measureBullet(const std::string& name, const SheetSize& size, long fr
   c.runs = static_cast<int>(ms.size());
   c.msPerFrame = median(ms);
   c.maxStrain = strain;
-  c.stable = !diverged && strain <= kStrainBound;
-  if (diverged) c.note = why + (strain > kStrainBound ? fmt::format("; final max link strain {:.3f}", strain) : "");
-  else if (!c.stable) c.note = fmt::format("final max link strain {:.3f} above {}", strain, kStrainBound);
+  c.stable = !diverged && strain <= strainBound;
+  if (diverged) c.note = why + (strain > strainBound ? fmt::format("; final max link strain {:.3f}", strain) : "");
+  else if (!c.stable) c.note = fmt::format("final max link strain {:.3f} above {}", strain, strainBound);
   return c;
 }
 
@@ -271,12 +274,15 @@ struct BenchOptions {
 int runBench(const BenchOptions& o) {
   const long frames = o.quick ? 20 : 300;
   const int repeats = o.quick ? 1 : o.repeats;
+  // The quick run's 20 frames end while the pinned sheet still swings from its impact on the
+  // sphere: its strain is a transient, so only divergence (NaN, speed) decides `stable`.
+  const double strainBound = o.quick ? std::numeric_limits<double>::infinity() : kStrainBound;
   const std::vector<std::pair<std::string, SheetSize>> sizes = {
       {"sheet-480", {16, 15}}, {"sheet-10k", {71, 70}}, {"sheet-40k", {142, 141}}};
   nlohmann::json cases = nlohmann::json::array();
   for (const auto& [name, size] : sizes) {
     spdlog::info("bench cloth: drape {} at {} substeps", name, kSubsteps);
-    const CaseResult c = measureDrape(name, size, kSubsteps, frames, repeats);
+    const CaseResult c = measureDrape(name, size, kSubsteps, frames, repeats, strainBound);
     cases.push_back(c.json());
     if (c.stable || o.quick) continue;
     // Not stable at 33 substeps: the smallest substep count that is (probes of 30 frames
@@ -293,7 +299,7 @@ int runBench(const BenchOptions& o) {
     for (const auto& [name, size] : sizes) {
       spdlog::info("bench cloth: bullet {}", name);
       // Bullet's 40k case takes minutes per run: one run there.
-      bullet.push_back(measureBullet(name, size, frames, size.cellsU > 100 ? 1 : repeats).json());
+      bullet.push_back(measureBullet(name, size, frames, size.cellsU > 100 ? 1 : repeats, strainBound).json());
     }
     peers.push_back({{"name", "bullet-softbody"},
                      {"version", fmt::format("{}", btGetVersion())},
@@ -330,7 +336,8 @@ int runBench(const BenchOptions& o) {
 RunFunction setupBenchCloth(CLI::App& app) {
   auto o = std::make_shared<BenchOptions>();
   app.add_flag("--json", o->json, "One-line JSON (the output is JSON either way)");
-  app.add_flag("--quick", o->quick, "20 frames, one run, no stable-substep search (a smoke test)");
+  app.add_flag("--quick", o->quick,
+               "20 frames, one run, no stable-substep search, `stable` judged on divergence only (a smoke test)");
   app.add_flag("--no-peers", o->noPeers, "Skip the Bullet peer");
   app.add_option("--repeats", o->repeats, "Runs per case (the median is reported)")->check(CLI::Range(1, 100));
   return [o] { return runBench(*o); };

@@ -175,6 +175,8 @@ TEST(BenchCloth, QuickPrintsTheCases) {
       EXPECT_TRUE(c.contains(key)) << key;
   EXPECT_EQ(j["cases"][0]["triangles"], 480);
   EXPECT_EQ(j["cases"][0]["substeps_per_frame"], 33);
+  // 20 frames end mid-swing: the quick run judges divergence, not the transient strain.
+  EXPECT_EQ(j["cases"][0]["stable"], true) << j["cases"][0].dump();
   EXPECT_TRUE(j.contains("peers"));
 }
 

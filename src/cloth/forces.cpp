@@ -55,7 +55,7 @@ struct MembraneConstants {
 // The kernels run in two passes. Pass 1 (per element, gathers only, no scatter) computes
 // every element's corner forces into the workspace, one column per component; pass 2
 // (scalar) adds them to the vertices: the membrane, every substep, per vertex over its
-// corners (CSR, measured 17 % faster than scattering per triangle); the hinges, every
+// corners (CSR: 4.1 instead of 4.3 us on a 480-triangle sheet); the hinges, every
 // bendEvery substeps, by a scatter. Pass 1 takes its arrays as restrict parameters: GCC 12
 // vectorises it so (gathers included), and not with the same pointers as function locals.
 

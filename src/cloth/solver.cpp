@@ -1,7 +1,7 @@
 #include "drape/cloth/solver.hpp"
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -45,7 +45,7 @@ void ClothSolver::checkBendingStep() const {
   if (settings_.bendEvery == 1 || span <= stable) return;  // every substep: the stability guard watches
   const int most = std::max(1, static_cast<int>(stable / settings_.substep_s()));
   throw Error(fmt::format("garment '{}': bending every {} substeps spans {:.3g} ms, above the bending forces' "
-                          "stable step of {:.3g} ms; use bendEvery {} or less",
+                          "stable step of {:.3g} ms; set bendEvery (--bend-every) to {} or less",
                           model_->name(), settings_.bendEvery, 1e3 * span, 1e3 * stable, most));
 }
 
@@ -111,8 +111,12 @@ void ClothSolver::collide(double t0, double t1) {
 
 void ClothSolver::applyFixtures(double t0, double t1, double dt) {
   for (const PinGroup& g : pins_) {
+    // Timed apart: on a moving body this is animation (the skeleton's evaluation and
+    // interpolation, whoever asks first in a substep), which the collision share leaves out.
+    const Clock::time_point poseStart = Clock::now();
     const RigidTransform now = g.motion ? g.motion->poseAt(t1) : RigidTransform::identity();
     const RigidTransform before = g.motion ? g.motion->poseAt(t0) : RigidTransform::identity();
+    times_.fixturePoses_s += secondsSince(poseStart);
     const Mat3 r1 = now.rotation.toRotationMatrix(), r0 = before.rotation.toRotationMatrix();
     const Vec3 p1 = now.translation, p0 = before.translation;
     const double invDt = 1.0 / dt;

@@ -117,7 +117,7 @@ TEST(MultirateBending, ASpanBeyondTheStableStepIsRefusedNamingTheLargest) {
   } catch (const Error& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("garment 'stiff'"), std::string::npos) << what;
-    EXPECT_NE(what.find(fmt::format("use bendEvery {} or less", std::max(1, largest))), std::string::npos) << what;
+    EXPECT_NE(what.find(fmt::format("set bendEvery (--bend-every) to {} or less", std::max(1, largest))), std::string::npos) << what;
   }
   settings.bendEvery = std::max(1, largest);
   EXPECT_NO_THROW(ClothSolver(model, settings));

@@ -29,6 +29,7 @@ struct StageTimes {
   double integrate_s = 0.0;
   double collide_s = 0.0;
   double fixtures_s = 0.0;
+  double fixturePoses_s = 0.0;  ///< the part of fixtures_s spent asking for the fixtures' poses
   double stability_s = 0.0;
 };
 

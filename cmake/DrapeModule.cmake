@@ -22,6 +22,7 @@ function(drape_add_test module)
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.cpp")
   add_executable(test_${module} ${sources})
   target_link_libraries(test_${module} PRIVATE drape::${module} ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+  target_include_directories(test_${module} PRIVATE "${PROJECT_SOURCE_DIR}/tests/support/include")
   target_compile_definitions(test_${module} PRIVATE
     DRAPE_DATA_DIR="${DRAPE_DATA_DIR}"
     DRAPE_SOURCE_DIR="${PROJECT_SOURCE_DIR}"

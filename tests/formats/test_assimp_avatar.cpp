@@ -14,6 +14,7 @@
 
 #include "drape/core/error.hpp"
 #include "drape/formats/assimp_avatar.hpp"
+#include "drape/testing/errors.hpp"
 
 namespace drape::formats {
 namespace {
@@ -21,15 +22,7 @@ namespace {
 std::string tube() { return std::string(DRAPE_TEST_DATA_DIR) + "/avatars/tube_two_joints.dae"; }
 std::string bad(const std::string& f) { return std::string(DRAPE_TEST_DATA_DIR) + "/bad/avatar/" + f; }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ExitCode::BadInput);
-    return e.what();
-  }
-  return "(no error)";
-}
+using drape::testing::errorOf;
 
 std::string slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -9,6 +9,7 @@
 #include "drape/formats/asf_amc.hpp"
 #include "drape/formats/bvh.hpp"
 #include "drape/formats/mhskel.hpp"
+#include "drape/testing/errors.hpp"
 
 namespace drape::formats {
 namespace {
@@ -16,15 +17,7 @@ namespace {
 std::string mocap(const std::string& f) { return std::string(DRAPE_DATA_DIR) + "/mocap/" + f; }
 std::string bad(const std::string& f) { return std::string(DRAPE_TEST_DATA_DIR) + "/bad/motion/" + f; }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ExitCode::BadInput);
-    return e.what();
-  }
-  return "(no error)";
-}
+using drape::testing::errorOf;
 
 TEST(Bvh, ReadsTheCmuWalk) {
   const BvhFile f = readBvh(mocap("cmu_walk_delfem2.bvh"));

@@ -11,6 +11,7 @@
 #include "drape/formats/vrml_read.hpp"
 #include "drape/formats/vrml_scan.hpp"
 #include "drape/formats/vrml_write.hpp"
+#include "drape/testing/errors.hpp"
 
 namespace drape::formats::vrml {
 namespace {
@@ -23,15 +24,7 @@ int count(const Document& d, const std::string& type) {
   return n;
 }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ExitCode::BadInput) << e.what();
-    return e.what();
-  }
-  return "(no error)";
-}
+using drape::testing::errorOf;
 
 std::string tempDir() {
   const auto dir = std::filesystem::temp_directory_path() / ("drape_test_vrml_" + std::to_string(::getpid()));

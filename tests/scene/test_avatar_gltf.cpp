@@ -9,6 +9,7 @@
 #include "drape/core/error.hpp"
 #include "drape/scene/avatar_gltf.hpp"
 #include "drape/scene/avatar_segment.hpp"
+#include "drape/testing/errors.hpp"
 
 namespace drape::scene {
 namespace {
@@ -16,14 +17,7 @@ namespace {
 std::string data(const std::string& file) { return std::string(DRAPE_DATA_DIR) + "/avatars/" + file; }
 std::string bad(const std::string& file) { return std::string(DRAPE_TEST_DATA_DIR) + "/bad/motion/" + file; }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using drape::testing::errorOf;
 
 TEST(GltfAvatar, ReadsInProcessToo) {
   // The same reader without the child process (what the fuzz target exercises).

@@ -12,6 +12,7 @@
 #include "drape/formats/vrml_read.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/scene/scene_build.hpp"
+#include "drape/testing/errors.hpp"
 
 namespace drape::scene {
 namespace {
@@ -22,15 +23,7 @@ Scene fromText(const std::string& text, const std::string& name = "scene.wrl", c
   return buildScene(formats::vrml::readText(text, name, dir));
 }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ExitCode::BadInput) << e.what();
-    return e.what();
-  }
-  return "(no error)";
-}
+using drape::testing::errorOf;
 
 std::string tempDir() {
   const auto dir = std::filesystem::temp_directory_path() / ("drape_test_scene_" + std::to_string(::getpid()));

@@ -284,6 +284,10 @@ int simulateRun(const RunSetup& setup) {
                    g.name, 100.0 * r.model->addedMassFraction(),
                    1e3 * r.model->addedMass_kg(), r.model->massScaledVertexCount(), r.model->vertexCount(),
                    1e3 * settings.substep_s());
+    if (settings.bendEvery > 1)
+      spdlog::info("{}: bending forces every {} substeps ({:.3g} ms, {:.0f} % of their stable step)", g.name,
+                   settings.bendEvery, 1e3 * settings.bendEvery * settings.substep_s(),
+                   100.0 * settings.bendEvery * settings.substep_s() / r.model->bendingStableStep_s());
     if (settings.substep_s() > stable)
       spdlog::warn("{}: the substep {:.3g} s is longer than the estimated stable step {:.3g} s; "
                    "the run may diverge (try --substeps {} or more)",

@@ -124,7 +124,7 @@ std::vector<std::uint64_t> clearanceBits(const field::DistanceField& f, double t
 
 Vec3i entryVoxel(const field::DistanceField& f, const Vec3i& inside, const Vec3i& outside) {
   Vec3i entry = inside;
-  walkVoxels(inside, outside, [&](const Vec3i& p) {
+  walkVoxelsByTable(inside, outside, [&](const Vec3i& p) {
     if (!walkable(f, p)) return false;
     entry = p;
     return true;
@@ -371,7 +371,7 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   // point already slides on the surface, at the first voxel below T2.
   bool hit = false;
   Vec3i hitVoxel = start;
-  const int walked = walkVoxels(start, v1, [&](const Vec3i& p) {
+  const int walked = walkVoxelsByTable(start, v1, [&](const Vec3i& p) {
     if (!walkable(f, p)) return false;
     if (state == PointState::OnSurf) return true;
     const std::uint32_t voxel = f.index(p.x(), p.y(), p.z());

@@ -192,6 +192,37 @@ TEST(FieldCollider, BresenhamLinesAreConnectedAndEndWhereAsked) {
   }
 }
 
+// The lookup-table walk (the paper's alternative to Bresenham, used by the collider) visits
+// exactly the Bresenham voxels: every offset within the table's reach and beyond it, from
+// several starts, whole and stopped early at every voxel.
+TEST(FieldCollider, TableWalkVisitsTheBresenhamVoxels) {
+  const auto voxels = [](auto&& walk, const Vec3i& a, const Vec3i& b, int stopAfter) {
+    std::vector<Vec3i> seen;
+    const int visited = walk(a, b, [&](const Vec3i& p) {
+      seen.push_back(p);
+      return static_cast<int>(seen.size()) != stopAfter;
+    });
+    EXPECT_EQ(visited, static_cast<int>(seen.size()));
+    return seen;
+  };
+  const auto bresenham = [](const Vec3i& a, const Vec3i& b, auto&& v) { return walkVoxels(a, b, v); };
+  const auto table = [](const Vec3i& a, const Vec3i& b, auto&& v) { return walkVoxelsByTable(a, b, v); };
+  const int r = kWalkTableReach + 2;  // beyond the table too
+  int compared = 0;
+  for (const Vec3i& a : {Vec3i(0, 0, 0), Vec3i(10, -3, 7), Vec3i(-5, 12, 40)})
+    for (int z = -r; z <= r; ++z)
+      for (int y = -r; y <= r; ++y)
+        for (int x = -r; x <= r; ++x) {
+          const Vec3i b = a + Vec3i(x, y, z);
+          const std::vector<Vec3i> whole = voxels(bresenham, a, b, 0);
+          ASSERT_EQ(voxels(table, a, b, 0), whole) << "offset " << x << " " << y << " " << z;
+          for (int stop = 1; stop <= static_cast<int>(whole.size()); ++stop)
+            ASSERT_EQ(voxels(table, a, b, stop), voxels(bresenham, a, b, stop));
+          ++compared;
+        }
+  EXPECT_EQ(compared, 3 * (2 * r + 1) * (2 * r + 1) * (2 * r + 1));
+}
+
 TEST(FieldCollider, ExercisesAllNineTransitions) {
   BodySetup s(field::makeSphere(0.1, Vec3::Zero(), 48, 24), std::make_shared<StaticMotion>());
   const double dt = 1e-3;

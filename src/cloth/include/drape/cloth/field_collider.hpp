@@ -65,6 +65,7 @@
 
 #include "drape/cloth/collider.hpp"
 #include "drape/cloth/fixture.hpp"
+#include "drape/cloth/voxel_walk.hpp"
 #include "drape/field/distance_field.hpp"
 
 namespace drape::cloth {
@@ -223,41 +224,6 @@ class FieldCollider final : public Collider {
   ColliderCounters counters_;
   FieldCollisionCounters field_;
 };
-
-/// The voxels of a 3D Bresenham line from voxel `from` to voxel `to` (both included),
-/// stopping early after a voxel for which `visit` returns false. Returns the number of
-/// voxels visited. Exposed for tests.
-template <typename Visit>
-int walkVoxels(const Vec3i& from, const Vec3i& to, Visit&& visit) {
-  Vec3i p = from;
-  const Vec3i d = (to - from).cwiseAbs();
-  const Vec3i s((to.x() > from.x()) - (to.x() < from.x()), (to.y() > from.y()) - (to.y() < from.y()),
-                (to.z() > from.z()) - (to.z() < from.z()));
-  int axis = 0;
-  if (d.y() > d[axis]) axis = 1;
-  if (d.z() > d[axis]) axis = 2;
-  const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
-  const int n = d[axis];
-  int e1 = 2 * d[a1] - n, e2 = 2 * d[a2] - n;
-  int visited = 1;
-  if (!visit(p)) return visited;
-  for (int i = 0; i < n; ++i) {
-    if (e1 > 0) {
-      p[a1] += s[a1];
-      e1 -= 2 * n;
-    }
-    if (e2 > 0) {
-      p[a2] += s[a2];
-      e2 -= 2 * n;
-    }
-    e1 += 2 * d[a1];
-    e2 += 2 * d[a2];
-    p[axis] += s[axis];
-    ++visited;
-    if (!visit(p)) break;
-  }
-  return visited;
-}
 
 /// The entry voxel of a walk that comes from outside the volume: walking backwards from
 /// `inside` (walkable) towards `outside`, the last walkable voxel before the walk leaves the

@@ -115,7 +115,16 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
   }
   stats["mean_collision_path_voxels"] = sum.meanPathVoxels();
   stats["points_per_state"] = {{"outside_vol", states[0]}, {"inside_vol", states[1]}, {"on_surf", states[2]}};
-  stats["vertex_substeps"] = sum.vertexSubsteps;
+  stats["vertex_substeps"] = sum.vertexSubsteps;  // free vertices x the substeps counted
+  int every = 1;
+  bool everySubstep = true;
+  for (const GarmentRun& r : runs)
+    if (r.collider) {
+      every = std::max(every, r.collider->every());
+      everySubstep = everySubstep && r.collider->countsEverySubstep();
+    }
+  stats["collision_every"] = every;
+  stats["penetration_counted_on"] = everySubstep ? "every substep" : "tested substeps";
   stats["vertex_substeps_below_T1"] = sum.vertexSubstepsBelowT1;
   stats["vertex_substeps_below_T0"] = sum.vertexSubstepsBelowT0;
   stats["vertex_substeps_inside_body"] = sum.vertexSubstepsInsideBody;
@@ -269,6 +278,7 @@ int simulateRun(const RunSetup& setup) {
     if (world) {
       r.solver = &world->mutableSolver(gi);
       r.collider = world->collider(gi);
+      world->collider(gi)->setCountEverySubstep(setup.countEverySubstep);
     } else {
       const mesh::Topology topology = mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
       auto model = cloth::ClothModel::build(g.mesh, topology, g.material, settings.massScaling());

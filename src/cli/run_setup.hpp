@@ -46,6 +46,9 @@ struct RunSetup {
   long objEvery = 1;                   ///< write an OBJ frame every K frames
   std::string outDir;
   bool preview = false;                ///< also a contact sheet and (with ffmpeg) an MP4
+  /// With reduced-frequency collision tests, count penetration on every substep (not only
+  /// the tested ones): about a collision test's time on each untested substep.
+  bool countEverySubstep = false;
 };
 
 /// Garments, materials, settings and the avatar (as the setup's character, without motion)

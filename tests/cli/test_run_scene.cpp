@@ -26,6 +26,33 @@ using testing::slurp;
 
 const std::string kSkirtDir = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt";
 
+// `--collision-every 3` runs the collision tests on every third substep; stats.json then
+// counts penetration on those only, unless `--count-every-substep` asks for all of them,
+// which reads and moves nothing: the same motion, three times the substeps counted.
+TEST(RunScene, ReducedFrequencyTestsSayWhatTheirFiguresCount) {
+  ScratchDir dir("run-collision-every");
+  const auto run = [&](const std::string& name, const std::string& extra) {
+    const std::string out = dir / name;
+    const CliResult r = runDrape("run '" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir +
+                                     "/walk.bvh' --lead-in 0.2 --frames 15 --collision-every 3 " + extra + " --out '" +
+                                     out + "'",
+                                 dir);
+    EXPECT_EQ(r.code, 0) << r.err;
+    return out;
+  };
+  const std::string tested = run("tested", ""), every = run("every", "--count-every-substep");
+  const nlohmann::json a = nlohmann::json::parse(slurp(tested + "/stats.json"));
+  const nlohmann::json b = nlohmann::json::parse(slurp(every + "/stats.json"));
+  EXPECT_EQ(a["collision_every"], 3);
+  EXPECT_EQ(a["penetration_counted_on"], "tested substeps");
+  EXPECT_EQ(b["penetration_counted_on"], "every substep");
+  // 16 frames (the initial one is not stepped: 15 x 33 substeps), 240 free vertices.
+  EXPECT_EQ(b["vertex_substeps"].get<long>(), 15L * 33 * 240);
+  EXPECT_EQ(b["vertex_substeps"].get<long>(), 3 * a["vertex_substeps"].get<long>());
+  EXPECT_EQ(slurp(tested + "/garment.pc2"), slurp(every + "/garment.pc2"));
+  EXPECT_EQ(b["vertex_substeps_inside_body"], 0);
+}
+
 TEST(RunScene, WalkingSkirtWritesEverything) {
   ScratchDir dir("run-walking-skirt");
   const std::string out = dir / "out";

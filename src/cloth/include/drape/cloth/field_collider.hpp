@@ -134,6 +134,9 @@ class FieldCollider final : public Collider {
   /// substeps between tests, reading where the points are and moving none: the figures then
   /// cover every substep, at the cost of a distance read per point and part on each.
   void setCountEverySubstep(bool on) { countEverySubstep_ = on; }
+  [[nodiscard]] bool countsEverySubstep() const { return countEverySubstep_ || every_ == 1; }
+  /// The collision tests run every every() substeps.
+  [[nodiscard]] int every() const { return every_; }
   /// Off: no pair skips its distance reads through the clearance bits (the reference the
   /// skip is tested against). On by default.
   void setClearanceSkip(bool on) { clearanceSkip_ = on; }

@@ -293,12 +293,15 @@ std::size_t FieldCollider::selectCandidates(std::size_t k, const PartFrame& fram
 }
 
 void FieldCollider::countPenetration() {
+  for (std::size_t i = 0; i < nearest_.size(); ++i) penalty_[i] = nearest_[i] < offsets_.t1_m;
+  countNearest();
+}
+
+void FieldCollider::countNearest() {
   field_.vertexSubsteps += freeCount_;
-  for (std::size_t i = 0; i < nearest_.size(); ++i) {
-    const double nearest = nearest_[i];
-    penalty_[i] = nearest < offsets_.t1_m;
-    field_.vertexSubstepsBelowT1 += penalty_[i];
-    if (nearest < offsets_.t0_m) ++field_.vertexSubstepsBelowT0;
+  for (const double nearest : nearest_) {
+    field_.vertexSubstepsBelowT1 += nearest < offsets_.t1_m;
+    field_.vertexSubstepsBelowT0 += nearest < offsets_.t0_m;
     if (nearest < 0) {
       ++field_.vertexSubstepsInsideBody;
       field_.maxPenetration_m = std::max(field_.maxPenetration_m, -nearest);
@@ -318,17 +321,7 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
       if (walkable(f, roundVoxel(c))) nearest_[i] = std::min(nearest_[i], f.distanceAtVoxel(c));
     }
   }
-  // countPenetration without its penalty flags: those belong to the tests' responses.
-  field_.vertexSubsteps += freeCount_;
-  for (const double nearest : nearest_) {
-    field_.vertexSubstepsBelowT1 += nearest < offsets_.t1_m;
-    field_.vertexSubstepsBelowT0 += nearest < offsets_.t0_m;
-    if (nearest < 0) {
-      ++field_.vertexSubstepsInsideBody;
-      field_.maxPenetration_m = std::max(field_.maxPenetration_m, -nearest);
-    }
-  }
-  counters_.maxPenetration_m = field_.maxPenetration_m;
+  countNearest();  // not the penalty flags: those belong to the tests' responses
 }
 
 void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::size_t i, const Vec3& c1, double dt_s,

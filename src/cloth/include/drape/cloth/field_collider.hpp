@@ -185,8 +185,11 @@ class FieldCollider final : public Collider {
   /// Moves every point by the mean of its parts' displacements; then the penetration
   /// figures of the corrected pairs, where the points ended.
   void applyCorrections(ClothState& io);
-  /// Penetration after the response, against the nearest part (the counters of Table 3).
+  /// Penetration after the response, against the nearest part (the counters of Table 3),
+  /// and the penalty flags of the points below T1.
   void countPenetration();
+  /// The penetration counters from nearest_ (countPenetration, countUntested).
+  void countNearest();
   /// The penetration figures of an untested substep ending at t_s (setCountEverySubstep).
   void countUntested(const ClothState& io, double t_s);
 

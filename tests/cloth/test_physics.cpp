@@ -271,6 +271,10 @@ TEST(Fixtures, PinnedVerticesFollowTheirTransform) {
     const Vec3 expected = pose.apply(Vec3(model->restX()[v], model->restY()[v], model->restZ()[v]));
     EXPECT_LT((solver.state().position(v) - expected).norm(), 1e-12);
   }
+  // The pose fetches are timed apart (animation, which the collision share leaves out) and
+  // are part of the fixtures' stage.
+  EXPECT_GT(solver.stageTimes().fixturePoses_s, 0.0);
+  EXPECT_LE(solver.stageTimes().fixturePoses_s, solver.stageTimes().fixtures_s);
 }
 
 // ---------------------------------------------------------------------------------------

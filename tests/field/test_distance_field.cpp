@@ -96,6 +96,35 @@ TEST(DistanceField, PointQueriesInterpolateBetweenVoxelCentres) {
   EXPECT_TRUE(f.bounds().contains(f.bodyBounds().max));
 }
 
+TEST(DistanceField, JetGradientIsTheTrilinearDerivative) {
+  // The jet's gradient against central differences of the trilinear distance, at random
+  // points away from the cell faces (where the derivative jumps); its sample is
+  // sampleAtVoxel's; beyond the grid, the clamped axis has no gradient.
+  const DistanceField f = DistanceField::build(makeRoundedTube(0.06, 0.04, 0.4), sphereSettings(FieldMethod::Dvdp));
+  std::mt19937 rng(13);
+  const GridDims& d = f.dims();
+  std::uniform_real_distribution<double> inCell(0.05, 0.95);
+  std::uniform_int_distribution<int> cx(0, d.nx - 2), cy(0, d.ny - 2), cz(0, d.nz - 2);
+  const double e = 1e-4;
+  double largest = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const Vec3 c(cx(rng) + inCell(rng), cy(rng) + inCell(rng), cz(rng) + inCell(rng));
+    const FieldJet jet = f.jetAtVoxel(c);
+    const FieldSample sample = f.sampleAtVoxel(c);
+    ASSERT_EQ(jet.sample.distance_m, sample.distance_m);
+    ASSERT_EQ(jet.sample.normal, sample.normal);
+    for (int axis = 0; axis < 3; ++axis) {
+      const Vec3 step = e * Vec3::Unit(axis);
+      const double difference = (f.distanceAtVoxel(c + step) - f.distanceAtVoxel(c - step)) / (2 * e);
+      ASSERT_NEAR(jet.gradient[axis], difference, 1e-9) << "point " << c.transpose() << " axis " << axis;
+      largest = std::max(largest, std::abs(jet.gradient[axis]));
+    }
+  }
+  EXPECT_GT(largest, 0.5 * f.voxelSize());  // a distance field: about one voxel per voxel
+  const FieldJet beyond = f.jetAtVoxel(Vec3(-3.0, d.ny / 2.0 + 0.3, d.nz / 2.0 + 0.3));
+  EXPECT_EQ(beyond.gradient.x(), 0.0);
+}
+
 TEST(DistanceField, DvdpAndExactAgreeWithinTheShellAndReferencesAreSurfaceVoxels) {
   const mesh::TriMesh tube = makeRoundedTube(0.05, 0.035, 0.3);
   const DistanceField a = DistanceField::build(tube, sphereSettings(FieldMethod::Dvdp));

@@ -60,6 +60,13 @@ struct FieldSample {
   Vec3 normal = Vec3::UnitZ();  ///< unit, pointing away from the body (local frame)
 };
 
+/// A sample and the gradient of the trilinear distance at the same point, from one gather:
+/// enough to continue the distance to first order (a tangent plane).
+struct FieldJet {
+  FieldSample sample;
+  Vec3 gradient = Vec3::Zero();  ///< m of distance per voxel of motion, the grid's axes
+};
+
 /// The result of DistanceField::locate for a local point.
 struct PointLocation {
   bool inVolume = false;      ///< inside the grid and not in the border layer
@@ -133,6 +140,9 @@ class DistanceField {
   // both from the one gather of 8 voxels when both are needed.
   [[nodiscard]] double distanceAtVoxel(const Vec3& voxel) const;
   [[nodiscard]] FieldSample sampleAtVoxel(const Vec3& voxel) const;
+  /// sampleAtVoxel and the trilinear distance's gradient (zero along an axis where the point
+  /// lies beyond the grid, which clamps it there).
+  [[nodiscard]] FieldJet jetAtVoxel(const Vec3& voxel) const;
 
   // --- Voronoi cells (cold: binary search) -----------------------------------------------------
   /// Surface voxels whose Voronoi cell holds this voxel (empty beyond the shell).
@@ -160,6 +170,8 @@ class DistanceField {
   struct Gather {
     std::array<std::size_t, 8> voxel;
     std::array<double, 8> weight;
+    double fx, fy, fz;  ///< the point's place in the cell, 0 to 1 per axis
+    bool clampedX, clampedY, clampedZ;  ///< beyond the grid's first or last voxel centre
   };
   [[nodiscard]] Gather gatherAt(const Vec3& voxel) const;
   [[nodiscard]] double blendDistance(const Gather& g) const;
@@ -183,16 +195,21 @@ class DistanceField {
 };
 
 inline DistanceField::Gather DistanceField::gatherAt(const Vec3& c) const {
-  const auto axis = [](double v, int n, int& i) {
-    v = std::clamp(v, 0.0, static_cast<double>(n - 1));
-    i = std::min(static_cast<int>(v), n - 2);
-    return v - i;
+  const auto axis = [](double v, int n, int& i, bool& clamped) {
+    const double inside = std::clamp(v, 0.0, static_cast<double>(n - 1));
+    clamped = inside != v;
+    i = std::min(static_cast<int>(inside), n - 2);
+    return inside - i;
   };
   int x, y, z;
-  const double fx = axis(c.x(), dims_.nx, x), fy = axis(c.y(), dims_.ny, y), fz = axis(c.z(), dims_.nz, z);
+  Gather g;
+  const double fx = axis(c.x(), dims_.nx, x, g.clampedX), fy = axis(c.y(), dims_.ny, y, g.clampedY),
+               fz = axis(c.z(), dims_.nz, z, g.clampedZ);
+  g.fx = fx;
+  g.fy = fy;
+  g.fz = fz;
   const std::size_t base = dims_.index(x, y, z);
   const std::size_t sy = static_cast<std::size_t>(dims_.nx), sz = sy * static_cast<std::size_t>(dims_.ny);
-  Gather g;
   for (int k = 0; k < 8; ++k) {
     g.voxel[k] = base + ((k & 1) ? 1 : 0) + ((k & 2) ? sy : 0) + ((k & 4) ? sz : 0);
     g.weight[k] = ((k & 1) ? fx : 1 - fx) * ((k & 2) ? fy : 1 - fy) * ((k & 4) ? fz : 1 - fz);
@@ -239,6 +256,23 @@ inline double DistanceField::distanceAtVoxel(const Vec3& c) const { return blend
 inline FieldSample DistanceField::sampleAtVoxel(const Vec3& c) const {
   const Gather g = gatherAt(c);
   return {blendDistance(g), blendNormal(g, c)};
+}
+
+inline FieldJet DistanceField::jetAtVoxel(const Vec3& c) const {
+  const Gather g = gatherAt(c);
+  double v[8];
+  for (int k = 0; k < 8; ++k) v[k] = distance_[g.voxel[k]];
+  // The derivative of the trilinear blend along each axis: the differences across the cell
+  // along that axis, blended over the other two (voxel k has x in bit 0, y in bit 1, z in bit 2).
+  const double fx = g.fx, fy = g.fy, fz = g.fz;
+  const double dx = (1 - fy) * (1 - fz) * (v[1] - v[0]) + fy * (1 - fz) * (v[3] - v[2]) +
+                    (1 - fy) * fz * (v[5] - v[4]) + fy * fz * (v[7] - v[6]);
+  const double dy = (1 - fx) * (1 - fz) * (v[2] - v[0]) + fx * (1 - fz) * (v[3] - v[1]) +
+                    (1 - fx) * fz * (v[6] - v[4]) + fx * fz * (v[7] - v[5]);
+  const double dz = (1 - fx) * (1 - fy) * (v[4] - v[0]) + fx * (1 - fy) * (v[5] - v[1]) +
+                    (1 - fx) * fy * (v[6] - v[2]) + fx * fy * (v[7] - v[3]);
+  const Vec3 gradient(g.clampedX ? 0.0 : dx, g.clampedY ? 0.0 : dy, g.clampedZ ? 0.0 : dz);
+  return {{blendDistance(g), blendNormal(g, c)}, gradient * metresPerUnit_};
 }
 
 /// Grid placement for a part: its bounding box plus `border` voxels each side (cubic voxels

@@ -108,6 +108,8 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
     sum.vertexSubsteps += c.vertexSubsteps;
     sum.maxPenetration_m = std::max(sum.maxPenetration_m, c.maxPenetration_m);
     sum.embeddedAtStart += c.embeddedAtStart;
+    sum.planeEstimates += c.planeEstimates;
+    sum.planeReads += c.planeReads;
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) sum.transitions[a][b] += c.transitions[a][b];
     const auto now = r.collider->pointsPerState();
@@ -132,6 +134,9 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
   stats["collisions_registered"] = sum.collisions;
   stats["last_resort_projections"] = sum.projections;
   stats["pairs_embedded_at_start"] = sum.embeddedAtStart;
+  const std::uint64_t slidingReads = sum.planeEstimates + sum.planeReads;
+  stats["sliding_reads_from_contact_planes"] =
+      slidingReads ? static_cast<double>(sum.planeEstimates) / static_cast<double>(slidingReads) : 0.0;
   nlohmann::json transitions;
   const char* names[3] = {"outside_vol", "inside_vol", "on_surf"};
   for (int a = 0; a < 3; ++a)

@@ -188,6 +188,7 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   if (free_.size() != n) setFixedVertices({}, n);
   states_.assign(parts_.size(), std::vector<PointState>(n, PointState::OutsideVol));
   lastVoxel_.assign(parts_.size(), std::vector<Vec3>(n, Vec3::Zero()));
+  planes_.assign(parts_.size(), std::vector<ContactPlane>(n));
   penalty_.assign(n, 0);
   embedded_.assign(parts_.size(), std::vector<std::uint8_t>(n, 0));
   for (std::vector<double>* v : {&correctionX_, &correctionY_, &correctionZ_}) v->assign(n, 0.0);
@@ -234,13 +235,13 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
   ++counters_.calls;
   if (states_.empty() || states_.front().size() != io.size()) initialise(io, t0_s);
   if ((calls_++ % every_) != 0) {  // reduced-frequency collision tests
-    if (countEverySubstep_) countUntested(io, t1_s);
+    if (countEverySubstep_ && measurePenetration_) countUntested(io, t1_s);
     return;
   }
   const double interval_s = t1_s - lastTime_s_;
   if (!(interval_s > 0)) return;
 
-  std::fill(nearest_.begin(), nearest_.end(), std::numeric_limits<double>::infinity());
+  if (measurePenetration_) std::fill(nearest_.begin(), nearest_.end(), std::numeric_limits<double>::infinity());
   for (std::vector<double>* v : {&correctionX_, &correctionY_, &correctionZ_}) std::fill(v->begin(), v->end(), 0.0);
   std::fill(corrections_.begin(), corrections_.end(), std::uint16_t{0});
   corrected_.clear();
@@ -264,7 +265,7 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
     }
   }
   applyCorrections(io);
-  countPenetration();
+  if (measurePenetration_) countPenetration();
   lastTime_s_ = t1_s;
 }
 
@@ -394,8 +395,9 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   bool moved = false;
   // Most pairs are InsideVol far from the body: they need the distance only. The normal
   // comes with it (one gather) where a response will read it.
-  const bool needNormal = state == PointState::OnSurf || hit;
-  field::FieldSample at = needNormal ? f.sampleAtVoxel(c) : field::FieldSample{f.distanceAtVoxel(c), Vec3::Zero()};
+  field::FieldSample at = state == PointState::OnSurf ? slidingSample(k, i, c)
+                          : hit                       ? f.sampleAtVoxel(c)
+                                                      : field::FieldSample{f.distanceAtVoxel(c), Vec3::Zero()};
   if (state != PointState::OnSurf && (hit || at.distance_m < offsets_.t2_m)) {
     // Collision: stop where the path meets T2. The contact point is the path point nearest
     // the first voxel below T2, moved along the offset-surface normal onto T2.
@@ -430,7 +432,7 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   }
 
   if (moved) {
-    at = f.sampleAtVoxel(c);  // the response reads the field where the point is to be
+    at = slidingSample(k, i, c);  // the response reads the field where the point is to be
     addCorrection(i, frame.toWorld1.apply(c) - io.position(i));
     corrected_.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(i)});
   } else {
@@ -439,6 +441,18 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   if (state == PointState::OnSurf) respondOnSurface(frame, c, at, i, dt_s, io);
   last = c;
   ++field_.transitions[toIndex(from)][toIndex(state)];
+}
+
+field::FieldSample FieldCollider::slidingSample(std::size_t k, std::size_t i, const Vec3& c) {
+  ContactPlane& plane = planes_[k][i];
+  if (contactPlanes_ && plane.reaches(c)) {
+    ++field_.planeEstimates;
+    return {plane.distanceAt(c), plane.normal};
+  }
+  ++field_.planeReads;
+  const field::FieldJet jet = parts_[k].field->jetAtVoxel(c);
+  plane = {c, jet.gradient, jet.sample.normal, jet.sample.distance_m};
+  return jet.sample;
 }
 
 // A point that ends in a voxel marked clear of T2, without a collision on its way, is where
@@ -502,6 +516,7 @@ void FieldCollider::applyCorrections(ClothState& io) {
     io.y[i] += share * correctionY_[i];
     io.z[i] += share * correctionZ_[i];
   }
+  if (!measurePenetration_) return;
   // The penetration figures of corrected pairs: where the points ended.
   for (const auto& [k, i] : corrected_) {
     const double d = parts_[k].field->distanceAtVoxel(frames_[k].toVoxel1.apply(io.position(i)));

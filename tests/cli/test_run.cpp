@@ -193,6 +193,7 @@ TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
   };
   const nlohmann::json every = bench("");
   const nlohmann::json third = bench("--collision-every 3 --bend-every 4");
+  const nlohmann::json exact = bench("--exact-sliding");
   for (const char* key : {"frames", "sim_fps", "ms_per_frame", "collision_time_share", "mean_collision_path_voxels",
                           "vertex_substeps_inside_body", "animation_ms_per_frame", "collision_every"})
     EXPECT_TRUE(every.contains(key)) << key;
@@ -204,7 +205,13 @@ TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
   EXPECT_EQ(third["bend_every"], 4);
   EXPECT_GT(every["vertex_substeps"].get<long>(), 0);
   EXPECT_EQ(third["vertex_substeps"], every["vertex_substeps"]);
-  for (const nlohmann::json* j : {&every, &third}) {
+  // Sliding tests answered by contact planes, unless every one reads the field.
+  EXPECT_EQ(every["contact_planes"], true);
+  EXPECT_GT(every["sliding_reads_from_contact_planes"].get<double>(), 0.5);
+  EXPECT_EQ(exact["contact_planes"], false);
+  EXPECT_EQ(exact["sliding_reads_from_contact_planes"], 0.0);
+  EXPECT_EQ(exact["vertex_substeps"], every["vertex_substeps"]);
+  for (const nlohmann::json* j : {&every, &third, &exact}) {
     EXPECT_GT((*j)["collision_time_share"].get<double>(), 0.0);
     EXPECT_LT((*j)["collision_time_share"].get<double>(), 1.0);
     EXPECT_GE((*j)["animation_ms_per_frame"].get<double>(), 0.0);

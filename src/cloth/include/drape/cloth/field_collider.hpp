@@ -55,6 +55,14 @@
 // walk itself skips the distance read of such voxels. States, positions and the collision
 // counters are those of the full test (tested against it); the penetration statistics only
 // miss distances above T2, which no threshold below T2 can see.
+//
+// Contact planes (most of the remaining field reads are sliding pairs'): a sliding point
+// moves a few hundredths of a voxel per substep relative to its part, and the field is
+// fixed in the part's frame. Each sliding pair keeps its last read (distance, the trilinear
+// distance's gradient, the normal) and answers its tests from it while it stays within half
+// a voxel of the read (ContactPlane): the distance from the tangent plane, the normal as
+// read. Collisions, first contacts and releases read the field; the planes' error against
+// the field is measured in the tests.
 
 #include <array>
 #include <cstdint>
@@ -83,6 +91,24 @@ struct OffsetSurfaces {
 
 enum class PointState : std::uint8_t { OutsideVol = 0, InsideVol = 1, OnSurf = 2 };
 
+/// A sliding pair's first-order picture of its part's field: the distance, its gradient and
+/// the offset-surface normal read at `at` (the part's continuous voxel coordinates). The
+/// field is fixed in the part's frame, so the picture never goes stale; it answers for points
+/// within kReach_voxels of `at` (FieldCollider::setContactPlanes).
+struct ContactPlane {
+  Vec3 at = Vec3::Constant(1e30);  ///< far from everything: no plane yet
+  Vec3 gradient = Vec3::Zero();    ///< of the trilinear distance, m per voxel
+  Vec3 normal = Vec3::UnitZ();     ///< unit, the part's frame: the response's direction
+  double distance_m = 0;
+
+  /// How far from `at` (voxels) the plane answers for the field.
+  static constexpr double kReach_voxels = 0.5;
+
+  [[nodiscard]] bool reaches(const Vec3& c) const { return (c - at).squaredNorm() <= kReach_voxels * kReach_voxels; }
+  /// The trilinear distance at c, to first order.
+  [[nodiscard]] double distanceAt(const Vec3& c) const { return distance_m + gradient.dot(c - at); }
+};
+
 /// One collidable body part. The field must outlive the collider.
 struct CollisionPart {
   std::string name;
@@ -104,6 +130,8 @@ struct FieldCollisionCounters {
   double maxPenetration_m = 0;      ///< deepest point below the body surface after the response
   std::uint64_t clearanceSkips = 0;  ///< pairs that stayed InsideVol without a trilinear read
   std::uint64_t embeddedAtStart = 0;  ///< (vertex, part) pairs below T1 at the start, eased out onto T2
+  std::uint64_t planeEstimates = 0;  ///< sliding pairs' field reads answered by their contact plane
+  std::uint64_t planeReads = 0;      ///< sliding pairs' field reads that went to the field
   std::array<std::array<std::uint64_t, 3>, 3> transitions{};  ///< [from][to] PointState counts
 
   /// Mean voxel path per tested (vertex, part) pair: the paper's "average collision path
@@ -134,9 +162,22 @@ class FieldCollider final : public Collider {
   /// substeps between tests, reading where the points are and moving none: the figures then
   /// cover every substep, at the cost of a distance read per point and part on each.
   void setCountEverySubstep(bool on) { countEverySubstep_ = on; }
-  [[nodiscard]] bool countsEverySubstep() const { return countEverySubstep_ || every_ == 1; }
+  [[nodiscard]] bool countsEverySubstep() const {
+    return measurePenetration_ && (countEverySubstep_ || every_ == 1);
+  }
   /// The collision tests run every every() substeps.
   [[nodiscard]] int every() const { return every_; }
+  /// Off: a sliding pair reads the field on every test (the reference the planes are tested
+  /// against). On by default: a sliding pair reads the field where it slides and answers
+  /// its next tests from that read's tangent plane while it stays within the plane's reach
+  /// (ContactPlane::kReach_voxels).
+  void setContactPlanes(bool on) { contactPlanes_ = on; }
+  /// Off: the collider keeps no penetration figures (vertex_substeps_*, max_penetration_m,
+  /// the penalty display flags): a timed run then times the collision work alone, and the
+  /// figures come from another run of the same motion, which they do not change. On by
+  /// default.
+  void setMeasurePenetration(bool on) { measurePenetration_ = on; }
+  [[nodiscard]] bool measuresPenetration() const { return measurePenetration_; }
   /// Off: no pair skips its distance reads through the clearance bits (the reference the
   /// skip is tested against). On by default.
   void setClearanceSkip(bool on) { clearanceSkip_ = on; }
@@ -177,6 +218,9 @@ class FieldCollider final : public Collider {
                     ClothState& io);
   /// Pair (k, vertex) ends at voxel coordinates c1 in a voxel clear of T2: InsideVol.
   void stayInside(std::size_t k, std::size_t vertex, const Vec3& c1);
+  /// The field at c for sliding pair (k, vertex): from its contact plane when the plane
+  /// reaches c, else read (and the plane moved there).
+  [[nodiscard]] field::FieldSample slidingSample(std::size_t k, std::size_t vertex, const Vec3& c);
   /// The velocity response of a point in contact with a part (friction, penalty floor).
   void respondOnSurface(const PartFrame& frame, const Vec3& voxel, const field::FieldSample& at, std::size_t vertex,
                         double dt_s, ClothState& io) const;
@@ -201,6 +245,8 @@ class FieldCollider final : public Collider {
   bool boxCulling_ = true;
   bool countEverySubstep_ = false;
   bool clearanceSkip_ = true;
+  bool contactPlanes_ = true;
+  bool measurePenetration_ = true;
   long calls_ = 0;
   double poseSeconds_ = 0;
   std::vector<PartFrame> frames_;  ///< per part, this interval's transforms (collide)
@@ -208,6 +254,7 @@ class FieldCollider final : public Collider {
   double lastTime_s_ = 0;
   std::vector<std::vector<PointState>> states_;   ///< [part][vertex]
   std::vector<std::vector<Vec3>> lastVoxel_;      ///< [part][vertex], part's voxel coordinates at lastTime
+  std::vector<std::vector<ContactPlane>> planes_;  ///< [part][vertex], the last field read of a sliding pair
   std::vector<std::uint8_t> penalty_;             ///< per vertex: below T1 of some part now
   /// [part][vertex]: the point started below T1 of the part and is being eased out onto T2
   /// (releaseEmbedded) rather than thrown there in one substep.

@@ -199,6 +199,7 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   for (std::vector<double>* v : {&endVoxelX_, &endVoxelY_, &endVoxelZ_, &nearest_}) v->assign(n, 0.0);
   keep_.assign(n + 8, 0);  // padded: the candidate scan reads eight flags at a time
   candidates_.assign(n, 0);
+  settledVoxel_.assign(parts_.size(), std::vector<Vec3i>(n, kNotSettled));
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     const field::DistanceField& f = *parts_[k].field;
     const Affine toVoxel = worldToVoxel(f, parts_[k].motion->poseAt(t_s));
@@ -259,9 +260,15 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
     field_.tests += freeCount_;
     counters_.pointsTested += freeCount_;
     field_.transitions[0][0] += freeCount_ - kept;
+    const std::vector<Vec3i>& settled = settledVoxel_[k];
     for (std::size_t j = 0; j < kept; ++j) {
       const std::uint32_t i = candidates_[j];
-      collidePoint(k, frame, i, Vec3(endVoxelX_[i], endVoxelY_[i], endVoxelZ_[i]), interval_s, io);
+      const Vec3 c1(endVoxelX_[i], endVoxelY_[i], endVoxelZ_[i]);
+      if (roundVoxel(c1) == settled[i]) {
+        settle(k, i, c1);
+      } else {
+        collidePoint(k, frame, i, c1, interval_s, io);
+      }
     }
   }
   applyCorrections(io);
@@ -331,6 +338,7 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   PointState& state = states_[k][i];
   Vec3& last = lastVoxel_[k][i];
   const PointState from = state;
+  settledVoxel_[k][i] = kNotSettled;  // stayInside sets it again
   if (embedded_[k][i]) {
     releaseEmbedded(k, frame, i, c1, dt_s, io);
     ++field_.transitions[toIndex(from)][toIndex(state)];
@@ -462,6 +470,18 @@ void FieldCollider::stayInside(std::size_t k, std::size_t i, const Vec3& c1) {
   PointState& state = states_[k][i];
   ++field_.transitions[toIndex(state)][toIndex(PointState::InsideVol)];
   state = PointState::InsideVol;
+  lastVoxel_[k][i] = c1;
+  ++field_.clearanceSkips;
+  // Until the pair leaves this voxel its test is this one: settle() repeats it.
+  settledVoxel_[k][i] = roundVoxel(c1);
+}
+
+// Pair (k, vertex) stayed InsideVol in a voxel clear of T2 at its last test and ends this
+// one in the same voxel: collidePoint would walk that one voxel, find it clear and call
+// stayInside. The same, from the cached voxel: no range test, no clearance bit, no call.
+void FieldCollider::settle(std::size_t k, std::size_t i, const Vec3& c1) {
+  ++field_.traces;
+  ++field_.transitions[toIndex(PointState::InsideVol)][toIndex(PointState::InsideVol)];
   lastVoxel_[k][i] = c1;
   ++field_.clearanceSkips;
 }

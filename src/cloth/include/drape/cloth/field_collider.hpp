@@ -54,7 +54,9 @@
 // ends in such a voxel without meeting T2 stays InsideVol without the 8-voxel read, and the
 // walk itself skips the distance read of such voxels. States, positions and the collision
 // counters are those of the full test (tested against it); the penetration statistics only
-// miss distances above T2, which no threshold below T2 can see.
+// miss distances above T2, which no threshold below T2 can see. A pair that stayed so keeps
+// its voxel, and while it ends its tests in that voxel they are settled from the cache
+// (settle): no range test, no clearance bit, no call of the per-pair test.
 //
 // Contact planes (most of the remaining field reads are sliding pairs'): a sliding point
 // moves a few hundredths of a voxel per substep relative to its part, and the field is
@@ -200,6 +202,10 @@ class FieldCollider final : public Collider {
   [[nodiscard]] const std::vector<CollisionPart>& parts() const { return parts_; }
   [[nodiscard]] const OffsetSurfaces& offsets() const { return offsets_; }
   [[nodiscard]] PointState state(std::size_t part, std::size_t vertex) const { return states_[part][vertex]; }
+  /// The pair's cached position in the part's voxel coordinates (where its next walk starts).
+  [[nodiscard]] const Vec3& cachedVoxel(std::size_t part, std::size_t vertex) const {
+    return lastVoxel_[part][vertex];
+  }
   /// Points per state now, summed over parts: [OutsideVol, InsideVol, OnSurf].
   [[nodiscard]] std::array<std::size_t, 3> pointsPerState() const;
   /// Per vertex, for display: 0 outside every volume, 1 inside a volume, 2 on a surface,
@@ -218,6 +224,8 @@ class FieldCollider final : public Collider {
                     ClothState& io);
   /// Pair (k, vertex) ends at voxel coordinates c1 in a voxel clear of T2: InsideVol.
   void stayInside(std::size_t k, std::size_t vertex, const Vec3& c1);
+  /// Pair (k, vertex), settled in its voxel by stayInside, ends in it again: the same.
+  void settle(std::size_t k, std::size_t vertex, const Vec3& c1);
   /// The field at c for sliding pair (k, vertex): from its contact plane when the plane
   /// reaches c, else read (and the plane moved there).
   [[nodiscard]] field::FieldSample slidingSample(std::size_t k, std::size_t vertex, const Vec3& c);
@@ -273,6 +281,10 @@ class FieldCollider final : public Collider {
   std::vector<double> endVoxelX_, endVoxelY_, endVoxelZ_;  ///< per vertex, the current part's voxel coordinates
   std::vector<std::uint8_t> keep_;                ///< per vertex: the current part must test it
   std::vector<std::uint32_t> candidates_;         ///< the vertices kept, ascending
+  /// [part][vertex]: the voxel in which the pair's last test found it staying InsideVol,
+  /// clear of T2 (stayInside); kNotSettled otherwise.
+  std::vector<std::vector<Vec3i>> settledVoxel_;
+  static inline const Vec3i kNotSettled = Vec3i::Constant(-1000000);
   std::vector<double> nearest_;                   ///< per vertex, m: distance to the nearest part after the response
   ColliderCounters counters_;
   FieldCollisionCounters field_;

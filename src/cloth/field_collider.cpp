@@ -236,7 +236,11 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
   ++counters_.calls;
   if (states_.empty() || states_.front().size() != io.size()) initialise(io, t0_s);
   if ((calls_++ % every_) != 0) {  // reduced-frequency collision tests
-    if (countEverySubstep_ && measurePenetration_) countUntested(io, t1_s);
+    if (countEverySubstep_ && measurePenetration_) {
+      const auto start = std::chrono::steady_clock::now();
+      countUntested(io, t1_s);
+      measureSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
     return;
   }
   const double interval_s = t1_s - lastTime_s_;
@@ -272,7 +276,12 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
     }
   }
   applyCorrections(io);
-  if (measurePenetration_) countPenetration();
+  if (measurePenetration_) {
+    const auto start = std::chrono::steady_clock::now();
+    measureCorrected(io);
+    countPenetration();
+    measureSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
   lastTime_s_ = t1_s;
 }
 
@@ -536,8 +545,9 @@ void FieldCollider::applyCorrections(ClothState& io) {
     io.y[i] += share * correctionY_[i];
     io.z[i] += share * correctionZ_[i];
   }
-  if (!measurePenetration_) return;
-  // The penetration figures of corrected pairs: where the points ended.
+}
+
+void FieldCollider::measureCorrected(const ClothState& io) {
   for (const auto& [k, i] : corrected_) {
     const double d = parts_[k].field->distanceAtVoxel(frames_[k].toVoxel1.apply(io.position(i)));
     nearest_[i] = std::min(nearest_[i], d);

@@ -51,6 +51,12 @@ TEST(RunScene, ReducedFrequencyTestsSayWhatTheirFiguresCount) {
   EXPECT_EQ(b["vertex_substeps"].get<long>(), 3 * a["vertex_substeps"].get<long>());
   EXPECT_EQ(slurp(tested + "/garment.pc2"), slurp(every + "/garment.pc2"));
   EXPECT_EQ(b["vertex_substeps_inside_body"], 0);
+  // The measuring is timed apart from the collision work (and left out of its share).
+  for (const nlohmann::json* j : {&a, &b}) {
+    EXPECT_GT((*j)["penetration_measure_ms_per_frame"].get<double>(), 0.0);
+    EXPECT_GT((*j)["collision_time_share"].get<double>(), 0.0);
+    EXPECT_LT((*j)["collision_time_share"].get<double>(), 1.0);
+  }
 }
 
 TEST(RunScene, WalkingSkirtWritesEverything) {

@@ -198,6 +198,9 @@ class FieldCollider final : public Collider {
   /// (the transforms built from the poses count as collision).
   /// Part of collide()'s time; the paper's collision share leaves it out.
   [[nodiscard]] double poseSeconds() const { return poseSeconds_; }
+  /// Time spent measuring the penetration figures, s (setMeasurePenetration): part of
+  /// collide()'s time, and not the collision's work.
+  [[nodiscard]] double measureSeconds() const { return measureSeconds_; }
 
   [[nodiscard]] const std::vector<CollisionPart>& parts() const { return parts_; }
   [[nodiscard]] const OffsetSurfaces& offsets() const { return offsets_; }
@@ -234,9 +237,10 @@ class FieldCollider final : public Collider {
                         double dt_s, ClothState& io) const;
   /// A part asks to move the point by `displacement` (world, m) this collision step.
   void addCorrection(std::size_t vertex, const Vec3& displacement);
-  /// Moves every point by the mean of its parts' displacements; then the penetration
-  /// figures of the corrected pairs, where the points ended.
+  /// Moves every point by the mean of its parts' displacements.
   void applyCorrections(ClothState& io);
+  /// The penetration figures of the corrected pairs, where the points ended.
+  void measureCorrected(const ClothState& io);
   /// Penetration after the response, against the nearest part (the counters of Table 3),
   /// and the penalty flags of the points below T1.
   void countPenetration();
@@ -257,6 +261,7 @@ class FieldCollider final : public Collider {
   bool measurePenetration_ = true;
   long calls_ = 0;
   double poseSeconds_ = 0;
+  double measureSeconds_ = 0;
   std::vector<PartFrame> frames_;  ///< per part, this interval's transforms (collide)
   std::vector<RigidTransform> poses_;  ///< per part, its poses at the interval's start and end
   double lastTime_s_ = 0;

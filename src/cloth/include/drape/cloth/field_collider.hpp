@@ -64,7 +64,9 @@
 // distance's gradient, the normal) and answers its tests from it while it stays within half
 // a voxel of the read (ContactPlane): the distance from the tangent plane, the normal as
 // read. Collisions, first contacts and releases read the field; the planes' error against
-// the field is measured in the tests.
+// the field is measured in the tests. A sliding point left where it is counts in the
+// penetration figures at its plane's distance (above T2, within the planes' error); a
+// moved one is read where it ended.
 
 #include <array>
 #include <cstdint>

@@ -382,17 +382,24 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   // point already slides on the surface, at the first voxel below T2.
   bool hit = false;
   Vec3i hitVoxel = start;
-  const int walked = walkVoxelsByTable(start, v1, [&](const Vec3i& p) {
-    if (!walkable(f, p)) return false;
-    if (state == PointState::OnSurf) return true;
-    const std::uint32_t voxel = f.index(p.x(), p.y(), p.z());
-    if (!clearOfT2(k, voxel) && f.distanceVoxels(voxel) < frame.t2Voxels) {
-      hit = true;
-      hitVoxel = p;
-      return false;
-    }
-    return true;
-  });
+  const auto walk = [&] {
+    return walkVoxelsByTable(start, v1, [&](const Vec3i& p) {
+      if (!walkable(f, p)) return false;
+      if (state == PointState::OnSurf) return true;
+      const std::uint32_t voxel = f.index(p.x(), p.y(), p.z());
+      if (!clearOfT2(k, voxel) && f.distanceVoxels(voxel) < frame.t2Voxels) {
+        hit = true;
+        hitVoxel = p;
+        return false;
+      }
+      return true;
+    });
+  };
+  // A sliding point's walk only looks for the volume's edge. Between two walkable voxels it
+  // cannot meet one (the walk keeps to their bounding box, inside the convex walkable box),
+  // so it would visit one voxel per step of its longest axis: count them without walking.
+  const bool slidesWithin = state == PointState::OnSurf && in1 && walkable(f, start);
+  const int walked = slidesWithin ? (v1 - start).cwiseAbs().maxCoeff() + 1 : walk();
   ++field_.traces;
   field_.traceVoxels += static_cast<std::uint64_t>(walked - 1);
 

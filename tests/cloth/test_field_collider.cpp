@@ -245,6 +245,29 @@ TEST(FieldCollider, WalkableIsExactlyNotBorder) {
       }
 }
 
+TEST(FieldCollider, WalksBetweenWalkableVoxelsStayWalkable) {
+  // What lets a sliding pair count its walk instead of walking it: between two walkable
+  // voxels the walk visits one walkable voxel per step of its longest axis, never leaving.
+  const field::DistanceField f = buildField(field::makeBox(Vec3(-0.03, -0.05, -0.02), Vec3(0.03, 0.05, 0.02)));
+  const auto& d = f.dims();
+  std::mt19937 rng(21);
+  std::uniform_int_distribution<int> x(1, d.nx - 2), y(1, d.ny - 2), z(1, d.nz - 2), near(-5, 5);
+  for (int k = 0; k < 5000; ++k) {
+    const Vec3i a(x(rng), y(rng), z(rng));
+    // Mostly short walks, as sliding points make, and some across the whole box.
+    const Vec3i b = k % 4 ? (a + Vec3i(near(rng), near(rng), near(rng))).cwiseMax(1).cwiseMin(Vec3i(d.nx - 2, d.ny - 2, d.nz - 2))
+                          : Vec3i(x(rng), y(rng), z(rng));
+    ASSERT_TRUE(walkable(f, a) && walkable(f, b));
+    int visited = 0;
+    const int walked = walkVoxelsByTable(a, b, [&](const Vec3i& p) {
+      ++visited;
+      return walkable(f, p);
+    });
+    ASSERT_EQ(walked, (b - a).cwiseAbs().maxCoeff() + 1) << a.transpose() << " -> " << b.transpose();
+    ASSERT_EQ(visited, walked);
+  }
+}
+
 TEST(FieldCollider, BresenhamLinesAreConnectedAndEndWhereAsked) {
   std::mt19937 rng(3);
   std::uniform_int_distribution<int> c(-20, 20);

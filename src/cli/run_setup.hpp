@@ -49,6 +49,8 @@ struct RunSetup {
   /// With reduced-frequency collision tests, count penetration on every substep (not only
   /// the tested ones): about a collision test's time on each untested substep.
   bool countEverySubstep = false;
+  /// Sliding points read the distance field on every test instead of their contact planes.
+  bool exactSliding = false;
 };
 
 /// Garments, materials, settings and the avatar (as the setup's character, without motion)

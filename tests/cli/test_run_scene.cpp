@@ -51,6 +51,12 @@ TEST(RunScene, ReducedFrequencyTestsSayWhatTheirFiguresCount) {
   EXPECT_EQ(b["vertex_substeps"].get<long>(), 3 * a["vertex_substeps"].get<long>());
   EXPECT_EQ(slurp(tested + "/garment.pc2"), slurp(every + "/garment.pc2"));
   EXPECT_EQ(b["vertex_substeps_inside_body"], 0);
+  // Sliding tests answered by contact planes unless asked to read the field on each.
+  const nlohmann::json exact =
+      nlohmann::json::parse(slurp(run("exact", "--exact-sliding") + "/stats.json"));
+  EXPECT_GT(a["sliding_reads_from_contact_planes"].get<double>(), 0.5);
+  EXPECT_EQ(exact["sliding_reads_from_contact_planes"], 0.0);
+  EXPECT_EQ(exact["vertex_substeps_inside_body"], 0);
   // The measuring is timed apart from the collision work (and left out of its share).
   for (const nlohmann::json* j : {&a, &b}) {
     EXPECT_GT((*j)["penetration_measure_ms_per_frame"].get<double>(), 0.0);

@@ -7,7 +7,6 @@
 // material is fixed up front and never tuned to hide an instability.
 
 #include <algorithm>
-#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -20,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "measure.hpp"
 #include "drape/cloth/forces.hpp"
 #include "drape/cloth/sheets.hpp"
 #include "drape/cloth/solver.hpp"
@@ -28,14 +28,6 @@
 
 namespace drape::cli {
 namespace {
-
-/// This thread's CPU time, s. The benchmark reports CPU time, not wall time, so that other
-/// processes on a shared machine do not inflate the figures (the runs are single-threaded).
-double threadSeconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
 
 // The scenario (fixed before any measurement).
 constexpr double kFrameRate = 30.0;
@@ -88,11 +80,6 @@ struct CaseResult {
   }
 };
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 // ---------------------------------------------------------------------------------------
 // drape
 
@@ -119,7 +106,7 @@ RunOutcome runDrape(const SheetSize& size, int substeps, long frames) {
   cloth::SphereCollider sphere(kSphereCentre, kSphereRadius);
   solver.addCollider(sphere);
   RunOutcome r;
-  const double start = threadSeconds();
+  const double start = threadCpuSeconds();
   long f = 1;
   for (; f <= frames; ++f)
     if (!solver.stepFrame(f)) {
@@ -127,7 +114,7 @@ RunOutcome runDrape(const SheetSize& size, int substeps, long frames) {
       r.why = solver.instability().describe("sheet", kSpeedBound_m_s);
       break;
     }
-  r.seconds = threadSeconds() - start;
+  r.seconds = threadCpuSeconds() - start;
   // Frames' worth of substeps actually run (a diverged run stops inside its first frames).
   r.frames = r.diverged ? static_cast<double>((solver.instability().frame - 1) * substeps + solver.instability().substep + 1) /
                               substeps
@@ -229,7 +216,7 @@ CaseResult measureBullet(const std::string& name, const SheetSize& size, long fr
 
     // Bullet keeps running past a speed excess (it rarely reaches NaN); the case is then
     // reported unstable with the first frame and speed, and timed over all frames.
-    const double start = threadSeconds();
+    const double start = threadCpuSeconds();
     long f = 0;
     bool nan = false;
     for (; f < frames && !nan; ++f) {
@@ -244,7 +231,7 @@ CaseResult measureBullet(const std::string& name, const SheetSize& size, long fr
         }
       }
     }
-    ms.push_back(1e3 * (threadSeconds() - start) / static_cast<double>(f));
+    ms.push_back(1e3 * (threadCpuSeconds() - start) / static_cast<double>(f));
     strain = 0.0;
     for (int i = 0; i < sheet->m_links.size(); ++i) {
       const btSoftBody::Link& l = sheet->m_links[i];

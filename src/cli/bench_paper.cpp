@@ -5,13 +5,13 @@
 
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <iostream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "measure.hpp"
 #include "drape/core/error.hpp"
 #include "drape/core/log.hpp"
 #include "drape/motion/animation.hpp"
@@ -33,14 +33,6 @@ struct PaperBenchOptions {
   bool exactSliding = false;  // sliding pairs read the field on every test (no contact planes)
   bool json = false;
 };
-
-/// This thread's CPU time, s: on a shared machine other processes inflate the wall clock,
-/// not this (the run is single-threaded).
-double threadSeconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
 
 struct PaperRun {
   long frames = 0;
@@ -83,10 +75,10 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
   // Animation and interpolation are inside the step: every part's pose is evaluated per
   // substep by the fixtures and colliders that ask for it.
   const auto start = std::chrono::steady_clock::now();
-  const double cpuStart = threadSeconds();
+  const double cpuStart = threadCpuSeconds();
   for (long f = 1; f <= r.frames; ++f)
     if (!world.stepFrame(f)) throw Error(world.instability(), ExitCode::Unstable);
-  r.simCpuSeconds = threadSeconds() - cpuStart;
+  r.simCpuSeconds = threadCpuSeconds() - cpuStart;
   r.simSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (std::size_t g = 0; g < world.garmentCount(); ++g) {
     const cloth::StageTimes& t = world.solver(g).stageTimes();

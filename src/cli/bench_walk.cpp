@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "measure.hpp"
 #include "drape/cloth/voxel_walk.hpp"
 #include "drape/core/error.hpp"
 
@@ -58,11 +59,6 @@ std::pair<double, std::uint64_t> timeWalks(const std::vector<Walk>& walks, const
     }));
   const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count();
   return {ns / static_cast<double>(walks.size()), sum};
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
 }
 
 RunFunction setupBenchWalk(CLI::App& app) {

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <ctime>
 #include <cmath>
 #include <functional>
 #include <vector>
@@ -15,6 +14,7 @@
 #include "drape/field/distance_field.hpp"
 #include "drape/field/propagation.hpp"
 #include "drape/field/voxelize.hpp"
+#include "measure.hpp"
 
 namespace drape::cli {
 
@@ -41,11 +41,7 @@ struct FieldMeasurement {
   double dvdpWallMs = 0, dvdpDistanceOnlyWallMs = 0, exactWallMs = 0, exactDistanceOnlyWallMs = 0;
 };
 
-inline double threadCpuMs() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
-}
+inline double threadCpuMs() { return 1e3 * threadCpuSeconds(); }
 
 /// Median over `runs` of the work's time (ms): this thread's CPU time, which a machine shared
 /// with other jobs inflates less than the wall clock; the median wall time goes to *wallMs.
@@ -58,10 +54,8 @@ inline double medianMs(int runs, const std::function<void()>& work, double* wall
     cpu.push_back(threadCpuMs() - startCpu);
     wall.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
   }
-  std::sort(cpu.begin(), cpu.end());
-  std::sort(wall.begin(), wall.end());
-  if (wallMs) *wallMs = wall[wall.size() / 2];
-  return cpu[cpu.size() / 2];
+  if (wallMs) *wallMs = median(wall);
+  return median(cpu);
 }
 
 inline std::size_t countShellMismatches(const field::Propagation& p, const std::vector<std::int32_t>& exact,

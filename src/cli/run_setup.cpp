@@ -25,6 +25,7 @@
 #include "drape/render/outputs.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/scene_setup.hpp"
+#include "measure.hpp"
 
 namespace drape::cli {
 namespace {
@@ -62,12 +63,6 @@ std::string sanitise(const std::string& name) {
   return out.empty() ? std::string("part") : out;
 }
 
-double medianOf(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 void createOutDir(const std::string& dir) {
   std::error_code ec;
@@ -431,7 +426,7 @@ int simulateRun(const RunSetup& setup) {
   stats["frame_rate"] = settings.frameRate_hz;
   stats["substeps_per_frame"] = settings.substepsPerFrame;
   stats["integrator"] = cloth::integratorName(settings.integrator);
-  stats["ms_per_frame"] = medianOf(frameMs);
+  stats["ms_per_frame"] = median(frameMs);
   stats["ms_per_stage"] = {{"forces", total.forces_s * perFrame},
                            {"integrate", total.integrate_s * perFrame},
                            {"collide", total.collide_s * perFrame},

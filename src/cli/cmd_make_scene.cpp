@@ -48,7 +48,7 @@ struct MakeSceneOptions {
   double bindThreshold_m = 0.04;
   cloth::Material material = knit();
 
-  /// The walking skirt's knit (examples/walking_skirt).
+  /// The walking skirt's knit (examples/walking_skirt) with a tenth of its damping.
   static cloth::Material knit() {
     cloth::Material m;
     m.density_kg_m3 = 300.0;
@@ -108,15 +108,6 @@ mesh::TriMesh fitMask(const mesh::TriMesh& mask, const scene::MakeHumanGarment& 
                             "modelled; is --units right?",
                             maskPath, unmatched, mask.positions.size()));
   return fitted;
-}
-
-void writeMaterial(std::ostream& os, const cloth::Material& m) {
-  fmt::print(os,
-             "DEF Knit ClothMaterial {{\n  density {:g}\n  thickness {:g}\n  youngsModulus {:g}\n"
-             "  poissonRatio {:g}\n  damping {:g}\n  staticFriction {:g}\n  dynamicFriction {:g}\n"
-             "  compressionScale {:g}\n}}\n\n",
-             m.density_kg_m3, m.thickness_m, m.youngsModulus_Pa, m.poissonRatio, m.damping_s, m.staticFriction,
-             m.dynamicFriction, m.compressionScale);
 }
 
 void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::TriMesh& garment,

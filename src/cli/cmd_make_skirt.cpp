@@ -61,11 +61,7 @@ void writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::
                  "  airViscosity 0.5\n  offsets [ 0.005 0.010 0.015 0.030 ]\n  voxelSize 0.005\n"
                  "  integrator \"symplectic-euler\"\n  collisionEvery 1\n  bendEvery {}\n}}\n\n",
              kFrameRate, kSubsteps, bendEvery);
-  fmt::print(os, "DEF Knit ClothMaterial {{\n  density {:g}\n  thickness {:g}\n  youngsModulus {:g}\n"
-                 "  poissonRatio {:g}\n  damping {:g}\n  staticFriction {:g}\n  dynamicFriction {:g}\n"
-                 "  compressionScale {:g}\n}}\n\n",
-             m.density_kg_m3, m.thickness_m, m.youngsModulus_Pa, m.poissonRatio, m.damping_s, m.staticFriction,
-             m.dynamicFriction, m.compressionScale);
+  writeMaterial(os, m);
   fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n}}\n\n", o.avatarUrl);
   fmt::print(os, "DEF Skirt ClothSet {{\n  cloth Shape {{\n    appearance Appearance {{ material Material {{ diffuseColor 0.7 0.15 0.2 }} }}\n"
                  "    geometry DEF SkirtMesh IndexedFaceSet {{\n      solid FALSE\n");

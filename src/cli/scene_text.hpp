@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <fmt/ostream.h>
 
+#include "drape/cloth/material.hpp"
 #include "drape/core/error.hpp"
 #include "drape/mesh/trimesh.hpp"
 
@@ -20,6 +21,16 @@ inline void writeIndexedFaceSet(std::ostream& os, const mesh::TriMesh& m, const 
   fmt::print(os, "{}] }}\n{}coordIndex [\n", indent, indent);
   for (const auto& t : m.triangles) fmt::print(os, "{}  {} {} {} -1,\n", indent, t[0], t[1], t[2]);
   fmt::print(os, "{}]\n", indent);
+}
+
+/// A ClothMaterial node named Knit with the material's values.
+inline void writeMaterial(std::ostream& os, const cloth::Material& m) {
+  fmt::print(os,
+             "DEF Knit ClothMaterial {{\n  density {:g}\n  thickness {:g}\n  youngsModulus {:g}\n"
+             "  poissonRatio {:g}\n  damping {:g}\n  staticFriction {:g}\n  dynamicFriction {:g}\n"
+             "  compressionScale {:g}\n}}\n\n",
+             m.density_kg_m3, m.thickness_m, m.youngsModulus_Pa, m.poissonRatio, m.damping_s, m.staticFriction,
+             m.dynamicFriction, m.compressionScale);
 }
 
 /// Creates the scene's directory (`--out`) and returns the Avatar url to write: `avatarUrl`

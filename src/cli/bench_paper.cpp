@@ -87,15 +87,7 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
     r.stepSeconds += t.forces_s + t.integrate_s + t.collide_s + t.fixtures_s + t.stability_s;
     r.colliderPoseSeconds += world.collider(g)->poseSeconds();
     r.poseSeconds += world.collider(g)->poseSeconds() + t.fixturePoses_s;
-    const cloth::FieldCollisionCounters& c = world.collider(g)->fieldCounters();
-    r.counters.tests += c.tests;
-    r.counters.traceVoxels += c.traceVoxels;
-    r.counters.planeEstimates += c.planeEstimates;
-    r.counters.planeReads += c.planeReads;
-    r.counters.vertexSubstepsInsideBody += c.vertexSubstepsInsideBody;
-    r.counters.vertexSubstepsBelowT1 += c.vertexSubstepsBelowT1;
-    r.counters.vertexSubsteps += c.vertexSubsteps;
-    r.counters.maxPenetration_m = std::max(r.counters.maxPenetration_m, c.maxPenetration_m);
+    r.counters += world.collider(g)->fieldCounters();
   }
   return r;
 }
@@ -146,9 +138,7 @@ RunFunction setupPaperBench(CLI::App& app) {
     j["collision_time_share"] = simulated > 0 ? (r.collideSeconds - r.colliderPoseSeconds) / simulated : 0.0;
     j["mean_collision_path_voxels"] = r.counters.meanPathVoxels();
     j["contact_planes"] = !o.exactSliding;
-    const std::uint64_t slidingReads = r.counters.planeEstimates + r.counters.planeReads;
-    j["sliding_reads_from_contact_planes"] =
-        slidingReads ? static_cast<double>(r.counters.planeEstimates) / static_cast<double>(slidingReads) : 0.0;
+    j["sliding_reads_from_contact_planes"] = r.counters.slidingReadsFromPlanes();
     j["vertex_substeps"] = penetration.vertexSubsteps;  // free vertices x substeps: all of them
     j["vertex_substeps_inside_body"] = penetration.vertexSubstepsInsideBody;
     j["vertex_substeps_below_T1_fraction"] =

@@ -63,7 +63,6 @@ std::string sanitise(const std::string& name) {
   return out.empty() ? std::string("part") : out;
 }
 
-
 void createOutDir(const std::string& dir) {
   std::error_code ec;
   fs::create_directories(fs::path(dir) / "frames", ec);
@@ -99,21 +98,7 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
   std::array<std::size_t, 3> states{};
   for (const GarmentRun& r : runs) {
     if (!r.collider) continue;
-    const cloth::FieldCollisionCounters& c = r.collider->fieldCounters();
-    sum.tests += c.tests;
-    sum.traceVoxels += c.traceVoxels;
-    sum.collisions += c.collisions;
-    sum.projections += c.projections;
-    sum.vertexSubstepsBelowT1 += c.vertexSubstepsBelowT1;
-    sum.vertexSubstepsBelowT0 += c.vertexSubstepsBelowT0;
-    sum.vertexSubstepsInsideBody += c.vertexSubstepsInsideBody;
-    sum.vertexSubsteps += c.vertexSubsteps;
-    sum.maxPenetration_m = std::max(sum.maxPenetration_m, c.maxPenetration_m);
-    sum.embeddedAtStart += c.embeddedAtStart;
-    sum.planeEstimates += c.planeEstimates;
-    sum.planeReads += c.planeReads;
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) sum.transitions[a][b] += c.transitions[a][b];
+    sum += r.collider->fieldCounters();
     const auto now = r.collider->pointsPerState();
     for (int k = 0; k < 3; ++k) states[k] += now[k];
   }
@@ -136,9 +121,7 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
   stats["collisions_registered"] = sum.collisions;
   stats["last_resort_projections"] = sum.projections;
   stats["pairs_embedded_at_start"] = sum.embeddedAtStart;
-  const std::uint64_t slidingReads = sum.planeEstimates + sum.planeReads;
-  stats["sliding_reads_from_contact_planes"] =
-      slidingReads ? static_cast<double>(sum.planeEstimates) / static_cast<double>(slidingReads) : 0.0;
+  stats["sliding_reads_from_contact_planes"] = sum.slidingReadsFromPlanes();
   nlohmann::json transitions;
   const char* names[3] = {"outside_vol", "inside_vol", "on_surf"};
   for (int a = 0; a < 3; ++a)

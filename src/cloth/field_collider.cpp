@@ -601,6 +601,20 @@ void FieldCollider::releaseEmbedded(std::size_t k, const PartFrame& frame, std::
   }
 }
 
+FieldCollisionCounters& FieldCollisionCounters::operator+=(const FieldCollisionCounters& o) {
+  for (auto [a, b] : {std::pair{&tests, o.tests}, {&traces, o.traces}, {&traceVoxels, o.traceVoxels},
+                      {&collisions, o.collisions}, {&projections, o.projections},
+                      {&vertexSubstepsBelowT1, o.vertexSubstepsBelowT1}, {&vertexSubstepsBelowT0, o.vertexSubstepsBelowT0},
+                      {&vertexSubstepsInsideBody, o.vertexSubstepsInsideBody}, {&vertexSubsteps, o.vertexSubsteps},
+                      {&clearanceSkips, o.clearanceSkips}, {&embeddedAtStart, o.embeddedAtStart},
+                      {&planeEstimates, o.planeEstimates}, {&planeReads, o.planeReads}})
+    *a += b;
+  maxPenetration_m = std::max(maxPenetration_m, o.maxPenetration_m);
+  for (int from = 0; from < 3; ++from)
+    for (int to = 0; to < 3; ++to) transitions[from][to] += o.transitions[from][to];
+  return *this;
+}
+
 std::array<std::size_t, 3> FieldCollider::pointsPerState() const {
   std::array<std::size_t, 3> counts{};
   for (const auto& part : states_)

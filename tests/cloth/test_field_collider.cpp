@@ -607,6 +607,33 @@ TEST(FieldCollider, APointPinchedBetweenTwoPartsSettlesBetweenThem) {
   EXPECT_EQ(c.state(1, 0), PointState::OnSurf);
 }
 
+TEST(FieldCollider, CountersOfTwoGarmentsAddUp) {
+  FieldCollisionCounters a;
+  std::uint64_t value = 1;
+  for (std::uint64_t* f : {&a.tests, &a.traces, &a.traceVoxels, &a.collisions, &a.projections,
+                           &a.vertexSubstepsBelowT1, &a.vertexSubstepsBelowT0, &a.vertexSubstepsInsideBody,
+                           &a.vertexSubsteps, &a.clearanceSkips, &a.embeddedAtStart, &a.planeEstimates, &a.planeReads})
+    *f = value++;
+  for (auto& row : a.transitions)
+    for (std::uint64_t& t : row) t = value++;
+  a.maxPenetration_m = 0.002;
+  FieldCollisionCounters b;
+  b.maxPenetration_m = 0.003;
+  b += a;
+  b += a;
+  const FieldCollisionCounters& c = b;
+  value = 1;
+  for (const std::uint64_t* f : {&c.tests, &c.traces, &c.traceVoxels, &c.collisions, &c.projections,
+                                 &c.vertexSubstepsBelowT1, &c.vertexSubstepsBelowT0, &c.vertexSubstepsInsideBody,
+                                 &c.vertexSubsteps, &c.clearanceSkips, &c.embeddedAtStart, &c.planeEstimates,
+                                 &c.planeReads})
+    EXPECT_EQ(*f, 2 * value++);
+  for (const auto& row : c.transitions)
+    for (const std::uint64_t t : row) EXPECT_EQ(t, 2 * value++);
+  EXPECT_EQ(c.maxPenetration_m, 0.003);  // the deepest, not a sum
+  EXPECT_DOUBLE_EQ(c.slidingReadsFromPlanes(), 12.0 / (12.0 + 13.0));
+}
+
 TEST(FieldCollider, MeasuringPenetrationMovesNothing) {
   // The same cloud and parts with the penetration figures kept and not kept: the same
   // states, positions and velocities after every substep, and no figure when not kept.

@@ -141,6 +141,13 @@ struct FieldCollisionCounters {
   /// Mean voxel path per tested (vertex, part) pair: the paper's "average collision path
   /// distance" (0.166 voxels in Table 3).
   [[nodiscard]] double meanPathVoxels() const { return tests ? double(traceVoxels) / double(tests) : 0.0; }
+  /// The share of sliding pairs' field reads their contact planes answered.
+  [[nodiscard]] double slidingReadsFromPlanes() const {
+    const std::uint64_t reads = planeEstimates + planeReads;
+    return reads ? double(planeEstimates) / double(reads) : 0.0;
+  }
+  /// Adds another collider's counters (several garments): sums, and the deepest penetration.
+  FieldCollisionCounters& operator+=(const FieldCollisionCounters& o);
 };
 
 class FieldCollider final : public Collider {

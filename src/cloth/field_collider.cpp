@@ -398,7 +398,7 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   // A sliding point's walk only looks for the volume's edge. Between two walkable voxels it
   // cannot meet one (the walk keeps to their bounding box, inside the convex walkable box),
   // so it would visit one voxel per step of its longest axis: count them without walking.
-  const bool slidesWithin = state == PointState::OnSurf && in1 && walkable(f, start);
+  const bool slidesWithin = clearanceSkip_ && state == PointState::OnSurf && in1 && walkable(f, start);
   const int walked = slidesWithin ? (v1 - start).cwiseAbs().maxCoeff() + 1 : walk();
   ++field_.traces;
   field_.traceVoxels += static_cast<std::uint64_t>(walked - 1);

@@ -189,8 +189,9 @@ class FieldCollider final : public Collider {
   /// default.
   void setMeasurePenetration(bool on) { measurePenetration_ = on; }
   [[nodiscard]] bool measuresPenetration() const { return measurePenetration_; }
-  /// Off: no pair skips its distance reads through the clearance bits (the reference the
-  /// skip is tested against). On by default.
+  /// Off: no pair skips its distance reads through the clearance bits (nor, so, settles
+  /// from a cached clear voxel), and no sliding pair counts its walk instead of walking it:
+  /// the reference these shortcuts are tested against. On by default.
   void setClearanceSkip(bool on) { clearanceSkip_ = on; }
   /// Whether every voxel of the 3x3x3 neighbourhood of part k's voxel lies above T2, so that
   /// no trilinear distance nearest to it can be below T2 (false with the skip off).

@@ -63,8 +63,8 @@ void StepSettings::validate(const std::string& prefix) const {
   require(maxSpeed_m_s > 0.0, prefix, "max-speed", "> 0 m/s", maxSpeed_m_s);
   require(maxAddedMass >= 0.0 && maxAddedMass <= 10.0, prefix, "max-added-mass", "in [0, 10] (a fraction)",
           maxAddedMass);
-  require(bendEvery >= 1 && bendEvery <= substepsPerFrame, prefix, "bend-every", "in [1, substeps per frame]",
-          bendEvery);
+  require(bendEvery >= 1 && bendEvery <= substepsPerFrame, prefix, "bend-every",
+          fmt::format("in [1, {}] (the substeps per frame)", substepsPerFrame), bendEvery);
   if (!finite(gravity_m_s2)) throw Error(fmt::format("{}gravity must be finite", prefix));
   if (!finite(wind_m_s)) throw Error(fmt::format("{}wind must be finite", prefix));
 }

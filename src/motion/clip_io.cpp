@@ -56,6 +56,10 @@ bool looksLikeTPose(const std::vector<Vec3>& points) {
   return maxY > minY && span > 0.7 * (maxY - minY);
 }
 
+/// The least joint speed an unfolding from the rest pose has (restUnfoldFrames), deg/s: a
+/// quarter turn in half a second.
+constexpr double kUnfoldFloor_deg_s = 180.0;
+
 double largestJointChangeDegrees(const Clip& clip, std::size_t f0, std::size_t f1) {
   const auto a = clip.frameRotations(f0);
   const auto b = clip.frameRotations(f1);
@@ -76,6 +80,10 @@ void finishClip(Clip& clip, double metresPerUnitValue, const ClipLoadOptions& op
   if (options.skipReferenceTPose && firstFrameIsReferenceTPose(clip)) {
     dropLeadingFrames(clip, 1);
     r.referenceTPoseSkipped = true;
+  }
+  if (options.skipRestUnfold) {
+    r.restUnfoldFramesSkipped = restUnfoldFrames(clip);
+    dropLeadingFrames(clip, r.restUnfoldFramesSkipped);
   }
   if (!(options.rate >= 0.0) || options.rate > 1e4) throw Error(fmt::format("motion rate {} Hz is out of range", options.rate));
   if (options.rate > 0.0 && std::abs(options.rate - clip.rate) > 1e-9 * clip.rate) clip = resample(clip, options.rate);
@@ -124,6 +132,32 @@ bool firstFrameIsReferenceTPose(const Clip& clip) {
   const double jump = largestJointChangeDegrees(clip, 0, 1);
   const double next = largestJointChangeDegrees(clip, 1, 2);
   return jump > 20.0 && jump > 4.0 * next;
+}
+
+std::size_t restUnfoldFrames(const Clip& clip) {
+  const std::size_t n = clip.frameCount();
+  if (n < 3 || !(clip.rate > 0.0)) return 0;
+  // Joint speeds between successive frames, degrees per second.
+  std::vector<double> speed(n - 1);
+  for (std::size_t f = 1; f < n; ++f) speed[f - 1] = largestJointChangeDegrees(clip, f - 1, f) * clip.rate;
+  std::vector<double> sorted = speed;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  const double fast = std::max(4.0 * sorted[sorted.size() / 2], kUnfoldFloor_deg_s);
+  std::size_t run = 0;
+  while (run < speed.size() && speed[run] > fast) ++run;
+  // Longer than a quarter second, or most of the clip: the motion itself is fast.
+  const auto longest = static_cast<std::size_t>(std::floor(0.25 * clip.rate));
+  if (run == 0 || run > longest || 2 * run >= n) return 0;
+  // From the rest pose: every joint the run turns far starts it near its rest orientation,
+  // within a quarter of the turn (a hand's relaxed fingers, say, may sit off rest and stay).
+  constexpr double kFarDegrees = 10.0, kRestShare = 0.25;
+  const auto first = clip.frameRotations(0), last = clip.frameRotations(run);
+  for (std::size_t j = 0; j < first.size(); ++j) {
+    const double turn = first[j].angularDistance(last[j]) * 180.0 / M_PI;
+    if (turn <= kFarDegrees) continue;
+    if (first[j].angularDistance(Quat::Identity()) * 180.0 / M_PI > kRestShare * turn) return 0;
+  }
+  return run;
 }
 
 void dropLeadingFrames(Clip& clip, std::size_t count) {

@@ -39,6 +39,16 @@ TEST(CliMotion, InspectBvh) {
   EXPECT_NE(r.out.find("reference T-pose"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("CMU units (0.0564 m)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("86 frames at 30 Hz"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("unfolding  none"), std::string::npos) << r.out;
+}
+
+TEST(CliMotion, InspectNamesTheUnfoldingFromTheRestPose) {
+  const Result r = run("inspect " + data("mocap/cmu_02_02_walk_dazstyle.bvh"));
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("frames 1-4 unfold from the rest pose (not played; the lead-in blends into frame 5)"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("74 frames at 30 Hz"), std::string::npos) << r.out;
 }
 
 TEST(CliMotion, InspectAmcAndAvatars) {

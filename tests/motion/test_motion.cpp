@@ -157,6 +157,57 @@ TEST(ClipIo, DazWalkIsCentimetres) {
   EXPECT_NEAR(clip.rootTranslations[0].y(), 0.78, 0.05);
 }
 
+TEST(ClipIo, DazWalksUnfoldingFromTheRestPoseIsNotPlayed) {
+  // Frame 1 of the file has the body at rest; frames 2 to 5 swing the arms down and the
+  // legs into the walk at up to 3,000 degrees per second (the walk itself: about 300).
+  const std::string path = std::string(DRAPE_DATA_DIR) + "/mocap/cmu_02_02_walk_dazstyle.bvh";
+  ClipLoadReport report;
+  const Clip clip = loadClip(path, {}, &report);
+  EXPECT_FALSE(report.referenceTPoseSkipped);
+  EXPECT_EQ(report.restUnfoldFramesSkipped, 4u);
+  // 295 frames at 120 Hz span 294/120 s = 2.45 s: 74 frames at 30 Hz.
+  EXPECT_EQ(clip.frameCount(), 74u);
+  ClipLoadOptions keep;
+  keep.skipRestUnfold = false;
+  ClipLoadReport kept;
+  EXPECT_EQ(loadClip(path, keep, &kept).frameCount(), 75u);
+  EXPECT_EQ(kept.restUnfoldFramesSkipped, 0u);
+  // The CMU clips have none (after their reference T-pose, where they have one).
+  for (const char* name : {"cmu_walk_delfem2.bvh", "cmu_12_03_walk.bvh", "cmu_11_01.amc"}) {
+    ClipLoadReport r;
+    (void)loadClip(std::string(DRAPE_DATA_DIR) + "/mocap/" + name, {}, &r);
+    EXPECT_EQ(r.restUnfoldFramesSkipped, 0u) << name;
+  }
+}
+
+/// Two joints at 120 Hz: the child turns about X from `startDegrees` by the per-frame steps
+/// given, then `steadyDegrees` per frame for 100 frames (a steady motion).
+Clip turningClip(double startDegrees, const std::vector<double>& stepsDegrees, double steadyDegrees = 1.0) {
+  Clip clip;
+  clip.rate = 120.0;
+  clip.skeleton.joints.push_back({"root", -1, Vec3::Zero(), std::nullopt});
+  clip.skeleton.joints.push_back({"arm", 0, Vec3(0.3, 0, 0), std::nullopt});
+  std::vector<double> steps = stepsDegrees;
+  steps.insert(steps.end(), 100, steadyDegrees);
+  double angle = startDegrees;
+  for (std::size_t f = 0; f <= steps.size(); ++f) {
+    clip.rotations.push_back(Quat::Identity());
+    clip.rotations.push_back(Quat(Eigen::AngleAxisd(angle * M_PI / 180.0, Vec3::UnitX())));
+    clip.rootTranslations.push_back(Vec3::Zero());
+    if (f < steps.size()) angle += steps[f];
+  }
+  return clip;
+}
+
+TEST(ClipIo, RestUnfoldingIsAShortFastRunFromRest) {
+  EXPECT_EQ(restUnfoldFrames(turningClip(0.0, {25, 25, 25})), 3u);  // 3,000 deg/s from rest, then 120
+  EXPECT_EQ(restUnfoldFrames(turningClip(0.0, {})), 0u);            // no fast run
+  EXPECT_EQ(restUnfoldFrames(turningClip(40.0, {25, 25, 25})), 0u); // fast, but not from rest
+  EXPECT_EQ(restUnfoldFrames(turningClip(0.0, std::vector<double>(40, 25.0))), 0u);  // a third of a second: the motion
+  EXPECT_EQ(restUnfoldFrames(turningClip(0.0, {1.4, 1.4}, 0.05)), 0u);  // 168 deg/s is no unfolding
+  EXPECT_EQ(restUnfoldFrames(turningClip(0.0, {1.6, 1.6}, 0.05)), 2u);  // 192 deg/s, from 6 deg/s
+}
+
 TEST(ClipIo, ScaleOverrideWins) {
   ClipLoadOptions options;
   options.metresPerUnit = 0.01;

@@ -33,6 +33,7 @@ struct ClipLoadOptions {
   double rate = 30.0;                      ///< resample to this many frames per second (0: keep)
   std::optional<double> metresPerUnit;     ///< overrides the units guess (--motion-scale)
   bool skipReferenceTPose = true;          ///< drop a CMU-style T-pose first frame
+  bool skipRestUnfold = true;              ///< drop a Daz-style unfolding from the rest pose (restUnfoldFrames)
   std::string asfPath;                     ///< for .amc files: the skeleton (default: the .asf next to it)
 };
 
@@ -43,6 +44,7 @@ struct ClipLoadReport {
   double sourceRate = 0.0;                 ///< frames per second in the file
   std::size_t sourceFrames = 0;            ///< frames in the file
   bool referenceTPoseSkipped = false;
+  std::size_t restUnfoldFramesSkipped = 0;  ///< file frames of an unfolding from the rest pose, not played
 };
 
 /// BVH channels to local rotations: the rotation channels in file order compose left to
@@ -64,6 +66,17 @@ struct ClipLoadReport {
 /// its arms are near horizontal and far apart, and the pose jumps to frame 1 by more than
 /// 20 degrees at some joint while frame 1 to frame 2 changes much less.
 [[nodiscard]] bool firstFrameIsReferenceTPose(const Clip& clip);
+
+/// The frames at the start of a clip (after any reference T-pose) that unfold the skeleton
+/// from its rest pose into the motion, as some exporters write them (Daz, Poser: frame 0
+/// with the body's rotations zero, then a few frames that turn joints far faster than the
+/// motion ever does): a run of frame-to-frame joint speeds from frame 0 above four times the
+/// clip's median (and above 180 degrees per second) that ends within a quarter second, in
+/// which every joint that turns more than 10 degrees starts nearer its rest orientation than
+/// a quarter of its turn. Returns the run's length, the frames to drop
+/// so that the clip starts where the unfolding ends (the lead-in then blends into that pose
+/// over its own time); 0 for any other clip.
+[[nodiscard]] std::size_t restUnfoldFrames(const Clip& clip);
 
 /// Resamples the clip to `rate` (SLERP of local rotations, linear root translation).
 [[nodiscard]] Clip resample(const Clip& clip, double rate);

@@ -36,17 +36,17 @@ ClothSolver::ClothSolver(std::shared_ptr<const ClothModel> model, const StepSett
       integrator_(makeIntegrator(settings.integrator)),
       state_(ClothState::atRest(*model_)) {
   settings_.validate("--");
-  checkBendingStep();
+  checkBendingStep(*model_, settings_);
 }
 
-void ClothSolver::checkBendingStep() const {
-  const double span = settings_.bendEvery * settings_.substep_s();
-  const double stable = model_->bendingStableStep_s();
-  if (settings_.bendEvery == 1 || span <= stable) return;  // every substep: the stability guard watches
-  const int most = std::max(1, static_cast<int>(stable / settings_.substep_s()));
+void checkBendingStep(const ClothModel& model, const StepSettings& settings) {
+  const double span = settings.bendEvery * settings.substep_s();
+  const double stable = model.bendingStableStep_s();
+  if (settings.bendEvery == 1 || span <= stable) return;  // every substep: the stability guard watches
+  const int most = std::max(1, static_cast<int>(stable / settings.substep_s()));
   throw Error(fmt::format("garment '{}': bending every {} substeps spans {:.3g} ms, above the bending forces' "
                           "stable step of {:.3g} ms; set bendEvery (--bend-every) to {} or less",
-                          model_->name(), settings_.bendEvery, 1e3 * span, 1e3 * stable, most));
+                          model.name(), settings.bendEvery, 1e3 * span, 1e3 * stable, most));
 }
 
 bool ClothSolver::stepFrame(long frame) {

@@ -102,17 +102,25 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
   poses_ = std::make_unique<AvatarPoses>(avatar, animation, settings.leadIn_s);
   for (GarmentSpec& g : garments)
     if (!g.offsetsGiven) g.offsets = cloth::OffsetSurfaces::fromVoxelSize(settings.voxel_m);
+  // The garments' models first: a material or a step they cannot take is refused before the
+  // distance fields are built (seconds, on a large avatar).
+  std::vector<std::shared_ptr<const cloth::ClothModel>> models;
+  for (GarmentSpec& spec : garments) {
+    spec.material.validate("garment '" + spec.name + "': ");
+    models.push_back(cloth::ClothModel::build(spec.mesh, mesh::Topology::build(spec.mesh), spec.material,
+                                              settings_.step.massScaling()));
+    cloth::checkBendingStep(*models.back(), settings_.step);
+  }
   buildFields(garments);
 
-  for (GarmentSpec& spec : garments) {
+  for (std::size_t g = 0; g < garments.size(); ++g) {
+    GarmentSpec& spec = garments[g];
+    const std::shared_ptr<const cloth::ClothModel>& model = models[g];
     std::vector<int> parts;
     for (const std::string& name : spec.collidesWith) {
       const auto it = std::find_if(fields_.begin(), fields_.end(), [&](const PartField& p) { return p.segment == name; });
       parts.push_back(static_cast<int>(it - fields_.begin()));
     }
-    spec.material.validate("garment '" + spec.name + "': ");
-    auto model = cloth::ClothModel::build(spec.mesh, mesh::Topology::build(spec.mesh), spec.material,
-                                          settings_.step.massScaling());
     std::vector<cloth::PinGroup> pins = bindMask(spec, parts);
     if (!spec.pinned.empty()) {
       const auto& m = *model;

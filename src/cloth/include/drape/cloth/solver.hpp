@@ -45,6 +45,11 @@ struct Instability {
   [[nodiscard]] std::string describe(const std::string& garment, double bound_m_s) const;
 };
 
+/// Throws drape::Error, naming the garment and the largest bendEvery that is stable, when
+/// settings.bendEvery substeps exceed the model's bending forces' stable step (the solver
+/// checks it; a caller may check it before costlier set-up).
+void checkBendingStep(const ClothModel& model, const StepSettings& settings);
+
 class ClothSolver {
  public:
   ClothSolver(std::shared_ptr<const ClothModel> model, const StepSettings& settings, std::vector<PinGroup> pins = {});
@@ -82,8 +87,6 @@ class ClothSolver {
   void collide(double t0_s, double t1_s);
   void applyFixtures(double t0_s, double t1_s, double dt_s);
   bool checkStability(long frame, int substepIndex);
-  /// Throws drape::Error when bendEvery substeps exceed the bending forces' stable step.
-  void checkBendingStep() const;
 
   std::shared_ptr<const ClothModel> model_;
   StepSettings settings_;

@@ -31,6 +31,7 @@ struct PaperBenchOptions {
   int collisionEvery = 0;  // 0: as the scene says
   int bendEvery = 0;       // 0: as the scene says
   bool exactSliding = false;  // sliding pairs read the field on every test (no contact planes)
+  bool freePinches = false;   // pinched points move freely between reduced-frequency tests
   bool json = false;
 };
 
@@ -62,6 +63,7 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
   for (std::size_t g = 0; g < world.garmentCount(); ++g) {
     world.collider(g)->setMeasurePenetration(measure);
     world.collider(g)->setContactPlanes(!o.exactSliding);
+    world.collider(g)->setPinchHold(!o.freePinches);
     world.collider(g)->setCountEverySubstep(measure);
   }
 
@@ -107,6 +109,9 @@ RunFunction setupPaperBench(CLI::App& app) {
   app.add_flag("--exact-sliding", o.exactSliding,
                "Sliding points read the distance field on every test instead of their contact planes "
                "(the reference the planes are measured against)");
+  app.add_flag("--free-pinches", o.freePinches,
+               "With --collision-every K > 1: points pinched between two parts move freely between tests "
+               "instead of being held by them (the paper's reduced-frequency tests as they are)");
   app.add_flag("--json", o.json, "Print JSON (the only format)");
   return [] {
     std::vector<PaperRun> runs;
@@ -139,6 +144,8 @@ RunFunction setupPaperBench(CLI::App& app) {
     j["mean_collision_path_voxels"] = r.counters.meanPathVoxels();
     j["contact_planes"] = !o.exactSliding;
     j["sliding_reads_from_contact_planes"] = r.counters.slidingReadsFromPlanes();
+    j["pinch_hold"] = !o.freePinches;
+    j["vertex_substeps_held_in_pinches"] = r.counters.heldVertexSubsteps;
     j["vertex_substeps"] = penetration.vertexSubsteps;  // free vertices x substeps: all of them
     j["vertex_substeps_inside_body"] = penetration.vertexSubstepsInsideBody;
     j["vertex_substeps_below_T1_fraction"] =

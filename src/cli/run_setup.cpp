@@ -122,6 +122,7 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
   stats["last_resort_projections"] = sum.projections;
   stats["pairs_embedded_at_start"] = sum.embeddedAtStart;
   stats["sliding_reads_from_contact_planes"] = sum.slidingReadsFromPlanes();
+  stats["vertex_substeps_held_in_pinches"] = sum.heldVertexSubsteps;
   nlohmann::json transitions;
   const char* names[3] = {"outside_vol", "inside_vol", "on_surf"};
   for (int a = 0; a < 3; ++a)

@@ -148,6 +148,11 @@ struct FieldCollider::PartFrame {
   double t2Voxels = 0;        ///< the collision surface T2 in voxels (the walk's test)
 };
 
+/// A part's rigid motion over one substep, world to world.
+struct FieldCollider::PartStep {
+  Affine motion;
+};
+
 FieldCollider::FieldCollider(std::string garmentName, std::vector<CollisionPart> parts, const OffsetSurfaces& offsets,
                              double staticFriction, double dynamicFriction, int every)
     : garment_(std::move(garmentName)),
@@ -168,6 +173,8 @@ FieldCollider::FieldCollider(std::string garmentName, std::vector<CollisionPart>
   }
   frames_.resize(parts_.size());
   poses_.resize(2 * parts_.size());
+  steps_.resize(parts_.size());
+  holds_.assign(parts_.size(), 0);
 }
 
 FieldCollider::~FieldCollider() = default;
@@ -195,6 +202,13 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   corrections_.assign(n, 0);
   corrected_.clear();
   corrected_.reserve(n * parts_.size());  // the step does not allocate
+  held_.clear();
+  held_.reserve(n);
+  heldParts_.clear();
+  heldParts_.reserve(n * parts_.size());
+  pinched_.clear();
+  pinched_.reserve(n * parts_.size());
+  askers_.assign(n, 0);
   field_.embeddedAtStart = 0;
   for (std::vector<double>* v : {&endVoxelX_, &endVoxelY_, &endVoxelZ_, &nearest_}) v->assign(n, 0.0);
   keep_.assign(n + 8, 0);  // padded: the candidate scan reads eight flags at a time
@@ -236,6 +250,7 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
   ++counters_.calls;
   if (states_.empty() || states_.front().size() != io.size()) initialise(io, t0_s);
   if ((calls_++ % every_) != 0) {  // reduced-frequency collision tests
+    holdPinches(t0_s, t1_s, io);
     if (countEverySubstep_ && measurePenetration_) {
       const auto start = std::chrono::steady_clock::now();
       countUntested(io, t1_s);
@@ -276,6 +291,7 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
     }
   }
   applyCorrections(io);
+  collectPinches(io);
   if (measurePenetration_) {
     const auto start = std::chrono::steady_clock::now();
     measureCorrected(io);
@@ -537,6 +553,56 @@ void FieldCollider::respondOnSurface(const PartFrame& frame, const Vec3& c, cons
   io.setVelocity(i, v);
 }
 
+void FieldCollider::collectPinches(const ClothState& io) {
+  held_.clear();
+  heldParts_.clear();
+  std::fill(holds_.begin(), holds_.end(), std::uint8_t{0});
+  if (!pinchHold_ || every_ == 1) return;
+  for (const auto& [k, i] : corrected_) ++askers_[i];
+  pinched_.clear();
+  for (const auto& [k, i] : corrected_)
+    if (askers_[i] >= 2) pinched_.push_back({i, k});
+  for (const auto& [k, i] : corrected_) askers_[i] = 0;
+  std::sort(pinched_.begin(), pinched_.end());
+  for (const auto& [i, k] : pinched_) {
+    if (held_.empty() || held_.back().vertex != i)
+      held_.push_back({i, static_cast<std::uint32_t>(heldParts_.size()), 0, io.position(i)});
+    heldParts_.push_back(k);
+    ++held_.back().partCount;
+    holds_[k] = 1;
+  }
+}
+
+void FieldCollider::holdPinches(double t0_s, double t1_s, ClothState& io) {
+  if (held_.empty() || !(t1_s > t0_s)) return;
+  // Each holding part's rigid motion over the substep, world to world:
+  // x -> R1 R0^T (x - p0) + p1.
+  const auto poseStart = std::chrono::steady_clock::now();
+  for (std::size_t k = 0; k < parts_.size(); ++k) {
+    if (!holds_[k]) continue;
+    poses_[2 * k] = parts_[k].motion->poseAt(t0_s);
+    poses_[2 * k + 1] = parts_[k].motion->poseAt(t1_s);
+  }
+  poseSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - poseStart).count();
+  for (std::size_t k = 0; k < parts_.size(); ++k) {
+    if (!holds_[k]) continue;
+    const RigidTransform& a = poses_[2 * k];
+    const RigidTransform& b = poses_[2 * k + 1];
+    const Mat3 r = (b.rotation * a.rotation.conjugate()).toRotationMatrix();
+    steps_[k].motion = {r, b.translation - r * a.translation};
+  }
+  const double invDt = 1.0 / (t1_s - t0_s);
+  for (HeldPoint& h : held_) {
+    Vec3 sum = Vec3::Zero();
+    for (std::uint32_t j = 0; j < h.partCount; ++j) sum += steps_[heldParts_[h.firstPart + j]].motion.apply(h.at);
+    const Vec3 next = sum / static_cast<double>(h.partCount);
+    io.setVelocity(h.vertex, (next - h.at) * invDt);
+    io.setPosition(h.vertex, next);
+    h.at = next;
+  }
+  field_.heldVertexSubsteps += held_.size();
+}
+
 void FieldCollider::addCorrection(std::size_t i, const Vec3& displacement) {
   correctionX_[i] += displacement.x();
   correctionY_[i] += displacement.y();
@@ -607,7 +673,8 @@ FieldCollisionCounters& FieldCollisionCounters::operator+=(const FieldCollisionC
                       {&vertexSubstepsBelowT1, o.vertexSubstepsBelowT1}, {&vertexSubstepsBelowT0, o.vertexSubstepsBelowT0},
                       {&vertexSubstepsInsideBody, o.vertexSubstepsInsideBody}, {&vertexSubsteps, o.vertexSubsteps},
                       {&clearanceSkips, o.clearanceSkips}, {&embeddedAtStart, o.embeddedAtStart},
-                      {&planeEstimates, o.planeEstimates}, {&planeReads, o.planeReads}})
+                      {&planeEstimates, o.planeEstimates}, {&planeReads, o.planeReads},
+                      {&heldVertexSubsteps, o.heldVertexSubsteps}})
     *a += b;
   maxPenetration_m = std::max(maxPenetration_m, o.maxPenetration_m);
   for (int from = 0; from < 3; ++from)

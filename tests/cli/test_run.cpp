@@ -194,6 +194,7 @@ TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
   const nlohmann::json every = bench("");
   const nlohmann::json third = bench("--collision-every 3 --bend-every 4");
   const nlohmann::json exact = bench("--exact-sliding");
+  const nlohmann::json free = bench("--collision-every 3 --bend-every 4 --free-pinches");
   for (const char* key : {"frames", "sim_fps", "ms_per_frame", "collision_time_share", "mean_collision_path_voxels",
                           "vertex_substeps_inside_body", "animation_ms_per_frame", "collision_every"})
     EXPECT_TRUE(every.contains(key)) << key;
@@ -211,6 +212,11 @@ TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
   EXPECT_EQ(exact["contact_planes"], false);
   EXPECT_EQ(exact["sliding_reads_from_contact_planes"], 0.0);
   EXPECT_EQ(exact["vertex_substeps"], every["vertex_substeps"]);
+  // Pinched points held between reduced-frequency tests, unless they move freely.
+  EXPECT_EQ(third["pinch_hold"], true);
+  EXPECT_EQ(free["pinch_hold"], false);
+  EXPECT_EQ(free["vertex_substeps_held_in_pinches"], 0);
+  EXPECT_EQ(every["vertex_substeps_held_in_pinches"], 0);  // tests on every substep: nothing to hold
   for (const nlohmann::json* j : {&every, &third, &exact}) {
     EXPECT_GT((*j)["collision_time_share"].get<double>(), 0.0);
     EXPECT_LT((*j)["collision_time_share"].get<double>(), 1.0);

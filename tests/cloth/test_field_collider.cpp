@@ -607,6 +607,58 @@ TEST(FieldCollider, APointPinchedBetweenTwoPartsSettlesBetweenThem) {
   EXPECT_EQ(c.state(1, 0), PointState::OnSurf);
 }
 
+/// A point 12 mm from each of two boxes that move together (closer than twice T2 apart),
+/// tested every fourth substep; between tests something throws it towards
+/// the left box at `throw_m_s` (the cloth's forces, in a garment). Returns the deepest it
+/// went into either box (m, 0 if never) and checks what a held point must do.
+double throwBetweenTests(bool hold, double throw_m_s, std::uint64_t* held = nullptr) {
+  const field::DistanceField leftField = buildField(field::makeBox(Vec3(-0.1, -0.05, -0.05), Vec3(0.0, 0.05, 0.05)));
+  const field::DistanceField rightField = buildField(field::makeBox(Vec3(0.0, -0.05, -0.05), Vec3(0.1, 0.05, 0.05)));
+  const Vec3 velocity(0, 0.3, 0);
+  // The boxes' fields put their faces' distance 2.5 mm outside the faces: 12 mm at 14.5 mm.
+  const double apart = 0.0145;
+  const std::vector<CollisionPart> parts = {
+      {"left", &leftField, std::make_shared<LinearMotion>(Vec3(-apart, 0, 0), velocity)},
+      {"right", &rightField, std::make_shared<LinearMotion>(Vec3(apart, 0, 0), velocity)}};
+  Point p(Vec3::Zero());
+  const int every = 4;
+  FieldCollider c("test", parts, kOffsets, 0.0, 0.0, every);
+  c.setPinchHold(hold);
+  c.initialise(p.state, 0.0);
+  EXPECT_EQ(c.fieldCounters().embeddedAtStart, 0u);
+  const double dt = 1e-3;
+  double deepest = 0;
+  for (int step = 0; step < 40; ++step) {
+    const bool tested = step % every == 0;
+    if (!tested) p.state.setVelocity(0, Vec3(-throw_m_s, 0.3, 0));
+    const Vec3 before = p.state.position(0);
+    p.state.setPosition(0, before + p.state.velocity(0) * dt);
+    c.collide(*p.model, step * dt, (step + 1) * dt, p.state);
+    const double x = p.state.position(0).x();
+    const Vec3 shift = velocity * (step + 1) * dt;
+    deepest = std::max({deepest, -leftField.distanceAt(p.state.position(0) - Vec3(-apart, 0, 0) - shift),
+                        -rightField.distanceAt(p.state.position(0) - Vec3(apart, 0, 0) - shift)});
+    if (hold && !tested) {
+      // Held where the test left it, moving with both boxes.
+      EXPECT_NEAR(x, 0.0, 1e-9) << "step " << step;
+      EXPECT_NEAR((p.state.position(0) - before - velocity * dt).norm(), 0.0, 1e-12) << "step " << step;
+      EXPECT_NEAR((p.state.velocity(0) - velocity).norm(), 0.0, 1e-9) << "step " << step;
+    }
+    if (tested) EXPECT_EQ(c.heldPoints(), hold ? 1u : 0u) << "step " << step;
+  }
+  if (held) *held = c.fieldCounters().heldVertexSubsteps;
+  return deepest;
+}
+
+TEST(FieldCollider, APointPinchedAtATestIsHeldByItsPartsUntilTheNext) {
+  std::uint64_t held = 0;
+  EXPECT_EQ(throwBetweenTests(true, 5.0, &held), 0.0);
+  EXPECT_EQ(held, 30u);  // 10 tests, each followed by 3 untested substeps
+  // Free between tests, 5 m/s carries it 15 mm in three substeps: 3 mm into the left box.
+  EXPECT_GT(throwBetweenTests(false, 5.0), 0.002);
+  EXPECT_LT(throwBetweenTests(false, 5.0), 0.004);
+}
+
 TEST(FieldCollider, CountersOfTwoGarmentsAddUp) {
   FieldCollisionCounters a;
   std::uint64_t value = 1;

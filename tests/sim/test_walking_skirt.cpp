@@ -1,7 +1,8 @@
 // The paper's scenario end to end (section 5): the bundled walking skirt over every walk in
 // data/mocap, with the collision tests on every substep (the scene's setting) and on every
-// third (the paper's reduced-frequency tests, section 6), penetration counted on every
-// substep either way. The skirt must stay out of the body: no NaN, not one vertex-substep
+// third and fourth (the paper's reduced-frequency tests, section 6; at every fourth, points
+// pinched between two parts must be held between tests, or the cloth's forces throw some
+// into a leg), penetration counted on every substep either way. The skirt must stay out of the body: no NaN, not one vertex-substep
 // inside it, fewer than 0.1 % of vertex-substeps below the inner envelope T1.
 
 #include <gtest/gtest.h>
@@ -63,8 +64,12 @@ TEST_P(WalkingSkirt, StaysOutOfTheBody) {
   // Every substep counted (240 free vertices), tested or not.
   EXPECT_EQ(r.counters.vertexSubsteps, static_cast<std::uint64_t>(r.frames) * 33u * 240u);
   EXPECT_GT(r.counters.collisions, 0u) << "the skirt never touched the legs: the scenario tests nothing";
-  // The sliding tests run on contact planes (the bundled default): most need no field read.
-  EXPECT_GT(r.counters.planeEstimates, 2 * r.counters.planeReads);
+  // The sliding tests run on contact planes (the bundled default): most need no field read
+  // (with tests every fourth substep the points travel further between them, and about
+  // half do on the Daz-style walk).
+  if (every <= 3) EXPECT_GT(r.counters.planeEstimates, 2 * r.counters.planeReads);
+  EXPECT_GT(r.counters.planeEstimates, r.counters.planeReads / 2);
+  if (every > 1) EXPECT_GT(r.counters.heldVertexSubsteps, 0u) << "no pinch held: the hold is untested";
   EXPECT_EQ(r.counters.vertexSubstepsInsideBody, 0u) << "deepest " << r.counters.maxPenetration_m << " m";
   const double belowT1 = double(r.counters.vertexSubstepsBelowT1) / double(r.counters.vertexSubsteps);
   EXPECT_LT(belowT1, 0.001);
@@ -73,7 +78,7 @@ TEST_P(WalkingSkirt, StaysOutOfTheBody) {
 INSTANTIATE_TEST_SUITE_P(Walks, WalkingSkirt,
                          ::testing::Combine(::testing::Values("cmu_12_03_walk.bvh", "cmu_walk_delfem2.bvh",
                                                               "cmu_02_02_walk_dazstyle.bvh"),
-                                            ::testing::Values(1, 3)),
+                                            ::testing::Values(1, 3, 4)),
                          [](const auto& info) {
                            const std::string& walk = std::get<0>(info.param);
                            std::string name = walk.substr(0, walk.find('.'));

@@ -40,6 +40,16 @@
 // forth, and a point one part touches moves exactly as that part asks. Velocity responses
 // apply part by part.
 //
+// Pinches between reduced-frequency tests (every > 1): the Jacobi mean leaves a point that
+// two parts press from both sides off the offset surface it would take with either alone,
+// and the garment pulls it back towards one of them; tested every substep, each test answers
+// the pull, but between tests the cloth's forces throw it at metres per second into a part
+// (traced on the walks: into a thigh from the crease of hip or knee, 2 to 3 m/s, a few
+// millimetres deep by the next test). So a point two or more parts asked to move at a test is
+// held by those parts until the next: each untested substep moves it by the mean of their
+// rigid motions over the substep and gives it that velocity, as friction between them would
+// (setPinchHold). With tests on every substep nothing is held.
+//
 // Culling (the paper's non-hierarchical boxes): once per part and collision substep, one
 // vectorised pass maps every point's end position into the part's voxel coordinates (the
 // part's rigid transform at t1 and the grid placement folded into one affine map) and keeps
@@ -136,6 +146,7 @@ struct FieldCollisionCounters {
   std::uint64_t embeddedAtStart = 0;  ///< (vertex, part) pairs below T1 at the start, eased out onto T2
   std::uint64_t planeEstimates = 0;  ///< sliding pairs' field reads answered by their contact plane
   std::uint64_t planeReads = 0;      ///< sliding pairs' field reads that went to the field
+  std::uint64_t heldVertexSubsteps = 0;  ///< untested substeps of points held in a pinch (setPinchHold)
   std::array<std::array<std::uint64_t, 3>, 3> transitions{};  ///< [from][to] PointState counts
 
   /// Mean voxel path per tested (vertex, part) pair: the paper's "average collision path
@@ -188,6 +199,16 @@ class FieldCollider final : public Collider {
   /// figures come from another run of the same motion, which they do not change. On by
   /// default.
   void setMeasurePenetration(bool on) { measurePenetration_ = on; }
+  /// With reduced-frequency tests (every > 1): a point that two or more parts asked to move
+  /// at a test (pressed from both sides, where their offset surfaces overlap: between the
+  /// thighs, in the crease of hip or knee) is held by them on the substeps until the next
+  /// test, moving with the mean of their rigid motions, as friction between them would hold
+  /// it. Off: it moves freely between tests (the paper's reduced-frequency tests as they
+  /// are), where the cloth's forces can throw it into a part before the next test. On by
+  /// default; with tests on every substep there is nothing to hold.
+  void setPinchHold(bool on) { pinchHold_ = on; }
+  /// The points held now (pinched at the last test).
+  [[nodiscard]] std::size_t heldPoints() const { return held_.size(); }
   [[nodiscard]] bool measuresPenetration() const { return measurePenetration_; }
   /// Off: no pair skips its distance reads through the clearance bits (nor, so, settles
   /// from a cached clear voxel), and no sliding pair counts its walk instead of walking it:
@@ -227,6 +248,7 @@ class FieldCollider final : public Collider {
 
  private:
   struct PartFrame;  // one part's transforms over the interval (field_collider.cpp)
+  struct PartStep;   // one part's rigid motion over an untested substep (field_collider.cpp)
   PartFrame framePart(const CollisionPart& part, const RigidTransform& pose0, const RigidTransform& pose1) const;
   /// Fills endVoxel* with every point's end position in part k's voxel coordinates and
   /// candidates_ with the points the per-pair test must see; returns their number.
@@ -258,6 +280,10 @@ class FieldCollider final : public Collider {
   void countNearest();
   /// The penetration figures of an untested substep ending at t_s (setCountEverySubstep).
   void countUntested(const ClothState& io, double t_s);
+  /// After a test's corrections: the points two or more parts asked to move (setPinchHold).
+  void collectPinches(const ClothState& io);
+  /// On an untested substep t0 -> t1: the held points move with their parts.
+  void holdPinches(double t0_s, double t1_s, ClothState& io);
 
   std::string garment_;
   std::vector<CollisionPart> parts_;
@@ -269,6 +295,7 @@ class FieldCollider final : public Collider {
   bool clearanceSkip_ = true;
   bool contactPlanes_ = true;
   bool measurePenetration_ = true;
+  bool pinchHold_ = true;
   long calls_ = 0;
   double poseSeconds_ = 0;
   double measureSeconds_ = 0;
@@ -301,6 +328,17 @@ class FieldCollider final : public Collider {
   std::vector<std::vector<Vec3i>> settledVoxel_;
   static inline const Vec3i kNotSettled = Vec3i::Constant(-1000000);
   std::vector<double> nearest_;                   ///< per vertex, m: distance to the nearest part after the response
+  /// A point held in a pinch: its parts are heldParts_[firstPart, firstPart + partCount).
+  struct HeldPoint {
+    std::uint32_t vertex = 0, firstPart = 0, partCount = 0;
+    Vec3 at = Vec3::Zero();  ///< world, m: where it is held now
+  };
+  std::vector<HeldPoint> held_;
+  std::vector<std::uint32_t> heldParts_;
+  std::vector<std::uint8_t> holds_;   ///< per part: some held point is held by it
+  std::vector<PartStep> steps_;       ///< per part: its motion over the current untested substep
+  std::vector<std::uint8_t> askers_;  ///< per vertex, scratch: the parts that asked to move it this test
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pinched_;  ///< scratch: (vertex, part), sorted
   ColliderCounters counters_;
   FieldCollisionCounters field_;
 };

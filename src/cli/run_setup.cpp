@@ -271,6 +271,7 @@ int simulateRun(const RunSetup& setup) {
       r.collider = world->collider(gi);
       world->collider(gi)->setCountEverySubstep(setup.countEverySubstep);
       world->collider(gi)->setContactPlanes(!setup.exactSliding);
+      world->collider(gi)->setPinchHold(!setup.freePinches);
     } else {
       const mesh::Topology topology = mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
       auto model = cloth::ClothModel::build(g.mesh, topology, g.material, settings.massScaling());

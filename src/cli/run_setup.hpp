@@ -51,6 +51,9 @@ struct RunSetup {
   bool countEverySubstep = false;
   /// Sliding points read the distance field on every test instead of their contact planes.
   bool exactSliding = false;
+  /// With reduced-frequency collision tests, pinched points move freely between tests
+  /// instead of being held by the parts that pressed them (FieldCollider::setPinchHold).
+  bool freePinches = false;
 };
 
 /// Garments, materials, settings and the avatar (as the setup's character, without motion)

@@ -57,9 +57,11 @@ TEST(RunScene, ReducedFrequencyTestsSayWhatTheirFiguresCount) {
   EXPECT_GT(a["sliding_reads_from_contact_planes"].get<double>(), 0.5);
   EXPECT_EQ(exact["sliding_reads_from_contact_planes"], 0.0);
   EXPECT_EQ(exact["vertex_substeps_inside_body"], 0);
-  // Points pinched at a test held until the next, so many vertex-substeps of them.
+  // Points pinched at a test held until the next, unless asked to move freely.
+  const nlohmann::json free = nlohmann::json::parse(slurp(run("free", "--free-pinches") + "/stats.json"));
   ASSERT_TRUE(a.contains("vertex_substeps_held_in_pinches"));
   EXPECT_EQ(a["vertex_substeps_held_in_pinches"], b["vertex_substeps_held_in_pinches"]);
+  EXPECT_EQ(free["vertex_substeps_held_in_pinches"], 0);
   // The measuring is timed apart from the collision work (and left out of its share).
   for (const nlohmann::json* j : {&a, &b}) {
     EXPECT_GT((*j)["penetration_measure_ms_per_frame"].get<double>(), 0.0);

@@ -644,7 +644,9 @@ double throwBetweenTests(bool hold, double throw_m_s, std::uint64_t* held = null
       EXPECT_NEAR((p.state.position(0) - before - velocity * dt).norm(), 0.0, 1e-12) << "step " << step;
       EXPECT_NEAR((p.state.velocity(0) - velocity).norm(), 0.0, 1e-9) << "step " << step;
     }
-    if (tested) EXPECT_EQ(c.heldPoints(), hold ? 1u : 0u) << "step " << step;
+    if (tested) {
+      EXPECT_EQ(c.heldPoints(), hold ? 1u : 0u) << "step " << step;
+    }
   }
   if (held) *held = c.fieldCounters().heldVertexSubsteps;
   return deepest;
@@ -664,7 +666,8 @@ TEST(FieldCollider, CountersOfTwoGarmentsAddUp) {
   std::uint64_t value = 1;
   for (std::uint64_t* f : {&a.tests, &a.traces, &a.traceVoxels, &a.collisions, &a.projections,
                            &a.vertexSubstepsBelowT1, &a.vertexSubstepsBelowT0, &a.vertexSubstepsInsideBody,
-                           &a.vertexSubsteps, &a.clearanceSkips, &a.embeddedAtStart, &a.planeEstimates, &a.planeReads})
+                           &a.vertexSubsteps, &a.clearanceSkips, &a.embeddedAtStart, &a.planeEstimates, &a.planeReads,
+                           &a.heldVertexSubsteps})
     *f = value++;
   for (auto& row : a.transitions)
     for (std::uint64_t& t : row) t = value++;
@@ -678,7 +681,7 @@ TEST(FieldCollider, CountersOfTwoGarmentsAddUp) {
   for (const std::uint64_t* f : {&c.tests, &c.traces, &c.traceVoxels, &c.collisions, &c.projections,
                                  &c.vertexSubstepsBelowT1, &c.vertexSubstepsBelowT0, &c.vertexSubstepsInsideBody,
                                  &c.vertexSubsteps, &c.clearanceSkips, &c.embeddedAtStart, &c.planeEstimates,
-                                 &c.planeReads})
+                                 &c.planeReads, &c.heldVertexSubsteps})
     EXPECT_EQ(*f, 2 * value++);
   for (const auto& row : c.transitions)
     for (const std::uint64_t t : row) EXPECT_EQ(t, 2 * value++);

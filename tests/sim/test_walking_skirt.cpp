@@ -67,9 +67,13 @@ TEST_P(WalkingSkirt, StaysOutOfTheBody) {
   // The sliding tests run on contact planes (the bundled default): most need no field read
   // (with tests every fourth substep the points travel further between them, and about
   // half do on the Daz-style walk).
-  if (every <= 3) EXPECT_GT(r.counters.planeEstimates, 2 * r.counters.planeReads);
+  if (every <= 3) {
+    EXPECT_GT(r.counters.planeEstimates, 2 * r.counters.planeReads);
+  }
   EXPECT_GT(r.counters.planeEstimates, r.counters.planeReads / 2);
-  if (every > 1) EXPECT_GT(r.counters.heldVertexSubsteps, 0u) << "no pinch held: the hold is untested";
+  if (every > 1) {
+    EXPECT_GT(r.counters.heldVertexSubsteps, 0u) << "no pinch held: the hold is untested";
+  }
   EXPECT_EQ(r.counters.vertexSubstepsInsideBody, 0u) << "deepest " << r.counters.maxPenetration_m << " m";
   const double belowT1 = double(r.counters.vertexSubstepsBelowT1) / double(r.counters.vertexSubsteps);
   EXPECT_LT(belowT1, 0.001);

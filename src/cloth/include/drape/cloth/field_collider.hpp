@@ -199,6 +199,7 @@ class FieldCollider final : public Collider {
   /// figures come from another run of the same motion, which they do not change. On by
   /// default.
   void setMeasurePenetration(bool on) { measurePenetration_ = on; }
+  [[nodiscard]] bool measuresPenetration() const { return measurePenetration_; }
   /// With reduced-frequency tests (every > 1): a point that two or more parts asked to move
   /// at a test (pressed from both sides, where their offset surfaces overlap: between the
   /// thighs, in the crease of hip or knee) is held by them on the substeps until the next
@@ -209,7 +210,6 @@ class FieldCollider final : public Collider {
   void setPinchHold(bool on) { pinchHold_ = on; }
   /// The points held now (pinched at the last test).
   [[nodiscard]] std::size_t heldPoints() const { return held_.size(); }
-  [[nodiscard]] bool measuresPenetration() const { return measurePenetration_; }
   /// Off: no pair skips its distance reads through the clearance bits (nor, so, settles
   /// from a cached clear voxel), and no sliding pair counts its walk instead of walking it:
   /// the reference these shortcuts are tested against. On by default.
@@ -337,7 +337,7 @@ class FieldCollider final : public Collider {
   std::vector<std::uint32_t> heldParts_;
   std::vector<std::uint8_t> holds_;   ///< per part: some held point is held by it
   std::vector<PartStep> steps_;       ///< per part: its motion over the current untested substep
-  std::vector<std::uint8_t> askers_;  ///< per vertex, scratch: the parts that asked to move it this test
+  std::vector<std::uint8_t> askers_;  ///< per vertex, scratch: how many parts asked to move it this test
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pinched_;  ///< scratch: (vertex, part), sorted
   ColliderCounters counters_;
   FieldCollisionCounters field_;

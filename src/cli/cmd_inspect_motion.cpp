@@ -33,12 +33,8 @@ void printClip(std::ostream& out, const std::string& path, const char* kind, con
   const double sourceDuration = r.sourceFrames > 1 ? static_cast<double>(r.sourceFrames - 1) / r.sourceRate : 0.0;
   fmt::print(out, "  frames     {} at {:.4g} Hz in the file ({:.3f} s)\n", r.sourceFrames, r.sourceRate, sourceDuration);
   fmt::print(out, "  T-pose     {}\n", r.referenceTPoseSkipped ? "frame 1 is a reference T-pose (not played)" : "no reference frame");
-  const std::size_t first = r.referenceTPoseSkipped ? 2 : 1;  // file frames count from 1
-  if (r.restUnfoldFramesSkipped > 0)
-    fmt::print(out, "  unfolding  frames {}-{} unfold from the rest pose (not played; the lead-in blends into frame {})\n",
-               first, first + r.restUnfoldFramesSkipped - 1, first + r.restUnfoldFramesSkipped);
-  else
-    fmt::print(out, "  unfolding  none from the rest pose\n");
+  const std::string unfolding = r.restUnfoldSkipped();
+  fmt::print(out, "  unfolding  {}\n", unfolding.empty() ? "none from the rest pose" : unfolding);
   fmt::print(out, "  played     {} frames at {:.4g} Hz ({:.3f} s), starting {}\n", clip.frameCount(), clip.rate, clip.duration(),
              clip.start.smpte());
   fmt::print(out, "  units      {} guessed from a rest extent of {:.4g} units ({:.3f} m each)\n", r.units.name,

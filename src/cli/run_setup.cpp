@@ -193,8 +193,12 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
   if (metresPerUnit > 0) mo.clip.metresPerUnit = metresPerUnit;
   mo.jointMapPath = jointMap;
   mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
-  setup.character->animation =
-      std::make_shared<const motion::AvatarAnimation>(motion::loadAnimation(*setup.character->avatar, motionPath, mo));
+  motion::ClipLoadReport report;
+  setup.character->animation = std::make_shared<const motion::AvatarAnimation>(
+      motion::loadAnimation(*setup.character->avatar, motionPath, mo, &report));
+  // Frames the motion file holds but drape does not play: say so, the timing shifts.
+  if (report.referenceTPoseSkipped) spdlog::info("{}: frame 1 is a reference T-pose, not played", motionPath);
+  if (report.restUnfoldFramesSkipped > 0) spdlog::info("{}: {}", motionPath, report.restUnfoldSkipped());
 }
 
 std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup) {

@@ -134,6 +134,14 @@ bool firstFrameIsReferenceTPose(const Clip& clip) {
   return jump > 20.0 && jump > 4.0 * next;
 }
 
+std::string ClipLoadReport::restUnfoldSkipped() const {
+  if (restUnfoldFramesSkipped == 0) return {};
+  const std::size_t first = referenceTPoseSkipped ? 2 : 1;
+  const std::size_t last = first + restUnfoldFramesSkipped - 1;
+  return fmt::format("frames {}-{} unfold from the rest pose (not played; the lead-in blends into frame {})", first,
+                     last, last + 1);
+}
+
 std::size_t restUnfoldFrames(const Clip& clip) {
   const std::size_t n = clip.frameCount();
   if (n < 3 || !(clip.rate > 0.0)) return 0;

@@ -45,6 +45,10 @@ struct ClipLoadReport {
   std::size_t sourceFrames = 0;            ///< frames in the file
   bool referenceTPoseSkipped = false;
   std::size_t restUnfoldFramesSkipped = 0;  ///< file frames of an unfolding from the rest pose, not played
+
+  /// "frames 2-5 unfold from the rest pose (not played; the lead-in blends into frame 6)",
+  /// file frames counted from 1; empty without such frames.
+  [[nodiscard]] std::string restUnfoldSkipped() const;
 };
 
 /// BVH channels to local rotations: the rotation channels in file order compose left to

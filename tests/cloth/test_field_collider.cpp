@@ -661,6 +661,58 @@ TEST(FieldCollider, APointPinchedAtATestIsHeldByItsPartsUntilTheNext) {
   EXPECT_LT(throwBetweenTests(false, 5.0), 0.004);
 }
 
+/// A frame that turns about an axis that itself turns (rotations at different times do not
+/// commute) while it moves.
+class WobblingMotion final : public FixtureMotion {
+ public:
+  [[nodiscard]] RigidTransform poseAt(double t) const override {
+    const Quat q = Quat(Eigen::AngleAxisd(4.0 * t, Vec3::UnitZ())) * Quat(Eigen::AngleAxisd(6.0 * t, Vec3::UnitX()));
+    return {q, Vec3(0.01 + 0.2 * t, 0.1 * t, 0)};
+  }
+};
+
+TEST(FieldCollider, AHeldPointTurnsWithItsParts) {
+  // Two boxes fixed in one frame that tumbles (turning and moving): a point pinched between
+  // them at a test rides the frame's rigid motion exactly until the next, whatever throws
+  // it: it stays where the test left it in the boxes' frame.
+  const double apart = 0.011;
+  const field::DistanceField leftField =
+      buildField(field::makeBox(Vec3(-0.1 - apart, -0.05, -0.05), Vec3(-apart, 0.05, 0.05)));
+  const field::DistanceField rightField =
+      buildField(field::makeBox(Vec3(apart, -0.05, -0.05), Vec3(0.1 + apart, 0.05, 0.05)));
+  const auto frame = std::make_shared<WobblingMotion>();
+  const std::vector<CollisionPart> parts = {{"left", &leftField, frame}, {"right", &rightField, frame}};
+  const Vec3 start(-0.0025, 0, 0);  // where both fields read 11 mm (their grids sit half a voxel apart)
+  Point p(frame->poseAt(0).apply(start));
+  const int every = 5;
+  FieldCollider c("test", parts, kOffsets, 0.0, 0.0, every);
+  c.initialise(p.state, 0.0);
+  ASSERT_EQ(c.state(0, 0), PointState::OnSurf) << leftField.distanceAt(start);
+  ASSERT_EQ(c.state(1, 0), PointState::OnSurf) << rightField.distanceAt(start);
+  ASSERT_EQ(c.fieldCounters().embeddedAtStart, 0u);
+  const double dt = 1e-3;
+  Vec3 atTest = Vec3::Zero();  // in the boxes' frame
+  for (int step = 0; step < 60; ++step) {
+    const bool tested = step % every == 0;
+    const Vec3 before = p.state.position(0);
+    if (!tested) p.state.setVelocity(0, Vec3(3, -2, 1));
+    p.state.setPosition(0, before + p.state.velocity(0) * dt);
+    c.collide(*p.model, step * dt, (step + 1) * dt, p.state);
+    const Vec3 local = frame->poseAt((step + 1) * dt).inverse().apply(p.state.position(0));
+    EXPECT_GT(leftField.distanceAt(local), 0.0) << "step " << step;
+    EXPECT_GT(rightField.distanceAt(local), 0.0) << "step " << step;
+    if (tested) {
+      ASSERT_EQ(c.heldPoints(), 1u) << "step " << step;
+      atTest = local;
+    } else {
+      EXPECT_NEAR((local - atTest).norm(), 0.0, 1e-12) << "step " << step;
+      const Vec3 expected = frame->poseAt((step + 1) * dt).apply(frame->poseAt(step * dt).inverse().apply(before));
+      EXPECT_NEAR((p.state.velocity(0) - (expected - before) / dt).norm(), 0.0, 1e-9) << "step " << step;
+    }
+  }
+  EXPECT_EQ(c.fieldCounters().heldVertexSubsteps, 48u);  // 12 tests, each followed by 4 untested substeps
+}
+
 TEST(FieldCollider, CountersOfTwoGarmentsAddUp) {
   FieldCollisionCounters a;
   std::uint64_t value = 1;

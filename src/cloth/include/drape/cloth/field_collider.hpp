@@ -300,7 +300,8 @@ class FieldCollider final : public Collider {
   double poseSeconds_ = 0;
   double measureSeconds_ = 0;
   std::vector<PartFrame> frames_;  ///< per part, this interval's transforms (collide)
-  std::vector<RigidTransform> poses_;  ///< per part, its poses at the interval's start and end (or the untested substep's: holdPinches)
+  /// Per part, its poses at the interval's start and end (or the untested substep's: holdPinches).
+  std::vector<RigidTransform> poses_;
   double lastTime_s_ = 0;
   std::vector<std::vector<PointState>> states_;   ///< [part][vertex]
   std::vector<std::vector<Vec3>> lastVoxel_;      ///< [part][vertex], part's voxel coordinates at lastTime

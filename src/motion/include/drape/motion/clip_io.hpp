@@ -77,9 +77,9 @@ struct ClipLoadReport {
 /// motion ever does): a run of frame-to-frame joint speeds from frame 0 above four times the
 /// clip's median (and above 180 degrees per second) that ends within a quarter second, in
 /// which every joint that turns more than 10 degrees starts nearer its rest orientation than
-/// a quarter of its turn. Returns the run's length, the frames to drop
-/// so that the clip starts where the unfolding ends (the lead-in then blends into that pose
-/// over its own time); 0 for any other clip.
+/// a quarter of its turn. Returns the run's length, the frames to drop so that the clip
+/// starts where the unfolding ends (the lead-in then blends into that pose over its own
+/// time); 0 for any other clip.
 [[nodiscard]] std::size_t restUnfoldFrames(const Clip& clip);
 
 /// Resamples the clip to `rate` (SLERP of local rotations, linear root translation).

@@ -231,6 +231,8 @@ RunFunction setupRun(CLI::App& app) {
       "Writes DIR/frames/frame_NNNNN.obj (every --every frames), DIR/garment.pc2 and DIR/garment.obj, the avatar's "
       "parts as DIR/segments/NAME.{obj,pc2}, DIR/result.wrl (VRML97), DIR/result.glb (glTF 2.0), DIR/stats.json and "
       "DIR/manifest.json. Units are SI; Y is up.\n"
+      "With a scene, the fabric, step and collision settings are the scene's; an option given here overrides "
+      "them for every garment. The defaults shown are those of --garment runs.\n"
       "Exit codes: 0 done, 2 bad input, 3 the simulation became unstable (files so far are kept).");
   app.add_option("scene", o->scene, "VRML97 scene with ClothSet garments (and an avatar)");
   app.add_option("--garment", o->garment, "Garment mesh (OBJ), instead of a scene");

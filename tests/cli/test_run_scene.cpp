@@ -70,6 +70,26 @@ TEST(RunScene, ReducedFrequencyTestsSayWhatTheirFiguresCount) {
   }
 }
 
+// The scene's settings stand unless an option is given; one that is overrides them (the
+// help says so): twice the scene's density (300 kg/m^3) doubles the skirt's mass.
+TEST(RunScene, OptionsGivenOverrideTheScenesSettings) {
+  ScratchDir dir("run-overrides");
+  const auto stats = [&](const std::string& name, const std::string& extra) {
+    const std::string out = dir / name;
+    const CliResult r = runDrape("run '" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir +
+                                     "/walk.bvh' --lead-in 0.1 --frames 1 " + extra + " --out '" + out + "'",
+                                 dir);
+    EXPECT_EQ(r.code, 0) << r.err;
+    return nlohmann::json::parse(slurp(out + "/stats.json"));
+  };
+  const nlohmann::json scene = stats("scene", "");
+  const nlohmann::json given = stats("given", "--density 600 --substeps 40");
+  EXPECT_EQ(scene["substeps_per_frame"], 33);
+  EXPECT_EQ(given["substeps_per_frame"], 40);
+  const double sceneMass = scene["garments"][0]["mass_kg"].get<double>();
+  EXPECT_NEAR(given["garments"][0]["mass_kg"].get<double>(), 2 * sceneMass, 1e-9);
+}
+
 TEST(RunScene, WalkingSkirtWritesEverything) {
   ScratchDir dir("run-walking-skirt");
   const std::string out = dir / "out";

@@ -10,6 +10,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <gtest/gtest.h>
+
 namespace drape::testing {
 
 struct CliResult {
@@ -47,6 +49,15 @@ inline CliResult runDrape(const std::string& args, const ScratchDir& scratch) {
   r.out = slurp(outFile);
   r.err = slurp(errFile);
   return r;
+}
+
+/// `drape run ARGS --out SCRATCH/NAME`, which must exit 0 (the test fails with its error
+/// otherwise); returns the output directory.
+inline std::string runInto(const ScratchDir& scratch, const std::string& name, const std::string& args) {
+  const std::string out = scratch / name;
+  const CliResult r = runDrape("run " + args + " --out '" + out + "'", scratch);
+  EXPECT_EQ(r.code, 0) << r.err;
+  return out;
 }
 
 inline int lineCount(const std::string& text) {

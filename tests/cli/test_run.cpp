@@ -26,11 +26,8 @@ TEST(Run, AutoSubstepsTakeTheMassScalingAllowance) {
   // within the allowance, far fewer than without it, and the run reports the mass it added.
   ScratchDir dir("run-auto-scaled");
   const auto runAuto = [&](const std::string& extra, const std::string& name) {
-    const std::string out = dir / name;
-    const CliResult r = runDrape("run --garment '" + kDress + "' --units dm --pin-mask '" + kMask +
-                                     "' --substeps auto --frames 1 " + extra + " --out '" + out + "'",
-                                 dir);
-    EXPECT_EQ(r.code, 0) << r.err;
+    const std::string out = testing::runInto(
+        dir, name, "--garment '" + kDress + "' --units dm --pin-mask '" + kMask + "' --substeps auto --frames 1 " + extra);
     return nlohmann::json::parse(slurp(out + "/stats.json"));
   };
   const nlohmann::json plain = runAuto("", "plain");

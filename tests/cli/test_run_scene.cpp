@@ -32,13 +32,9 @@ const std::string kSkirtDir = std::string(DRAPE_SOURCE_DIR) + "/examples/walking
 TEST(RunScene, ReducedFrequencyTestsSayWhatTheirFiguresCount) {
   ScratchDir dir("run-collision-every");
   const auto run = [&](const std::string& name, const std::string& extra) {
-    const std::string out = dir / name;
-    const CliResult r = runDrape("run '" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir +
-                                     "/walk.bvh' --lead-in 0.2 --frames 15 --collision-every 3 " + extra + " --out '" +
-                                     out + "'",
-                                 dir);
-    EXPECT_EQ(r.code, 0) << r.err;
-    return out;
+    return testing::runInto(dir, name,
+                            "'" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir +
+                                "/walk.bvh' --lead-in 0.2 --frames 15 --collision-every 3 " + extra);
   };
   const std::string tested = run("tested", ""), every = run("every", "--count-every-substep");
   const nlohmann::json a = nlohmann::json::parse(slurp(tested + "/stats.json"));
@@ -75,11 +71,8 @@ TEST(RunScene, ReducedFrequencyTestsSayWhatTheirFiguresCount) {
 TEST(RunScene, OptionsGivenOverrideTheScenesSettings) {
   ScratchDir dir("run-overrides");
   const auto stats = [&](const std::string& name, const std::string& extra) {
-    const std::string out = dir / name;
-    const CliResult r = runDrape("run '" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir +
-                                     "/walk.bvh' --lead-in 0.1 --frames 1 " + extra + " --out '" + out + "'",
-                                 dir);
-    EXPECT_EQ(r.code, 0) << r.err;
+    const std::string out = testing::runInto(
+        dir, name, "'" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir + "/walk.bvh' --lead-in 0.1 --frames 1 " + extra);
     return nlohmann::json::parse(slurp(out + "/stats.json"));
   };
   const nlohmann::json scene = stats("scene", "");

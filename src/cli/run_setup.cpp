@@ -197,7 +197,7 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
   setup.character->animation = std::make_shared<const motion::AvatarAnimation>(
       motion::loadAnimation(*setup.character->avatar, motionPath, mo, &report));
   // Frames the motion file holds but drape does not play: say so, the timing shifts.
-  if (report.referenceTPoseSkipped) spdlog::info("{}: frame 1 is a reference T-pose, not played", motionPath);
+  if (report.referenceTPoseSkipped) spdlog::info("{}: {}", motionPath, report.referenceTPose());
   if (report.restUnfoldFramesSkipped > 0) spdlog::info("{}: {}", motionPath, report.restUnfoldSkipped());
 }
 

@@ -134,6 +134,10 @@ bool firstFrameIsReferenceTPose(const Clip& clip) {
   return jump > 20.0 && jump > 4.0 * next;
 }
 
+std::string ClipLoadReport::referenceTPose() const {
+  return referenceTPoseSkipped ? "frame 1 is a reference T-pose, not played" : "";
+}
+
 std::string ClipLoadReport::restUnfoldSkipped() const {
   if (restUnfoldFramesSkipped == 0) return {};
   const std::size_t first = referenceTPoseSkipped ? 2 : 1;

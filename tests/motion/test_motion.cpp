@@ -139,6 +139,7 @@ TEST(ClipIo, CmuWalkIsCmuUnitsWithATPoseFirstFrame) {
   const Clip clip = loadClip(std::string(DRAPE_DATA_DIR) + "/mocap/cmu_walk_delfem2.bvh", {}, &report);
   EXPECT_EQ(report.units.name, "CMU units (0.0564 m)");
   EXPECT_TRUE(report.referenceTPoseSkipped);
+  EXPECT_EQ(report.referenceTPose(), "frame 1 is a reference T-pose, not played");
   EXPECT_EQ(report.sourceFrames, 344u);
   EXPECT_NEAR(report.sourceRate, 120.0, 0.01);
   // 343 frames at 120 Hz span 342/120 s = 2.85 s: 86 frames at 30 Hz.
@@ -164,6 +165,7 @@ TEST(ClipIo, DazWalksUnfoldingFromTheRestPoseIsNotPlayed) {
   ClipLoadReport report;
   const Clip clip = loadClip(path, {}, &report);
   EXPECT_FALSE(report.referenceTPoseSkipped);
+  EXPECT_EQ(report.referenceTPose(), "");
   EXPECT_EQ(report.restUnfoldFramesSkipped, 4u);
   // 295 frames at 120 Hz span 294/120 s = 2.45 s: 74 frames at 30 Hz.
   EXPECT_EQ(clip.frameCount(), 74u);

@@ -46,6 +46,8 @@ struct ClipLoadReport {
   bool referenceTPoseSkipped = false;
   std::size_t restUnfoldFramesSkipped = 0;  ///< file frames of an unfolding from the rest pose, not played
 
+  /// "frame 1 is a reference T-pose, not played"; empty without one.
+  [[nodiscard]] std::string referenceTPose() const;
   /// "frames 2-5 unfold from the rest pose (not played; the lead-in blends into frame 6)",
   /// file frames counted from 1; empty without such frames.
   [[nodiscard]] std::string restUnfoldSkipped() const;

@@ -121,6 +121,7 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
   stats["collisions_registered"] = sum.collisions;
   stats["last_resort_projections"] = sum.projections;
   stats["pairs_embedded_at_start"] = sum.embeddedAtStart;
+  stats["pairs_embedded_timed_out"] = sum.embeddedTimedOut;
   stats["sliding_reads_from_contact_planes"] = sum.slidingReadsFromPlanes();
   stats["vertex_substeps_held_in_pinches"] = sum.heldVertexSubsteps;
   nlohmann::json transitions;

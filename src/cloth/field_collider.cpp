@@ -19,6 +19,9 @@ namespace {
 constexpr double kPenaltyRate = 0.25;
 /// How fast a point that started below T1 is eased out (releaseEmbedded), m/s.
 constexpr double kEmbeddedSpeed_m_s = 0.1;
+/// An eased pair that has not reached T2 in this many times the time its depth takes at
+/// kEmbeddedSpeed collides as any other from then on.
+constexpr double kEaseTimeFactor = 2.0;
 
 int toIndex(PointState s) { return static_cast<int>(s); }
 
@@ -198,6 +201,7 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   planes_.assign(parts_.size(), std::vector<ContactPlane>(n));
   penalty_.assign(n, 0);
   embedded_.assign(parts_.size(), std::vector<std::uint8_t>(n, 0));
+  easeUntil_s_.assign(parts_.size(), std::vector<double>(n, 0.0));
   for (std::vector<double>* v : {&correctionX_, &correctionY_, &correctionZ_}) v->assign(n, 0.0);
   corrections_.assign(n, 0);
   corrected_.clear();
@@ -226,6 +230,7 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
       if (d < offsets_.t1_m) {
         states_[k][i] = PointState::InsideVol;
         embedded_[k][i] = 1;
+        easeUntil_s_[k][i] = t_s + kEaseTimeFactor * (offsets_.t2_m - d) / kEmbeddedSpeed_m_s;
         ++field_.embeddedAtStart;
       }
     }
@@ -366,6 +371,15 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   settledVoxel_[k][i] = kNotSettled;  // stayInside sets it again
   if (embedded_[k][i]) {
     releaseEmbedded(k, frame, i, c1, dt_s, io);
+    if (embedded_[k][i] && lastTime_s_ + dt_s >= easeUntil_s_[k][i]) {
+      // Still below T2 when it should long have reached it: the garment holds it there
+      // (pinched, or tied to bound vertices inside the part). Eased on, it would never
+      // collide with the part nor count in the penetration figures: it collides as any
+      // other from the next test.
+      embedded_[k][i] = 0;
+      state = PointState::OnSurf;
+      ++field_.embeddedTimedOut;
+    }
     ++field_.transitions[toIndex(from)][toIndex(state)];
     return;
   }
@@ -673,6 +687,7 @@ FieldCollisionCounters& FieldCollisionCounters::operator+=(const FieldCollisionC
                       {&vertexSubstepsBelowT1, o.vertexSubstepsBelowT1}, {&vertexSubstepsBelowT0, o.vertexSubstepsBelowT0},
                       {&vertexSubstepsInsideBody, o.vertexSubstepsInsideBody}, {&vertexSubsteps, o.vertexSubsteps},
                       {&clearanceSkips, o.clearanceSkips}, {&embeddedAtStart, o.embeddedAtStart},
+                      {&embeddedTimedOut, o.embeddedTimedOut},
                       {&planeEstimates, o.planeEstimates}, {&planeReads, o.planeReads},
                       {&heldVertexSubsteps, o.heldVertexSubsteps}})
     *a += b;

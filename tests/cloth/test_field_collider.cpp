@@ -719,7 +719,7 @@ TEST(FieldCollider, CountersOfTwoGarmentsAddUp) {
   for (std::uint64_t* f : {&a.tests, &a.traces, &a.traceVoxels, &a.collisions, &a.projections,
                            &a.vertexSubstepsBelowT1, &a.vertexSubstepsBelowT0, &a.vertexSubstepsInsideBody,
                            &a.vertexSubsteps, &a.clearanceSkips, &a.embeddedAtStart, &a.planeEstimates, &a.planeReads,
-                           &a.heldVertexSubsteps})
+                           &a.heldVertexSubsteps, &a.embeddedTimedOut})
     *f = value++;
   for (auto& row : a.transitions)
     for (std::uint64_t& t : row) t = value++;
@@ -733,7 +733,7 @@ TEST(FieldCollider, CountersOfTwoGarmentsAddUp) {
   for (const std::uint64_t* f : {&c.tests, &c.traces, &c.traceVoxels, &c.collisions, &c.projections,
                                  &c.vertexSubstepsBelowT1, &c.vertexSubstepsBelowT0, &c.vertexSubstepsInsideBody,
                                  &c.vertexSubsteps, &c.clearanceSkips, &c.embeddedAtStart, &c.planeEstimates,
-                                 &c.planeReads, &c.heldVertexSubsteps})
+                                 &c.planeReads, &c.heldVertexSubsteps, &c.embeddedTimedOut})
     EXPECT_EQ(*f, 2 * value++);
   for (const auto& row : c.transitions)
     for (const std::uint64_t t : row) EXPECT_EQ(t, 2 * value++);
@@ -781,6 +781,39 @@ TEST(FieldCollider, PointsStartingBelowT2AreEasedOutNotThrown) {
   // 14 mm at 0.1 m/s: about 140 substeps of 1 ms.
   EXPECT_NEAR(steps, (kOffsets.t2_m - 0.001) / (easing_m_s * dt), 20);
   EXPECT_EQ(c.fieldCounters().vertexSubstepsInsideBody, 0u);
+}
+
+TEST(FieldCollider, APointHeldBelowT2WhileEasedCollidesAsAnyOtherInTime) {
+  // A point that starts near a sphere's surface, below T1 (10 mm; T2 = 15 mm), and that the
+  // garment puts back where it started on every substep (tied to bound vertices inside the
+  // part): eased, it would never reach T2. After twice the time its depth below T2 takes at
+  // the easing speed it collides as any other: the next test moves it out.
+  BodySetup s(field::makeSphere(0.1, Vec3::Zero(), 64, 32), std::make_shared<StaticMotion>());
+  const Vec3 start(0.101, 0.0, 0.0);
+  Point p(start);
+  FieldCollider c("test", s.parts, kOffsets, 0.0, 0.0);
+  c.initialise(p.state, 0.0);
+  ASSERT_EQ(c.fieldCounters().embeddedAtStart, 1u);
+  const double dt = 1e-3;
+  const double d0 = s.field.distanceAt(start);  // the field's reading: 2.7 mm
+  ASSERT_LT(d0, kOffsets.t1_m);
+  const int deadline = static_cast<int>(std::ceil(2.0 * (kOffsets.t2_m - d0) / 0.1 / dt));  // 246 substeps
+  int step = 0;
+  for (; step < 400 && c.fieldCounters().embeddedTimedOut == 0; ++step) {
+    p.state.setPosition(0, start);
+    p.state.setVelocity(0, Vec3::Zero());
+    c.collide(*p.model, step * dt, (step + 1) * dt, p.state);
+    EXPECT_LT(s.field.distanceAt(p.state.position(0)), d0 + 0.1 * dt * 1.05) << "step " << step << ": eased";
+  }
+  EXPECT_NEAR(step, deadline, 1);
+  EXPECT_EQ(c.fieldCounters().embeddedTimedOut, 1u);
+  EXPECT_EQ(c.state(0, 0), PointState::OnSurf);
+  p.state.setPosition(0, start);
+  c.collide(*p.model, step * dt, (step + 1) * dt, p.state);
+  // Below T0, the last resort: projected along the normal towards T2 in one step (a step
+  // of the field's normal from 2.7 mm lands at 12 mm), out of the penalty zone.
+  EXPECT_EQ(c.fieldCounters().projections, 1u);
+  EXPECT_GT(s.field.distanceAt(p.state.position(0)), kOffsets.t1_m);
 }
 
 }  // namespace

@@ -31,7 +31,9 @@
 //                              below T1 the outward relative velocity gets a penalty floor;
 //                              below T0 the last-resort projection is counted
 //   OnSurf     -> InsideVol    when forces carry it beyond T3
-// A point that starts below T1 of a part is eased out onto T2 at a bounded speed first.
+// A point that starts below T1 of a part is eased out onto T2 at a bounded speed first; one
+// the garment still holds below T2 after twice the time its depth takes at that speed
+// collides as any other from then on.
 //
 // Position corrections are gathered over all parts and applied together at the end of the
 // collision step, each point moved by the mean of the displacements its parts asked for
@@ -144,6 +146,7 @@ struct FieldCollisionCounters {
   double maxPenetration_m = 0;      ///< deepest point below the body surface after the response
   std::uint64_t clearanceSkips = 0;  ///< pairs that stayed InsideVol without a trilinear read
   std::uint64_t embeddedAtStart = 0;  ///< (vertex, part) pairs below T1 at the start, eased out onto T2
+  std::uint64_t embeddedTimedOut = 0;  ///< eased pairs that had not reached T2 in time and then collided as any other
   std::uint64_t planeEstimates = 0;  ///< sliding pairs' field reads answered by their contact plane
   std::uint64_t planeReads = 0;      ///< sliding pairs' field reads that went to the field
   std::uint64_t heldVertexSubsteps = 0;  ///< untested substeps of points held in a pinch (setPinchHold)
@@ -310,6 +313,7 @@ class FieldCollider final : public Collider {
   /// [part][vertex]: the point started below T1 of the part and is being eased out onto T2
   /// (releaseEmbedded) rather than thrown there in one substep.
   std::vector<std::vector<std::uint8_t>> embedded_;
+  std::vector<std::vector<double>> easeUntil_s_;  ///< [part][vertex]: when an eased pair collides as any other
   /// Per vertex, this collision step: the sum of the displacements parts asked for (m) and
   /// their number (addCorrection); the (part, vertex) pairs that asked.
   std::vector<double> correctionX_, correctionY_, correctionZ_;

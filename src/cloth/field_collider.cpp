@@ -372,8 +372,8 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   if (embedded_[k][i]) {
     releaseEmbedded(k, frame, i, c1, dt_s, io);
     if (embedded_[k][i] && lastTime_s_ + dt_s >= easeUntil_s_[k][i]) {
-      // Still below T2 when it should long have reached it: the garment holds it there
-      // (pinched, or tied to bound vertices inside the part). Eased on, it would never
+      // Still below T2 when it should long have reached it: the garment holds it there (a
+      // sleeve narrower than the arm's offset surface, a pinch, bound vertices inside). Eased on, it would never
       // collide with the part nor count in the penetration figures: it collides as any
       // other from the next test.
       embedded_[k][i] = 0;

@@ -30,6 +30,26 @@
 namespace drape::cli {
 namespace {
 
+/// Where the garment starts inside the offset surfaces (eased out onto T2 rather than thrown
+/// there): a garment tighter than the offsets, which a user may want to loosen or offset less.
+void logEasedPairs(const std::string& garment, const cloth::FieldCollider& collider) {
+  const std::vector<std::size_t> counts = collider.easedPairsPerPart();
+  std::vector<std::pair<std::size_t, std::string>> parts;
+  std::size_t total = 0;
+  for (std::size_t k = 0; k < counts.size(); ++k) {
+    total += counts[k];
+    if (counts[k] > 0) parts.push_back({counts[k], collider.parts()[k].name});
+  }
+  if (total == 0) return;
+  std::sort(parts.begin(), parts.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<std::string> most;
+  for (std::size_t j = 0; j < parts.size() && j < 4; ++j) most.push_back(fmt::format("{} {}", parts[j].second, parts[j].first));
+  if (parts.size() > 4) most.push_back(fmt::format("{} more parts", parts.size() - 4));
+  spdlog::info("{}: {} (vertex, part) pairs start below T1 ({:g} mm), the garment tighter than the offset surfaces "
+               "there; they are eased out onto T2: {}",
+               garment, total, 1e3 * collider.offsets().t1_m, fmt::join(most, ", "));
+}
+
 using Clock = std::chrono::steady_clock;
 namespace fs = std::filesystem;
 
@@ -38,6 +58,7 @@ constexpr double kMinTriangleArea_m2 = 1e-12;
 
 /// One garment being simulated: its model, solver and output streams.
 struct GarmentRun {
+  std::string name;
   std::string fileStem;  ///< "garment" alone, "garment-<name>" when there are several
   const cloth::ClothModel* model = nullptr;
   std::unique_ptr<cloth::ClothSolver> ownedSolver;  ///< without a character
@@ -99,6 +120,10 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
   for (const GarmentRun& r : runs) {
     if (!r.collider) continue;
     sum += r.collider->fieldCounters();
+    if (const std::uint64_t late = r.collider->fieldCounters().embeddedTimedOut; late > 0)
+      spdlog::info("{}: {} of the eased pairs were still below T2 after twice their easing time, held there by "
+                   "the garment; they collided as any other from then on",
+                   r.name, late);
     const auto now = r.collider->pointsPerState();
     for (int k = 0; k < 3; ++k) states[k] += now[k];
   }
@@ -270,6 +295,7 @@ int simulateRun(const RunSetup& setup) {
   for (std::size_t gi = 0; gi < setup.garments.size(); ++gi) {
     const GarmentSetup& g = setup.garments[gi];
     GarmentRun r;
+    r.name = g.name;
     r.fileStem = setup.garments.size() == 1 ? "garment" : "garment-" + sanitise(g.name);
     if (world) {
       r.solver = &world->mutableSolver(gi);
@@ -277,6 +303,7 @@ int simulateRun(const RunSetup& setup) {
       world->collider(gi)->setCountEverySubstep(setup.countEverySubstep);
       world->collider(gi)->setContactPlanes(!setup.exactSliding);
       world->collider(gi)->setPinchHold(!setup.freePinches);
+      logEasedPairs(g.name, *world->collider(gi));
     } else {
       const mesh::Topology topology = mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
       auto model = cloth::ClothModel::build(g.mesh, topology, g.material, settings.massScaling());

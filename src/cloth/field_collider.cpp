@@ -697,6 +697,13 @@ FieldCollisionCounters& FieldCollisionCounters::operator+=(const FieldCollisionC
   return *this;
 }
 
+std::vector<std::size_t> FieldCollider::easedPairsPerPart() const {
+  std::vector<std::size_t> counts(parts_.size(), 0);
+  for (std::size_t k = 0; k < embedded_.size(); ++k)
+    counts[k] = static_cast<std::size_t>(std::count(embedded_[k].begin(), embedded_[k].end(), std::uint8_t{1}));
+  return counts;
+}
+
 std::array<std::size_t, 3> FieldCollider::pointsPerState() const {
   std::array<std::size_t, 3> counts{};
   for (const auto& part : states_)

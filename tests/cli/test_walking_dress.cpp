@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
@@ -45,6 +46,13 @@ TEST(WalkingDress, WalksStablyWithFewPointsInsideTheBody) {
   // has had its time.
   EXPECT_GT(stats["pairs_embedded_timed_out"].get<long>(), 0);
   EXPECT_LT(stats["pairs_embedded_timed_out"].get<long>(), stats["pairs_embedded_at_start"].get<long>());
+  // The run says where the garment starts inside the offset surfaces, and what timed out.
+  EXPECT_NE(r.err.find("dress: 1001 (vertex, part) pairs start below T1 (4 mm)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("LeftForeArm"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(fmt::format("dress: {} of the eased pairs were still below T2",
+                                   stats["pairs_embedded_timed_out"].get<long>())),
+            std::string::npos)
+      << r.err;
 }
 
 TEST(WalkingDress, AnUnstableBendingStepIsRefusedBeforeTheFieldsAreBuilt) {

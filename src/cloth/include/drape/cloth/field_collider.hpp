@@ -243,6 +243,9 @@ class FieldCollider final : public Collider {
   [[nodiscard]] const Vec3& cachedVoxel(std::size_t part, std::size_t vertex) const {
     return lastVoxel_[part][vertex];
   }
+  /// Per part, the (vertex, part) pairs being eased out onto T2 now: right after initialise,
+  /// those that start below T1.
+  [[nodiscard]] std::vector<std::size_t> easedPairsPerPart() const;
   /// Points per state now, summed over parts: [OutsideVol, InsideVol, OnSurf].
   [[nodiscard]] std::array<std::size_t, 3> pointsPerState() const;
   /// Per vertex, for display: 0 outside every volume, 1 inside a volume, 2 on a surface,

@@ -373,9 +373,9 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
     releaseEmbedded(k, frame, i, c1, dt_s, io);
     if (embedded_[k][i] && lastTime_s_ + dt_s >= easeUntil_s_[k][i]) {
       // Still below T2 when it should long have reached it: the garment holds it there (a
-      // sleeve narrower than the arm's offset surface, a pinch, bound vertices inside). Eased on, it would never
-      // collide with the part nor count in the penetration figures: it collides as any
-      // other from the next test.
+      // sleeve narrower than the arm's offset surface, a pinch, bound vertices inside).
+      // Eased on, it would never collide with the part nor count in the penetration
+      // figures: it collides as any other from the next test.
       embedded_[k][i] = 0;
       state = PointState::OnSurf;
       ++field_.embeddedTimedOut;

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 
 #include <BulletSoftBody/btSoftBodyHelpers.h>
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
@@ -23,6 +24,7 @@
 #include "drape/cloth/forces.hpp"
 #include "drape/cloth/sheets.hpp"
 #include "drape/cloth/solver.hpp"
+#include "drape/core/error.hpp"
 #include "drape/core/log.hpp"
 #include "drape/mesh/topology.hpp"
 
@@ -101,11 +103,21 @@ RunOutcome runDrape(const SheetSize& size, int substeps, long frames) {
   settings.maxSpeed_m_s = kSpeedBound_m_s;
   const std::vector<std::uint32_t> corners = {cloth::sheetVertex(spec, 0, 0),
                                               cloth::sheetVertex(spec, spec.cellsU, 0)};
-  cloth::ClothSolver solver(model, settings,
-                            {cloth::PinGroup::atRest(corners, model->restX(), model->restY(), model->restZ())});
+  RunOutcome r;
+  std::unique_ptr<cloth::ClothSolver> made;
+  try {
+    made = std::make_unique<cloth::ClothSolver>(
+        model, settings,
+        std::vector{cloth::PinGroup::atRest(corners, model->restX(), model->restY(), model->restZ())});
+  } catch (const Error& e) {  // a step the solver refuses (its damping) counts as diverging at once
+    r.diverged = true;
+    r.why = e.what();
+    r.frames = 0.0;  // no time per frame: the JSON says null
+    return r;
+  }
+  cloth::ClothSolver& solver = *made;
   cloth::SphereCollider sphere(kSphereCentre, kSphereRadius);
   solver.addCollider(sphere);
-  RunOutcome r;
   const double start = threadCpuSeconds();
   long f = 1;
   for (; f <= frames; ++f)

@@ -50,6 +50,21 @@ void logEasedPairs(const std::string& garment, const cloth::FieldCollider& colli
                garment, total, 1e3 * collider.offsets().t1_m, fmt::join(most, ", "));
 }
 
+/// How much of what the substep allows the internal damping takes (the solver has refused
+/// more): near 100 %, a little more damping, or fewer substeps, will diverge.
+void logDamping(const std::string& garment, const cloth::ClothSolver& solver) {
+  const cloth::ClothModel& model = solver.model();
+  const double beta = model.material().damping_s;
+  if (!(beta > 0.0) || solver.settings().integrator != cloth::IntegratorKind::SymplecticEuler) return;
+  std::vector<std::uint8_t> fixed(model.vertexCount(), 0);
+  for (const cloth::PinGroup& g : solver.pins())
+    for (const std::uint32_t v : g.vertices) fixed[v] = 1;
+  const double most = cloth::largestStableDamping_s(model.membraneFrequency_rad_s(fixed), solver.settings().substep_s());
+  if (most > 0.0)
+    spdlog::info("{}: internal damping {:.3g} ms, {:.0f} % of the most the {:.3g} ms substep allows ({:.3g} ms)",
+                 garment, 1e3 * beta, 100.0 * beta / most, 1e3 * solver.settings().substep_s(), 1e3 * most);
+}
+
 using Clock = std::chrono::steady_clock;
 namespace fs = std::filesystem;
 
@@ -323,6 +338,7 @@ int simulateRun(const RunSetup& setup) {
       spdlog::info("{}: bending forces every {} substeps ({:.3g} ms, {:.0f} % of their stable step)", g.name,
                    settings.bendEvery, 1e3 * settings.bendEvery * settings.substep_s(),
                    100.0 * settings.bendEvery * settings.substep_s() / r.model->bendingStableStep_s());
+    logDamping(g.name, *r.solver);
     if (settings.substep_s() > stable)
       spdlog::warn("{}: the substep {:.3g} s is longer than the estimated stable step {:.3g} s; "
                    "the run may diverge (try --substeps {} or more)",

@@ -273,6 +273,84 @@ double ClothModel::estimatedStableStep_s() const {
   return std::min(membrane, bending);
 }
 
+void ClothModel::membraneStiffnessTimes(std::span<const double> u, std::span<double> out) const {
+  std::fill(out.begin(), out.end(), 0.0);
+  const auto at = [&](std::uint32_t i) { return Vec3(u[3 * i], u[3 * i + 1], u[3 * i + 2]); };
+  const auto rest = [&](std::uint32_t i) { return Vec3(restX_[i], restY_[i], restZ_[i]); };
+  for (const MembraneElement& el : membrane_) {
+    // At rest F maps the rest plane onto the triangle's tangents (fu, fv) and S = 0, so a
+    // displacement's force is that of its stress alone: dE = sym(F^T dF), dS = lambda_t
+    // tr(dE) I + 2 mu_t dE, df_i = -A F dS grad(N_i) (the kernel's formula with S -> dS).
+    const Vec3 d1 = rest(el.v1) - rest(el.v0), d2 = rest(el.v2) - rest(el.v0);
+    const Vec3 fu = d1 * el.g1u + d2 * el.g2u, fv = d1 * el.g1v + d2 * el.g2v;
+    const Vec3 w1 = at(el.v1) - at(el.v0), w2 = at(el.v2) - at(el.v0);
+    const Vec3 du = w1 * el.g1u + w2 * el.g2u, dv = w1 * el.g1v + w2 * el.g2v;
+    const double e11 = fu.dot(du), e22 = fv.dot(dv), e12 = 0.5 * (fu.dot(dv) + fv.dot(du));
+    const double tr = lambdaT_ * (e11 + e22);
+    const double sa = tr + 2.0 * muT_ * e11, sb = tr + 2.0 * muT_ * e22, sc = 2.0 * muT_ * e12;
+    const double A = el.restArea_m2;
+    const Vec3 f1 = -A * ((sa * el.g1u + sc * el.g1v) * fu + (sc * el.g1u + sb * el.g1v) * fv);
+    const Vec3 f2 = -A * ((sa * el.g2u + sc * el.g2v) * fu + (sc * el.g2u + sb * el.g2v) * fv);
+    const std::array<std::pair<std::uint32_t, Vec3>, 3> corners = {{{el.v0, -(f1 + f2)}, {el.v1, f1}, {el.v2, f2}}};
+    for (const auto& [v, f] : corners)
+      for (int a = 0; a < 3; ++a) out[3 * v + static_cast<std::size_t>(a)] -= f[a];  // K u = -df
+  }
+}
+
+// Power iteration on M^-1/2 K M^-1/2 (symmetric, so the Rayleigh quotient converges fast and
+// from below) from a fixed pseudo-random start, until the quotient moves less than 1e-6
+// (relative) over 20 iterations. Fixed vertices are left out: their rows and columns are
+// zero, as if their mass were infinite.
+double ClothModel::membraneFrequency_rad_s(std::span<const std::uint8_t> fixed) const {
+  const std::size_t n = 3 * vertexCount();
+  std::vector<double> weight(n), q(n), kq(n), scaled(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool held = !fixed.empty() && fixed[i / 3];
+    weight[i] = held ? 0.0 : std::sqrt(inverseMass_[i / 3]);
+  }
+  std::uint64_t seed = 0x9E3779B97F4A7C15ULL;
+  for (std::size_t i = 0; i < n; ++i) {
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    q[i] = weight[i] * (static_cast<double>(seed >> 11) / static_cast<double>(1ULL << 53) - 0.5);
+  }
+  const auto normalise = [](std::vector<double>& x) {
+    double s = 0.0;
+    for (const double e : x) s += e * e;
+    const double inv = s > 0.0 ? 1.0 / std::sqrt(s) : 0.0;
+    for (double& e : x) e *= inv;
+  };
+  normalise(q);
+  double lambda = 0.0, checkpoint = 0.0;
+  for (int it = 1; it <= kMaxPowerIterations; ++it) {
+    for (std::size_t i = 0; i < n; ++i) scaled[i] = q[i] * weight[i];
+    membraneStiffnessTimes(scaled, kq);
+    lambda = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      kq[i] *= weight[i];
+      lambda += q[i] * kq[i];
+    }
+    q.swap(kq);
+    normalise(q);
+    if (it % 20 == 0) {
+      if (std::abs(lambda - checkpoint) <= 1e-6 * lambda) break;
+      checkpoint = lambda;
+    }
+  }
+  return std::sqrt(std::max(lambda, 0.0));
+}
+
+double dampedStableStep_s(double omega_rad_s, double damping_s) {
+  if (!(omega_rad_s > 0.0)) return std::numeric_limits<double>::infinity();
+  const double w = omega_rad_s / kDampedStepMargin;
+  return std::sqrt(damping_s * damping_s + 4.0 / (w * w)) - damping_s;
+}
+
+double largestStableDamping_s(double omega_rad_s, double step_s) {
+  if (!(omega_rad_s > 0.0)) return std::numeric_limits<double>::infinity();
+  const double w = omega_rad_s / kDampedStepMargin;
+  return (4.0 / (w * w) - step_s * step_s) / (2.0 * step_s);
+}
+
 double ClothModel::bendingStableStep_s() const {
   return bendingOmega_ > 0.0 ? 1.8 / bendingOmega_ : std::numeric_limits<double>::infinity();
 }
@@ -293,7 +371,14 @@ SubstepChoice fewestStableSubsteps(const mesh::TriMesh& mesh, const mesh::Topolo
                                    const Material& material, double frameRate_hz, double maxAddedFraction,
                                    int least) {
   constexpr int kMost = 100000;
-  const double unscaledStep = ClothModel::build(mesh, topology, material)->estimatedStableStep_s();
+  const double beta = material.damping_s;
+  // The step a model allows: the wave-speed estimate, and with internal damping the bound of
+  // the membrane's highest frequency (every vertex free: the garment's pins are not known here).
+  const auto allowedStep = [&](const ClothModel& model) {
+    const double step = model.estimatedStableStep_s();
+    return beta > 0.0 ? std::min(step, dampedStableStep_s(model.membraneFrequency_rad_s(), beta)) : step;
+  };
+  const double unscaledStep = allowedStep(*ClothModel::build(mesh, topology, material));
   const double unscaled = std::ceil(1.0 / (frameRate_hz * unscaledStep));
   if (!(unscaled <= kMost))
     throw Error(fmt::format("garment '{}': no substep count up to {} is stable at {:g} frames/s", mesh.name, kMost,
@@ -301,8 +386,12 @@ SubstepChoice fewestStableSubsteps(const mesh::TriMesh& mesh, const mesh::Topolo
   const int none = std::max(least, static_cast<int>(unscaled));  // needs no mass scaling
   if (maxAddedFraction > 0.0) {
     for (int n = std::max(1, least); n < none; n = std::max(n + 1, static_cast<int>(std::ceil(n * 1.05)))) {
-      const double added = addedMassFractionAt(mesh, topology, material, frameRate_hz, n);
-      if (added <= maxAddedFraction) return {n, added};
+      // An unbounded allowance: the model reports the mass it needs instead of refusing.
+      const double step = 1.0 / (frameRate_hz * n);
+      const auto model = ClothModel::build(mesh, topology, material,
+                                           {step, std::numeric_limits<double>::infinity()});
+      const double added = model->addedMassFraction();
+      if (added <= maxAddedFraction && (!(beta > 0.0) || step <= allowedStep(*model))) return {n, added};
     }
   }
   return {none, 0.0};

@@ -37,6 +37,10 @@ ClothSolver::ClothSolver(std::shared_ptr<const ClothModel> model, const StepSett
       state_(ClothState::atRest(*model_)) {
   settings_.validate("--");
   checkBendingStep(*model_, settings_);
+  std::vector<std::uint8_t> fixed(model_->vertexCount(), 0);
+  for (const PinGroup& g : pins_)
+    for (const std::uint32_t v : g.vertices) fixed[v] = 1;
+  checkDampedStep(*model_, settings_, fixed);
 }
 
 void checkBendingStep(const ClothModel& model, const StepSettings& settings) {
@@ -47,6 +51,28 @@ void checkBendingStep(const ClothModel& model, const StepSettings& settings) {
   throw Error(fmt::format("garment '{}': bending every {} substeps spans {:.3g} ms, above the bending forces' "
                           "stable step of {:.3g} ms; set bendEvery (--bend-every) to {} or less",
                           model.name(), settings.bendEvery, 1e3 * span, 1e3 * stable, most));
+}
+
+void checkDampedStep(const ClothModel& model, const StepSettings& settings, std::span<const std::uint8_t> fixed) {
+  const double beta = model.material().damping_s;
+  if (!(beta > 0.0) || settings.integrator != IntegratorKind::SymplecticEuler) return;
+  const double omega = model.membraneFrequency_rad_s(fixed);
+  const double dt = settings.substep_s();
+  // A substep too long even undamped is the wave-speed estimate's to warn about (it diverges
+  // either way); this check is for the damping.
+  if (dt <= dampedStableStep_s(omega, beta) || dt > dampedStableStep_s(omega, 0.0)) return;
+  const double most = largestStableDamping_s(omega, dt);
+  const long substeps = static_cast<long>(std::ceil(1.0 / (settings.frameRate_hz * dampedStableStep_s(omega, beta))));
+  const std::string lessDamping = fmt::format("set damping to {:.3g} s or less, or ", most);
+  // More substeps need less mass scaling, which raises the frequency again: the count is a
+  // floor there, and the ladder of fewestStableSubsteps (--substeps auto) finds the count.
+  const std::string count = settings.maxAddedMass > 0.0
+                                ? fmt::format("at least {} substeps per frame (--substeps auto finds how many)", substeps)
+                                : fmt::format("{} substeps per frame or more", substeps);
+  throw Error(fmt::format("garment '{}': internal damping of {:.3g} s makes the substep of {:.3g} ms unstable (the "
+                          "membrane's stiffest mode, {:.4g} rad/s, allows at most {:.3g} ms at this damping); {}use {}",
+                          model.name(), beta, 1e3 * dt, omega, 1e3 * dampedStableStep_s(omega, beta), lessDamping,
+                          count));
 }
 
 bool ClothSolver::stepFrame(long frame) {

@@ -146,6 +146,22 @@ TEST(RunScene, MotionWithoutAvatarIsABadInput) {
   EXPECT_NE(r.err.find("--motion: there is no avatar"), std::string::npos) << r.err;
 }
 
+TEST(RunScene, DampingTheSubstepCannotCarryIsRefusedWithTheWayOut) {
+  // The skirt's 1.01 ms substep carries at most 3.87 ms of damping (its membrane's stiffest
+  // mode, the waistband held: 605 rad/s); 10 ms diverged in the first frame before the check.
+  ScratchDir dir("run-damping");
+  const std::string scene = "run '" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir + "/walk.bvh' --frames 1 ";
+  const CliResult r = runDrape(scene + "--damping 0.01 --out '" + (dir / "out") + "'", dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("internal damping of 0.01 s makes the substep of 1.01 ms unstable"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("set damping to 0.00387 s or less, or use 78 substeps per frame or more"), std::string::npos)
+      << r.err;
+  // What it suggests runs, and says how close to the bound it is.
+  const CliResult ok = runDrape(scene + "--damping 0.01 --substeps 78 --out '" + (dir / "ok") + "'", dir);
+  EXPECT_EQ(ok.code, 0) << ok.err;
+  EXPECT_NE(ok.err.find("Skirt: internal damping 10 ms, 9"), std::string::npos) << ok.err;
+}
+
 }  // namespace
 }  // namespace drape
 

@@ -11,6 +11,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -50,9 +51,19 @@ struct Instability {
 /// checks it; a caller may check it before costlier set-up).
 void checkBendingStep(const ClothModel& model, const StepSettings& settings);
 
+/// Throws drape::Error, naming the garment, the most damping the substep allows and the
+/// substeps per frame the damping needs, when the material's internal damping makes the
+/// symplectic Euler substep unstable (dampedStableStep_s with the membrane's highest
+/// frequency, `fixed` vertices held; forward Euler is not checked). A substep too long even
+/// without damping is left to the wave-speed estimate's warning. The solver checks it.
+void checkDampedStep(const ClothModel& model, const StepSettings& settings, std::span<const std::uint8_t> fixed = {});
+
 class ClothSolver {
  public:
   ClothSolver(std::shared_ptr<const ClothModel> model, const StepSettings& settings, std::vector<PinGroup> pins = {});
+
+  /// The pinned and bound vertices' groups (what the fixtures move).
+  [[nodiscard]] const std::vector<PinGroup>& pins() const { return pins_; }
 
   /// Adds a collider (not owned; it must outlive the solver's steps).
   void addCollider(Collider& collider) { colliders_.push_back(&collider); }

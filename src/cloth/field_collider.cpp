@@ -492,7 +492,7 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   } else {
     nearest_[i] = std::min(nearest_[i], at.distance_m);  // corrected pairs: applyCorrections
   }
-  if (state == PointState::OnSurf) respondOnSurface(frame, c, at, i, dt_s, io);
+  if (state == PointState::OnSurf) respondOnSurface(frame, c, at, moved, i, dt_s, io);
   last = c;
   ++field_.transitions[toIndex(from)][toIndex(state)];
 }
@@ -532,14 +532,18 @@ void FieldCollider::settle(std::size_t k, std::size_t i, const Vec3& c1) {
   ++field_.clearanceSkips;
 }
 
-void FieldCollider::respondOnSurface(const PartFrame& frame, const Vec3& c, const field::FieldSample& at,
+void FieldCollider::respondOnSurface(const PartFrame& frame, const Vec3& c, const field::FieldSample& at, bool moved,
                                      std::size_t i, double dt_s, ClothState& io) const {
   const Vec3 n = frame.rotation1 * at.normal;
   const Vec3 world = frame.toWorld1.apply(c);
   const Vec3 partVelocity = (world - frame.toWorld0.apply(c)) / dt_s;
   Vec3 v = io.velocity(i);
+  // A point just moved onto T2 is in contact whatever the distance read there says: the
+  // read (trilinear, or the contact plane) can put it a few micrometres above T2, and then
+  // its inward velocity, which the correction did not touch, would survive every substep
+  // and grow with the forces pressing it in (at many substeps per frame, to the speed bound).
   const double depth = offsets_.t2_m - at.distance_m;
-  if (depth > -1e-12) {
+  if (moved || depth > -1e-12) {
     // In contact: remove the inward normal velocity relative to the part, with Coulomb
     // friction on the tangential part (stick below the static coefficient).
     const Vec3 rel = v - partVelocity;

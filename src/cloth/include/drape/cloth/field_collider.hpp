@@ -270,9 +270,10 @@ class FieldCollider final : public Collider {
   /// The field at c for sliding pair (k, vertex): from its contact plane when the plane
   /// reaches c, else read (and the plane moved there).
   [[nodiscard]] field::FieldSample slidingSample(std::size_t k, std::size_t vertex, const Vec3& c);
-  /// The velocity response of a point in contact with a part (friction, penalty floor).
-  void respondOnSurface(const PartFrame& frame, const Vec3& voxel, const field::FieldSample& at, std::size_t vertex,
-                        double dt_s, ClothState& io) const;
+  /// The velocity response of a point in contact with a part (friction, penalty floor):
+  /// `moved`, the collider has just put it on T2; else in contact when at or below T2.
+  void respondOnSurface(const PartFrame& frame, const Vec3& voxel, const field::FieldSample& at, bool moved,
+                        std::size_t vertex, double dt_s, ClothState& io) const;
   /// A part asks to move the point by `displacement` (world, m) this collision step.
   void addCorrection(std::size_t vertex, const Vec3& displacement);
   /// Moves every point by the mean of its parts' displacements.

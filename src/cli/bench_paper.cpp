@@ -110,8 +110,9 @@ RunFunction setupPaperBench(CLI::App& app) {
                "Sliding points read the distance field on every test instead of their contact planes "
                "(the reference the planes are measured against)");
   app.add_flag("--free-pinches", o.freePinches,
-               "With --collision-every K > 1: points pinched between two parts move freely between tests "
-               "instead of being held by them (the paper's reduced-frequency tests as they are)");
+               "Points pinched between two or more parts keep their own velocity at a test and, with "
+               "--collision-every K > 1, move freely until the next, instead of taking their parts' mean "
+               "velocity and being held by them (the paper's collision response as it is)");
   app.add_flag("--json", o.json, "Print JSON (the only format)");
   return [] {
     std::vector<PaperRun> runs;
@@ -146,6 +147,7 @@ RunFunction setupPaperBench(CLI::App& app) {
     j["sliding_reads_from_contact_planes"] = r.counters.slidingReadsFromPlanes();
     j["pinch_hold"] = !o.freePinches;
     j["vertex_substeps_held_in_pinches"] = r.counters.heldVertexSubsteps;
+    j["vertex_tests_pinched"] = r.counters.pinchedVertexTests;
     j["vertex_substeps"] = penetration.vertexSubsteps;  // free vertices x substeps: all of them
     j["vertex_substeps_inside_body"] = penetration.vertexSubstepsInsideBody;
     j["vertex_substeps_below_T1_fraction"] =

@@ -257,9 +257,9 @@ RunFunction setupRun(CLI::App& app) {
                "Sliding points read the distance field on every collision test instead of answering from "
                "their contact planes (slower; the reference the planes are measured against)");
   app.add_flag("--free-pinches", o->freePinches,
-               "With collision tests every K > 1 substeps: points pinched between two parts at a test move "
-               "freely until the next instead of being held by those parts (the paper's reduced-frequency "
-               "tests as they are)");
+               "Points pinched between two or more parts at a collision test keep their own velocity and, "
+               "with tests every K > 1 substeps, move freely until the next, instead of taking those parts' "
+               "mean velocity and being held by them (the paper's collision response as it is)");
   app.add_option("--units", o->units, "Length unit of the OBJ files: m, dm, cm, mm, in")->capture_default_str();
   auto* pins = app.add_option("--pin-vertices", o->pinVertices, "Vertices pinned in place, 0-based, e.g. 0,12,40");
   auto* mask = app.add_option("--pin-mask", o->pinMask, "OBJ whose vertices mark the pinned garment vertices");

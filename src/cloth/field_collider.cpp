@@ -213,6 +213,7 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   pinched_.clear();
   pinched_.reserve(n * parts_.size());
   askers_.assign(n, 0);
+  partVelocity_.assign(n, Vec3::Zero());
   field_.embeddedAtStart = 0;
   for (std::vector<double>* v : {&endVoxelX_, &endVoxelY_, &endVoxelZ_, &nearest_}) v->assign(n, 0.0);
   keep_.assign(n + 8, 0);  // padded: the candidate scan reads eight flags at a time
@@ -296,7 +297,7 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
     }
   }
   applyCorrections(io);
-  collectPinches(io);
+  collectPinches(interval_s, io);
   if (measurePenetration_) {
     const auto start = std::chrono::steady_clock::now();
     measureCorrected(io);
@@ -571,16 +572,30 @@ void FieldCollider::respondOnSurface(const PartFrame& frame, const Vec3& c, cons
   io.setVelocity(i, v);
 }
 
-void FieldCollider::collectPinches(const ClothState& io) {
+void FieldCollider::collectPinches(double dt_s, ClothState& io) {
   held_.clear();
   heldParts_.clear();
   std::fill(holds_.begin(), holds_.end(), std::uint8_t{0});
-  if (!pinchHold_ || every_ == 1) return;
-  for (const auto& [k, i] : corrected_) ++askers_[i];
+  if (!pinchHold_) return;
+  for (const auto& [k, i] : corrected_) {
+    ++askers_[i];
+    partVelocity_[i].setZero();
+  }
   pinched_.clear();
-  for (const auto& [k, i] : corrected_)
-    if (askers_[i] >= 2) pinched_.push_back({i, k});
-  for (const auto& [k, i] : corrected_) askers_[i] = 0;
+  for (const auto& [k, i] : corrected_) {
+    if (askers_[i] < 2) continue;
+    pinched_.push_back({i, k});
+    const Vec3 c = frames_[k].toVoxel1.apply(io.position(i));  // where the corrections put it
+    partVelocity_[i] += (frames_[k].toWorld1.apply(c) - frames_[k].toWorld0.apply(c)) / dt_s;
+  }
+  for (const auto& [k, i] : corrected_) {
+    if (askers_[i] >= 2) {
+      io.setVelocity(i, partVelocity_[i] / static_cast<double>(askers_[i]));
+      ++field_.pinchedVertexTests;
+    }
+    askers_[i] = 0;  // once per point: the velocity is set and counted on its first pair
+  }
+  if (every_ == 1) return;  // nothing to hold between tests
   std::sort(pinched_.begin(), pinched_.end());
   for (const auto& [i, k] : pinched_) {
     if (held_.empty() || held_.back().vertex != i)
@@ -693,7 +708,7 @@ FieldCollisionCounters& FieldCollisionCounters::operator+=(const FieldCollisionC
                       {&clearanceSkips, o.clearanceSkips}, {&embeddedAtStart, o.embeddedAtStart},
                       {&embeddedTimedOut, o.embeddedTimedOut},
                       {&planeEstimates, o.planeEstimates}, {&planeReads, o.planeReads},
-                      {&heldVertexSubsteps, o.heldVertexSubsteps}})
+                      {&heldVertexSubsteps, o.heldVertexSubsteps}, {&pinchedVertexTests, o.pinchedVertexTests}})
     *a += b;
   maxPenetration_m = std::max(maxPenetration_m, o.maxPenetration_m);
   for (int from = 0; from < 3; ++from)

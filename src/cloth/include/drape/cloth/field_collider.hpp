@@ -52,6 +52,13 @@
 // rigid motions over the substep and gives it that velocity, as friction between them would
 // (setPinchHold). With tests on every substep nothing is held.
 //
+// At the test itself a pinched point takes the mean velocity of its parts at the point. Its
+// own velocity there is what the cloth's forces gave it since the last test; where the
+// parts' offset surfaces overlap by more than the cloth can fit (a sleeve between arm and
+// chest, an armpit pressed by three parts), every test moves the point back by millimetres
+// and none takes that velocity away, so it grew from test to test with the cloth's pull
+// until the run diverged (the walking dress on other walks, traced to such points).
+//
 // Culling (the paper's non-hierarchical boxes): once per part and collision substep, one
 // vectorised pass maps every point's end position into the part's voxel coordinates (the
 // part's rigid transform at t1 and the grid placement folded into one affine map) and keeps
@@ -150,6 +157,7 @@ struct FieldCollisionCounters {
   std::uint64_t planeEstimates = 0;  ///< sliding pairs' field reads answered by their contact plane
   std::uint64_t planeReads = 0;      ///< sliding pairs' field reads that went to the field
   std::uint64_t heldVertexSubsteps = 0;  ///< untested substeps of points held in a pinch (setPinchHold)
+  std::uint64_t pinchedVertexTests = 0;  ///< tests at which two or more parts moved a point (setPinchHold)
   std::array<std::array<std::uint64_t, 3>, 3> transitions{};  ///< [from][to] PointState counts
 
   /// Mean voxel path per tested (vertex, part) pair: the paper's "average collision path
@@ -207,9 +215,10 @@ class FieldCollider final : public Collider {
   /// at a test (pressed from both sides, where their offset surfaces overlap: between the
   /// thighs, in the crease of hip or knee) is held by them on the substeps until the next
   /// test, moving with the mean of their rigid motions, as friction between them would hold
-  /// it. Off: it moves freely between tests (the paper's reduced-frequency tests as they
-  /// are), where the cloth's forces can throw it into a part before the next test. On by
-  /// default; with tests on every substep there is nothing to hold.
+  /// it. At every test, with every frequency, a pinched point takes its parts' mean velocity.
+  /// Off: it keeps its own velocity and moves freely between tests (the paper's collision
+  /// response and reduced-frequency tests as they are), where the cloth's forces can throw
+  /// it into a part before the next test. On by default.
   void setPinchHold(bool on) { pinchHold_ = on; }
   /// The points held now (pinched at the last test).
   [[nodiscard]] std::size_t heldPoints() const { return held_.size(); }
@@ -287,8 +296,10 @@ class FieldCollider final : public Collider {
   void countNearest();
   /// The penetration figures of an untested substep ending at t_s (setCountEverySubstep).
   void countUntested(const ClothState& io, double t_s);
-  /// After a test's corrections: the points two or more parts asked to move (setPinchHold).
-  void collectPinches(const ClothState& io);
+  /// After a test's corrections: the points two or more parts asked to move take the mean
+  /// of those parts' velocities at them and, with reduced-frequency tests, are held until
+  /// the next (setPinchHold). dt_s: the interval the test covered.
+  void collectPinches(double dt_s, ClothState& io);
   /// On an untested substep t0 -> t1: the held points move with their parts.
   void holdPinches(double t0_s, double t1_s, ClothState& io);
 
@@ -347,6 +358,7 @@ class FieldCollider final : public Collider {
   std::vector<std::uint8_t> holds_;   ///< per part: some held point is held by it
   std::vector<PartStep> steps_;       ///< per part: its motion over the current untested substep
   std::vector<std::uint8_t> askers_;  ///< per vertex, scratch: how many parts asked to move it this test
+  std::vector<Vec3> partVelocity_;    ///< per vertex, scratch: the sum of its pinching parts' velocities there
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pinched_;  ///< scratch: (vertex, part), sorted
   ColliderCounters counters_;
   FieldCollisionCounters field_;

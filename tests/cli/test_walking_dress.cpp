@@ -17,6 +17,7 @@ using testing::ScratchDir;
 using testing::slurp;
 
 const std::string kSource = DRAPE_SOURCE_DIR;
+const std::string kDressScene = kSource + "/examples/walking_dress/scene.wrl";
 
 TEST(WalkingDress, WalksStablyWithFewPointsInsideTheBody) {
   ScratchDir dir("walking-dress");
@@ -74,11 +75,8 @@ TEST(WalkingDress, RunsTheDazStyleWalkToTheEnd) {
   // Spine1 and the upper arm at once gathered speed from test to test and the run stopped in
   // frame 69.
   ScratchDir dir("walking-dress-daz");
-  const std::string out = dir / "out";
-  const CliResult r = runDrape("run '" + kSource + "/examples/walking_dress/scene.wrl' --motion '" + kSource +
-                                   "/data/mocap/cmu_02_02_walk_dazstyle.bvh' --every 1000 --out '" + out + "'",
-                               dir);
-  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string out = testing::runInto(dir, "out", "'" + kDressScene + "' --motion '" + kSource +
+                                                         "/data/mocap/cmu_02_02_walk_dazstyle.bvh' --every 1000");
   const nlohmann::json stats = nlohmann::json::parse(slurp(out + "/stats.json"));
   EXPECT_FALSE(stats["unstable"].get<bool>());
   EXPECT_GT(stats["frames"].get<int>(), 100);
@@ -92,12 +90,9 @@ TEST(WalkingDress, StaysStableWithMoreSubsteps) {
   // frame 4, when a point the collider put back on T2 kept its velocity into the part
   // wherever the distance read there said it was above T2.
   ScratchDir dir("walking-dress-300");
-  const std::string out = dir / "out";
-  const CliResult r = runDrape("run '" + kSource + "/examples/walking_dress/scene.wrl' --motion '" + kSource +
-                                   "/examples/walking_skirt/walk.bvh' --substeps 300 --damping 0 --frames 8 --every 8 "
-                                   "--out '" + out + "'",
-                               dir);
-  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string out = testing::runInto(dir, "out", "'" + kDressScene + "' --motion '" + kSource +
+                                                         "/examples/walking_skirt/walk.bvh' --substeps 300 --damping 0 "
+                                                         "--frames 8 --every 8");
   EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["frames"].get<int>(), 8);
 }
 

@@ -45,9 +45,9 @@ void logEasedPairs(const std::string& garment, const cloth::FieldCollider& colli
   std::vector<std::string> most;
   for (std::size_t j = 0; j < parts.size() && j < 4; ++j) most.push_back(fmt::format("{} {}", parts[j].second, parts[j].first));
   if (parts.size() > 4) most.push_back(fmt::format("{} more parts", parts.size() - 4));
-  spdlog::info("{}: {} (vertex, part) pairs start below T1 ({:g} mm), the garment tighter than the offset surfaces "
+  spdlog::info("{}: {} (vertex, part) pairs start below T2 ({:g} mm), the garment tighter than the offset surfaces "
                "there; they are eased out onto T2: {}",
-               garment, total, 1e3 * collider.offsets().t1_m, fmt::join(most, ", "));
+               garment, total, 1e3 * collider.offsets().t2_m, fmt::join(most, ", "));
 }
 
 /// How much of what the substep allows the internal damping takes (the solver has refused

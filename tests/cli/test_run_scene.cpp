@@ -91,7 +91,7 @@ TEST(RunScene, WalkingSkirtWritesEverything) {
                                dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("walk.bvh: frame 1 is a reference T-pose, not played"), std::string::npos) << r.err;
-  EXPECT_EQ(r.err.find("start below T1"), std::string::npos) << "the skirt hangs clear of the body:\n" << r.err;
+  EXPECT_EQ(r.err.find("start below T2"), std::string::npos) << "the skirt hangs clear of the body:\n" << r.err;
   for (const char* f : {"garment.pc2", "garment.obj", "result.wrl", "result.glb", "stats.json", "manifest.json",
                         "frames/frame_00015.obj", "segments/Hips.pc2", "segments/LeftLeg.obj"})
     EXPECT_TRUE(std::filesystem::exists(out + "/" + f)) << f;

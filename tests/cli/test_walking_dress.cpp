@@ -43,12 +43,12 @@ TEST(WalkingDress, WalksStablyWithFewPointsInsideTheBody) {
   EXPECT_LT(stats["max_penetration_m"].get<double>(), 0.005);
   EXPECT_LT(stats["max_strain"].get<double>(), 1.6);
   // The sleeves, narrower than the arms' offset surfaces, hold some of the vertices that
-  // start below T1 there: they collide as any other (and count above) once their easing
+  // start below T2 there: they collide as any other (and count above) once their easing
   // has had its time.
   EXPECT_GT(stats["pairs_embedded_timed_out"].get<long>(), 0);
   EXPECT_LT(stats["pairs_embedded_timed_out"].get<long>(), stats["pairs_embedded_at_start"].get<long>());
   // The run says where the garment starts inside the offset surfaces, and what timed out.
-  EXPECT_NE(r.err.find("dress: 1001 (vertex, part) pairs start below T1 (4 mm)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("dress: 1343 (vertex, part) pairs start below T2 (6 mm)"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("LeftForeArm"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find(fmt::format("dress: {} of the eased pairs were still below T2",
                                    stats["pairs_embedded_timed_out"].get<long>())),

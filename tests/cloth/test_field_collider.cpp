@@ -55,6 +55,15 @@ struct BodySetup {
 
 const OffsetSurfaces kOffsets = OffsetSurfaces::fromVoxelSize(kVoxel);
 
+/// Initialises the collider with the point far from every part, then puts it at `at`: the
+/// first test meets it there as a point that has just arrived (its contacts registered
+/// there), not as one the garment starts in below T2 (which is eased out).
+void initialiseArriving(FieldCollider& c, Point& p, const Vec3& at) {
+  p.state.setPosition(0, Vec3(40, 40, 40));
+  c.initialise(p.state, 0.0);
+  p.state.setPosition(0, at);
+}
+
 TEST(FieldCollider, StopsOnT2AndNeverEndsBelowT0StaticField) {
   BodySetup s(field::makeSphere(0.1, Vec3::Zero(), 64, 32), std::make_shared<StaticMotion>());
   Point p(Vec3(0.3, 0.01, 0.0));
@@ -112,10 +121,9 @@ TEST(FieldCollider, SlidingFrictionDeceleratesAtMuG) {
   // A large box whose top face is y = 0; the point slides on T2 at 1 m/s under gravity.
   BodySetup s(field::makeBox(Vec3(-0.5, -0.1, -0.5), Vec3(0.5, 0.0, 0.5)), std::make_shared<StaticMotion>());
   const double mu = 0.4, g = 9.81, dt = 1e-4;
-  Point p(Vec3(-0.3, kOffsets.t2_m, 0.0));
+  Point p(Vec3::Zero());
   FieldCollider c("test", s.parts, kOffsets, mu, mu);
-  c.initialise(p.state, 0.0);
-  ASSERT_EQ(c.state(0, 0), PointState::OnSurf);
+  initialiseArriving(c, p, Vec3(-0.3, kOffsets.t2_m, 0.0));
   const double v0 = 1.0;
   p.state.setVelocity(0, Vec3(v0, 0, 0));
   const int steps = 1000;  // 0.1 s: expected speed loss mu g t = 0.392 m/s
@@ -657,7 +665,7 @@ double throwBetweenTests(bool hold, double throw_m_s, std::uint64_t* held = null
   const int every = 4;
   FieldCollider c("test", parts, kOffsets, 0.0, 0.0, every);
   c.setPinchHold(hold);
-  c.initialise(p.state, 0.0);
+  initialiseArriving(c, p, Vec3::Zero());
   EXPECT_EQ(c.fieldCounters().embeddedAtStart, 0u);
   const double dt = 1e-3;
   double deepest = 0;
@@ -700,7 +708,7 @@ TEST(FieldCollider, APointPinchedAtATestTakesItsPartsMeanVelocity) {
     Point p(Vec3::Zero());
     FieldCollider c("test", parts, kOffsets, 0.5, 0.3);
     c.setPinchHold(hold);
-    c.initialise(p.state, 0.0);
+    initialiseArriving(c, p, Vec3::Zero());
     const double dt = 1e-3;
     for (int step = 0; step < 20; ++step) {
       p.state.setVelocity(0, p.state.velocity(0) + Vec3(-2.0, 0, 0));
@@ -748,12 +756,10 @@ TEST(FieldCollider, AHeldPointTurnsWithItsParts) {
   const auto frame = std::make_shared<WobblingMotion>();
   const std::vector<CollisionPart> parts = {{"left", &leftField, frame}, {"right", &rightField, frame}};
   const Vec3 start(-0.0025, 0, 0);  // where both fields read 11 mm (their grids sit half a voxel apart)
-  Point p(frame->poseAt(0).apply(start));
+  Point p(Vec3::Zero());
   const int every = 5;
   FieldCollider c("test", parts, kOffsets, 0.0, 0.0, every);
-  c.initialise(p.state, 0.0);
-  ASSERT_EQ(c.state(0, 0), PointState::OnSurf) << leftField.distanceAt(start);
-  ASSERT_EQ(c.state(1, 0), PointState::OnSurf) << rightField.distanceAt(start);
+  initialiseArriving(c, p, frame->poseAt(0).apply(start));
   ASSERT_EQ(c.fieldCounters().embeddedAtStart, 0u);
   const double dt = 1e-3;
   Vec3 atTest = Vec3::Zero();  // in the boxes' frame
@@ -767,6 +773,8 @@ TEST(FieldCollider, AHeldPointTurnsWithItsParts) {
     EXPECT_GT(leftField.distanceAt(local), 0.0) << "step " << step;
     EXPECT_GT(rightField.distanceAt(local), 0.0) << "step " << step;
     if (tested) {
+      ASSERT_EQ(c.state(0, 0), PointState::OnSurf) << "step " << step << ": " << leftField.distanceAt(local);
+      ASSERT_EQ(c.state(1, 0), PointState::OnSurf) << "step " << step << ": " << rightField.distanceAt(local);
       ASSERT_EQ(c.heldPoints(), 1u) << "step " << step;
       atTest = local;
     } else {
@@ -821,31 +829,34 @@ TEST(FieldCollider, ClearanceSkipChangesNothing) {
 }
 
 TEST(FieldCollider, PointsStartingBelowT2AreEasedOutNotThrown) {
-  // A garment modelled tight on the body starts below T1 (here 1 mm from a sphere whose T1
-  // is 10 mm): it rises at the easing speed, never in one jump, and then slides on T2.
+  // A garment modelled tight on the body starts below T2: 1 mm from a sphere whose T1 is
+  // 10 mm, or 12 mm from it, between T1 and T2 (15 mm). It rises at the easing speed, never
+  // in one jump, and then slides on T2.
   BodySetup s(field::makeSphere(0.1, Vec3::Zero(), 64, 32), std::make_shared<StaticMotion>());
-  Point p(Vec3(0.101, 0.0, 0.0));
-  FieldCollider c("test", s.parts, kOffsets, 0.0, 0.0);
-  c.initialise(p.state, 0.0);
-  EXPECT_EQ(c.fieldCounters().embeddedAtStart, 1u);
-  const double dt = 1e-3;
-  const double easing_m_s = 0.1;
-  double previous = s.field.distanceAt(p.state.position(0));
-  int steps = 0;
-  for (; steps < 1000 && c.state(0, 0) != PointState::OnSurf; ++steps) {
-    p.state.setVelocity(0, Vec3(-0.5, 0, 0));  // pressed inwards every substep
-    c.collide(*p.model, steps * dt, (steps + 1) * dt, p.state);
-    const double d = s.field.distanceAt(p.state.position(0));
-    EXPECT_LE(d - previous, easing_m_s * dt * 1.05 + 1e-9) << "step " << steps << ": no jump";
-    EXPECT_GE(d, previous - 1e-9) << "step " << steps << ": never deeper";
-    EXPECT_GE(p.state.velocity(0).dot(s.field.normalAt(p.state.position(0))), -1e-4) << "no inward velocity";
-    previous = d;
+  for (const double gap : {0.001, 0.012}) {
+    Point p(Vec3(0.1 + gap, 0.0, 0.0));
+    FieldCollider c("test", s.parts, kOffsets, 0.0, 0.0);
+    c.initialise(p.state, 0.0);
+    EXPECT_EQ(c.fieldCounters().embeddedAtStart, 1u);
+    const double dt = 1e-3;
+    const double easing_m_s = 0.1;
+    double previous = s.field.distanceAt(p.state.position(0));
+    int steps = 0;
+    for (; steps < 1000 && c.state(0, 0) != PointState::OnSurf; ++steps) {
+      p.state.setVelocity(0, Vec3(-0.5, 0, 0));  // pressed inwards every substep
+      c.collide(*p.model, steps * dt, (steps + 1) * dt, p.state);
+      const double d = s.field.distanceAt(p.state.position(0));
+      EXPECT_LE(d - previous, easing_m_s * dt * 1.05 + 1e-9) << "gap " << gap << ", step " << steps << ": no jump";
+      EXPECT_GE(d, previous - 1e-9) << "gap " << gap << ", step " << steps << ": never deeper";
+      EXPECT_GE(p.state.velocity(0).dot(s.field.normalAt(p.state.position(0))), -1e-4) << "no inward velocity";
+      previous = d;
+    }
+    EXPECT_EQ(c.state(0, 0), PointState::OnSurf);
+    EXPECT_NEAR(previous, kOffsets.t2_m, 0.2 * kVoxel);
+    // 14 mm at 0.1 m/s: about 140 substeps of 1 ms; 3 mm: about 30.
+    EXPECT_NEAR(steps, (kOffsets.t2_m - gap) / (easing_m_s * dt), 20) << "gap " << gap;
+    EXPECT_EQ(c.fieldCounters().vertexSubstepsInsideBody, 0u);
   }
-  EXPECT_EQ(c.state(0, 0), PointState::OnSurf);
-  EXPECT_NEAR(previous, kOffsets.t2_m, 0.2 * kVoxel);
-  // 14 mm at 0.1 m/s: about 140 substeps of 1 ms.
-  EXPECT_NEAR(steps, (kOffsets.t2_m - 0.001) / (easing_m_s * dt), 20);
-  EXPECT_EQ(c.fieldCounters().vertexSubstepsInsideBody, 0u);
 }
 
 TEST(FieldCollider, APointHeldBelowT2WhileEasedCollidesAsAnyOtherInTime) {

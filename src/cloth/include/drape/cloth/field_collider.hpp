@@ -31,7 +31,7 @@
 //                              below T1 the outward relative velocity gets a penalty floor;
 //                              below T0 the last-resort projection is counted
 //   OnSurf     -> InsideVol    when forces carry it beyond T3
-// A point that starts below T1 of a part is eased out onto T2 at a bounded speed first; one
+// A point that starts below T2 of a part is eased out onto T2 at a bounded speed first; one
 // the garment still holds below T2 after twice the time its depth takes at that speed
 // collides as any other from then on.
 //
@@ -152,7 +152,7 @@ struct FieldCollisionCounters {
   std::uint64_t vertexSubsteps = 0;            ///< vertices x collision substeps
   double maxPenetration_m = 0;      ///< deepest point below the body surface after the response
   std::uint64_t clearanceSkips = 0;  ///< pairs that stayed InsideVol without a trilinear read
-  std::uint64_t embeddedAtStart = 0;  ///< (vertex, part) pairs below T1 at the start, eased out onto T2
+  std::uint64_t embeddedAtStart = 0;  ///< (vertex, part) pairs below T2 at the start, eased out onto T2
   std::uint64_t embeddedTimedOut = 0;  ///< eased pairs that had not reached T2 in time and then collided as any other
   std::uint64_t planeEstimates = 0;  ///< sliding pairs' field reads answered by their contact plane
   std::uint64_t planeReads = 0;      ///< sliding pairs' field reads that went to the field
@@ -253,7 +253,7 @@ class FieldCollider final : public Collider {
     return lastVoxel_[part][vertex];
   }
   /// Per part, the (vertex, part) pairs being eased out onto T2 now: right after initialise,
-  /// those that start below T1.
+  /// those that start below T2.
   [[nodiscard]] std::vector<std::size_t> easedPairsPerPart() const;
   /// Points per state now, summed over parts: [OutsideVol, InsideVol, OnSurf].
   [[nodiscard]] std::array<std::size_t, 3> pointsPerState() const;

@@ -13,6 +13,7 @@
 #include "drape/core/log.hpp"
 
 #include "command.hpp"
+#include "drape/cloth/field_collider.hpp"
 #include "drape/core/error.hpp"
 #include "drape/formats/obj.hpp"
 #include "drape/formats/units.hpp"
@@ -35,6 +36,7 @@ struct RunOptions {
   double pinTolerance_m = 1e-4;
   long frames = 0, every = 1;
   int collisionEvery = 1;
+  std::vector<double> offsets;  ///< T0..T3, m; empty: the scene's, or from the voxel size
   cloth::Material material;
   cloth::StepSettings settings;
 };
@@ -112,6 +114,17 @@ int substepsFrom(const std::string& text) {
   return static_cast<int>(value);
 }
 
+/// --offsets for every garment, checked.
+void applyOffsets(const RunOptions& o, RunSetup& setup) {
+  if (o.offsets.empty()) return;
+  const cloth::OffsetSurfaces offsets{o.offsets[0], o.offsets[1], o.offsets[2], o.offsets[3]};
+  offsets.validate("--");
+  for (GarmentSetup& g : setup.garments) {
+    g.offsets = offsets;
+    g.offsetsGiven = true;
+  }
+}
+
 /// Command-line values that override the scene's (only those the user gave).
 void applyOverrides(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   cloth::StepSettings& s = setup.settings;
@@ -169,6 +182,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     setup = runSetupFromScene(o.scene);
     if (setup.character) avatar = setup.character->avatar;
     applyOverrides(app, o, setup);
+    applyOffsets(o, setup);
   } else {
     if (!o.avatar.empty()) avatar = std::make_shared<const scene::Avatar>(scene::loadAvatarFile(o.avatar));
     setupFromGarment(o, setup, avatar != nullptr);
@@ -177,6 +191,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
       for (GarmentSetup& g : setup.garments)
         for (const scene::Segment& seg : avatar->segments) g.collidesWith.push_back(seg.name);
     }
+    applyOffsets(o, setup);
   }
   if (!o.motion.empty() && !avatar)
     throw Error("--motion: there is no avatar to move (the scene has none; without a scene, give --avatar FILE)");
@@ -246,6 +261,11 @@ RunFunction setupRun(CLI::App& app) {
       ->check(CLI::IsMember({"dvdp", "exact"}));
   app.add_option("--lead-in", o->leadIn_s, "Seconds to blend from the rest pose into the motion")->capture_default_str();
   app.add_flag("--preview", o->preview, "Also render a contact sheet and, with ffmpeg, an MP4 into the output directory");
+  app.add_option("--offsets", o->offsets,
+                 "The offset surfaces T0,T1,T2,T3 in m, overriding the scene's (default: 1, 2, 3 and 6 voxels); "
+                 "collisions register on T2")
+      ->delimiter(',')
+      ->expected(4);
   app.add_option("--collision-every", o->collisionEvery,
                  "Collision tests every K substeps, overriding the scene's collisionEvery (the paper's "
                  "reduced-frequency tests)")

@@ -474,14 +474,19 @@ int simulateRun(const RunSetup& setup) {
   nlohmann::json garments = nlohmann::json::array();
   for (std::size_t g = 0; g < runs.size(); ++g) {
     const cloth::ClothModel& m = *runs[g].model;
-    garments.push_back({{"name", setup.garments[g].name},
-                        {"vertices", m.vertexCount()},
-                        {"triangles", m.triangleCount()},
-                        {"pinned", setup.garments[g].pinned.size()},
-                        {"mass_kg", m.totalMass_kg()},
-                        {"added_mass_kg", m.addedMass_kg()},
-                        {"mass_scaled_vertices", m.massScaledVertexCount()},
-                        {"estimated_stable_substep_s", m.estimatedStableStep_s()}});
+    nlohmann::json entry = {{"name", setup.garments[g].name},
+                            {"vertices", m.vertexCount()},
+                            {"triangles", m.triangleCount()},
+                            {"pinned", setup.garments[g].pinned.size()},
+                            {"mass_kg", m.totalMass_kg()},
+                            {"added_mass_kg", m.addedMass_kg()},
+                            {"mass_scaled_vertices", m.massScaledVertexCount()},
+                            {"estimated_stable_substep_s", m.estimatedStableStep_s()}};
+    if (runs[g].collider) {
+      const cloth::OffsetSurfaces& o = runs[g].collider->offsets();
+      entry["offsets_m"] = {o.t0_m, o.t1_m, o.t2_m, o.t3_m};
+    }
+    garments.push_back(std::move(entry));
   }
   stats["garments"] = garments;
   addCollisionStats(stats, runs, total, done, world.get());

@@ -146,6 +146,24 @@ TEST(RunScene, MotionWithoutAvatarIsABadInput) {
   EXPECT_NE(r.err.find("--motion: there is no avatar"), std::string::npos) << r.err;
 }
 
+TEST(RunScene, OffsetsGivenOverrideTheScenesAndAreChecked) {
+  ScratchDir dir("run-offsets");
+  const std::string scene = "'" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir + "/walk.bvh' --frames 2 ";
+  const std::string out = testing::runInto(dir, "out", scene + "--offsets 0.004,0.008,0.012,0.024");
+  const nlohmann::json stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  EXPECT_EQ(stats["garments"][0]["offsets_m"], nlohmann::json({0.004, 0.008, 0.012, 0.024}));
+  // Without the option, the scene's (5, 10, 15 and 30 mm, VRML97 single-precision floats).
+  const std::string plain = testing::runInto(dir, "plain", scene);
+  const nlohmann::json scenes = nlohmann::json::parse(slurp(plain + "/stats.json"))["garments"][0]["offsets_m"];
+  ASSERT_EQ(scenes.size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) EXPECT_NEAR(scenes[k].get<double>(), 0.005 * double(k == 3 ? 6 : k + 1), 1e-8);
+  const CliResult bad = runDrape("run " + scene + "--offsets 0.004,0.003,0.012,0.024 --out '" + (dir / "bad") + "'", dir);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--offsets must satisfy 0 <= T0 < T1 < T2 < T3 (m), got 0.004 0.003 0.012 0.024"),
+            std::string::npos)
+      << bad.err;
+}
+
 TEST(RunScene, DampingTheSubstepCannotCarryIsRefusedWithTheWayOut) {
   // The skirt's 1.01 ms substep carries at most 3.87 ms of damping (its membrane's stiffest
   // mode, the waistband held: 605 rad/s); 10 ms diverged in the first frame before the check.

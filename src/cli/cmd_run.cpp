@@ -304,7 +304,7 @@ RunFunction setupRun(CLI::App& app) {
       ->capture_default_str();
 
   cloth::StepSettings& s = o->settings;
-  app.add_option("--substeps", o->substeps, "Substeps per frame, or 'auto' (the fewest estimated stable, with --max-added-mass of mass scaling)")
+  app.add_option("--substeps", o->substeps, "Substeps per frame, or 'auto' (the fewest estimated stable, the damping included, with --max-added-mass of mass scaling)")
       ->capture_default_str();
   app.add_option("--frame-rate", s.frameRate_hz, "Frames per second")->capture_default_str();
   app.add_option("--integrator", o->integrator, "symplectic-euler or forward-euler (the paper's)")

@@ -53,13 +53,10 @@ void logEasedPairs(const std::string& garment, const cloth::FieldCollider& colli
 /// How much of what the substep allows the internal damping takes (the solver has refused
 /// more): near 100 %, a little more damping, or fewer substeps, will diverge.
 void logDamping(const std::string& garment, const cloth::ClothSolver& solver) {
-  const cloth::ClothModel& model = solver.model();
-  const double beta = model.material().damping_s;
-  if (!(beta > 0.0) || solver.settings().integrator != cloth::IntegratorKind::SymplecticEuler) return;
-  std::vector<std::uint8_t> fixed(model.vertexCount(), 0);
-  for (const cloth::PinGroup& g : solver.pins())
-    for (const std::uint32_t v : g.vertices) fixed[v] = 1;
-  const double most = cloth::largestStableDamping_s(model.membraneFrequency_rad_s(fixed), solver.settings().substep_s());
+  const double omega = solver.dampedMembraneFrequency_rad_s();
+  if (!(omega > 0.0)) return;  // undamped, or not the symplectic step
+  const double beta = solver.model().material().damping_s;
+  const double most = cloth::largestStableDamping_s(omega, solver.settings().substep_s());
   if (most > 0.0)
     spdlog::info("{}: internal damping {:.3g} ms, {:.0f} % of the most the {:.3g} ms substep allows ({:.3g} ms)",
                  garment, 1e3 * beta, 100.0 * beta / most, 1e3 * solver.settings().substep_s(), 1e3 * most);

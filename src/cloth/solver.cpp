@@ -37,10 +37,13 @@ ClothSolver::ClothSolver(std::shared_ptr<const ClothModel> model, const StepSett
       state_(ClothState::atRest(*model_)) {
   settings_.validate("--");
   checkBendingStep(*model_, settings_);
-  std::vector<std::uint8_t> fixed(model_->vertexCount(), 0);
-  for (const PinGroup& g : pins_)
-    for (const std::uint32_t v : g.vertices) fixed[v] = 1;
-  checkDampedStep(*model_, settings_, fixed);
+  if (model_->material().damping_s > 0.0 && settings_.integrator == IntegratorKind::SymplecticEuler) {
+    std::vector<std::uint8_t> fixed(model_->vertexCount(), 0);
+    for (const PinGroup& g : pins_)
+      for (const std::uint32_t v : g.vertices) fixed[v] = 1;
+    dampedOmega_ = model_->membraneFrequency_rad_s(fixed);
+    checkDampedStep(*model_, settings_, dampedOmega_);
+  }
 }
 
 void checkBendingStep(const ClothModel& model, const StepSettings& settings) {
@@ -53,10 +56,9 @@ void checkBendingStep(const ClothModel& model, const StepSettings& settings) {
                           model.name(), settings.bendEvery, 1e3 * span, 1e3 * stable, most));
 }
 
-void checkDampedStep(const ClothModel& model, const StepSettings& settings, std::span<const std::uint8_t> fixed) {
+void checkDampedStep(const ClothModel& model, const StepSettings& settings, double omega) {
   const double beta = model.material().damping_s;
   if (!(beta > 0.0) || settings.integrator != IntegratorKind::SymplecticEuler) return;
-  const double omega = model.membraneFrequency_rad_s(fixed);
   const double dt = settings.substep_s();
   // A substep too long even undamped is the wave-speed estimate's to warn about (it diverges
   // either way); this check is for the damping.

@@ -325,7 +325,7 @@ class FieldCollider final : public Collider {
   std::vector<std::vector<Vec3>> lastVoxel_;      ///< [part][vertex], part's voxel coordinates at lastTime
   std::vector<std::vector<ContactPlane>> planes_;  ///< [part][vertex], the last field read of a sliding pair
   std::vector<std::uint8_t> penalty_;             ///< per vertex: below T1 of some part now
-  /// [part][vertex]: the point started below T1 of the part and is being eased out onto T2
+  /// [part][vertex]: the point started below T2 of the part and is being eased out onto it
   /// (releaseEmbedded) rather than thrown there in one substep.
   std::vector<std::vector<std::uint8_t>> embedded_;
   std::vector<std::vector<double>> easeUntil_s_;  ///< [part][vertex]: when an eased pair collides as any other

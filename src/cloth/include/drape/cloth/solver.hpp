@@ -11,7 +11,6 @@
 #include <array>
 #include <cstdint>
 #include <memory>
-#include <span>
 #include <string>
 #include <vector>
 
@@ -53,17 +52,15 @@ void checkBendingStep(const ClothModel& model, const StepSettings& settings);
 
 /// Throws drape::Error, naming the garment, the most damping the substep allows and the
 /// substeps per frame the damping needs, when the material's internal damping makes the
-/// symplectic Euler substep unstable (dampedStableStep_s with the membrane's highest
-/// frequency, `fixed` vertices held; forward Euler is not checked). A substep too long even
-/// without damping is left to the wave-speed estimate's warning. The solver checks it.
-void checkDampedStep(const ClothModel& model, const StepSettings& settings, std::span<const std::uint8_t> fixed = {});
+/// symplectic Euler substep unstable (dampedStableStep_s with `omega_rad_s`, the membrane's
+/// highest frequency, ClothModel::membraneFrequency_rad_s; forward Euler is not checked). A
+/// substep too long even without damping is left to the wave-speed estimate's warning. The
+/// solver checks it.
+void checkDampedStep(const ClothModel& model, const StepSettings& settings, double omega_rad_s);
 
 class ClothSolver {
  public:
   ClothSolver(std::shared_ptr<const ClothModel> model, const StepSettings& settings, std::vector<PinGroup> pins = {});
-
-  /// The pinned and bound vertices' groups (what the fixtures move).
-  [[nodiscard]] const std::vector<PinGroup>& pins() const { return pins_; }
 
   /// Adds a collider (not owned; it must outlive the solver's steps).
   void addCollider(Collider& collider) { colliders_.push_back(&collider); }
@@ -89,6 +86,9 @@ class ClothSolver {
   [[nodiscard]] const StageTimes& stageTimes() const { return times_; }
   [[nodiscard]] const Instability& instability() const { return instability_; }
   [[nodiscard]] const std::vector<Collider*>& colliders() const { return colliders_; }
+  /// With internal damping and symplectic Euler: the membrane's highest frequency with the
+  /// pinned and bound vertices held, which checkDampedStep judged the substep by; else 0.
+  [[nodiscard]] double dampedMembraneFrequency_rad_s() const { return dampedOmega_; }
   /// Total energy (kinetic + gravitational + membrane + bending), J.
   [[nodiscard]] double totalEnergy() const;
 
@@ -108,6 +108,7 @@ class ClothSolver {
   StageTimes times_;
   Instability instability_;
   long substepCount_ = 0;  ///< substeps taken, for the bending rhythm
+  double dampedOmega_ = 0.0;  ///< dampedMembraneFrequency_rad_s
 };
 
 }  // namespace drape::cloth

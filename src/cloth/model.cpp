@@ -128,40 +128,79 @@ double ClothModel::membraneStableStep(const mesh::TriMesh& mesh, std::size_t tri
 // garment; scaling them adds little mass where it changes nothing visible.
 void ClothModel::applyMassScaling(const mesh::TriMesh& mesh, const MassScaling& scaling) {
   if (!(scaling.targetStep_s > 0.0)) return;
-  const double target = scaling.targetStep_s;
+  const double step = scaling.targetStep_s;
+  const double beta = material_.damping_s;
   const double unscaledStep = estimatedStableStep_s();  // for the error message
   const double baseMass = totalMass_;
-  const std::vector<double> before = mass_;
+  const std::vector<double> base = mass_;
+  scaleMassesFor(mesh, base, step, step);
+  if (beta > 0.0) holdDampedStep(mesh, base, step);
+  addedMass_ = totalMass_ - baseMass;
+  massScaledVertices_ = 0;
+  for (std::size_t i = 0; i < mass_.size(); ++i) massScaledVertices_ += mass_[i] > base[i] ? 1 : 0;
+  if (addedMass_ > scaling.maxAddedFraction * baseMass) {
+    double stableStep = unscaledStep;
+    if (beta > 0.0) {  // the unscaled masses back, for the damped bound the message names
+      mass_ = base;
+      updateInverseMasses();
+      stableStep = std::min(stableStep, dampedStableStep_s(membraneFrequency_rad_s(), beta));
+    }
+    const std::string stableAt =
+        scaling.frameRate_hz > 0.0
+            ? fmt::format("{} substeps per frame",
+                          static_cast<long>(std::ceil(1.0 / (scaling.frameRate_hz * stableStep))))
+            : fmt::format("a substep of {:.3g} ms", 1e3 * stableStep);
+    const std::string damped = beta > 0.0 ? fmt::format(" with internal damping of {:.3g} s", beta) : "";
+    throw Error(fmt::format("{}: keeping the substep of {:.3g} ms stable{} needs {:.1f} % more mass on {} of {} "
+                            "vertices, more than maxAddedMass {:g} allows; use more substeps per frame (the "
+                            "garment is stable without mass scaling at {}) or allow more added mass",
+                            name_, 1e3 * step, damped, 100.0 * addedMass_ / baseMass, massScaledVertices_,
+                            mass_.size(), scaling.maxAddedFraction, stableAt));
+  }
+}
+
+void ClothModel::scaleMassesFor(const mesh::TriMesh& mesh, const std::vector<double>& base, double membraneTarget_s,
+                                double bendingTarget_s) {
+  mass_ = base;
   const double areal = material_.arealDensity();
   membraneStep_ = std::numeric_limits<double>::infinity();
   for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
     const double dt = membraneStableStep(mesh, t);
-    if (dt < target) {
-      const double added = areal * mesh.triangleArea(t) / 3.0 * ((target / dt) * (target / dt) - 1.0);
+    if (dt < membraneTarget_s) {
+      const double ratio = membraneTarget_s / dt;
+      const double added = areal * mesh.triangleArea(t) / 3.0 * (ratio * ratio - 1.0);
       for (std::uint32_t v : mesh.triangles[t]) mass_[v] += added;
     }
-    membraneStep_ = std::min(membraneStep_, std::max(dt, target));
+    membraneStep_ = std::min(membraneStep_, std::max(dt, membraneTarget_s));
   }
-  const double omegaMax = 1.8 / target;  // bending: symplectic Euler's 2 / omega, with 0.9 of it
+  const double omegaMax = 1.8 / bendingTarget_s;  // bending: symplectic Euler's 2 / omega, with 0.9 of it
   const std::vector<double> rowSum = bendingRowSums(mesh);
   for (std::size_t i = 0; i < mass_.size(); ++i) mass_[i] = std::max(mass_[i], rowSum[i] / (omegaMax * omegaMax));
   updateInverseMasses();
   bendingOmega_ = estimateBendingOmega(mesh);
-  addedMass_ = totalMass_ - baseMass;
-  massScaledVertices_ = 0;
-  for (std::size_t i = 0; i < mass_.size(); ++i) massScaledVertices_ += mass_[i] > before[i] ? 1 : 0;
-  if (addedMass_ > scaling.maxAddedFraction * baseMass) {
-    const std::string stableAt =
-        scaling.frameRate_hz > 0.0
-            ? fmt::format("{} substeps per frame",
-                          static_cast<long>(std::ceil(1.0 / (scaling.frameRate_hz * unscaledStep))))
-            : fmt::format("a substep of {:.3g} ms", 1e3 * unscaledStep);
-    throw Error(fmt::format("{}: keeping the substep of {:.3g} ms stable needs {:.1f} % more mass on {} of {} "
-                            "vertices, more than maxAddedMass {:g} allows; use more substeps per frame (the "
-                            "garment is stable without mass scaling at {}) or allow more added mass",
-                            name_, 1e3 * target, 100.0 * addedMass_ / baseMass, massScaledVertices_, mass_.size(),
-                            scaling.maxAddedFraction, stableAt));
+}
+
+// Internal damping beta shortens the membrane's stable step: a mode of frequency omega needs
+// omega^2 dt (dt + 2 beta) < 4, so masses scaled for dt alone can leave the stiffest mode too
+// fast. Its slivers are then scaled for a longer step, in proportion to how much too fast it
+// is (a scaled triangle's frequency goes as one over its target), measured again, and so on
+// for a few rounds; bending is not damped and keeps dt. A mode still too fast after the last
+// round is the solver's to refuse (checkDampedStep), with the way out in its message.
+void ClothModel::holdDampedStep(const mesh::TriMesh& mesh, const std::vector<double>& base, double step_s) {
+  constexpr int kRounds = 4;
+  constexpr double kOvershoot = 1.02;  // the next round aims a little past the bound
+  const double allowed = 2.0 * kDampedStepMargin / undampedEquivalentStep_s(step_s, material_.damping_s);
+  double membraneTarget = step_s;
+  for (int round = 0; round < kRounds; ++round) {
+    const double omega = membraneFrequency_rad_s();
+    if (omega <= allowed) return;
+    membraneTarget *= kOvershoot * omega / allowed;
+    scaleMassesFor(mesh, base, membraneTarget, step_s);
   }
+}
+
+double undampedEquivalentStep_s(double step_s, double damping_s) {
+  return std::sqrt(step_s * (step_s + 2.0 * std::max(damping_s, 0.0)));
 }
 
 // Bending: one hinge per interior edge; k = 2 C D |e|^2 / (A1 + A2) from the rest geometry.

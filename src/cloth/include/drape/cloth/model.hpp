@@ -136,6 +136,11 @@ class ClothModel {
   void buildEdges(const mesh::Topology& topology);
   void buildKernelData();
   void applyMassScaling(const mesh::TriMesh& mesh, const MassScaling& scaling);
+  /// Masses from `base`: triangles scaled for a membrane step of membraneTarget_s, vertices
+  /// topped up for a bending step of bendingTarget_s.
+  void scaleMassesFor(const mesh::TriMesh& mesh, const std::vector<double>& base, double membraneTarget_s,
+                      double bendingTarget_s);
+  void holdDampedStep(const mesh::TriMesh& mesh, const std::vector<double>& base, double step_s);
   void updateInverseMasses();
   [[nodiscard]] std::vector<double> bendingRowSums(const mesh::TriMesh& mesh) const;
   [[nodiscard]] double estimateBendingOmega(const mesh::TriMesh& mesh) const;
@@ -172,6 +177,8 @@ class ClothModel {
 inline constexpr double kDampedStepMargin = 0.9;
 /// The longest stable step with damping `damping_s` (infinite for omega = 0).
 [[nodiscard]] double dampedStableStep_s(double omega_rad_s, double damping_s);
+/// The undamped step with the bound of `step_s` at damping `damping_s`: sqrt(dt (dt + 2 beta)).
+[[nodiscard]] double undampedEquivalentStep_s(double step_s, double damping_s);
 /// The most damping stable at `step_s` (negative when the step is too long even undamped).
 [[nodiscard]] double largestStableDamping_s(double omega_rad_s, double step_s);
 

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -423,15 +424,37 @@ SubstepChoice fewestStableSubsteps(const mesh::TriMesh& mesh, const mesh::Topolo
     throw Error(fmt::format("garment '{}': no substep count up to {} is stable at {:g} frames/s", mesh.name, kMost,
                             frameRate_hz));
   const int none = std::max(least, static_cast<int>(unscaled));  // needs no mass scaling
-  if (maxAddedFraction > 0.0) {
-    for (int n = std::max(1, least); n < none; n = std::max(n + 1, static_cast<int>(std::ceil(n * 1.05)))) {
-      // An unbounded allowance: the model reports the mass it needs instead of refusing.
-      const double step = 1.0 / (frameRate_hz * n);
-      const auto model = ClothModel::build(mesh, topology, material,
-                                           {step, std::numeric_limits<double>::infinity()});
-      const double added = model->addedMassFraction();
-      if (added <= maxAddedFraction && (!(beta > 0.0) || step <= allowedStep(*model))) return {n, added};
+  if (!(maxAddedFraction > 0.0)) return {none, 0.0};
+  // The mass a count needs, or nothing when it needs more than allowed or the damping
+  // forbids it.
+  const auto scaledAt = [&](int n) -> std::optional<double> {
+    const double step = 1.0 / (frameRate_hz * n);
+    // An unbounded allowance: the model reports the mass it needs instead of refusing.
+    const auto model = ClothModel::build(mesh, topology, material, {step, std::numeric_limits<double>::infinity()});
+    const double added = model->addedMassFraction();
+    if (added <= maxAddedFraction && (!(beta > 0.0) || step <= allowedStep(*model))) return added;
+    return std::nullopt;
+  };
+  // A ladder of 5 % rungs up to the first count that passes, then bisection between it and
+  // the rung below: more substeps never need more mass, so that is the fewest.
+  int failing = std::max(1, least) - 1;
+  for (int n = std::max(1, least); n < none; n = std::max(n + 1, static_cast<int>(std::ceil(n * 1.05)))) {
+    std::optional<double> added = scaledAt(n);
+    if (!added) {
+      failing = n;
+      continue;
     }
+    int passing = n;
+    while (passing - failing > 1) {
+      const int mid = failing + (passing - failing) / 2;
+      if (const std::optional<double> a = scaledAt(mid)) {
+        passing = mid;
+        added = a;
+      } else {
+        failing = mid;
+      }
+    }
+    return {passing, *added};
   }
   return {none, 0.0};
 }

@@ -196,7 +196,9 @@ struct SubstepChoice {
 /// The fewest substeps per frame, from `least` up, at which the garment is stable when mass
 /// scaling may add at most `maxAddedFraction` of its mass (0: no scaling: the estimated
 /// stable count). Counts below the unscaled stable count are tried on a ladder of 5 % steps
-/// (every count up to 20), each by building the model; at most 100000. With internal damping
+/// (every count up to 20), each by building the model, and the first that passes is narrowed
+/// by bisection down to the rung below (more substeps never need more mass); at most 100000.
+/// With internal damping
 /// a count must also keep dampedStableStep_s of the membrane's highest frequency (every
 /// vertex free), which mass scaling lowers. Throws drape::Error naming the garment when none
 /// is stable.

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 namespace drape::testing {
 
@@ -58,6 +59,17 @@ inline std::string runInto(const ScratchDir& scratch, const std::string& name, c
   const CliResult r = runDrape("run " + args + " --out '" + out + "'", scratch);
   EXPECT_EQ(r.code, 0) << r.err;
   return out;
+}
+
+/// The stats.json of a run's output directory (an empty object, and a test failure, when
+/// the run wrote none).
+inline nlohmann::json statsOf(const std::string& out) {
+  const std::string path = out + "/stats.json";
+  if (!std::filesystem::exists(path)) {
+    ADD_FAILURE() << path << " was not written";
+    return nlohmann::json::object();
+  }
+  return nlohmann::json::parse(slurp(path));
 }
 
 inline int lineCount(const std::string& text) {

@@ -17,7 +17,7 @@ namespace {
 using testing::CliResult;
 using testing::runDrape;
 using testing::ScratchDir;
-using testing::slurp;
+using testing::statsOf;
 
 const std::string kSource = DRAPE_SOURCE_DIR;
 
@@ -53,7 +53,7 @@ TEST(MakeScene, DressOnTheWalkingBody) {
                                      "/examples/walking_skirt/walk.bvh' --lead-in 0.2 --frames 3 --out '" + out + "'",
                                  dir);
   ASSERT_EQ(ran.code, 0) << ran.err;
-  const nlohmann::json stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  const nlohmann::json stats = statsOf(out);
   EXPECT_EQ(stats["frames"].get<int>(), 3);
   EXPECT_EQ(stats["vertex_substeps_inside_body"].get<long>(), 0);
   EXPECT_GT(stats["pairs_embedded_at_start"].get<long>(), 0) << "the dress is modelled tight on the body";

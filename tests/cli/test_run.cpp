@@ -16,7 +16,7 @@ using testing::CliResult;
 using testing::lineCount;
 using testing::runDrape;
 using testing::ScratchDir;
-using testing::slurp;
+using testing::statsOf;
 
 const std::string kDress = std::string(DRAPE_SOURCE_DIR) + "/examples/hanging_dress/dress.obj";
 const std::string kMask = std::string(DRAPE_SOURCE_DIR) + "/examples/hanging_dress/shoulders_mask.obj";
@@ -28,7 +28,7 @@ TEST(Run, AutoSubstepsTakeTheMassScalingAllowance) {
   const auto runAuto = [&](const std::string& extra, const std::string& name) {
     const std::string out = testing::runInto(
         dir, name, "--garment '" + kDress + "' --units dm --pin-mask '" + kMask + "' --substeps auto --frames 1 " + extra);
-    return nlohmann::json::parse(slurp(out + "/stats.json"));
+    return statsOf(out);
   };
   const nlohmann::json plain = runAuto("", "plain");
   const nlohmann::json scaled = runAuto("--max-added-mass 0.02", "scaled");
@@ -73,7 +73,7 @@ TEST(Run, BundledExampleWritesEverything) {
   }
   EXPECT_LT(moved, -1e-4);
 
-  const nlohmann::json stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  const nlohmann::json stats = statsOf(out);
   for (const char* key : {"frames", "substeps_per_frame", "ms_per_frame", "ms_per_stage", "energy", "max_strain",
                           "nan_detected"})
     EXPECT_TRUE(stats.contains(key)) << key;
@@ -145,7 +145,7 @@ TEST(Run, UnstableRunExits3AndKeepsWhatItWrote) {
   EXPECT_EQ(r.code, 3) << r.err;
   EXPECT_NE(r.err.find("garment 'dress': vertex"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("in frame 1"), std::string::npos) << r.err;
-  const nlohmann::json stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  const nlohmann::json stats = statsOf(out);
   EXPECT_TRUE(stats["unstable"].get<bool>());
   EXPECT_EQ(stats["frames"], 0);
   EXPECT_EQ(formats::readPc2(out + "/garment.pc2").frames.size(), 1u);

@@ -23,6 +23,7 @@ using testing::CliResult;
 using testing::runDrape;
 using testing::ScratchDir;
 using testing::slurp;
+using testing::statsOf;
 
 const std::string kSkirtDir = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt";
 
@@ -37,8 +38,8 @@ TEST(RunScene, ReducedFrequencyTestsSayWhatTheirFiguresCount) {
                                 "/walk.bvh' --lead-in 0.2 --frames 15 --collision-every 3 " + extra);
   };
   const std::string tested = run("tested", ""), every = run("every", "--count-every-substep");
-  const nlohmann::json a = nlohmann::json::parse(slurp(tested + "/stats.json"));
-  const nlohmann::json b = nlohmann::json::parse(slurp(every + "/stats.json"));
+  const nlohmann::json a = statsOf(tested);
+  const nlohmann::json b = statsOf(every);
   EXPECT_EQ(a["collision_every"], 3);
   EXPECT_EQ(a["penetration_counted_on"], "tested substeps");
   EXPECT_EQ(b["penetration_counted_on"], "every substep");
@@ -49,12 +50,12 @@ TEST(RunScene, ReducedFrequencyTestsSayWhatTheirFiguresCount) {
   EXPECT_EQ(b["vertex_substeps_inside_body"], 0);
   // Sliding tests answered by contact planes unless asked to read the field on each.
   const nlohmann::json exact =
-      nlohmann::json::parse(slurp(run("exact", "--exact-sliding") + "/stats.json"));
+      statsOf(run("exact", "--exact-sliding"));
   EXPECT_GT(a["sliding_reads_from_contact_planes"].get<double>(), 0.5);
   EXPECT_EQ(exact["sliding_reads_from_contact_planes"], 0.0);
   EXPECT_EQ(exact["vertex_substeps_inside_body"], 0);
   // Points pinched at a test held until the next, unless asked to move freely.
-  const nlohmann::json free = nlohmann::json::parse(slurp(run("free", "--free-pinches") + "/stats.json"));
+  const nlohmann::json free = statsOf(run("free", "--free-pinches"));
   ASSERT_TRUE(a.contains("vertex_substeps_held_in_pinches"));
   EXPECT_EQ(a["vertex_substeps_held_in_pinches"], b["vertex_substeps_held_in_pinches"]);
   EXPECT_EQ(free["vertex_substeps_held_in_pinches"], 0);
@@ -73,7 +74,7 @@ TEST(RunScene, OptionsGivenOverrideTheScenesSettings) {
   const auto stats = [&](const std::string& name, const std::string& extra) {
     const std::string out = testing::runInto(
         dir, name, "'" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir + "/walk.bvh' --lead-in 0.1 --frames 1 " + extra);
-    return nlohmann::json::parse(slurp(out + "/stats.json"));
+    return statsOf(out);
   };
   const nlohmann::json scene = stats("scene", "");
   const nlohmann::json given = stats("given", "--density 600 --substeps 40");
@@ -107,7 +108,7 @@ TEST(RunScene, WalkingSkirtWritesEverything) {
   ASSERT_EQ(shin.frames.size(), 16u);
   EXPECT_GT((shin.frames.back()[0] - shin.frames.front()[0]).norm(), 0.02);
 
-  const nlohmann::json stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  const nlohmann::json stats = statsOf(out);
   for (const char* key : {"collision_time_share", "mean_collision_path_voxels", "points_per_state",
                           "vertex_substeps_below_T1", "vertex_substeps_below_T0", "vertex_substeps_inside_body",
                           "max_penetration_m", "distance_fields"})
@@ -150,11 +151,11 @@ TEST(RunScene, OffsetsGivenOverrideTheScenesAndAreChecked) {
   ScratchDir dir("run-offsets");
   const std::string scene = "'" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir + "/walk.bvh' --frames 2 ";
   const std::string out = testing::runInto(dir, "out", scene + "--offsets 0.004,0.008,0.012,0.024");
-  const nlohmann::json stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  const nlohmann::json stats = statsOf(out);
   EXPECT_EQ(stats["garments"][0]["offsets_m"], nlohmann::json({0.004, 0.008, 0.012, 0.024}));
   // Without the option, the scene's (5, 10, 15 and 30 mm, VRML97 single-precision floats).
   const std::string plain = testing::runInto(dir, "plain", scene);
-  const nlohmann::json scenes = nlohmann::json::parse(slurp(plain + "/stats.json"))["garments"][0]["offsets_m"];
+  const nlohmann::json scenes = statsOf(plain)["garments"][0]["offsets_m"];
   ASSERT_EQ(scenes.size(), 4u);
   for (std::size_t k = 0; k < 4; ++k) EXPECT_NEAR(scenes[k].get<double>(), 0.005 * double(k == 3 ? 6 : k + 1), 1e-8);
   const CliResult bad = runDrape("run " + scene + "--offsets 0.004,0.003,0.012,0.024 --out '" + (dir / "bad") + "'", dir);

@@ -14,7 +14,7 @@ namespace {
 using testing::CliResult;
 using testing::runDrape;
 using testing::ScratchDir;
-using testing::slurp;
+using testing::statsOf;
 
 const std::string kSource = DRAPE_SOURCE_DIR;
 const std::string kDressScene = kSource + "/examples/walking_dress/scene.wrl";
@@ -26,7 +26,7 @@ TEST(WalkingDress, WalksStablyWithFewPointsInsideTheBody) {
                                    "/examples/walking_skirt/walk.bvh' --frames 45 --every 45 --out '" + out + "'",
                                dir);
   ASSERT_EQ(r.code, 0) << r.err;
-  const nlohmann::json stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  const nlohmann::json stats = statsOf(out);
   EXPECT_EQ(stats["frames"].get<int>(), 45);
   EXPECT_FALSE(stats["unstable"].get<bool>());
   EXPECT_EQ(stats["substeps_per_frame"].get<int>(), 155);
@@ -77,7 +77,7 @@ TEST(WalkingDress, RunsTheDazStyleWalkToTheEnd) {
   ScratchDir dir("walking-dress-daz");
   const std::string out = testing::runInto(dir, "out", "'" + kDressScene + "' --motion '" + kSource +
                                                          "/data/mocap/cmu_02_02_walk_dazstyle.bvh' --every 1000");
-  const nlohmann::json stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  const nlohmann::json stats = statsOf(out);
   EXPECT_FALSE(stats["unstable"].get<bool>());
   EXPECT_GT(stats["frames"].get<int>(), 100);
   EXPECT_GT(stats["vertex_tests_pinched"].get<long>(), 0);
@@ -93,7 +93,7 @@ TEST(WalkingDress, StaysStableWithMoreSubsteps) {
   const std::string out = testing::runInto(dir, "out", "'" + kDressScene + "' --motion '" + kSource +
                                                          "/examples/walking_skirt/walk.bvh' --substeps 300 --damping 0 "
                                                          "--frames 8 --every 8");
-  EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["frames"].get<int>(), 8);
+  EXPECT_EQ(statsOf(out)["frames"].get<int>(), 8);
 }
 
 }  // namespace

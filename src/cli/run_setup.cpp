@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <array>
 #include <fstream>
+#include <span>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -233,8 +234,15 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
   mo.jointMapPath = jointMap;
   mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
   motion::ClipLoadReport report;
+  motion::JointMap map;
   setup.character->animation = std::make_shared<const motion::AvatarAnimation>(
-      motion::loadAnimation(*setup.character->avatar, motionPath, mo, &report));
+      motion::loadAnimation(*setup.character->avatar, motionPath, mo, &report, &map));
+  // What was read and how it drives the avatar: a wrong unit or a poor map shows here first.
+  const std::span<const int> driving = setup.character->animation->drivingJoint();
+  const auto driven = std::count_if(driving.begin(), driving.end(), [](int j) { return j >= 0; });
+  spdlog::info("{}: {} frames at {:g} Hz in {}{}; joint map '{}' drives {} of the avatar's {} joints", motionPath,
+               report.sourceFrames, report.sourceRate, report.units.name, report.unitsOverridden ? " (given)" : "",
+               map.name, driven, driving.size());
   // Frames the motion file holds but drape does not play: say so, the timing shifts.
   if (report.referenceTPoseSkipped) spdlog::info("{}: {}", motionPath, report.referenceTPose());
   if (report.restUnfoldFramesSkipped > 0) spdlog::info("{}: {}", motionPath, report.restUnfoldSkipped());

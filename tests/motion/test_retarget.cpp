@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "drape/core/error.hpp"
@@ -120,6 +121,81 @@ TEST(Retarget, JointSeparationWithinAFrameIsSmall) {
 TEST(Retarget, CmuWalkDelfem2OnMakeHuman) { checkWalk("cmu_walk_delfem2.bvh"); }
 TEST(Retarget, CmuWalk12_03OnMakeHuman) { checkWalk("cmu_12_03_walk.bvh"); }
 TEST(Retarget, DazStyleWalkOnMakeHuman) { checkWalk("cmu_02_02_walk_dazstyle.bvh"); }
+
+/// Joint positions of the motion's own skeleton at frame f (forward kinematics: offsets are
+/// in the parent's frame at rest, whose axes are the world's).
+std::vector<Vec3> motionJointPositions(const Clip& clip, std::size_t f) {
+  const Pose pose = clip.pose(f);
+  const std::size_t n = clip.skeleton.size();
+  std::vector<Quat> world(n);
+  std::vector<Vec3> at(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    const int parent = clip.skeleton.joints[j].parent;
+    if (parent < 0) {
+      world[j] = pose.local[j];
+      at[j] = pose.rootTranslation;
+      continue;
+    }
+    const auto p = static_cast<std::size_t>(parent);
+    world[j] = world[p] * pose.local[j];
+    at[j] = at[p] + world[p] * clip.skeleton.joints[j].offset;
+  }
+  return at;
+}
+
+/// The largest angle, over the clip's frames and the limb bones named (motion joint and its
+/// child, as the map names them), between a bone's direction in the motion and the same
+/// bone's direction on the retargeted avatar, in degrees.
+double largestLimbAngle_deg(const scene::Avatar& avatar, const Clip& clip, const JointMap& map,
+                            const AvatarAnimation& anim, const std::vector<std::pair<std::string, std::string>>& bones) {
+  double largest = 0.0;
+  for (std::size_t f = 0; f < anim.frameCount(); ++f) {
+    const std::vector<Vec3> motion = motionJointPositions(clip, f);
+    const auto world = anim.frame(f);
+    for (const auto& [from, to] : bones) {
+      const Vec3 m = motion[static_cast<std::size_t>(clip.skeleton.find(from))] -
+                     motion[static_cast<std::size_t>(clip.skeleton.find(to))];
+      const auto avatarJoint = [&](const std::string& motionJoint) {
+        return world[static_cast<std::size_t>(avatar.findJoint(*map.avatarJointFor(motionJoint)))].translation;
+      };
+      const Vec3 a = avatarJoint(from) - avatarJoint(to);
+      const double cosine = std::clamp(m.normalized().dot(a.normalized()), -1.0, 1.0);
+      largest = std::max(largest, std::acos(cosine) * 180.0 / 3.14159265358979323846);
+    }
+  }
+  return largest;
+}
+
+// The CMU originals (Acclaim ASF/AMC, a soccer kick) drive the MakeHuman body through the
+// shipped 'acclaim' map: every bone is paired, and each limb on the avatar points where the
+// motion's does on every frame (a wrong pairing, such as left for right or thigh for shin,
+// puts them tens of degrees apart in a kick).
+TEST(Retarget, AcclaimKickOnMakeHumanFollowsTheMotionsLimbs) {
+  const scene::Avatar& avatar = makeHuman();
+  const Clip clip = loadClip(std::string(DRAPE_DATA_DIR) + "/mocap/cmu_11_01.amc");
+  const JointMap map = chooseJointMap(shippedMaps(), clip.skeleton, avatar);
+  EXPECT_EQ(map.name, "acclaim");
+  for (const SkeletonJoint& j : clip.skeleton.joints) {
+    const std::string* paired = map.avatarJointFor(j.name);
+    ASSERT_NE(paired, nullptr) << j.name;
+    EXPECT_GE(avatar.findJoint(*paired), 0) << j.name;
+  }
+  const AvatarAnimation anim = AvatarAnimation::build(avatar, clip, map);
+  ASSERT_EQ(anim.frameCount(), clip.frameCount());
+  const std::vector<std::pair<std::string, std::string>> limbs = {
+      {"lfemur", "ltibia"},   {"ltibia", "lfoot"},   {"rfemur", "rtibia"},   {"rtibia", "rfoot"},
+      {"lhumerus", "lradius"}, {"lradius", "lwrist"}, {"rhumerus", "rradius"}, {"rradius", "rwrist"}};
+  const double angle = largestLimbAngle_deg(avatar, clip, map, anim, limbs);
+  std::printf("cmu_11_01.amc: largest limb angle between motion and avatar %.2f degrees\n", angle);
+  EXPECT_LT(angle, 5.0);
+  // The check is sharp: the same motion with the legs' maps swapped left for right fails it.
+  JointMap swapped = map;
+  for (JointMapEntry& e : swapped.entries) {
+    if (e.motionJoint == "lfemur" || e.motionJoint == "ltibia" || e.motionJoint == "lfoot") e.motionJoint[0] = 'r';
+    else if (e.motionJoint == "rfemur" || e.motionJoint == "rtibia" || e.motionJoint == "rfoot") e.motionJoint[0] = 'l';
+  }
+  EXPECT_GT(largestLimbAngle_deg(avatar, clip, map, AvatarAnimation::build(avatar, clip, swapped), limbs), 20.0);
+}
 
 TEST(Retarget, LoadAnimationWithTheShippedMaps) {
   MotionOptions options;

@@ -160,10 +160,15 @@ AvatarAnimation AvatarAnimation::build(const scene::Avatar& avatar, const Clip& 
   anim.rate_ = clip.rate;
   anim.start_ = clip.start;
   anim.driving_ = drivingJoints(avatar, clip.skeleton, map);
-  for (std::size_t a = 0; a < n; ++a)
-    if (avatar.joints[a].parent < 0 && anim.driving_[a] < 0)
-      throw Error(fmt::format("{}: no joint of the motion {} drives the avatar's root joint '{}' (joint map '{}')",
-                              avatar.source.empty() ? avatar.name : avatar.source, clip.source, avatar.joints[a].name, map.name));
+  for (std::size_t a = 0; a < n; ++a) {
+    if (avatar.joints[a].parent >= 0 || anim.driving_[a] >= 0) continue;
+    const auto paired = std::count_if(anim.driving_.begin(), anim.driving_.end(), [](int j) { return j >= 0; });
+    throw Error(fmt::format("{}: no joint of the motion {} drives the avatar's root joint '{}' (joint map '{}' pairs "
+                            "{} of the motion's {} joints with the avatar's); give a joint map naming the motion's "
+                            "joints (--joint-map FILE, docs/MOTION.md)",
+                            avatar.source.empty() ? avatar.name : avatar.source, clip.source, avatar.joints[a].name,
+                            map.name, paired, clip.skeleton.size()));
+  }
 
   const std::vector<Vec3> motionRest = clip.skeleton.restPositions();
   const std::vector<Quat> correction = restCorrections(avatar, anim.driving_, motionRest, clip.skeleton);

@@ -197,6 +197,22 @@ TEST(Retarget, AcclaimKickOnMakeHumanFollowsTheMotionsLimbs) {
   EXPECT_GT(largestLimbAngle_deg(avatar, clip, map, AvatarAnimation::build(avatar, clip, swapped), limbs), 20.0);
 }
 
+// A map that leaves the avatar's root undriven is refused with how much it pairs and the
+// way out, not left to move a body that stands still.
+TEST(Retarget, AMapThatMissesTheRootSaysHowMuchItPairs) {
+  const Clip clip = loadClip(std::string(DRAPE_DATA_DIR) + "/mocap/cmu_11_01.amc");
+  try {
+    (void)AvatarAnimation::build(makeHuman(), clip, JointMap::identity(clip.skeleton));
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("drives the avatar's root joint 'Hips' (joint map 'same names' pairs 0 of "
+                                         "the motion's 31 joints with the avatar's); give a joint map naming the "
+                                         "motion's joints (--joint-map FILE"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Retarget, LoadAnimationWithTheShippedMaps) {
   MotionOptions options;
   options.jointMapDirectory = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";

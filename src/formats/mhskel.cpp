@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drape/core/error.hpp"
+#include "drape/formats/json_text.hpp"
 #include "motion_text.hpp"
 
 namespace drape::formats {
@@ -15,28 +16,6 @@ namespace {
 using nlohmann::json;
 
 constexpr std::size_t kMaxVertexIndex = 100'000'000;
-
-json parseJson(std::string_view text, const std::string& name) {
-  try {
-    return json::parse(text.begin(), text.end());
-  } catch (const json::parse_error& e) {
-    SourcePos pos{name, 1, 1};
-    const std::size_t at = e.byte > 0 ? std::min<std::size_t>(e.byte - 1, text.size()) : 0;
-    for (std::size_t i = 0; i < at; ++i) {
-      if (text[i] == '\n') {
-        ++pos.line;
-        pos.column = 1;
-      } else {
-        ++pos.column;
-      }
-    }
-    std::string what = e.what();
-    if (const auto colon = what.find(": "); colon != std::string::npos) what = what.substr(colon + 2);
-    throw Error::at(pos, what);
-  } catch (const json::exception& e) {  // out_of_range: a number too large for a double
-    throw Error(fmt::format("{}: bad JSON ({})", name, e.what()));
-  }
-}
 
 std::string stringOr(const json& j, const char* key, const std::string& fallback) {
   const auto it = j.find(key);
@@ -70,7 +49,7 @@ int MhSkeleton::find(std::string_view bone) const {
 }
 
 MhSkeleton parseMhskel(std::string_view text, const std::string& name) {
-  const json doc = parseJson(text, name);
+  const json doc = parseJsonText(text, name);
   if (!doc.is_object() || !doc.contains("bones") || !doc["bones"].is_object() || !doc.contains("joints") ||
       !doc["joints"].is_object())
     throw Error(fmt::format("{}: expected a MakeHuman skeleton (a JSON object with \"bones\" and \"joints\")", name));
@@ -128,7 +107,7 @@ MhSkeleton parseMhskel(std::string_view text, const std::string& name) {
 MhSkeleton readMhskel(const std::string& path) { return parseMhskel(detail::readWholeFile(path, 64u << 20), path); }
 
 MhWeights parseMhw(std::string_view text, const std::string& name) {
-  const json doc = parseJson(text, name);
+  const json doc = parseJsonText(text, name);
   if (!doc.is_object() || !doc.contains("weights") || !doc["weights"].is_object())
     throw Error(fmt::format("{}: expected MakeHuman weights (a JSON object with \"weights\")", name));
   MhWeights out;
@@ -151,7 +130,7 @@ MhWeights readMhw(const std::string& path) { return parseMhw(detail::readWholeFi
 
 std::map<std::string, std::string> readMakeHumanWeightFold(const std::string& path, bool neckFix) {
   const std::string text = detail::readWholeFile(path, 64u << 20);
-  const json doc = parseJson(text, path);
+  const json doc = parseJsonText(text, path);
   const char* key = neckFix ? "default_bone_weights_to_bvh_neck_fix" : "default_bone_weights_to_bvh";
   if (!doc.is_object() || !doc.contains(key) || !doc[key].is_object())
     throw Error(fmt::format("{}: expected an object \"{}\" of default bone -> BVH joint", path, key));

@@ -1,26 +1,54 @@
 #include "drape/formats/run_manifest.hpp"
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "drape/core/error.hpp"
+#include "drape/formats/json_text.hpp"
 
 namespace drape::formats {
 namespace {
 
 constexpr int kVersion = 1;
 
-template <typename T>
-T required(const nlohmann::json& j, const char* key, const std::string& file) {
-  if (!j.contains(key)) throw Error(fmt::format("{}: missing key '{}'", file, key));
-  try {
-    return j.at(key).get<T>();
-  } catch (const nlohmann::json::exception&) {
-    throw Error(fmt::format("{}: key '{}' has the wrong type", file, key));
-  }
+// The value under `key`; "missing key" when `j` is not an object or lacks it.
+const nlohmann::json& requiredKey(const nlohmann::json& j, const char* key, const std::string& file) {
+  if (!j.is_object() || !j.contains(key)) throw Error(fmt::format("{}: missing key '{}'", file, key));
+  return j.at(key);
+}
+
+[[noreturn]] void wrongType(const char* key, const std::string& file) {
+  throw Error(fmt::format("{}: key '{}' has the wrong type", file, key));
+}
+
+std::string requiredString(const nlohmann::json& j, const char* key, const std::string& file) {
+  const nlohmann::json& v = requiredKey(j, key, file);
+  if (!v.is_string()) wrongType(key, file);
+  return v.get<std::string>();
+}
+
+// Whole numbers only: nlohmann would convert 2.5 or 1e300 to an integer unchecked (the
+// latter undefined behaviour).
+long long wholeNumber(const nlohmann::json& v, const char* key, const std::string& file) {
+  if (!v.is_number_integer()) wrongType(key, file);
+  if (v.is_number_unsigned() && v.get<std::uint64_t>() > std::uint64_t(std::numeric_limits<long long>::max())) wrongType(key, file);
+  return v.get<long long>();
+}
+
+long long requiredWhole(const nlohmann::json& j, const char* key, const std::string& file) {
+  return wholeNumber(requiredKey(j, key, file), key, file);
+}
+
+double requiredNumber(const nlohmann::json& j, const char* key, const std::string& file) {
+  const nlohmann::json& v = requiredKey(j, key, file);
+  if (!v.is_number()) wrongType(key, file);
+  return v.get<double>();
 }
 
 }  // namespace
@@ -42,33 +70,40 @@ void writeRunManifest(const std::string& directory, const RunManifest& manifest)
   if (!out) throw Error(fmt::format("{}: cannot be written", path));
 }
 
-RunManifest readRunManifest(const std::string& directory) {
-  const std::string path = (std::filesystem::path(directory) / "manifest.json").string();
-  std::ifstream in(path);
-  if (!in) throw Error(fmt::format("{}: not a drape run directory (no manifest.json)", directory));
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw Error(fmt::format("{}: not valid JSON (byte {})", path, e.byte));
-  }
-  if (!j.is_object() || j.value("format", "") != "drape-run") throw Error(fmt::format("{}: not a drape run manifest", path));
-  const int version = required<int>(j, "version", path);
-  if (version != kVersion) throw Error(fmt::format("{}: manifest version {} (this drape reads {})", path, version, kVersion));
+RunManifest parseRunManifest(std::string_view text, const std::string& name) {
+  const nlohmann::json j = parseJsonText(text, name);
+  const auto format = j.is_object() ? j.find("format") : j.end();
+  if (format == j.end() || !format->is_string() || format->get<std::string>() != "drape-run")
+    throw Error(fmt::format("{}: not a drape run manifest", name));
+  const long long version = requiredWhole(j, "version", name);
+  if (version != kVersion) throw Error(fmt::format("{}: manifest version {} (this drape reads {})", name, version, kVersion));
   RunManifest m;
-  m.frameRate = required<double>(j, "frame_rate", path);
-  m.frames = required<long>(j, "frames", path);
-  m.startFrame = j.value("start_frame", 0L);
-  if (!(m.frameRate > 0) || m.frames < 0) throw Error(fmt::format("{}: frame_rate must be > 0 and frames >= 0", path));
-  for (const auto& mesh : required<nlohmann::json>(j, "meshes", path)) {
+  m.frameRate = requiredNumber(j, "frame_rate", name);
+  const long long frames = requiredWhole(j, "frames", name);
+  const long long startFrame = j.contains("start_frame") ? wholeNumber(j["start_frame"], "start_frame", name) : 0;
+  if (!(m.frameRate > 0) || frames < 0) throw Error(fmt::format("{}: frame_rate must be > 0 and frames >= 0", name));
+  m.frames = static_cast<long>(frames);
+  m.startFrame = static_cast<long>(startFrame);
+  const nlohmann::json& meshes = requiredKey(j, "meshes", name);
+  if (!meshes.is_array()) wrongType("meshes", name);
+  for (const nlohmann::json& mesh : meshes) {
     RunMesh r;
-    r.name = required<std::string>(mesh, "name", path);
-    r.role = required<std::string>(mesh, "role", path);
-    r.topology = required<std::string>(mesh, "topology", path);
-    r.cache = required<std::string>(mesh, "cache", path);
+    r.name = requiredString(mesh, "name", name);
+    r.role = requiredString(mesh, "role", name);
+    r.topology = requiredString(mesh, "topology", name);
+    r.cache = requiredString(mesh, "cache", name);
     m.meshes.push_back(std::move(r));
   }
   return m;
+}
+
+RunManifest readRunManifest(const std::string& directory) {
+  const std::string path = (std::filesystem::path(directory) / "manifest.json").string();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(fmt::format("{}: not a drape run directory (no manifest.json)", directory));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parseRunManifest(text.str(), path);
 }
 
 }  // namespace drape::formats

@@ -3,37 +3,61 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "drape/core/error.hpp"
+#include "drape/formats/json_text.hpp"
 
 namespace drape::motion {
 namespace {
 
-// 1-based line and column of byte offset `at` in `text`.
-SourcePos positionOf(std::string_view text, std::size_t at, const std::string& name) {
-  SourcePos pos{name, 1, 1};
-  for (std::size_t i = 0; i < std::min(at, text.size()); ++i) {
-    if (text[i] == '\n') {
-      ++pos.line;
-      pos.column = 1;
-    } else {
-      ++pos.column;
-    }
-  }
-  return pos;
+// Index just past the string token that starts at text[open] (a '"'), escapes skipped.
+std::size_t endOfString(std::string_view text, std::size_t open) {
+  std::size_t i = open + 1;
+  while (i < text.size() && text[i] != '"') i += text[i] == '\\' ? 2 : 1;
+  return std::min(i + 1, text.size());
 }
 
-// nlohmann's DOM keeps no positions, so an entry's line is found by searching for its
-// quoted key after the "joints" key (names are unique keys of one object).
-int lineOfKey(std::string_view text, const std::string& key) {
-  const std::size_t joints = text.find("\"joints\"");
-  const std::size_t at = text.find("\"" + key + "\"", joints == std::string_view::npos ? 0 : joints);
-  if (at == std::string_view::npos) return 0;
-  return static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n')) + 1;
+// nlohmann's DOM keeps no positions, so the line of each key of the top-level "joints"
+// object is found in one pass over the text (already parsed, so valid JSON: strings hold
+// no raw newline). A search per key was quadratic: 6,500 keys in 64 KB took seconds.
+// A key written twice keeps its first line.
+std::map<std::string, int> jointKeyLines(std::string_view text) {
+  std::map<std::string, int> lines;
+  int line = 1;
+  int depth = 0;
+  bool inJoints = false;  // inside the top-level "joints" object
+  std::string topKey;     // the last key of the top-level object
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') {
+      ++line;
+    } else if (c == '{' || c == '[') {
+      if (++depth == 2) inJoints = c == '{' && topKey == "joints";
+    } else if (c == '}' || c == ']') {
+      if (depth == 2) inJoints = false;
+      --depth;
+    } else if (c == '"') {
+      const std::size_t end = endOfString(text, i);
+      const std::size_t next = text.find_first_not_of(" \t\r\n", end);
+      const bool isKey = next != std::string_view::npos && text[next] == ':';
+      const std::string_view token = text.substr(i, end - i);
+      i = end - 1;
+      if (isKey && (depth == 1 || (depth == 2 && inJoints))) {
+        // The key as nlohmann decoded it (escapes resolved); no exception on the off chance
+        // the token is not one string: that key just has no line.
+        const nlohmann::json key = nlohmann::json::parse(token, nullptr, false);
+        if (!key.is_string()) continue;
+        if (depth == 1) topKey = key.get<std::string>();
+        else lines.emplace(key.get<std::string>(), line);
+      }
+    }
+  }
+  return lines;
 }
 
 }  // namespace
@@ -52,25 +76,17 @@ JointMap JointMap::identity(const Skeleton& skeleton) {
 }
 
 JointMap parseJointMap(std::string_view json, const std::string& name) {
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(json.begin(), json.end());
-  } catch (const nlohmann::json::parse_error& e) {
-    std::string what = e.what();
-    if (const auto colon = what.find(": "); colon != std::string::npos) what = what.substr(colon + 2);
-    throw Error::at(positionOf(json, e.byte > 0 ? e.byte - 1 : 0, name), what);
-  } catch (const nlohmann::json::exception& e) {  // out_of_range: a number too large for a double
-    throw Error(fmt::format("{}: bad JSON ({})", name, e.what()));
-  }
+  const nlohmann::json doc = formats::parseJsonText(json, name);
   if (!doc.is_object() || !doc.contains("joints") || !doc["joints"].is_object())
     throw Error(fmt::format("{}: expected a JSON object with a \"joints\" object of motion joint -> avatar joint", name));
   JointMap map;
   map.source = name;
   map.name = doc.contains("name") && doc["name"].is_string() ? doc["name"].get<std::string>()
                                                              : std::filesystem::path(name).stem().string();
-  std::string text(json);
+  const std::map<std::string, int> lines = jointKeyLines(json);
   for (const auto& [motionJoint, avatarJoint] : doc["joints"].items()) {
-    const int line = lineOfKey(text, motionJoint);
+    const auto found = lines.find(motionJoint);
+    const int line = found == lines.end() ? 0 : found->second;
     if (!avatarJoint.is_string())
       throw Error::at({name, line, 0}, fmt::format("the avatar joint for '{}' must be a string", motionJoint));
     map.entries.push_back({motionJoint, avatarJoint.get<std::string>(), line});

@@ -5,6 +5,7 @@
 
 #include "drape/core/error.hpp"
 #include "drape/formats/run_manifest.hpp"
+#include "drape/testing/errors.hpp"
 
 namespace drape::formats {
 namespace {
@@ -44,6 +45,29 @@ TEST(RunManifest, ClearErrors) {
   }
   std::ofstream(dir + "/manifest.json") << "{not json";
   EXPECT_THROW((void)readRunManifest(dir), Error);
+}
+
+// Each case is a run directory of its own: tests/data/bad/cache/<case>/manifest.json.
+TEST(RunManifest, MalformedCorpus) {
+  struct BadCase {
+    const char* directory;
+    const char* expected;  ///< message after "DIR/manifest.json:"
+  };
+  const BadCase cases[] = {
+      // nlohmann's out_of_range used to escape as a non-drape exception.
+      {"run_number_overflow", "2:16: expected a finite number, found '1e999'"},
+      // json::value() threw type_error on a non-string "format".
+      {"run_format_not_string", " not a drape run manifest"},
+      // 1e300 converted to long was undefined behaviour.
+      {"run_frames_not_whole", " key 'frames' has the wrong type"},
+      {"run_meshes_not_list", " key 'meshes' has the wrong type"},
+      // Copying 600 nested arrays recursed once per level.
+      {"run_deep_nesting", "2:523: nesting deeper than 512 levels"},
+  };
+  for (const BadCase& c : cases) {
+    const std::string dir = std::string(DRAPE_TEST_DATA_DIR) + "/bad/cache/" + c.directory;
+    EXPECT_EQ(drape::testing::errorOf([&] { (void)readRunManifest(dir); }), dir + "/manifest.json:" + c.expected) << c.directory;
+  }
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 //                "cache": "garment.pc2"}, ...]}
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace drape::formats {
@@ -30,6 +31,10 @@ struct RunManifest {
 
 /// Writes DIR/manifest.json.
 void writeRunManifest(const std::string& directory, const RunManifest& manifest);
+/// Parses manifest text read from `name` (used in messages); throws drape::Error
+/// "name:line:column: ..." on bad JSON, "name: ..." naming the key on anything missing or
+/// of the wrong type.
+[[nodiscard]] RunManifest parseRunManifest(std::string_view text, const std::string& name);
 /// Reads DIR/manifest.json; throws drape::Error naming the file and the key on anything
 /// missing or malformed (including a file that is not a drape run directory).
 [[nodiscard]] RunManifest readRunManifest(const std::string& directory);

@@ -1,0 +1,21 @@
+#pragma once
+// JSON text as drape's JSON readers (MakeHuman rigs, joint maps, run manifests) take it:
+// nlohmann_json underneath, with every failure turned into "name:line:column: what".
+
+#include <string>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+namespace drape::formats {
+
+/// Deepest nesting of arrays and objects accepted. nlohmann parses without recursion but
+/// copies and dumps recursively, so a hostile file of 30,000 '[' would overflow the stack.
+inline constexpr int kMaxJsonDepth = 512;
+
+/// Parses `text` (read from `name`, used in messages). Throws drape::Error
+/// "name:line:column: what" for a syntax error, a number too large for a double (1e999)
+/// or nesting deeper than kMaxJsonDepth.
+[[nodiscard]] nlohmann::json parseJsonText(std::string_view text, const std::string& name);
+
+}  // namespace drape::formats

@@ -1,0 +1,98 @@
+#include "drape/formats/json_text.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "drape/core/error.hpp"
+
+namespace drape::formats {
+namespace {
+
+using nlohmann::json;
+
+// 1-based line and column of byte offset `at` in `text`.
+SourcePos positionOf(std::string_view text, std::size_t at, const std::string& name) {
+  SourcePos pos{name, 1, 1};
+  for (std::size_t i = 0; i < std::min(at, text.size()); ++i) {
+    if (text[i] == '\n') {
+      ++pos.line;
+      pos.column = 1;
+    } else {
+      ++pos.column;
+    }
+  }
+  return pos;
+}
+
+// nlohmann's message without its "[json.exception.parse_error.101] parse error at ...: " prefix.
+std::string messageOf(const json::parse_error& e) {
+  std::string what = e.what();
+  if (const auto colon = what.find(": "); colon != std::string::npos) what = what.substr(colon + 2);
+  return what;
+}
+
+// Rejects nesting deeper than kMaxJsonDepth before nlohmann sees the text: brackets inside
+// strings do not count (a backslash escapes the next character there).
+void checkDepth(std::string_view text, const std::string& name) {
+  int depth = 0;
+  bool inString = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (inString) {
+      if (c == '\\') ++i;
+      else if (c == '"') inString = false;
+    } else if (c == '"') {
+      inString = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth)
+        throw Error::at(positionOf(text, i, name), fmt::format("nesting deeper than {} levels", kMaxJsonDepth));
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+}
+
+// Where nlohmann gave up: it reports a number too large for a double (out_of_range 406)
+// without the position a parse_error carries, so a second, SAX-only pass records where
+// the token that stopped it began.
+class FailureLocator : public nlohmann::json_sax<json> {
+ public:
+  std::size_t start = 0;
+  std::string token;
+
+  bool null() override { return true; }
+  bool boolean(bool) override { return true; }
+  bool number_integer(number_integer_t) override { return true; }
+  bool number_unsigned(number_unsigned_t) override { return true; }
+  bool number_float(number_float_t, const string_t&) override { return true; }
+  bool string(string_t&) override { return true; }
+  bool binary(binary_t&) override { return true; }
+  bool start_object(std::size_t) override { return true; }
+  bool key(string_t&) override { return true; }
+  bool end_object() override { return true; }
+  bool start_array(std::size_t) override { return true; }
+  bool end_array() override { return true; }
+  bool parse_error(std::size_t position, const std::string& lastToken, const nlohmann::detail::exception&) override {
+    start = position >= lastToken.size() ? position - lastToken.size() : 0;
+    token = lastToken;
+    return false;
+  }
+};
+
+}  // namespace
+
+nlohmann::json parseJsonText(std::string_view text, const std::string& name) {
+  checkDepth(text, name);
+  try {
+    return json::parse(text.begin(), text.end());
+  } catch (const json::parse_error& e) {
+    throw Error::at(positionOf(text, e.byte > 0 ? e.byte - 1 : 0, name), messageOf(e));
+  } catch (const json::exception&) {  // out_of_range: a number too large for a double
+    FailureLocator locator;
+    (void)json::sax_parse(text.begin(), text.end(), &locator);
+    throw Error::at(positionOf(text, locator.start, name), fmt::format("expected a finite number, found '{}'", locator.token.substr(0, 40)));
+  }
+}
+
+}  // namespace drape::formats

@@ -3,9 +3,11 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -32,32 +34,101 @@ bool wanted(const std::string& shapeName, const std::vector<std::string>& groups
   return groups.empty() || std::find(groups.begin(), groups.end(), shapeName) != groups.end();
 }
 
-}  // namespace
+/// A word of a line and its 1-based column.
+struct Word {
+  std::string_view text;
+  int column = 0;
+};
 
-mesh::TriMesh readObj(const std::string& path, const ObjReadOptions& options) {
-  requireReadableFile(path);
-  tinyobj::ObjReaderConfig config;
-  config.triangulate = false;  // fans below keep the polygon's vertex order
-  config.vertex_color = false;
-  tinyobj::ObjReader reader;
-  if (!reader.ParseFromFile(path, config)) {
-    const std::string err = firstLine(reader.Error());
-    throw Error(fmt::format("{}: {}", path, err.empty() ? "not a readable OBJ file" : err));
+// The first `count` words of `line` (fewer if it has fewer), stopping at a '#' comment.
+std::vector<Word> leadingWords(std::string_view line, std::size_t count) {
+  std::vector<Word> words;
+  std::size_t i = 0;
+  while (words.size() < count) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
+    if (i == line.size() || line[i] == '#') break;
+    const std::size_t start = i;
+    while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r') ++i;
+    words.push_back({line.substr(start, i - start), static_cast<int>(start) + 1});
   }
+  return words;
+}
 
-  const auto& attrib = reader.GetAttrib();
+bool isFiniteNumber(std::string_view t) {
+  if (!t.empty() && t.front() == '+') t.remove_prefix(1);
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), value);
+  return !t.empty() && ec == std::errc() && end == t.data() + t.size() && std::isfinite(value);
+}
+
+// tinyobjloader reads a coordinate it cannot parse ("nan", "abc") as 0 and one too large
+// (1e999) as infinity, and reports neither; drape checks every `v` line's x y z first so
+// that such a file is an error naming the line and column. Lines end as tinyobjloader
+// ends them: at "\n", "\r\n" or a lone "\r".
+void checkVertexLines(std::string_view text, const std::string& name) {
+  static constexpr const char* kAxes[3] = {"x", "y", "z"};
+  int lineNo = 0;
+  for (std::size_t pos = 0; pos < text.size();) {
+    const std::size_t end = std::min(text.find_first_of("\r\n", pos), text.size());
+    const std::string_view line = text.substr(pos, end - pos);
+    pos = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
+    ++lineNo;
+    const std::size_t first = line.find_first_not_of(" \t");
+    if (first == std::string_view::npos || line[first] != 'v' || first + 1 >= line.size() ||
+        (line[first + 1] != ' ' && line[first + 1] != '\t'))
+      continue;
+    const std::vector<Word> words = leadingWords(line.substr(first + 2), 3);
+    const int offset = static_cast<int>(first) + 2;
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (k == words.size()) {
+        const int column = words.empty() ? static_cast<int>(first) + 2
+                                         : offset + words.back().column + static_cast<int>(words.back().text.size());
+        throw Error::at({name, lineNo, column}, fmt::format("expected 3 coordinates (x y z) on a vertex line, found {}", k));
+      }
+      if (!isFiniteNumber(words[k].text)) {
+        throw Error::at({name, lineNo, offset + words[k].column},
+                        fmt::format("expected a number for the vertex's {} coordinate, found '{}'", kAxes[k],
+                                    words[k].text.substr(0, 40)));
+      }
+    }
+  }
+}
+
+/// What tinyobjloader read: positions and the faces of each g/o group.
+struct TinyObj {
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+};
+
+// `materials` resolves mtllib lines (nullptr: ignored). drape uses only the geometry, but
+// tinyobjloader's own complaints about a material file come first in its error text.
+TinyObj loadWithTinyObj(std::string_view text, const std::string& name, tinyobj::MaterialReader* materials) {
+  std::istringstream in{std::string(text)};
+  TinyObj obj;
+  std::vector<tinyobj::material_t> materialList;
+  std::string warnings, errors;
+  // triangulate = false: fans below keep the polygon's vertex order; no vertex colours.
+  if (!tinyobj::LoadObj(&obj.attrib, &obj.shapes, &materialList, &warnings, &errors, &in, materials, false, false)) {
+    const std::string err = firstLine(errors);
+    throw Error(fmt::format("{}: {}", name, err.empty() ? "not a readable OBJ file" : err));
+  }
+  return obj;
+}
+
+mesh::TriMesh buildMesh(const TinyObj& obj, const std::string& name, const ObjReadOptions& options) {
+  const auto& attrib = obj.attrib;
   mesh::TriMesh out;
-  out.name = path;
+  out.name = name;
   const std::size_t vertexCount = attrib.vertices.size() / 3;
   out.positions.reserve(vertexCount);
   for (std::size_t v = 0; v < vertexCount; ++v) {
     const Vec3 p(attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]);
-    if (!p.allFinite()) throw Error(fmt::format("{}: vertex {} has a non-finite coordinate", path, v + 1));
+    if (!p.allFinite()) throw Error(fmt::format("{}: vertex {} has a non-finite coordinate", name, v + 1));
     out.positions.push_back(p * options.metresPerUnit);
   }
 
   std::vector<std::uint32_t> polygon;
-  for (const auto& shape : reader.GetShapes()) {
+  for (const auto& shape : obj.shapes) {
     if (!wanted(shape.name, options.groups)) continue;
     std::size_t offset = 0;
     for (const auto faceSize : shape.mesh.num_face_vertices) {
@@ -66,19 +137,19 @@ mesh::TriMesh readObj(const std::string& path, const ObjReadOptions& options) {
         const int index = shape.mesh.indices[offset + k].vertex_index;
         if (index < 0 || static_cast<std::size_t>(index) >= vertexCount) {
           throw Error(fmt::format("{}: a face in group '{}' refers to vertex {} but the file has {} vertices",
-                                  path, shape.name, index + 1, vertexCount));
+                                  name, shape.name, index + 1, vertexCount));
         }
         polygon.push_back(static_cast<std::uint32_t>(index));
       }
       offset += faceSize;
-      if (polygon.size() < 3) throw Error(fmt::format("{}: a face in group '{}' has fewer than 3 vertices", path, shape.name));
+      if (polygon.size() < 3) throw Error(fmt::format("{}: a face in group '{}' has fewer than 3 vertices", name, shape.name));
       mesh::triangulatePolygon(polygon, out.triangles);
     }
   }
   if (out.triangles.empty()) {
     throw Error(options.groups.empty()
-                    ? fmt::format("{}: no faces found, expected a triangle or polygon mesh", path)
-                    : fmt::format("{}: no faces in the requested group(s) {}", path, fmt::join(options.groups, ", ")));
+                    ? fmt::format("{}: no faces found, expected a triangle or polygon mesh", name)
+                    : fmt::format("{}: no faces in the requested group(s) {}", name, fmt::join(options.groups, ", ")));
   }
 
   if (!options.keepUnusedVertices) {
@@ -96,6 +167,29 @@ mesh::TriMesh readObj(const std::string& path, const ObjReadOptions& options) {
     out.positions = std::move(kept);
   }
   return out;
+}
+
+mesh::TriMesh parseWith(std::string_view text, const std::string& name, const ObjReadOptions& options,
+                        tinyobj::MaterialReader* materials) {
+  checkVertexLines(text, name);
+  return buildMesh(loadWithTinyObj(text, name, materials), name, options);
+}
+
+}  // namespace
+
+mesh::TriMesh parseObj(std::string_view text, const std::string& name, const ObjReadOptions& options) {
+  return parseWith(text, name, options, nullptr);  // text has no folder to find an .mtl in
+}
+
+mesh::TriMesh readObj(const std::string& path, const ObjReadOptions& options) {
+  requireReadableFile(path);
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  // Material files beside the OBJ, as tinyobjloader's own file reader finds them.
+  const std::size_t slash = path.find_last_of('/');
+  tinyobj::MaterialFileReader materials(slash == std::string::npos ? std::string() : path.substr(0, slash + 1));
+  return parseWith(text.str(), path, options, &materials);
 }
 
 void writeObj(const std::string& path, std::span<const Vec3> positions,

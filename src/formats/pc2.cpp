@@ -1,8 +1,10 @@
 #include "drape/formats/pc2.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -74,40 +76,71 @@ void Pc2Writer::close() {
   if (!ok || !closed) throw Error(fmt::format("{}: write failed", path_));
 }
 
-Pc2Cache readPc2(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) throw Error(fmt::format("{}: no such file", path));
+namespace {
+
+// The header's promise checked against the bytes there are, dimension by dimension: the
+// product of two 31-bit counts and 12 bytes overflows 64 bits.
+void checkPayloadSize(const Pc2Header& h, std::size_t payload, std::size_t total, const std::string& name) {
+  const std::uint64_t pointBytes = std::uint64_t(h.numPoints) * 12u;
+  const bool fits = h.numSamples == 0 || (pointBytes <= payload && std::uint64_t(h.numSamples) <= payload / pointBytes);
+  if (!fits) {
+    // long double: the promise may exceed 64 bits, and its 64-bit mantissa holds it exactly.
+    const long double promised = static_cast<long double>(sizeof h) + static_cast<long double>(pointBytes) * h.numSamples;
+    throw Error(fmt::format("{}: truncated: the header promises {} samples of {} points ({:.0f} bytes), the file has {}",
+                            name, h.numSamples, h.numPoints, promised, total));
+  }
+}
+
+// The timing must be finite and the rate positive: NaN or infinity from a file would reach
+// the time codes of players and exporters unnoticed.
+void checkHeaderNumbers(const Pc2Header& h, const std::string& name) {
+  if (!std::isfinite(h.startFrame)) throw Error(fmt::format("{}: the start frame {} is not a finite number", name, h.startFrame));
+  if (!std::isfinite(h.sampleRate) || !(h.sampleRate > 0.0f))
+    throw Error(fmt::format("{}: the sample rate {} is not a finite number > 0", name, h.sampleRate));
+}
+
+}  // namespace
+
+Pc2Cache parsePc2(std::string_view bytes, const std::string& name) {
   Pc2Header h{};
-  const bool headerOk = std::fread(&h, sizeof h, 1, f) == 1;
-  if (!headerOk || std::memcmp(h.signature, kSignature, sizeof kSignature) != 0 || h.version != 1 ||
+  if (bytes.size() >= sizeof h) std::memcpy(&h, bytes.data(), sizeof h);
+  if (bytes.size() < sizeof h || std::memcmp(h.signature, kSignature, sizeof kSignature) != 0 || h.version != 1 ||
       h.numPoints < 0 || h.numSamples < 0) {
-    std::fclose(f);
-    throw Error(fmt::format("{}: not a PC2 point cache (expected the POINTCACHE2 header, version 1)", path));
+    throw Error(fmt::format("{}: not a PC2 point cache (expected the POINTCACHE2 header, version 1)", name));
   }
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  const std::uint64_t expected = sizeof h + std::uint64_t(h.numPoints) * 12u * std::uint64_t(h.numSamples);
-  if (ec || size < expected) {
-    std::fclose(f);
-    throw Error(fmt::format("{}: truncated: the header promises {} samples of {} points ({} bytes), the file has {}",
-                            path, h.numSamples, h.numPoints, expected, size));
-  }
+  // Samples of no points would cost a vector each and say nothing: 2^31 of them is 48 GB.
+  if (h.numPoints == 0 && h.numSamples > 0)
+    throw Error(fmt::format("{}: the header promises {} samples of 0 points, expected at least 1 point", name, h.numSamples));
+  checkPayloadSize(h, bytes.size() - sizeof h, bytes.size(), name);
+  checkHeaderNumbers(h, name);
   Pc2Cache cache;
   cache.pointCount = static_cast<std::size_t>(h.numPoints);
   cache.startFrame = h.startFrame;
   cache.sampleRate = h.sampleRate;
-  std::vector<float> buffer(cache.pointCount * 3);
   cache.frames.resize(static_cast<std::size_t>(h.numSamples));
-  for (auto& frame : cache.frames) {
-    if (std::fread(buffer.data(), sizeof(float), buffer.size(), f) != buffer.size()) {
-      std::fclose(f);
-      throw Error(fmt::format("{}: truncated sample data", path));
-    }
+  const char* at = bytes.data() + sizeof h;
+  for (std::size_t s = 0; s < cache.frames.size(); ++s) {
+    std::vector<Vec3>& frame = cache.frames[s];
     frame.resize(cache.pointCount);
-    for (std::size_t i = 0; i < cache.pointCount; ++i) frame[i] = Vec3(buffer[3 * i], buffer[3 * i + 1], buffer[3 * i + 2]);
+    for (std::size_t i = 0; i < cache.pointCount; ++i, at += 12) {
+      float xyz[3];
+      std::memcpy(xyz, at, sizeof xyz);
+      if (!std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2])) {
+        throw Error(fmt::format("{}: sample {} point {} has a non-finite coordinate (byte {})", name, s, i,
+                                at - bytes.data()));
+      }
+      frame[i] = Vec3(xyz[0], xyz[1], xyz[2]);
+    }
   }
-  std::fclose(f);
   return cache;
+}
+
+Pc2Cache readPc2(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(fmt::format("{}: no such file", path));
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return parsePc2(bytes.str(), path);
 }
 
 }  // namespace drape::formats

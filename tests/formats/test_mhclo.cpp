@@ -4,6 +4,7 @@
 
 #include "drape/core/error.hpp"
 #include "drape/formats/mhclo.hpp"
+#include "drape/testing/errors.hpp"
 
 namespace drape::formats {
 namespace {
@@ -57,6 +58,23 @@ TEST(Mhclo, MalformedLinesNameLineAndColumn) {
   expectError("x_scale 1 2\nverts 0\n1\n", "bad.mhclo:1:1:", "expected 'x_scale A B DISTANCE'");
   expectError("x_scale 1 2 0\nverts 0\n1\n", "bad.mhclo:1:13:", "reference distance > 0");
   expectError("name nothing\n", "bad.mhclo:", "no 'verts' list");
+}
+
+// Weights, offsets and scale distances must be finite: nan, inf and 1e999 (beyond double).
+TEST(Mhclo, MalformedCorpus) {
+  struct BadCase {
+    const char* file;
+    const char* expected;  ///< message after "path:"
+  };
+  const BadCase cases[] = {
+      {"mhclo_infinite_offset.mhclo", "3:25: expected a number, found 'inf'"},
+      {"mhclo_nan_weight.mhclo", "3:7: expected a number, found 'nan'"},
+      {"mhclo_overflow_scale.mhclo", "1:13: expected a number, found '1e999'"},
+  };
+  for (const BadCase& c : cases) {
+    const std::string path = std::string(DRAPE_TEST_DATA_DIR) + "/bad/mesh/" + c.file;
+    EXPECT_EQ(drape::testing::errorOf([&] { (void)readMhclo(path); }), path + ":" + c.expected) << c.file;
+  }
 }
 
 TEST(Mhclo, TheBundledDressHasOneLinePerMeshVertex) {

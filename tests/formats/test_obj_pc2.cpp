@@ -8,6 +8,7 @@
 #include "drape/formats/pc2.hpp"
 #include "drape/formats/units.hpp"
 #include "drape/mesh/topology.hpp"
+#include "drape/testing/errors.hpp"
 
 namespace drape::formats {
 namespace {
@@ -56,6 +57,45 @@ TEST(Obj, ClearErrors) {
   EXPECT_THROW((void)readObj(path), Error);
 }
 
+std::string badMesh(const std::string& f) { return std::string(DRAPE_TEST_DATA_DIR) + "/bad/mesh/" + f; }
+std::string badCache(const std::string& f) { return std::string(DRAPE_TEST_DATA_DIR) + "/bad/cache/" + f; }
+
+using drape::testing::errorOf;
+
+struct BadCase {
+  const char* file;
+  const char* expected;  ///< message after "path:"
+};
+
+// tinyobjloader reads "nan" as 0 and 1e999 as infinity without a word; drape names the spot.
+TEST(Obj, MalformedCorpus) {
+  const BadCase cases[] = {
+      {"obj_nan_coordinate.obj", "2:5: expected a number for the vertex's y coordinate, found 'nan'"},
+      {"obj_overflow_coordinate.obj", "4:7: expected a number for the vertex's z coordinate, found '1e999'"},
+      {"obj_two_coordinates.obj", "2:6: expected 3 coordinates (x y z) on a vertex line, found 2"},
+      {"obj_face_out_of_range.obj", " a face in group '' refers to vertex 7 but the file has 3 vertices"},
+      {"obj_zero_index.obj", " Failed parse `f' line(e.g. zero value for face index. line 4.)"},
+  };
+  for (const BadCase& c : cases) {
+    const std::string path = badMesh(c.file);
+    EXPECT_EQ(errorOf([&] { (void)readObj(path); }), path + ":" + c.expected) << c.file;
+  }
+}
+
+TEST(Obj, ParseObjMatchesReadObj) {
+  const std::string path = std::string(DRAPE_DATA_DIR) + "/garments/makehuman_female_elegantsuit01_dress.obj";
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const mesh::TriMesh parsed = parseObj(text, path, {});
+  const mesh::TriMesh read = readObj(path);
+  EXPECT_EQ(parsed.positions, read.positions);
+  EXPECT_EQ(parsed.triangles, read.triangles);
+  EXPECT_EQ(errorOf([] { (void)parseObj("v 0 0 0\r\nv 1 0 inf\r\n", "crlf.obj", {}); }),
+            "crlf.obj:2:7: expected a number for the vertex's z coordinate, found 'inf'");
+  // Comments after the coordinates and tabs stay valid, as tinyobjloader reads them.
+  EXPECT_EQ(parseObj("v 0 0 0 # origin\nv\t1 0 0\nv 0 1 0\nf 1 2 3\n", "ok.obj", {}).triangles.size(), 1u);
+}
+
 TEST(Obj, WriteThenReadRoundTrips) {
   const std::vector<Vec3> p = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0.25}};
   const std::vector<mesh::Triangle> t = {{0, 1, 2}};
@@ -92,6 +132,26 @@ TEST(Pc2, RejectsTruncatedFiles) {
   }
   std::filesystem::resize_file(path, 40);
   EXPECT_THROW((void)readPc2(path), Error);
+}
+
+TEST(Pc2, MalformedCorpus) {
+  const BadCase cases[] = {
+      {"pc2_nan_coordinate.pc2", " sample 1 point 1 has a non-finite coordinate (byte 68)"},
+      // 2^31 samples of nothing: 48 GB of empty frames before this check.
+      {"pc2_zero_points.pc2", " the header promises 2147483647 samples of 0 points, expected at least 1 point"},
+      // 12 x 716165683 x 2146470725 bytes wraps to 10,484 in 64 bits: the size check passed
+      // and 8.6 GB were allocated for one sample.
+      {"pc2_size_overflow.pc2",
+       " truncated: the header promises 2146470725 samples of 716165683 points (18446744073709562132 bytes), the file has 10516"},
+      {"pc2_zero_rate.pc2", " the sample rate 0 is not a finite number > 0"},
+      {"pc2_truncated.pc2", " truncated: the header promises 2 samples of 3 points (104 bytes), the file has 68"},
+  };
+  for (const BadCase& c : cases) {
+    const std::string path = badCache(c.file);
+    EXPECT_EQ(errorOf([&] { (void)readPc2(path); }), path + ":" + c.expected) << c.file;
+  }
+  EXPECT_EQ(errorOf([] { (void)parsePc2("POINTCACHE2", "short.pc2"); }),
+            "short.pc2: not a PC2 point cache (expected the POINTCACHE2 header, version 1)");
 }
 
 TEST(Units, KnownAndUnknown) {

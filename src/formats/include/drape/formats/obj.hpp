@@ -3,6 +3,7 @@
 
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "drape/mesh/trimesh.hpp"
@@ -15,8 +16,12 @@ struct ObjReadOptions {
   bool keepUnusedVertices = true;   ///< false: drop vertices no kept face uses (renumbers)
 };
 
-/// Reads an OBJ file; polygons are triangulated as fans. Throws drape::Error with
-/// "file:line: what" for syntax errors, "file: ..." for a missing file or an empty mesh.
+/// Parses OBJ text read from `name` (used in messages); polygons are triangulated as fans.
+/// Throws drape::Error "name:line:column: what" for a vertex line without three finite
+/// coordinates, "name: what" for other syntax errors (tinyobjloader's text, which names the
+/// line), faces that refer to missing vertices, or an empty mesh. mtllib lines are ignored.
+[[nodiscard]] mesh::TriMesh parseObj(std::string_view text, const std::string& name, const ObjReadOptions& options = {});
+/// Reads and parses an OBJ file; "file: ..." also for a missing or unreadable file.
 [[nodiscard]] mesh::TriMesh readObj(const std::string& path, const ObjReadOptions& options = {});
 
 /// Writes positions and triangles as OBJ (positions in metres, 1-based indices).

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "drape/core/math.hpp"
@@ -41,7 +42,11 @@ struct Pc2Cache {
   std::vector<std::vector<Vec3>> frames;
 };
 
-/// Reads a whole PC2 file. Throws drape::Error on a bad header or a truncated file.
+/// Parses the bytes of a PC2 file read from `name` (used in messages). Throws drape::Error
+/// "name: ..." on a bad header, a truncated file, or a non-finite time or coordinate (with
+/// its sample, point and byte offset: the format is binary, it has no lines).
+[[nodiscard]] Pc2Cache parsePc2(std::string_view bytes, const std::string& name);
+/// Reads and parses a whole PC2 file.
 [[nodiscard]] Pc2Cache readPc2(const std::string& path);
 
 }  // namespace drape::formats

@@ -262,7 +262,9 @@ AmcMotion parseAmc(std::string_view text, const std::string& name, const AsfSkel
       const auto [end, ec] = std::from_chars(key.data(), key.data() + key.size(), number);
       if (ec != std::errc() || end != key.data() + key.size())
         throw Error::at(r.at(l, 0), fmt::format("expected a frame number, found {}", quoted(key)));
-      if (out.frameCount > 0 && number != previousNumber + 1)
+      // number - 1, not previousNumber + 1: the word starts with a digit, so number >= 0 and
+      // cannot underflow, while a previous frame numbered LONG_MAX would overflow.
+      if (out.frameCount > 0 && number - 1 != previousNumber)
         throw Error::at(r.at(l, 0), fmt::format("frame {} follows frame {}", number, previousNumber));
       previousNumber = number;
       ++out.frameCount;

@@ -100,6 +100,8 @@ TEST(AsfAmc, MalformedCorpus) {
       {"amc_unknown_bone.amc", "8:1: unknown bone 'tibia' (not in the ASF skeleton)"},
       {"amc_wrong_count.amc", "5:1: bone 'femur' has 2 values, expected 3 (its degrees of freedom)"},
       {"amc_frame_gap.amc", "6:1: frame 3 follows frame 1"},
+      // Frame LONG_MAX, then 1: computing LONG_MAX + 1 overflowed a long (undefined behaviour).
+      {"amc_frame_number_overflow.amc", "6:1: frame 1 follows frame 9223372036854775807"},
   };
   for (const BadCase& c : cases) {
     const std::string path = bad(c.file);
@@ -138,6 +140,12 @@ TEST(MhSkel, MalformedCorpus) {
             badJson + ":5:3: syntax error while parsing object key - unexpected '}'; expected string literal");
   const std::string twoRoots = bad("mhskel_two_roots.mhskel");
   EXPECT_EQ(errorOf([&] { (void)readMhskel(twoRoots); }), twoRoots + ": two root bones ('a' and 'b')");
+  // A weight beyond double range: nlohmann reports it without a position; drape finds it.
+  const std::string overflow = bad("mhw_weight_overflow.mhw");
+  EXPECT_EQ(errorOf([&] { (void)readMhw(overflow); }), overflow + ":3:29: expected a finite number, found '2e400'");
+  // Deep nesting: the message for a bad [vertex, weight] pair dumped it recursively.
+  const std::string deep = bad("mhw_deep_nesting.mhw");
+  EXPECT_EQ(errorOf([&] { (void)readMhw(deep); }), deep + ":1:533: nesting deeper than 512 levels");
 }
 
 }  // namespace

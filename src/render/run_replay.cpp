@@ -3,11 +3,14 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "drape/core/error.hpp"
+#include "drape/formats/json_text.hpp"
 #include "drape/formats/obj.hpp"
 #include "drape/formats/pc2.hpp"
 #include "drape/formats/run_manifest.hpp"
@@ -19,14 +22,10 @@ namespace {
 /// Anything else in the file is not the player's business; a malformed file is reported.
 std::vector<StageTime> readStageTimes(const std::filesystem::path& directory) {
   const std::filesystem::path path = directory / "stats.json";
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) return {};
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw Error(fmt::format("{}: not valid JSON (byte {})", path.string(), e.byte));
-  }
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const nlohmann::json j = formats::parseJsonText(text, path.string());
   std::vector<StageTime> stages;
   if (!j.is_object() || !j.contains("ms_per_stage") || !j["ms_per_stage"].is_object()) return stages;
   for (const auto& [stage, value] : j["ms_per_stage"].items()) {

@@ -67,6 +67,26 @@ TEST(RunReplay, RefusesInconsistentRuns) {
   }
 }
 
+// stats.json is read for its stage times only, but a broken one is a drape error with its
+// line and column, whatever nlohmann stops on (a number beyond a double escaped before).
+TEST(RunReplay, ABrokenStatsFileIsAnErrorWithItsPosition) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("replay_stats"), 4);
+  const std::string stats = dir + "/stats.json";
+  const std::pair<const char*, const char*> cases[] = {
+      {"{\n  \"frames\": 1e999\n}", "stats.json:2:13: expected a finite number, found '1e999'"},
+      {"{\n  \"frames\": 4,\n", "stats.json:3:1: "},
+  };
+  for (const auto& [text, expected] : cases) {
+    std::ofstream(stats, std::ios::trunc) << text;
+    try {
+      RunReplay replay(dir);
+      FAIL() << "accepted " << text;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(ContactSheet, SixteenEvenlySpacedFramesFromFirstToLast) {
   const std::vector<std::int64_t> f = contactSheetFrames(91);
   ASSERT_EQ(f.size(), 16u);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include <fmt/format.h>
 
@@ -22,6 +23,47 @@ std::vector<int> drivingJoints(const scene::Avatar& avatar, const Skeleton& skel
   return driving;
 }
 
+// For each avatar joint, the head of its chain: the highest of the consecutive ancestors
+// driven by the same motion joint (itself when its parent is driven by another, or none).
+std::vector<std::size_t> chainHeads(const scene::Avatar& avatar, const std::vector<int>& driving) {
+  std::vector<std::size_t> head(avatar.joints.size());
+  for (std::size_t a = 0; a < head.size(); ++a) {
+    const int p = avatar.joints[a].parent;
+    head[a] = p >= 0 && driving[a] >= 0 && driving[a] == driving[static_cast<std::size_t>(p)]
+                  ? head[static_cast<std::size_t>(p)]
+                  : a;
+  }
+  return head;
+}
+
+struct Hub {
+  int joint = -1;                   ///< the avatar joint the motion's root drives, under an undriven root
+  std::vector<std::uint8_t> above;  ///< its ancestors, all undriven
+};
+
+// Where the avatar's root is not driven (a game rig's Root on the floor under the pelvis):
+// the highest avatar joint that the motion's root joint drives, when everything above it
+// is undriven. None (joint -1) otherwise.
+Hub findHub(const scene::Avatar& avatar, const std::vector<int>& driving, const Skeleton& skeleton) {
+  Hub hub;
+  hub.above.assign(avatar.joints.size(), 0);
+  for (std::size_t a = 0; a < avatar.joints.size(); ++a) {
+    const int m = driving[a];
+    if (m < 0 || skeleton.joints[static_cast<std::size_t>(m)].parent >= 0) continue;
+    std::vector<std::size_t> path;
+    int p = avatar.joints[a].parent;
+    while (p >= 0 && driving[static_cast<std::size_t>(p)] < 0) {
+      path.push_back(static_cast<std::size_t>(p));
+      p = avatar.joints[static_cast<std::size_t>(p)].parent;
+    }
+    if (p >= 0 || path.empty()) return hub;  // a driven ancestor, or the root itself: no hub
+    hub.joint = static_cast<int>(a);
+    for (const std::size_t q : path) hub.above[q] = 1;
+    return hub;
+  }
+  return hub;
+}
+
 // Rest-pose correction per avatar joint: the world rotation that turns the avatar's rest
 // bone directions (towards its driven children) onto the motion skeleton's rest bone
 // directions towards the same children. A T-pose motion then lifts an A-pose avatar's
@@ -31,16 +73,20 @@ std::vector<int> drivingJoints(const scene::Avatar& avatar, const Skeleton& skel
 std::vector<Quat> restCorrections(const scene::Avatar& avatar, const std::vector<int>& driving,
                                   const std::vector<Vec3>& motionRest, const Skeleton& skeleton) {
   const std::size_t n = avatar.joints.size();
+  const std::vector<std::size_t> head = chainHeads(avatar, driving);
   std::vector<Vec3> avatarDir(n, Vec3::Zero()), motionDir(n, Vec3::Zero());
   for (std::size_t c = 0; c < n; ++c) {
     const int a = avatar.joints[c].parent;
     if (a < 0 || driving[c] < 0 || driving[static_cast<std::size_t>(a)] < 0) continue;
-    const Vec3 da = avatar.joints[c].restCenter - avatar.joints[static_cast<std::size_t>(a)].restCenter;
+    if (driving[c] == driving[static_cast<std::size_t>(a)]) continue;  // within one chain: one bone
+    // A chain (twist joints) is one bone from its head: the direction is measured there.
+    const std::size_t h = head[static_cast<std::size_t>(a)];
+    const Vec3 da = avatar.joints[c].restCenter - avatar.joints[h].restCenter;
     const Vec3 dm = motionRest[static_cast<std::size_t>(driving[c])] -
                     motionRest[static_cast<std::size_t>(driving[static_cast<std::size_t>(a)])];
     if (da.norm() < 1e-9 || dm.norm() < 1e-9) continue;
-    avatarDir[static_cast<std::size_t>(a)] += da.normalized();
-    motionDir[static_cast<std::size_t>(a)] += dm.normalized();
+    avatarDir[h] += da.normalized();
+    motionDir[h] += dm.normalized();
   }
   // A driven joint with no driven child (a foot whose toes the motion lacks, a head):
   // its motion end site against the avatar's directions to all its children.
@@ -62,7 +108,9 @@ std::vector<Quat> restCorrections(const scene::Avatar& avatar, const std::vector
   for (std::size_t a = 0; a < n; ++a) {
     const int parent = avatar.joints[a].parent;
     if (parent < 0) continue;
-    if (avatarDir[a].norm() > 1e-9 && motionDir[a].norm() > 1e-9) {
+    if (head[a] != a) {
+      correction[a] = correction[head[a]];  // the rest of a chain turns with its head
+    } else if (avatarDir[a].norm() > 1e-9 && motionDir[a].norm() > 1e-9) {
       correction[a] = Quat::FromTwoVectors(avatarDir[a], motionDir[a]);
     } else {
       correction[a] = correction[static_cast<std::size_t>(parent)];
@@ -72,7 +120,7 @@ std::vector<Quat> restCorrections(const scene::Avatar& avatar, const std::vector
 }
 
 // Leg-length ratio avatar / motion over LeftUpLeg -> LeftLeg -> LeftFoot (or the right
-// leg); falls back to the ratio of overall extents.
+// leg); for other names, the ratio of hip heights; else the ratio of overall extents.
 double legLengthRatio(const scene::Avatar& avatar, const std::vector<int>& driving, const std::vector<Vec3>& motionRest,
                       const Skeleton& skeleton) {
   for (const char* side : {"Left", "Right"}) {
@@ -87,6 +135,23 @@ double legLengthRatio(const scene::Avatar& avatar, const std::vector<int>& drivi
     auto rest = [&](int j) { return motionRest[static_cast<std::size_t>(j)]; };
     const double a = (centre(knee) - centre(up)).norm() + (centre(foot) - centre(knee)).norm();
     const double m = (rest(mk) - rest(mu)).norm() + (rest(mf) - rest(mk)).norm();
+    if (a > 1e-6 && m > 1e-6) return a / m;
+  }
+  // Other names (another rig): the height of the joint the motion's root drives above the
+  // driven joint lowest in the motion, against the same two motion joints at rest.
+  int hip = -1, low = -1;
+  for (std::size_t a = 0; a < avatar.joints.size(); ++a) {
+    const int m = driving[a];
+    if (m < 0) continue;
+    if (hip < 0 && skeleton.joints[static_cast<std::size_t>(m)].parent < 0) hip = static_cast<int>(a);
+    if (low < 0 || motionRest[static_cast<std::size_t>(m)].y() <
+                       motionRest[static_cast<std::size_t>(driving[static_cast<std::size_t>(low)])].y())
+      low = static_cast<int>(a);
+  }
+  if (hip >= 0 && low >= 0) {
+    const auto h = static_cast<std::size_t>(hip), l = static_cast<std::size_t>(low);
+    const double a = avatar.joints[h].restCenter.y() - avatar.joints[l].restCenter.y();
+    const double m = motionRest[static_cast<std::size_t>(driving[h])].y() - motionRest[static_cast<std::size_t>(driving[l])].y();
     if (a > 1e-6 && m > 1e-6) return a / m;
   }
   Aabb box;
@@ -160,8 +225,12 @@ AvatarAnimation AvatarAnimation::build(const scene::Avatar& avatar, const Clip& 
   anim.rate_ = clip.rate;
   anim.start_ = clip.start;
   anim.driving_ = drivingJoints(avatar, clip.skeleton, map);
+  // An avatar root the motion does not drive (a game rig's Root on the floor under the
+  // pelvis) carries the hub: the avatar joint the motion's root drives.
+  const Hub hub = findHub(avatar, anim.driving_, clip.skeleton);
+  const std::vector<std::uint8_t>& aboveHub = hub.above;
   for (std::size_t a = 0; a < n; ++a) {
-    if (avatar.joints[a].parent >= 0 || anim.driving_[a] >= 0) continue;
+    if (avatar.joints[a].parent >= 0 || anim.driving_[a] >= 0 || aboveHub[a]) continue;
     const auto paired = std::count_if(anim.driving_.begin(), anim.driving_.end(), [](int j) { return j >= 0; });
     throw Error(fmt::format("{}: no joint of the motion {} drives the avatar's root joint '{}' (joint map '{}' pairs "
                             "{} of the motion's {} joints with the avatar's); give a joint map naming the motion's "
@@ -183,25 +252,40 @@ AvatarAnimation AvatarAnimation::build(const scene::Avatar& avatar, const Clip& 
   anim.world_.resize(anim.frames_ * n);
   anim.inverse_.resize(anim.frames_ * n);
   anim.rootPath_.resize(anim.frames_);
+  // The scaled motion root path from an avatar joint's rest position (the root's, or the hub's).
+  const auto rootPathFrom = [&](const Vec3& rest, const Vec3& motionRoot, const Vec3& first) {
+    Vec3 p = anim.rootScale_ * motionRoot;
+    if (options.anchorRootAtRest) {
+      p.x() = rest.x() + anim.rootScale_ * (motionRoot.x() - first.x());
+      p.z() = rest.z() + anim.rootScale_ * (motionRoot.z() - first.z());
+    }
+    p.y() = anim.rootHeightOffset_ + anim.rootScale_ * motionRoot.y();
+    return p;
+  };
+  Vec3 hubShift = Vec3::Zero();  // the hub's horizontal move from its rest position
   for (std::size_t f = 0; f < anim.frames_; ++f) {
     forwardKinematics(clip.skeleton, clip.frameRotations(f), clip.rootTranslations[f], motionWorld);
+    if (hub.joint >= 0) {
+      const auto h = static_cast<std::size_t>(hub.joint);
+      const Vec3 motionRoot = motionWorld[static_cast<std::size_t>(anim.driving_[h])].translation;
+      if (f == 0) firstRoot[h] = motionRoot;
+      hubShift = rootPathFrom(avatar.joints[h].restCenter, motionRoot, firstRoot[h]) - avatar.joints[h].restCenter;
+      hubShift.y() = 0.0;
+    }
     for (std::size_t a = 0; a < n; ++a) {
       const scene::Joint& joint = avatar.joints[a];
       const int m = anim.driving_[a];
       const auto parent = static_cast<std::size_t>(joint.parent);
-      if (joint.parent < 0) {
-        // Root: rotation from the motion, position along the scaled motion root path.
+      if (aboveHub[a]) {
+        // Above the hub: upright, at rest height, moving with the hub across the floor.
+        delta[a] = Quat::Identity();
+        position[a] = joint.restCenter + hubShift;
+      } else if (joint.parent < 0 || static_cast<int>(a) == hub.joint) {
+        // Root (or hub): rotation from the motion, position along the scaled motion root path.
         const Vec3 motionRoot = motionWorld[static_cast<std::size_t>(m)].translation;
         if (f == 0) firstRoot[a] = motionRoot;
         delta[a] = motionWorld[static_cast<std::size_t>(m)].rotation;
-        Vec3 p = anim.rootScale_ * motionRoot;
-        if (options.anchorRootAtRest) {
-          p.x() = joint.restCenter.x() + anim.rootScale_ * (motionRoot.x() - firstRoot[a].x());
-          p.z() = joint.restCenter.z() + anim.rootScale_ * (motionRoot.z() - firstRoot[a].z());
-        }
-        p.y() = anim.rootHeightOffset_ + anim.rootScale_ * motionRoot.y();
-        position[a] = p;
-        if (a == 0) anim.rootPath_[f] = p;
+        position[a] = rootPathFrom(joint.restCenter, motionRoot, firstRoot[a]);
       } else {
         delta[a] = m >= 0 ? Quat((motionWorld[static_cast<std::size_t>(m)].rotation * correction[a]).normalized())
                           : delta[parent];

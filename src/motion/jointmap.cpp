@@ -87,11 +87,21 @@ JointMap parseJointMap(std::string_view json, const std::string& name) {
   for (const auto& [motionJoint, avatarJoint] : doc["joints"].items()) {
     const auto found = lines.find(motionJoint);
     const int line = found == lines.end() ? 0 : found->second;
-    if (!avatarJoint.is_string())
-      throw Error::at({name, line, 0}, fmt::format("the avatar joint for '{}' must be a string", motionJoint));
-    map.entries.push_back({motionJoint, avatarJoint.get<std::string>(), line});
+    // A list: a chain of avatar joints (parent first) that together make the motion's one
+    // bone, as rigs with twist joints split a thigh in two; all of them take its rotation.
+    const bool chain = avatarJoint.is_array() && !avatarJoint.empty() &&
+                       std::all_of(avatarJoint.begin(), avatarJoint.end(), [](const auto& j) { return j.is_string(); });
+    if (!avatarJoint.is_string() && !chain)
+      throw Error::at({name, line, 0},
+                      fmt::format("the avatar joint for '{}' must be a string or a list of strings", motionJoint));
+    if (chain) {
+      for (const auto& joint : avatarJoint) map.entries.push_back({motionJoint, joint.get<std::string>(), line});
+    } else {
+      map.entries.push_back({motionJoint, avatarJoint.get<std::string>(), line});
+    }
   }
-  std::sort(map.entries.begin(), map.entries.end(), [](const JointMapEntry& a, const JointMapEntry& b) { return a.line < b.line; });
+  std::stable_sort(map.entries.begin(), map.entries.end(),
+                   [](const JointMapEntry& a, const JointMapEntry& b) { return a.line < b.line; });
   return map;
 }
 
@@ -121,16 +131,33 @@ std::size_t matchedJointCount(const JointMap& map, const Skeleton& skeleton, con
   }));
 }
 
+JointMap composeJointMaps(const JointMap& first, const JointMap& second) {
+  JointMap composed;
+  composed.name = first.name + " + " + second.name;
+  composed.source = first.source;
+  for (const JointMapEntry& a : first.entries)
+    for (const JointMapEntry& b : second.entries)
+      if (b.motionJoint == a.avatarJoint) composed.entries.push_back({a.motionJoint, b.avatarJoint, a.line});
+  return composed;
+}
+
 JointMap chooseJointMap(const std::vector<JointMap>& candidates, const Skeleton& skeleton, const scene::Avatar& avatar) {
   JointMap best = JointMap::identity(skeleton);
   std::size_t bestCount = matchedJointCount(best, skeleton, avatar);
-  for (const JointMap& m : candidates) {
+  const auto consider = [&](const JointMap& m) {
     const std::size_t count = matchedJointCount(m, skeleton, avatar);
     if (count > bestCount) {
       best = m;
       bestCount = count;
     }
-  }
+  };
+  for (const JointMap& m : candidates) consider(m);
+  // Then pairs: a naming style's map onto drape's names followed by a rig's map from drape's
+  // names onto its own (the Daz style onto MakeHuman's default rig). A pair wins only where
+  // it pairs strictly more joints than every single map.
+  for (const JointMap& a : candidates)
+    for (const JointMap& b : candidates)
+      if (&a != &b) consider(composeJointMaps(a, b));
   return best;
 }
 

@@ -267,7 +267,7 @@ TEST(JointMap, UnknownJointsAreErrorsWithTheirLine) {
     (void)parseJointMap("{\n \"joints\": {\n  \"a\": 1\n }\n}", "bad.json");
     FAIL() << "expected an error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "bad.json:3: the avatar joint for 'a' must be a string");
+    EXPECT_STREQ(e.what(), "bad.json:3: the avatar joint for 'a' must be a string or a list of strings");
   }
   try {
     (void)parseJointMap("{\n \"joints\": {\n  \"a\": \n }\n}", "broken.json");
@@ -284,7 +284,7 @@ TEST(JointMap, EntryLinesInOnePass) {
     (void)parseJointMap("{\n \"joints\": {\n  \"z\": {\"k\": \"v\"},\n  \"b\": 2\n }\n}", "nested.json");
     FAIL() << "expected an error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "nested.json:4: the avatar joint for 'b' must be a string");
+    EXPECT_STREQ(e.what(), "nested.json:4: the avatar joint for 'b' must be a string or a list of strings");
   }
   const JointMap escaped = parseJointMap("{\"name\": \"joints\",\n\"joints\": {\n\"\\u0062\": \"B\"}}", "e.json");
   ASSERT_EQ(escaped.entries.size(), 1u);
@@ -297,6 +297,34 @@ TEST(JointMap, EntryLinesInOnePass) {
   ASSERT_EQ(map.entries.size(), 6500u);
   EXPECT_EQ(map.entries.back().motionJoint, "j6499");
   EXPECT_EQ(map.entries.back().line, 6501);
+}
+
+// A list value is a chain of avatar joints driven by one motion joint, in its order; a rig's
+// map composes with a naming style's through drape's names, and only where both pair.
+TEST(JointMap, ChainsParseInOrderAndMapsCompose) {
+  const JointMap rig = parseJointMap(
+      "{\"name\": \"rig\", \"joints\": {\n\"LeftUpLeg\": [\"thigh1\", \"thigh2\"],\n\"LeftLeg\": \"shin\"}}", "rig.json");
+  ASSERT_EQ(rig.entries.size(), 3u);
+  EXPECT_EQ(rig.entries[0].avatarJoint, "thigh1");
+  EXPECT_EQ(rig.entries[1].avatarJoint, "thigh2");
+  EXPECT_EQ(rig.entries[1].line, 2);
+  EXPECT_EQ(*rig.avatarJointFor("LeftUpLeg"), "thigh1");  // the chain's head
+  const JointMap style =
+      parseJointMap("{\"name\": \"style\", \"joints\": {\"lThigh\": \"LeftUpLeg\", \"lShin\": \"LeftLeg\", \"lFoot\": \"LeftFoot\"}}",
+                    "style.json");
+  const JointMap both = composeJointMaps(style, rig);
+  EXPECT_EQ(both.name, "style + rig");
+  std::vector<std::string> pairs;  // lFoot drives nothing: the rig has no LeftFoot
+  for (const JointMapEntry& e : both.entries) pairs.push_back(e.motionJoint + "->" + e.avatarJoint);
+  EXPECT_EQ(pairs, (std::vector<std::string>{"lShin->shin", "lThigh->thigh1", "lThigh->thigh2"}));
+  for (const char* bad : {"[]", "[\"a\", 2]", "[[\"a\"]]"}) {
+    try {
+      (void)parseJointMap(std::string("{\"joints\": {\n\"x\": ") + bad + "}}", "chain.json");
+      FAIL() << bad;
+    } catch (const Error& e) {
+      EXPECT_STREQ(e.what(), "chain.json:2: the avatar joint for 'x' must be a string or a list of strings") << bad;
+    }
+  }
 }
 
 TEST(JointMap, MalformedCorpus) {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <tuple>
 
 #include "drape/core/error.hpp"
 #include "drape/motion/animation.hpp"
@@ -195,6 +196,53 @@ TEST(Retarget, AcclaimKickOnMakeHumanFollowsTheMotionsLimbs) {
     else if (e.motionJoint == "rfemur" || e.motionJoint == "rtibia" || e.motionJoint == "rfoot") e.motionJoint[0] = 'l';
   }
   EXPECT_GT(largestLimbAngle_deg(avatar, clip, map, AvatarAnimation::build(avatar, clip, swapped), limbs), 20.0);
+}
+
+// MakeHuman's default rig (twist bones: two per thigh, shin, upper arm and forearm) and its
+// game-engine rig (a Root on the floor above the pelvis) take every shipped naming style
+// through a style's map composed with the rig's. Each limb points where the motion's does:
+// a chain of twist bones turns as one bone, measured from its head (measured from the
+// twist bone, the default rig's limbs stood up to 23 degrees off). On the game-engine rig
+// the pelvis follows the motion's root and the Root stays on the floor below it.
+TEST(Retarget, MakeHumanRigsWithTwistBonesOrAFloorRootFollowTheMotionsLimbs) {
+  const std::vector<std::pair<std::string, std::string>> rigs = {{"makehuman_rig_default.mhskel", "makehuman_default"},
+                                                                 {"makehuman_rig_game_engine.mhskel", "makehuman_game_engine"}};
+  const std::vector<std::tuple<std::string, std::string, std::vector<std::pair<std::string, std::string>>>> motions = {
+      {"cmu_12_03_walk.bvh", "motionbuilder",
+       {{"LeftUpLeg", "LeftLeg"}, {"LeftLeg", "LeftFoot"}, {"RightArm", "RightForeArm"}, {"RightForeArm", "RightHand"}}},
+      {"cmu_02_02_walk_dazstyle.bvh", "daz",
+       {{"lThigh", "lShin"}, {"lShin", "lFoot"}, {"rShldr", "rForeArm"}, {"rForeArm", "rHand"}}},
+      {"cmu_11_01.amc", "acclaim", {{"lfemur", "ltibia"}, {"ltibia", "lfoot"}, {"rhumerus", "rradius"}, {"rradius", "rwrist"}}}};
+  for (const auto& [rigFile, rigMap] : rigs) {
+    scene::MakeHumanAvatarOptions options;
+    options.directory = std::string(DRAPE_DATA_DIR) + "/avatars";
+    options.skeletonFile = rigFile;
+    const scene::Avatar avatar = scene::buildMakeHumanAvatar(options);
+    for (const auto& [file, style, limbs] : motions) {
+      const Clip clip = loadClip(std::string(DRAPE_DATA_DIR) + "/mocap/" + file);
+      const JointMap map = chooseJointMap(shippedMaps(), clip.skeleton, avatar);
+      EXPECT_EQ(map.name, style + " + " + rigMap) << file;
+      const AvatarAnimation anim = AvatarAnimation::build(avatar, clip, map);
+      const double angle = largestLimbAngle_deg(avatar, clip, map, anim, limbs);
+      std::printf("%s on %s: largest limb angle %.2f degrees, root scale %.3f\n", file.c_str(), rigFile.c_str(), angle,
+                  anim.rootScale());
+      EXPECT_LT(angle, 5.0) << file << " on " << rigFile;
+      EXPECT_GT(anim.rootScale(), 0.8);
+      EXPECT_LT(anim.rootScale(), 1.2);
+      const int root = avatar.findJoint("Root"), pelvis = avatar.findJoint("pelvis");
+      if (root < 0) continue;
+      const scene::Joint& r = avatar.joints[static_cast<std::size_t>(root)];
+      const Vec3 offset = r.restCenter - avatar.joints[static_cast<std::size_t>(pelvis)].restCenter;
+      for (std::size_t f = 0; f < anim.frameCount(); ++f) {
+        const Vec3 at = anim.frame(f)[static_cast<std::size_t>(root)].translation;
+        const Vec3 below = anim.frame(f)[static_cast<std::size_t>(pelvis)].translation + offset;
+        EXPECT_NEAR(at.y(), r.restCenter.y() - anim.groundCorrection()[f], 1e-9) << file << " frame " << f;
+        // Where it stands from the pelvis at rest, horizontally, whatever the pelvis does.
+        EXPECT_NEAR(at.x(), below.x(), 1e-9) << file << " frame " << f;
+        EXPECT_NEAR(at.z(), below.z(), 1e-9) << file << " frame " << f;
+      }
+    }
+  }
 }
 
 // A map that leaves the avatar's root undriven is refused with how much it pairs and the

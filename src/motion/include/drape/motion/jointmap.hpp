@@ -6,7 +6,13 @@
 //
 //   { "name": "daz", "description": "...", "joints": { "hip": "Hips", "lThigh": "LeftUpLeg" } }
 //
-// Keys are motion joints, values avatar joints.
+// Keys are motion joints, values avatar joints, or lists of avatar joints (parent first)
+// where a rig splits one motion bone into several (twist joints):
+//
+//   { "name": "makehuman_default", "joints": { "LeftUpLeg": ["upperleg01.L", "upperleg02.L"] } }
+//
+// A rig's map from drape's names onto its own composes with a naming style's map
+// (chooseJointMap tries the pairs).
 
 #include <optional>
 #include <string>
@@ -44,7 +50,13 @@ struct JointMap {
 /// Number of entries of `map` whose motion joint is in `skeleton` and avatar joint in `avatar`.
 [[nodiscard]] std::size_t matchedJointCount(const JointMap& map, const Skeleton& skeleton, const scene::Avatar& avatar);
 
-/// The candidate (or the identity map) that pairs the most joints of `skeleton` with `avatar`.
+/// `first` then `second`: motion joint m drives r wherever `first` pairs m with a joint c
+/// and `second` pairs c with r (a naming style's map, then a rig's map from drape's names).
+[[nodiscard]] JointMap composeJointMaps(const JointMap& first, const JointMap& second);
+
+/// The candidate, ordered pair of candidates composed (composeJointMaps) or the identity map
+/// that pairs the most joints of `skeleton` with `avatar`; a later one only where it pairs
+/// strictly more.
 [[nodiscard]] JointMap chooseJointMap(const std::vector<JointMap>& candidates, const Skeleton& skeleton,
                                       const scene::Avatar& avatar);
 

@@ -2,12 +2,11 @@
 
 #include <charconv>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "motion_text.hpp"
 
 namespace drape::formats {
 namespace {
@@ -121,12 +120,6 @@ Mhclo parseMhclo(std::string_view text, const std::string& name) {
   return m;
 }
 
-Mhclo readMhclo(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(fmt::format("{}: cannot be opened", path));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parseMhclo(text.str(), path);
-}
+Mhclo readMhclo(const std::string& path) { return parseMhclo(detail::readWholeFile(path), path); }
 
 }  // namespace drape::formats

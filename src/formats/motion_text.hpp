@@ -1,5 +1,5 @@
 #pragma once
-// Private helpers of the hand-written motion and rig readers (BVH, ASF/AMC, MakeHuman):
+// Private helpers of the hand-written readers (BVH, ASF/AMC, MakeHuman rigs and clothes, PC2):
 // whole-file reading with a size limit, and a line/column tracking word scanner.
 
 #include <cstddef>

@@ -3,12 +3,12 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
-#include <sstream>
+#include <limits>
 
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "motion_text.hpp"
 
 namespace drape::formats {
 namespace {
@@ -136,11 +136,8 @@ Pc2Cache parsePc2(std::string_view bytes, const std::string& name) {
 }
 
 Pc2Cache readPc2(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(fmt::format("{}: no such file", path));
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  return parsePc2(bytes.str(), path);
+  // No size limit: a cache is as long as its take, and parsePc2 checks the header against it.
+  return parsePc2(detail::readWholeFile(path, std::numeric_limits<std::size_t>::max()), path);
 }
 
 }  // namespace drape::formats

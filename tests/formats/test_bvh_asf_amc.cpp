@@ -18,6 +18,7 @@ std::string mocap(const std::string& f) { return std::string(DRAPE_DATA_DIR) + "
 std::string bad(const std::string& f) { return std::string(DRAPE_TEST_DATA_DIR) + "/bad/motion/" + f; }
 
 using drape::testing::errorOf;
+using drape::testing::expectCorpus;
 
 TEST(Bvh, ReadsTheCmuWalk) {
   const BvhFile f = readBvh(mocap("cmu_walk_delfem2.bvh"));
@@ -42,13 +43,9 @@ TEST(Bvh, ReadsTheDazWalkWithTabSeparators) {
   EXPECT_EQ(f.frameCount, 299u);
 }
 
-struct BadCase {
-  const char* file;
-  const char* expected;  ///< message after "path:"
-};
-
 TEST(Bvh, MalformedCorpus) {
-  const BadCase cases[] = {
+  const std::string dir = std::string(DRAPE_TEST_DATA_DIR) + "/bad/motion";
+  expectCorpus(dir, {
       // The 7.7 GB Assimp regression: rejected from the header, nothing allocated.
       {"huge_frames.bvh", "8:9: Frames: 329490295 exceeds the limit of 1000000"},
       {"frames_exceed_file.bvh", "20:1: the file ends after 1 of the 900000 frames declared"},
@@ -61,11 +58,7 @@ TEST(Bvh, MalformedCorpus) {
       {"unknown_channel.bvh", "5:24: unknown channel 'Wrotation' (expected Xposition..Zrotation)"},
       {"missing_brace.bvh", "3:3: expected '{', found 'OFFSET'"},
       {"too_many_channels.bvh", "5:12: channel count 7 exceeds the limit of 6"},
-  };
-  for (const BadCase& c : cases) {
-    const std::string path = bad(c.file);
-    EXPECT_EQ(errorOf([&] { (void)readBvh(path); }), path + ":" + c.expected) << c.file;
-  }
+  }, [](const std::string& path) { (void)readBvh(path); });
 }
 
 TEST(Bvh, EmptyAndMissing) {
@@ -96,17 +89,13 @@ TEST(AsfAmc, ReadsTheCmuSoccerKick) {
 
 TEST(AsfAmc, MalformedCorpus) {
   const AsfSkeleton asf = readAsf(bad("small.asf"));
-  const BadCase cases[] = {
+  expectCorpus(std::string(DRAPE_TEST_DATA_DIR) + "/bad/motion", {
       {"amc_unknown_bone.amc", "8:1: unknown bone 'tibia' (not in the ASF skeleton)"},
       {"amc_wrong_count.amc", "5:1: bone 'femur' has 2 values, expected 3 (its degrees of freedom)"},
       {"amc_frame_gap.amc", "6:1: frame 3 follows frame 1"},
       // Frame LONG_MAX, then 1: computing LONG_MAX + 1 overflowed a long (undefined behaviour).
       {"amc_frame_number_overflow.amc", "6:1: frame 1 follows frame 9223372036854775807"},
-  };
-  for (const BadCase& c : cases) {
-    const std::string path = bad(c.file);
-    EXPECT_EQ(errorOf([&] { (void)readAmc(path, asf); }), path + ":" + c.expected) << c.file;
-  }
+  }, [&](const std::string& path) { (void)readAmc(path, asf); });
   const std::string asfPath = bad("asf_unknown_parent.asf");
   EXPECT_EQ(errorOf([&] { (void)readAsf(asfPath); }), asfPath + ":26:5: unknown bone 'shin' in the hierarchy");
 }

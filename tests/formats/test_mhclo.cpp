@@ -62,19 +62,11 @@ TEST(Mhclo, MalformedLinesNameLineAndColumn) {
 
 // Weights, offsets and scale distances must be finite: nan, inf and 1e999 (beyond double).
 TEST(Mhclo, MalformedCorpus) {
-  struct BadCase {
-    const char* file;
-    const char* expected;  ///< message after "path:"
-  };
-  const BadCase cases[] = {
+  drape::testing::expectCorpus(std::string(DRAPE_TEST_DATA_DIR) + "/bad/mesh", {
       {"mhclo_infinite_offset.mhclo", "3:25: expected a number, found 'inf'"},
       {"mhclo_nan_weight.mhclo", "3:7: expected a number, found 'nan'"},
       {"mhclo_overflow_scale.mhclo", "1:13: expected a number, found '1e999'"},
-  };
-  for (const BadCase& c : cases) {
-    const std::string path = std::string(DRAPE_TEST_DATA_DIR) + "/bad/mesh/" + c.file;
-    EXPECT_EQ(drape::testing::errorOf([&] { (void)readMhclo(path); }), path + ":" + c.expected) << c.file;
-  }
+  }, [](const std::string& path) { (void)readMhclo(path); });
 }
 
 TEST(Mhclo, TheBundledDressHasOneLinePerMeshVertex) {

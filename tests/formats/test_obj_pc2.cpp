@@ -57,29 +57,19 @@ TEST(Obj, ClearErrors) {
   EXPECT_THROW((void)readObj(path), Error);
 }
 
-std::string badMesh(const std::string& f) { return std::string(DRAPE_TEST_DATA_DIR) + "/bad/mesh/" + f; }
-std::string badCache(const std::string& f) { return std::string(DRAPE_TEST_DATA_DIR) + "/bad/cache/" + f; }
 
 using drape::testing::errorOf;
-
-struct BadCase {
-  const char* file;
-  const char* expected;  ///< message after "path:"
-};
+using drape::testing::expectCorpus;
 
 // tinyobjloader reads "nan" as 0 and 1e999 as infinity without a word; drape names the spot.
 TEST(Obj, MalformedCorpus) {
-  const BadCase cases[] = {
+  expectCorpus(std::string(DRAPE_TEST_DATA_DIR) + "/bad/mesh", {
       {"obj_nan_coordinate.obj", "2:5: expected a number for the vertex's y coordinate, found 'nan'"},
       {"obj_overflow_coordinate.obj", "4:7: expected a number for the vertex's z coordinate, found '1e999'"},
       {"obj_two_coordinates.obj", "2:6: expected 3 coordinates (x y z) on a vertex line, found 2"},
       {"obj_face_out_of_range.obj", " a face in group '' refers to vertex 7 but the file has 3 vertices"},
       {"obj_zero_index.obj", " Failed parse `f' line(e.g. zero value for face index. line 4.)"},
-  };
-  for (const BadCase& c : cases) {
-    const std::string path = badMesh(c.file);
-    EXPECT_EQ(errorOf([&] { (void)readObj(path); }), path + ":" + c.expected) << c.file;
-  }
+  }, [](const std::string& path) { (void)readObj(path); });
 }
 
 TEST(Obj, ParseObjMatchesReadObj) {
@@ -135,7 +125,7 @@ TEST(Pc2, RejectsTruncatedFiles) {
 }
 
 TEST(Pc2, MalformedCorpus) {
-  const BadCase cases[] = {
+  expectCorpus(std::string(DRAPE_TEST_DATA_DIR) + "/bad/cache", {
       {"pc2_nan_coordinate.pc2", " sample 1 point 1 has a non-finite coordinate (byte 68)"},
       // 2^31 samples of nothing: 48 GB of empty frames before this check.
       {"pc2_zero_points.pc2", " the header promises 2147483647 samples of 0 points, expected at least 1 point"},
@@ -145,11 +135,7 @@ TEST(Pc2, MalformedCorpus) {
        " truncated: the header promises 2146470725 samples of 716165683 points (18446744073709562132 bytes), the file has 10516"},
       {"pc2_zero_rate.pc2", " the sample rate 0 is not a finite number > 0"},
       {"pc2_truncated.pc2", " truncated: the header promises 2 samples of 3 points (104 bytes), the file has 68"},
-  };
-  for (const BadCase& c : cases) {
-    const std::string path = badCache(c.file);
-    EXPECT_EQ(errorOf([&] { (void)readPc2(path); }), path + ":" + c.expected) << c.file;
-  }
+  }, [](const std::string& path) { (void)readPc2(path); });
   EXPECT_EQ(errorOf([] { (void)parsePc2("POINTCACHE2", "short.pc2"); }),
             "short.pc2: not a PC2 point cache (expected the POINTCACHE2 header, version 1)");
 }

@@ -49,11 +49,7 @@ TEST(RunManifest, ClearErrors) {
 
 // Each case is a run directory of its own: tests/data/bad/cache/<case>/manifest.json.
 TEST(RunManifest, MalformedCorpus) {
-  struct BadCase {
-    const char* directory;
-    const char* expected;  ///< message after "DIR/manifest.json:"
-  };
-  const BadCase cases[] = {
+  drape::testing::expectCorpus(std::string(DRAPE_TEST_DATA_DIR) + "/bad/cache", {
       // nlohmann's out_of_range used to escape as a non-drape exception.
       {"run_number_overflow", "2:16: expected a finite number, found '1e999'"},
       // json::value() threw type_error on a non-string "format".
@@ -63,11 +59,7 @@ TEST(RunManifest, MalformedCorpus) {
       {"run_meshes_not_list", " key 'meshes' has the wrong type"},
       // Copying 600 nested arrays recursed once per level.
       {"run_deep_nesting", "2:523: nesting deeper than 512 levels"},
-  };
-  for (const BadCase& c : cases) {
-    const std::string dir = std::string(DRAPE_TEST_DATA_DIR) + "/bad/cache/" + c.directory;
-    EXPECT_EQ(drape::testing::errorOf([&] { (void)readRunManifest(dir); }), dir + "/manifest.json:" + c.expected) << c.directory;
-  }
+  }, [](const std::string& dir) { (void)readRunManifest(dir); }, "/manifest.json");
 }
 
 }  // namespace

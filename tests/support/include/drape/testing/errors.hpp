@@ -2,6 +2,7 @@
 // Shared by the test modules: what a call that must refuse its input says.
 
 #include <functional>
+#include <initializer_list>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -20,6 +21,23 @@ inline std::string errorOf(const std::function<void()>& f) {
     return e.what();
   }
   return "(no error)";
+}
+
+/// A file of a malformed-input corpus and the message it must give after "path:".
+struct BadCase {
+  const char* file;
+  const char* expected;
+};
+
+/// Every case's `directory/file` given to `read` must be refused with exactly
+/// "directory/file" + messageSuffix + ":" + expected (the suffix for readers that take a
+/// directory and name a file in it).
+inline void expectCorpus(const std::string& directory, std::initializer_list<BadCase> cases,
+                         const std::function<void(const std::string&)>& read, const std::string& messageSuffix = "") {
+  for (const BadCase& c : cases) {
+    const std::string path = directory + "/" + c.file;
+    EXPECT_EQ(errorOf([&] { read(path); }), path + messageSuffix + ":" + c.expected) << c.file;
+  }
 }
 
 }  // namespace drape::testing

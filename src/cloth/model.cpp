@@ -142,6 +142,7 @@ void ClothModel::applyMassScaling(const mesh::TriMesh& mesh, const MassScaling& 
   if (addedMass_ > scaling.maxAddedFraction * baseMass) {
     double stableStep = unscaledStep;
     if (beta > 0.0) {  // the unscaled masses back, for the damped bound the message names
+      freeMembraneOmega_ = 0.0;
       mass_ = base;
       updateInverseMasses();
       stableStep = std::min(stableStep, dampedStableStep_s(membraneFrequency_rad_s(), beta));
@@ -162,6 +163,7 @@ void ClothModel::applyMassScaling(const mesh::TriMesh& mesh, const MassScaling& 
 
 void ClothModel::scaleMassesFor(const mesh::TriMesh& mesh, const std::vector<double>& base, double membraneTarget_s,
                                 double bendingTarget_s) {
+  freeMembraneOmega_ = 0.0;
   mass_ = base;
   const double areal = material_.arealDensity();
   membraneStep_ = std::numeric_limits<double>::infinity();
@@ -194,7 +196,10 @@ void ClothModel::holdDampedStep(const mesh::TriMesh& mesh, const std::vector<dou
   double membraneTarget = step_s;
   for (int round = 0; round < kRounds; ++round) {
     const double omega = membraneFrequency_rad_s();
-    if (omega <= allowed) return;
+    if (omega <= allowed) {
+      freeMembraneOmega_ = omega;  // the masses are final: the substep search asks again
+      return;
+    }
     membraneTarget *= kOvershoot * omega / allowed;
     scaleMassesFor(mesh, base, membraneTarget, step_s);
   }
@@ -342,6 +347,7 @@ void ClothModel::membraneStiffnessTimes(std::span<const double> u, std::span<dou
 // (relative) over 20 iterations. Fixed vertices are left out: their rows and columns are
 // zero, as if their mass were infinite.
 double ClothModel::membraneFrequency_rad_s(std::span<const std::uint8_t> fixed) const {
+  if (fixed.empty() && freeMembraneOmega_ > 0.0) return freeMembraneOmega_;
   const std::size_t n = 3 * vertexCount();
   std::vector<double> weight(n), q(n), kq(n), scaled(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -437,8 +443,23 @@ SubstepChoice fewestStableSubsteps(const mesh::TriMesh& mesh, const mesh::Topolo
   };
   // A ladder of 5 % rungs up to the first count that passes, then bisection between it and
   // the rung below: more substeps never need more mass, so that is the fewest.
+  const auto nextRung = [](int n) { return std::max(n + 1, static_cast<int>(std::ceil(n * 1.05))); };
   int failing = std::max(1, least) - 1;
-  for (int n = std::max(1, least); n < none; n = std::max(n + 1, static_cast<int>(std::ceil(n * 1.05)))) {
+  int n = std::max(1, least);
+  if (beta > 0.0) {
+    // Damping only adds mass (ClothModel::holdDampedStep, a power iteration per model): the
+    // rungs that the undamped masses already put over the allowance are passed over first,
+    // on models that need none.
+    Material undamped = material;
+    undamped.damping_s = 0.0;
+    for (; n < none; n = nextRung(n)) {
+      const auto model = ClothModel::build(mesh, topology, undamped,
+                                           {1.0 / (frameRate_hz * n), std::numeric_limits<double>::infinity()});
+      if (model->addedMassFraction() <= maxAddedFraction) break;
+      failing = n;
+    }
+  }
+  for (; n < none; n = nextRung(n)) {
     std::optional<double> added = scaledAt(n);
     if (!added) {
       failing = n;

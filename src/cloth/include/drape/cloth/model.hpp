@@ -119,7 +119,8 @@ class ClothModel {
   /// unsoftened) and the masses as scaled; vertices flagged in `fixed` (one flag per vertex,
   /// or empty) held still. By power iteration: about 20 ms for 4,000 triangles. With
   /// internal damping this frequency, not the wave speed, bounds the explicit step
-  /// (dampedStableStep_s).
+  /// (dampedStableStep_s). With every vertex free, the value mass scaling measured on the
+  /// final masses (with damping) is returned without iterating again.
   [[nodiscard]] double membraneFrequency_rad_s(std::span<const std::uint8_t> fixed = {}) const;
   /// K u for the membrane linearised at rest; u and out hold x, y, z per vertex (3 n values).
   void membraneStiffnessTimes(std::span<const double> u, std::span<double> out) const;
@@ -163,6 +164,9 @@ class ClothModel {
   std::vector<mesh::Triangle> triangles_;
   double minAltitude_ = 0.0;
   double bendingOmega_ = 0.0;  ///< highest bending frequency bound, rad/s (buildBending)
+  /// membraneFrequency_rad_s() with every vertex free, when mass scaling measured it on the
+  /// final masses (0: not measured).
+  double freeMembraneOmega_ = 0.0;
   double membraneStep_ = 0.0;  ///< stable step of the stiffest triangle after mass scaling, s
   double addedMass_ = 0.0;
   std::size_t massScaledVertices_ = 0;

@@ -12,6 +12,7 @@
 namespace drape::formats {
 namespace {
 
+using detail::finiteNumber;
 using detail::quoted;
 
 constexpr std::size_t kMaxBones = 10'000;
@@ -59,13 +60,9 @@ struct Reader {
   }
   [[nodiscard]] double number(const Line& l, std::size_t word) const {
     if (word >= l.words.size()) throw Error::at({file, l.number, 0}, fmt::format("expected a number after '{}'", l.words[0]));
-    double v = 0.0;
-    std::string_view t = l.words[word];
-    if (!t.empty() && t.front() == '+') t.remove_prefix(1);
-    const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-    if (t.empty() || ec != std::errc() || end != t.data() + t.size() || !std::isfinite(v))
-      throw Error::at(at(l, word), fmt::format("expected a number, found {}", quoted(l.words[word])));
-    return v;
+    const std::optional<double> v = finiteNumber(l.words[word]);
+    if (!v) throw Error::at(at(l, word), fmt::format("expected a number, found {}", quoted(l.words[word])));
+    return *v;
   }
   [[nodiscard]] Vec3 vec3(const Line& l, std::size_t first) const {
     return {number(l, first), number(l, first + 1), number(l, first + 2)};

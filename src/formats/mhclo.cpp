@@ -47,12 +47,10 @@ class LineReader {
     return v;
   }
   [[nodiscard]] double number(std::size_t k) const {
-    double v = 0;
     const std::string_view t = words_.at(k).text;
-    const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-    if (ec != std::errc() || end != t.data() + t.size() || !std::isfinite(v))
-      throw error(k, fmt::format("expected a number, found '{}'", t));
-    return v;
+    const std::optional<double> v = detail::finiteNumber(t);
+    if (!v) throw error(k, fmt::format("expected a number, found '{}'", t));
+    return *v;
   }
 
  private:

@@ -89,14 +89,18 @@ std::string quoted(std::string_view word) {
   return "'" + s + (word.size() > 40 ? "...'" : "'");
 }
 
-double parseNumber(const WordScanner& s, const WordScanner::Word& w) {
+std::optional<double> finiteNumber(std::string_view word) {
+  if (!word.empty() && word.front() == '+') word.remove_prefix(1);
   double value = 0.0;
-  std::string_view t = w.text;
-  if (!t.empty() && t.front() == '+') t.remove_prefix(1);
-  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), value);
-  if (t.empty() || ec != std::errc() || end != t.data() + t.size() || !std::isfinite(value))
-    throw Error::at(s.pos(w), fmt::format("expected a number, found {}", quoted(w.text)));
+  const auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), value);
+  if (word.empty() || ec != std::errc() || end != word.data() + word.size() || !std::isfinite(value)) return std::nullopt;
   return value;
+}
+
+double parseNumber(const WordScanner& s, const WordScanner::Word& w) {
+  const std::optional<double> value = finiteNumber(w.text);
+  if (!value) throw Error::at(s.pos(w), fmt::format("expected a number, found {}", quoted(w.text)));
+  return *value;
 }
 
 std::size_t parseCount(const WordScanner& s, const WordScanner::Word& w, std::size_t max, const char* what) {

@@ -3,6 +3,7 @@
 // whole-file reading with a size limit, and a line/column tracking word scanner.
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -50,6 +51,9 @@ class WordScanner {
   int column_ = 1;
 };
 
+/// A whole word as a finite double (a leading '+' allowed); nothing for anything else:
+/// "nan", "inf", 1e999, trailing characters, an empty word.
+[[nodiscard]] std::optional<double> finiteNumber(std::string_view word);
 /// Parses a whole word as a finite double; throws "expected a number, found 'x'" at w.
 [[nodiscard]] double parseNumber(const WordScanner& s, const WordScanner::Word& w);
 /// Parses a whole word as a non-negative integer no larger than `max`.

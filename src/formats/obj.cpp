@@ -3,7 +3,6 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "motion_text.hpp"
 
 namespace drape::formats {
 namespace {
@@ -54,13 +54,6 @@ std::vector<Word> leadingWords(std::string_view line, std::size_t count) {
   return words;
 }
 
-bool isFiniteNumber(std::string_view t) {
-  if (!t.empty() && t.front() == '+') t.remove_prefix(1);
-  double value = 0.0;
-  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), value);
-  return !t.empty() && ec == std::errc() && end == t.data() + t.size() && std::isfinite(value);
-}
-
 // tinyobjloader reads a coordinate it cannot parse ("nan", "abc") as 0 and one too large
 // (1e999) as infinity, and reports neither; drape checks every `v` line's x y z first so
 // that such a file is an error naming the line and column. Lines end as tinyobjloader
@@ -85,7 +78,7 @@ void checkVertexLines(std::string_view text, const std::string& name) {
                                          : offset + words.back().column + static_cast<int>(words.back().text.size());
         throw Error::at({name, lineNo, column}, fmt::format("expected 3 coordinates (x y z) on a vertex line, found {}", k));
       }
-      if (!isFiniteNumber(words[k].text)) {
+      if (!detail::finiteNumber(words[k].text)) {
         throw Error::at({name, lineNo, offset + words[k].column},
                         fmt::format("expected a number for the vertex's {} coordinate, found '{}'", kAxes[k],
                                     words[k].text.substr(0, 40)));

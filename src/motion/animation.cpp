@@ -262,14 +262,21 @@ AvatarAnimation AvatarAnimation::build(const scene::Avatar& avatar, const Clip& 
     p.y() = anim.rootHeightOffset_ + anim.rootScale_ * motionRoot.y();
     return p;
   };
-  Vec3 hubShift = Vec3::Zero();  // the hub's horizontal move from its rest position
+  // A root (or the hub) turns with its motion joint and moves along the scaled root path.
+  const auto placeRoot = [&](std::size_t a, std::size_t f) {
+    const RigidTransform& motion = motionWorld[static_cast<std::size_t>(anim.driving_[a])];
+    if (f == 0) firstRoot[a] = motion.translation;
+    delta[a] = motion.rotation;
+    position[a] = rootPathFrom(avatar.joints[a].restCenter, motion.translation, firstRoot[a]);
+  };
   for (std::size_t f = 0; f < anim.frames_; ++f) {
     forwardKinematics(clip.skeleton, clip.frameRotations(f), clip.rootTranslations[f], motionWorld);
+    // The hub first: the joints above it, earlier in the order, move with it.
+    Vec3 hubShift = Vec3::Zero();
     if (hub.joint >= 0) {
       const auto h = static_cast<std::size_t>(hub.joint);
-      const Vec3 motionRoot = motionWorld[static_cast<std::size_t>(anim.driving_[h])].translation;
-      if (f == 0) firstRoot[h] = motionRoot;
-      hubShift = rootPathFrom(avatar.joints[h].restCenter, motionRoot, firstRoot[h]) - avatar.joints[h].restCenter;
+      placeRoot(h, f);
+      hubShift = position[h] - avatar.joints[h].restCenter;
       hubShift.y() = 0.0;
     }
     for (std::size_t a = 0; a < n; ++a) {
@@ -280,13 +287,9 @@ AvatarAnimation AvatarAnimation::build(const scene::Avatar& avatar, const Clip& 
         // Above the hub: upright, at rest height, moving with the hub across the floor.
         delta[a] = Quat::Identity();
         position[a] = joint.restCenter + hubShift;
-      } else if (joint.parent < 0 || static_cast<int>(a) == hub.joint) {
-        // Root (or hub): rotation from the motion, position along the scaled motion root path.
-        const Vec3 motionRoot = motionWorld[static_cast<std::size_t>(m)].translation;
-        if (f == 0) firstRoot[a] = motionRoot;
-        delta[a] = motionWorld[static_cast<std::size_t>(m)].rotation;
-        position[a] = rootPathFrom(joint.restCenter, motionRoot, firstRoot[a]);
-      } else {
+      } else if (joint.parent < 0) {
+        placeRoot(a, f);
+      } else if (static_cast<int>(a) != hub.joint) {
         delta[a] = m >= 0 ? Quat((motionWorld[static_cast<std::size_t>(m)].rotation * correction[a]).normalized())
                           : delta[parent];
         position[a] = position[parent] + delta[parent] * (joint.restCenter - avatar.joints[parent].restCenter);

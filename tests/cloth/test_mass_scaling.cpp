@@ -120,6 +120,9 @@ TEST(MassScaling, WithDampingTheStiffestModeKeepsTheDampedBound) {
 
   const auto scaled = ClothModel::build(s.mesh, topology, damped, MassScaling{step, unbounded});
   EXPECT_GE(dampedStableStep_s(scaled->membraneFrequency_rad_s(), damped.damping_s), step);
+  // The frequency the scaling measured and keeps is the one a fresh iteration finds.
+  const std::vector<std::uint8_t> noneHeld(scaled->vertexCount(), 0);
+  EXPECT_DOUBLE_EQ(scaled->membraneFrequency_rad_s(), scaled->membraneFrequency_rad_s(noneHeld));
   EXPECT_GT(scaled->addedMass_kg(), forStepAlone->addedMass_kg());
   // Scaled for the measured mode, not every triangle for the undamped step of the same bound
   // (the per-triangle estimate is conservative and would add several times the mass).
@@ -143,6 +146,22 @@ TEST(MassScaling, WithDampingTheStiffestModeKeepsTheDampedBound) {
   const int unscaled = fewestStableSubsteps(s.mesh, topology, justCarried, rate, 0.0).substepsPerFrame;
   const SubstepChoice withScaling = fewestStableSubsteps(s.mesh, topology, justCarried, rate, 0.2);
   EXPECT_LT(withScaling.substepsPerFrame, 0.7 * unscaled);
+  // And it is the fewest, at that damping and at a tenth of it (where the damping adds little
+  // mass, so the search's first rungs, passed over on undamped models, decide): one substep
+  // fewer needs more mass than allowed or breaks the damped bound.
+  for (const double share : {1.0, 0.1}) {
+    Material m = justCarried;
+    m.damping_s *= share;
+    for (const double allowance : {0.01, 0.2}) {
+      const int fewest = fewestStableSubsteps(s.mesh, topology, m, rate, allowance).substepsPerFrame;
+      const double fewer = 1.0 / (rate * (fewest - 1));
+      const auto below = ClothModel::build(s.mesh, topology, m, MassScaling{fewer, unbounded});
+      const std::vector<std::uint8_t> free(below->vertexCount(), 0);
+      EXPECT_TRUE(below->addedMassFraction() > allowance ||
+                  dampedStableStep_s(below->membraneFrequency_rad_s(free), m.damping_s) < fewer)
+          << "damping share " << share << ", allowance " << allowance << ": " << fewest - 1 << " would do";
+    }
+  }
   StepSettings chosen = testing::settingsWithStep(1.0 / (rate * withScaling.substepsPerFrame));
   chosen.maxAddedMass = 0.2;
   EXPECT_NO_THROW(ClothSolver(ClothModel::build(s.mesh, topology, justCarried, chosen.massScaling()), chosen));

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drape/core/error.hpp"
+#include "drape/formats/json_text.hpp"
 #include "motion_text.hpp"
 
 namespace drape::formats {
@@ -217,15 +218,11 @@ GModel parseDocument(std::string_view bytes, const std::string& name, const std:
   std::vector<unsigned char> bin;
   const bool glb = bytes.size() >= 4 && bytes.substr(0, 4) == "glTF";
   if (glb) splitGlb(bytes, name, jsonText, bin);
-  json doc;
-  try {
-    doc = json::parse(jsonText.begin(), jsonText.end());
-  } catch (const json::exception& e) {  // parse_error, and out_of_range for numbers that overflow
-    std::string what = e.what();
-    if (what.rfind("[json.exception", 0) == 0 && what.find("] ") != std::string::npos) what = what.substr(what.find("] ") + 2);
-    if (const auto colon = what.find(": "); colon != std::string::npos) what = what.substr(colon + 2);
-    throw Error(fmt::format("{}: not a glTF 2.0 file ({})", name, what));
-  }
+  if (!glb && jsonText.substr(std::min(jsonText.find_first_not_of(" \t\r\n"), jsonText.size()), 1) != "{")
+    throw Error(fmt::format("{}: not a glTF 2.0 file (neither the GLB header 'glTF' nor a JSON object)", name));
+  // The shared reader gives syntax errors a line and column (within the JSON chunk for GLB)
+  // and bounds the nesting before nlohmann's recursive parser sees it.
+  const json doc = parseJsonText(jsonText, glb ? name + " (JSON chunk)" : name);
   if (!doc.is_object() || !doc.contains("asset") || !doc["asset"].is_object())
     throw Error(fmt::format("{}: not a glTF 2.0 file (no \"asset\" object)", name));
   const auto versionIt = doc["asset"].find("version");

@@ -22,42 +22,75 @@ std::size_t endOfString(std::string_view text, std::size_t open) {
   return std::min(i + 1, text.size());
 }
 
-// nlohmann's DOM keeps no positions, so the line of each key of the top-level "joints"
-// object is found in one pass over the text (already parsed, so valid JSON: strings hold
-// no raw newline). A search per key was quadratic: 6,500 keys in 64 KB took seconds.
-// A key written twice keeps its first line.
-std::map<std::string, int> jointKeyLines(std::string_view text) {
-  std::map<std::string, int> lines;
-  int line = 1;
+// Where a joint entry was written: its key, its value, and each string inside the value.
+struct EntryPositions {
+  TextPos key;
+  TextPos value;
+  std::vector<TextPos> strings;
+};
+
+// The place of text[at], counting from `from` (whose place is `start`).
+TextPos advance(std::string_view text, std::size_t from, TextPos start, std::size_t at) {
+  for (std::size_t i = from; i < at; ++i) {
+    if (text[i] == '\n') {
+      ++start.line;
+      start.column = 1;
+    } else {
+      ++start.column;
+    }
+  }
+  return start;
+}
+
+// nlohmann's DOM keeps no positions, so the key of each entry of the top-level "joints"
+// object, and the strings of its value, are located in one pass over the text (already
+// parsed, so valid JSON: strings hold no raw newline). A search per key was quadratic:
+// 6,500 keys in 64 KB took seconds. A key written twice keeps its first place.
+std::map<std::string, EntryPositions> jointEntryPositions(std::string_view text) {
+  std::map<std::string, EntryPositions> positions;
+  TextPos here{1, 1};        // of the string being read
+  std::size_t lineStart = 0;  // index of its line's first character
   int depth = 0;
-  bool inJoints = false;  // inside the top-level "joints" object
-  std::string topKey;     // the last key of the top-level object
+  bool inJoints = false;                // inside the top-level "joints" object
+  std::string topKey;                   // the last key of the top-level object
+  EntryPositions* current = nullptr;    // the entry whose value is being read
   for (std::size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
     if (c == '\n') {
-      ++line;
+      ++here.line;
+      lineStart = i + 1;
     } else if (c == '{' || c == '[') {
       if (++depth == 2) inJoints = c == '{' && topKey == "joints";
     } else if (c == '}' || c == ']') {
       if (depth == 2) inJoints = false;
       --depth;
     } else if (c == '"') {
+      here.column = static_cast<int>(i - lineStart) + 1;
       const std::size_t end = endOfString(text, i);
       const std::size_t next = text.find_first_not_of(" \t\r\n", end);
       const bool isKey = next != std::string_view::npos && text[next] == ':';
       const std::string_view token = text.substr(i, end - i);
       i = end - 1;
-      if (isKey && (depth == 1 || (depth == 2 && inJoints))) {
-        // The key as nlohmann decoded it (escapes resolved); no exception on the off chance
-        // the token is not one string: that key just has no line.
-        const nlohmann::json key = nlohmann::json::parse(token, nullptr, false);
-        if (!key.is_string()) continue;
-        if (depth == 1) topKey = key.get<std::string>();
-        else lines.emplace(key.get<std::string>(), line);
+      if (!isKey) {
+        if (inJoints && current != nullptr && depth <= 3) current->strings.push_back(here);
+        continue;
       }
+      if (depth != 1 && !(depth == 2 && inJoints)) continue;
+      // The key as nlohmann decoded it (escapes resolved); no exception on the off chance
+      // the token is not one string: that key just has no place.
+      const nlohmann::json key = nlohmann::json::parse(token, nullptr, false);
+      if (!key.is_string()) continue;
+      if (depth == 1) {
+        topKey = key.get<std::string>();
+        continue;
+      }
+      const std::size_t value = std::min(text.find_first_not_of(" \t\r\n", next + 1), text.size());
+      const TextPos valuePos = advance(text, end - token.size(), here, value);
+      const auto [it, fresh] = positions.emplace(key.get<std::string>(), EntryPositions{here, valuePos, {}});
+      current = fresh ? &it->second : nullptr;
     }
   }
-  return lines;
+  return positions;
 }
 
 }  // namespace
@@ -71,7 +104,7 @@ const std::string* JointMap::avatarJointFor(std::string_view motionJoint) const 
 JointMap JointMap::identity(const Skeleton& skeleton) {
   JointMap map;
   map.name = "same names";
-  for (const SkeletonJoint& j : skeleton.joints) map.entries.push_back({j.name, j.name, 0});
+  for (const SkeletonJoint& j : skeleton.joints) map.entries.push_back({j.name, j.name, {}, {}});
   return map;
 }
 
@@ -83,25 +116,28 @@ JointMap parseJointMap(std::string_view json, const std::string& name) {
   map.source = name;
   map.name = doc.contains("name") && doc["name"].is_string() ? doc["name"].get<std::string>()
                                                              : std::filesystem::path(name).stem().string();
-  const std::map<std::string, int> lines = jointKeyLines(json);
+  const std::map<std::string, EntryPositions> positions = jointEntryPositions(json);
   for (const auto& [motionJoint, avatarJoint] : doc["joints"].items()) {
-    const auto found = lines.find(motionJoint);
-    const int line = found == lines.end() ? 0 : found->second;
+    const auto found = positions.find(motionJoint);
+    const EntryPositions where = found == positions.end() ? EntryPositions{} : found->second;
+    // The k-th avatar joint's own place where the scan found it, else the value's.
+    const auto valueAt = [&](std::size_t k) { return k < where.strings.size() ? where.strings[k] : where.value; };
     // A list: a chain of avatar joints (parent first) that together make the motion's one
     // bone, as rigs with twist joints split a thigh in two; all of them take its rotation.
     const bool chain = avatarJoint.is_array() && !avatarJoint.empty() &&
                        std::all_of(avatarJoint.begin(), avatarJoint.end(), [](const auto& j) { return j.is_string(); });
     if (!avatarJoint.is_string() && !chain)
-      throw Error::at({name, line, 0},
+      throw Error::at({name, where.value.line, where.value.column},
                       fmt::format("the avatar joint for '{}' must be a string or a list of strings", motionJoint));
     if (chain) {
-      for (const auto& joint : avatarJoint) map.entries.push_back({motionJoint, joint.get<std::string>(), line});
+      for (std::size_t k = 0; k < avatarJoint.size(); ++k)
+        map.entries.push_back({motionJoint, avatarJoint[k].get<std::string>(), where.key, valueAt(k)});
     } else {
-      map.entries.push_back({motionJoint, avatarJoint.get<std::string>(), line});
+      map.entries.push_back({motionJoint, avatarJoint.get<std::string>(), where.key, valueAt(0)});
     }
   }
   std::stable_sort(map.entries.begin(), map.entries.end(),
-                   [](const JointMapEntry& a, const JointMapEntry& b) { return a.line < b.line; });
+                   [](const JointMapEntry& a, const JointMapEntry& b) { return a.at.line < b.at.line; });
   return map;
 }
 
@@ -137,7 +173,7 @@ JointMap composeJointMaps(const JointMap& first, const JointMap& second) {
   composed.source = first.source;
   for (const JointMapEntry& a : first.entries)
     for (const JointMapEntry& b : second.entries)
-      if (b.motionJoint == a.avatarJoint) composed.entries.push_back({a.motionJoint, b.avatarJoint, a.line});
+      if (b.motionJoint == a.avatarJoint) composed.entries.push_back({a.motionJoint, b.avatarJoint, a.at, a.avatarAt});
   return composed;
 }
 
@@ -164,9 +200,9 @@ JointMap chooseJointMap(const std::vector<JointMap>& candidates, const Skeleton&
 void checkJointMap(const JointMap& map, const Skeleton& skeleton, const scene::Avatar& avatar) {
   for (const JointMapEntry& e : map.entries) {
     if (skeleton.find(e.motionJoint) < 0)
-      throw Error::at({map.source, e.line, 0}, fmt::format("unknown motion joint '{}' (not in the motion's skeleton)", e.motionJoint));
+      throw Error::at({map.source, e.at.line, e.at.column}, fmt::format("unknown motion joint '{}' (not in the motion's skeleton)", e.motionJoint));
     if (avatar.findJoint(e.avatarJoint) < 0)
-      throw Error::at({map.source, e.line, 0}, fmt::format("unknown avatar joint '{}' (not in avatar '{}')", e.avatarJoint, avatar.name));
+      throw Error::at({map.source, e.avatarAt.line, e.avatarAt.column}, fmt::format("unknown avatar joint '{}' (not in avatar '{}')", e.avatarJoint, avatar.name));
   }
 }
 

@@ -261,13 +261,19 @@ TEST(JointMap, UnknownJointsAreErrorsWithTheirLine) {
     checkJointMap(map, clip.skeleton, avatar);
     FAIL() << "expected an error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "mine.json:5: unknown motion joint 'ankle' (not in the motion's skeleton)");
+    EXPECT_STREQ(e.what(), "mine.json:5:5: unknown motion joint 'ankle' (not in the motion's skeleton)");
+  }
+  try {  // an unknown avatar joint is reported where its name is written, in a chain too
+    checkJointMap(parseJointMap("{\"joints\": {\n  \"hips\": [\"Hips\",\n    \"Pelvis\"]}}", "chain.json"), clip.skeleton, avatar);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "chain.json:3:5: unknown avatar joint 'Pelvis' (not in avatar 'a')");
   }
   try {
     (void)parseJointMap("{\n \"joints\": {\n  \"a\": 1\n }\n}", "bad.json");
     FAIL() << "expected an error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "bad.json:3: the avatar joint for 'a' must be a string or a list of strings");
+    EXPECT_STREQ(e.what(), "bad.json:3:8: the avatar joint for 'a' must be a string or a list of strings");
   }
   try {
     (void)parseJointMap("{\n \"joints\": {\n  \"a\": \n }\n}", "broken.json");
@@ -284,19 +290,21 @@ TEST(JointMap, EntryLinesInOnePass) {
     (void)parseJointMap("{\n \"joints\": {\n  \"z\": {\"k\": \"v\"},\n  \"b\": 2\n }\n}", "nested.json");
     FAIL() << "expected an error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "nested.json:4: the avatar joint for 'b' must be a string or a list of strings");
+    EXPECT_STREQ(e.what(), "nested.json:4:8: the avatar joint for 'b' must be a string or a list of strings");
   }
   const JointMap escaped = parseJointMap("{\"name\": \"joints\",\n\"joints\": {\n\"\\u0062\": \"B\"}}", "e.json");
   ASSERT_EQ(escaped.entries.size(), 1u);
   EXPECT_EQ(escaped.entries[0].motionJoint, "b");
-  EXPECT_EQ(escaped.entries[0].line, 3);
+  EXPECT_EQ(escaped.entries[0].at.line, 3);
+  EXPECT_EQ(escaped.entries[0].at.column, 1);
+  EXPECT_EQ(escaped.entries[0].avatarAt.column, 11);
   std::string many = "{\"joints\": {";
   for (int i = 0; i < 6500; ++i) many += std::string(i ? "," : "") + "\n\"j" + std::to_string(i) + "\": \"b\"";
   many += "}}";
   const JointMap map = parseJointMap(many, "many.json");
   ASSERT_EQ(map.entries.size(), 6500u);
   EXPECT_EQ(map.entries.back().motionJoint, "j6499");
-  EXPECT_EQ(map.entries.back().line, 6501);
+  EXPECT_EQ(map.entries.back().at.line, 6501);
 }
 
 // A list value is a chain of avatar joints driven by one motion joint, in its order; a rig's
@@ -307,7 +315,9 @@ TEST(JointMap, ChainsParseInOrderAndMapsCompose) {
   ASSERT_EQ(rig.entries.size(), 3u);
   EXPECT_EQ(rig.entries[0].avatarJoint, "thigh1");
   EXPECT_EQ(rig.entries[1].avatarJoint, "thigh2");
-  EXPECT_EQ(rig.entries[1].line, 2);
+  EXPECT_EQ(rig.entries[1].at.line, 2);
+  EXPECT_EQ(rig.entries[1].avatarAt.line, 2);
+  EXPECT_EQ(rig.entries[1].avatarAt.column, 25);
   EXPECT_EQ(*rig.avatarJointFor("LeftUpLeg"), "thigh1");  // the chain's head
   const JointMap style =
       parseJointMap("{\"name\": \"style\", \"joints\": {\"lThigh\": \"LeftUpLeg\", \"lShin\": \"LeftLeg\", \"lFoot\": \"LeftFoot\"}}",
@@ -322,7 +332,7 @@ TEST(JointMap, ChainsParseInOrderAndMapsCompose) {
       (void)parseJointMap(std::string("{\"joints\": {\n\"x\": ") + bad + "}}", "chain.json");
       FAIL() << bad;
     } catch (const Error& e) {
-      EXPECT_STREQ(e.what(), "chain.json:2: the avatar joint for 'x' must be a string or a list of strings") << bad;
+      EXPECT_STREQ(e.what(), "chain.json:2:6: the avatar joint for 'x' must be a string or a list of strings") << bad;
     }
   }
 }

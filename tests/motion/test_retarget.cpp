@@ -281,7 +281,7 @@ TEST(Retarget, UnknownJointInAUserMapIsAnErrorWithItsLine) {
     (void)loadAnimation(makeHuman(), std::string(DRAPE_DATA_DIR) + "/mocap/cmu_walk_delfem2.bvh", options);
     FAIL() << "expected an error";
   } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()), options.jointMapPath + ":5: unknown motion joint 'LeftKnee' (not in the motion's skeleton)");
+    EXPECT_EQ(std::string(e.what()), options.jointMapPath + ":5:5: unknown motion joint 'LeftKnee' (not in the motion's skeleton)");
     EXPECT_EQ(e.code(), ExitCode::BadInput);
   }
 }

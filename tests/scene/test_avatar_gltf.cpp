@@ -87,7 +87,13 @@ TEST(GltfAvatar, BufferUriOutsideTheFolderIsRefused) {
 // out_of_range, which escaped as an uncaught exception.
 TEST(GltfAvatar, NumberOverflowIsAnError) {
   const std::string e = errorOf([] { (void)loadGltfAvatar(bad("number_overflow.gltf")); });
-  EXPECT_NE(e.find("not a glTF 2.0 file (number overflow"), std::string::npos) << e;
+  EXPECT_EQ(e.rfind(bad("number_overflow.gltf") + ":1:40: expected a finite number, found '0.9E99998807907105", 0), 0u) << e;
+}
+
+// A syntax error names its line and column, as every other reader's does.
+TEST(GltfAvatar, SyntaxErrorsNameTheirLineAndColumn) {
+  const std::string e = errorOf([] { (void)loadGltfAvatar(bad("trailing_comma.gltf")); });
+  EXPECT_EQ(e.rfind(bad("trailing_comma.gltf") + ":3:32: syntax error while parsing value - unexpected ']'", 0), 0u) << e;
 }
 
 TEST(GltfAvatar, UnknownAvatarExtension) {

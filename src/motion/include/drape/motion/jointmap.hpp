@@ -24,10 +24,17 @@
 
 namespace drape::motion {
 
+/// A 1-based line and column in a map's file; 0 where the entry was built in code.
+struct TextPos {
+  int line = 0;
+  int column = 0;
+};
+
 struct JointMapEntry {
   std::string motionJoint;
   std::string avatarJoint;
-  int line = 0;  ///< line of the entry in its file (0 if built in code)
+  TextPos at;        ///< where the entry's key (the motion joint) is written
+  TextPos avatarAt;  ///< where its avatar joint is written
 };
 
 struct JointMap {
@@ -60,8 +67,8 @@ struct JointMap {
 [[nodiscard]] JointMap chooseJointMap(const std::vector<JointMap>& candidates, const Skeleton& skeleton,
                                       const scene::Avatar& avatar);
 
-/// A user's map must name only joints that exist: throws "file:line: unknown motion joint
-/// 'X' ..." or "... unknown avatar joint 'Y' ...".
+/// A user's map must name only joints that exist: throws "file:line:column: unknown motion
+/// joint 'X' ..." (at its key) or "... unknown avatar joint 'Y' ..." (at that joint's name).
 void checkJointMap(const JointMap& map, const Skeleton& skeleton, const scene::Avatar& avatar);
 
 }  // namespace drape::motion

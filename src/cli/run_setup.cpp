@@ -52,15 +52,24 @@ void logEasedPairs(const std::string& garment, const cloth::FieldCollider& colli
 }
 
 /// How much of what the substep allows the internal damping takes (the solver has refused
-/// more): near 100 %, a little more damping, or fewer substeps, will diverge.
+/// more): near 100 %, a little more damping, or fewer substeps, will diverge. Forward Euler:
+/// where in its window the damping lies.
 void logDamping(const std::string& garment, const cloth::ClothSolver& solver) {
   const double omega = solver.dampedMembraneFrequency_rad_s();
-  if (!(omega > 0.0)) return;  // undamped, or not the symplectic step
+  if (!(omega > 0.0)) return;  // undamped symplectic Euler
   const double beta = solver.model().material().damping_s;
-  const double most = cloth::largestStableDamping_s(omega, solver.settings().substep_s());
+  const double dt = solver.settings().substep_s();
+  if (solver.settings().integrator == cloth::IntegratorKind::ForwardEuler) {
+    const cloth::ForwardEulerDampingWindow window = cloth::forwardEulerDampingWindow(omega, dt);
+    spdlog::info("{}: forward Euler with internal damping {:.3g} ms, within the {:.3g} to {:.3g} ms the {:.3g} ms "
+                 "substep allows",
+                 garment, 1e3 * beta, 1e3 * window.least_s, 1e3 * window.most_s, 1e3 * dt);
+    return;
+  }
+  const double most = cloth::largestStableDamping_s(omega, dt);
   if (most > 0.0)
     spdlog::info("{}: internal damping {:.3g} ms, {:.0f} % of the most the {:.3g} ms substep allows ({:.3g} ms)",
-                 garment, 1e3 * beta, 100.0 * beta / most, 1e3 * solver.settings().substep_s(), 1e3 * most);
+                 garment, 1e3 * beta, 100.0 * beta / most, 1e3 * dt, 1e3 * most);
 }
 
 using Clock = std::chrono::steady_clock;

@@ -397,6 +397,12 @@ double largestStableDamping_s(double omega_rad_s, double step_s) {
   return (4.0 / (w * w) - step_s * step_s) / (2.0 * step_s);
 }
 
+ForwardEulerDampingWindow forwardEulerDampingWindow(double omega_rad_s, double step_s) {
+  if (!(omega_rad_s > 0.0)) return {step_s, std::numeric_limits<double>::infinity()};
+  const double w = omega_rad_s / kDampedStepMargin;
+  return {step_s, 0.5 * step_s + 2.0 / (w * w * step_s)};
+}
+
 double ClothModel::bendingStableStep_s() const {
   return bendingOmega_ > 0.0 ? 1.8 / bendingOmega_ : std::numeric_limits<double>::infinity();
 }

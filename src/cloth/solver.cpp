@@ -37,13 +37,36 @@ ClothSolver::ClothSolver(std::shared_ptr<const ClothModel> model, const StepSett
       state_(ClothState::atRest(*model_)) {
   settings_.validate("--");
   checkBendingStep(*model_, settings_);
-  if (model_->material().damping_s > 0.0 && settings_.integrator == IntegratorKind::SymplecticEuler) {
+  const bool forwardEuler = settings_.integrator == IntegratorKind::ForwardEuler;
+  if (model_->material().damping_s > 0.0 || forwardEuler) {
     std::vector<std::uint8_t> fixed(model_->vertexCount(), 0);
     for (const PinGroup& g : pins_)
       for (const std::uint32_t v : g.vertices) fixed[v] = 1;
     dampedOmega_ = model_->membraneFrequency_rad_s(fixed);
-    checkDampedStep(*model_, settings_, dampedOmega_);
+    if (forwardEuler) checkForwardEulerStep(*model_, settings_, dampedOmega_);
+    else checkDampedStep(*model_, settings_, dampedOmega_);
   }
+}
+
+void checkForwardEulerStep(const ClothModel& model, const StepSettings& settings, double omega) {
+  const double beta = model.material().damping_s;
+  const double dt = settings.substep_s();
+  const ForwardEulerDampingWindow window = forwardEulerDampingWindow(omega, dt);
+  if (window.holds(beta)) return;
+  const std::string head =
+      fmt::format("garment '{}': forward Euler is unstable at a substep of {:.3g} ms with internal damping of {:.3g} ms",
+                  model.name(), 1e3 * dt, 1e3 * beta);
+  if (!window.empty())
+    throw Error(fmt::format("{}: its modes grow unless the damping is above the substep and, for the membrane's "
+                            "stiffest mode ({:.4g} rad/s), at most {:.3g} ms; set damping above {:.3g} ms and at most "
+                            "{:.3g} ms, or use --integrator symplectic-euler",
+                            head, omega, 1e3 * window.most_s, 1e3 * window.least_s, 1e3 * window.most_s));
+  // The window opens once the step is below 2 kDampedStepMargin / omega.
+  const long substeps = static_cast<long>(std::floor(omega / (2.0 * kDampedStepMargin * settings.frameRate_hz)));
+  throw Error(fmt::format("{}: no damping keeps the membrane's stiffest mode ({:.4g} rad/s) stable at this substep; "
+                          "use more than {} substeps per frame (then damping above the substep), or --integrator "
+                          "symplectic-euler",
+                          head, omega, substeps));
 }
 
 void checkBendingStep(const ClothModel& model, const StepSettings& settings) {

@@ -126,9 +126,11 @@ TEST(MembraneFrequency, MatchesADenseEigensolveOnRandomSheets) {
   }
 }
 
-/// The amplitude, relative to its start, of the stiffest mode after `steps` symplectic Euler
-/// steps of the membrane with its internal damping, started from that mode at rest.
-double growthOfTheStiffestMode(const mesh::TriMesh& sheet, double damping_s, double dt, int steps) {
+/// The amplitude, relative to its start, of the stiffest mode after `steps` steps of the
+/// membrane with its internal damping (symplectic Euler unless told), started from that mode
+/// at rest.
+double growthOfTheStiffestMode(const mesh::TriMesh& sheet, double damping_s, double dt, int steps,
+                               IntegratorKind kind = IntegratorKind::SymplecticEuler) {
   const auto model = testing::makeModel(sheet, knit(damping_s));
   const std::vector<std::uint8_t> none(model->vertexCount(), 0);
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaledStiffness(*model, none));
@@ -145,12 +147,15 @@ double growthOfTheStiffestMode(const mesh::TriMesh& sheet, double damping_s, dou
   }
   const auto displacement = [&] {
     double most = 0.0;
-    for (std::size_t v = 0; v < model->vertexCount(); ++v)
-      most = std::max(most, (s.position(v) - Vec3(model->restX()[v], model->restY()[v], model->restZ()[v])).norm());
+    for (std::size_t v = 0; v < model->vertexCount(); ++v) {
+      const double d = (s.position(v) - Vec3(model->restX()[v], model->restY()[v], model->restZ()[v])).norm();
+      if (!std::isfinite(d)) return std::numeric_limits<double>::infinity();  // grown past doubles
+      most = std::max(most, d);
+    }
     return most;
   };
   const double start = displacement();
-  const auto integrator = makeIntegrator(IntegratorKind::SymplecticEuler);
+  const auto integrator = makeIntegrator(kind);
   for (int k = 0; k < steps; ++k) {
     clearForces(s);
     accumulateMembraneForces(*model, s);
@@ -201,9 +206,61 @@ TEST(DampedStep, TheSolverRefusesDampingItsSubstepCannotCarryAndSaysWhatWould) {
   std::vector<std::uint8_t> pinned(model->vertexCount(), 0);
   for (std::uint32_t v = 0; v < model->vertexCount(); v += 2) pinned[v] = 1;
   EXPECT_LT(model->membraneFrequency_rad_s(pinned), omega);
-  // The forward Euler step is not held to the symplectic bound.
-  settings.integrator = IntegratorKind::ForwardEuler;
-  EXPECT_NO_THROW(ClothSolver(testing::makeModel(sheet, knit(1.5 * most)), settings));
+}
+
+// Forward Euler's window, (dt, dt / 2 + 2 / (omega^2 dt)): just inside either end the
+// stiffest mode dies away, just outside it grows (below the step every mode grows, undamped
+// too). The solver refuses what lies outside, naming the window or the substeps that open one.
+TEST(DampedStep, ForwardEulerHoldsOnlyInsideItsDampingWindow) {
+  const mesh::TriMesh sheet = irregularSheet(5, 7);
+  const auto model = testing::makeModel(sheet, knit());
+  const double omega = model->membraneFrequency_rad_s();
+  const double dt = 0.5 / omega;
+  const double upper = 0.5 * dt + 2.0 / (omega * omega * dt);  // neutral, without margin
+  constexpr IntegratorKind kForward = IntegratorKind::ForwardEuler;
+  EXPECT_LT(growthOfTheStiffestMode(sheet, 1.1 * dt, dt, 400, kForward), 1.0);
+  EXPECT_LT(growthOfTheStiffestMode(sheet, 0.95 * upper, dt, 400, kForward), 1.0);
+  EXPECT_GT(growthOfTheStiffestMode(sheet, 0.0, dt, 400, kForward), 1e3);
+  EXPECT_GT(growthOfTheStiffestMode(sheet, 0.5 * dt, dt, 400, kForward), 1e3);
+  EXPECT_GT(growthOfTheStiffestMode(sheet, 1.05 * upper, dt, 400, kForward), 1e3);
+  const ForwardEulerDampingWindow window = forwardEulerDampingWindow(omega, dt);
+  EXPECT_DOUBLE_EQ(window.least_s, dt);
+  EXPECT_NEAR(window.most_s, 0.5 * dt + 2.0 / (std::pow(omega / kDampedStepMargin, 2) * dt), 1e-15);
+  EXPECT_TRUE(forwardEulerDampingWindow(omega, 1.01 * 2.0 * kDampedStepMargin / omega).empty());
+
+  StepSettings settings;
+  settings.integrator = kForward;
+  settings.frameRate_hz = 30;
+  settings.substepsPerFrame = static_cast<int>(std::ceil(omega / (30.0 * 0.5)));
+  const ForwardEulerDampingWindow at = forwardEulerDampingWindow(omega, settings.substep_s());
+  EXPECT_NO_THROW(ClothSolver(testing::makeModel(sheet, knit(0.5 * (at.least_s + at.most_s))), settings));
+  for (const double damping : {0.0, 0.9 * at.least_s, 1.1 * at.most_s}) {
+    try {
+      ClothSolver solver(testing::makeModel(sheet, knit(damping)), settings);
+      FAIL() << "expected an error at " << damping;
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("forward Euler is unstable"), std::string::npos) << what;
+      EXPECT_NE(what.find(fmt::format("set damping above {:.3g} ms and at most {:.3g} ms", 1e3 * at.least_s,
+                                      1e3 * at.most_s)),
+                std::string::npos)
+          << what;
+    }
+  }
+  // A substep past 2 kDampedStepMargin / omega: no damping works, more substeps would.
+  settings.substepsPerFrame = static_cast<int>(std::floor(omega / (30.0 * 2.0)));
+  const long needed = static_cast<long>(std::floor(omega / (2.0 * kDampedStepMargin * 30.0)));
+  try {
+    ClothSolver solver(testing::makeModel(sheet, knit(settings.substep_s())), settings);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(fmt::format("use more than {} substeps per frame", needed)), std::string::npos)
+        << e.what();
+  }
+  settings.substepsPerFrame = static_cast<int>(needed) + 1;
+  const ForwardEulerDampingWindow opened = forwardEulerDampingWindow(omega, settings.substep_s());
+  ASSERT_FALSE(opened.empty());
+  EXPECT_NO_THROW(ClothSolver(testing::makeModel(sheet, knit(0.5 * (opened.least_s + opened.most_s))), settings));
 }
 
 TEST(DampedStep, TheFewestStableSubstepsCountTheDamping) {

@@ -243,9 +243,9 @@ TEST(Integrators, SymplecticEulerEnergyBounded) {
   const double drift = energyDrift(IntegratorKind::SymplecticEuler, &kinetic);
   ASSERT_GT(kinetic, 1e-3);
   EXPECT_LT(drift, 0.02 * kinetic);
-  double forwardKinetic = 0.0;
-  const double forward = energyDrift(IntegratorKind::ForwardEuler, &forwardKinetic);
-  EXPECT_GT(forward, 2 * drift);
+  // Undamped, forward Euler gains energy in every mode at any step (DampedStep.
+  // ForwardEulerHoldsOnlyInsideItsDampingWindow measures it): the solver refuses it.
+  EXPECT_THROW((void)energyDrift(IntegratorKind::ForwardEuler, &kinetic), Error);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -186,6 +186,20 @@ inline constexpr double kDampedStepMargin = 0.9;
 /// The most damping stable at `step_s` (negative when the step is too long even undamped).
 [[nodiscard]] double largestStableDamping_s(double omega_rad_s, double step_s);
 
+/// Forward Euler (x += dt v, v += dt a) on the same mode is the map with trace 2 - b and
+/// determinant 1 - b + a (a = omega^2 dt^2, b = damping_s omega^2 dt): stable while
+/// dt < damping_s (every mode, however slow, gains energy otherwise, undamped at any step)
+/// and omega^2 dt (2 damping_s - dt) < 4. So only damping within a window works:
+/// (dt, dt / 2 + 2 / (omega^2 dt)), with omega / kDampedStepMargin; empty once dt reaches
+/// 2 kDampedStepMargin / omega.
+struct ForwardEulerDampingWindow {
+  double least_s = 0.0;  ///< damping must exceed this (the step)
+  double most_s = 0.0;   ///< and stay at or below this (below least_s: no damping works)
+  [[nodiscard]] bool holds(double damping_s) const { return damping_s > least_s && damping_s <= most_s; }
+  [[nodiscard]] bool empty() const { return most_s <= least_s; }
+};
+[[nodiscard]] ForwardEulerDampingWindow forwardEulerDampingWindow(double omega_rad_s, double step_s);
+
 /// A substep count and the mass scaling it needs.
 struct SubstepChoice {
   int substepsPerFrame = 0;

@@ -53,10 +53,17 @@ void checkBendingStep(const ClothModel& model, const StepSettings& settings);
 /// Throws drape::Error, naming the garment, the most damping the substep allows and the
 /// substeps per frame the damping needs, when the material's internal damping makes the
 /// symplectic Euler substep unstable (dampedStableStep_s with `omega_rad_s`, the membrane's
-/// highest frequency, ClothModel::membraneFrequency_rad_s; forward Euler is not checked). A
+/// highest frequency, ClothModel::membraneFrequency_rad_s; forward Euler has
+/// checkForwardEulerStep). A
 /// substep too long even without damping is left to the wave-speed estimate's warning. The
 /// solver checks it.
 void checkDampedStep(const ClothModel& model, const StepSettings& settings, double omega_rad_s);
+
+/// Throws drape::Error, naming the garment and the damping window that would work (or the
+/// substeps per frame that open one), when forward Euler cannot keep the membrane stable:
+/// internal damping outside forwardEulerDampingWindow(omega_rad_s, dt), undamped included.
+/// The solver checks it for forward Euler, with omega_rad_s measured with the pins held.
+void checkForwardEulerStep(const ClothModel& model, const StepSettings& settings, double omega_rad_s);
 
 class ClothSolver {
  public:
@@ -86,8 +93,9 @@ class ClothSolver {
   [[nodiscard]] const StageTimes& stageTimes() const { return times_; }
   [[nodiscard]] const Instability& instability() const { return instability_; }
   [[nodiscard]] const std::vector<Collider*>& colliders() const { return colliders_; }
-  /// With internal damping and symplectic Euler: the membrane's highest frequency with the
-  /// pinned and bound vertices held, which checkDampedStep judged the substep by; else 0.
+  /// With internal damping and symplectic Euler, or with forward Euler: the membrane's
+  /// highest frequency with the pinned and bound vertices held, which checkDampedStep or
+  /// checkForwardEulerStep judged the substep by; else 0.
   [[nodiscard]] double dampedMembraneFrequency_rad_s() const { return dampedOmega_; }
   /// Total energy (kinetic + gravitational + membrane + bending), J.
   [[nodiscard]] double totalEnergy() const;

@@ -11,7 +11,7 @@
 
 #include "drape/core/error.hpp"
 #include "drape/formats/json_text.hpp"
-#include "motion_text.hpp"
+#include "text_scan.hpp"
 
 namespace drape::formats {
 namespace {

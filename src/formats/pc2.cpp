@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
-#include "motion_text.hpp"
+#include "text_scan.hpp"
 
 namespace drape::formats {
 namespace {

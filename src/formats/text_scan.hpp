@@ -1,6 +1,7 @@
 #pragma once
-// Private helpers of the hand-written readers (BVH, ASF/AMC, MakeHuman rigs and clothes, PC2):
-// whole-file reading with a size limit, and a line/column tracking word scanner.
+// Private helpers of the hand-written readers (BVH, ASF/AMC, MakeHuman rigs and clothes, PC2,
+// the OBJ vertex check): whole-file reading with a size limit, a line/column tracking word
+// scanner, and number checks.
 
 #include <cstddef>
 #include <optional>

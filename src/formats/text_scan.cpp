@@ -1,4 +1,4 @@
-#include "motion_text.hpp"
+#include "text_scan.hpp"
 
 #include <charconv>
 #include <cmath>

@@ -20,10 +20,10 @@ constexpr std::size_t kMaxBones = 10'000;
 // A line split into words with their columns: both formats are line-oriented.
 struct Line {
   int number = 0;
-  std::vector<std::string_view> words;
-  std::vector<int> columns;
+  std::vector<detail::LineWord> words;
 };
 
+// The lines that hold words, '#' comments dropped (anywhere in a line, as the formats allow).
 std::vector<Line> splitLines(std::string_view text) {
   std::vector<Line> lines;
   int number = 0;
@@ -34,18 +34,7 @@ std::vector<Line> splitLines(std::string_view text) {
     ++number;
     std::string_view raw = text.substr(start, end - start);
     if (const auto hash = raw.find('#'); hash != std::string_view::npos) raw = raw.substr(0, hash);
-    Line line;
-    line.number = number;
-    std::size_t i = 0;
-    while (i < raw.size()) {
-      while (i < raw.size() && std::isspace(static_cast<unsigned char>(raw[i]))) ++i;
-      const std::size_t w = i;
-      while (i < raw.size() && !std::isspace(static_cast<unsigned char>(raw[i]))) ++i;
-      if (i > w) {
-        line.words.push_back(raw.substr(w, i - w));
-        line.columns.push_back(static_cast<int>(w) + 1);
-      }
-    }
+    Line line{number, detail::lineWords(raw)};
     if (!line.words.empty()) lines.push_back(std::move(line));
     if (end == text.size()) break;
     start = end + 1;
@@ -56,12 +45,12 @@ std::vector<Line> splitLines(std::string_view text) {
 struct Reader {
   std::string file;
   [[nodiscard]] SourcePos at(const Line& l, std::size_t word) const {
-    return {file, l.number, word < l.columns.size() ? l.columns[word] : 0};
+    return {file, l.number, word < l.words.size() ? l.words[word].column : 0};
   }
   [[nodiscard]] double number(const Line& l, std::size_t word) const {
-    if (word >= l.words.size()) throw Error::at({file, l.number, 0}, fmt::format("expected a number after '{}'", l.words[0]));
-    const std::optional<double> v = finiteNumber(l.words[word]);
-    if (!v) throw Error::at(at(l, word), fmt::format("expected a number, found {}", quoted(l.words[word])));
+    if (word >= l.words.size()) throw Error::at({file, l.number, 0}, fmt::format("expected a number after '{}'", l.words[0].text));
+    const std::optional<double> v = finiteNumber(l.words[word].text);
+    if (!v) throw Error::at(at(l, word), fmt::format("expected a number, found {}", quoted(l.words[word].text)));
     return *v;
   }
   [[nodiscard]] Vec3 vec3(const Line& l, std::size_t first) const {
@@ -70,7 +59,7 @@ struct Reader {
 };
 
 AcclaimDof parseDof(const Reader& r, const Line& l, std::size_t word) {
-  std::string w(l.words[word]);
+  std::string w(l.words[word].text);
   std::transform(w.begin(), w.end(), w.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (w == "rx") return AcclaimDof::RX;
   if (w == "ry") return AcclaimDof::RY;
@@ -79,16 +68,16 @@ AcclaimDof parseDof(const Reader& r, const Line& l, std::size_t word) {
   if (w == "ty") return AcclaimDof::TY;
   if (w == "tz") return AcclaimDof::TZ;
   if (w == "l") return AcclaimDof::L;
-  throw Error::at(r.at(l, word), fmt::format("unknown degree of freedom {} (expected rx ry rz tx ty tz l)", quoted(l.words[word])));
+  throw Error::at(r.at(l, word), fmt::format("unknown degree of freedom {} (expected rx ry rz tx ty tz l)", quoted(l.words[word].text)));
 }
 
 std::string axisOrder(const Reader& r, const Line& l, std::size_t word) {
   if (word >= l.words.size()) return "XYZ";
-  std::string order(l.words[word]);
+  std::string order(l.words[word].text);
   std::transform(order.begin(), order.end(), order.begin(), [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
   std::string sorted = order;
   std::sort(sorted.begin(), sorted.end());
-  if (sorted != "XYZ") throw Error::at(r.at(l, word), fmt::format("expected an axis order such as XYZ, found {}", quoted(l.words[word])));
+  if (sorted != "XYZ") throw Error::at(r.at(l, word), fmt::format("expected an axis order such as XYZ, found {}", quoted(l.words[word].text)));
   return order;
 }
 
@@ -99,11 +88,11 @@ std::size_t readBone(const Reader& r, const std::vector<Line>& lines, std::size_
   bool named = false;
   for (++i; i < lines.size(); ++i) {
     const Line& l = lines[i];
-    const std::string_view key = l.words[0];
+    const std::string_view key = l.words[0].text;
     if (key == "end") break;
     if (key == "name") {
       if (l.words.size() < 2) throw Error::at(r.at(l, 0), "expected a bone name after 'name'");
-      bone.name = std::string(l.words[1]);
+      bone.name = std::string(l.words[1].text);
       named = true;
     } else if (key == "direction") {
       bone.direction = r.vec3(l, 1);
@@ -133,19 +122,19 @@ std::size_t readBone(const Reader& r, const std::vector<Line>& lines, std::size_
 std::size_t readHierarchy(const Reader& r, const std::vector<Line>& lines, std::size_t i, AsfSkeleton& out) {
   std::vector<int> parent(out.bones.size(), -2);  // -2: not yet placed
   std::size_t j = i + 1;
-  if (j < lines.size() && lines[j].words[0] == "begin") ++j;
-  for (; j < lines.size() && lines[j].words[0] != "end" && lines[j].words[0].front() != ':'; ++j) {
+  if (j < lines.size() && lines[j].words[0].text == "begin") ++j;
+  for (; j < lines.size() && lines[j].words[0].text != "end" && lines[j].words[0].text.front() != ':'; ++j) {
     const Line& l = lines[j];
     int p = -1;
-    if (l.words[0] != "root") {
-      p = out.find(l.words[0]);
-      if (p < 0) throw Error::at(r.at(l, 0), fmt::format("unknown bone {} in the hierarchy", quoted(l.words[0])));
+    if (l.words[0].text != "root") {
+      p = out.find(l.words[0].text);
+      if (p < 0) throw Error::at(r.at(l, 0), fmt::format("unknown bone {} in the hierarchy", quoted(l.words[0].text)));
     }
     for (std::size_t w = 1; w < l.words.size(); ++w) {
-      const int c = out.find(l.words[w]);
-      if (c < 0) throw Error::at(r.at(l, w), fmt::format("unknown bone {} in the hierarchy", quoted(l.words[w])));
+      const int c = out.find(l.words[w].text);
+      if (c < 0) throw Error::at(r.at(l, w), fmt::format("unknown bone {} in the hierarchy", quoted(l.words[w].text)));
       if (parent[static_cast<std::size_t>(c)] != -2)
-        throw Error::at(r.at(l, w), fmt::format("bone {} has two parents", quoted(l.words[w])));
+        throw Error::at(r.at(l, w), fmt::format("bone {} has two parents", quoted(l.words[w].text)));
       parent[static_cast<std::size_t>(c)] = p;
     }
   }
@@ -168,7 +157,7 @@ std::size_t readHierarchy(const Reader& r, const std::vector<Line>& lines, std::
   }
   if (ordered.size() != out.bones.size()) throw Error::at(r.at(lines[i], 0), "the hierarchy has a cycle");
   out.bones = std::move(ordered);
-  return (j < lines.size() && lines[j].words[0] == "end") ? j : j - 1;
+  return (j < lines.size() && lines[j].words[0].text == "end") ? j : j - 1;
 }
 
 }  // namespace
@@ -189,10 +178,10 @@ AsfSkeleton parseAsf(std::string_view text, const std::string& name) {
   bool sawBones = false, sawHierarchy = false;
   for (std::size_t i = 0; i < lines.size(); ++i) {
     const Line& l = lines[i];
-    const std::string_view key = l.words[0];
+    const std::string_view key = l.words[0].text;
     if (key.front() == ':') {
       section = std::string(key);
-      if (section == ":name" && l.words.size() > 1) out.name = std::string(l.words[1]);
+      if (section == ":name" && l.words.size() > 1) out.name = std::string(l.words[1].text);
       if (section == ":hierarchy") {
         if (!sawBones) throw Error::at(r.at(l, 0), "':hierarchy' before ':bonedata'");
         i = readHierarchy(r, lines, i, out);
@@ -205,9 +194,9 @@ AsfSkeleton parseAsf(std::string_view text, const std::string& name) {
     if (section == ":units") {
       if (key == "length") out.lengthScale = r.number(l, 1);
       if (key == "angle") {
-        if (l.words.size() < 2 || (l.words[1] != "deg" && l.words[1] != "rad"))
+        if (l.words.size() < 2 || (l.words[1].text != "deg" && l.words[1].text != "rad"))
           throw Error::at(r.at(l, 1), "expected 'angle deg' or 'angle rad'");
-        out.degrees = l.words[1] == "deg";
+        out.degrees = l.words[1].text == "deg";
       }
     } else if (section == ":root") {
       if (key == "order") {
@@ -246,13 +235,13 @@ AmcMotion parseAmc(std::string_view text, const std::string& name, const AsfSkel
   // file really holds.
   std::size_t frames = 0;
   for (const Line& l : lines)
-    if (l.words.size() == 1 && std::isdigit(static_cast<unsigned char>(l.words[0].front()))) ++frames;
+    if (l.words.size() == 1 && std::isdigit(static_cast<unsigned char>(l.words[0].text.front()))) ++frames;
   if (frames > kMaxAmcFrames) throw Error(fmt::format("{}: more than {} frames", name, kMaxAmcFrames));
   out.values.reserve(frames * out.valuesPerFrame);
   std::vector<bool> seen;
   long previousNumber = 0;
   for (const Line& l : lines) {
-    const std::string_view key = l.words[0];
+    const std::string_view key = l.words[0].text;
     if (key.front() == ':') continue;  // :FULLY-SPECIFIED, :DEGREES
     if (l.words.size() == 1 && std::isdigit(static_cast<unsigned char>(key.front()))) {
       long number = 0;

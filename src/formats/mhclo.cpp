@@ -11,23 +11,7 @@
 namespace drape::formats {
 namespace {
 
-/// Whitespace-separated words of one line, with their 1-based columns.
-struct Word {
-  std::string_view text;
-  int column;
-};
-
-std::vector<Word> splitWords(std::string_view line) {
-  std::vector<Word> words;
-  std::size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
-    const std::size_t start = i;
-    while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r') ++i;
-    if (i > start) words.push_back({line.substr(start, i - start), static_cast<int>(start) + 1});
-  }
-  return words;
-}
+using Word = detail::LineWord;
 
 class LineReader {
  public:
@@ -87,7 +71,7 @@ Mhclo parseMhclo(std::string_view text, const std::string& name) {
     const std::string_view line = text.substr(pos, end - pos);
     pos = end + 1;
     ++lineNo;
-    const std::vector<Word> words = splitWords(line);
+    const std::vector<Word> words = detail::lineWords(line);
     if (words.empty() || words[0].text.front() == '#') {
       if (end == text.size()) break;
       continue;

@@ -34,26 +34,6 @@ bool wanted(const std::string& shapeName, const std::vector<std::string>& groups
   return groups.empty() || std::find(groups.begin(), groups.end(), shapeName) != groups.end();
 }
 
-/// A word of a line and its 1-based column.
-struct Word {
-  std::string_view text;
-  int column = 0;
-};
-
-// The first `count` words of `line` (fewer if it has fewer), stopping at a '#' comment.
-std::vector<Word> leadingWords(std::string_view line, std::size_t count) {
-  std::vector<Word> words;
-  std::size_t i = 0;
-  while (words.size() < count) {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
-    if (i == line.size() || line[i] == '#') break;
-    const std::size_t start = i;
-    while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r') ++i;
-    words.push_back({line.substr(start, i - start), static_cast<int>(start) + 1});
-  }
-  return words;
-}
-
 // tinyobjloader reads a coordinate it cannot parse ("nan", "abc") as 0 and one too large
 // (1e999) as infinity, and reports neither; drape checks every `v` line's x y z first so
 // that such a file is an error naming the line and column. Lines end as tinyobjloader
@@ -70,7 +50,7 @@ void checkVertexLines(std::string_view text, const std::string& name) {
     if (first == std::string_view::npos || line[first] != 'v' || first + 1 >= line.size() ||
         (line[first + 1] != ' ' && line[first + 1] != '\t'))
       continue;
-    const std::vector<Word> words = leadingWords(line.substr(first + 2), 3);
+    const std::vector<detail::LineWord> words = detail::lineWords(line.substr(first + 2), 3, '#');
     const int offset = static_cast<int>(first) + 2;
     for (std::size_t k = 0; k < 3; ++k) {
       if (k == words.size()) {

@@ -81,6 +81,20 @@ WordScanner::Word WordScanner::restOfLine() {
   return w;
 }
 
+std::vector<LineWord> lineWords(std::string_view line, std::size_t most, char comment) {
+  const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  std::vector<LineWord> words;
+  std::size_t i = 0;
+  while (words.size() < most) {
+    while (i < line.size() && space(line[i])) ++i;
+    if (i == line.size() || (comment != '\0' && line[i] == comment)) break;
+    const std::size_t start = i;
+    while (i < line.size() && !space(line[i])) ++i;
+    words.push_back({line.substr(start, i - start), static_cast<int>(start) + 1});
+  }
+  return words;
+}
+
 std::string quoted(std::string_view word) {
   if (word.empty()) return "end of file";
   std::string s(word.substr(0, 40));

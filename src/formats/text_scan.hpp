@@ -4,9 +4,11 @@
 // scanner, and number checks.
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "drape/core/error.hpp"
 
@@ -51,6 +53,17 @@ class WordScanner {
   int line_ = 1;
   int column_ = 1;
 };
+
+/// A word of one line and its 1-based column.
+struct LineWord {
+  std::string_view text;
+  int column = 0;
+};
+
+/// The words of one line (separated by spaces, tabs and carriage returns), at most `most`;
+/// a word that starts with `comment` (when given) ends the line. For the line-oriented
+/// readers (ASF/AMC, mhclo, the OBJ vertex check).
+[[nodiscard]] std::vector<LineWord> lineWords(std::string_view line, std::size_t most = SIZE_MAX, char comment = '\0');
 
 /// A whole word as a finite double (a leading '+' allowed); nothing for anything else:
 /// "nan", "inf", 1e999, trailing characters, an empty word.

@@ -17,6 +17,7 @@
 
 #include "command.hpp"
 #include "drape/cloth/model.hpp"
+#include "drape/cloth/solver.hpp"
 #include "drape/core/error.hpp"
 #include "drape/formats/obj.hpp"
 #include "drape/formats/units.hpp"
@@ -44,7 +45,7 @@ struct MakeSceneOptions {
   double frameRate = 30.0;
   int stepsPerFrame = 0;
   double maxAddedMass = 0.02;
-  int bendEvery = 1;  ///< chosen by makeScene from the garment
+  int bendEvery = 0;  ///< --bend-every, or 0: chosen by makeScene from the garment
   double bindThreshold_m = 0.04;
   cloth::Material material = knit();
 
@@ -183,9 +184,18 @@ int makeScene(MakeSceneOptions& o) {
                             "--max-added-mass {:g}; {} substeps per frame need no more than that",
                             o.stepsPerFrame, 100.0 * added, o.maxAddedMass, choice.substepsPerFrame));
 
-  // Unscaled masses: scaling only adds mass, which slows bending, so this is the cautious rhythm.
-  o.bendEvery = cloth::suggestedBendEvery(*cloth::ClothModel::build(garment, topology, o.material),
-                                          1.0 / (o.frameRate * o.stepsPerFrame));
+  // Unscaled masses: scaling only adds mass, which slows bending, so this is the cautious rhythm;
+  // a rhythm asked for is held to the bending forces' stable step, as drape run holds it.
+  const auto unscaled = cloth::ClothModel::build(garment, topology, o.material);
+  if (o.bendEvery == 0) {
+    o.bendEvery = cloth::suggestedBendEvery(*unscaled, 1.0 / (o.frameRate * o.stepsPerFrame));
+  } else {
+    cloth::StepSettings rhythm;
+    rhythm.frameRate_hz = o.frameRate;
+    rhythm.substepsPerFrame = o.stepsPerFrame;
+    rhythm.bendEvery = o.bendEvery;
+    cloth::checkBendingStep(*unscaled, rhythm);
+  }
 
   o.avatarUrl = prepareSceneDir(o.out, o.avatar, o.avatarUrl);
   const std::filesystem::path dir(o.out);
@@ -233,6 +243,10 @@ RunFunction setupMakeScene(CLI::App& app) {
   app.add_option("--frame-rate", o.frameRate, "Frames per second")->capture_default_str();
   app.add_option("--substeps", o.stepsPerFrame,
                  "Substeps per frame (default: the fewest that are stable, with mass scaling within --max-added-mass)");
+  app.add_option("--bend-every", o.bendEvery,
+                 "Bending forces every K substeps, written as the scene's bendEvery (default: a rhythm well inside "
+                 "the bending forces' stable step; a K beyond that step is refused)")
+      ->check(CLI::Range(1, 1000));
   app.add_option("--max-added-mass", o.maxAddedMass, "Mass scaling allowed, a fraction of the garment's mass")
       ->capture_default_str();
   app.add_option("--youngs-modulus", o.material.youngsModulus_Pa, "The knit's Young's modulus, Pa")->capture_default_str();

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include <nlohmann/json.hpp>
 
@@ -67,13 +68,15 @@ TEST(MakeScene, AMakeHumanGarmentIsRefittedWithItsMask) {
   // OBJ as modelled, moves with the fit, so the scene still matches all of it.
   ScratchDir dir("make-scene-mhclo");
   const std::string sceneDir = dir / "dress";
-  const CliResult made = runDrape(makeDressScene("mhclo", "--substeps 155 --collides-with Hips,Spine1", sceneDir), dir);
+  const CliResult made =
+      runDrape(makeDressScene("mhclo", "--substeps 155 --bend-every 2 --collides-with Hips,Spine1", sceneDir), dir);
   ASSERT_EQ(made.code, 0) << made.err;
   const scene::Scene sc = scene::loadScene(sceneDir + "/scene.wrl");
   ASSERT_EQ(sc.garments.size(), 1u);
   EXPECT_EQ(sc.garments[0].mesh.triangleCount(), 4192u);
   EXPECT_EQ(sc.garments[0].maskVertices.size(), 222u);
   EXPECT_EQ(sc.simulation.stepsPerFrame, 155);
+  EXPECT_EQ(sc.simulation.bendEvery, 2);
   // Refitted: the sleeves' cuffs rise to the body's wrists (about 0.2-0.3 m up, not 0.14-0.19).
   double highestCuff = -1;
   for (const Vec3& p : sc.garments[0].mesh.positions)
@@ -86,6 +89,13 @@ TEST(MakeScene, AMakeHumanGarmentIsRefittedWithItsMask) {
                                    dir);
   EXPECT_EQ(wrong.code, 2);
   EXPECT_NE(wrong.err.find("give a .mhskel avatar"), std::string::npos) << wrong.err;
+
+  // A bending rhythm beyond the bending forces' stable step is refused as drape run refuses it.
+  const CliResult tooSlow = runDrape(
+      makeDressScene("mhclo", "--substeps 155 --bend-every 33 --collides-with Hips,Spine1", dir / "slow"), dir);
+  EXPECT_EQ(tooSlow.code, 2) << tooSlow.err;
+  EXPECT_NE(tooSlow.err.find("bending every 33 substeps spans 7.1 ms"), std::string::npos) << tooSlow.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "slow/scene.wrl"));
 }
 
 TEST(MakeScene, TooFewSubstepsForTheAddedMassIsAClearError) {

@@ -13,16 +13,7 @@ using nlohmann::json;
 
 // 1-based line and column of byte offset `at` in `text`.
 SourcePos positionOf(std::string_view text, std::size_t at, const std::string& name) {
-  SourcePos pos{name, 1, 1};
-  for (std::size_t i = 0; i < std::min(at, text.size()); ++i) {
-    if (text[i] == '\n') {
-      ++pos.line;
-      pos.column = 1;
-    } else {
-      ++pos.column;
-    }
-  }
-  return pos;
+  return advancePosition(text, 0, {name, 1, 1}, at);
 }
 
 // nlohmann's message without its "[json.exception.parse_error.101] parse error at ...: " prefix.
@@ -81,6 +72,18 @@ class FailureLocator : public nlohmann::json_sax<json> {
 };
 
 }  // namespace
+
+SourcePos advancePosition(std::string_view text, std::size_t from, SourcePos start, std::size_t at) {
+  for (std::size_t i = from; i < std::min(at, text.size()); ++i) {
+    if (text[i] == '\n') {
+      ++start.line;
+      start.column = 1;
+    } else {
+      ++start.column;
+    }
+  }
+  return start;
+}
 
 nlohmann::json parseJsonText(std::string_view text, const std::string& name) {
   checkDepth(text, name);

@@ -31,15 +31,8 @@ struct EntryPositions {
 
 // The place of text[at], counting from `from` (whose place is `start`).
 TextPos advance(std::string_view text, std::size_t from, TextPos start, std::size_t at) {
-  for (std::size_t i = from; i < at; ++i) {
-    if (text[i] == '\n') {
-      ++start.line;
-      start.column = 1;
-    } else {
-      ++start.column;
-    }
-  }
-  return start;
+  const SourcePos p = formats::advancePosition(text, from, {{}, start.line, start.column}, at);
+  return {p.line, p.column};
 }
 
 // nlohmann's DOM keeps no positions, so the key of each entry of the top-level "joints"

@@ -1,11 +1,13 @@
 #pragma once
-// JSON text as drape's JSON readers (MakeHuman rigs, joint maps, run manifests) take it:
+// JSON text as drape's JSON readers (MakeHuman rigs, glTF, joint maps, run manifests) take it:
 // nlohmann_json underneath, with every failure turned into "name:line:column: what".
 
 #include <string>
 #include <string_view>
 
 #include <nlohmann/json.hpp>
+
+#include "drape/core/error.hpp"
 
 namespace drape::formats {
 
@@ -17,5 +19,9 @@ inline constexpr int kMaxJsonDepth = 512;
 /// "name:line:column: what" for a syntax error, a number too large for a double (1e999)
 /// or nesting deeper than kMaxJsonDepth.
 [[nodiscard]] nlohmann::json parseJsonText(std::string_view text, const std::string& name);
+
+/// The 1-based line and column of text[at], counting on from text[from], whose place is
+/// `start` (for readers that locate what nlohmann's DOM does not keep).
+[[nodiscard]] SourcePos advancePosition(std::string_view text, std::size_t from, SourcePos start, std::size_t at);
 
 }  // namespace drape::formats

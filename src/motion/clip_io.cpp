@@ -333,6 +333,10 @@ Clip loadClip(const std::string& path, const ClipLoadOptions& options, ClipLoadR
     const formats::AsfSkeleton asf = formats::readAsf(asfPath);
     return clipFromAsfAmc(asf, formats::readAmc(path, asf), options, report);
   }
+  if (ext == ".asf")  // the Acclaim pair's skeleton half: the motion is in its .amc files
+    throw Error(fmt::format("{}: an ASF file holds a skeleton, not motion; give one of its .amc motions (drape "
+                            "reads the .asf beside it, or the one --asf names)",
+                            path));
   throw Error(fmt::format("{}: unknown motion format '{}' (expected .bvh or .amc)", path, ext));
 }
 

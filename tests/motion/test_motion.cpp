@@ -240,6 +240,25 @@ TEST(ClipIo, AsfAmcSoccerKick) {
   EXPECT_NEAR(low, 0.0, 0.15);
 }
 
+// Given the skeleton half of an Acclaim pair, or a file of no motion format, the message
+// says what to give instead.
+TEST(ClipIo, TheWrongFileSaysWhatToGive) {
+  const std::string asf = std::string(DRAPE_DATA_DIR) + "/mocap/cmu_11.asf";
+  try {
+    (void)loadClip(asf, {});
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(asf + ": an ASF file holds a skeleton, not motion; give one of its .amc", 0), 0u)
+        << e.what();
+  }
+  try {
+    (void)loadClip("walk.fbx", {});
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "walk.fbx: unknown motion format '.fbx' (expected .bvh or .amc)");
+  }
+}
+
 TEST(ClipIo, ResampleKeepsEndpoints) {
   const Clip clip = tinyClip();
   const Clip r = resample(clip, 8.0);  // 0.5 s at 8 Hz: 5 frames

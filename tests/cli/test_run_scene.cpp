@@ -225,6 +225,27 @@ TEST(RunScene, DampingTheSubstepCannotCarryIsRefusedWithTheWayOut) {
   EXPECT_NE(ok.err.find("Skirt: internal damping 10 ms, 9"), std::string::npos) << ok.err;
 }
 
+TEST(RunScene, ForwardEulerRunsInsideItsDampingWindowOnly) {
+  // The paper's integrator: the skirt's 2 ms of damping lies inside the window its 1.01 ms
+  // substep allows; undamped, every mode would grow, and the run is refused with the window.
+  ScratchDir dir("run-forward-euler");
+  const std::string scene = "run '" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir +
+                            "/walk.bvh' --frames 3 --integrator forward-euler ";
+  const CliResult ok = runDrape(scene + "--out '" + (dir / "ok") + "'", dir);
+  EXPECT_EQ(ok.code, 0) << ok.err;
+  EXPECT_NE(ok.err.find("Skirt: forward Euler with internal damping 2 ms, within the 1.01 to 4.88 ms"),
+            std::string::npos)
+      << ok.err;
+  EXPECT_EQ(statsOf(dir / "ok")["integrator"].get<std::string>(), "forward-euler");
+  const CliResult undamped = runDrape(scene + "--damping 0 --out '" + (dir / "undamped") + "'", dir);
+  EXPECT_EQ(undamped.code, 2) << undamped.err;
+  EXPECT_NE(undamped.err.find("garment 'Skirt': forward Euler is unstable at a substep of 1.01 ms with internal "
+                              "damping of 0 ms"),
+            std::string::npos)
+      << undamped.err;
+  EXPECT_NE(undamped.err.find("set damping above 1.01 ms and at most 4.88 ms"), std::string::npos) << undamped.err;
+}
+
 }  // namespace
 }  // namespace drape
 

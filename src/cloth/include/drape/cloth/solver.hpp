@@ -54,9 +54,8 @@ void checkBendingStep(const ClothModel& model, const StepSettings& settings);
 /// substeps per frame the damping needs, when the material's internal damping makes the
 /// symplectic Euler substep unstable (dampedStableStep_s with `omega_rad_s`, the membrane's
 /// highest frequency, ClothModel::membraneFrequency_rad_s; forward Euler has
-/// checkForwardEulerStep). A
-/// substep too long even without damping is left to the wave-speed estimate's warning. The
-/// solver checks it.
+/// checkForwardEulerStep). A substep too long even without damping is left to the
+/// wave-speed estimate's warning. The solver checks it.
 void checkDampedStep(const ClothModel& model, const StepSettings& settings, double omega_rad_s);
 
 /// Throws drape::Error, naming the garment and the damping window that would work (or the

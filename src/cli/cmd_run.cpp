@@ -307,7 +307,9 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--substeps", o->substeps, "Substeps per frame, or 'auto' (the fewest estimated stable, the damping included, with --max-added-mass of mass scaling)")
       ->capture_default_str();
   app.add_option("--frame-rate", s.frameRate_hz, "Frames per second")->capture_default_str();
-  app.add_option("--integrator", o->integrator, "symplectic-euler or forward-euler (the paper's; stable only with --damping inside a window the substep sets, which a refusal names)")
+  app.add_option("--integrator", o->integrator,
+                 "symplectic-euler or forward-euler (the paper's; stable only with --damping inside a window the "
+                 "substep sets, which a refusal names)")
       ->capture_default_str();
   app.add_option("--air-viscosity", s.airViscosity_Ns_m3, "Linear air drag per area, N s/m^3")->capture_default_str();
   app.add_option("--wind", o->wind, "Wind velocity x,y,z, m/s");

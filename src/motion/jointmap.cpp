@@ -38,8 +38,8 @@ TextPos advance(std::string_view text, std::size_t from, TextPos start, std::siz
 // nlohmann's DOM keeps no positions, so the key of each entry of the top-level "joints"
 // object, and the strings of its value, are located in one pass over the text (already
 // parsed, so valid JSON: strings hold no raw newline). A search per key was quadratic:
-// 6,500 keys in 64 KB took seconds. A key written twice keeps its first place.
-std::map<std::string, EntryPositions> jointEntryPositions(std::string_view text) {
+// 6,500 keys in 64 KB took seconds. A key written twice is an error.
+std::map<std::string, EntryPositions> jointEntryPositions(std::string_view text, const std::string& name) {
   std::map<std::string, EntryPositions> positions;
   TextPos here{1, 1};        // of the string being read
   std::size_t lineStart = 0;  // index of its line's first character
@@ -80,7 +80,13 @@ std::map<std::string, EntryPositions> jointEntryPositions(std::string_view text)
       const std::size_t value = std::min(text.find_first_not_of(" \t\r\n", next + 1), text.size());
       const TextPos valuePos = advance(text, end - token.size(), here, value);
       const auto [it, fresh] = positions.emplace(key.get<std::string>(), EntryPositions{here, valuePos, {}});
-      current = fresh ? &it->second : nullptr;
+      // JSON leaves a repeated key's meaning open (nlohmann keeps the last): in a map it is
+      // a slip, one of the two pairings silently lost.
+      if (!fresh)
+        throw Error::at({name, here.line, here.column},
+                        fmt::format("motion joint '{}' is mapped twice (first at line {}, column {})", it->first,
+                                    it->second.key.line, it->second.key.column));
+      current = &it->second;
     }
   }
   return positions;
@@ -109,7 +115,7 @@ JointMap parseJointMap(std::string_view json, const std::string& name) {
   map.source = name;
   map.name = doc.contains("name") && doc["name"].is_string() ? doc["name"].get<std::string>()
                                                              : std::filesystem::path(name).stem().string();
-  const std::map<std::string, EntryPositions> positions = jointEntryPositions(json);
+  const std::map<std::string, EntryPositions> positions = jointEntryPositions(json, name);
   for (const auto& [motionJoint, avatarJoint] : doc["joints"].items()) {
     const auto found = positions.find(motionJoint);
     const EntryPositions where = found == positions.end() ? EntryPositions{} : found->second;

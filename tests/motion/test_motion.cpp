@@ -324,6 +324,15 @@ TEST(JointMap, EntryLinesInOnePass) {
   ASSERT_EQ(map.entries.size(), 6500u);
   EXPECT_EQ(map.entries.back().motionJoint, "j6499");
   EXPECT_EQ(map.entries.back().at.line, 6501);
+  try {  // a motion joint written twice: nlohmann would keep the second pairing silently
+    (void)parseJointMap("{\"joints\": {\n  \"Hips\": \"hips\",\n  \"Spine\": \"spine\",\n  \"Hips\": \"pelvis\"}}",
+                        "twice.json");
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "twice.json:4:3: motion joint 'Hips' is mapped twice (first at line 2, column 3)");
+  }
+  // The same name as a key of another object is no repeat.
+  EXPECT_EQ(parseJointMap("{\"name\": \"n\", \"joints\": {\"name\": \"a\"}}", "other.json").entries.size(), 1u);
 }
 
 // A list value is a chain of avatar joints driven by one motion joint, in its order; a rig's

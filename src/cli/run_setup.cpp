@@ -441,6 +441,9 @@ int simulateRun(const RunSetup& setup) {
     for (std::size_t g = 0; g < runs.size() && unstable.empty(); ++g)
       if (!runs[g].solver->stepFrame(frame)) {
         unstable = runs[g].solver->instability().describe(setup.garments[g].name, settings.maxSpeed_m_s);
+        if (runs[g].collider)
+          unstable += cloth::pinchNear(*runs[g].model, *runs[g].collider, runs[g].solver->instability().vertex,
+                                       settings.substepsPerFrame);
         unstableNan = runs[g].solver->instability().nan;
       }
     frameMs.push_back(1e3 * std::chrono::duration<double>(Clock::now() - start).count());

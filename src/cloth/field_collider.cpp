@@ -7,6 +7,7 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "drape/core/error.hpp"
 
@@ -213,6 +214,8 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   pinched_.clear();
   pinched_.reserve(n * parts_.size());
   askers_.assign(n, 0);
+  pinchCall_.assign(n, -1);
+  pinchParts_.assign(n, 0);
   partVelocity_.assign(n, Vec3::Zero());
   field_.embeddedAtStart = 0;
   for (std::vector<double>* v : {&endVoxelX_, &endVoxelY_, &endVoxelZ_, &nearest_}) v->assign(n, 0.0);
@@ -584,6 +587,9 @@ void FieldCollider::collectPinches(double dt_s, ClothState& io) {
   for (const auto& [k, i] : corrected_) {
     if (askers_[i] < 2) continue;
     pinched_.push_back({i, k});
+    if (pinchCall_[i] != calls_) pinchParts_[i] = 0;
+    pinchCall_[i] = calls_;
+    if (k < 64) pinchParts_[i] |= std::uint64_t{1} << k;
     const Vec3 c = frames_[k].toVoxel1.apply(io.position(i));  // where the corrections put it
     partVelocity_[i] += (frames_[k].toWorld1.apply(c) - frames_[k].toWorld0.apply(c)) / dt_s;
   }
@@ -633,6 +639,50 @@ void FieldCollider::holdPinches(double t0_s, double t1_s, ClothState& io) {
     h.at = next;
   }
   field_.heldVertexSubsteps += held_.size();
+}
+
+std::vector<std::string> FieldCollider::partsTouching(std::size_t vertex) const {
+  std::vector<std::string> names;
+  for (std::size_t k = 0; k < parts_.size(); ++k)
+    if (vertex < states_[k].size() && states_[k][vertex] == PointState::OnSurf) names.push_back(parts_[k].name);
+  return names;
+}
+
+FieldCollider::LastPinch FieldCollider::lastPinch(std::size_t vertex) const {
+  LastPinch pinch;
+  if (vertex >= pinchCall_.size() || pinchCall_[vertex] < 0) return pinch;
+  for (std::size_t k = 0; k < std::min<std::size_t>(parts_.size(), 64); ++k)
+    if (pinchParts_[vertex] >> k & 1) pinch.parts.push_back(parts_[k].name);
+  pinch.substepsAgo = calls_ - pinchCall_[vertex];
+  return pinch;
+}
+
+std::string pinchNear(const ClothModel& model, const FieldCollider& collider, std::uint32_t vertex,
+                      long withinSubsteps) {
+  constexpr double kReach_m = 0.05;
+  if (vertex >= model.vertexCount()) return "";
+  const auto restAt = [&](std::uint32_t v) { return Vec3(model.restX()[v], model.restY()[v], model.restZ()[v]); };
+  double nearest = kReach_m;
+  std::uint32_t found = vertex;
+  FieldCollider::LastPinch pinch;
+  for (std::uint32_t v = 0; v < model.vertexCount(); ++v) {
+    const double d = (restAt(v) - restAt(vertex)).norm();
+    if (d >= nearest) continue;
+    FieldCollider::LastPinch p = collider.lastPinch(v);
+    if (p.parts.empty() || p.substepsAgo > withinSubsteps) continue;
+    nearest = d;
+    found = v;
+    pinch = std::move(p);
+    if (v == vertex) break;  // its own pinch is the one to name
+  }
+  if (pinch.parts.empty()) return "";
+  const std::string who = found == vertex ? "it" : fmt::format("vertex {}, {:.0f} mm from it,", found, 1e3 * nearest);
+  const std::string when = pinch.substepsAgo == 0   ? "in that substep"
+                           : pinch.substepsAgo == 1 ? "1 substep before"
+                                                    : fmt::format("{} substeps before", pinch.substepsAgo);
+  return fmt::format("; {}, {} was pressed by {} at once (a pinch: their offset surfaces overlap there, and no "
+                     "place is outside them all)",
+                     when, who, fmt::join(pinch.parts, ", "));
 }
 
 void FieldCollider::addCorrection(std::size_t i, const Vec3& displacement) {

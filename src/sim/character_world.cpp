@@ -284,6 +284,10 @@ bool CharacterWorld::stepFrame(long frame) {
   for (GarmentRun& g : garments_) {
     if (!g.solver->stepFrame(frame)) {
       instability_ = g.solver->instability().describe(g.spec.name, settings_.step.maxSpeed_m_s);
+      // Where the vertex was held: most garments that blow up on a body do it in a pinch,
+      // between parts whose offset surfaces overlap (docs/PHYSICS.md, examples/walking_dress).
+      instability_ += cloth::pinchNear(g.solver->model(), *g.collider, g.solver->instability().vertex,
+                                       settings_.step.substepsPerFrame);
       return false;
     }
   }

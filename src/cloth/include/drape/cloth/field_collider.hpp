@@ -248,6 +248,16 @@ class FieldCollider final : public Collider {
   [[nodiscard]] const std::vector<CollisionPart>& parts() const { return parts_; }
   [[nodiscard]] const OffsetSurfaces& offsets() const { return offsets_; }
   [[nodiscard]] PointState state(std::size_t part, std::size_t vertex) const { return states_[part][vertex]; }
+  /// The parts `vertex` lay on (OnSurf) after the last collision test, in part order: two or
+  /// more, and it was pinched between them. For instability reports.
+  [[nodiscard]] std::vector<std::string> partsTouching(std::size_t vertex) const;
+  /// The last test at which two or more parts moved `vertex` (a pinch): those parts, in part
+  /// order, and how many substeps before the last one handled it came; no parts if never.
+  struct LastPinch {
+    std::vector<std::string> parts;
+    long substepsAgo = 0;
+  };
+  [[nodiscard]] LastPinch lastPinch(std::size_t vertex) const;
   /// The pair's cached position in the part's voxel coordinates (where its next walk starts).
   [[nodiscard]] const Vec3& cachedVoxel(std::size_t part, std::size_t vertex) const {
     return lastVoxel_[part][vertex];
@@ -358,6 +368,8 @@ class FieldCollider final : public Collider {
   std::vector<std::uint8_t> holds_;   ///< per part: some held point is held by it
   std::vector<PartStep> steps_;       ///< per part: its motion over the current untested substep
   std::vector<std::uint8_t> askers_;  ///< per vertex, scratch: how many parts asked to move it this test
+  std::vector<long> pinchCall_;             ///< per vertex: the call (calls_) of its last pinch, -1 if none
+  std::vector<std::uint64_t> pinchParts_;   ///< per vertex: the parts of that pinch, one bit each (parts < 64)
   std::vector<Vec3> partVelocity_;    ///< per vertex, scratch: the sum of its pinching parts' velocities there
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pinched_;  ///< scratch: (vertex, part), sorted
   ColliderCounters counters_;
@@ -376,5 +388,12 @@ class FieldCollider final : public Collider {
   const field::GridDims& d = field.dims();
   return p.x() >= 1 && p.y() >= 1 && p.z() >= 1 && p.x() < d.nx - 1 && p.y() < d.ny - 1 && p.z() < d.nz - 1;
 }
+
+/// For an instability report: the pinch nearest to `vertex` (on the garment as modelled,
+/// within 5 cm) in the last `withinSubsteps` substeps, as "; N substeps before, vertex W, D mm
+/// from it, was pressed by A, B at once (...)", or "" if there was none. The vertex that runs
+/// away is often a neighbour of the pinched one, pulled by the cloth around it.
+[[nodiscard]] std::string pinchNear(const ClothModel& model, const FieldCollider& collider, std::uint32_t vertex,
+                                    long withinSubsteps);
 
 }  // namespace drape::cloth

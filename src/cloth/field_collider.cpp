@@ -641,13 +641,6 @@ void FieldCollider::holdPinches(double t0_s, double t1_s, ClothState& io) {
   field_.heldVertexSubsteps += held_.size();
 }
 
-std::vector<std::string> FieldCollider::partsTouching(std::size_t vertex) const {
-  std::vector<std::string> names;
-  for (std::size_t k = 0; k < parts_.size(); ++k)
-    if (vertex < states_[k].size() && states_[k][vertex] == PointState::OnSurf) names.push_back(parts_[k].name);
-  return names;
-}
-
 FieldCollider::LastPinch FieldCollider::lastPinch(std::size_t vertex) const {
   LastPinch pinch;
   if (vertex >= pinchCall_.size() || pinchCall_[vertex] < 0) return pinch;

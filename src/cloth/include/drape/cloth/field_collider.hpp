@@ -248,9 +248,6 @@ class FieldCollider final : public Collider {
   [[nodiscard]] const std::vector<CollisionPart>& parts() const { return parts_; }
   [[nodiscard]] const OffsetSurfaces& offsets() const { return offsets_; }
   [[nodiscard]] PointState state(std::size_t part, std::size_t vertex) const { return states_[part][vertex]; }
-  /// The parts `vertex` lay on (OnSurf) after the last collision test, in part order: two or
-  /// more, and it was pinched between them. For instability reports.
-  [[nodiscard]] std::vector<std::string> partsTouching(std::size_t vertex) const;
   /// The last test at which two or more parts moved `vertex` (a pinch): those parts, in part
   /// order, and how many substeps before the last one handled it came; no parts if never.
   struct LastPinch {

@@ -23,6 +23,11 @@ constexpr double kEmbeddedSpeed_m_s = 0.1;
 /// An eased pair that has not reached T2 in this many times the time its depth takes at
 /// kEmbeddedSpeed collides as any other from then on.
 constexpr double kEaseTimeFactor = 2.0;
+/// Voxels by which a stored distance may exceed the distance to the surface voxels (the
+/// propagation beyond the shell: at most 0.25, FIELDS.md; the fixed-point rounding 1/128):
+/// the resting balls' margin.
+constexpr double kFieldSlack_voxels = 0.5;
+constexpr double kSqrt3 = 1.7320508075688772;
 
 int toIndex(PointState s) { return static_cast<int>(s); }
 
@@ -72,16 +77,38 @@ void mapPoints(const Affine& m, std::size_t n, const double* __restrict x, const
   }
 }
 
+/// The same map for one point, with the same arithmetic as mapPoints (a resting pair's
+/// cached position must be bit for bit what the cull would have computed).
+Vec3 mapPoint(const Affine& m, double px, double py, double pz) {
+  return {m.linear(0, 0) * px + m.linear(0, 1) * py + m.linear(0, 2) * pz + m.offset.x(),
+          m.linear(1, 0) * px + m.linear(1, 1) * py + m.linear(1, 2) * pz + m.offset.y(),
+          m.linear(2, 0) * px + m.linear(2, 1) * py + m.linear(2, 2) * pz + m.offset.z()};
+}
+
+/// A pair's resting ball (FieldCollider::rest), structure of arrays over the vertices.
+struct Balls {
+  const double* __restrict x;
+  const double* __restrict y;
+  const double* __restrict z;
+  const double* __restrict r2;  ///< squared radius; negative: no ball
+};
+
 /// keep[i]: the point is free and ends in the box [0.5, boxMax) of voxel coordinates, or
-/// its state is not OutsideVol, or `all` (a fixed point is always OutsideVol).
-void markCandidates(std::size_t n, const double* __restrict cx, const double* __restrict cy,
-                    const double* __restrict cz, const Vec3& boxMax, const std::uint8_t* __restrict state, bool all,
-                    const std::uint8_t* __restrict free, std::uint8_t* __restrict keep) {
+/// its state is not OutsideVol, or `all` (a fixed point is always OutsideVol); and it does
+/// not end inside its resting ball. Returns how many end inside their balls.
+std::size_t markCandidates(std::size_t n, const double* __restrict cx, const double* __restrict cy,
+                           const double* __restrict cz, const Vec3& boxMax, const std::uint8_t* __restrict state,
+                           bool all, const std::uint8_t* __restrict free, Balls balls, std::uint8_t* __restrict keep) {
   const double hx = boxMax.x(), hy = boxMax.y(), hz = boxMax.z();
+  std::size_t resting = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const bool inBox = (cx[i] >= 0.5) & (cx[i] < hx) & (cy[i] >= 0.5) & (cy[i] < hy) & (cz[i] >= 0.5) & (cz[i] < hz);
-    keep[i] = static_cast<std::uint8_t>((inBox | (state[i] != 0) | all) & (free[i] != 0));
+    const double dx = cx[i] - balls.x[i], dy = cy[i] - balls.y[i], dz = cz[i] - balls.z[i];
+    const bool inBall = dx * dx + dy * dy + dz * dz < balls.r2[i];
+    keep[i] = static_cast<std::uint8_t>((inBox | (state[i] != 0) | all) & (free[i] != 0) & !inBall);
+    resting += inBall;
   }
+  return resting;
 }
 
 /// b = min(a[i - stride], a[i], a[i + stride]) for every voxel, along the axis whose index
@@ -120,6 +147,33 @@ std::vector<std::uint64_t> clearanceBits(const field::DistanceField& f, double t
       for (int x = 1; x < d.nx - 1; ++x) {
         const std::uint32_t v = d.index(x, y, z);
         if (b[v] > limit) bits[v >> 6] |= std::uint64_t{1} << (v & 63);
+      }
+  return bits;
+}
+
+/// The least resting radius worth a ball, voxels.
+constexpr double kLeastRadius_voxels = 0.25;
+
+/// The least stored distance (voxels) below which no point of a voxel gets a resting ball
+/// of kLeastRadius (FieldCollider::restingRadius, |c - v| at most sqrt(3)/2); infinite when
+/// the part's shell is too narrow for balls.
+double restingDistance(const field::DistanceField& f, double t2Voxels) {
+  if (0.75 * f.shell_m() / f.voxelSize() <= t2Voxels + kFieldSlack_voxels) return std::numeric_limits<double>::infinity();
+  return kFieldSlack_voxels + std::max(t2Voxels, 0.5 * kSqrt3) + 1.5 * kSqrt3 + kLeastRadius_voxels;
+}
+
+/// Per walkable voxel, one bit: its stored distance reaches restingDistance, so that a
+/// point ending in it may rest (FieldCollider::restable_). Distances are read where the bit
+/// is set only: the points near the body, which change voxels most, read nothing more.
+std::vector<std::uint64_t> restableBits(const field::DistanceField& f, double t2Voxels) {
+  const field::GridDims& d = f.dims();
+  std::vector<std::uint64_t> bits((f.voxelCount() + 63) / 64, 0);
+  const double least = restingDistance(f, t2Voxels);
+  for (int z = 1; z < d.nz - 1; ++z)
+    for (int y = 1; y < d.ny - 1; ++y)
+      for (int x = 1; x < d.nx - 1; ++x) {
+        const std::uint32_t v = d.index(x, y, z);
+        if (f.distanceVoxels(v) >= least) bits[v >> 6] |= std::uint64_t{1} << (v & 63);
       }
   return bits;
 }
@@ -174,6 +228,7 @@ FieldCollider::FieldCollider(std::string garmentName, std::vector<CollisionPart>
                               garment_, p.name, p.field->shell_m(), offsets_.t3_m));
     }
     clearOfT2_.push_back(clearanceBits(*p.field, offsets_.t2_m / p.field->voxelSize()));
+    restable_.push_back(restableBits(*p.field, offsets_.t2_m / p.field->voxelSize()));
   }
   frames_.resize(parts_.size());
   poses_.resize(2 * parts_.size());
@@ -222,6 +277,11 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   keep_.assign(n + 8, 0);  // padded: the candidate scan reads eight flags at a time
   candidates_.assign(n, 0);
   settledVoxel_.assign(parts_.size(), std::vector<Vec3i>(n, kNotSettled));
+  for (auto* b : {&ballX_, &ballY_, &ballZ_}) b->assign(parts_.size(), std::vector<double>(n, 0.0));
+  ballR2_.assign(parts_.size(), std::vector<double>(n, -1.0));
+  ballTest_.assign(parts_.size(), std::vector<long>(n, 0));
+  for (std::vector<double>* v : {&testX_, &testY_, &testZ_, &nextTestX_, &nextTestY_, &nextTestZ_}) v->assign(n, 0.0);
+  tests_ = 0;
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     const field::DistanceField& f = *parts_[k].field;
     const Affine toVoxel = worldToVoxel(f, parts_[k].motion->poseAt(t_s));
@@ -280,17 +340,30 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
   }
   poseSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - poseStart).count();
   for (std::size_t k = 0; k < parts_.size(); ++k) frames_[k] = framePart(parts_[k], poses_[2 * k], poses_[2 * k + 1]);
+  ++tests_;
+  // Where the points are before this test's corrections: where the walks of the pairs
+  // resting now would start at the next test (wake).
+  std::copy(io.x.begin(), io.x.end(), nextTestX_.begin());
+  std::copy(io.y.begin(), io.y.end(), nextTestY_.begin());
+  std::copy(io.z.begin(), io.z.end(), nextTestZ_.begin());
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     const PartFrame& frame = frames_[k];
-    const std::size_t kept = selectCandidates(k, frame, io);
-    // The culled pairs are OutsideVol -> OutsideVol without a trace.
+    std::size_t resting = 0;
+    const std::size_t kept = selectCandidates(k, frame, io, resting);
+    // The culled pairs are OutsideVol -> OutsideVol without a trace; the resting ones
+    // InsideVol -> InsideVol, walked within their balls.
     field_.tests += freeCount_;
     counters_.pointsTested += freeCount_;
-    field_.transitions[0][0] += freeCount_ - kept;
+    field_.transitions[0][0] += freeCount_ - kept - resting;
+    field_.transitions[1][1] += resting;
+    field_.traces += resting;
+    field_.restingSkips += resting;
     const std::vector<Vec3i>& settled = settledVoxel_[k];
+    const std::vector<double>& ballR2 = ballR2_[k];
     for (std::size_t j = 0; j < kept; ++j) {
       const std::uint32_t i = candidates_[j];
       const Vec3 c1(endVoxelX_[i], endVoxelY_[i], endVoxelZ_[i]);
+      if (ballR2[i] >= 0) wake(k, i);
       if (roundVoxel(c1) == settled[i]) {
         settle(k, i, c1);
       } else {
@@ -298,6 +371,9 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
       }
     }
   }
+  testX_.swap(nextTestX_);
+  testY_.swap(nextTestY_);
+  testZ_.swap(nextTestZ_);
   applyCorrections(io);
   collectPinches(interval_s, io);
   if (measurePenetration_) {
@@ -309,15 +385,18 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
   lastTime_s_ = t1_s;
 }
 
-std::size_t FieldCollider::selectCandidates(std::size_t k, const PartFrame& frame, const ClothState& io) {
+std::size_t FieldCollider::selectCandidates(std::size_t k, const PartFrame& frame, const ClothState& io,
+                                            std::size_t& resting) {
   const std::size_t n = io.size();
   mapPoints(frame.toVoxel1, n, io.x.data(), io.y.data(), io.z.data(), endVoxelX_.data(), endVoxelY_.data(),
             endVoxelZ_.data());
   // The walkable box: voxels 1 .. n-2 along each axis (the border layer is the outermost).
   const field::GridDims& d = parts_[k].field->dims();
   const Vec3 boxMax(d.nx - 1.5, d.ny - 1.5, d.nz - 1.5);
-  markCandidates(n, endVoxelX_.data(), endVoxelY_.data(), endVoxelZ_.data(), boxMax,
-                 reinterpret_cast<const std::uint8_t*>(states_[k].data()), !boxCulling_, free_.data(), keep_.data());
+  const Balls balls{ballX_[k].data(), ballY_[k].data(), ballZ_[k].data(), ballR2_[k].data()};
+  resting = markCandidates(n, endVoxelX_.data(), endVoxelY_.data(), endVoxelZ_.data(), boxMax,
+                           reinterpret_cast<const std::uint8_t*>(states_[k].data()), !boxCulling_, free_.data(), balls,
+                           keep_.data());
   const std::uint8_t* keep = keep_.data();
   // Most flags are zero: skip them eight at a time.
   std::size_t kept = 0;
@@ -498,6 +577,7 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
   if (state == PointState::OnSurf) respondOnSurface(frame, c, at, moved, i, dt_s, io);
   last = c;
   ++field_.transitions[toIndex(from)][toIndex(state)];
+  if (state == PointState::InsideVol && !moved) rest(k, i, c);
 }
 
 field::FieldSample FieldCollider::slidingSample(std::size_t k, std::size_t i, const Vec3& c) {
@@ -523,6 +603,7 @@ void FieldCollider::stayInside(std::size_t k, std::size_t i, const Vec3& c1) {
   ++field_.clearanceSkips;
   // Until the pair leaves this voxel its test is this one: settle() repeats it.
   settledVoxel_[k][i] = roundVoxel(c1);
+  rest(k, i, c1);
 }
 
 // Pair (k, vertex) stayed InsideVol in a voxel clear of T2 at its last test and ends this
@@ -533,6 +614,62 @@ void FieldCollider::settle(std::size_t k, std::size_t i, const Vec3& c1) {
   ++field_.transitions[toIndex(PointState::InsideVol)][toIndex(PointState::InsideVol)];
   lastVoxel_[k][i] = c1;
   ++field_.clearanceSkips;
+}
+
+// The full test of a pair resting at the previous test would start its walk where the
+// point was then, before that test's corrections, in the part's voxel coordinates of then;
+// its state was InsideVol throughout (its ball lies inside the walkable box and clear of T2).
+void FieldCollider::wake(std::size_t k, std::size_t i) {
+  const bool restedLastTest = ballTest_[k][i] < tests_ - 1;
+  ballR2_[k][i] = -1.0;
+  if (!restedLastTest) return;
+  lastVoxel_[k][i] = mapPoint(frames_[k].toVoxel0, testX_[i], testY_[i], testZ_[i]);
+  states_[k][i] = PointState::InsideVol;
+  settledVoxel_[k][i] = kNotSettled;
+}
+
+void FieldCollider::rest(std::size_t k, std::size_t i, const Vec3& c1) {
+  const double r = restingRadius(k, c1);
+  if (!(r > 0)) return;
+  ballX_[k][i] = c1.x();
+  ballY_[k][i] = c1.y();
+  ballZ_[k][i] = c1.z();
+  ballR2_[k][i] = r * r;
+  ballTest_[k][i] = tests_;
+}
+
+// Why the radius holds (voxel units; v the voxel nearest c, d_v its stored distance, D the
+// distance to the surface voxels' centres, which changes by at most the distance moved):
+// - a walk within the ball visits voxels within sqrt(3)/2 of its points, and a trilinear
+//   distance there blends voxels within sqrt(3) of the point, so every voxel that counts
+//   lies within R = sqrt(3) + r + |c - v| of v;
+// - stored distances are D rounded, within the shell, and beyond it between 0.75 D and
+//   D + 0.25 (FIELDS.md): a voxel u outside the body has d_u >= d_v - slack - |u - v|, above
+//   T2 while |u - v| < d_v - slack - T2; beyond the shell d_u >= 0.75 shell, above T2 when
+//   the shell is wide enough (otherwise no part rests);
+// - a voxel inside the body (negative) is at least D_v - sqrt(3)/2 from v, since the segment
+//   between them crosses the surface in a surface voxel: out of reach while
+//   |u - v| < d_v - slack - sqrt(3)/2.
+double FieldCollider::restingRadius(std::size_t k, const Vec3& c) const {
+  if (!restingBalls_) return 0;
+  const field::DistanceField& f = *parts_[k].field;
+  const Vec3i v = roundVoxel(c);
+  if (!walkable(f, v)) return 0;
+  const std::uint32_t voxel = f.index(v.x(), v.y(), v.z());
+  if (!((restable_[k][voxel >> 6] >> (voxel & 63)) & 1)) return 0;
+  const double t2Voxels = offsets_.t2_m / f.voxelSize();
+  const field::GridDims& d = f.dims();
+  const double toBox = std::min({c.x() - 0.5, c.y() - 0.5, c.z() - 0.5, d.nx - 1.5 - c.x(), d.ny - 1.5 - c.y(),
+                                 d.nz - 1.5 - c.z()});
+  const double dv = f.distanceVoxels(voxel);
+  const double r = dv - kFieldSlack_voxels - std::max(t2Voxels, 0.5 * kSqrt3) - kSqrt3 - (c - v.cast<double>()).norm();
+  return std::min(r, toBox);
+}
+
+Vec3 FieldCollider::cachedVoxel(std::size_t k, std::size_t i) const {
+  if (ballR2_[k][i] >= 0 && ballTest_[k][i] < tests_)  // resting now: where the full test left it
+    return mapPoint(frames_[k].toVoxel1, testX_[i], testY_[i], testZ_[i]);
+  return lastVoxel_[k][i];
 }
 
 void FieldCollider::respondOnSurface(const PartFrame& frame, const Vec3& c, const field::FieldSample& at, bool moved,
@@ -750,7 +887,8 @@ FieldCollisionCounters& FieldCollisionCounters::operator+=(const FieldCollisionC
                       {&collisions, o.collisions}, {&projections, o.projections},
                       {&vertexSubstepsBelowT1, o.vertexSubstepsBelowT1}, {&vertexSubstepsBelowT0, o.vertexSubstepsBelowT0},
                       {&vertexSubstepsInsideBody, o.vertexSubstepsInsideBody}, {&vertexSubsteps, o.vertexSubsteps},
-                      {&clearanceSkips, o.clearanceSkips}, {&embeddedAtStart, o.embeddedAtStart},
+                      {&clearanceSkips, o.clearanceSkips}, {&restingSkips, o.restingSkips},
+                      {&embeddedAtStart, o.embeddedAtStart},
                       {&embeddedTimedOut, o.embeddedTimedOut},
                       {&planeEstimates, o.planeEstimates}, {&planeReads, o.planeReads},
                       {&heldVertexSubsteps, o.heldVertexSubsteps}, {&pinchedVertexTests, o.pinchedVertexTests}})

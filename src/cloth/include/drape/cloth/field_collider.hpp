@@ -77,6 +77,19 @@
 // its voxel, and while it ends its tests in that voxel they are settled from the cache
 // (settle): no range test, no clearance bit, no call of the per-pair test.
 //
+// Resting balls (most tested pairs are still InsideVol points far from the body, moving a
+// little relative to their part): a pair that ends a test InsideVol, unmoved, gets a ball
+// around where it ended, in the part's voxel coordinates, inside the walkable box and so far
+// from T2 that no walk within it can meet a voxel below T2 and no trilinear distance within
+// it is below T2 (restingRadius). While the pair ends its tests inside that ball, every walk
+// of the full test (from the last test's end to this one's, both in the ball, which is
+// convex) stays in it and finds nothing: the pair stays InsideVol and nothing moves. The
+// cull's vector pass, which maps every point into the part anyway, leaves such pairs out
+// (restingSkips). A pair that leaves its ball is tested again from where the full test would
+// start its walk: the point's position at the previous test, before that test's corrections,
+// mapped with the part's pose then. States, positions, velocities and every counter but the
+// walked voxels (traceVoxels) are those of the full test (tested against it).
+//
 // Contact planes (most of the remaining field reads are sliding pairs'): a sliding point
 // moves a few hundredths of a voxel per substep relative to its part, and the field is
 // fixed in the part's frame. Each sliding pair keeps its last read (distance, the trilinear
@@ -152,6 +165,7 @@ struct FieldCollisionCounters {
   std::uint64_t vertexSubsteps = 0;            ///< vertices x collision substeps
   double maxPenetration_m = 0;      ///< deepest point below the body surface after the response
   std::uint64_t clearanceSkips = 0;  ///< pairs that stayed InsideVol without a trilinear read
+  std::uint64_t restingSkips = 0;    ///< pairs left out by the cull: they ended inside their resting ball
   std::uint64_t embeddedAtStart = 0;  ///< (vertex, part) pairs below T2 at the start, eased out onto T2
   std::uint64_t embeddedTimedOut = 0;  ///< eased pairs that had not reached T2 in time and then collided as any other
   std::uint64_t planeEstimates = 0;  ///< sliding pairs' field reads answered by their contact plane
@@ -231,6 +245,13 @@ class FieldCollider final : public Collider {
   [[nodiscard]] bool clearOfT2(std::size_t k, std::uint32_t voxel) const {
     return clearanceSkip_ && ((clearOfT2_[k][voxel >> 6] >> (voxel & 63)) & 1);
   }
+  /// Off: no pair rests in a ball (the reference they are tested against). On by default.
+  void setRestingBalls(bool on) { restingBalls_ = on; }
+  /// The radius, in voxels, of the resting ball of a pair of part k that ends a test
+  /// unmoved and InsideVol at voxel coordinates c: within it no walk meets a voxel below T2
+  /// and no trilinear distance is below T2, and it lies inside the walkable box. Not
+  /// positive: no ball.
+  [[nodiscard]] double restingRadius(std::size_t k, const Vec3& c) const;
 
   [[nodiscard]] std::string name() const override { return "distance fields"; }
   void collide(const ClothModel& model, double t0_s, double t1_s, ClothState& io) override;
@@ -255,10 +276,9 @@ class FieldCollider final : public Collider {
     long substepsAgo = 0;
   };
   [[nodiscard]] LastPinch lastPinch(std::size_t vertex) const;
-  /// The pair's cached position in the part's voxel coordinates (where its next walk starts).
-  [[nodiscard]] const Vec3& cachedVoxel(std::size_t part, std::size_t vertex) const {
-    return lastVoxel_[part][vertex];
-  }
+  /// The pair's cached position in the part's voxel coordinates (where its next walk starts;
+  /// for a pair resting in its ball, where the full test would start it).
+  [[nodiscard]] Vec3 cachedVoxel(std::size_t part, std::size_t vertex) const;
   /// Per part, the (vertex, part) pairs being eased out onto T2 now: right after initialise,
   /// those that start below T2.
   [[nodiscard]] std::vector<std::size_t> easedPairsPerPart() const;
@@ -274,7 +294,8 @@ class FieldCollider final : public Collider {
   PartFrame framePart(const CollisionPart& part, const RigidTransform& pose0, const RigidTransform& pose1) const;
   /// Fills endVoxel* with every point's end position in part k's voxel coordinates and
   /// candidates_ with the points the per-pair test must see; returns their number.
-  std::size_t selectCandidates(std::size_t k, const PartFrame& frame, const ClothState& io);
+  /// `resting`: how many of the points rest in their balls (left out).
+  std::size_t selectCandidates(std::size_t k, const PartFrame& frame, const ClothState& io, std::size_t& resting);
   void releaseEmbedded(std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& endVoxel, double dt_s,
                        ClothState& io);
   void collidePoint(std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& endVoxel, double dt_s,
@@ -283,6 +304,11 @@ class FieldCollider final : public Collider {
   void stayInside(std::size_t k, std::size_t vertex, const Vec3& c1);
   /// Pair (k, vertex), settled in its voxel by stayInside, ends in it again: the same.
   void settle(std::size_t k, std::size_t vertex, const Vec3& c1);
+  /// Pair (k, vertex) is about to be tested: if it rested in its ball at the previous test,
+  /// its state and cached position become the full test's; its ball is dropped either way.
+  void wake(std::size_t k, std::size_t vertex);
+  /// Pair (k, vertex) ended this test InsideVol and unmoved at c1: its resting ball.
+  void rest(std::size_t k, std::size_t vertex, const Vec3& c1);
   /// The field at c for sliding pair (k, vertex): from its contact plane when the plane
   /// reaches c, else read (and the plane moved there).
   [[nodiscard]] field::FieldSample slidingSample(std::size_t k, std::size_t vertex, const Vec3& c);
@@ -321,7 +347,9 @@ class FieldCollider final : public Collider {
   bool contactPlanes_ = true;
   bool measurePenetration_ = true;
   bool pinchHold_ = true;
+  bool restingBalls_ = true;
   long calls_ = 0;
+  long tests_ = 0;  ///< collision tests run
   double poseSeconds_ = 0;
   double measureSeconds_ = 0;
   std::vector<PartFrame> frames_;  ///< per part, this interval's transforms (collide)
@@ -346,6 +374,9 @@ class FieldCollider final : public Collider {
   /// [part][voxel / 64], bit voxel % 64: the voxel's whole 3x3x3 neighbourhood lies above
   /// T2 (walkable voxels only). Built with the collider: the fields are fixed, and so is T2.
   std::vector<std::vector<std::uint64_t>> clearOfT2_;
+  /// [part][voxel / 64], bit voxel % 64: a point ending in the voxel may get a resting ball
+  /// (its stored distance is far enough above T2; restingRadius reads it only then).
+  std::vector<std::vector<std::uint64_t>> restable_;
   // Per-substep scratch, sized by initialise (the step does not allocate).
   std::vector<double> endVoxelX_, endVoxelY_, endVoxelZ_;  ///< per vertex, the current part's voxel coordinates
   std::vector<std::uint8_t> keep_;                ///< per vertex: the current part must test it
@@ -353,6 +384,14 @@ class FieldCollider final : public Collider {
   /// [part][vertex]: the voxel in which the pair's last test found it staying InsideVol,
   /// clear of T2 (stayInside); kNotSettled otherwise.
   std::vector<std::vector<Vec3i>> settledVoxel_;
+  /// [part][vertex]: the pair's resting ball (centre in voxel coordinates, squared radius;
+  /// negative: none) and the test that set it (rest).
+  std::vector<std::vector<double>> ballX_, ballY_, ballZ_, ballR2_;
+  std::vector<std::vector<long>> ballTest_;
+  /// Per vertex, m: the point's position at the last test, before its corrections (where a
+  /// resting pair's full test would start its next walk).
+  std::vector<double> testX_, testY_, testZ_;
+  std::vector<double> nextTestX_, nextTestY_, nextTestZ_;  ///< scratch: this test's, until it ends
   static inline const Vec3i kNotSettled = Vec3i::Constant(-1000000);
   std::vector<double> nearest_;                   ///< per vertex, m: distance to the nearest part after the response
   /// A point held in a pinch: its parts are heldParts_[firstPart, firstPart + partCount).

@@ -1,6 +1,8 @@
 #include "drape/formats/json_text.hpp"
 
 #include <algorithm>
+#include <unordered_map>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -71,7 +73,58 @@ class FailureLocator : public nlohmann::json_sax<json> {
   }
 };
 
+// JSON leaves the meaning of a key written twice in one object open, and nlohmann keeps the
+// last silently: in a rig, a glTF asset or a joint map that is a slip, one of the two values
+// lost. One pass over the text (already parsed, so valid JSON), with the keys of every open
+// object; a key is compared as written, or decoded where it holds an escape.
+void checkRepeatedKeys(std::string_view text, const std::string& name) {
+  struct Open {
+    bool object = false;
+    std::unordered_map<std::string, SourcePos> keys;
+  };
+  std::vector<Open> open;  // by depth; reused, so that sibling objects do not allocate anew
+  std::size_t depth = 0;
+  SourcePos here{name, 1, 1};
+  std::size_t counted = 0;  // `here` is the place of text[counted]
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '{' || c == '[') {
+      if (open.size() <= depth) open.emplace_back();
+      open[depth].object = c == '{';
+      open[depth].keys.clear();
+      ++depth;
+    } else if (c == '}' || c == ']') {
+      depth -= depth > 0;
+    } else if (c == '"') {
+      const std::size_t end = endOfJsonString(text, i);
+      const std::size_t next = text.find_first_not_of(" \t\r\n", end);
+      if (depth > 0 && open[depth - 1].object && next != std::string_view::npos && text[next] == ':') {
+        const std::string_view token = text.substr(i, end - i);
+        std::string key(token.substr(1, token.size() - 2));
+        if (key.find('\\') != std::string::npos) {
+          const json decoded = json::parse(token, nullptr, false);
+          if (decoded.is_string()) key = decoded.get<std::string>();
+        }
+        here = advancePosition(text, counted, here, i);
+        counted = i;
+        const auto [first, fresh] = open[depth - 1].keys.emplace(std::move(key), here);
+        if (!fresh)
+          throw Error::at(here, fmt::format("key '{}' is written twice in one object (first at line {}, column {}); "
+                                            "which one counts is left open",
+                                            first->first, first->second.line, first->second.column));
+      }
+      i = end - 1;
+    }
+  }
+}
+
 }  // namespace
+
+std::size_t endOfJsonString(std::string_view text, std::size_t open) {
+  std::size_t i = open + 1;
+  while (i < text.size() && text[i] != '"') i += text[i] == '\\' ? 2 : 1;
+  return std::min(i + 1, text.size());
+}
 
 SourcePos advancePosition(std::string_view text, std::size_t from, SourcePos start, std::size_t at) {
   for (std::size_t i = from; i < std::min(at, text.size()); ++i) {
@@ -88,7 +141,9 @@ SourcePos advancePosition(std::string_view text, std::size_t from, SourcePos sta
 nlohmann::json parseJsonText(std::string_view text, const std::string& name) {
   checkDepth(text, name);
   try {
-    return json::parse(text.begin(), text.end());
+    json doc = json::parse(text.begin(), text.end());
+    checkRepeatedKeys(text, name);
+    return doc;
   } catch (const json::parse_error& e) {
     throw Error::at(positionOf(text, e.byte > 0 ? e.byte - 1 : 0, name), messageOf(e));
   } catch (const json::exception&) {  // out_of_range: a number too large for a double

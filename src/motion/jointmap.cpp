@@ -15,13 +15,6 @@
 namespace drape::motion {
 namespace {
 
-// Index just past the string token that starts at text[open] (a '"'), escapes skipped.
-std::size_t endOfString(std::string_view text, std::size_t open) {
-  std::size_t i = open + 1;
-  while (i < text.size() && text[i] != '"') i += text[i] == '\\' ? 2 : 1;
-  return std::min(i + 1, text.size());
-}
-
 // Where a joint entry was written: its key, its value, and each string inside the value.
 struct EntryPositions {
   TextPos key;
@@ -38,8 +31,8 @@ TextPos advance(std::string_view text, std::size_t from, TextPos start, std::siz
 // nlohmann's DOM keeps no positions, so the key of each entry of the top-level "joints"
 // object, and the strings of its value, are located in one pass over the text (already
 // parsed, so valid JSON: strings hold no raw newline). A search per key was quadratic:
-// 6,500 keys in 64 KB took seconds. A key written twice is an error.
-std::map<std::string, EntryPositions> jointEntryPositions(std::string_view text, const std::string& name) {
+// 6,500 keys in 64 KB took seconds.
+std::map<std::string, EntryPositions> jointEntryPositions(std::string_view text) {
   std::map<std::string, EntryPositions> positions;
   TextPos here{1, 1};        // of the string being read
   std::size_t lineStart = 0;  // index of its line's first character
@@ -59,7 +52,7 @@ std::map<std::string, EntryPositions> jointEntryPositions(std::string_view text,
       --depth;
     } else if (c == '"') {
       here.column = static_cast<int>(i - lineStart) + 1;
-      const std::size_t end = endOfString(text, i);
+      const std::size_t end = formats::endOfJsonString(text, i);
       const std::size_t next = text.find_first_not_of(" \t\r\n", end);
       const bool isKey = next != std::string_view::npos && text[next] == ':';
       const std::string_view token = text.substr(i, end - i);
@@ -79,14 +72,8 @@ std::map<std::string, EntryPositions> jointEntryPositions(std::string_view text,
       }
       const std::size_t value = std::min(text.find_first_not_of(" \t\r\n", next + 1), text.size());
       const TextPos valuePos = advance(text, end - token.size(), here, value);
-      const auto [it, fresh] = positions.emplace(key.get<std::string>(), EntryPositions{here, valuePos, {}});
-      // JSON leaves a repeated key's meaning open (nlohmann keeps the last): in a map it is
-      // a slip, one of the two pairings silently lost.
-      if (!fresh)
-        throw Error::at({name, here.line, here.column},
-                        fmt::format("motion joint '{}' is mapped twice (first at line {}, column {})", it->first,
-                                    it->second.key.line, it->second.key.column));
-      current = &it->second;
+      // A key written twice was refused by parseJsonText.
+      current = &positions.emplace(key.get<std::string>(), EntryPositions{here, valuePos, {}}).first->second;
     }
   }
   return positions;
@@ -115,7 +102,7 @@ JointMap parseJointMap(std::string_view json, const std::string& name) {
   map.source = name;
   map.name = doc.contains("name") && doc["name"].is_string() ? doc["name"].get<std::string>()
                                                              : std::filesystem::path(name).stem().string();
-  const std::map<std::string, EntryPositions> positions = jointEntryPositions(json, name);
+  const std::map<std::string, EntryPositions> positions = jointEntryPositions(json);
   for (const auto& [motionJoint, avatarJoint] : doc["joints"].items()) {
     const auto found = positions.find(motionJoint);
     const EntryPositions where = found == positions.end() ? EntryPositions{} : found->second;

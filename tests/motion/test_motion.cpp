@@ -329,7 +329,9 @@ TEST(JointMap, EntryLinesInOnePass) {
                         "twice.json");
     FAIL() << "expected an error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "twice.json:4:3: motion joint 'Hips' is mapped twice (first at line 2, column 3)");
+    EXPECT_STREQ(e.what(),
+                 "twice.json:4:3: key 'Hips' is written twice in one object (first at line 2, column 3); which one "
+                 "counts is left open");
   }
   // The same name as a key of another object is no repeat.
   EXPECT_EQ(parseJointMap("{\"name\": \"n\", \"joints\": {\"name\": \"a\"}}", "other.json").entries.size(), 1u);

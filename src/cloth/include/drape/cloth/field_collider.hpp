@@ -88,7 +88,8 @@
 // (restingSkips). A pair that leaves its ball is tested again from where the full test would
 // start its walk: the point's position at the previous test, before that test's corrections,
 // mapped with the part's pose then. States, positions, velocities and every counter but the
-// walked voxels (traceVoxels) are those of the full test (tested against it).
+// walked voxels (traceVoxels) and the clearance skips are those of the full test (tested
+// against it).
 //
 // Contact planes (most of the remaining field reads are sliding pairs'): a sliding point
 // moves a few hundredths of a voxel per substep relative to its part, and the field is

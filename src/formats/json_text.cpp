@@ -26,17 +26,13 @@ std::string messageOf(const json::parse_error& e) {
 }
 
 // Rejects nesting deeper than kMaxJsonDepth before nlohmann sees the text: brackets inside
-// strings do not count (a backslash escapes the next character there).
+// strings do not count.
 void checkDepth(std::string_view text, const std::string& name) {
   int depth = 0;
-  bool inString = false;
   for (std::size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
-    if (inString) {
-      if (c == '\\') ++i;
-      else if (c == '"') inString = false;
-    } else if (c == '"') {
-      inString = true;
+    if (c == '"') {
+      i = endOfJsonString(text, i) - 1;
     } else if (c == '[' || c == '{') {
       if (++depth > kMaxJsonDepth)
         throw Error::at(positionOf(text, i, name), fmt::format("nesting deeper than {} levels", kMaxJsonDepth));

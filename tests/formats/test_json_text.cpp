@@ -42,6 +42,11 @@ TEST(JsonText, TheSameKeyInOtherObjectsIsNoRepeat) {
 TEST(JsonText, SyntaxErrorsAndDepthKeepTheirPlaces) {
   EXPECT_EQ(errorOf("{\"a\": 1,\n}"), "t.json:2:1: syntax error while parsing object key - unexpected '}'; expected string literal");
   EXPECT_EQ(errorOf("[1e999]"), "t.json:1:2: expected a finite number, found '1e999'");
+  // Brackets inside strings (after an escaped quote too) do not count towards the depth.
+  const std::string deep = std::string(600, '[') + std::string(600, ']');
+  EXPECT_EQ(errorOf(deep), "t.json:1:513: nesting deeper than 512 levels");
+  const std::string quoted = "[\"\\\"" + std::string(600, '[') + "\"]";
+  EXPECT_EQ(parseJsonText(quoted, "t.json").size(), 1u);
 }
 
 }  // namespace

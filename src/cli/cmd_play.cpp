@@ -100,6 +100,7 @@ RunFunction setupPlay(CLI::App& app) {
       if (o.frames > 0) options.maxFrames = o.frames;
       options.realTime = !o.fast;
       options.view = o.picture.view();
+      options.follow = o.picture.follow;
       options.overlay = o.picture.overlay();
       options.screenshot = o.screenshot;
       return playScene(o, options);
@@ -112,6 +113,7 @@ RunFunction setupPlay(CLI::App& app) {
     options.loop = !o.once;
     options.realTime = !o.fast;
     options.view = o.picture.view();
+    options.follow = o.picture.follow;
     options.view.bounds = replay.bounds();
     options.overlay = o.picture.overlay();
     options.screenshot = o.screenshot;

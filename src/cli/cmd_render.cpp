@@ -79,6 +79,7 @@ RunFunction setupRender(CLI::App& app) {
     job.contactSheet = o.sheet;
     job.hud = !o.noHud;
     job.orbitDeg = o.orbit;
+    job.follow = o.picture.follow;
     job.view = o.picture.view();
     job.overlay = o.picture.overlay();
     const render::RenderSummary summary = render::renderRun(runDir, job);

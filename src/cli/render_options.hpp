@@ -17,6 +17,7 @@ struct PictureOptions {
   double azimuthDeg = 30.0;
   double elevationDeg = 12.0;
   double zoom = 1.0;
+  bool follow = false;
   bool noFloor = false;
   bool noShadows = false;
   bool collisionColours = false;
@@ -30,6 +31,9 @@ struct PictureOptions {
         ->capture_default_str();
     app.add_option("--elevation", elevationDeg, "Camera angle above the horizon, degrees")->capture_default_str();
     app.add_option("--zoom", zoom, "Camera zoom (> 1 is closer)")->capture_default_str()->check(CLI::PositiveNumber);
+    app.add_flag("--follow", follow,
+                 "The camera follows the characters (one size, centred on each frame, moving smoothly) "
+                 "instead of framing the whole run");
     app.add_flag("--no-floor", noFloor, "Leave out the floor grid (and its shadows)");
     app.add_flag("--no-shadows", noShadows, "Leave out the shadows on the floor");
     app.add_flag("--collision-states", collisionColours, "Colour garment vertices by collision state");

@@ -14,6 +14,7 @@
 
 #include "drape/core/error.hpp"
 #include "drape/core/progress.hpp"
+#include "drape/render/follow.hpp"
 #include "drape/render/headless.hpp"
 #include "drape/render/run_replay.hpp"
 
@@ -98,11 +99,20 @@ void paste(Image& sheet, const Image& tile, int x0, int y0) {
   }
 }
 
-/// The view at frame i of n: the job's camera, turned by its share of the orbit.
-ViewSettings viewAt(const ViewSettings& base, double orbitDeg, std::int64_t i, std::int64_t n) {
+/// The view at frame i of n: the job's camera, turned by its share of the orbit, framing
+/// the follow camera's box when there is one.
+ViewSettings viewAt(const ViewSettings& base, double orbitDeg, const std::vector<Aabb>& follow, std::int64_t i,
+                    std::int64_t n) {
   ViewSettings v = base;
   if (n > 1) v.azimuthDeg += orbitDeg * static_cast<double>(i) / static_cast<double>(n - 1);
+  if (!follow.empty()) v.bounds = follow[static_cast<std::size_t>(i)];
   return v;
+}
+
+std::vector<Aabb> followBoxes(const RunReplay& replay) {
+  std::vector<Aabb> boxes;
+  for (std::int64_t i = 0; i < *replay.frameCount(); ++i) boxes.push_back(replay.frameBounds(i));
+  return followFraming(boxes, replay.frameRate());
 }
 
 HudInfo hudFor(const Frame& frame, const RunReplay& replay) {
@@ -136,6 +146,7 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
   const std::int64_t frames = *replay.frameCount();
   ViewSettings view = job.view;
   if (!view.bounds) view.bounds = replay.bounds();
+  const std::vector<Aabb> follow = job.follow ? followBoxes(replay) : std::vector<Aabb>{};
 
   if (!job.pngDirectory.empty()) {
     std::error_code ec;
@@ -159,7 +170,7 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
       replay.read(i, frame);
       HudInfo hud = hudFor(frame, replay);
       hud.show = job.hud;
-      const Image image = renderer.render(frame, viewAt(view, job.orbitDeg, i, frames), job.overlay, hud);
+      const Image image = renderer.render(frame, viewAt(view, job.orbitDeg, follow, i, frames), job.overlay, hud);
       if (!job.pngDirectory.empty())
         writePng((fs::path(job.pngDirectory) / fmt::format("frame_{:05d}.png", i)).string(), image);
       if (video) video->write(image);
@@ -187,7 +198,7 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
       replay.read(index, frame);
       HudInfo hud = hudFor(frame, replay);
       hud.timeCodeOnly = true;
-      const Image tile = renderer.render(frame, viewAt(view, job.orbitDeg, index, frames), job.overlay, hud);
+      const Image tile = renderer.render(frame, viewAt(view, job.orbitDeg, follow, index, frames), job.overlay, hud);
       paste(sheet, tile, gap + (t % kSheetColumns) * (tileW + gap), gap + (t / kSheetColumns) * (tileH + gap));
     }
     writePng(job.contactSheet, sheet);
@@ -199,6 +210,7 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
 PreviewFiles renderPreview(const std::string& runDirectory) {
   PreviewFiles files;
   RenderJob job;
+  job.follow = true;  // a character walking across the floor fills the picture
   files.contactSheet = (fs::path(runDirectory) / "preview.png").string();
   job.contactSheet = files.contactSheet;
   if (ffmpegAvailable()) {

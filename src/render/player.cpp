@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "drape/render/follow.hpp"
 #include "drape/render/image.hpp"
 #include "gl_util.hpp"
 #include "hud.hpp"
@@ -67,7 +68,7 @@ class Keys {
 
 /// The overlay panel: toggles for every overlay, the T1-T3 offsets, the slice part.
 void drawPanel(OverlaySettings& overlay, const std::vector<MeshInfo>& meshes, bool hasStates, bool& paused,
-               ViewSettings& view, const ViewSettings& initialView) {
+               bool& following, ViewSettings& view, const ViewSettings& initialView) {
   const ImGuiIO& io = ImGui::GetIO();
   ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 10.0f, 10.0f), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
   ImGui::SetNextWindowBgAlpha(0.75f);
@@ -75,6 +76,7 @@ void drawPanel(OverlaySettings& overlay, const std::vector<MeshInfo>& meshes, bo
                                 ImGuiCond_FirstUseEver);  // small windows: keep the picture clear
   ImGui::Begin("overlays", nullptr, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove);
   ImGui::Checkbox("paused (space)", &paused);
+  ImGui::Checkbox("follow the characters (F)", &following);
   ImGui::Checkbox("floor", &overlay.floor);
   ImGui::SameLine();
   ImGui::Checkbox("shadows", &overlay.shadows);
@@ -163,6 +165,9 @@ PlayerStats Player::run(FrameSource& source) {
     renderer.setFrame(frame);
     stats.framesDrawn = 1;
     Aabb seen = frameBounds(frame);
+    FollowCamera follow;
+    follow.update(seen, 0.0);
+    bool following = options_.follow;
     const bool hasStates =
         std::any_of(frame.states.begin(), frame.states.end(), [](const auto& s) { return !s.empty(); });
 
@@ -188,6 +193,7 @@ PlayerStats Player::run(FrameSource& source) {
       index = to;
       renderer.setFrame(frame);
       const Aabb box = frameBounds(frame);
+      follow.update(box, 1.0 / source.frameRate());
       if (!box.empty()) {
         seen.extend(box.min);
         seen.extend(box.max);
@@ -206,6 +212,7 @@ PlayerStats Player::run(FrameSource& source) {
       if (keys.pressed(window, GLFW_KEY_ESCAPE) || keys.pressed(window, GLFW_KEY_Q)) break;
       if (keys.pressed(window, GLFW_KEY_SPACE)) paused = !paused;
       if (keys.pressed(window, GLFW_KEY_R)) view = initialView;
+      if (keys.pressed(window, GLFW_KEY_F)) following = !following;
       if (paused && keys.pressed(window, GLFW_KEY_RIGHT)) advance(index + 1);
       if (paused && keys.pressed(window, GLFW_KEY_LEFT) && source.frameCount()) advance(index - 1);
       double cursorX = 0, cursorY = 0;
@@ -233,7 +240,11 @@ PlayerStats Player::run(FrameSource& source) {
       glfwGetFramebufferSize(window, &width, &height);
       if (width > 0 && height > 0) {
         ViewSettings drawView = view;
-        if (!drawView.bounds) drawView.bounds = seen;
+        if (following) {
+          drawView.bounds = follow.framing();
+        } else if (!drawView.bounds) {
+          drawView.bounds = seen;
+        }
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         renderer.draw(width, height, drawView, overlay);
         imgui.beginFrame(width, height, &ImGui_ImplGlfw_NewFrame);
@@ -244,7 +255,7 @@ PlayerStats Player::run(FrameSource& source) {
         hud.fps = fps;
         hud.stages = frame.stages;
         imgui.drawHud(hud, width, height);
-        drawPanel(overlay, source.meshes(), hasStates, paused, view, initialView);
+        drawPanel(overlay, source.meshes(), hasStates, paused, following, view, initialView);
         imgui.endFrame();
         if (!options_.screenshot.empty() && glfwWindowShouldClose(window))
           writePng(options_.screenshot, readBackBuffer(width, height));

@@ -81,6 +81,13 @@ RunReplay::RunReplay(const std::string& directory) : directory_(directory) {
   stages_ = readStageTimes(dir);
 }
 
+Aabb RunReplay::frameBounds(std::int64_t f) const {
+  Aabb box;
+  for (std::size_t m = 0; m < caches_.size(); ++m)
+    for (const Vec3& p : positions(m, f)) box.extend(p);
+  return box;
+}
+
 bool RunReplay::read(std::int64_t index, Frame& out) {
   if (index < 0 || index >= frames_) return false;
   out.index = index;

@@ -99,6 +99,18 @@ TEST(RenderCli, ContactSheetHas16TilesWithTimeCodes) {
   EXPECT_EQ(labels.size(), 16u);
 }
 
+TEST(RenderCli, FollowCameraFramesEachFrameNotTheWholeRun) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_follow"), 8);
+  const Result fixed = run(drape() + " render " + dir + " --png " + dir + "/fixed --size 160x120 --no-hud");
+  ASSERT_EQ(fixed.status, 0) << fixed.output;
+  const Result follow = run(drape() + " render " + dir + " --png " + dir + "/follow --size 160x120 --no-hud --follow");
+  ASSERT_EQ(follow.status, 0) << follow.output;
+  // The follow camera frames a square box around each frame: another picture of the same frame.
+  const Image a = readPng(dir + "/fixed/frame_00003.png"), b = readPng(dir + "/follow/frame_00003.png");
+  ASSERT_EQ(a.rgb.size(), b.rgb.size());
+  EXPECT_NE(a.rgb, b.rgb);
+}
+
 TEST(PlayCli, WindowUnderXvfbClosesByItselfAfterNFrames) {
   if (!have("xvfb-run")) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps installs xvfb)";
   const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_play"), 24);
@@ -114,6 +126,16 @@ TEST(PlayCli, WindowUnderXvfbClosesByItselfAfterNFrames) {
   for (int y = 0; y < shot.height; ++y)
     for (int x = 0; x < shot.width; ++x) red += shot.pixel(x, y)[0] > shot.pixel(x, y)[1] + 40;
   EXPECT_GT(red, 500) << "the window showed the garment";
+
+  // The same with the camera following the characters.
+  const Result followed = run("ASAN_OPTIONS=detect_leaks=0 timeout 300 xvfb-run -a " + drape() + " play " + dir +
+                              " --frames 8 --fast --size 320x240 --follow --screenshot " + dir + "/follow.png");
+  ASSERT_EQ(followed.status, 0) << followed.output;
+  const Image followShot = readPng(dir + "/follow.png");
+  long followRed = 0;
+  for (int y = 0; y < followShot.height; ++y)
+    for (int x = 0; x < followShot.width; ++x) followRed += followShot.pixel(x, y)[0] > followShot.pixel(x, y)[1] + 40;
+  EXPECT_GT(followRed, 500) << "the following window showed the garment";
 }
 
 TEST(PlayCli, NoDisplayIsAClearError) {

@@ -21,6 +21,7 @@ struct RenderJob {
   int sheetHeight = 1080;
   bool hud = true;  ///< time code and frame on PNG and video frames
   double orbitDeg = 0.0;  ///< the camera turns this far about the vertical from first to last frame
+  bool follow = false;    ///< the camera follows the characters (followFraming) instead of framing the whole run
   ViewSettings view;
   OverlaySettings overlay;
 };
@@ -48,7 +49,7 @@ struct PreviewFiles {
   std::string video;         ///< DIR/preview.mp4, or "" when ffmpeg is not installed
 };
 /// What `drape run --preview` adds to a run directory: a contact sheet and, when ffmpeg
-/// exists, an MP4 of every frame (1280x720).
+/// exists, an MP4 of every frame (1280x720), both with a camera that follows the characters.
 PreviewFiles renderPreview(const std::string& runDirectory);
 
 }  // namespace drape::render

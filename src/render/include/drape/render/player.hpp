@@ -7,7 +7,7 @@
 //   render::Player(render::PlayerOptions{}).run(live);
 //
 // Mouse: drag to orbit, wheel to zoom. Keys: space pause, left/right step (paused),
-// R reset the view, Esc or Q quit.
+// F follow the characters or frame all seen so far, R reset the view, Esc or Q quit.
 
 #include <cstdint>
 #include <optional>
@@ -26,6 +26,7 @@ struct PlayerOptions {
   bool loop = true;                       ///< a replay starts over at its end (a live source ends the player)
   bool realTime = true;                   ///< advance at the source's frame rate; false: one frame per redraw
   ViewSettings view;
+  bool follow = false;  ///< the camera follows the characters (FollowCamera); F toggles it
   OverlaySettings overlay;
   std::string screenshot;  ///< "": none; else the last picture the window showed, as PNG
 };

@@ -23,6 +23,8 @@ class RunReplay final : public FrameSource {
   [[nodiscard]] const std::string& directory() const { return directory_; }
   /// Bounds over every frame of every mesh (m): what the camera frames.
   [[nodiscard]] Aabb bounds() const { return bounds_; }
+  /// Bounds of every mesh at frame `f` alone (m): what a camera that follows frames.
+  [[nodiscard]] Aabb frameBounds(std::int64_t f) const;
   /// World positions of mesh `m` at frame `f` (m).
   [[nodiscard]] const std::vector<Vec3>& positions(std::size_t m, std::int64_t f) const {
     return caches_[m][static_cast<std::size_t>(f)];

@@ -482,7 +482,9 @@ FieldCollisionCounters expectSameAsReference(Configure&& reference, bool measure
   const FieldCollisionCounters& b = full.fieldCounters();
   EXPECT_EQ(a.tests, b.tests);
   EXPECT_EQ(a.traces, b.traces);
-  if (sameWalks) EXPECT_EQ(a.traceVoxels, b.traceVoxels);
+  if (sameWalks) {
+    EXPECT_EQ(a.traceVoxels, b.traceVoxels);
+  }
   EXPECT_EQ(a.collisions, b.collisions);
   EXPECT_EQ(a.projections, b.projections);
   if (measure) {
@@ -801,7 +803,8 @@ TEST(FieldCollider, CountersOfTwoGarmentsAddUp) {
   for (std::uint64_t* f : {&a.tests, &a.traces, &a.traceVoxels, &a.collisions, &a.projections,
                            &a.vertexSubstepsBelowT1, &a.vertexSubstepsBelowT0, &a.vertexSubstepsInsideBody,
                            &a.vertexSubsteps, &a.clearanceSkips, &a.embeddedAtStart, &a.planeEstimates, &a.planeReads,
-                           &a.heldVertexSubsteps, &a.embeddedTimedOut})
+                           &a.heldVertexSubsteps, &a.embeddedTimedOut, &a.restingSkips,
+                           &a.pinchedVertexTests})
     *f = value++;
   for (auto& row : a.transitions)
     for (std::uint64_t& t : row) t = value++;
@@ -815,7 +818,8 @@ TEST(FieldCollider, CountersOfTwoGarmentsAddUp) {
   for (const std::uint64_t* f : {&c.tests, &c.traces, &c.traceVoxels, &c.collisions, &c.projections,
                                  &c.vertexSubstepsBelowT1, &c.vertexSubstepsBelowT0, &c.vertexSubstepsInsideBody,
                                  &c.vertexSubsteps, &c.clearanceSkips, &c.embeddedAtStart, &c.planeEstimates,
-                                 &c.planeReads, &c.heldVertexSubsteps, &c.embeddedTimedOut})
+                                 &c.planeReads, &c.heldVertexSubsteps, &c.embeddedTimedOut, &c.restingSkips,
+                                 &c.pinchedVertexTests})
     EXPECT_EQ(*f, 2 * value++);
   for (const auto& row : c.transitions)
     for (const std::uint64_t t : row) EXPECT_EQ(t, 2 * value++);

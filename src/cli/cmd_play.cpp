@@ -10,6 +10,7 @@
 #include "command.hpp"
 #include "drape/core/error.hpp"
 #include "drape/core/log.hpp"
+#include "drape/render/follow.hpp"
 #include "drape/render/player.hpp"
 #include "drape/render/run_replay.hpp"
 #include "drape/sim/character_world.hpp"
@@ -114,6 +115,7 @@ RunFunction setupPlay(CLI::App& app) {
     options.realTime = !o.fast;
     options.view = o.picture.view();
     options.follow = o.picture.follow;
+    options.followFraming = render::followFraming(replay);  // the whole run is known: no lag
     options.view.bounds = replay.bounds();
     options.overlay = o.picture.overlay();
     options.screenshot = o.screenshot;

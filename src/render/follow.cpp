@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "drape/render/run_replay.hpp"
 
 namespace drape::render {
 namespace {
@@ -55,6 +56,12 @@ std::vector<Aabb> followFraming(const std::vector<Aabb>& frameBoxes, double fram
     framing[i].max = Vec3(centreX[i] + halfWidth, maxY, centreZ[i] + halfWidth);
   }
   return framing;
+}
+
+std::vector<Aabb> followFraming(const RunReplay& replay) {
+  std::vector<Aabb> boxes;
+  for (std::int64_t i = 0; i < replay.frameCount().value_or(0); ++i) boxes.push_back(replay.frameBounds(i));
+  return followFraming(boxes, replay.frameRate());
 }
 
 Aabb FollowCamera::update(const Aabb& frameBox, double dt_s) {

@@ -109,11 +109,6 @@ ViewSettings viewAt(const ViewSettings& base, double orbitDeg, const std::vector
   return v;
 }
 
-std::vector<Aabb> followBoxes(const RunReplay& replay) {
-  std::vector<Aabb> boxes;
-  for (std::int64_t i = 0; i < *replay.frameCount(); ++i) boxes.push_back(replay.frameBounds(i));
-  return followFraming(boxes, replay.frameRate());
-}
 
 HudInfo hudFor(const Frame& frame, const RunReplay& replay) {
   HudInfo hud;
@@ -146,7 +141,7 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
   const std::int64_t frames = *replay.frameCount();
   ViewSettings view = job.view;
   if (!view.bounds) view.bounds = replay.bounds();
-  const std::vector<Aabb> follow = job.follow ? followBoxes(replay) : std::vector<Aabb>{};
+  const std::vector<Aabb> follow = job.follow ? followFraming(replay) : std::vector<Aabb>{};
 
   if (!job.pngDirectory.empty()) {
     std::error_code ec;

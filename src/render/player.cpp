@@ -241,7 +241,8 @@ PlayerStats Player::run(FrameSource& source) {
       if (width > 0 && height > 0) {
         ViewSettings drawView = view;
         if (following) {
-          drawView.bounds = follow.framing();
+          const auto at = static_cast<std::size_t>(index);
+          drawView.bounds = at < options_.followFraming.size() ? options_.followFraming[at] : follow.framing();
         } else if (!drawView.bounds) {
           drawView.bounds = seen;
         }

@@ -13,6 +13,8 @@
 
 namespace drape::render {
 
+class RunReplay;
+
 /// One framing box per frame of a finished run (offline: it sees the whole run). Each is
 /// centred horizontally on the mean of the frames' centres within `window_s` around it (a
 /// window that narrows at the ends, so a steady walk is followed without lag), spans the
@@ -21,6 +23,9 @@ namespace drape::render {
 /// start). Throws drape::Error when every box is empty or the frame rate is not positive.
 [[nodiscard]] std::vector<Aabb> followFraming(const std::vector<Aabb>& frameBoxes, double frameRate,
                                               double window_s = 1.0);
+
+/// followFraming of every frame of a run directory, at its frame rate.
+[[nodiscard]] std::vector<Aabb> followFraming(const RunReplay& replay);
 
 /// The live form (the player: frames arrive one at a time): the centre eases toward each
 /// frame's centre with time constant `timeConstant_s`; the size and the height range grow

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "drape/render/frame.hpp"
 #include "drape/render/renderer.hpp"
@@ -26,7 +27,10 @@ struct PlayerOptions {
   bool loop = true;                       ///< a replay starts over at its end (a live source ends the player)
   bool realTime = true;                   ///< advance at the source's frame rate; false: one frame per redraw
   ViewSettings view;
-  bool follow = false;  ///< the camera follows the characters (FollowCamera); F toggles it
+  bool follow = false;  ///< the camera follows the characters; F toggles it
+  /// Per frame index, the follow camera's framing when the whole run is known beforehand
+  /// (followFraming: centred, no lag); empty: the live FollowCamera, which eases after each frame.
+  std::vector<Aabb> followFraming;
   OverlaySettings overlay;
   std::string screenshot;  ///< "": none; else the last picture the window showed, as PNG
 };

@@ -567,14 +567,20 @@ void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::siz
     state = PointState::InsideVol;
   }
 
+  Vec3 world1;  // where the point is to be, in the world at the interval's end
   if (moved) {
     at = slidingSample(k, i, c);  // the response reads the field where the point is to be
-    addCorrection(i, frame.toWorld1.apply(c) - io.position(i));
+    world1 = frame.toWorld1.apply(c);
+    addCorrection(i, world1 - io.position(i));
     corrected_.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(i)});
   } else {
     nearest_[i] = std::min(nearest_[i], at.distance_m);  // corrected pairs: applyCorrections
   }
-  if (state == PointState::OnSurf) respondOnSurface(frame, c, at, moved, i, dt_s, io);
+  // A sliding point left above T2 keeps its velocity: the response would change nothing.
+  if (state == PointState::OnSurf && (moved || inContact(at))) {
+    if (!moved) world1 = frame.toWorld1.apply(c);
+    respondOnSurface(frame, c, world1, at, i, dt_s, io);
+  }
   last = c;
   ++field_.transitions[toIndex(from)][toIndex(state)];
   if (state == PointState::InsideVol && !moved) rest(k, i, c);
@@ -672,32 +678,24 @@ Vec3 FieldCollider::cachedVoxel(std::size_t k, std::size_t i) const {
   return lastVoxel_[k][i];
 }
 
-void FieldCollider::respondOnSurface(const PartFrame& frame, const Vec3& c, const field::FieldSample& at, bool moved,
-                                     std::size_t i, double dt_s, ClothState& io) const {
+void FieldCollider::respondOnSurface(const PartFrame& frame, const Vec3& c, const Vec3& world,
+                                     const field::FieldSample& at, std::size_t i, double dt_s, ClothState& io) const {
   const Vec3 n = frame.rotation1 * at.normal;
-  const Vec3 world = frame.toWorld1.apply(c);
   const Vec3 partVelocity = (world - frame.toWorld0.apply(c)) / dt_s;
   Vec3 v = io.velocity(i);
-  // A point just moved onto T2 is in contact whatever the distance read there says: the
-  // read (trilinear, or the contact plane) can put it a few micrometres above T2, and then
-  // its inward velocity, which the correction did not touch, would survive every substep
-  // and grow with the forces pressing it in (at many substeps per frame, to the speed bound).
-  const double depth = offsets_.t2_m - at.distance_m;
-  if (moved || depth > -1e-12) {
-    // In contact: remove the inward normal velocity relative to the part, with Coulomb
-    // friction on the tangential part (stick below the static coefficient).
-    const Vec3 rel = v - partVelocity;
-    const double vn = rel.dot(n);
-    if (vn < 0) {
-      Vec3 vt = rel - vn * n;
-      const double speed = vt.norm();
-      if (speed <= staticFriction_ * -vn) {
-        vt.setZero();
-      } else {
-        vt *= 1.0 - dynamicFriction_ * -vn / speed;
-      }
-      v = partVelocity + vt;
+  // In contact: remove the inward normal velocity relative to the part, with Coulomb
+  // friction on the tangential part (stick below the static coefficient).
+  const Vec3 rel = v - partVelocity;
+  const double vn = rel.dot(n);
+  if (vn < 0) {
+    Vec3 vt = rel - vn * n;
+    const double speed = vt.norm();
+    if (speed <= staticFriction_ * -vn) {
+      vt.setZero();
+    } else {
+      vt *= 1.0 - dynamicFriction_ * -vn / speed;
     }
+    v = partVelocity + vt;
   }
   const double belowT1 = offsets_.t1_m - at.distance_m;
   if (belowT1 > 0) {

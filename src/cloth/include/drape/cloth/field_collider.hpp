@@ -313,9 +313,16 @@ class FieldCollider final : public Collider {
   /// The field at c for sliding pair (k, vertex): from its contact plane when the plane
   /// reaches c, else read (and the plane moved there).
   [[nodiscard]] field::FieldSample slidingSample(std::size_t k, std::size_t vertex, const Vec3& c);
-  /// The velocity response of a point in contact with a part (friction, penalty floor):
-  /// `moved`, the collider has just put it on T2; else in contact when at or below T2.
-  void respondOnSurface(const PartFrame& frame, const Vec3& voxel, const field::FieldSample& at, bool moved,
+  /// Whether a sliding point the collider did not move is in contact with its part: at or
+  /// below T2 by the read `at`. A point just moved onto T2 is in contact whatever the read
+  /// there says: the read (trilinear, or the contact plane) can put it a few micrometres
+  /// above T2, and then its inward velocity, which the correction did not touch, would
+  /// survive every substep and grow with the forces pressing it in (at many substeps per
+  /// frame, to the speed bound).
+  [[nodiscard]] bool inContact(const field::FieldSample& at) const { return offsets_.t2_m - at.distance_m > -1e-12; }
+  /// The velocity response of a point in contact with a part (friction, penalty floor), at
+  /// voxel coordinates `voxel`, which are `world` in the world at the interval's end.
+  void respondOnSurface(const PartFrame& frame, const Vec3& voxel, const Vec3& world, const field::FieldSample& at,
                         std::size_t vertex, double dt_s, ClothState& io) const;
   /// A part asks to move the point by `displacement` (world, m) this collision step.
   void addCorrection(std::size_t vertex, const Vec3& displacement);

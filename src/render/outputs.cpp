@@ -109,7 +109,6 @@ ViewSettings viewAt(const ViewSettings& base, double orbitDeg, const std::vector
   return v;
 }
 
-
 HudInfo hudFor(const Frame& frame, const RunReplay& replay) {
   HudInfo hud;
   hud.time = frame.time;

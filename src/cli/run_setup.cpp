@@ -20,9 +20,11 @@
 #include "drape/formats/obj.hpp"
 #include "drape/formats/pc2.hpp"
 #include "drape/formats/run_manifest.hpp"
+#include "drape/formats/state_cache.hpp"
 #include "drape/formats/gltf_writer.hpp"
 #include "drape/formats/vrml_write.hpp"
 #include "drape/mesh/topology.hpp"
+#include "drape/render/frame.hpp"
 #include "drape/render/outputs.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/scene_setup.hpp"
@@ -87,6 +89,8 @@ struct GarmentRun {
   cloth::ClothSolver* solver = nullptr;             ///< owned here or by the character world
   const cloth::FieldCollider* collider = nullptr;   ///< on a character
   std::unique_ptr<formats::Pc2Writer> cache;
+  std::unique_ptr<formats::StateCacheWriter> states;  ///< per vertex and frame: collision state, pinned, bound
+  std::vector<std::uint8_t> fixtureFlags;           ///< per vertex: render::vertex_state::kPinned or kBound
   std::vector<std::vector<Vec3>> frames;            ///< every frame, for result.wrl
 };
 
@@ -99,6 +103,18 @@ struct SegmentRun {
   const mesh::TriMesh* mesh = nullptr;  ///< in the joint's frame
   std::unique_ptr<formats::Pc2Writer> cache;
 };
+
+/// Per vertex of a garment: pinned in place (a pin group without motion) or bound to a body
+/// part (one that follows a part), as the overlays mark them.
+std::vector<std::uint8_t> fixtureFlags(const cloth::ClothSolver& solver, std::size_t vertexCount) {
+  std::vector<std::uint8_t> flags(vertexCount, 0);
+  for (const cloth::PinGroup& group : solver.pins()) {
+    const std::uint8_t flag = group.motion ? render::vertex_state::kBound : render::vertex_state::kPinned;
+    for (const std::uint32_t v : group.vertices)
+      if (v < vertexCount) flags[v] |= flag;
+  }
+  return flags;
+}
 
 std::string sanitise(const std::string& name) {
   std::string out;
@@ -363,7 +379,10 @@ int simulateRun(const RunSetup& setup) {
                       "drape run: rest topology of " + g.name + " (m)");
     r.cache = std::make_unique<formats::Pc2Writer>((out / (r.fileStem + ".pc2")).string(), g.mesh.vertexCount(), 0.0,
                                                    1.0);
-    manifest.meshes.push_back({g.name, "garment", r.fileStem + ".obj", r.fileStem + ".pc2"});
+    r.states = std::make_unique<formats::StateCacheWriter>((out / (r.fileStem + ".states")).string(),
+                                                           g.mesh.vertexCount());
+    r.fixtureFlags = fixtureFlags(*r.solver, g.mesh.vertexCount());
+    manifest.meshes.push_back({g.name, "garment", r.fileStem + ".obj", r.fileStem + ".pc2", r.fileStem + ".states"});
     runs.push_back(std::move(r));
   }
 
@@ -389,7 +408,7 @@ int simulateRun(const RunSetup& setup) {
       formats::writeObj((out / (sr.fileStem + ".obj")).string(), rest, seg.mesh.triangles,
                         "drape run: body part " + seg.name + " (m)");
       sr.cache = std::make_unique<formats::Pc2Writer>((out / (sr.fileStem + ".pc2")).string(), rest.size(), 0.0, 1.0);
-      manifest.meshes.push_back({seg.name, "segment", sr.fileStem + ".obj", sr.fileStem + ".pc2"});
+      manifest.meshes.push_back({seg.name, "segment", sr.fileStem + ".obj", sr.fileStem + ".pc2", ""});
       segments.push_back(std::move(sr));
     }
   }
@@ -398,6 +417,7 @@ int simulateRun(const RunSetup& setup) {
   std::vector<double> frameMs, energy;
   double maxStrain = 0.0, outputSeconds = 0.0;
   std::vector<Vec3> positions;
+  std::vector<std::uint8_t> states;
   std::string unstable;
   bool unstableNan = false;
 
@@ -409,6 +429,12 @@ int simulateRun(const RunSetup& setup) {
       s.copyPositions(positions);
       r.cache->writeFrame(positions);
       r.frames.push_back(positions);
+      // Before the first collision test a collider has no states yet: all outside.
+      if (r.collider) r.collider->vertexDisplayStates(states);
+      if (!r.collider || states.size() != positions.size())
+        states.assign(positions.size(), render::vertex_state::kOutside);
+      for (std::size_t v = 0; v < states.size(); ++v) states[v] |= r.fixtureFlags[v];
+      r.states->writeFrame(states);
       if (frame % setup.objEvery == 0 || frame == setup.frames) {
         const std::string name =
             runs.size() == 1 ? fmt::format("frame_{:05d}.obj", frame) : fmt::format("{}_{:05d}.obj", r.fileStem, frame);
@@ -455,7 +481,10 @@ int simulateRun(const RunSetup& setup) {
   progress.finish();
 
   // Close the caches and write stats and manifest (also after an instability).
-  for (GarmentRun& r : runs) r.cache->close();
+  for (GarmentRun& r : runs) {
+    r.cache->close();
+    r.states->close();
+  }
   for (SegmentRun& sr : segments) sr.cache->close();
   manifest.frames = done + 1;
   formats::writeRunManifest(setup.outDir, manifest);

@@ -62,7 +62,9 @@ void writeRunManifest(const std::string& directory, const RunManifest& manifest)
   j["start_frame"] = manifest.startFrame;
   j["meshes"] = nlohmann::json::array();
   for (const RunMesh& m : manifest.meshes) {
-    j["meshes"].push_back({{"name", m.name}, {"role", m.role}, {"topology", m.topology}, {"cache", m.cache}});
+    nlohmann::json mesh = {{"name", m.name}, {"role", m.role}, {"topology", m.topology}, {"cache", m.cache}};
+    if (!m.states.empty()) mesh["states"] = m.states;
+    j["meshes"].push_back(std::move(mesh));
   }
   const std::string path = (std::filesystem::path(directory) / "manifest.json").string();
   std::ofstream out(path);
@@ -92,6 +94,7 @@ RunManifest parseRunManifest(std::string_view text, const std::string& name) {
     r.role = requiredString(mesh, "role", name);
     r.topology = requiredString(mesh, "topology", name);
     r.cache = requiredString(mesh, "cache", name);
+    if (mesh.contains("states")) r.states = requiredString(mesh, "states", name);
     m.meshes.push_back(std::move(r));
   }
   return m;

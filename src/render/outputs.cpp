@@ -141,6 +141,10 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
   ViewSettings view = job.view;
   if (!view.bounds) view.bounds = replay.bounds();
   const std::vector<Aabb> follow = job.follow ? followFraming(replay) : std::vector<Aabb>{};
+  if ((job.overlay.collisionColours || job.overlay.markers) && !replay.hasStates())
+    spdlog::warn("{}: the run has no vertex states (it was made before drape recorded them): the collision "
+                 "states and markers overlays show nothing",
+                 runDirectory);
 
   if (!job.pngDirectory.empty()) {
     std::error_code ec;

@@ -14,6 +14,7 @@
 #include "drape/formats/obj.hpp"
 #include "drape/formats/pc2.hpp"
 #include "drape/formats/run_manifest.hpp"
+#include "drape/formats/state_cache.hpp"
 
 namespace drape::render {
 namespace {
@@ -72,10 +73,23 @@ RunReplay::RunReplay(const std::string& directory) : directory_(directory) {
     } catch (const Error& e) {
       throw Error(fmt::format("{}: {}", (dir / "manifest.json").string(), e.what()));
     }
+    std::vector<std::vector<std::uint8_t>> states;
+    if (!m.states.empty()) {
+      const std::string statesPath = (dir / m.states).string();
+      formats::StateCache read = formats::readStateCache(statesPath);
+      if (read.vertexCount != topology.vertexCount())
+        throw Error(fmt::format("{}: {} vertices per frame, but {} has {}", statesPath, read.vertexCount, objPath,
+                                topology.vertexCount()));
+      if (static_cast<std::int64_t>(read.frames.size()) < frames_)
+        throw Error(fmt::format("{}: {} frames, the manifest says {}", statesPath, read.frames.size(), frames_));
+      read.frames.resize(static_cast<std::size_t>(frames_));
+      states = std::move(read.frames);
+    }
     info.vertexCount = topology.vertexCount();
     info.triangles = std::move(topology.triangles);
     meshes_.push_back(std::move(info));
     caches_.push_back(std::move(cache.frames));
+    states_.push_back(std::move(states));
   }
   if (meshes_.empty()) throw Error(fmt::format("{}: the run lists no meshes", (dir / "manifest.json").string()));
   stages_ = readStageTimes(dir);
@@ -94,7 +108,9 @@ bool RunReplay::read(std::int64_t index, Frame& out) {
   out.time = TimeCode{startFrame_ + index, frameRate_};
   out.positions.resize(meshes_.size());
   for (std::size_t m = 0; m < meshes_.size(); ++m) out.positions[m] = caches_[m][static_cast<std::size_t>(index)];
-  out.states.clear();
+  out.states.assign(meshes_.size(), {});
+  for (std::size_t m = 0; m < meshes_.size(); ++m)
+    if (!states_[m].empty()) out.states[m] = states_[m][static_cast<std::size_t>(index)];
   out.stages = stages_;
   return true;
 }

@@ -14,6 +14,7 @@
 #include "cli_runner.hpp"
 #include "drape/formats/pc2.hpp"
 #include "drape/formats/run_manifest.hpp"
+#include "drape/formats/state_cache.hpp"
 #include "drape/scene/scene.hpp"
 
 namespace drape {
@@ -67,7 +68,9 @@ TEST(RunScene, TheSkirtWalksOnMakeHumansOtherRigs) {
     const nlohmann::json stats = statsOf(out);
     EXPECT_EQ(stats["frames"].get<int>(), 60);
     EXPECT_FALSE(stats["unstable"].get<bool>());
-    if (rig == "default") EXPECT_EQ(stats["vertex_substeps_inside_body"].get<long>(), 0);
+    if (rig == "default") {
+      EXPECT_EQ(stats["vertex_substeps_inside_body"].get<long>(), 0);
+    }
   }
 }
 
@@ -146,6 +149,19 @@ TEST(RunScene, WalkingSkirtWritesEverything) {
   std::size_t segments = 0;
   for (const auto& m : manifest.meshes) segments += m.role == "segment";
   EXPECT_EQ(segments, 31u);
+
+  // The skirt's vertex states: one frame per cache frame, its waist bound to the body
+  // (0x08) from the first frame, and points on the collision surface (2) once it walks.
+  ASSERT_EQ(manifest.meshes.front().states, "garment.states");
+  const formats::StateCache states = formats::readStateCache(out + "/garment.states");
+  const formats::Pc2Cache skirt = formats::readPc2(out + "/garment.pc2");
+  ASSERT_EQ(states.frames.size(), 16u);
+  EXPECT_EQ(states.vertexCount, skirt.pointCount);
+  std::size_t bound = 0, sliding = 0;
+  for (const std::uint8_t s : states.frames.front()) bound += (s & 0x08) != 0;
+  for (const std::uint8_t s : states.frames.back()) sliding += (s & 0x03) == 2;
+  EXPECT_GT(bound, 10u);
+  EXPECT_GT(sliding, 0u);
 
   // The left shin moves as the avatar walks.
   const formats::Pc2Cache shin = formats::readPc2(out + "/segments/LeftLeg.pc2");

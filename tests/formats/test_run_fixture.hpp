@@ -2,11 +2,13 @@
 // A small run directory written the way `drape run` writes one (manifest, OBJ topologies,
 // PC2 caches), for the player, renderer and exporter tests: a closed cylinder "torso"
 // segment that turns and sways rigidly, and a square "flag" garment beside it that waves
-// (its left edge pinned, so that edge stays put). Units m, Y up.
+// (its left edge pinned, so that edge stays put), with a state cache for the overlays.
+// Units m, Y up.
 
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <numbers>
 #include <string>
@@ -16,6 +18,7 @@
 #include "drape/formats/obj.hpp"
 #include "drape/formats/pc2.hpp"
 #include "drape/formats/run_manifest.hpp"
+#include "drape/formats/state_cache.hpp"
 #include "drape/mesh/trimesh.hpp"
 
 namespace drape::testrun {
@@ -91,6 +94,16 @@ inline std::vector<Vec3> flagPositions(long f) {
   return p;
 }
 
+/// The flag's vertex states at frame f (render::vertex_state bits): its pinned left edge
+/// (0x04), the right half on a collision surface (2) from frame 1 on, the rest outside (0).
+inline std::vector<std::uint8_t> flagStates(long f) {
+  std::vector<std::uint8_t> s;
+  for (int j = 0; j < kFlagRows; ++j)
+    for (int i = 0; i < kFlagColumns; ++i)
+      s.push_back(i == 0 ? std::uint8_t{0x04} : (f > 0 && 2 * i >= kFlagColumns) ? std::uint8_t{2} : std::uint8_t{0});
+  return s;
+}
+
 /// Writes the run into `dir` with `frames` frames; returns dir.
 inline std::string writeTestRun(const std::string& dir, long frames = 24) {
   const mesh::TriMesh torso = cylinder(0.15, 0.35, 1.05);
@@ -100,18 +113,21 @@ inline std::string writeTestRun(const std::string& dir, long frames = 24) {
   {
     formats::Pc2Writer torsoCache(dir + "/torso.pc2", torso.vertexCount(), 0.0, 1.0);
     formats::Pc2Writer flagCache(dir + "/flag.pc2", static_cast<std::size_t>(kFlagColumns * kFlagRows), 0.0, 1.0);
+    formats::StateCacheWriter stateCache(dir + "/flag.states", static_cast<std::size_t>(kFlagColumns * kFlagRows));
     for (long f = 0; f < frames; ++f) {
       std::vector<Vec3> moved = torso.positions;
       for (Vec3& p : moved) p = torsoMotion(f).apply(p);
       torsoCache.writeFrame(moved);
       flagCache.writeFrame(flagPositions(f));
+      stateCache.writeFrame(flagStates(f));
     }
   }
   formats::RunManifest manifest;
   manifest.frameRate = kRate;
   manifest.frames = frames;
   manifest.startFrame = 0;
-  manifest.meshes = {{"torso", "segment", "torso.obj", "torso.pc2"}, {"flag", "garment", "flag.obj", "flag.pc2"}};
+  manifest.meshes = {{"torso", "segment", "torso.obj", "torso.pc2", ""},
+                     {"flag", "garment", "flag.obj", "flag.pc2", "flag.states"}};
   formats::writeRunManifest(dir, manifest);
   return dir;
 }

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include "drape/core/error.hpp"
 #include "drape/formats/run_manifest.hpp"
@@ -22,7 +23,8 @@ TEST(RunManifest, RoundTrips) {
   m.frameRate = 25;
   m.frames = 12;
   m.startFrame = 3;
-  m.meshes = {{"skirt", "garment", "skirt.obj", "skirt.pc2"}, {"hips", "segment", "segments/hips.obj", "segments/hips.pc2"}};
+  m.meshes = {{"skirt", "garment", "skirt.obj", "skirt.pc2", "skirt.states"},
+              {"hips", "segment", "segments/hips.obj", "segments/hips.pc2", ""}};
   writeRunManifest(dir, m);
   const RunManifest r = readRunManifest(dir);
   EXPECT_EQ(r.frameRate, 25);
@@ -31,6 +33,23 @@ TEST(RunManifest, RoundTrips) {
   ASSERT_EQ(r.meshes.size(), 2u);
   EXPECT_EQ(r.meshes[1].cache, "segments/hips.pc2");
   EXPECT_EQ(r.meshes[1].role, "segment");
+  EXPECT_EQ(r.meshes[0].states, "skirt.states");
+  EXPECT_EQ(r.meshes[1].states, "");  // no key written, none read
+  std::ifstream written(dir + "/manifest.json");
+  const std::string text((std::istreambuf_iterator<char>(written)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.find("\"states\": \"\""), std::string::npos) << text;
+}
+
+TEST(RunManifest, StatesMustBeAString) {
+  const std::string dir = tempDir("states");
+  std::ofstream(dir + "/manifest.json") << R"({"format": "drape-run", "version": 1, "frame_rate": 30, "frames": 1,
+    "meshes": [{"name": "a", "role": "garment", "topology": "a.obj", "cache": "a.pc2", "states": 3}]})";
+  try {
+    (void)readRunManifest(dir);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'states' has the wrong type"), std::string::npos) << e.what();
+  }
 }
 
 TEST(RunManifest, ClearErrors) {

@@ -111,6 +111,36 @@ TEST(RenderCli, FollowCameraFramesEachFrameNotTheWholeRun) {
   EXPECT_NE(a.rgb, b.rgb);
 }
 
+TEST(RenderCli, CollisionStatesComeFromTheRunsStateCache) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_states"), 4);
+  const auto greenPixels = [](const Image& image) {
+    long n = 0;
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x) {
+        const std::uint8_t* p = image.pixel(x, y);
+        n += p[1] > p[0] + 40 && p[1] > p[2] + 40;
+      }
+    return n;
+  };
+  const Result plain = run(drape() + " render " + dir + " --png " + dir + "/plain --size 200x150 --no-hud");
+  ASSERT_EQ(plain.status, 0) << plain.output;
+  const Result states =
+      run(drape() + " render " + dir + " --png " + dir + "/states --size 200x150 --no-hud --collision-states");
+  ASSERT_EQ(states.status, 0) << states.output;
+  // Frame 3: the flag's right half is on a collision surface, drawn green.
+  EXPECT_EQ(greenPixels(readPng(dir + "/plain/frame_00003.png")), 0);
+  EXPECT_GT(greenPixels(readPng(dir + "/states/frame_00003.png")), 200);
+  EXPECT_EQ(states.output.find("no vertex states"), std::string::npos) << states.output;
+  // A run without state caches says the overlay has nothing to show.
+  formats::RunManifest m = formats::readRunManifest(dir);
+  m.meshes[1].states.clear();
+  formats::writeRunManifest(dir, m);
+  const Result old =
+      run(drape() + " render " + dir + " --png " + dir + "/old --size 200x150 --no-hud --collision-states");
+  ASSERT_EQ(old.status, 0) << old.output;
+  EXPECT_NE(old.output.find("the run has no vertex states"), std::string::npos) << old.output;
+}
+
 TEST(PlayCli, WindowUnderXvfbClosesByItselfAfterNFrames) {
   if (!have("xvfb-run")) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps installs xvfb)";
   const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_play"), 24);

@@ -38,6 +38,52 @@ TEST(RunReplay, ReadsFramesTimeCodesAndStageTimes) {
   EXPECT_NEAR(replay.bounds().min.y(), 0.35, 1e-6);
 }
 
+TEST(RunReplay, ReadsTheGarmentsVertexStates) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("replay_states"), 6);
+  RunReplay replay(dir);
+  EXPECT_TRUE(replay.hasStates());
+  Frame f;
+  for (std::int64_t i : {0, 3, 5}) {
+    ASSERT_TRUE(replay.read(i, f));
+    ASSERT_EQ(f.states.size(), 2u);
+    EXPECT_TRUE(f.states[0].empty()) << "the torso has no state cache";
+    EXPECT_EQ(f.states[1], testrun::flagStates(i)) << "frame " << i;
+  }
+  // A run without state caches (made before drape wrote them) replays without states.
+  formats::RunManifest m = formats::readRunManifest(dir);
+  m.meshes[1].states.clear();
+  formats::writeRunManifest(dir, m);
+  RunReplay old(dir);
+  EXPECT_FALSE(old.hasStates());
+  ASSERT_TRUE(old.read(2, f));
+  EXPECT_TRUE(f.states[1].empty());
+  // A state cache that does not fit its mesh or is too short is refused, naming the file.
+  {
+    formats::StateCacheWriter w(dir + "/short.states", static_cast<std::size_t>(testrun::kFlagColumns * testrun::kFlagRows));
+    w.writeFrame(testrun::flagStates(0));
+  }
+  m.meshes[1].states = "short.states";
+  formats::writeRunManifest(dir, m);
+  try {
+    RunReplay replay(dir);
+    FAIL() << "accepted a state cache of 1 frame for 6";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("short.states: 1 frames, the manifest says 6"), std::string::npos) << e.what();
+  }
+  {
+    formats::StateCacheWriter w(dir + "/narrow.states", 5);
+    for (int i = 0; i < 6; ++i) w.writeFrame(std::vector<std::uint8_t>(5, 0));
+  }
+  m.meshes[1].states = "narrow.states";
+  formats::writeRunManifest(dir, m);
+  try {
+    RunReplay replay(dir);
+    FAIL() << "accepted a state cache of 5 vertices";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("narrow.states: 5 vertices per frame, but"), std::string::npos) << e.what();
+  }
+}
+
 TEST(RunReplay, RefusesInconsistentRuns) {
   const std::string dir = testrun::writeTestRun(testrun::freshDir("replay_bad"), 4);
   // The manifest claims more frames than the caches hold.

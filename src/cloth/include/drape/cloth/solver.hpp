@@ -92,6 +92,8 @@ class ClothSolver {
   [[nodiscard]] const StageTimes& stageTimes() const { return times_; }
   [[nodiscard]] const Instability& instability() const { return instability_; }
   [[nodiscard]] const std::vector<Collider*>& colliders() const { return colliders_; }
+  /// The pinned vertices (no motion) and the bound ones (following a body part).
+  [[nodiscard]] const std::vector<PinGroup>& pins() const { return pins_; }
   /// With internal damping and symplectic Euler, or with forward Euler: the membrane's
   /// highest frequency with the pinned and bound vertices held, which checkDampedStep or
   /// checkForwardEulerStep judged the substep by; else 0.

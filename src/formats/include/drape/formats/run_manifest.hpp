@@ -5,9 +5,12 @@
 // sample per frame, Y up. Garments and avatar segments are listed alike; `role` tells a
 // renderer how to draw them.
 //
+// A garment may also have a state cache (formats/state_cache.hpp): per vertex and frame,
+// its collision state and whether it is pinned or bound, for the overlays.
+//
 //   {"format": "drape-run", "version": 1, "frame_rate": 30, "frames": 90, "start_frame": 0,
 //    "meshes": [{"name": "dress", "role": "garment", "topology": "garment.obj",
-//                "cache": "garment.pc2"}, ...]}
+//                "cache": "garment.pc2", "states": "garment.states"}, ...]}
 
 #include <string>
 #include <string_view>
@@ -20,6 +23,7 @@ struct RunMesh {
   std::string role;      ///< "garment" or "segment" (an avatar body part)
   std::string topology;  ///< OBJ file, relative to the run directory
   std::string cache;     ///< PC2 file, relative to the run directory
+  std::string states;    ///< state cache, relative to the run directory; "": none (optional key)
 };
 
 struct RunManifest {

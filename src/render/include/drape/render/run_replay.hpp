@@ -1,6 +1,7 @@
 #pragma once
 // Replays a finished run directory (DIR/manifest.json, its OBJ topologies and PC2 caches,
-// and DIR/stats.json's `ms_per_stage` when present) as a FrameSource.
+// the garments' state caches and DIR/stats.json's `ms_per_stage` when present) as a
+// FrameSource.
 
 #include <string>
 
@@ -25,6 +26,13 @@ class RunReplay final : public FrameSource {
   [[nodiscard]] Aabb bounds() const { return bounds_; }
   /// Bounds of every mesh at frame `f` alone (m): what a camera that follows frames.
   [[nodiscard]] Aabb frameBounds(std::int64_t f) const;
+  /// Whether some mesh has per-vertex states (a state cache; runs made before drape wrote
+  /// them have none, and their overlays that need states show nothing).
+  [[nodiscard]] bool hasStates() const {
+    for (const auto& s : states_)
+      if (!s.empty()) return true;
+    return false;
+  }
   /// World positions of mesh `m` at frame `f` (m).
   [[nodiscard]] const std::vector<Vec3>& positions(std::size_t m, std::int64_t f) const {
     return caches_[m][static_cast<std::size_t>(f)];
@@ -34,6 +42,7 @@ class RunReplay final : public FrameSource {
   std::string directory_;
   std::vector<MeshInfo> meshes_;
   std::vector<std::vector<std::vector<Vec3>>> caches_;  ///< [mesh][frame][vertex], m
+  std::vector<std::vector<std::vector<std::uint8_t>>> states_;  ///< [mesh][frame][vertex], or [mesh] empty
   std::vector<StageTime> stages_;                       ///< from stats.json, per run
   double frameRate_ = 30.0;
   std::int64_t frames_ = 0;

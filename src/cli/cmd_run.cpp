@@ -232,7 +232,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   setup.exactSliding = o.exactSliding;
   setup.freePinches = o.freePinches;
   const int code = simulateRun(setup);
-  fmt::print("results in {}/: garment caches (.pc2), frames/, result.wrl, result.glb, stats.json{}\n", o.out,
+  fmt::print("results in {}/: garment caches (.pc2, .states), frames/, result.wrl, result.glb, stats.json{}\n", o.out,
              o.preview ? ", preview.png" : "");
   return code;
 }

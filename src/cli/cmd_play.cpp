@@ -62,7 +62,7 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
     out.states.resize(meshes.size());
     for (std::size_t g = 0; g < world.garmentCount(); ++g) {
       world.solver(g).state().copyPositions(out.positions[g]);
-      world.collider(g)->vertexDisplayStates(out.states[g]);
+      garmentVertexStates(world.solver(g), world.collider(g), out.states[g]);
     }
     world.poses().evaluate(world.frameTime(frame), joints);
     for (std::size_t s = 0; s < avatar->segments.size(); ++s) {

@@ -90,7 +90,6 @@ struct GarmentRun {
   const cloth::FieldCollider* collider = nullptr;   ///< on a character
   std::unique_ptr<formats::Pc2Writer> cache;
   std::unique_ptr<formats::StateCacheWriter> states;  ///< per vertex and frame: collision state, pinned, bound
-  std::vector<std::uint8_t> fixtureFlags;           ///< per vertex: render::vertex_state::kPinned or kBound
   std::vector<std::vector<Vec3>> frames;            ///< every frame, for result.wrl
 };
 
@@ -103,18 +102,6 @@ struct SegmentRun {
   const mesh::TriMesh* mesh = nullptr;  ///< in the joint's frame
   std::unique_ptr<formats::Pc2Writer> cache;
 };
-
-/// Per vertex of a garment: pinned in place (a pin group without motion) or bound to a body
-/// part (one that follows a part), as the overlays mark them.
-std::vector<std::uint8_t> fixtureFlags(const cloth::ClothSolver& solver, std::size_t vertexCount) {
-  std::vector<std::uint8_t> flags(vertexCount, 0);
-  for (const cloth::PinGroup& group : solver.pins()) {
-    const std::uint8_t flag = group.motion ? render::vertex_state::kBound : render::vertex_state::kPinned;
-    for (const std::uint32_t v : group.vertices)
-      if (v < vertexCount) flags[v] |= flag;
-  }
-  return flags;
-}
 
 std::string sanitise(const std::string& name) {
   std::string out;
@@ -323,6 +310,18 @@ int stableSubsteps(const RunSetup& setup) {
   return n;
 }
 
+void garmentVertexStates(const cloth::ClothSolver& solver, const cloth::FieldCollider* collider,
+                         std::vector<std::uint8_t>& out) {
+  const std::size_t n = solver.state().size();
+  if (collider) collider->vertexDisplayStates(out);
+  if (!collider || out.size() != n) out.assign(n, render::vertex_state::kOutside);  // before the first test too
+  for (const cloth::PinGroup& group : solver.pins()) {
+    const std::uint8_t flag = group.motion ? render::vertex_state::kBound : render::vertex_state::kPinned;
+    for (const std::uint32_t v : group.vertices)
+      if (v < n) out[v] |= flag;
+  }
+}
+
 int simulateRun(const RunSetup& setup) {
   validateRunSetup(setup);
   createOutDir(setup.outDir);
@@ -381,7 +380,6 @@ int simulateRun(const RunSetup& setup) {
                                                    1.0);
     r.states = std::make_unique<formats::StateCacheWriter>((out / (r.fileStem + ".states")).string(),
                                                            g.mesh.vertexCount());
-    r.fixtureFlags = fixtureFlags(*r.solver, g.mesh.vertexCount());
     manifest.meshes.push_back({g.name, "garment", r.fileStem + ".obj", r.fileStem + ".pc2", r.fileStem + ".states"});
     runs.push_back(std::move(r));
   }
@@ -429,11 +427,7 @@ int simulateRun(const RunSetup& setup) {
       s.copyPositions(positions);
       r.cache->writeFrame(positions);
       r.frames.push_back(positions);
-      // Before the first collision test a collider has no states yet: all outside.
-      if (r.collider) r.collider->vertexDisplayStates(states);
-      if (!r.collider || states.size() != positions.size())
-        states.assign(positions.size(), render::vertex_state::kOutside);
-      for (std::size_t v = 0; v < states.size(); ++v) states[v] |= r.fixtureFlags[v];
+      garmentVertexStates(*r.solver, r.collider, states);
       r.states->writeFrame(states);
       if (frame % setup.objEvery == 0 || frame == setup.frames) {
         const std::string name =

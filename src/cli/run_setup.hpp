@@ -5,6 +5,7 @@
 // one loop that steps every garment and writes DIR/frames/, DIR/*.pc2, DIR/*.obj,
 // DIR/stats.json and DIR/manifest.json.
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -86,5 +87,12 @@ void validateRunSetup(const RunSetup& setup);
 /// written so far (caches, stats with nan_detected, manifest) and throws drape::Error with
 /// ExitCode::Unstable naming garment, vertex and frame.
 int simulateRun(const RunSetup& setup);
+
+/// A garment's vertex states now, as the overlays draw them (render::vertex_state): its
+/// collider's collision states (all outside without a collider, or before its first test)
+/// with the pinned and bound flags of its fixtures. `drape run` records them per frame,
+/// `drape play` shows them live.
+void garmentVertexStates(const cloth::ClothSolver& solver, const cloth::FieldCollider* collider,
+                         std::vector<std::uint8_t>& out);
 
 }  // namespace drape::cli

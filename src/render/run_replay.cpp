@@ -19,6 +19,10 @@
 namespace drape::render {
 namespace {
 
+// A state cache holds exactly the bits the renderer draws by.
+static_assert((vertex_state::kCollisionMask | vertex_state::kPinned | vertex_state::kBound) ==
+              formats::kKnownStateBits);
+
 /// DIR/stats.json's "ms_per_stage" object ({"forces": 1.2, ...}), when the run wrote one.
 /// Anything else in the file is not the player's business; a malformed file is reported.
 std::vector<StageTime> readStageTimes(const std::filesystem::path& directory) {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <iostream>
+#include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -33,6 +34,7 @@ struct PaperBenchOptions {
   bool exactSliding = false;  // sliding pairs read the field on every test (no contact planes)
   bool freePinches = false;   // pinched points move freely between reduced-frequency tests
   bool noRestingBalls = false;  // every pair inside a part's volume goes through the per-pair test
+  std::optional<std::vector<std::string>> faceSamplesWith;  // set: overrides the scene's
   bool json = false;
 };
 
@@ -58,6 +60,8 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
   if (o.collisionEvery > 0)
     for (GarmentSetup& g : setup.garments) g.collisionEvery = o.collisionEvery;
   if (o.bendEvery > 0) setup.settings.bendEvery = o.bendEvery;
+  if (o.faceSamplesWith)
+    for (GarmentSetup& g : setup.garments) g.faceSamplesWith = *o.faceSamplesWith;
   addMotion(setup, o.motion);
   const std::unique_ptr<sim::CharacterWorld> worldPtr = buildWorld(setup);
   sim::CharacterWorld& world = *worldPtr;
@@ -119,6 +123,14 @@ RunFunction setupPaperBench(CLI::App& app) {
                "Every pair whose point is inside a part's volume goes through the per-pair test, instead "
                "of being left out while the point stays in a ball found clear of T2 (the reference the "
                "balls are measured against)");
+  app.add_option_function<std::vector<std::string>>(
+         "--face-samples-with",
+         [](const std::vector<std::string>& parts) {
+           o.faceSamplesWith = parts == std::vector<std::string>{"none"} ? std::vector<std::string>{} : parts;
+         },
+         "Body parts against which the triangles' centroids collide too, overriding the scene's "
+         "faceSamplesWith; 'none' for none")
+      ->delimiter(',');
   app.add_flag("--json", o.json, "Print JSON (the only format)");
   return [] {
     std::vector<PaperRun> runs;
@@ -160,6 +172,8 @@ RunFunction setupPaperBench(CLI::App& app) {
     j["pinch_hold"] = !o.freePinches;
     j["vertex_substeps_held_in_pinches"] = r.counters.heldVertexSubsteps;
     j["vertex_tests_pinched"] = r.counters.pinchedVertexTests;
+    j["face_tests"] = r.counters.faceTests;
+    j["face_contacts"] = r.counters.faceContacts;
     j["vertex_substeps"] = penetration.vertexSubsteps;  // free vertices x substeps: all of them
     j["vertex_substeps_inside_body"] = penetration.vertexSubstepsInsideBody;
     j["vertex_substeps_below_T1_fraction"] =

@@ -30,6 +30,7 @@ struct RunOptions {
   std::string scene, avatar, motion, jointMap, fieldMethod = "dvdp";
   double motionScale = 0.0, voxel_m = 0.0, leadIn_s = 1.0;
   bool preview = false, countEverySubstep = false, exactSliding = false, freePinches = false;
+  std::vector<std::string> faceSamplesWith;
   std::string garment, units = "m", pinVertices, pinMask, out, substeps = "33", integrator = "symplectic-euler";
   std::string wind, gravity;
   std::vector<std::string> spheres;
@@ -138,6 +139,9 @@ void applyOverrides(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   if (app.count("--gravity")) s.gravity_m_s2 = parseVec3(o.gravity, "--gravity");
   for (GarmentSetup& g : setup.garments) {
     if (app.count("--collision-every")) g.collisionEvery = o.collisionEvery;
+    if (app.count("--face-samples-with"))
+      g.faceSamplesWith = o.faceSamplesWith == std::vector<std::string>{"none"} ? std::vector<std::string>{}
+                                                                                : o.faceSamplesWith;
     cloth::Material& m = g.material;
     if (app.count("--density")) m.density_kg_m3 = o.material.density_kg_m3;
     if (app.count("--thickness")) m.thickness_m = o.material.thickness_m;
@@ -280,6 +284,11 @@ RunFunction setupRun(CLI::App& app) {
                "Points pinched between two or more parts at a collision test keep their own velocity and, "
                "with tests every K > 1 substeps, move freely until the next, instead of taking those parts' "
                "mean velocity and being held by them (the paper's collision response as it is)");
+  app.add_option("--face-samples-with", o->faceSamplesWith,
+                 "Body parts against which the garments' triangle centroids collide too, not only their "
+                 "vertices, overriding the scene's faceSamplesWith (e.g. LeftUpLeg,RightUpLeg): the parts no "
+                 "longer bulge through triangles that are large against their curvature; 'none' for none")
+      ->delimiter(',');
   app.add_option("--units", o->units, "Length unit of the OBJ files: m, dm, cm, mm, in")->capture_default_str();
   auto* pins = app.add_option("--pin-vertices", o->pinVertices, "Vertices pinned in place, 0-based, e.g. 0,12,40");
   auto* mask = app.add_option("--pin-mask", o->pinMask, "OBJ whose vertices mark the pinned garment vertices");

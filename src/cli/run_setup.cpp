@@ -175,6 +175,9 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
   stats["sliding_reads_from_contact_planes"] = sum.slidingReadsFromPlanes();
   stats["vertex_substeps_held_in_pinches"] = sum.heldVertexSubsteps;
   stats["vertex_tests_pinched"] = sum.pinchedVertexTests;
+  stats["face_tests"] = sum.faceTests;
+  stats["face_contacts"] = sum.faceContacts;
+  stats["face_contacts_inside_body"] = sum.facesInsideBody;
   nlohmann::json transitions;
   const char* names[3] = {"outside_vol", "inside_vol", "on_surf"};
   for (int a = 0; a < 3; ++a)

@@ -1,6 +1,7 @@
 #include "drape/cloth/field_collider.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -28,6 +29,9 @@ constexpr double kEaseTimeFactor = 2.0;
 /// the resting balls' margin.
 constexpr double kFieldSlack_voxels = 0.5;
 constexpr double kSqrt3 = 1.7320508075688772;
+/// The share of a face sample's depth below T2 its triangle is moved out by per test
+/// (collideFaces).
+constexpr double kFaceRate = 0.25;
 
 int toIndex(PointState s) { return static_cast<int>(s); }
 
@@ -227,6 +231,14 @@ FieldCollider::FieldCollider(std::string garmentName, std::vector<CollisionPart>
                               "less than the outer offset T3 = {:.4f} m",
                               garment_, p.name, p.field->shell_m(), offsets_.t3_m));
     }
+    if (p.faceSamples) {
+      const auto k = static_cast<std::size_t>(&p - parts_.data());
+      if (k >= 64)
+        throw Error(fmt::format("garment '{}': body part '{}' takes face samples, but only the first 64 collidable "
+                                "parts can (it is number {})",
+                                garment_, p.name, k + 1));
+      faceParts_ |= std::uint64_t{1} << k;
+    }
     clearOfT2_.push_back(clearanceBits(*p.field, offsets_.t2_m / p.field->voxelSize()));
     restable_.push_back(restableBits(*p.field, offsets_.t2_m / p.field->voxelSize()));
   }
@@ -260,6 +272,9 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   easeUntil_s_.assign(parts_.size(), std::vector<double>(n, 0.0));
   for (std::vector<double>* v : {&correctionX_, &correctionY_, &correctionZ_}) v->assign(n, 0.0);
   corrections_.assign(n, 0);
+  slidingParts_.assign(n, 0);
+  for (std::vector<double>* v : {&faceDX_, &faceDY_, &faceDZ_, &faceDVX_, &faceDVY_, &faceDVZ_}) v->assign(n, 0.0);
+  faceCount_.assign(n, 0);
   corrected_.clear();
   corrected_.reserve(n * parts_.size());  // the step does not allocate
   held_.clear();
@@ -314,7 +329,7 @@ FieldCollider::PartFrame FieldCollider::framePart(const CollisionPart& part, con
   return frame;
 }
 
-void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_s, ClothState& io) {
+void FieldCollider::collide(const ClothModel& model, double t0_s, double t1_s, ClothState& io) {
   ++counters_.calls;
   if (states_.empty() || states_.front().size() != io.size()) initialise(io, t0_s);
   if ((calls_++ % every_) != 0) {  // reduced-frequency collision tests
@@ -375,6 +390,7 @@ void FieldCollider::collide(const ClothModel& /*model*/, double t0_s, double t1_
   testY_.swap(nextTestY_);
   testZ_.swap(nextTestZ_);
   applyCorrections(io);
+  if (faceParts_) collideFaces(model, interval_s, io);
   collectPinches(interval_s, io);
   if (measurePenetration_) {
     const auto start = std::chrono::steady_clock::now();
@@ -830,6 +846,123 @@ void FieldCollider::applyCorrections(ClothState& io) {
   }
 }
 
+// Face samples (CollisionPart::faceSamples). Which triangles: those with a
+// vertex sliding on a face-sample part, all three vertices free (a bound vertex is the
+// fixtures' to place) and none being eased out of that part (it started below T2: its
+// triangle would be thrown onto T2 at once, which the easing is there to avoid); and no
+// vertex within one ring of them sliding on another part. Where two parts' offset surfaces
+// meet (a sleeve between arm and chest) no place is outside both, and pushing the triangle
+// off one of them pushes it into the other: measured on the walking dress, the face samples
+// there stopped the Daz-style walk in frame 74.
+//
+// The push: the centroid c = (x_a + x_b + x_c) / 3 below T2 by `below` moves its three
+// vertices by kFaceRate below along the normal, and the centroid loses its inward velocity
+// relative to the part (each vertex by the same change). A part of the depth per test, not
+// all of it: the vertices' own contacts are already answered, and a triangle thrown onto T2
+// at once yanks its neighbours (measured: with the whole depth the walking dress stopped in
+// frame 20). The bulge rises by a fraction of a millimetre per substep, so the triangle
+// keeps up with it.
+void FieldCollider::buildFaceTopology(const ClothModel& model) {
+  const std::size_t n = model.vertexCount();
+  const std::vector<mesh::Triangle>& triangles = model.triangles();
+  // Vertex -> its triangles, and vertex -> its neighbours (itself included), as CSR lists.
+  std::vector<std::vector<std::uint32_t>> around(n), ring(n);
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (const std::uint32_t i : triangles[t]) {
+      around[i].push_back(static_cast<std::uint32_t>(t));
+      for (const std::uint32_t j : triangles[t]) ring[i].push_back(j);
+    }
+  const auto flatten = [n](std::vector<std::vector<std::uint32_t>>& lists, std::vector<std::uint32_t>& start,
+                           std::vector<std::uint32_t>& flat) {
+    start.assign(n + 1, 0);
+    flat.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+      std::sort(lists[i].begin(), lists[i].end());
+      lists[i].erase(std::unique(lists[i].begin(), lists[i].end()), lists[i].end());
+      flat.insert(flat.end(), lists[i].begin(), lists[i].end());
+      start[i + 1] = static_cast<std::uint32_t>(flat.size());
+    }
+  };
+  flatten(around, vertexTrianglesStart_, vertexTriangles_);
+  flatten(ring, vertexRingStart_, vertexRing_);
+  faceStamp_.assign(triangles.size(), -1);
+}
+
+void FieldCollider::collideFaces(const ClothModel& model, double dt_s, ClothState& io) {
+  const std::size_t n = io.size();
+  if (vertexTrianglesStart_.size() != n + 1) buildFaceTopology(model);  // once, at the first test
+  std::fill(slidingParts_.begin(), slidingParts_.end(), std::uint64_t{0});
+  for (std::size_t k = 0; k < std::min<std::size_t>(parts_.size(), 64); ++k) {
+    const PointState* s = states_[k].data();
+    for (std::size_t i = 0; i < n; ++i)
+      slidingParts_[i] |= static_cast<std::uint64_t>(s[i] == PointState::OnSurf) << k;
+  }
+  // Every part a vertex within one ring of v slides on.
+  const auto ringParts = [&](std::uint32_t v) {
+    std::uint64_t parts = 0;
+    for (std::uint32_t j = vertexRingStart_[v]; j < vertexRingStart_[v + 1]; ++j) parts |= slidingParts_[vertexRing_[j]];
+    return parts;
+  };
+  const std::vector<mesh::Triangle>& triangles = model.triangles();
+  bool any = false;
+  for (std::uint32_t v = 0; v < n; ++v) {
+    if (!(slidingParts_[v] & faceParts_)) continue;
+    for (std::uint32_t j = vertexTrianglesStart_[v]; j < vertexTrianglesStart_[v + 1]; ++j) {
+      const std::uint32_t tri = vertexTriangles_[j];
+      if (faceStamp_[tri] == tests_) continue;  // met through another of its vertices
+      faceStamp_[tri] = tests_;
+      const mesh::Triangle& t = triangles[tri];
+      if (!(free_[t[0]] & free_[t[1]] & free_[t[2]])) continue;
+      const std::uint64_t near = ringParts(t[0]) | ringParts(t[1]) | ringParts(t[2]);
+      if (near & (near - 1)) continue;
+      const auto k = static_cast<std::size_t>(std::countr_zero(near));  // the one part near, a face part
+      if (embedded_[k][t[0]] | embedded_[k][t[1]] | embedded_[k][t[2]]) continue;
+      const field::DistanceField& f = *parts_[k].field;
+      const PartFrame& frame = frames_[k];
+      const Vec3 p = (io.position(t[0]) + io.position(t[1]) + io.position(t[2])) / 3.0;
+      const Vec3 c = frame.toVoxel1.apply(p);
+      const Vec3i voxel = roundVoxel(c);
+      if (!walkable(f, voxel) || clearOfT2(k, f.index(voxel.x(), voxel.y(), voxel.z()))) continue;
+      ++field_.faceTests;
+      const field::FieldSample at = f.sampleAtVoxel(c);
+      const double below = offsets_.t2_m - at.distance_m;
+      if (below <= 0) continue;
+      ++field_.faceContacts;
+      field_.facesInsideBody += at.distance_m < 0;
+      const Vec3 normal = frame.rotation1 * at.normal;
+      const Vec3 partVelocity = (frame.toWorld1.apply(c) - frame.toWorld0.apply(c)) / dt_s;
+      const Vec3 velocity = (io.velocity(t[0]) + io.velocity(t[1]) + io.velocity(t[2])) / 3.0;
+      const double vn = (velocity - partVelocity).dot(normal);
+      const Vec3 dx = kFaceRate * below * normal;
+      const Vec3 dv = vn < 0 ? Vec3(-vn * normal) : Vec3::Zero();
+      for (const std::uint32_t i : t) {
+        faceDX_[i] += dx.x();
+        faceDY_[i] += dx.y();
+        faceDZ_[i] += dx.z();
+        faceDVX_[i] += dv.x();
+        faceDVY_[i] += dv.y();
+        faceDVZ_[i] += dv.z();
+        ++faceCount_[i];
+      }
+      any = true;
+    }
+  }
+  if (!any) return;
+  // A vertex several triangles push takes their mean (Jacobi, as the vertices' corrections).
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!faceCount_[i]) continue;
+    const double share = 1.0 / faceCount_[i];
+    io.x[i] += share * faceDX_[i];
+    io.y[i] += share * faceDY_[i];
+    io.z[i] += share * faceDZ_[i];
+    io.vx[i] += share * faceDVX_[i];
+    io.vy[i] += share * faceDVY_[i];
+    io.vz[i] += share * faceDVZ_[i];
+    faceDX_[i] = faceDY_[i] = faceDZ_[i] = faceDVX_[i] = faceDVY_[i] = faceDVZ_[i] = 0.0;
+    faceCount_[i] = 0;
+  }
+}
+
 void FieldCollider::measureCorrected(const ClothState& io) {
   for (const auto& [k, i] : corrected_) {
     const double d = parts_[k].field->distanceAtVoxel(frames_[k].toVoxel1.apply(io.position(i)));
@@ -889,7 +1022,8 @@ FieldCollisionCounters& FieldCollisionCounters::operator+=(const FieldCollisionC
                       {&embeddedAtStart, o.embeddedAtStart},
                       {&embeddedTimedOut, o.embeddedTimedOut},
                       {&planeEstimates, o.planeEstimates}, {&planeReads, o.planeReads},
-                      {&heldVertexSubsteps, o.heldVertexSubsteps}, {&pinchedVertexTests, o.pinchedVertexTests}})
+                      {&heldVertexSubsteps, o.heldVertexSubsteps}, {&pinchedVertexTests, o.pinchedVertexTests},
+                      {&faceTests, o.faceTests}, {&faceContacts, o.faceContacts}, {&facesInsideBody, o.facesInsideBody}})
     *a += b;
   maxPenetration_m = std::max(maxPenetration_m, o.maxPenetration_m);
   for (int from = 0; from < 3; ++from)

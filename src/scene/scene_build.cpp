@@ -431,6 +431,12 @@ class Builder {
       throw Error::at(where(n, "bindThreshold"),
                       fmt::format("ClothSet {}: bindThreshold {:g} m is negative", g.name, g.bindThreshold));
     g.collidesWith = strings(n, "collidesWith");
+    g.faceSamplesWith = strings(n, "faceSamplesWith");
+    for (const std::string& s : g.faceSamplesWith)
+      if (!g.collidesWith.empty() && std::find(g.collidesWith.begin(), g.collidesWith.end(), s) == g.collidesWith.end())
+        throw Error::at(where(n, "faceSamplesWith"),
+                        fmt::format("ClothSet {}: faceSamplesWith names '{}', which is not in its collidesWith",
+                                    g.name, s));
     avatarOf(n, g);
     if (const std::int32_t mask = node(n, "constraintMask"); mask >= 0)
       g.maskVertices = matchMask(transformed(faceSet(mask, n, "constraintMask"), pending.world, g.name), g, n);
@@ -449,6 +455,11 @@ class Builder {
         if (avatar.findSegment(s) < 0)
           throw Error::at(where(n, "collidesWith"),
                           fmt::format("ClothSet {}: collidesWith names '{}', which avatar {} has no segment called",
+                                      g.name, s, avatar.name));
+      for (const std::string& s : g.faceSamplesWith)
+        if (avatar.findSegment(s) < 0)
+          throw Error::at(where(n, "faceSamplesWith"),
+                          fmt::format("ClothSet {}: faceSamplesWith names '{}', which avatar {} has no segment called",
                                       g.name, s, avatar.name));
       return;
     }

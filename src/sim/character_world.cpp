@@ -128,7 +128,11 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
     }
     GarmentRun run;
     std::vector<cloth::CollisionPart> collisionParts;
-    for (int p : parts) collisionParts.push_back({fields_[p].segment, &fields_[p].field, partMotions_[p]});
+    for (int p : parts) {
+      const bool faces = std::find(spec.faceSamplesWith.begin(), spec.faceSamplesWith.end(), fields_[p].segment) !=
+                         spec.faceSamplesWith.end();
+      collisionParts.push_back({fields_[p].segment, &fields_[p].field, partMotions_[p], faces});
+    }
     run.collider = std::make_unique<cloth::FieldCollider>(spec.name, std::move(collisionParts), spec.offsets,
                                                           spec.material.staticFriction, spec.material.dynamicFriction,
                                                           spec.collisionEvery);
@@ -160,6 +164,11 @@ void CharacterWorld::buildFields(const std::vector<GarmentSpec>& garments) {
       }
       if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
     }
+    for (const std::string& name : g.faceSamplesWith)
+      if (std::find(g.collidesWith.begin(), g.collidesWith.end(), name) == g.collidesWith.end())
+        throw Error(fmt::format("garment '{}': face samples with '{}', which it does not collide with (it collides "
+                                "with: {})",
+                                g.name, name, fmt::join(g.collidesWith, ", ")));
   }
   field::FieldSettings fs;
   fs.voxelSize_m = settings_.voxel_m;

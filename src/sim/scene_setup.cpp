@@ -70,6 +70,7 @@ std::vector<GarmentSpec> garmentSpecs(const scene::Scene& scene, const scene::Av
     if (avatar) {
       spec.bound = g.maskVertices;
       spec.collidesWith = g.collidesWith;
+      spec.faceSamplesWith = g.faceSamplesWith;
       if (spec.collidesWith.empty())
         for (const scene::Segment& s : avatar->segments) spec.collidesWith.push_back(s.name);
     } else {

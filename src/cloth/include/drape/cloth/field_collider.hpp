@@ -151,6 +151,12 @@ struct CollisionPart {
   std::string name;
   const field::DistanceField* field = nullptr;
   std::shared_ptr<const FixtureMotion> motion;  ///< the part's pose in the world at time t
+  /// Beyond the paper, whose collision is vertex against body: the centroids of the
+  /// garment's triangles collide with this part too (FieldCollider, face samples). Where a
+  /// garment's triangles are large against the part's curvature (a pencil skirt stretched
+  /// over a swinging thigh), the part bulges through them between vertices that all stay
+  /// outside it. One of the first 64 parts.
+  bool faceSamples = false;
 };
 
 /// The paper's Table 3 figures and ours, accumulated over the run.
@@ -173,6 +179,9 @@ struct FieldCollisionCounters {
   std::uint64_t planeReads = 0;      ///< sliding pairs' field reads that went to the field
   std::uint64_t heldVertexSubsteps = 0;  ///< untested substeps of points held in a pinch (setPinchHold)
   std::uint64_t pinchedVertexTests = 0;  ///< tests at which two or more parts moved a point (setPinchHold)
+  std::uint64_t faceTests = 0;     ///< (triangle, part) pairs whose centroid was read (face samples)
+  std::uint64_t faceContacts = 0;  ///< of those, centroids below T2: their triangle moved out
+  std::uint64_t facesInsideBody = 0;  ///< of those, centroids inside the body (signed distance < 0) before the move
   std::array<std::array<std::uint64_t, 3>, 3> transitions{};  ///< [from][to] PointState counts
 
   /// Mean voxel path per tested (vertex, part) pair: the paper's "average collision path
@@ -246,6 +255,8 @@ class FieldCollider final : public Collider {
   [[nodiscard]] bool clearOfT2(std::size_t k, std::uint32_t voxel) const {
     return clearanceSkip_ && ((clearOfT2_[k][voxel >> 6] >> (voxel & 63)) & 1);
   }
+  /// Whether some part takes face samples (CollisionPart::faceSamples).
+  [[nodiscard]] bool faceSamples() const { return faceParts_ != 0; }
   /// Off: no pair rests in a ball (the reference they are tested against). On by default.
   void setRestingBalls(bool on) { restingBalls_ = on; }
   /// The radius, in voxels, of the resting ball of a pair of part k that ends a test
@@ -328,6 +339,10 @@ class FieldCollider final : public Collider {
   void addCorrection(std::size_t vertex, const Vec3& displacement);
   /// Moves every point by the mean of its parts' displacements.
   void applyCorrections(ClothState& io);
+  /// The lists collideFaces walks, from the garment's triangles (at its first call).
+  void buildFaceTopology(const ClothModel& model);
+  /// The triangles' centroids against the face-sample parts their vertices slide on.
+  void collideFaces(const ClothModel& model, double dt_s, ClothState& io);
   /// The penetration figures of the corrected pairs, where the points ended.
   void measureCorrected(const ClothState& io);
   /// Penetration after the response, against the nearest part (the counters of Table 3),
@@ -356,6 +371,7 @@ class FieldCollider final : public Collider {
   bool measurePenetration_ = true;
   bool pinchHold_ = true;
   bool restingBalls_ = true;
+  std::uint64_t faceParts_ = 0;  ///< bit k: part k takes face samples
   long calls_ = 0;
   long tests_ = 0;  ///< collision tests run
   double poseSeconds_ = 0;
@@ -377,6 +393,16 @@ class FieldCollider final : public Collider {
   std::vector<double> correctionX_, correctionY_, correctionZ_;
   std::vector<std::uint16_t> corrections_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> corrected_;
+  /// Per vertex, this test: the parts it slides on, one bit each (parts < 64), and the face
+  /// samples' summed displacements (m) and velocity changes (m/s) and their number.
+  std::vector<std::uint64_t> slidingParts_;
+  std::vector<double> faceDX_, faceDY_, faceDZ_, faceDVX_, faceDVY_, faceDVZ_;
+  std::vector<std::uint16_t> faceCount_;
+  /// The garment's topology for the face samples (buildFaceTopology): each vertex's
+  /// triangles and its neighbours (itself included), as CSR lists; per triangle, the test
+  /// that last met it.
+  std::vector<std::uint32_t> vertexTrianglesStart_, vertexTriangles_, vertexRingStart_, vertexRing_;
+  std::vector<long> faceStamp_;
   std::vector<std::uint8_t> free_;       ///< per vertex: 1 unless a fixture moves it (setFixedVertices)
   std::size_t freeCount_ = 0;            ///< vertices the collider tests
   /// [part][voxel / 64], bit voxel % 64: the voxel's whole 3x3x3 neighbourhood lies above

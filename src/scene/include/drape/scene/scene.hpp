@@ -66,6 +66,7 @@ struct Garment {
   double maskTolerance = 0.001;             ///< m
   double bindThreshold = 0.02;              ///< m, farthest a mask vertex binds to a body part
   std::vector<std::string> collidesWith;    ///< segment names; empty: every segment
+  std::vector<std::string> faceSamplesWith;  ///< of those, where triangle centroids collide too
   int avatar = -1;                          ///< index into Scene::avatars (a Humanoid), or -1
   int externalAvatar = -1;                  ///< index into Scene::externalAvatars, or -1
   SourcePos source;

@@ -35,6 +35,8 @@ struct GarmentSpec {
   std::vector<std::uint32_t> bound;         ///< constraint-mask vertices: follow the nearest part
   double bindThreshold_m = 0.03;            ///< farthest a bound vertex may be from its part
   std::vector<std::string> collidesWith;    ///< body segment names
+  /// Of collidesWith, the parts the triangles' centroids collide with too (face samples).
+  std::vector<std::string> faceSamplesWith;
   cloth::OffsetSurfaces offsets;            ///< used when offsetsGiven, else from the voxel size
   bool offsetsGiven = false;
   int collisionEvery = 1;                   ///< collision tests every k substeps

@@ -50,6 +50,8 @@ void printGarment(std::ostream& out, const scene::Scene& s, const scene::Garment
   fmt::print(
       out, "    collides with {}\n",
       g.collidesWith.empty() ? std::string("every segment") : fmt::format("{}", fmt::join(g.collidesWith, ", ")));
+  if (!g.faceSamplesWith.empty())
+    fmt::print(out, "    triangle centroids collide too with {}\n", fmt::join(g.faceSamplesWith, ", "));
 }
 
 void inspectScene(const std::string& path, std::ostream& out) {

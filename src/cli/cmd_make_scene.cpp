@@ -39,6 +39,7 @@ struct MakeSceneOptions {
   std::string name;
   std::string title;
   std::vector<std::string> collidesWith;
+  std::vector<std::string> faceSamplesWith;
   double reach_m = 0.03;
   double voxel_m = 0.005;
   std::vector<double> offsets;  ///< T0..T3, m; empty: 1, 2, 3 and 6 voxels
@@ -141,6 +142,8 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
   writeIndexedFaceSet(os, mask, "    ");
   fmt::print(os, "  }}\n  material USE Knit\n  avatar USE Body\n");
   fmt::print(os, "  collidesWith [ \"{}\" ]\n", fmt::join(o.collidesWith, "\", \""));
+  if (!o.faceSamplesWith.empty())
+    fmt::print(os, "  faceSamplesWith [ \"{}\" ]\n", fmt::join(o.faceSamplesWith, "\", \""));
   fmt::print(os, "  maskTolerance 0.0005\n  bindThreshold {:.3f}\n}}\n", o.bindThreshold_m);
   if (!os) throw Error(fmt::format("{}: cannot be written", path));
 }
@@ -170,6 +173,10 @@ int makeScene(MakeSceneOptions& o) {
   if (o.collidesWith.empty())
     throw Error(fmt::format("{}: the garment is not within {} m of any segment of {}; is --units right?", o.garment,
                             o.reach_m, o.avatar));
+  for (const std::string& s : o.faceSamplesWith)
+    if (std::find(o.collidesWith.begin(), o.collidesWith.end(), s) == o.collidesWith.end())
+      throw Error(fmt::format("--face-samples-with: '{}' is not one of the collidable segments ({})", s,
+                              fmt::join(o.collidesWith, ", ")));
   // The fewest substeps per frame, at least the paper's 33, that mass scaling keeps stable
   // within the allowance; or the count asked for, and what it needs.
   const mesh::Topology topology = mesh::Topology::build(garment);
@@ -230,6 +237,10 @@ RunFunction setupMakeScene(CLI::App& app) {
   app.add_option("--avatar-url", o.avatarUrl, "The Avatar url written into scene.wrl (default: the avatar's path relative to --out)");
   app.add_option("--collides-with", o.collidesWith,
                  "Collidable segments (default: every segment the garment comes within --reach of at rest)")
+      ->delimiter(',');
+  app.add_option("--face-samples-with", o.faceSamplesWith,
+                 "Of the collidable segments, those the garment's triangle centroids collide with too, not only "
+                 "its vertices (where its triangles are large against the segment's curvature)")
       ->delimiter(',');
   app.add_option("--reach", o.reach_m, "Distance from a segment's box that makes it collidable, m")->capture_default_str();
   app.add_option("--voxel", o.voxel_m, "Distance-field voxel, m; without --offsets, T0..T3 are 1, 2, 3 and 6 voxels")

@@ -528,6 +528,10 @@ int simulateRun(const RunSetup& setup) {
     if (runs[g].collider) {
       const cloth::OffsetSurfaces& o = runs[g].collider->offsets();
       entry["offsets_m"] = {o.t0_m, o.t1_m, o.t2_m, o.t3_m};
+      nlohmann::json faces = nlohmann::json::array();
+      for (const cloth::CollisionPart& p : runs[g].collider->parts())
+        if (p.faceSamples) faces.push_back(p.name);
+      entry["face_samples_with"] = faces;
     }
     garments.push_back(std::move(entry));
   }

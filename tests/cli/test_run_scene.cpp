@@ -225,6 +225,24 @@ TEST(RunScene, OffsetsGivenOverrideTheScenesAndAreChecked) {
       << bad.err;
 }
 
+TEST(RunScene, FaceSamplesAreChosenByPartAndChecked) {
+  ScratchDir dir("run-faces");
+  const std::string scene = "'" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir + "/walk.bvh' --frames 2 ";
+  const nlohmann::json plain = statsOf(testing::runInto(dir, "plain", scene));
+  EXPECT_EQ(plain["garments"][0]["face_samples_with"], nlohmann::json::array());
+  EXPECT_EQ(plain["face_tests"].get<long>(), 0);
+  const nlohmann::json legs = statsOf(testing::runInto(dir, "legs", scene + "--face-samples-with LeftUpLeg,RightUpLeg"));
+  EXPECT_EQ(legs["garments"][0]["face_samples_with"], nlohmann::json({"LeftUpLeg", "RightUpLeg"}));
+  EXPECT_TRUE(legs.contains("face_contacts_inside_body"));
+  const CliResult bad =
+      runDrape("run " + scene + "--face-samples-with LeftUpLeg,Head --out '" + (dir / "bad") + "'", dir);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("garment 'Skirt': face samples with 'Head', which it does not collide with (it collides "
+                         "with: LowerBack, Hips, LeftUpLeg, RightUpLeg, LeftLeg, RightLeg)"),
+            std::string::npos)
+      << bad.err;
+}
+
 TEST(RunScene, DampingTheSubstepCannotCarryIsRefusedWithTheWayOut) {
   // The skirt's 1.01 ms substep carries at most 3.87 ms of damping (its membrane's stiffest
   // mode, the waistband held: 605 rad/s); 10 ms diverged in the first frame before the check.

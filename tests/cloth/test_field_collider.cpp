@@ -3,10 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <numbers>
 #include <random>
 
 #include "drape/cloth/field_collider.hpp"
 #include "drape/cloth/model.hpp"
+#include "drape/core/error.hpp"
 #include "drape/field/shapes.hpp"
 #include "drape/mesh/topology.hpp"
 
@@ -804,7 +807,7 @@ TEST(FieldCollider, CountersOfTwoGarmentsAddUp) {
                            &a.vertexSubstepsBelowT1, &a.vertexSubstepsBelowT0, &a.vertexSubstepsInsideBody,
                            &a.vertexSubsteps, &a.clearanceSkips, &a.embeddedAtStart, &a.planeEstimates, &a.planeReads,
                            &a.heldVertexSubsteps, &a.embeddedTimedOut, &a.restingSkips,
-                           &a.pinchedVertexTests})
+                           &a.pinchedVertexTests, &a.faceTests, &a.faceContacts, &a.facesInsideBody})
     *f = value++;
   for (auto& row : a.transitions)
     for (std::uint64_t& t : row) t = value++;
@@ -819,7 +822,7 @@ TEST(FieldCollider, CountersOfTwoGarmentsAddUp) {
                                  &c.vertexSubstepsBelowT1, &c.vertexSubstepsBelowT0, &c.vertexSubstepsInsideBody,
                                  &c.vertexSubsteps, &c.clearanceSkips, &c.embeddedAtStart, &c.planeEstimates,
                                  &c.planeReads, &c.heldVertexSubsteps, &c.embeddedTimedOut, &c.restingSkips,
-                                 &c.pinchedVertexTests})
+                                 &c.pinchedVertexTests, &c.faceTests, &c.faceContacts, &c.facesInsideBody})
     EXPECT_EQ(*f, 2 * value++);
   for (const auto& row : c.transitions)
     for (const std::uint64_t t : row) EXPECT_EQ(t, 2 * value++);
@@ -1016,6 +1019,148 @@ TEST(FieldCollider, APointHeldBelowT2WhileEasedCollidesAsAnyOtherInTime) {
   // of the field's normal from 2.7 mm lands at 12 mm), out of the penalty zone.
   EXPECT_EQ(c.fieldCounters().projections, 1u);
   EXPECT_GT(s.field.distanceAt(p.state.position(0)), kOffsets.t1_m);
+}
+
+/// One triangle over the pole of a ball of radius 5 cm, its vertices 30 degrees from the
+/// pole: with the vertices on T2 (15 mm), its centroid lies 6 mm from the surface, 9 mm below
+/// T2. The ball is still; its parts take face samples.
+struct Cap {
+  static constexpr double kRadius = 0.05;
+  field::DistanceField field = buildField(field::makeSphere(kRadius, Vec3::Zero(), 64, 32));
+  std::vector<CollisionPart> parts;
+  std::shared_ptr<const ClothModel> model;
+  ClothState state;
+  std::array<Vec3, 3> directions;
+
+  explicit Cap(int partCount = 1, bool faceSamples = true) {
+    for (int k = 0; k < partCount; ++k)
+      parts.push_back({"ball" + std::to_string(k), &field, std::make_shared<LinearMotion>(Vec3::Zero(), Vec3::Zero()),
+                       faceSamples});
+    const double polar = std::numbers::pi / 6.0;
+    mesh::TriMesh m;
+    for (int i = 0; i < 3; ++i) {
+      const double around = 2.0 * std::numbers::pi * i / 3.0;
+      directions[i] = Vec3(std::sin(polar) * std::cos(around), std::sin(polar) * std::sin(around), std::cos(polar));
+      m.positions.push_back(Vec3(40, 40, 40) + directions[i]);  // far from the ball at first
+    }
+    m.triangles = {{0, 1, 2}};
+    model = ClothModel::build(m, mesh::Topology::build(m), Material{});
+    state = ClothState::atRest(*model);
+  }
+  /// Initialises the collider with the triangle far away, then brings its vertices 2 mm
+  /// below T2 moving inwards: the first test registers their collisions on T2.
+  void arrive(FieldCollider& c) {
+    c.initialise(state, 0.0);
+    for (int i = 0; i < 3; ++i) {
+      state.setPosition(i, (kRadius + kOffsets.t2_m - 0.002) * directions[i]);
+      state.setVelocity(i, -0.5 * directions[i]);
+    }
+  }
+  [[nodiscard]] Vec3 centroid() const { return (state.position(0) + state.position(1) + state.position(2)) / 3.0; }
+  [[nodiscard]] Vec3 centroidVelocity() const {
+    return (state.velocity(0) + state.velocity(1) + state.velocity(2)) / 3.0;
+  }
+};
+
+TEST(FieldCollider, FaceSamplesLiftATriangleUntilItsCentroidIsOnT2) {
+  // Beyond the paper, whose vertices alone collide: then the ball reaches 9 mm past T2 into
+  // the triangle, between vertices that all rest on T2.
+  constexpr double dt = 1e-3;
+  for (const bool faces : {false, true}) {
+    SCOPED_TRACE(faces ? "face samples" : "vertices alone");
+    Cap cap(1, faces);
+    FieldCollider c("test", cap.parts, kOffsets, 0.0, 0.0);
+    EXPECT_EQ(c.faceSamples(), faces);
+    cap.arrive(c);
+    c.collide(*cap.model, 0.0, dt, cap.state);
+    for (int i = 0; i < 3; ++i) {
+      ASSERT_EQ(c.state(0, i), PointState::OnSurf);
+      if (!faces) EXPECT_NEAR(cap.field.distanceAt(cap.state.position(i)), kOffsets.t2_m, 5e-4) << "vertex " << i;
+    }
+    // With face samples the first test already lifted the triangle by a quarter of 9 mm.
+    EXPECT_NEAR(cap.field.distanceAt(cap.centroid()), faces ? 0.006 + 0.25 * 0.009 : 0.006, 1e-3);
+    for (int step = 1; step < 60; ++step) c.collide(*cap.model, step * dt, (step + 1) * dt, cap.state);
+    const double centroid = cap.field.distanceAt(cap.centroid());
+    if (faces) {
+      // A quarter of the depth per test: 0.75^60 of 9 mm is nothing.
+      EXPECT_NEAR(centroid, kOffsets.t2_m, 5e-4);
+      EXPECT_GT(c.fieldCounters().faceContacts, 10u);
+      EXPECT_EQ(c.fieldCounters().facesInsideBody, 0u);
+      // Lifted along the ball's normal at the centroid (the same displacement for the
+      // three vertices): still about the pole, the vertices between T2 and T3, still sliding.
+      for (int i = 0; i < 3; ++i) {
+        const double d = cap.field.distanceAt(cap.state.position(i));
+        EXPECT_GT(d, kOffsets.t2_m + 0.005) << "vertex " << i;
+        EXPECT_LT(d, kOffsets.t3_m) << "vertex " << i;
+        EXPECT_EQ(c.state(0, i), PointState::OnSurf);
+      }
+      EXPECT_LT(std::hypot(cap.centroid().x(), cap.centroid().y()), 5e-4);
+    } else {
+      EXPECT_NEAR(centroid, 0.006, 1e-3) << "nothing lifts the triangle";
+      EXPECT_EQ(c.fieldCounters().faceTests, 0u);
+    }
+  }
+}
+
+TEST(FieldCollider, AFaceSampleBelowT2LosesItsInwardVelocity) {
+  // All three vertices fall straight down onto the ball; their own responses (or none, where
+  // a read puts a vertex a hair above T2) leave the centroid sinking. A face sample takes that
+  // away: the centroid, below T2, keeps no velocity into the ball.
+  constexpr double dt = 1e-3;
+  for (const bool faces : {false, true}) {
+    SCOPED_TRACE(faces ? "face samples" : "vertices alone");
+    Cap cap(1, faces);
+    FieldCollider c("test", cap.parts, kOffsets, 0.0, 0.0);
+    cap.arrive(c);
+    c.collide(*cap.model, 0.0, dt, cap.state);
+    for (int i = 0; i < 3; ++i) cap.state.setVelocity(i, Vec3(0, 0, -0.3));
+    c.collide(*cap.model, dt, 2 * dt, cap.state);
+    const double down = cap.centroidVelocity().z();
+    if (faces) {
+      EXPECT_NEAR(down, 0.0, 0.01);
+    } else {
+      EXPECT_LT(down, -0.05);
+    }
+  }
+}
+
+TEST(FieldCollider, FaceSamplesLeaveAloneWhatTwoPartsPressAndWhatFixturesHold) {
+  // Two parts in one place: every vertex slides on both, as where two parts' offset surfaces
+  // overlap, and lifting the triangle off one would push it into the other. A bound vertex:
+  // the fixtures place it. Either way no centroid is tested and nothing moves but as the
+  // vertices alone would move it.
+  constexpr double dt = 1e-3;
+  const auto run = [&](int partCount, bool faces, bool bound) {
+    Cap cap(partCount, faces);
+    FieldCollider c("test", cap.parts, kOffsets, 0.0, 0.0);
+    if (bound) c.setFixedVertices({0}, 3);
+    cap.arrive(c);
+    for (int step = 0; step < 20; ++step) c.collide(*cap.model, step * dt, (step + 1) * dt, cap.state);
+    return std::pair{cap.state, c.fieldCounters().faceTests};
+  };
+  for (const bool bound : {false, true}) {
+    const int partCount = bound ? 1 : 2;
+    const auto [withFaces, faceTests] = run(partCount, true, bound);
+    const auto [without, none] = run(partCount, false, bound);
+    EXPECT_EQ(faceTests, 0u) << (bound ? "bound vertex" : "two parts");
+    EXPECT_EQ(withFaces.x, without.x);
+    EXPECT_EQ(withFaces.z, without.z);
+  }
+  // And the one-part, all-free cap is tested (the two cases above are not vacuous).
+  EXPECT_GT(run(1, true, false).second, 0u);
+}
+
+TEST(FieldCollider, OnlyTheFirst64PartsTakeFaceSamples) {
+  Cap cap(65, false);
+  cap.parts.back().faceSamples = true;
+  try {
+    FieldCollider c("coat", cap.parts, kOffsets, 0.0, 0.0);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("garment 'coat': body part 'ball64' takes face samples, but only the first 64"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

@@ -98,7 +98,8 @@ TEST(VrmlScene, EveryFieldWithValues) {
       "DEF Silk ClothMaterial { name \"silk\" density 1300 thickness 0.0002 youngsModulus 2e6 poissonRatio 0.25 "
       "bendingStiffness 1e-6\n"
       "  damping 0.1 staticFriction 0.4 dynamicFriction 0.2 compressionScale 0.5 }\n"
-      "DEF Scarf ClothSet { name \"scarf\" material USE Silk avatar USE Body collidesWith [ \"hips\" ] maskTolerance "
+      "DEF Scarf ClothSet { name \"scarf\" material USE Silk avatar USE Body collidesWith [ \"hips\" ] faceSamplesWith "
+      "[ \"hips\" ] maskTolerance "
       "0.002 "
       "bindThreshold 0.03\n  cloth " +
       kTriangle + "\n  constraintMask " + kTriangle +
@@ -140,6 +141,7 @@ TEST(VrmlScene, EveryFieldWithValues) {
   EXPECT_EQ(g.material, 0);
   EXPECT_EQ(g.avatar, 0);
   EXPECT_EQ(g.collidesWith, std::vector<std::string>{"hips"});
+  EXPECT_EQ(g.faceSamplesWith, std::vector<std::string>{"hips"});
   EXPECT_NEAR(g.maskTolerance, 0.002, 1e-9);
   EXPECT_NEAR(g.bindThreshold, 0.03, 1e-9);
   EXPECT_EQ(g.maskVertices, (std::vector<std::uint32_t>{0, 1, 2}));
@@ -304,6 +306,22 @@ TEST(VrmlScene, MoreDomainErrors) {
                   "ClothSet { avatar USE H collidesWith [ \"elbow\" ] cloth " +
                   kTriangle + " }\n");
             }).find("collidesWith names 'elbow', which avatar H has no segment called"),
+            std::string::npos);
+  // Face samples: with parts the garment collides with, on its avatar.
+  EXPECT_NE(errorOf([&] {
+              (void)fromText(
+                  "#VRML V2.0 utf8\nDEF H Humanoid { humanoidBody Joint { children [ Segment { name \"hips\" } "
+                  "Segment { name \"thigh\" } ] } }\n"
+                  "ClothSet { avatar USE H collidesWith [ \"hips\" ]\n  faceSamplesWith [ \"thigh\" ] cloth " +
+                  kTriangle + " }\n");
+            }).find("scene.wrl:4: ClothSet garment 1: faceSamplesWith names 'thigh', which is not in its collidesWith"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] {
+              (void)fromText(
+                  "#VRML V2.0 utf8\nDEF H Humanoid { humanoidBody Joint { children Segment { name \"hips\" } } }\n"
+                  "ClothSet { avatar USE H faceSamplesWith [ \"knee\" ] cloth " +
+                  kTriangle + " }\n");
+            }).find("faceSamplesWith names 'knee', which avatar H has no segment called"),
             std::string::npos);
   EXPECT_NE(errorOf([&] {
               (void)fromText("#VRML V2.0 utf8\nClothSet { cloth Shape { geometry Box { } } }\n");

@@ -1,4 +1,4 @@
-// `drape run` end to end on the bundled example, every bad input of issue 2, and an
+// `drape run` end to end on the bundled example, every bad input it must refuse, and an
 // unstable run.
 #include <gtest/gtest.h>
 
@@ -159,7 +159,7 @@ namespace drape {
 namespace {
 
 // The benchmark's smoke test: `drape bench cloth --quick --no-peers` prints one JSON object
-// with the issue's keys for the three sheet sizes.
+// with the benchmark's keys for the three sheet sizes.
 TEST(BenchCloth, QuickPrintsTheCases) {
   testing::ScratchDir dir("bench-cloth");
   const testing::CliResult r = testing::runDrape("bench cloth --quick --no-peers --json", dir);
@@ -178,7 +178,7 @@ TEST(BenchCloth, QuickPrintsTheCases) {
 }
 
 // `drape bench paper` on the first frames of the walking skirt, with the collision tests
-// every substep and every third (and bending every fourth): the issue's keys, the paper's
+// every substep and every third (and bending every fourth): the benchmark's keys, the paper's
 // Table 3 beside them, the reduced frequency seen in the counters, and the penetration
 // figures still over every substep.
 TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {

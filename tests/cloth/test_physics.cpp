@@ -1,4 +1,4 @@
-// Physics against analytic answers (issue 2, "Tests that mean something").
+// Physics against analytic answers.
 #include <gtest/gtest.h>
 
 #include <random>

@@ -121,7 +121,7 @@ TEST(VrmlRead, MalformedCorpusGivesTheExpectedMessageAndLine) {
   EXPECT_GE(cases, 14);
 }
 
-// Issue 3: the two inputs that crash or hang Coin itself are stopped before Coin sees them.
+// The two inputs that crash or hang Coin itself are stopped before Coin sees them.
 TEST(VrmlRead, CoinNullDereferenceUseInsideOwnDefIsAScanError) {
   const std::string text = "#VRML V2.0 utf8\nDEF T Transform { children Shape { geometry USE T\n";
   ASSERT_EQ(text.size(), 66u);

@@ -1,5 +1,5 @@
 // glTF skinned characters: CesiumMan segmented into 19 closed segments covering every
-// triangle; the Assimp failure cases of the motion issue as regressions.
+// triangle; the Assimp failure cases found so far as regressions.
 
 #include <gtest/gtest.h>
 

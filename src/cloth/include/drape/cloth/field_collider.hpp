@@ -100,6 +100,13 @@
 // the field is measured in the tests. A sliding point left where it is counts in the
 // penetration figures at its plane's distance (above T2, within the planes' error); a
 // moved one is read where it ended.
+//
+// Face samples (beyond the paper; CollisionPart::faceSamples): the vertices alone collide, so
+// a part bulges through a triangle larger than its curvature allows at T2 between vertices
+// that all rest on it. For the parts a garment marks, each test after the vertices'
+// corrections also reads the centroid of every triangle with a vertex sliding on such a part,
+// and one below T2 moves its triangle out by a quarter of the depth and loses its inward
+// velocity relative to the part (collideFaces says which triangles are left out, and why).
 
 #include <array>
 #include <cstdint>

@@ -126,6 +126,20 @@ void applyOffsets(const RunOptions& o, RunSetup& setup) {
   }
 }
 
+/// --collision-every and --face-samples-with for every garment (a scene's or --garment's).
+void applyCollisionOptions(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
+  const bool faces = app.count("--face-samples-with") > 0;
+  if (faces && !setup.character && o.faceSamplesWith != std::vector<std::string>{"none"})
+    throw Error("--face-samples-with: there is no avatar to collide with (the scene has none; without a scene, give "
+                "--avatar FILE)");
+  for (GarmentSetup& g : setup.garments) {
+    if (app.count("--collision-every")) g.collisionEvery = o.collisionEvery;
+    if (faces)
+      g.faceSamplesWith = o.faceSamplesWith == std::vector<std::string>{"none"} ? std::vector<std::string>{}
+                                                                                : o.faceSamplesWith;
+  }
+}
+
 /// Command-line values that override the scene's (only those the user gave).
 void applyOverrides(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   cloth::StepSettings& s = setup.settings;
@@ -138,10 +152,6 @@ void applyOverrides(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   if (app.count("--wind")) s.wind_m_s = parseVec3(o.wind, "--wind");
   if (app.count("--gravity")) s.gravity_m_s2 = parseVec3(o.gravity, "--gravity");
   for (GarmentSetup& g : setup.garments) {
-    if (app.count("--collision-every")) g.collisionEvery = o.collisionEvery;
-    if (app.count("--face-samples-with"))
-      g.faceSamplesWith = o.faceSamplesWith == std::vector<std::string>{"none"} ? std::vector<std::string>{}
-                                                                                : o.faceSamplesWith;
     cloth::Material& m = g.material;
     if (app.count("--density")) m.density_kg_m3 = o.material.density_kg_m3;
     if (app.count("--thickness")) m.thickness_m = o.material.thickness_m;
@@ -187,6 +197,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     if (setup.character) avatar = setup.character->avatar;
     applyOverrides(app, o, setup);
     applyOffsets(o, setup);
+    applyCollisionOptions(app, o, setup);
   } else {
     if (!o.avatar.empty()) avatar = std::make_shared<const scene::Avatar>(scene::loadAvatarFile(o.avatar));
     setupFromGarment(o, setup, avatar != nullptr);
@@ -196,6 +207,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
         for (const scene::Segment& seg : avatar->segments) g.collidesWith.push_back(seg.name);
     }
     applyOffsets(o, setup);
+    applyCollisionOptions(app, o, setup);
   }
   if (!o.motion.empty() && !avatar)
     throw Error("--motion: there is no avatar to move (the scene has none; without a scene, give --avatar FILE)");

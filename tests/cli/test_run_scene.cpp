@@ -241,6 +241,20 @@ TEST(RunScene, FaceSamplesAreChosenByPartAndChecked) {
                          "with: LowerBack, Hips, LeftUpLeg, RightUpLeg, LeftLeg, RightLeg)"),
             std::string::npos)
       << bad.err;
+  const CliResult bodiless = runDrape("run --garment '" + kSkirtDir + "/skirt.obj' --face-samples-with Hips --frames 1 "
+                                      "--out '" + (dir / "bodiless") + "'",
+                                      dir);
+  EXPECT_EQ(bodiless.code, 2);
+  EXPECT_NE(bodiless.err.find("--face-samples-with: there is no avatar to collide with"), std::string::npos)
+      << bodiless.err;
+  // Without a scene, on an avatar: the collision options apply there too (before, the
+  // --garment path left out --collision-every).
+  const nlohmann::json worn = statsOf(testing::runInto(
+      dir, "worn", "--garment '" + kSkirtDir + "/skirt.obj' --avatar '" + std::string(DRAPE_SOURCE_DIR) +
+                       "/data/avatars/makehuman_rig_cmu_mb.mhskel' --pin-mask '" + kSkirtDir +
+                       "/waistband.obj' --collision-every 3 --face-samples-with LeftUpLeg --frames 1"));
+  EXPECT_EQ(worn["collision_every"].get<int>(), 3);
+  EXPECT_EQ(worn["garments"][0]["face_samples_with"], nlohmann::json({"LeftUpLeg"}));
 }
 
 TEST(RunScene, DampingTheSubstepCannotCarryIsRefusedWithTheWayOut) {

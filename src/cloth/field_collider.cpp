@@ -846,22 +846,6 @@ void FieldCollider::applyCorrections(ClothState& io) {
   }
 }
 
-// Face samples (CollisionPart::faceSamples). Which triangles: those with a
-// vertex sliding on a face-sample part, all three vertices free (a bound vertex is the
-// fixtures' to place) and none being eased out of that part (it started below T2: its
-// triangle would be thrown onto T2 at once, which the easing is there to avoid); and no
-// vertex within one ring of them sliding on another part. Where two parts' offset surfaces
-// meet (a sleeve between arm and chest) no place is outside both, and pushing the triangle
-// off one of them pushes it into the other: measured on the walking dress, the face samples
-// there stopped the Daz-style walk in frame 74.
-//
-// The push: the centroid c = (x_a + x_b + x_c) / 3 below T2 by `below` moves its three
-// vertices by kFaceRate below along the normal, and the centroid loses its inward velocity
-// relative to the part (each vertex by the same change). A part of the depth per test, not
-// all of it: the vertices' own contacts are already answered, and a triangle thrown onto T2
-// at once yanks its neighbours (measured: with the whole depth the walking dress stopped in
-// frame 20). The bulge rises by a fraction of a millimetre per substep, so the triangle
-// keeps up with it.
 void FieldCollider::buildFaceTopology(const ClothModel& model) {
   const std::size_t n = model.vertexCount();
   const std::vector<mesh::Triangle>& triangles = model.triangles();
@@ -888,6 +872,22 @@ void FieldCollider::buildFaceTopology(const ClothModel& model) {
   faceStamp_.assign(triangles.size(), -1);
 }
 
+// Face samples (CollisionPart::faceSamples). Which triangles: those with a vertex sliding on
+// a face-sample part, all three vertices free (a bound vertex is the fixtures' to place) and
+// none being eased out of that part (it started below T2: its triangle would be thrown onto
+// T2 at once, which the easing is there to avoid); and no vertex within one ring of them
+// sliding on another part. Where two parts' offset surfaces meet (a sleeve between arm and
+// chest) no place is outside both, and pushing the triangle off one of them pushes it into
+// the other: measured on the walking dress, the face samples there stopped the Daz-style
+// walk in frame 74.
+//
+// The push: the centroid c = (x_a + x_b + x_c) / 3 below T2 by `below` moves its three
+// vertices by kFaceRate below along the normal, and the centroid loses its inward velocity
+// relative to the part (each vertex by the same change). A part of the depth per test, not
+// all of it: the vertices' own contacts are already answered, and a triangle thrown onto T2
+// at once yanks its neighbours (measured: with the whole depth the walking dress stopped in
+// frame 20). The bulge rises by a fraction of a millimetre per substep, so the triangle
+// keeps up with it.
 void FieldCollider::collideFaces(const ClothModel& model, double dt_s, ClothState& io) {
   const std::size_t n = io.size();
   if (vertexTrianglesStart_.size() != n + 1) buildFaceTopology(model);  // once, at the first test

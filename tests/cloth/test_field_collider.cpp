@@ -1056,6 +1056,12 @@ struct Cap {
       state.setVelocity(i, -0.5 * directions[i]);
     }
   }
+  [[nodiscard]] FieldCollider collider() const { return FieldCollider("test", parts, kOffsets, 0.0, 0.0); }
+  /// arrive, then the first test over dt: the vertices land on T2.
+  void land(FieldCollider& c, double dt) {
+    arrive(c);
+    c.collide(*model, 0.0, dt, state);
+  }
   [[nodiscard]] Vec3 centroid() const { return (state.position(0) + state.position(1) + state.position(2)) / 3.0; }
   [[nodiscard]] Vec3 centroidVelocity() const {
     return (state.velocity(0) + state.velocity(1) + state.velocity(2)) / 3.0;
@@ -1069,10 +1075,9 @@ TEST(FieldCollider, FaceSamplesLiftATriangleUntilItsCentroidIsOnT2) {
   for (const bool faces : {false, true}) {
     SCOPED_TRACE(faces ? "face samples" : "vertices alone");
     Cap cap(1, faces);
-    FieldCollider c("test", cap.parts, kOffsets, 0.0, 0.0);
+    FieldCollider c = cap.collider();
     EXPECT_EQ(c.faceSamples(), faces);
-    cap.arrive(c);
-    c.collide(*cap.model, 0.0, dt, cap.state);
+    cap.land(c, dt);
     for (int i = 0; i < 3; ++i) {
       ASSERT_EQ(c.state(0, i), PointState::OnSurf);
       if (!faces) EXPECT_NEAR(cap.field.distanceAt(cap.state.position(i)), kOffsets.t2_m, 5e-4) << "vertex " << i;
@@ -1110,9 +1115,8 @@ TEST(FieldCollider, AFaceSampleBelowT2LosesItsInwardVelocity) {
   for (const bool faces : {false, true}) {
     SCOPED_TRACE(faces ? "face samples" : "vertices alone");
     Cap cap(1, faces);
-    FieldCollider c("test", cap.parts, kOffsets, 0.0, 0.0);
-    cap.arrive(c);
-    c.collide(*cap.model, 0.0, dt, cap.state);
+    FieldCollider c = cap.collider();
+    cap.land(c, dt);
     for (int i = 0; i < 3; ++i) cap.state.setVelocity(i, Vec3(0, 0, -0.3));
     c.collide(*cap.model, dt, 2 * dt, cap.state);
     const double down = cap.centroidVelocity().z();
@@ -1132,7 +1136,7 @@ TEST(FieldCollider, FaceSamplesLeaveAloneWhatTwoPartsPressAndWhatFixturesHold) {
   constexpr double dt = 1e-3;
   const auto run = [&](int partCount, bool faces, bool bound) {
     Cap cap(partCount, faces);
-    FieldCollider c("test", cap.parts, kOffsets, 0.0, 0.0);
+    FieldCollider c = cap.collider();
     if (bound) c.setFixedVertices({0}, 3);
     cap.arrive(c);
     for (int step = 0; step < 20; ++step) c.collide(*cap.model, step * dt, (step + 1) * dt, cap.state);

@@ -1080,7 +1080,9 @@ TEST(FieldCollider, FaceSamplesLiftATriangleUntilItsCentroidIsOnT2) {
     cap.land(c, dt);
     for (int i = 0; i < 3; ++i) {
       ASSERT_EQ(c.state(0, i), PointState::OnSurf);
-      if (!faces) EXPECT_NEAR(cap.field.distanceAt(cap.state.position(i)), kOffsets.t2_m, 5e-4) << "vertex " << i;
+      if (!faces) {
+        EXPECT_NEAR(cap.field.distanceAt(cap.state.position(i)), kOffsets.t2_m, 5e-4) << "vertex " << i;
+      }
     }
     // With face samples the first test already lifted the triangle by a quarter of 9 mm.
     EXPECT_NEAR(cap.field.distanceAt(cap.centroid()), faces ? 0.006 + 0.25 * 0.009 : 0.006, 1e-3);

@@ -36,7 +36,8 @@ TEST(MakeScene, DressOnTheWalkingBody) {
   const CliResult made = runDrape(makeDressScene("obj",
                                                   "--name dress --offsets 0.002,0.004,0.006,0.016 --collides-with "
                                                   "Hips,LowerBack,Spine,Spine1,Neck,LeftShoulder,RightShoulder,"
-                                                  "LeftArm,RightArm,LeftUpLeg,RightUpLeg",
+                                                  "LeftArm,RightArm,LeftUpLeg,RightUpLeg --face-samples-with "
+                                                  "LeftUpLeg,RightUpLeg",
                                                   sceneDir),
                                    dir);
   ASSERT_EQ(made.code, 0) << made.err;
@@ -46,6 +47,7 @@ TEST(MakeScene, DressOnTheWalkingBody) {
   ASSERT_EQ(sc.garments.size(), 1u);
   EXPECT_EQ(sc.garments[0].mesh.triangleCount(), 4192u);
   EXPECT_EQ(sc.garments[0].maskVertices.size(), 222u);
+  EXPECT_EQ(sc.garments[0].faceSamplesWith, (std::vector<std::string>{"LeftUpLeg", "RightUpLeg"}));
   EXPECT_GT(sc.simulation.stepsPerFrame, 33) << "the dress's slivers need more substeps than the skirt";
   EXPECT_GT(sc.simulation.maxAddedMass, 0.0);
 
@@ -61,6 +63,7 @@ TEST(MakeScene, DressOnTheWalkingBody) {
   const nlohmann::json& g = stats["garments"][0];
   EXPECT_GT(g["added_mass_kg"].get<double>(), 0.0);
   EXPECT_LT(g["added_mass_kg"].get<double>(), 0.02 * g["mass_kg"].get<double>());
+  EXPECT_EQ(g["face_samples_with"], nlohmann::json({"LeftUpLeg", "RightUpLeg"}));
 }
 
 TEST(MakeScene, AMakeHumanGarmentIsRefittedWithItsMask) {
@@ -102,6 +105,13 @@ TEST(MakeScene, TooFewSubstepsForTheAddedMassIsAClearError) {
   ScratchDir dir("make-scene-substeps");
   const std::string sceneDir = dir / "dress";
   // make-scene refuses a count that needs more mass than allowed, and names one that does not.
+  // Face samples only with parts the garment collides with, said before the substep search.
+  const CliResult faces =
+      runDrape(makeDressScene("obj", "--collides-with Hips,Spine1 --face-samples-with Hips,LeftUpLeg", sceneDir), dir);
+  EXPECT_EQ(faces.code, 2) << faces.err;
+  EXPECT_NE(faces.err.find("--face-samples-with: 'LeftUpLeg' is not one of the collidable segments (Hips, Spine1)"),
+            std::string::npos)
+      << faces.err;
   const CliResult refused = runDrape(makeDressScene("obj", "--substeps 33 --collides-with Hips,Spine1", sceneDir), dir);
   EXPECT_EQ(refused.code, 2) << refused.err;
   EXPECT_NE(refused.err.find("more than --max-added-mass 0.02"), std::string::npos) << refused.err;

@@ -125,9 +125,7 @@ RunFunction setupPaperBench(CLI::App& app) {
                "balls are measured against)");
   app.add_option_function<std::vector<std::string>>(
          "--face-samples-with",
-         [](const std::vector<std::string>& parts) {
-           o.faceSamplesWith = parts == std::vector<std::string>{"none"} ? std::vector<std::string>{} : parts;
-         },
+         [](const std::vector<std::string>& parts) { o.faceSamplesWith = facePartsOption(parts); },
          "Body parts against which the triangles' centroids collide too, overriding the scene's "
          "faceSamplesWith; 'none' for none")
       ->delimiter(',');

@@ -129,14 +129,13 @@ void applyOffsets(const RunOptions& o, RunSetup& setup) {
 /// --collision-every and --face-samples-with for every garment (a scene's or --garment's).
 void applyCollisionOptions(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   const bool faces = app.count("--face-samples-with") > 0;
-  if (faces && !setup.character && o.faceSamplesWith != std::vector<std::string>{"none"})
+  const std::vector<std::string> faceParts = facePartsOption(o.faceSamplesWith);
+  if (faces && !setup.character && !faceParts.empty())
     throw Error("--face-samples-with: there is no avatar to collide with (the scene has none; without a scene, give "
                 "--avatar FILE)");
   for (GarmentSetup& g : setup.garments) {
     if (app.count("--collision-every")) g.collisionEvery = o.collisionEvery;
-    if (faces)
-      g.faceSamplesWith = o.faceSamplesWith == std::vector<std::string>{"none"} ? std::vector<std::string>{}
-                                                                                : o.faceSamplesWith;
+    if (faces) g.faceSamplesWith = faceParts;
   }
 }
 

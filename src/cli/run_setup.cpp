@@ -313,6 +313,10 @@ int stableSubsteps(const RunSetup& setup) {
   return n;
 }
 
+std::vector<std::string> facePartsOption(const std::vector<std::string>& given) {
+  return given == std::vector<std::string>{"none"} ? std::vector<std::string>{} : given;
+}
+
 void garmentVertexStates(const cloth::ClothSolver& solver, const cloth::FieldCollider* collider,
                          std::vector<std::uint8_t>& out) {
   const std::size_t n = solver.state().size();

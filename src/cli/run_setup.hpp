@@ -88,6 +88,9 @@ void validateRunSetup(const RunSetup& setup);
 /// ExitCode::Unstable naming garment, vertex and frame.
 int simulateRun(const RunSetup& setup);
 
+/// The parts a --face-samples-with option names: as given, or none for "none".
+[[nodiscard]] std::vector<std::string> facePartsOption(const std::vector<std::string>& given);
+
 /// A garment's vertex states now, as the overlays draw them (render::vertex_state): its
 /// collider's collision states (all outside without a collider, or before its first test)
 /// with the pinned and bound flags of its fixtures. `drape run` records them per frame,

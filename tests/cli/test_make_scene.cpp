@@ -64,6 +64,14 @@ TEST(MakeScene, DressOnTheWalkingBody) {
   EXPECT_GT(g["added_mass_kg"].get<double>(), 0.0);
   EXPECT_LT(g["added_mass_kg"].get<double>(), 0.02 * g["mass_kg"].get<double>());
   EXPECT_EQ(g["face_samples_with"], nlohmann::json({"LeftUpLeg", "RightUpLeg"}));
+  // 'none' takes the scene's face samples away.
+  const std::string plain = dir / "plain";
+  const CliResult none = runDrape("run '" + sceneDir + "/scene.wrl' --motion '" + kSource +
+                                      "/examples/walking_skirt/walk.bvh' --lead-in 0.2 --frames 1 --face-samples-with none "
+                                      "--out '" + plain + "'",
+                                  dir);
+  ASSERT_EQ(none.code, 0) << none.err;
+  EXPECT_EQ(statsOf(plain)["garments"][0]["face_samples_with"], nlohmann::json::array());
 }
 
 TEST(MakeScene, AMakeHumanGarmentIsRefittedWithItsMask) {

@@ -102,8 +102,10 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
 
 RunFunction setupPaperBench(CLI::App& app) {
   static PaperBenchOptions o;
-  app.add_option("--scene", o.scene, "The scenario's scene")->capture_default_str();
-  app.add_option("--motion", o.motion, "The scenario's motion")->capture_default_str();
+  // The defaults live in the source tree; the help names them relative to it, not by the
+  // absolute path they had where drape was built.
+  app.add_option("--scene", o.scene, "The scenario's scene (default: the bundled examples/walking_skirt/scene.wrl)");
+  app.add_option("--motion", o.motion, "The scenario's motion (default: the bundled examples/walking_skirt/walk.bvh)");
   app.add_option("--frames", o.frames, "Frames per run (default: the lead-in and the whole clip)");
   app.add_option("--runs", o.runs, "Runs; the median is reported")->capture_default_str()->check(CLI::Range(1, 100));
   app.add_option("--collision-every", o.collisionEvery,

@@ -37,6 +37,7 @@ ClothSolver::ClothSolver(std::shared_ptr<const ClothModel> model, const StepSett
       state_(ClothState::atRest(*model_)) {
   settings_.validate("--");
   checkBendingStep(*model_, settings_);
+  checkPinGroups();
   const bool forwardEuler = settings_.integrator == IntegratorKind::ForwardEuler;
   if (model_->material().damping_s > 0.0 || forwardEuler) {
     std::vector<std::uint8_t> fixed(model_->vertexCount(), 0);
@@ -45,6 +46,32 @@ ClothSolver::ClothSolver(std::shared_ptr<const ClothModel> model, const StepSett
     dampedOmega_ = model_->membraneFrequency_rad_s(fixed);
     if (forwardEuler) checkForwardEulerStep(*model_, settings_, dampedOmega_);
     else checkDampedStep(*model_, settings_, dampedOmega_);
+  }
+}
+
+void ClothSolver::checkPinGroups() {
+  // Each blended vertex's weights sum to 1, unless a group without weights places it (which
+  // wins: those groups are applied last).
+  const std::size_t n = model_->vertexCount();
+  std::vector<std::uint8_t> alone(n, 0);
+  std::vector<double> weightSum(n, 0.0);
+  for (const PinGroup& g : pins_) {
+    if (!g.weight.empty() && g.weight.size() != g.vertices.size())
+      throw Error(fmt::format("a fixture group has {} weights for {} vertices", g.weight.size(), g.vertices.size()),
+                  ExitCode::Internal);
+    for (std::size_t k = 0; k < g.vertices.size(); ++k) {
+      const std::uint32_t v = g.vertices[k];
+      if (v >= n) throw Error(fmt::format("fixture vertex {} is out of range ({} vertices)", v, n), ExitCode::Internal);
+      if (g.weight.empty()) alone[v] = 1;
+      else weightSum[v] += g.weight[k];
+    }
+  }
+  for (std::size_t v = 0; v < n; ++v) {
+    if (weightSum[v] == 0.0) continue;
+    if (!alone[v] && std::abs(weightSum[v] - 1.0) > 1e-9)
+      throw Error(fmt::format("fixture vertex {} has weights summing to {}, not 1", v, weightSum[v]),
+                  ExitCode::Internal);
+    blended_.push_back(static_cast<std::uint32_t>(v));
   }
 }
 
@@ -161,23 +188,38 @@ void ClothSolver::collide(double t0, double t1) {
 }
 
 void ClothSolver::applyFixtures(double t0, double t1, double dt) {
-  for (const PinGroup& g : pins_) {
-    // Timed apart: on a moving body this is animation (the skeleton's evaluation and
-    // interpolation, whoever asks first in a substep), which the collision share leaves out.
-    const Clock::time_point poseStart = Clock::now();
-    const RigidTransform now = g.motion ? g.motion->poseAt(t1) : RigidTransform::identity();
-    const RigidTransform before = g.motion ? g.motion->poseAt(t0) : RigidTransform::identity();
-    times_.fixturePoses_s += secondsSince(poseStart);
-    const Mat3 r1 = now.rotation.toRotationMatrix(), r0 = before.rotation.toRotationMatrix();
-    const Vec3 p1 = now.translation, p0 = before.translation;
-    const double invDt = 1.0 / dt;
-    for (std::size_t k = 0; k < g.vertices.size(); ++k) {
-      const Vec3 local(g.localX[k], g.localY[k], g.localZ[k]);
-      const Vec3 at = r1 * local + p1;
-      const Vec3 was = r0 * local + p0;
-      const std::uint32_t v = g.vertices[k];
+  // A blended vertex is the sum of its groups' weighted placements: cleared first.
+  for (const std::uint32_t v : blended_) {
+    state_.setPosition(v, Vec3::Zero());
+    state_.setVelocity(v, Vec3::Zero());
+  }
+  for (const bool weighted : {true, false})
+    for (const PinGroup& g : pins_)
+      if (g.weight.empty() != weighted) applyFixture(g, t0, t1, dt);
+}
+
+void ClothSolver::applyFixture(const PinGroup& g, double t0, double t1, double dt) {
+  // Timed apart: on a moving body this is animation (the skeleton's evaluation and
+  // interpolation, whoever asks first in a substep), which the collision share leaves out.
+  const Clock::time_point poseStart = Clock::now();
+  const RigidTransform now = g.motion ? g.motion->poseAt(t1) : RigidTransform::identity();
+  const RigidTransform before = g.motion ? g.motion->poseAt(t0) : RigidTransform::identity();
+  times_.fixturePoses_s += secondsSince(poseStart);
+  const Mat3 r1 = now.rotation.toRotationMatrix(), r0 = before.rotation.toRotationMatrix();
+  const Vec3 p1 = now.translation, p0 = before.translation;
+  const double invDt = 1.0 / dt;
+  for (std::size_t k = 0; k < g.vertices.size(); ++k) {
+    const Vec3 local(g.localX[k], g.localY[k], g.localZ[k]);
+    const Vec3 at = r1 * local + p1;
+    const Vec3 was = r0 * local + p0;
+    const std::uint32_t v = g.vertices[k];
+    if (g.weight.empty()) {
       state_.setPosition(v, at);
       state_.setVelocity(v, (at - was) * invDt);
+    } else {
+      const double w = g.weight[k];
+      state_.setPosition(v, state_.position(v) + w * at);
+      state_.setVelocity(v, state_.velocity(v) + (w * invDt) * (at - was));
     }
   }
 }

@@ -186,39 +186,116 @@ void CharacterWorld::buildFields(const std::vector<GarmentSpec>& garments) {
 
 namespace {
 
-/// Connected pieces of the constraint mask: mask vertices joined by a garment edge whose two
-/// ends are both in the mask. Returns each mask entry's piece index.
-std::vector<std::size_t> maskPieces(const mesh::TriMesh& mesh, const std::vector<std::uint32_t>& bound) {
-  std::vector<std::size_t> parent(bound.size());
-  std::iota(parent.begin(), parent.end(), std::size_t{0});
-  const auto find = [&](std::size_t a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  };
+/// The constraint mask's own edges: for each mask entry, the entries it shares a garment
+/// edge with.
+std::vector<std::vector<std::size_t>> maskNeighbours(const mesh::TriMesh& mesh, const std::vector<std::uint32_t>& bound) {
   std::unordered_map<std::uint32_t, std::size_t> entry;
   for (std::size_t i = 0; i < bound.size(); ++i) entry.emplace(bound[i], i);
+  std::vector<std::vector<std::size_t>> next(bound.size());
   for (const mesh::Triangle& t : mesh.triangles) {
     for (int k = 0; k < 3; ++k) {
       const auto a = entry.find(t[static_cast<std::size_t>(k)]);
       const auto b = entry.find(t[static_cast<std::size_t>((k + 1) % 3)]);
-      if (a != entry.end() && b != entry.end()) parent[find(a->second)] = find(b->second);
+      if (a == entry.end() || b == entry.end()) continue;
+      next[a->second].push_back(b->second);
+      next[b->second].push_back(a->second);
     }
   }
-  std::vector<std::size_t> piece(bound.size());
-  for (std::size_t i = 0; i < bound.size(); ++i) piece[i] = find(i);
-  return piece;
+  for (std::vector<std::size_t>& n : next) {
+    std::sort(n.begin(), n.end());
+    n.erase(std::unique(n.begin(), n.end()), n.end());
+  }
+  return next;
+}
+
+/// Each mask vertex's home part: the part most vertices of its connected piece of the mask
+/// are nearest to (distance: n x np, row-major).
+std::vector<std::size_t> homeParts(const std::vector<double>& distance, std::size_t np,
+                                   const std::vector<std::vector<std::size_t>>& neighbours) {
+  const std::size_t n = neighbours.size();
+  std::vector<std::size_t> piece(n, n), home(n, 0);
+  for (std::size_t seed = 0; seed < n; ++seed) {
+    if (piece[seed] != n) continue;
+    std::vector<std::size_t> members{seed};
+    piece[seed] = seed;
+    for (std::size_t m = 0; m < members.size(); ++m)
+      for (const std::size_t j : neighbours[members[m]])
+        if (piece[j] == n) {
+          piece[j] = seed;
+          members.push_back(j);
+        }
+    std::vector<int> votes(np, 0);
+    for (const std::size_t i : members) {
+      const auto row = distance.begin() + static_cast<std::ptrdiff_t>(i * np);
+      ++votes[static_cast<std::size_t>(std::min_element(row, row + static_cast<std::ptrdiff_t>(np)) - row)];
+    }
+    const auto part = static_cast<std::size_t>(std::max_element(votes.begin(), votes.end()) - votes.begin());
+    for (const std::size_t i : members) home[i] = part;
+  }
+  return home;
+}
+
+/// Blend weights of the mask vertices over the parts (n x np, rows sum to 1). A vertex
+/// follows its home part and the parts joined to it by one joint of the skeleton
+/// (`adjacent`, np x np), each of those within kBlendWidth_m of as near to it as the nearest
+/// of them, the nearer the more. The weights are then smoothed along the mask's edges, so
+/// that they vary from vertex to vertex as gently as the cloth can follow, and shares below
+/// kLeast are dropped.
+std::vector<double> maskBlendWeights(const std::vector<double>& distance, std::size_t np,
+                                     const std::vector<std::vector<std::size_t>>& neighbours,
+                                     const std::vector<std::uint8_t>& adjacent) {
+  constexpr double kBlendWidth_m = 0.01;
+  constexpr int kSmoothingPasses = 3;
+  constexpr double kLeast = 0.02;
+  const std::size_t n = neighbours.size();
+  const std::vector<std::size_t> home = homeParts(distance, np, neighbours);
+  std::vector<double> w(n * np, 0.0);
+  const auto normalise = [&](std::size_t i) {
+    double sum = 0.0;
+    for (std::size_t k = 0; k < np; ++k) sum += w[i * np + k];
+    for (std::size_t k = 0; k < np; ++k) w[i * np + k] /= sum;
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto allowed = [&](std::size_t k) { return k == home[i] || adjacent[home[i] * np + k]; };
+    double nearest = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < np; ++k)
+      if (allowed(k)) nearest = std::min(nearest, distance[i * np + k]);
+    for (std::size_t k = 0; k < np; ++k)
+      if (allowed(k)) w[i * np + k] = std::max(0.0, 1.0 - (distance[i * np + k] - nearest) / kBlendWidth_m);
+    if (!std::isfinite(nearest)) w[i * np + home[i]] = 1.0;  // beyond every allowed part's grid
+    normalise(i);
+  }
+  std::vector<double> next(w.size());
+  for (int pass = 0; pass < kSmoothingPasses; ++pass) {
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t k = 0; k < np; ++k) {
+        double sum = w[i * np + k];
+        for (const std::size_t j : neighbours[i]) sum += w[j * np + k];
+        next[i * np + k] = sum / static_cast<double>(1 + neighbours[i].size());
+      }
+    w.swap(next);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t k = 0; k < np; ++k)
+      if (w[i * np + k] < kLeast) w[i * np + k] = 0.0;
+    normalise(i);
+  }
+  return w;
 }
 
 }  // namespace
 
 std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, const std::vector<int>& parts) const {
   // Each mask vertex must lie within the threshold of a collidable part (measured with the
-  // distance fields) and from then on moves rigidly with a part (section 4.1). The paper
-  // binds each vertex to its nearest part; where an automatic segmentation puts a few waist
-  // vertices nearer a thigh than the pelvis, or a shoulder seam's ends nearer the clavicles
-  // than the chest, that tears the cloth between them as the parts move apart. So each
-  // connected piece of the mask (a waistband, a shoulder yoke, a cuff) moves as one, with
-  // the part most of its vertices are nearest to.
+  // distance fields) and from then on moves rigidly with the body (section 4.1). The paper
+  // binds each vertex to its nearest part. Where a mask spans a joint that tears the cloth
+  // between neighbours bound to parts that move apart (a few waist vertices nearer a thigh
+  // than the pelvis, a shoulder seam's ends nearer the clavicles than the chest). Binding a
+  // whole piece of the mask to one part instead lets the other parts move through the bound
+  // cloth: the clavicles through a jacket's yoke bound to the chest as the arms come down.
+  // So each piece has a home part (the one most of its vertices are nearest to) and each of
+  // its vertices follows a blend of the home part and the parts one joint away from it that
+  // it lies on (linear blend skinning), with weights that vary smoothly along the mask.
   const std::size_t n = spec.bound.size();
   const std::size_t np = parts.size();
   std::vector<double> distance(n * np, std::numeric_limits<double>::infinity());
@@ -236,41 +313,20 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
         nearest[i] = static_cast<int>(k);
     }
   }
-  const std::vector<std::size_t> piece = maskPieces(spec.mesh, spec.bound);
-  std::unordered_map<std::size_t, std::vector<int>> votes;  // piece -> votes per part
-  for (std::size_t i = 0; i < n; ++i) {
-    std::vector<int>& v = votes.try_emplace(piece[i], std::vector<int>(np, 0)).first->second;
-    if (nearest[i] >= 0 && distance[i * np + static_cast<std::size_t>(nearest[i])] <= spec.bindThreshold_m)
-      ++v[static_cast<std::size_t>(nearest[i])];
-  }
-  std::unordered_map<std::size_t, std::size_t> majority;  // piece -> part
-  for (const auto& [p, v] : votes)
-    majority[p] = static_cast<std::size_t>(std::max_element(v.begin(), v.end()) - v.begin());
-
-  std::vector<cloth::PinGroup> groups(np);
   std::size_t unbound = 0;
   std::string firstUnbound;
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t v = spec.bound[i];
     const int k = nearest[i];
-    if (k < 0 || distance[i * np + static_cast<std::size_t>(k)] > spec.bindThreshold_m) {
-      const Vec3& p = spec.mesh.positions[v];
-      if (unbound++ == 0) {
-        firstUnbound = k < 0 ? fmt::format("vertex {} at ({:.3f}, {:.3f}, {:.3f}) m is near no collidable part", v,
-                                           p.x(), p.y(), p.z())
-                             : fmt::format("vertex {} at ({:.3f}, {:.3f}, {:.3f}) m is {:.3f} m from '{}'", v, p.x(),
-                                           p.y(), p.z(), distance[i * np + static_cast<std::size_t>(k)],
-                                           fields_[static_cast<std::size_t>(parts[static_cast<std::size_t>(k)])].segment);
-      }
-      continue;
+    if (k >= 0 && distance[i * np + static_cast<std::size_t>(k)] <= spec.bindThreshold_m) continue;
+    const Vec3& p = spec.mesh.positions[v];
+    if (unbound++ == 0) {
+      firstUnbound = k < 0 ? fmt::format("vertex {} at ({:.3f}, {:.3f}, {:.3f}) m is near no collidable part", v,
+                                         p.x(), p.y(), p.z())
+                           : fmt::format("vertex {} at ({:.3f}, {:.3f}, {:.3f}) m is {:.3f} m from '{}'", v, p.x(),
+                                         p.y(), p.z(), distance[i * np + static_cast<std::size_t>(k)],
+                                         fields_[static_cast<std::size_t>(parts[static_cast<std::size_t>(k)])].segment);
     }
-    const std::size_t m = majority[piece[i]];
-    cloth::PinGroup& g = groups[m];
-    const Vec3& l = local[i * np + m];
-    g.vertices.push_back(v);
-    g.localX.push_back(l.x());
-    g.localY.push_back(l.y());
-    g.localZ.push_back(l.z());
   }
   if (unbound > 0) {
     throw Error(fmt::format("garment '{}': {} of {} constraint-mask vertices cannot be bound within bindThreshold "
@@ -278,14 +334,45 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
                             spec.name, unbound, n, spec.bindThreshold_m, fmt::join(spec.collidesWith, ", "),
                             firstUnbound));
   }
+
+  std::vector<std::uint8_t> adjacent(np * np, 0);  // parts whose joints are parent and child
+  for (std::size_t a = 0; a < np; ++a)
+    for (std::size_t b = 0; b < np; ++b) {
+      const int ja = fields_[static_cast<std::size_t>(parts[a])].joint;
+      const int jb = fields_[static_cast<std::size_t>(parts[b])].joint;
+      adjacent[a * np + b] = ja >= 0 && jb >= 0 && ja != jb &&
+                             (avatar_.joints[static_cast<std::size_t>(ja)].parent == jb ||
+                              avatar_.joints[static_cast<std::size_t>(jb)].parent == ja);
+    }
+  const std::vector<double> weight = maskBlendWeights(distance, np, maskNeighbours(spec.mesh, spec.bound), adjacent);
+  std::vector<cloth::PinGroup> groups(np);
+  std::size_t blended = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t shares = 0;
+    for (std::size_t k = 0; k < np; ++k) {
+      if (weight[i * np + k] == 0.0) continue;
+      ++shares;
+      cloth::PinGroup& g = groups[k];
+      const Vec3& l = local[i * np + k];
+      g.vertices.push_back(spec.bound[i]);
+      g.localX.push_back(l.x());
+      g.localY.push_back(l.y());
+      g.localZ.push_back(l.z());
+      g.weight.push_back(weight[i * np + k]);
+    }
+    blended += shares > 1;
+  }
   std::vector<cloth::PinGroup> out;
   for (std::size_t k = 0; k < groups.size(); ++k) {
     if (groups[k].vertices.empty()) continue;
-    spdlog::debug("garment '{}': {} mask vertices bound to '{}'", spec.name, groups[k].vertices.size(),
+    spdlog::debug("garment '{}': {} mask vertices follow '{}'", spec.name, groups[k].vertices.size(),
                   fields_[static_cast<std::size_t>(parts[k])].segment);
     groups[k].motion = partMotions_[static_cast<std::size_t>(parts[k])];
     out.push_back(std::move(groups[k]));
   }
+  if (blended > 0)
+    spdlog::info("garment '{}': {} of {} constraint-mask vertices follow a blend of parts across a joint", spec.name,
+                 blended, n);
   return out;
 }
 

@@ -278,6 +278,66 @@ TEST(Fixtures, PinnedVerticesFollowTheirTransform) {
 }
 
 // ---------------------------------------------------------------------------------------
+TEST(Fixtures, BlendedVerticesFollowTheWeightedSumOfTheirGroups) {
+  // One row bound to two frames turning and sliding apart, with weights 0.3 and 0.7 (linear
+  // blend skinning); a group without weights places one vertex of the row alone, over the
+  // blend.
+  struct Turn final : FixtureMotion {
+    double sign;
+    explicit Turn(double s) : sign(s) {}
+    RigidTransform poseAt(double t) const override {
+      RigidTransform r;
+      r.translation = Vec3(0.2 * sign * t, 0.1 * t, 0);
+      r.rotation = Quat(Eigen::AngleAxisd(0.5 * sign * t, Vec3::UnitZ()));
+      return r;
+    }
+  };
+  SheetSpec spec{0.2, 0.2, 4, 4, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), "sheet"};
+  auto model = makeModel(gridSheet(spec), fabric(1e4, 1e-3, 300));
+  const auto a = std::make_shared<Turn>(1.0), b = std::make_shared<Turn>(-1.0);
+  const std::vector<std::uint32_t> top = row(spec, spec.cellsV);
+  PinGroup ga = PinGroup::atRest(top, model->restX(), model->restY(), model->restZ(), a);
+  PinGroup gb = PinGroup::atRest(top, model->restX(), model->restY(), model->restZ(), b);
+  ga.weight.assign(top.size(), 0.3);
+  gb.weight.assign(top.size(), 0.7);
+  const std::uint32_t alone = top.front();
+  PinGroup still = PinGroup::atRest({alone}, model->restX(), model->restY(), model->restZ());
+  StepSettings settings = settingsWithStep(2e-4, 0.5);
+  ClothSolver solver(model, settings, {ga, gb, still});
+  const long steps = 300;
+  ASSERT_TRUE(run(solver, steps));
+  const double t1 = steps * settings.substep_s(), t0 = (steps - 1) * settings.substep_s();
+  const auto blendAt = [&](double t, std::uint32_t v) {
+    const Vec3 rest(model->restX()[v], model->restY()[v], model->restZ()[v]);
+    return Vec3(0.3 * a->poseAt(t).apply(rest) + 0.7 * b->poseAt(t).apply(rest));
+  };
+  for (std::uint32_t v : top) {
+    const Vec3 rest(model->restX()[v], model->restY()[v], model->restZ()[v]);
+    const Vec3 expected = v == alone ? rest : blendAt(t1, v);
+    const Vec3 velocity = v == alone ? Vec3::Zero() : Vec3((blendAt(t1, v) - blendAt(t0, v)) / settings.substep_s());
+    EXPECT_LT((solver.state().position(v) - expected).norm(), 1e-12) << "vertex " << v;
+    EXPECT_LT((solver.state().velocity(v) - velocity).norm(), 1e-9) << "vertex " << v;
+  }
+  // Where the two frames have moved apart, the blend is neither of them.
+  const std::uint32_t v = top.back();
+  const Vec3 rest(model->restX()[v], model->restY()[v], model->restZ()[v]);
+  const Vec3 onA = a->poseAt(t1).apply(rest), onB = b->poseAt(t1).apply(rest);
+  ASSERT_GT((onA - onB).norm(), 0.01);
+  EXPECT_NEAR((solver.state().position(v) - onA).norm(), 0.7 * (onA - onB).norm(), 1e-12);
+  EXPECT_NEAR((solver.state().position(v) - onB).norm(), 0.3 * (onA - onB).norm(), 1e-12);
+}
+
+TEST(Fixtures, BlendWeightsMustSumToOne) {
+  SheetSpec spec{0.2, 0.2, 2, 2, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), "sheet"};
+  auto model = makeModel(gridSheet(spec), fabric(1e4, 1e-3, 300));
+  PinGroup g = PinGroup::atRest(row(spec, spec.cellsV), model->restX(), model->restY(), model->restZ());
+  g.weight.assign(g.vertices.size(), 0.6);
+  EXPECT_THROW(ClothSolver(model, settingsWithStep(2e-4, 0.5), {g}), Error);
+  g.weight.pop_back();
+  EXPECT_THROW(ClothSolver(model, settingsWithStep(2e-4, 0.5), {g}), Error);
+}
+
+// ---------------------------------------------------------------------------------------
 TEST(Collision, SheetDrapesOnSphereWithoutPenetrating) {
   SheetSpec spec{1.0, 1.0, 12, 12, Vec3(-0.5, 0, -0.5), Vec3::UnitX(), Vec3::UnitZ(), "sheet"};
   Material mat = fabric(2e4, 1e-3, 300);

@@ -106,11 +106,14 @@ class ClothSolver {
   void integrate(double dt_s);
   void collide(double t0_s, double t1_s);
   void applyFixtures(double t0_s, double t1_s, double dt_s);
+  void applyFixture(const PinGroup& g, double t0_s, double t1_s, double dt_s);
+  void checkPinGroups();
   bool checkStability(long frame, int substepIndex);
 
   std::shared_ptr<const ClothModel> model_;
   StepSettings settings_;
   std::vector<PinGroup> pins_;
+  std::vector<std::uint32_t> blended_;  ///< vertices placed by weighted groups
   std::unique_ptr<Integrator> integrator_;
   std::vector<Collider*> colliders_;
   ClothState state_;

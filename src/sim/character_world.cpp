@@ -276,8 +276,10 @@ std::vector<double> maskBlendWeights(const std::vector<double>& distance, std::s
     w.swap(next);
   }
   for (std::size_t i = 0; i < n; ++i) {
+    const double largest = *std::max_element(w.begin() + static_cast<std::ptrdiff_t>(i * np),
+                                             w.begin() + static_cast<std::ptrdiff_t>((i + 1) * np));
     for (std::size_t k = 0; k < np; ++k)
-      if (w[i * np + k] < kLeast) w[i * np + k] = 0.0;
+      if (w[i * np + k] < kLeast && w[i * np + k] < largest) w[i * np + k] = 0.0;
     normalise(i);
   }
   return w;

@@ -47,6 +47,7 @@ struct MakeSceneOptions {
   int stepsPerFrame = 0;
   double maxAddedMass = 0.02;
   int bendEvery = 0;  ///< --bend-every, or 0: chosen by makeScene from the garment
+  int collisionEvery = 1;  ///< --collision-every
   double bindThreshold_m = 0.04;
   cloth::Material material = knit();
 
@@ -128,8 +129,8 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
   fmt::print(os,
              "DEF Simulation Simulation {{\n  gravity 0 -9.81 0\n  frameRate {:g}\n  stepsPerFrame {}\n"
              "  maxAddedMass {:g}\n  airViscosity 0.5\n  offsets [ {:g} {:g} {:g} {:g} ]\n  voxelSize {:g}\n"
-             "  integrator \"symplectic-euler\"\n  collisionEvery 1\n  bendEvery {}\n}}\n\n",
-             o.frameRate, o.stepsPerFrame, o.maxAddedMass, t[0], t[1], t[2], t[3], v, o.bendEvery);
+             "  integrator \"symplectic-euler\"\n  collisionEvery {}\n  bendEvery {}\n}}\n\n",
+             o.frameRate, o.stepsPerFrame, o.maxAddedMass, t[0], t[1], t[2], t[3], v, o.collisionEvery, o.bendEvery);
   writeMaterial(os, o.material);
   fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n}}\n\n", o.avatarUrl);
   fmt::print(os,
@@ -257,6 +258,10 @@ RunFunction setupMakeScene(CLI::App& app) {
   app.add_option("--bend-every", o.bendEvery,
                  "Bending forces every K substeps, written as the scene's bendEvery (default: a rhythm well inside "
                  "the bending forces' stable step; a K beyond that step is refused)")
+      ->check(CLI::Range(1, 1000));
+  app.add_option("--collision-every", o.collisionEvery,
+                 "Collision tests every K substeps, written as the scene's collisionEvery")
+      ->capture_default_str()
       ->check(CLI::Range(1, 1000));
   app.add_option("--max-added-mass", o.maxAddedMass, "Mass scaling allowed, a fraction of the garment's mass")
       ->capture_default_str();

@@ -80,7 +80,9 @@ TEST(MakeScene, AMakeHumanGarmentIsRefittedWithItsMask) {
   ScratchDir dir("make-scene-mhclo");
   const std::string sceneDir = dir / "dress";
   const CliResult made =
-      runDrape(makeDressScene("mhclo", "--substeps 155 --bend-every 2 --collides-with Hips,Spine1", sceneDir), dir);
+      runDrape(makeDressScene("mhclo", "--substeps 155 --bend-every 2 --collision-every 3 --collides-with Hips,Spine1",
+                              sceneDir),
+               dir);
   ASSERT_EQ(made.code, 0) << made.err;
   const scene::Scene sc = scene::loadScene(sceneDir + "/scene.wrl");
   ASSERT_EQ(sc.garments.size(), 1u);
@@ -88,6 +90,7 @@ TEST(MakeScene, AMakeHumanGarmentIsRefittedWithItsMask) {
   EXPECT_EQ(sc.garments[0].maskVertices.size(), 222u);
   EXPECT_EQ(sc.simulation.stepsPerFrame, 155);
   EXPECT_EQ(sc.simulation.bendEvery, 2);
+  EXPECT_EQ(sc.simulation.collisionEvery, 3);
   // Refitted: the sleeves' cuffs rise to the body's wrists (about 0.2-0.3 m up, not 0.14-0.19).
   double highestCuff = -1;
   for (const Vec3& p : sc.garments[0].mesh.positions)

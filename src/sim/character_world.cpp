@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <unordered_map>
 
 #include <fmt/format.h>
@@ -290,7 +289,7 @@ std::vector<double> maskBlendWeights(const std::vector<double>& distance, std::s
 std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, const std::vector<int>& parts) const {
   // Each mask vertex must lie within the threshold of a collidable part (measured with the
   // distance fields) and from then on moves rigidly with the body (section 4.1). The paper
-  // binds each vertex to its nearest part. Where a mask spans a joint that tears the cloth
+  // binds each vertex to its nearest part. Where a mask spans a joint, that tears the cloth
   // between neighbours bound to parts that move apart (a few waist vertices nearer a thigh
   // than the pelvis, a shoulder seam's ends nearer the clavicles than the chest). Binding a
   // whole piece of the mask to one part instead lets the other parts move through the bound

@@ -28,6 +28,22 @@ using testing::statsOf;
 
 const std::string kSkirtDir = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt";
 
+// The smallest bundled scene (an H-Anim humanoid of primitives, no motion: it stands) runs
+// as it is, without a warning, and its skirt stays out of the body.
+TEST(RunScene, TheDressedAvatarExampleRunsAsItIs) {
+  ScratchDir dir("run-dressed-avatar");
+  const std::string out = dir / "dressed";
+  const CliResult r = runDrape(
+      "run '" + std::string(DRAPE_SOURCE_DIR) + "/examples/dressed_avatar/scene.wrl' --frames 20 --out '" + out + "'",
+      dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  const nlohmann::json stats = statsOf(out);
+  EXPECT_EQ(stats["frames"], 20);
+  EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
+  EXPECT_GT(stats["vertex_substeps"].get<long>(), 0);
+}
+
 // The CMU original of a capture (Acclaim ASF/AMC; subject 11's soccer kick) drives the
 // scene's MakeHuman body through the shipped 'acclaim' map, every joint paired, and the
 // skirt keeps out of the body through the kick.

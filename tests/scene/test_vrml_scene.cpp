@@ -352,7 +352,7 @@ TEST(VrmlScene, DrapeInspectSummarisesAScene) {
   EXPECT_NE(out.find("2 boundary loops"), std::string::npos) << out;
   EXPECT_NE(out.find("constraint mask 24 vertices"), std::string::npos) << out;
   EXPECT_NE(out.find("Cotton: density 300 kg/m^3"), std::string::npos) << out;
-  EXPECT_NE(out.find("30 frames/s x 33 steps/frame"), std::string::npos) << out;
+  EXPECT_NE(out.find("30 frames/s x 70 steps/frame"), std::string::npos) << out;
 }
 
 TEST(VrmlScene, DrapeInspectRejectsABadFileWithExitCode2) {

@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <fmt/ostream.h>
 
 #include "command.hpp"
@@ -76,6 +77,21 @@ void writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::
   if (!os) throw Error(fmt::format("{}: cannot be written", path));
 }
 
+/// Every segment the fit and the scene name must be the avatar's: the defaults are the
+/// MakeHuman CMU rig's, and another rig's avatar names its own.
+void checkSegments(const scene::Avatar& avatar, const MakeSkirtOptions& o) {
+  const auto check = [&](const std::string& name, const char* option) {
+    if (avatar.findSegment(name) >= 0) return;
+    std::vector<std::string> names;
+    for (const scene::Segment& seg : avatar.segments) names.push_back(seg.name);
+    throw Error(fmt::format("{}: the avatar has no segment '{}'; name one of its own with {} (it has: {})", o.avatar,
+                            name, option, fmt::join(names, ", ")));
+  };
+  check(o.fit.waistSegment, "--waist-segment");
+  for (const std::string& name : o.fit.hipSegments) check(name, "--hip-segments");
+  for (const std::string& name : o.fit.legSegments) check(name, "--leg-segments");
+}
+
 RunFunction setupMakeSkirt(CLI::App& app) {
   static MakeSkirtOptions o;
   app.add_option("avatar", o.avatar, "Avatar file to fit the skirt to (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel)")->required();
@@ -87,9 +103,18 @@ RunFunction setupMakeSkirt(CLI::App& app) {
   app.add_option("--around", o.fit.segments, "Vertices around")->capture_default_str()->check(CLI::Range(6, 1000));
   app.add_option("--rings", o.fit.rings, "Bands from waist to hem")->capture_default_str()->check(CLI::Range(2, 1000));
   app.add_option("--waist-segment", o.fit.waistSegment, "Segment at whose joint the waist sits")->capture_default_str();
+  app.add_option("--hip-segments", o.fit.hipSegments, "Segments below the waist the skirt clears and collides with")
+      ->delimiter(',')
+      ->capture_default_str();
+  app.add_option("--leg-segments", o.fit.legSegments,
+                 "Leg segments the skirt clears and collides with; its default length reaches a little above the "
+                 "knees")
+      ->delimiter(',')
+      ->capture_default_str();
   app.add_option("--bind-threshold", o.bindThreshold_m, "Written into the ClothSet, m")->capture_default_str();
   return [] {
     const scene::Avatar avatar = scene::loadAvatarFile(o.avatar);
+    checkSegments(avatar, o);
     const mesh::Skirt skirt = scene::fitSkirt(avatar, o.fit);
     o.avatarUrl = prepareSceneDir(o.out, o.avatar, o.avatarUrl);
     const std::filesystem::path dir(o.out);

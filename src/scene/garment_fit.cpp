@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "drape/core/error.hpp"
 #include "drape/formats/mhclo.hpp"
@@ -16,7 +17,12 @@ namespace {
 
 std::vector<Vec3> restWorldVertices(const Avatar& avatar, const std::string& segmentName) {
   const int s = avatar.findSegment(segmentName);
-  if (s < 0) throw Error(fmt::format("{}: the avatar has no segment '{}' to fit a skirt to", avatar.source, segmentName));
+  if (s < 0) {
+    std::vector<std::string> names;
+    for (const Segment& seg : avatar.segments) names.push_back(seg.name);
+    throw Error(fmt::format("{}: the avatar has no segment '{}' to fit a skirt to (its segments: {})", avatar.source,
+                            segmentName, fmt::join(names, ", ")));
+  }
   const Segment& seg = avatar.segments[static_cast<std::size_t>(s)];
   const RigidTransform rest = avatar.joints[static_cast<std::size_t>(seg.joint)].restWorld();
   std::vector<Vec3> out;

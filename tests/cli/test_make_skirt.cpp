@@ -1,0 +1,79 @@
+// `drape make-skirt` end to end: a skirt fitted to the bundled MakeHuman body and to another
+// rig's avatar, whose segments it names itself; the scenes it writes load and run.
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.hpp"
+#include "drape/scene/scene.hpp"
+
+namespace drape {
+namespace {
+
+using testing::CliResult;
+using testing::runDrape;
+using testing::ScratchDir;
+using testing::statsOf;
+
+const std::string kAvatars = std::string(DRAPE_DATA_DIR) + "/avatars";
+
+/// Runs the scene `dir/scene.wrl` for a few frames (the avatar stands) and checks the skirt
+/// stayed out of the body.
+void runsClean(const ScratchDir& scratch, const std::string& dir) {
+  const std::string out = dir + "-run";
+  const CliResult r = runDrape("run '" + dir + "/scene.wrl' --frames 5 --out '" + out + "'", scratch);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json stats = statsOf(out);
+  EXPECT_EQ(stats["frames"], 5);
+  EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
+}
+
+TEST(MakeSkirt, FitsTheMakeHumanBodyWithItsDefaultSegments) {
+  ScratchDir dir("make-skirt-makehuman");
+  const std::string out = dir / "skirt";
+  const CliResult r = runDrape("make-skirt '" + kAvatars + "/makehuman_rig_cmu_mb.mhskel' --out '" + out + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const scene::Scene sc = scene::loadScene(out + "/scene.wrl");
+  ASSERT_EQ(sc.garments.size(), 1u);
+  EXPECT_EQ(sc.garments[0].mesh.triangleCount(), 480u);
+  EXPECT_EQ(sc.garments[0].collidesWith,
+            (std::vector<std::string>{"LowerBack", "Hips", "LeftUpLeg", "RightUpLeg", "LeftLeg", "RightLeg"}));
+  runsClean(dir, out);
+}
+
+TEST(MakeSkirt, AnotherRigNamesItsOwnSegments) {
+  // MakeHuman's game-engine rig names its segments as game engines do: the defaults (the
+  // CMU rig's) are refused with the avatar's own names, which then fit the skirt.
+  ScratchDir dir("make-skirt-game-engine");
+  const std::string avatar = "'" + kAvatars + "/makehuman_rig_game_engine.mhskel'";
+  const CliResult refused = runDrape("make-skirt " + avatar + " --out '" + (dir / "refused") + "'", dir);
+  EXPECT_EQ(refused.code, 2);
+  EXPECT_NE(refused.err.find("no segment 'LowerBack'"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("--waist-segment"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("spine_01"), std::string::npos) << refused.err;
+
+  const CliResult wrongLeg = runDrape("make-skirt " + avatar + " --waist-segment spine_01 --hip-segments pelvis " +
+                                          "--leg-segments thigh_l,knee_l --out '" + (dir / "wrong") + "'",
+                                      dir);
+  EXPECT_EQ(wrongLeg.code, 2);
+  EXPECT_NE(wrongLeg.err.find("no segment 'knee_l'; name one of its own with --leg-segments"), std::string::npos)
+      << wrongLeg.err;
+
+  const std::string out = dir / "skirt";
+  const CliResult made = runDrape("make-skirt " + avatar + " --waist-segment spine_01 --hip-segments pelvis " +
+                                      "--leg-segments thigh_l,thigh_r,calf_l,calf_r --out '" + out + "'",
+                                  dir);
+  ASSERT_EQ(made.code, 0) << made.err;
+  const scene::Scene sc = scene::loadScene(out + "/scene.wrl");
+  ASSERT_EQ(sc.garments.size(), 1u);
+  EXPECT_EQ(sc.garments[0].collidesWith,
+            (std::vector<std::string>{"spine_01", "pelvis", "thigh_l", "thigh_r", "calf_l", "calf_r"}));
+  // Down to a little above the knees, as on the CMU rig: well below the hips.
+  const Aabb box = sc.garments[0].mesh.bounds();
+  EXPECT_GT(box.max.y() - box.min.y(), 0.3);
+  runsClean(dir, out);
+}
+
+}  // namespace
+}  // namespace drape

@@ -44,10 +44,14 @@ cloth::Material knit() {
   return m;
 }
 
-void writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::Skirt& skirt) {
+/// Writes the scene; returns its substeps per frame.
+int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::Skirt& skirt) {
   constexpr double kFrameRate = 30.0;
-  constexpr int kSubsteps = 33;
   const cloth::Material m = knit();
+  // The paper's 33 substeps per frame, or as many more as this skirt's smallest elements and
+  // the knit's damping need (a small avatar's skirt has smaller, stiffer triangles).
+  const int kSubsteps =
+      cloth::fewestStableSubsteps(skirt.mesh, mesh::Topology::build(skirt.mesh), m, kFrameRate, 0.0, 33).substepsPerFrame;
   const int bendEvery = cloth::suggestedBendEvery(
       *cloth::ClothModel::build(skirt.mesh, mesh::Topology::build(skirt.mesh), m), 1.0 / (kFrameRate * kSubsteps));
   std::ofstream os(path);
@@ -75,6 +79,7 @@ void writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::
   for (const std::string& s : o.fit.legSegments) fmt::print(os, ", \"{}\"", s);
   fmt::print(os, " ]\n  maskTolerance 0.0005\n  bindThreshold {:.3f}\n}}\n", o.bindThreshold_m);
   if (!os) throw Error(fmt::format("{}: cannot be written", path));
+  return kSubsteps;
 }
 
 /// Every segment the fit and the scene name must be the avatar's: the defaults are the
@@ -121,10 +126,10 @@ RunFunction setupMakeSkirt(CLI::App& app) {
     formats::writeObj((dir / "skirt.obj").string(), skirt.mesh.positions, skirt.mesh.triangles, "drape make-skirt (m)");
     formats::writeObj((dir / "waistband.obj").string(), skirt.waistband.positions, skirt.waistband.triangles,
                       "drape make-skirt: constraint mask (m)");
-    writeScene((dir / "scene.wrl").string(), o, skirt);
+    const int substeps = writeScene((dir / "scene.wrl").string(), o, skirt);
     const Aabb box = skirt.mesh.bounds();
-    fmt::print("skirt: {} vertices, {} triangles, waist at y = {:.3f} m, hem at y = {:.3f} m\n",
-               skirt.mesh.vertexCount(), skirt.mesh.triangleCount(), box.max.y(), box.min.y());
+    fmt::print("skirt: {} vertices, {} triangles, waist at y = {:.3f} m, hem at y = {:.3f} m; {} substeps per frame\n",
+               skirt.mesh.vertexCount(), skirt.mesh.triangleCount(), box.max.y(), box.min.y(), substeps);
     fmt::print("wrote {}/scene.wrl, skirt.obj, waistband.obj\n", o.out);
     return 0;
   };

@@ -1,5 +1,6 @@
-// `drape make-skirt` end to end: a skirt fitted to the bundled MakeHuman body and to another
-// rig's avatar, whose segments it names itself; the scenes it writes load and run.
+// `drape make-skirt` end to end: a skirt fitted to the bundled MakeHuman body, to another
+// rig's avatar, whose segments it names itself, and to a small glTF character; the scenes it
+// writes load and run.
 
 #include <gtest/gtest.h>
 
@@ -72,6 +73,24 @@ TEST(MakeSkirt, AnotherRigNamesItsOwnSegments) {
   // Down to a little above the knees, as on the CMU rig: well below the hips.
   const Aabb box = sc.garments[0].mesh.bounds();
   EXPECT_GT(box.max.y() - box.min.y(), 0.3);
+  runsClean(dir, out);
+}
+
+TEST(MakeSkirt, ASmallCharactersSkirtGetsTheSubstepsItNeeds) {
+  // CesiumMan (glTF, 1.5 m): its skirt's triangles are smaller and stiffer than the paper's,
+  // and the knit's damping would make 33 substeps per frame unstable, which drape run
+  // refuses; the scene asks for as many as it needs.
+  ScratchDir dir("make-skirt-cesium");
+  const std::string out = dir / "skirt";
+  const CliResult made = runDrape("make-skirt '" + kAvatars + "/CesiumMan.glb' --waist-segment joint1 " +
+                                      "--hip-segments joint0 --leg-segments joint11,joint12,joint13,joint14 --out '" +
+                                      out + "'",
+                                  dir);
+  ASSERT_EQ(made.code, 0) << made.err;
+  const scene::Scene sc = scene::loadScene(out + "/scene.wrl");
+  EXPECT_GT(sc.simulation.stepsPerFrame, 33);
+  EXPECT_NE(made.out.find(std::to_string(sc.simulation.stepsPerFrame) + " substeps per frame"), std::string::npos)
+      << made.out;
   runsClean(dir, out);
 }
 

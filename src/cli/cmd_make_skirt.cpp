@@ -87,10 +87,8 @@ int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::S
 void checkSegments(const scene::Avatar& avatar, const MakeSkirtOptions& o) {
   const auto check = [&](const std::string& name, const char* option) {
     if (avatar.findSegment(name) >= 0) return;
-    std::vector<std::string> names;
-    for (const scene::Segment& seg : avatar.segments) names.push_back(seg.name);
     throw Error(fmt::format("{}: the avatar has no segment '{}'; name one of its own with {} (it has: {})", o.avatar,
-                            name, option, fmt::join(names, ", ")));
+                            name, option, fmt::join(avatar.segmentNames(), ", ")));
   };
   check(o.fit.waistSegment, "--waist-segment");
   for (const std::string& name : o.fit.hipSegments) check(name, "--hip-segments");

@@ -18,10 +18,8 @@ namespace {
 std::vector<Vec3> restWorldVertices(const Avatar& avatar, const std::string& segmentName) {
   const int s = avatar.findSegment(segmentName);
   if (s < 0) {
-    std::vector<std::string> names;
-    for (const Segment& seg : avatar.segments) names.push_back(seg.name);
     throw Error(fmt::format("{}: the avatar has no segment '{}' to fit a skirt to (its segments: {})", avatar.source,
-                            segmentName, fmt::join(names, ", ")));
+                            segmentName, fmt::join(avatar.segmentNames(), ", ")));
   }
   const Segment& seg = avatar.segments[static_cast<std::size_t>(s)];
   const RigidTransform rest = avatar.joints[static_cast<std::size_t>(seg.joint)].restWorld();

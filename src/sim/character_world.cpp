@@ -156,10 +156,8 @@ void CharacterWorld::buildFields(const std::vector<GarmentSpec>& garments) {
     shell_m = std::max(shell_m, g.offsets.t3_m);
     for (const std::string& name : g.collidesWith) {
       if (avatar_.findSegment(name) < 0) {
-        std::vector<std::string> known;
-        for (const auto& s : avatar_.segments) known.push_back(s.name);
         throw Error(fmt::format("garment '{}': collidesWith names '{}', which avatar '{}' does not have (it has: {})",
-                                g.name, name, avatar_.name, fmt::join(known, ", ")));
+                                g.name, name, avatar_.name, fmt::join(avatar_.segmentNames(), ", ")));
       }
       if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
     }

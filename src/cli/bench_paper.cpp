@@ -40,6 +40,7 @@ struct PaperBenchOptions {
 
 struct PaperRun {
   long frames = 0;
+  long framesRefined = 0;  ///< frames computed again with more substeps (StepSettings::maxRefinement)
   double simSeconds = 0, simCpuSeconds = 0, collideSeconds = 0, forcesSeconds = 0, stepSeconds = 0;
   double poseSeconds = 0;  ///< pose fetches (animation, interpolation) by the collider and the fixtures
   double colliderPoseSeconds = 0;  ///< the collider's, inside the collide stage
@@ -96,6 +97,7 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
     r.colliderPoseSeconds += world.collider(g)->poseSeconds();
     r.poseSeconds += world.collider(g)->poseSeconds() + t.fixturePoses_s;
     r.counters += world.collider(g)->fieldCounters();
+    r.framesRefined += world.solver(g).refinedFrames();
   }
   return r;
 }
@@ -146,6 +148,7 @@ RunFunction setupPaperBench(CLI::App& app) {
     nlohmann::json j;
     j["scenario"] = "walking skirt: MakeHuman body, CMU walk, hips/thighs/shins collidable";
     j["frames"] = r.frames;
+    j["frames_refined"] = r.framesRefined;
     j["triangles"] = r.triangles;
     j["substeps_per_frame"] = r.substeps;
     j["collision_every"] = r.collisionEvery;

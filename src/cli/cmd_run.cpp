@@ -147,6 +147,7 @@ void applyOverrides(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   if (app.count("--max-speed")) s.maxSpeed_m_s = o.settings.maxSpeed_m_s;
   if (app.count("--max-added-mass")) s.maxAddedMass = o.settings.maxAddedMass;
   if (app.count("--bend-every")) s.bendEvery = o.settings.bendEvery;
+  if (app.count("--max-refinement")) s.maxRefinement = o.settings.maxRefinement;
   if (app.count("--integrator")) s.integrator = cloth::parseIntegrator(o.integrator, "--integrator");
   if (app.count("--wind")) s.wind_m_s = parseVec3(o.wind, "--wind");
   if (app.count("--gravity")) s.gravity_m_s2 = parseVec3(o.gravity, "--gravity");
@@ -342,6 +343,10 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--bend-every", s.bendEvery,
                  "Bending forces every K substeps, applied as one impulse (multiple time stepping; must stay "
                  "within the bending forces' stable step)")
+      ->capture_default_str();
+  app.add_option("--max-refinement", s.maxRefinement,
+                 "A frame that goes unstable is computed again with 2, 4, ... up to this many times the substeps "
+                 "before the run stops on it (1: stop at once)")
       ->capture_default_str();
   app.add_option("--sphere", o->spheres, "A static sphere collider x,y,z,radius (m); repeatable");
   return [o, &app] { return runCommand(app, *o); };

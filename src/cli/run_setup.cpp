@@ -465,14 +465,18 @@ int simulateRun(const RunSetup& setup) {
   long done = 0;
   for (long frame = 1; frame <= setup.frames && unstable.empty(); ++frame) {
     const Clock::time_point start = Clock::now();
-    for (std::size_t g = 0; g < runs.size() && unstable.empty(); ++g)
-      if (!runs[g].solver->stepFrame(frame)) {
+    for (std::size_t g = 0; g < runs.size() && unstable.empty(); ++g) {
+      const bool stable = runs[g].solver->stepFrame(frame);
+      if (runs[g].solver->lastRefinement() > 1)
+        spdlog::info("{}", cloth::describeRefinedFrame(*runs[g].solver, setup.garments[g].name));
+      if (!stable) {
         unstable = runs[g].solver->instability().describe(setup.garments[g].name, settings.maxSpeed_m_s);
         if (runs[g].collider)
           unstable += cloth::pinchNear(*runs[g].model, *runs[g].collider, runs[g].solver->instability().vertex,
                                        settings.substepsPerFrame);
         unstableNan = runs[g].solver->instability().nan;
       }
+    }
     frameMs.push_back(1e3 * std::chrono::duration<double>(Clock::now() - start).count());
     if (!unstable.empty()) break;
     writeFrame(frame);
@@ -528,7 +532,8 @@ int simulateRun(const RunSetup& setup) {
                             {"mass_kg", m.totalMass_kg()},
                             {"added_mass_kg", m.addedMass_kg()},
                             {"mass_scaled_vertices", m.massScaledVertexCount()},
-                            {"estimated_stable_substep_s", m.estimatedStableStep_s()}};
+                            {"estimated_stable_substep_s", m.estimatedStableStep_s()},
+                            {"frames_refined", runs[g].solver->refinedFrames()}};
     if (runs[g].collider) {
       const cloth::OffsetSurfaces& o = runs[g].collider->offsets();
       entry["offsets_m"] = {o.t0_m, o.t1_m, o.t2_m, o.t3_m};

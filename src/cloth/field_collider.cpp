@@ -316,6 +316,37 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   lastTime_s_ = t_s;
 }
 
+void FieldCollider::beginFrame(const ClothState&, double) {
+  frameStartCounters_ = counters_;
+  frameStartField_ = field_;
+}
+
+void FieldCollider::restartFrame(const ClothState& state, double t_s) {
+  counters_ = frameStartCounters_;
+  field_ = frameStartField_;
+  if (states_.empty() || states_.front().size() != state.size()) return;  // not yet initialised
+  held_.clear();
+  heldParts_.clear();
+  std::fill(holds_.begin(), holds_.end(), std::uint8_t{0});
+  for (std::size_t k = 0; k < parts_.size(); ++k) {
+    const field::DistanceField& f = *parts_[k].field;
+    const Affine toVoxel = worldToVoxel(f, parts_[k].motion->poseAt(t_s));
+    for (std::size_t i = 0; i < state.size(); ++i) {
+      const Vec3 c = toVoxel.apply(state.position(i));
+      lastVoxel_[k][i] = c;
+      settledVoxel_[k][i] = kNotSettled;
+      ballR2_[k][i] = -1.0;
+      if (!free_[i] || embedded_[k][i]) continue;
+      if (!walkable(f, roundVoxel(c))) {
+        states_[k][i] = PointState::OutsideVol;
+        continue;
+      }
+      states_[k][i] = f.distanceAtVoxel(c) < offsets_.t3_m ? PointState::OnSurf : PointState::InsideVol;
+    }
+  }
+  lastTime_s_ = t_s;
+}
+
 FieldCollider::PartFrame FieldCollider::framePart(const CollisionPart& part, const RigidTransform& pose0,
                                                   const RigidTransform& pose1) const {
   const field::DistanceField& f = *part.field;

@@ -65,6 +65,7 @@ void StepSettings::validate(const std::string& prefix) const {
           maxAddedMass);
   require(bendEvery >= 1 && bendEvery <= substepsPerFrame, prefix, "bend-every",
           fmt::format("in [1, {}] (the substeps per frame)", substepsPerFrame), bendEvery);
+  require(maxRefinement >= 1 && maxRefinement <= 64, prefix, "max-refinement", "in [1, 64]", maxRefinement);
   if (!finite(gravity_m_s2)) throw Error(fmt::format("{}gravity must be finite", prefix));
   if (!finite(wind_m_s)) throw Error(fmt::format("{}wind must be finite", prefix));
 }

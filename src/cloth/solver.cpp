@@ -21,11 +21,15 @@ double secondsSince(Clock::time_point start) {
 }  // namespace
 
 std::string Instability::describe(const std::string& garment, double bound) const {
-  if (nan)
-    return fmt::format("garment '{}': vertex {} became NaN or infinite in frame {}, substep {}", garment, vertex,
-                       frame, substep);
-  return fmt::format("garment '{}': vertex {} reached {:.4g} m/s (bound {:.4g} m/s) in frame {}, substep {}", garment,
-                     vertex, speed_m_s, bound, frame, substep);
+  const std::string what =
+      nan ? fmt::format("garment '{}': vertex {} became NaN or infinite in frame {}, substep {}", garment, vertex,
+                        frame, substep)
+          : fmt::format("garment '{}': vertex {} reached {:.4g} m/s (bound {:.4g} m/s) in frame {}, substep {}",
+                        garment, vertex, speed_m_s, bound, frame, substep);
+  if (refinement <= 1) return what;
+  return fmt::format("{} of {} (the frame computed again with {} times the substeps, after it went unstable with "
+                     "fewer)",
+                     what, substepsPerFrame, refinement);
 }
 
 ClothSolver::ClothSolver(std::shared_ptr<const ClothModel> model, const StepSettings& settings,
@@ -34,7 +38,9 @@ ClothSolver::ClothSolver(std::shared_ptr<const ClothModel> model, const StepSett
       settings_(settings),
       pins_(std::move(pins)),
       integrator_(makeIntegrator(settings.integrator)),
-      state_(ClothState::atRest(*model_)) {
+      state_(ClothState::atRest(*model_)),
+      dt_(settings_.substep_s()),
+      substepsPerFrame_(settings_.substepsPerFrame) {
   settings_.validate("--");
   checkBendingStep(*model_, settings_);
   checkPinGroups();
@@ -128,17 +134,52 @@ void checkDampedStep(const ClothModel& model, const StepSettings& settings, doub
 }
 
 bool ClothSolver::stepFrame(long frame) {
-  const int n = settings_.substepsPerFrame;
-  const double dt = settings_.substep_s();
-  for (int s = 0; s < n; ++s) {
+  // A frame that goes unstable is computed again from its start with twice the substeps
+  // (an explicit step's stability limit scales with the substep): a garment crushed where
+  // the body's parts overlap, or moved by a collision in one substep by more than its
+  // smallest triangles' size, stiffens locally beyond the substep the rest shape allows.
+  // Copying the state costs a few microseconds per frame; no allocation after the first.
+  const double t0 = static_cast<double>(frame - 1) / settings_.frameRate_hz;
+  if (settings_.maxRefinement > 1) {
+    frameStart_ = state_;
+    frameStartSubsteps_ = substepCount_;
+    for (Collider* c : colliders_) c->beginFrame(state_, t0);
+  }
+  lastRefinement_ = 1;
+  for (int refinement = 1;; refinement *= 2) {
+    if (runFrame(frame, refinement)) {
+      if (refinement > 1) ++refinedFrames_;
+      lastRefinement_ = refinement;
+      return true;
+    }
+    if (refinement * 2 > settings_.maxRefinement) return false;
+    if (refinement == 1) refinedBecause_ = instability_;
+    state_ = frameStart_;
+    substepCount_ = frameStartSubsteps_;
+    for (Collider* c : colliders_) c->restartFrame(state_, t0);
+  }
+}
+
+bool ClothSolver::runFrame(long frame, int refinement) {
+  const int n = settings_.substepsPerFrame * refinement;
+  // The same expression as StepSettings::substep_s: unrefined frames keep their bits.
+  const double dt = 1.0 / (settings_.frameRate_hz * n);
+  dt_ = dt;
+  substepsPerFrame_ = n;
+  refinement_ = refinement;
+  bool stable = true;
+  for (int s = 0; s < n && stable; ++s) {
     // Times from a substep counter, not an accumulated sum, so no drift over long takes;
     // both ends from the counter, so this substep's t1 is the next one's t0 exactly (the
     // poses of the body parts are cached by time).
     const double t0 = static_cast<double>((frame - 1) * n + s) * dt;
     const double t1 = static_cast<double>((frame - 1) * n + s + 1) * dt;
-    if (!substep(t0, t1, frame, s)) return false;
+    stable = substep(t0, t1, frame, s);
   }
-  return true;
+  dt_ = settings_.substep_s();
+  substepsPerFrame_ = settings_.substepsPerFrame;
+  refinement_ = 1;
+  return stable;
 }
 
 bool ClothSolver::substep(double t0, long frame, int substepIndex) {
@@ -146,7 +187,7 @@ bool ClothSolver::substep(double t0, long frame, int substepIndex) {
 }
 
 bool ClothSolver::substep(double t0, double t1, long frame, int substepIndex) {
-  const double dt = settings_.substep_s();
+  const double dt = dt_;
   Clock::time_point start = Clock::now();
   accumulateForces();  // membrane, bending, drag into state_.f*
   times_.forces_s += secondsSince(start);
@@ -242,11 +283,21 @@ bool ClothSolver::checkStability(long frame, int substepIndex) {
     const double p = x[i] + y[i] + z[i];
     const bool nan = !std::isfinite(s2) || !std::isfinite(p);
     if (nan || s2 > bound2) {
-      instability_ = {true, nan, static_cast<std::uint32_t>(i), nan ? 0.0 : std::sqrt(s2), frame, substepIndex};
+      instability_ = {true,  nan,          static_cast<std::uint32_t>(i), nan ? 0.0 : std::sqrt(s2), frame,
+                      substepIndex, substepsPerFrame_, refinement_};
       return false;
     }
   }
   return true;
+}
+
+std::string describeRefinedFrame(const ClothSolver& solver, const std::string& garment) {
+  const int refinement = solver.lastRefinement();
+  if (refinement <= 1) return "";
+  const StepSettings& s = solver.settings();
+  return fmt::format("{}; computed again with {} times the substeps ({} per frame)",
+                     solver.refinedBecause().describe(garment, s.maxSpeed_m_s), refinement,
+                     refinement * s.substepsPerFrame);
 }
 
 double ClothSolver::totalEnergy() const {

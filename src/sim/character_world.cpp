@@ -377,7 +377,9 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
 
 bool CharacterWorld::stepFrame(long frame) {
   for (GarmentRun& g : garments_) {
-    if (!g.solver->stepFrame(frame)) {
+    const bool stable = g.solver->stepFrame(frame);
+    if (g.solver->lastRefinement() > 1) spdlog::info("{}", cloth::describeRefinedFrame(*g.solver, g.spec.name));
+    if (!stable) {
       instability_ = g.solver->instability().describe(g.spec.name, settings_.step.maxSpeed_m_s);
       // Where the vertex was held: most garments that blow up on a body do it in a pinch,
       // between parts whose offset surfaces overlap (docs/PHYSICS.md, examples/walking_dress).

@@ -138,9 +138,10 @@ TEST(Run, BadInputsGiveOneLineAndExitCode2) {
 TEST(Run, UnstableRunExits3AndKeepsWhatItWrote) {
   ScratchDir dir("run-unstable");
   const std::string out = dir / "out";
-  // The dress at the default 33 substeps is far beyond its stable step.
+  // The dress at the default 33 substeps is far beyond its stable step; no frame is
+  // computed again with more.
   const CliResult r = runDrape("run --garment '" + kDress + "' --units dm --pin-mask '" + kMask +
-                                   "' --frames 5 --out '" + out + "'",
+                                   "' --frames 5 --max-refinement 1 --out '" + out + "'",
                                dir);
   EXPECT_EQ(r.code, 3) << r.err;
   EXPECT_NE(r.err.find("garment 'dress': vertex"), std::string::npos) << r.err;
@@ -150,6 +151,25 @@ TEST(Run, UnstableRunExits3AndKeepsWhatItWrote) {
   EXPECT_EQ(stats["frames"], 0);
   EXPECT_EQ(formats::readPc2(out + "/garment.pc2").frames.size(), 1u);
   EXPECT_EQ(formats::readRunManifest(out).frames, 1);
+}
+
+TEST(Run, AnUnstableFrameIsComputedAgainWithMoreSubsteps) {
+  ScratchDir dir("run-refined");
+  const std::string out = dir / "out";
+  // The same dress and substeps: each frame goes unstable, and is computed again with 2, 4
+  // or 8 times the substeps (--max-refinement's default), which hold it.
+  const CliResult r = runDrape("run --garment '" + kDress + "' --units dm --pin-mask '" + kMask +
+                                   "' --frames 3 --out '" + out + "'",
+                               dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("garment 'dress': vertex"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("in frame 1, substep"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("; computed again with"), std::string::npos) << r.err;
+  const nlohmann::json stats = statsOf(out);
+  EXPECT_FALSE(stats["unstable"].get<bool>());
+  EXPECT_EQ(stats["frames"], 3);
+  EXPECT_GE(stats["garments"][0]["frames_refined"].get<int>(), 1);
+  EXPECT_LE(stats["garments"][0]["frames_refined"].get<int>(), 3);
 }
 
 }  // namespace

@@ -141,6 +141,53 @@ TEST(FieldCollider, SlidingFrictionDeceleratesAtMuG) {
   EXPECT_NEAR(p.state.position(0).y(), kOffsets.t2_m, 0.5 * kVoxel);
 }
 
+TEST(FieldCollider, AFrameComputedAgainForgetsItsAttemptAndKeepsSliding) {
+  // The solver computes an unstable frame again with more substeps (ClothSolver::stepFrame):
+  // the collider goes back to the frame's start. A point sliding on a box's top at 1 m/s
+  // keeps sliding with friction from the first test of the new attempt (not eased out nor
+  // thrown onto T2), and the counters hold nothing of the attempt.
+  BodySetup s(field::makeBox(Vec3(-0.5, -0.1, -0.5), Vec3(0.5, 0.0, 0.5)), std::make_shared<StaticMotion>());
+  const double mu = 0.4, g = 9.81, dt = 1e-4;
+  Point p(Vec3::Zero());
+  FieldCollider c("test", s.parts, kOffsets, mu, mu);
+  initialiseArriving(c, p, Vec3(-0.3, kOffsets.t2_m, 0.0));
+  p.state.setVelocity(0, Vec3(1.0, 0, 0));
+  const auto slide = [&](double t0, double step, int steps) {
+    for (int k = 0; k < steps; ++k) {
+      Vec3 v = p.state.velocity(0) + Vec3(0, -g, 0) * step;
+      p.state.setVelocity(0, v);
+      p.state.setPosition(0, p.state.position(0) + v * step);
+      c.collide(*p.model, t0 + k * step, t0 + (k + 1) * step, p.state);
+    }
+  };
+  slide(0.0, dt, 300);
+  const double t = 300 * dt;
+  const ClothState start = p.state;
+  c.beginFrame(start, t);
+  const FieldCollisionCounters before = c.fieldCounters();
+  const std::uint64_t callsBefore = c.counters().calls;
+  slide(t, dt, 200);  // the attempt
+  ASSERT_GT(c.fieldCounters().tests, before.tests);
+
+  c.restartFrame(start, t);
+  p.state = start;
+  EXPECT_EQ(c.fieldCounters().tests, before.tests);
+  EXPECT_EQ(c.fieldCounters().collisions, before.collisions);
+  EXPECT_EQ(c.fieldCounters().transitions, before.transitions);
+  EXPECT_EQ(c.counters().calls, callsBefore);
+  EXPECT_EQ(c.state(0, 0), PointState::OnSurf);
+
+  const int steps = 400;  // the frame again at half the substep: 0.02 s
+  const double v0 = p.state.velocity(0).x();
+  slide(t, dt / 2, steps);
+  const double deceleration = (v0 - p.state.velocity(0).x()) / (steps * dt / 2);
+  EXPECT_NEAR(deceleration, mu * g, 0.05 * mu * g);
+  EXPECT_NEAR(p.state.position(0).y(), kOffsets.t2_m, 0.5 * kVoxel);
+  const std::uint64_t testsPerCall = before.tests / 300;
+  EXPECT_EQ(c.fieldCounters().tests, before.tests + static_cast<std::uint64_t>(steps) * testsPerCall);
+  EXPECT_EQ(c.fieldCounters().embeddedAtStart, before.embeddedAtStart);
+}
+
 TEST(FieldCollider, APointPressedOntoT2GathersNoInwardVelocity) {
   // A point pressed into a sphere at 1,000 m/s^2 (a tight sleeve's tension on its vertex) at
   // a 35 us substep (945 per frame) from 40 directions. Each collision step puts it back on

@@ -30,6 +30,12 @@ class Collider {
   /// Corrects io's positions and velocities at the end of the substep [t0_s, t1_s].
   virtual void collide(const ClothModel& model, double t0_s, double t1_s, ClothState& io) = 0;
   [[nodiscard]] virtual ColliderCounters counters() const = 0;
+  /// The solver is about to compute a frame it may compute again (StepSettings::
+  /// maxRefinement) from `state` at t_s: keep what restartFrame needs.
+  virtual void beginFrame(const ClothState& state, double t_s) = 0;
+  /// The frame went unstable and is computed again, with more substeps, from the state
+  /// beginFrame saw at t_s: forget what the attempt did (its counts included).
+  virtual void restartFrame(const ClothState& state, double t_s) = 0;
 };
 
 /// A static analytic sphere. A point that ends a substep inside radius + margin is put
@@ -42,11 +48,14 @@ class SphereCollider final : public Collider {
   [[nodiscard]] std::string name() const override { return "sphere"; }
   void collide(const ClothModel& model, double t0_s, double t1_s, ClothState& io) override;
   [[nodiscard]] ColliderCounters counters() const override { return counters_; }
+  void beginFrame(const ClothState&, double) override { frameStart_ = counters_; }
+  void restartFrame(const ClothState&, double) override { counters_ = frameStart_; }
 
  private:
   Vec3 centre_;
   double radius_;
   ColliderCounters counters_;
+  ColliderCounters frameStart_;  ///< the counters when the frame began
 };
 
 }  // namespace drape::cloth

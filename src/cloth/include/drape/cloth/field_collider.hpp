@@ -275,6 +275,13 @@ class FieldCollider final : public Collider {
   [[nodiscard]] std::string name() const override { return "distance fields"; }
   void collide(const ClothModel& model, double t0_s, double t1_s, ClothState& io) override;
   [[nodiscard]] ColliderCounters counters() const override { return counters_; }
+  void beginFrame(const ClothState& state, double t_s) override;
+  /// The counters go back to the frame's start. Every pair's state is established again
+  /// from where the point is at t_s, as at the first step, except that a pair within T3 of
+  /// its part slides (OnSurf) rather than being eased out (a frame's start finds most
+  /// sliding points between T1 and T2): no pair rests or is settled, no point is held, and
+  /// the pairs being eased out stay so.
+  void restartFrame(const ClothState& state, double t_s) override;
   [[nodiscard]] const FieldCollisionCounters& fieldCounters() const { return field_; }
   /// Time spent fetching the parts' poses at the ends of each collision interval, s: the
   /// animation and its micro-interpolation when the collider is the first to ask for a time
@@ -381,6 +388,9 @@ class FieldCollider final : public Collider {
   std::uint64_t faceParts_ = 0;  ///< bit k: part k takes face samples
   long calls_ = 0;
   long tests_ = 0;  ///< collision tests run
+  /// The counters when the frame began (beginFrame), for restartFrame.
+  ColliderCounters frameStartCounters_;
+  FieldCollisionCounters frameStartField_;
   double poseSeconds_ = 0;
   double measureSeconds_ = 0;
   std::vector<PartFrame> frames_;  ///< per part, this interval's transforms (collide)

@@ -67,6 +67,10 @@ struct StepSettings {
   /// Multiple time stepping: bending, the slow force, is evaluated every bendEvery-th substep
   /// and applied there as an impulse over the bendEvery substeps (r-RESPA); 1: every substep.
   int bendEvery = 1;
+  /// A frame that goes unstable (a NaN, a vertex beyond maxSpeed) is computed again from its
+  /// start with 2, 4, ... times the substeps, up to this factor, before the instability is
+  /// reported (ClothSolver::stepFrame); 1: reported at once, the fixed step as it is.
+  int maxRefinement = 8;
 
   [[nodiscard]] double substep_s() const { return 1.0 / (frameRate_hz * substepsPerFrame); }
   /// What ClothModel::build needs to honour maxAddedMass.

@@ -41,6 +41,10 @@ struct Instability {
   double speed_m_s = 0.0;
   long frame = 0;             ///< the frame being computed
   int substep = 0;
+  int substepsPerFrame = 0;   ///< of the attempt that went unstable
+  /// How many times the settings' substeps that attempt took (StepSettings::maxRefinement):
+  /// 1 unless the frame had gone unstable with fewer.
+  int refinement = 1;
   /// "garment 'dress': vertex 12 reached 73.2 m/s (bound 50 m/s) in frame 4, substep 17".
   [[nodiscard]] std::string describe(const std::string& garment, double bound_m_s) const;
 };
@@ -72,10 +76,19 @@ class ClothSolver {
   void addCollider(Collider& collider) { colliders_.push_back(&collider); }
 
   /// Computes frame `frame` (1-based: frame 0 is the initial state) from the current state:
-  /// settings.substepsPerFrame substeps covering [(frame - 1) / fps, frame / fps].
-  /// Returns false and fills instability() when the guard trips (the state is left as it
-  /// was at that substep).
+  /// settings.substepsPerFrame substeps covering [(frame - 1) / fps, frame / fps]. When the
+  /// guard trips, the frame is computed again from its start with twice the substeps, and
+  /// again, up to settings.maxRefinement times as many (the colliders start the frame over,
+  /// Collider::restartFrame); the next frame goes back to the settings' substeps. Returns
+  /// false and fills instability() when the guard trips on the last attempt (the state is
+  /// left as it was at that substep).
   bool stepFrame(long frame);
+  /// How many times the settings' substeps the last frame took (1: it was stable with them).
+  [[nodiscard]] int lastRefinement() const { return lastRefinement_; }
+  /// Frames computed again with more substeps, so far.
+  [[nodiscard]] long refinedFrames() const { return refinedFrames_; }
+  /// Why the last refined frame was computed again: the first attempt's instability.
+  [[nodiscard]] const Instability& refinedBecause() const { return refinedBecause_; }
 
   /// One substep over [t0, t0 + dt] (exposed for tests); returns false on instability.
   bool substep(double t0_s, long frame, int substepIndex);
@@ -102,6 +115,8 @@ class ClothSolver {
   [[nodiscard]] double totalEnergy() const;
 
  private:
+  /// The frame's substeps at `refinement` times the settings' count; false when the guard trips.
+  bool runFrame(long frame, int refinement);
   void accumulateForces();
   void integrate(double dt_s);
   void collide(double t0_s, double t1_s);
@@ -120,7 +135,21 @@ class ClothSolver {
   StageTimes times_;
   Instability instability_;
   long substepCount_ = 0;  ///< substeps taken, for the bending rhythm
+  double dt_ = 0.0;        ///< the substep being taken, s (shorter in a refined frame)
+  int substepsPerFrame_ = 0;  ///< of the frame being computed
+  int refinement_ = 1;        ///< of the frame being computed
+  /// Where the frame being computed started, to compute it again (stepFrame).
+  ClothState frameStart_;
+  long frameStartSubsteps_ = 0;
+  int lastRefinement_ = 1;
+  long refinedFrames_ = 0;
+  Instability refinedBecause_;
   double dampedOmega_ = 0.0;  ///< dampedMembraneFrequency_rad_s
 };
+
+/// What the last frame's refinement was, for a log line: "garment 'dress': vertex 1046
+/// reached 74.08 m/s (bound 50 m/s) in frame 26, substep 115; computed again with 2 times
+/// the substeps (310 per frame)". Empty when the frame was stable at once.
+[[nodiscard]] std::string describeRefinedFrame(const ClothSolver& solver, const std::string& garment);
 
 }  // namespace drape::cloth

@@ -390,6 +390,7 @@ TEST(Stability, GuardReportsVertexAndFrame) {
   const Instability& bad = solver.instability();
   EXPECT_TRUE(bad.detected);
   EXPECT_EQ(bad.frame, f - 1);
+  EXPECT_EQ(bad.refinement, StepSettings{}.maxRefinement) << "unstable at every refinement too";
   EXPECT_LT(bad.vertex, model->vertexCount());
   EXPECT_NE(bad.describe("sheet", 50).find("garment 'sheet': vertex"), std::string::npos);
 }

@@ -27,6 +27,7 @@
 #include "drape/render/frame.hpp"
 #include "drape/render/outputs.hpp"
 #include "drape/scene/scene.hpp"
+#include "drape/sim/body_overlap.hpp"
 #include "drape/sim/scene_setup.hpp"
 #include "measure.hpp"
 
@@ -277,6 +278,38 @@ std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup) {
   return world;
 }
 
+namespace {
+
+std::vector<sim::BodyOverlap> findOverlaps(const RunSetup& setup, const sim::CharacterWorld& world) {
+  // Deeper than a voxel beyond rest: the fields read distances to about half a voxel.
+  const double threshold_m = setup.character->voxel_m;
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<sim::BodyOverlap> found = sim::findBodyOverlaps(*setup.character->avatar, world.poses(), world.fields(),
+                                                              setup.frames, setup.settings.frameRate_hz, threshold_m);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!found.empty())
+    spdlog::info("the motion puts collidable parts of the body inside each other beyond their overlap at rest, {} "
+                 "pairs (stats.json: body_overlaps; found in {:.2f} s); deepest: {}",
+                 found.size(), seconds, sim::describe(found.front()));
+  return found;
+}
+
+/// For an instability report: which of the pinch's parts the motion puts inside each other
+/// in that frame.
+std::string overlapsInFrame(const std::vector<sim::BodyOverlap>& overlaps, const std::vector<std::string>& parts,
+                            long frame) {
+  const auto named = [&](const std::string& p) { return std::find(parts.begin(), parts.end(), p) != parts.end(); };
+  std::string out;
+  for (const sim::BodyOverlap& o : overlaps) {
+    const auto f = static_cast<std::size_t>(frame);
+    if (!named(o.part) || !named(o.into) || f >= o.depthPerFrame.size() || o.depthPerFrame[f] <= 0) continue;
+    out += fmt::format("{}{} is {:.0f} mm into {}", out.empty() ? "" : ", ", o.part, 1e3 * o.depthPerFrame[f], o.into);
+  }
+  return out.empty() ? "" : fmt::format("; in that frame the motion puts the body inside itself: {}", out);
+}
+
+}  // namespace
+
 long defaultFrames(const RunSetup& setup) {
   if (!setup.character || !setup.character->animation)
     throw Error("--frames is required (it defaults to the motion's length only with --motion)");
@@ -341,6 +374,8 @@ int simulateRun(const RunSetup& setup) {
   for (const SphereSetup& s : setup.spheres) spheres.emplace_back(s.centre_m, s.radius_m);
   for (const GarmentSetup& g : setup.garments) (void)mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
   std::unique_ptr<sim::CharacterWorld> world = setup.character ? buildWorld(setup) : nullptr;
+  const std::vector<sim::BodyOverlap> overlaps =
+      world && setup.character->animation ? findOverlaps(setup, *world) : std::vector<sim::BodyOverlap>{};
   std::vector<GarmentRun> runs;
   formats::RunManifest manifest;
   manifest.frameRate = settings.frameRate_hz;
@@ -473,7 +508,14 @@ int simulateRun(const RunSetup& setup) {
         unstable = runs[g].solver->instability().describe(setup.garments[g].name, settings.maxSpeed_m_s);
         if (runs[g].collider)
           unstable += cloth::pinchNear(*runs[g].model, *runs[g].collider, runs[g].solver->instability().vertex,
-                                       settings.substepsPerFrame);
+                                       runs[g].solver->instability().substepsPerFrame);
+        if (runs[g].collider)
+          unstable += overlapsInFrame(overlaps,
+                                      cloth::nearestPinch(*runs[g].model, *runs[g].collider,
+                                                          runs[g].solver->instability().vertex,
+                                                          runs[g].solver->instability().substepsPerFrame)
+                                          .pinch.parts,
+                                      frame);
         unstableNan = runs[g].solver->instability().nan;
       }
     }
@@ -545,6 +587,16 @@ int simulateRun(const RunSetup& setup) {
     garments.push_back(std::move(entry));
   }
   stats["garments"] = garments;
+  nlohmann::json bodyOverlaps = nlohmann::json::array();
+  for (const sim::BodyOverlap& o : overlaps)
+    bodyOverlaps.push_back({{"part", o.part},
+                            {"into", o.into},
+                            {"depth_m", o.depth_m},
+                            {"deepest_frame", o.deepestFrame},
+                            {"first_frame", o.firstFrame},
+                            {"last_frame", o.lastFrame},
+                            {"frames", o.frames}});
+  stats["body_overlaps"] = bodyOverlaps;
   addCollisionStats(stats, runs, total, done, world.get());
   const std::string statsPath = (out / "stats.json").string();
   std::ofstream statsFile(statsPath);

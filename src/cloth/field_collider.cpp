@@ -832,26 +832,32 @@ FieldCollider::LastPinch FieldCollider::lastPinch(std::size_t vertex) const {
   return pinch;
 }
 
-std::string pinchNear(const ClothModel& model, const FieldCollider& collider, std::uint32_t vertex,
-                      long withinSubsteps) {
+NearestPinch nearestPinch(const ClothModel& model, const FieldCollider& collider, std::uint32_t vertex,
+                          long withinSubsteps) {
   constexpr double kReach_m = 0.05;
-  if (vertex >= model.vertexCount()) return "";
+  NearestPinch found;
+  if (vertex >= model.vertexCount()) return found;
   const auto restAt = [&](std::uint32_t v) { return Vec3(model.restX()[v], model.restY()[v], model.restZ()[v]); };
   double nearest = kReach_m;
-  std::uint32_t found = vertex;
-  FieldCollider::LastPinch pinch;
   for (std::uint32_t v = 0; v < model.vertexCount(); ++v) {
     const double d = (restAt(v) - restAt(vertex)).norm();
     if (d >= nearest) continue;
     FieldCollider::LastPinch p = collider.lastPinch(v);
     if (p.parts.empty() || p.substepsAgo > withinSubsteps) continue;
     nearest = d;
-    found = v;
-    pinch = std::move(p);
+    found = {v, d, std::move(p)};
     if (v == vertex) break;  // its own pinch is the one to name
   }
+  return found;
+}
+
+std::string pinchNear(const ClothModel& model, const FieldCollider& collider, std::uint32_t vertex,
+                      long withinSubsteps) {
+  const NearestPinch near = nearestPinch(model, collider, vertex, withinSubsteps);
+  const FieldCollider::LastPinch& pinch = near.pinch;
   if (pinch.parts.empty()) return "";
-  const std::string who = found == vertex ? "it" : fmt::format("vertex {}, {:.0f} mm from it,", found, 1e3 * nearest);
+  const std::string who =
+      near.vertex == vertex ? "it" : fmt::format("vertex {}, {:.0f} mm from it,", near.vertex, 1e3 * near.distance_m);
   const std::string when = pinch.substepsAgo == 0   ? "in that substep"
                            : pinch.substepsAgo == 1 ? "1 substep before"
                                                     : fmt::format("{} substeps before", pinch.substepsAgo);

@@ -384,7 +384,7 @@ bool CharacterWorld::stepFrame(long frame) {
       // Where the vertex was held: most garments that blow up on a body do it in a pinch,
       // between parts whose offset surfaces overlap (docs/PHYSICS.md, examples/walking_dress).
       instability_ += cloth::pinchNear(g.solver->model(), *g.collider, g.solver->instability().vertex,
-                                       settings_.step.substepsPerFrame);
+                                       g.solver->instability().substepsPerFrame);
       return false;
     }
   }

@@ -187,8 +187,11 @@ TEST(RunScene, WalkingSkirtWritesEverything) {
   const nlohmann::json stats = statsOf(out);
   for (const char* key : {"collision_time_share", "mean_collision_path_voxels", "points_per_state",
                           "vertex_substeps_below_T1", "vertex_substeps_below_T0", "vertex_substeps_inside_body",
-                          "max_penetration_m", "distance_fields"})
+                          "max_penetration_m", "distance_fields", "body_overlaps"})
     EXPECT_TRUE(stats.contains(key)) << key;
+  for (const auto& o : stats["body_overlaps"])
+    for (const char* key : {"part", "into", "depth_m", "deepest_frame", "first_frame", "last_frame", "frames"})
+      EXPECT_TRUE(o.contains(key)) << key;
   EXPECT_EQ(stats["vertex_substeps_inside_body"].get<long>(), 0);
   const double share = stats["collision_time_share"].get<double>();
   EXPECT_GT(share, 0.0);

@@ -476,6 +476,17 @@ class FieldCollider final : public Collider {
   return p.x() >= 1 && p.y() >= 1 && p.z() >= 1 && p.x() < d.nx - 1 && p.y() < d.ny - 1 && p.z() < d.nz - 1;
 }
 
+/// The pinch nearest to `vertex` (on the garment as modelled, within 5 cm) in the last
+/// `withinSubsteps` substeps: the pinched vertex, how far from `vertex` it is (m), its parts
+/// and when; no parts if there was none.
+struct NearestPinch {
+  std::uint32_t vertex = 0;
+  double distance_m = 0;
+  FieldCollider::LastPinch pinch;
+};
+[[nodiscard]] NearestPinch nearestPinch(const ClothModel& model, const FieldCollider& collider, std::uint32_t vertex,
+                                        long withinSubsteps);
+
 /// For an instability report: the pinch nearest to `vertex` (on the garment as modelled,
 /// within 5 cm) in the last `withinSubsteps` substeps, as "; N substeps before, vertex W, D mm
 /// from it, was pressed by A, B at once (...)", or "" if there was none. The vertex that runs

@@ -139,7 +139,8 @@ bool ClothSolver::stepFrame(long frame) {
   // the body's parts overlap, or moved by a collision in one substep by more than its
   // smallest triangles' size, stiffens locally beyond the substep the rest shape allows.
   // Copying the state costs a few microseconds per frame; no allocation after the first.
-  const double t0 = static_cast<double>(frame - 1) / settings_.frameRate_hz;
+  // The frame's start as its first unrefined substep has it (runFrame).
+  const double t0 = static_cast<double>((frame - 1) * settings_.substepsPerFrame) * settings_.substep_s();
   if (settings_.maxRefinement > 1) {
     frameStart_ = state_;
     frameStartSubsteps_ = substepCount_;
@@ -283,8 +284,8 @@ bool ClothSolver::checkStability(long frame, int substepIndex) {
     const double p = x[i] + y[i] + z[i];
     const bool nan = !std::isfinite(s2) || !std::isfinite(p);
     if (nan || s2 > bound2) {
-      instability_ = {true,  nan,          static_cast<std::uint32_t>(i), nan ? 0.0 : std::sqrt(s2), frame,
-                      substepIndex, substepsPerFrame_, refinement_};
+      instability_ = {true, nan, static_cast<std::uint32_t>(i), nan ? 0.0 : std::sqrt(s2), frame, substepIndex,
+                      substepsPerFrame_, refinement_};
       return false;
     }
   }

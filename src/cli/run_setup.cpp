@@ -308,6 +308,18 @@ std::string overlapsInFrame(const std::vector<sim::BodyOverlap>& overlaps, const
   return out.empty() ? "" : fmt::format("; in that frame the motion puts the body inside itself: {}", out);
 }
 
+/// Why garment run r stopped in `frame`: the vertex that ran away, the pinch nearest it, and
+/// which of the pinch's parts the motion puts inside each other then.
+std::string describeInstability(const GarmentRun& r, double maxSpeed_m_s,
+                                const std::vector<sim::BodyOverlap>& overlaps, long frame) {
+  const cloth::Instability& bad = r.solver->instability();
+  std::string out = bad.describe(r.name, maxSpeed_m_s);
+  if (!r.collider) return out;
+  out += cloth::pinchNear(*r.model, *r.collider, bad.vertex, bad.substepsPerFrame);
+  const cloth::NearestPinch near = cloth::nearestPinch(*r.model, *r.collider, bad.vertex, bad.substepsPerFrame);
+  return out + overlapsInFrame(overlaps, near.pinch.parts, frame);
+}
+
 }  // namespace
 
 long defaultFrames(const RunSetup& setup) {
@@ -505,17 +517,7 @@ int simulateRun(const RunSetup& setup) {
       if (runs[g].solver->lastRefinement() > 1)
         spdlog::info("{}", cloth::describeRefinedFrame(*runs[g].solver, setup.garments[g].name));
       if (!stable) {
-        unstable = runs[g].solver->instability().describe(setup.garments[g].name, settings.maxSpeed_m_s);
-        if (runs[g].collider)
-          unstable += cloth::pinchNear(*runs[g].model, *runs[g].collider, runs[g].solver->instability().vertex,
-                                       runs[g].solver->instability().substepsPerFrame);
-        if (runs[g].collider)
-          unstable += overlapsInFrame(overlaps,
-                                      cloth::nearestPinch(*runs[g].model, *runs[g].collider,
-                                                          runs[g].solver->instability().vertex,
-                                                          runs[g].solver->instability().substepsPerFrame)
-                                          .pinch.parts,
-                                      frame);
+        unstable = describeInstability(runs[g], settings.maxSpeed_m_s, overlaps, frame);
         unstableNan = runs[g].solver->instability().nan;
       }
     }

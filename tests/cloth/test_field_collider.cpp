@@ -120,6 +120,17 @@ TEST(FieldCollider, StopsOnT2AndNeverEndsBelowT0MovingField) {
   EXPECT_TRUE(touched);
 }
 
+/// `steps` symplectic Euler steps of `dt` from t0 of point 0 under gravity alone, the
+/// collider answering each.
+void slideUnderGravity(FieldCollider& c, Point& p, double t0, double dt, int steps) {
+  for (int k = 0; k < steps; ++k) {
+    const Vec3 v = p.state.velocity(0) + Vec3(0, -9.81, 0) * dt;
+    p.state.setVelocity(0, v);
+    p.state.setPosition(0, p.state.position(0) + v * dt);
+    c.collide(*p.model, t0 + k * dt, t0 + (k + 1) * dt, p.state);
+  }
+}
+
 TEST(FieldCollider, SlidingFrictionDeceleratesAtMuG) {
   // A large box whose top face is y = 0; the point slides on T2 at 1 m/s under gravity.
   BodySetup s(field::makeBox(Vec3(-0.5, -0.1, -0.5), Vec3(0.5, 0.0, 0.5)), std::make_shared<StaticMotion>());
@@ -130,12 +141,7 @@ TEST(FieldCollider, SlidingFrictionDeceleratesAtMuG) {
   const double v0 = 1.0;
   p.state.setVelocity(0, Vec3(v0, 0, 0));
   const int steps = 1000;  // 0.1 s: expected speed loss mu g t = 0.392 m/s
-  for (int step = 0; step < steps; ++step) {
-    Vec3 v = p.state.velocity(0) + Vec3(0, -g, 0) * dt;
-    p.state.setVelocity(0, v);
-    p.state.setPosition(0, p.state.position(0) + v * dt);
-    c.collide(*p.model, step * dt, (step + 1) * dt, p.state);
-  }
+  slideUnderGravity(c, p, 0.0, dt, steps);
   const double deceleration = (v0 - p.state.velocity(0).x()) / (steps * dt);
   EXPECT_NEAR(deceleration, mu * g, 0.05 * mu * g);
   EXPECT_NEAR(p.state.position(0).y(), kOffsets.t2_m, 0.5 * kVoxel);
@@ -152,14 +158,7 @@ TEST(FieldCollider, AFrameComputedAgainForgetsItsAttemptAndKeepsSliding) {
   FieldCollider c("test", s.parts, kOffsets, mu, mu);
   initialiseArriving(c, p, Vec3(-0.3, kOffsets.t2_m, 0.0));
   p.state.setVelocity(0, Vec3(1.0, 0, 0));
-  const auto slide = [&](double t0, double step, int steps) {
-    for (int k = 0; k < steps; ++k) {
-      Vec3 v = p.state.velocity(0) + Vec3(0, -g, 0) * step;
-      p.state.setVelocity(0, v);
-      p.state.setPosition(0, p.state.position(0) + v * step);
-      c.collide(*p.model, t0 + k * step, t0 + (k + 1) * step, p.state);
-    }
-  };
+  const auto slide = [&](double t0, double step, int steps) { slideUnderGravity(c, p, t0, step, steps); };
   slide(0.0, dt, 300);
   const double t = 300 * dt;
   const ClothState start = p.state;

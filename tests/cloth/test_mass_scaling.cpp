@@ -11,16 +11,9 @@
 namespace drape::cloth {
 namespace {
 
+using testing::knit;
 using testing::row;
 using testing::run;
-
-Material knit() {
-  Material m;
-  m.youngsModulus_Pa = 5e4;
-  m.thickness_m = 5e-4;
-  m.density_kg_m3 = 300;
-  return m;
-}
 
 /// A 0.5 m sheet of 10 x 10 cells whose vertex (4, 5) is moved 47 % of a cell towards
 /// (5, 5): the triangles around it become slivers, as in garments modelled for drawing.

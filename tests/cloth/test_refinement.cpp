@@ -15,15 +15,8 @@ namespace drape::cloth {
 namespace {
 
 using testing::makeModel;
+using testing::knit;
 using testing::row;
-
-Material knit() {
-  Material m;
-  m.youngsModulus_Pa = 5e4;
-  m.thickness_m = 5e-4;
-  m.density_kg_m3 = 300;
-  return m;
-}
 
 /// A sheet hanging from its top row, pushed out of its plane so that it swings into a
 /// sphere, undamped, at `substeps` per frame.

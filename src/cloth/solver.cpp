@@ -138,7 +138,8 @@ bool ClothSolver::stepFrame(long frame) {
   // (an explicit step's stability limit scales with the substep): a garment crushed where
   // the body's parts overlap, or moved by a collision in one substep by more than its
   // smallest triangles' size, stiffens locally beyond the substep the rest shape allows.
-  // Copying the state costs a few microseconds per frame; no allocation after the first.
+  // The copy of the state is 72 bytes a vertex (the skirt 19 KB, the dress 160 KB) per frame,
+  // with no allocation after the first; the benchmark's figures did not move with it.
   // The frame's start as its first unrefined substep has it (runFrame).
   const double t0 = static_cast<double>((frame - 1) * settings_.substepsPerFrame) * settings_.substep_s();
   if (settings_.maxRefinement > 1) {

@@ -138,8 +138,9 @@ class ClothSolver {
   double dt_ = 0.0;        ///< the substep being taken, s (shorter in a refined frame)
   int substepsPerFrame_ = 0;  ///< of the frame being computed
   int refinement_ = 1;        ///< of the frame being computed
-  /// Where the frame being computed started, to compute it again (stepFrame).
-  ClothState frameStart_;
+  /// Where the frame being computed started, to compute it again (stepFrame): positions
+  /// and velocities (the forces and the kernels' workspace are rebuilt every substep).
+  std::array<std::vector<double>, 6> frameStart_;
   long frameStartSubsteps_ = 0;
   int lastRefinement_ = 1;
   long refinedFrames_ = 0;

@@ -126,6 +126,7 @@ TEST(Run, BadInputsGiveOneLineAndExitCode2) {
        "--frames must be >= 1"},
       {"bad substeps", dress + " --substeps fast", "--substeps must be"},
       {"bad integrator", dress + " --integrator rk4", "--integrator must be"},
+      {"no refinement", dress + " --max-refinement 0", "--max-refinement must be in [1, 64], got 0"},
   };
   for (const BadCase& c : cases) {
     const CliResult r = runDrape("run " + c.args, dir);

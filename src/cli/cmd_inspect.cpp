@@ -4,10 +4,14 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 
 #include <fmt/format.h>
+#include <fmt/ostream.h>
 
 #include "command.hpp"
+#include "drape/sim/body_overlap.hpp"
+#include "run_setup.hpp"
 #include "drape/core/error.hpp"
 
 namespace drape::cli {
@@ -24,9 +28,29 @@ std::string lowerExtension(const std::string& path) {
   return ext;
 }
 
+/// With a scene and its avatar's motion: where the motion puts the collidable parts inside
+/// each other (sim::findBodyOverlaps), as `drape run` finds it, without simulating.
+void inspectBodyOverlaps(const std::string& scenePath, const std::string& motionPath, std::ostream& out) {
+  RunSetup setup = runSetupFromScene(scenePath);
+  if (!setup.character) throw Error(fmt::format("--motion: {} has no avatar to move", scenePath));
+  addMotion(setup, motionPath);
+  const std::unique_ptr<sim::CharacterWorld> world = buildWorld(setup);
+  const long frames = defaultFrames(setup);
+  const std::vector<sim::BodyOverlap> found = sim::findBodyOverlaps(
+      *setup.character->avatar, world->poses(), world->fields(), frames, setup.settings.frameRate_hz,
+      setup.character->voxel_m);
+  fmt::print(out, "body overlaps over {} frames with {} (collidable parts inside each other beyond their overlap at "
+                  "rest, deeper than a voxel): {}\n",
+             frames, motionPath, found.empty() ? "none" : std::to_string(found.size()));
+  for (const sim::BodyOverlap& o : found) fmt::print(out, "  {}\n", sim::describe(o));
+}
+
 RunFunction setupInspect(CLI::App& app) {
-  static std::string path;
+  static std::string path, motion;
   app.add_option("file", path, "The file to summarise")->required();
+  app.add_option("--motion", motion,
+                 "With a scene: also load this motion onto its avatar and list where it puts the collidable parts "
+                 "inside each other (cloth between them has no place), without simulating");
   app.footer([] {
     std::string text = "Understands:";
     for (const InspectorEntry& e : registeredInspectors()) text += fmt::format("\n  {:<18} {}", fmt::join(e.extensions, " "), e.what);
@@ -37,7 +61,10 @@ RunFunction setupInspect(CLI::App& app) {
     const std::string ext = lowerExtension(path);
     for (const InspectorEntry& e : registeredInspectors()) {
       if (std::find(e.extensions.begin(), e.extensions.end(), ext) != e.extensions.end()) {
+        if (!motion.empty() && ext != ".wrl" && ext != ".vrml")
+          throw Error(fmt::format("--motion goes with a scene (.wrl), not with {}", path));
         e.inspect(path, std::cout);
+        if (!motion.empty()) inspectBodyOverlaps(path, motion, std::cout);
         return 0;
       }
     }

@@ -128,6 +128,24 @@ TEST(WalkingDress, ThePinchIsWeatheredByComputingItsFramesAgain) {
   EXPECT_GE(stats["garments"][0]["frames_refined"].get<int>(), 2);
 }
 
+TEST(WalkingDress, InspectListsWhereTheMotionPutsTheBodyInsideItself) {
+  // Before any simulation: the same pairs drape run lists in stats.json.
+  ScratchDir dir("walking-dress-inspect");
+  const CliResult r =
+      runDrape("inspect '" + kDressScene + "' --motion '" + kSource + "/data/mocap/cmu_walk_delfem2.bvh'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("garments: 1"), std::string::npos) << r.out;  // the scene's summary first
+  EXPECT_NE(r.out.find("body overlaps over 115 frames with "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  LeftForeArm goes up to "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" mm into LowerBack (frames "), std::string::npos) << r.out;
+
+  const CliResult mesh = runDrape("inspect '" + kSource + "/examples/walking_dress/dress.obj' --motion '" + kSource +
+                                      "/data/mocap/cmu_walk_delfem2.bvh'",
+                                  dir);
+  EXPECT_EQ(mesh.code, 2) << mesh.err;
+  EXPECT_NE(mesh.err.find("--motion goes with a scene (.wrl)"), std::string::npos) << mesh.err;
+}
+
 TEST(WalkingDress, StaysStableWithMoreSubsteps) {
   // More substeps must not make a garment less stable. At 300 per frame (undamped: the
   // scene's damping is more than that substep carries) the dress reached the speed bound in

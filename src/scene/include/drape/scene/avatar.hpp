@@ -49,13 +49,13 @@ struct Avatar {
       if (joints[i].name == name) return static_cast<int>(i);
     return -1;
   }
-  /// Index of the segment named `name`, or -1.
   /// Every segment's name, in order (for messages that list what the avatar has).
   [[nodiscard]] std::vector<std::string> segmentNames() const {
     std::vector<std::string> names;
     for (const Segment& s : segments) names.push_back(s.name);
     return names;
   }
+  /// Index of the segment named `name`, or -1.
   [[nodiscard]] int findSegment(const std::string& name) const {
     for (std::size_t i = 0; i < segments.size(); ++i)
       if (segments[i].name == name) return static_cast<int>(i);

@@ -316,7 +316,7 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   lastTime_s_ = t_s;
 }
 
-void FieldCollider::beginFrame(const ClothState&, double) {
+void FieldCollider::beginFrame() {
   frameStartCounters_ = counters_;
   frameStartField_ = field_;
 }

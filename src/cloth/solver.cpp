@@ -141,13 +141,11 @@ bool ClothSolver::stepFrame(long frame) {
   // The copy is of positions and velocities, 48 bytes a vertex (the skirt 13 KB, the dress
   // 106 KB) per frame, with no allocation after the first; the benchmark's figures did not
   // move with it.
-  // The frame's start as its first unrefined substep has it (runFrame).
-  const double t0 = static_cast<double>((frame - 1) * settings_.substepsPerFrame) * settings_.substep_s();
   const std::array<std::vector<double>*, 6> motion{&state_.x, &state_.y, &state_.z, &state_.vx, &state_.vy, &state_.vz};
   if (settings_.maxRefinement > 1) {
     for (std::size_t k = 0; k < motion.size(); ++k) frameStart_[k] = *motion[k];
     frameStartSubsteps_ = substepCount_;
-    for (Collider* c : colliders_) c->beginFrame(state_, t0);
+    for (Collider* c : colliders_) c->beginFrame();
   }
   lastRefinement_ = 1;
   for (int refinement = 1;; refinement *= 2) {
@@ -160,6 +158,8 @@ bool ClothSolver::stepFrame(long frame) {
     if (refinement == 1) refinedBecause_ = instability_;
     for (std::size_t k = 0; k < motion.size(); ++k) *motion[k] = frameStart_[k];
     substepCount_ = frameStartSubsteps_;
+    // The frame's start as its first unrefined substep has it (runFrame).
+    const double t0 = static_cast<double>((frame - 1) * settings_.substepsPerFrame) * settings_.substep_s();
     for (Collider* c : colliders_) c->restartFrame(state_, t0);
   }
 }

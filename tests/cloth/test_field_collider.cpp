@@ -162,7 +162,7 @@ TEST(FieldCollider, AFrameComputedAgainForgetsItsAttemptAndKeepsSliding) {
   slide(0.0, dt, 300);
   const double t = 300 * dt;
   const ClothState start = p.state;
-  c.beginFrame(start, t);
+  c.beginFrame();
   const FieldCollisionCounters before = c.fieldCounters();
   const std::uint64_t callsBefore = c.counters().calls;
   slide(t, dt, 200);  // the attempt

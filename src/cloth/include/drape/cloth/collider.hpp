@@ -31,10 +31,10 @@ class Collider {
   virtual void collide(const ClothModel& model, double t0_s, double t1_s, ClothState& io) = 0;
   [[nodiscard]] virtual ColliderCounters counters() const = 0;
   /// The solver is about to compute a frame it may compute again (StepSettings::
-  /// maxRefinement) from `state` at t_s: keep what restartFrame needs.
-  virtual void beginFrame(const ClothState& state, double t_s) = 0;
-  /// The frame went unstable and is computed again, with more substeps, from the state
-  /// beginFrame saw at t_s: forget what the attempt did (its counts included).
+  /// maxRefinement): keep what restartFrame needs.
+  virtual void beginFrame() = 0;
+  /// The frame went unstable and is computed again, with more substeps, from `state`, where
+  /// the frame started at t_s: forget what the attempt did (its counts included).
   virtual void restartFrame(const ClothState& state, double t_s) = 0;
 };
 
@@ -48,7 +48,7 @@ class SphereCollider final : public Collider {
   [[nodiscard]] std::string name() const override { return "sphere"; }
   void collide(const ClothModel& model, double t0_s, double t1_s, ClothState& io) override;
   [[nodiscard]] ColliderCounters counters() const override { return counters_; }
-  void beginFrame(const ClothState&, double) override { frameStart_ = counters_; }
+  void beginFrame() override { frameStart_ = counters_; }
   void restartFrame(const ClothState&, double) override { counters_ = frameStart_; }
 
  private:

@@ -275,7 +275,7 @@ class FieldCollider final : public Collider {
   [[nodiscard]] std::string name() const override { return "distance fields"; }
   void collide(const ClothModel& model, double t0_s, double t1_s, ClothState& io) override;
   [[nodiscard]] ColliderCounters counters() const override { return counters_; }
-  void beginFrame(const ClothState& state, double t_s) override;
+  void beginFrame() override;
   /// The counters go back to the frame's start. Every pair's state is established again
   /// from where the point is at t_s, as at the first step, except that a pair within T3 of
   /// its part slides (OnSurf) rather than being eased out (a frame's start finds most

@@ -10,9 +10,9 @@
 #include <fmt/ostream.h>
 
 #include "command.hpp"
+#include "drape/core/error.hpp"
 #include "drape/sim/body_overlap.hpp"
 #include "run_setup.hpp"
-#include "drape/core/error.hpp"
 
 namespace drape::cli {
 namespace {
@@ -34,14 +34,12 @@ void inspectBodyOverlaps(const std::string& scenePath, const std::string& motion
   RunSetup setup = runSetupFromScene(scenePath);
   if (!setup.character) throw Error(fmt::format("--motion: {} has no avatar to move", scenePath));
   addMotion(setup, motionPath);
+  setup.frames = defaultFrames(setup);
   const std::unique_ptr<sim::CharacterWorld> world = buildWorld(setup);
-  const long frames = defaultFrames(setup);
-  const std::vector<sim::BodyOverlap> found = sim::findBodyOverlaps(
-      *setup.character->avatar, world->poses(), world->fields(), frames, setup.settings.frameRate_hz,
-      setup.character->voxel_m);
+  const std::vector<sim::BodyOverlap> found = bodyOverlaps(setup, *world);
   fmt::print(out, "body overlaps over {} frames with {} (collidable parts inside each other beyond their overlap at "
                   "rest, deeper than a voxel): {}\n",
-             frames, motionPath, found.empty() ? "none" : std::to_string(found.size()));
+             setup.frames, motionPath, found.empty() ? "none" : std::to_string(found.size()));
   for (const sim::BodyOverlap& o : found) fmt::print(out, "  {}\n", sim::describe(o));
 }
 

@@ -278,14 +278,18 @@ std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup) {
   return world;
 }
 
+std::vector<sim::BodyOverlap> bodyOverlaps(const RunSetup& setup, const sim::CharacterWorld& world) {
+  if (!setup.character || !setup.character->animation) return {};
+  // Deeper than a voxel beyond rest: the fields read distances to about half a voxel.
+  return sim::findBodyOverlaps(*setup.character->avatar, world.poses(), world.fields(), setup.frames,
+                               setup.settings.frameRate_hz, setup.character->voxel_m);
+}
+
 namespace {
 
 std::vector<sim::BodyOverlap> findOverlaps(const RunSetup& setup, const sim::CharacterWorld& world) {
-  // Deeper than a voxel beyond rest: the fields read distances to about half a voxel.
-  const double threshold_m = setup.character->voxel_m;
   const auto start = std::chrono::steady_clock::now();
-  std::vector<sim::BodyOverlap> found = sim::findBodyOverlaps(*setup.character->avatar, world.poses(), world.fields(),
-                                                              setup.frames, setup.settings.frameRate_hz, threshold_m);
+  std::vector<sim::BodyOverlap> found = bodyOverlaps(setup, world);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!found.empty())
     spdlog::info("the motion puts collidable parts of the body inside each other beyond their overlap at rest, {} "
@@ -299,9 +303,9 @@ std::vector<sim::BodyOverlap> findOverlaps(const RunSetup& setup, const sim::Cha
 std::string overlapsInFrame(const std::vector<sim::BodyOverlap>& overlaps, const std::vector<std::string>& parts,
                             long frame) {
   const auto named = [&](const std::string& p) { return std::find(parts.begin(), parts.end(), p) != parts.end(); };
+  const auto f = static_cast<std::size_t>(frame);
   std::string out;
   for (const sim::BodyOverlap& o : overlaps) {
-    const auto f = static_cast<std::size_t>(frame);
     if (!named(o.part) || !named(o.into) || f >= o.depthPerFrame.size() || o.depthPerFrame[f] <= 0) continue;
     out += fmt::format("{}{} is {:.0f} mm into {}", out.empty() ? "" : ", ", o.part, 1e3 * o.depthPerFrame[f], o.into);
   }
@@ -315,9 +319,8 @@ std::string describeInstability(const GarmentRun& r, double maxSpeed_m_s,
   const cloth::Instability& bad = r.solver->instability();
   std::string out = bad.describe(r.name, maxSpeed_m_s);
   if (!r.collider) return out;
-  out += cloth::pinchNear(*r.model, *r.collider, bad.vertex, bad.substepsPerFrame);
   const cloth::NearestPinch near = cloth::nearestPinch(*r.model, *r.collider, bad.vertex, bad.substepsPerFrame);
-  return out + overlapsInFrame(overlaps, near.pinch.parts, frame);
+  return out + cloth::describePinch(near, bad.vertex) + overlapsInFrame(overlaps, near.pinch.parts, frame);
 }
 
 }  // namespace
@@ -386,8 +389,7 @@ int simulateRun(const RunSetup& setup) {
   for (const SphereSetup& s : setup.spheres) spheres.emplace_back(s.centre_m, s.radius_m);
   for (const GarmentSetup& g : setup.garments) (void)mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
   std::unique_ptr<sim::CharacterWorld> world = setup.character ? buildWorld(setup) : nullptr;
-  const std::vector<sim::BodyOverlap> overlaps =
-      world && setup.character->animation ? findOverlaps(setup, *world) : std::vector<sim::BodyOverlap>{};
+  const std::vector<sim::BodyOverlap> overlaps = world ? findOverlaps(setup, *world) : std::vector<sim::BodyOverlap>{};
   std::vector<GarmentRun> runs;
   formats::RunManifest manifest;
   manifest.frameRate = settings.frameRate_hz;

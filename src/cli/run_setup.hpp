@@ -16,6 +16,7 @@
 #include "drape/mesh/trimesh.hpp"
 #include "drape/motion/animation.hpp"
 #include "drape/scene/avatar.hpp"
+#include "drape/sim/body_overlap.hpp"
 #include "drape/sim/character_world.hpp"
 
 namespace drape::cli {
@@ -70,6 +71,11 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
 /// ready. Used by `drape run`, `drape play SCENE` and `drape bench paper` alike.
 [[nodiscard]] std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup);
 
+/// Where the setup's motion puts the world's collidable parts inside each other over
+/// setup.frames, beyond their overlap at rest and deeper than a voxel (sim::findBodyOverlaps);
+/// none without a motion. `drape run` writes them into stats.json, `drape inspect --motion`
+/// lists them.
+[[nodiscard]] std::vector<sim::BodyOverlap> bodyOverlaps(const RunSetup& setup, const sim::CharacterWorld& world);
 /// Frames to simulate when none are asked for: the lead-in plus the whole motion. Throws
 /// naming --frames when there is no motion.
 [[nodiscard]] long defaultFrames(const RunSetup& setup);

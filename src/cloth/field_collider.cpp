@@ -853,7 +853,10 @@ NearestPinch nearestPinch(const ClothModel& model, const FieldCollider& collider
 
 std::string pinchNear(const ClothModel& model, const FieldCollider& collider, std::uint32_t vertex,
                       long withinSubsteps) {
-  const NearestPinch near = nearestPinch(model, collider, vertex, withinSubsteps);
+  return describePinch(nearestPinch(model, collider, vertex, withinSubsteps), vertex);
+}
+
+std::string describePinch(const NearestPinch& near, std::uint32_t vertex) {
   const FieldCollider::LastPinch& pinch = near.pinch;
   if (pinch.parts.empty()) return "";
   const std::string who =

@@ -486,6 +486,8 @@ struct NearestPinch {
 };
 [[nodiscard]] NearestPinch nearestPinch(const ClothModel& model, const FieldCollider& collider, std::uint32_t vertex,
                                         long withinSubsteps);
+/// pinchNear's words for a pinch nearestPinch found for `vertex`.
+[[nodiscard]] std::string describePinch(const NearestPinch& near, std::uint32_t vertex);
 
 /// For an instability report: the pinch nearest to `vertex` (on the garment as modelled,
 /// within 5 cm) in the last `withinSubsteps` substeps, as "; N substeps before, vertex W, D mm

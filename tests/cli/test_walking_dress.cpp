@@ -98,14 +98,14 @@ TEST(WalkingDress, AnInstabilitySaysWhichPartsPinchedTheCloth) {
   EXPECT_NE(r.err.find("garment 'dress': vertex "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("was pressed by LowerBack, Spine, LeftArm, LeftForeArm at once (a pinch"), std::string::npos)
       << r.err;
-  EXPECT_NE(statsOf(dir / "out")["instability"].get<std::string>().find("was pressed by"), std::string::npos);
+  const nlohmann::json stats = statsOf(dir / "out");
+  EXPECT_NE(stats["instability"].get<std::string>().find("was pressed by"), std::string::npos);
   // And that the motion puts the pinch's parts inside each other there: on this body the
   // walk swings the left forearm into the small of the back.
   EXPECT_NE(r.err.find("; in that frame the motion puts the body inside itself: LeftForeArm is "), std::string::npos)
       << r.err;
   EXPECT_NE(r.err.find(" mm into LowerBack"), std::string::npos) << r.err;
   bool forearmInBack = false;
-  const nlohmann::json stats = statsOf(dir / "out");
   for (const auto& o : stats["body_overlaps"])
     forearmInBack |= o["part"] == "LeftForeArm" && o["into"] == "LowerBack" && o["depth_m"].get<double>() > 0.01;
   EXPECT_TRUE(forearmInBack);

@@ -30,10 +30,12 @@ std::string lowerExtension(const std::string& path) {
 
 /// With a scene and its avatar's motion: where the motion puts the collidable parts inside
 /// each other (sim::findBodyOverlaps), as `drape run` finds it, without simulating.
-void inspectBodyOverlaps(const std::string& scenePath, const std::string& motionPath, std::ostream& out) {
+void inspectBodyOverlaps(const std::string& scenePath, const std::string& motionPath,
+                         const std::vector<std::string>& keepApart, std::ostream& out) {
   RunSetup setup = runSetupFromScene(scenePath);
   if (!setup.character) throw Error(fmt::format("--motion: {} has no avatar to move", scenePath));
   addMotion(setup, motionPath);
+  setup.character->keepApart = keepApart;
   setup.frames = defaultFrames(setup);
   const std::unique_ptr<sim::CharacterWorld> world = buildWorld(setup);
   const std::vector<sim::BodyOverlap> found = bodyOverlaps(setup, *world);
@@ -45,10 +47,15 @@ void inspectBodyOverlaps(const std::string& scenePath, const std::string& motion
 
 RunFunction setupInspect(CLI::App& app) {
   static std::string path, motion;
+  static std::vector<std::string> keepApart;
   app.add_option("file", path, "The file to summarise")->required();
   app.add_option("--motion", motion,
                  "With a scene: also load this motion onto its avatar and list where it puts the collidable parts "
                  "inside each other (cloth between them has no place), without simulating");
+  app.add_option("--keep-apart", keepApart,
+                 "With --motion: first correct the motion to keep these parts out of the others, as `drape run "
+                 "--keep-apart` does, and list what is left")
+      ->delimiter(',');
   app.footer([] {
     std::string text = "Understands:";
     for (const InspectorEntry& e : registeredInspectors()) text += fmt::format("\n  {:<18} {}", fmt::join(e.extensions, " "), e.what);
@@ -59,10 +66,11 @@ RunFunction setupInspect(CLI::App& app) {
     const std::string ext = lowerExtension(path);
     for (const InspectorEntry& e : registeredInspectors()) {
       if (std::find(e.extensions.begin(), e.extensions.end(), ext) != e.extensions.end()) {
+        if (!keepApart.empty() && motion.empty()) throw Error("--keep-apart goes with --motion");
         if (!motion.empty() && ext != ".wrl" && ext != ".vrml")
           throw Error(fmt::format("--motion goes with a scene (.wrl), not with {}", path));
         e.inspect(path, std::cout);
-        if (!motion.empty()) inspectBodyOverlaps(path, motion, std::cout);
+        if (!motion.empty()) inspectBodyOverlaps(path, motion, keepApart, std::cout);
         return 0;
       }
     }

@@ -30,7 +30,7 @@ struct RunOptions {
   std::string scene, avatar, motion, jointMap, fieldMethod = "dvdp";
   double motionScale = 0.0, voxel_m = 0.0, leadIn_s = 1.0;
   bool preview = false, countEverySubstep = false, exactSliding = false, freePinches = false;
-  std::vector<std::string> faceSamplesWith;
+  std::vector<std::string> faceSamplesWith, keepApart;
   std::string garment, units = "m", pinVertices, pinMask, out, substeps = "33", integrator = "symplectic-euler";
   std::string wind, gravity;
   std::vector<std::string> spheres;
@@ -226,6 +226,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     if (!(o.leadIn_s >= 0)) throw Error(fmt::format("--lead-in must be >= 0 s, got {}", o.leadIn_s));
     ch.leadIn_s = o.leadIn_s;
     if (!o.motion.empty()) addMotion(setup, o.motion, o.motionScale, o.jointMap);
+    ch.keepApart = o.keepApart;
   }
 
   if (app.count("--substeps") || o.scene.empty()) {
@@ -275,6 +276,11 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--field-method", o->fieldMethod, "dvdp (the paper's) or exact")
       ->capture_default_str()
       ->check(CLI::IsMember({"dvdp", "exact"}));
+  app.add_option("--keep-apart", o->keepApart,
+                 "Body parts whose motion is corrected, before simulating, to keep them out of the collidable parts "
+                 "they go into (a forearm swung through the back): each is swung about the joint above it and "
+                 "keeps twice the garments' T2 from the other part's surface, e.g. LeftForeArm,RightForeArm")
+      ->delimiter(',');
   app.add_option("--lead-in", o->leadIn_s, "Seconds to blend from the rest pose into the motion")->capture_default_str();
   app.add_flag("--preview", o->preview, "Also render a contact sheet and, with ffmpeg, an MP4 into the output directory");
   app.add_option("--offsets", o->offsets,

@@ -264,6 +264,19 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
   if (report.restUnfoldFramesSkipped > 0) spdlog::info("{}: {}", motionPath, report.restUnfoldSkipped());
 }
 
+namespace {
+
+/// What --keep-apart changed in the motion: one line, and one per pair it moved.
+void logKeptApart(const sim::KeepApartReport& report, const std::vector<std::string>& parts) {
+  if (parts.empty()) return;
+  spdlog::info("--keep-apart {}: the motion corrected in {} frames, turned by up to {:.1f} degrees, in {:.2f} s; {}",
+               fmt::join(parts, ","), report.framesChanged, report.largestAngle_deg, report.seconds,
+               report.pairs.empty() ? "no part lacked its clearance" : fmt::format("{} pairs", report.pairs.size()));
+  for (const sim::KeptApart& k : report.pairs) spdlog::info("  {}", sim::describe(k));
+}
+
+}  // namespace
+
 std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup) {
   if (!setup.character) throw Error("drape: the scene has no avatar to simulate on");
   sim::WorldSettings ws;
@@ -271,10 +284,14 @@ std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup) {
   ws.voxel_m = setup.character->voxel_m;
   ws.fieldMethod = setup.character->fieldMethod;
   ws.leadIn_s = setup.character->leadIn_s;
+  ws.keepApart.parts = setup.character->keepApart;
+  if (!ws.keepApart.parts.empty() && !setup.character->animation)
+    throw Error("--keep-apart: there is no motion to correct (give --motion FILE)");
   spdlog::info("building distance fields ({:.4g} m voxels) and binding constraint masks", ws.voxel_m);
   auto world = std::make_unique<sim::CharacterWorld>(*setup.character->avatar, setup.character->animation.get(),
                                                      setup.garments, ws);
   spdlog::info("{} distance fields in {:.2f} s", world->fields().size(), world->fieldBuild_s());
+  logKeptApart(world->keepApartReport(), ws.keepApart.parts);
   return world;
 }
 

@@ -32,6 +32,8 @@ struct CharacterSetup {
   double voxel_m = 0.005;                                     ///< distance-field voxel size
   field::FieldMethod fieldMethod = field::FieldMethod::Dvdp;
   double leadIn_s = 1.0;                                      ///< rest pose -> first motion frame
+  /// Parts whose motion is corrected to keep them out of the collidable parts (--keep-apart).
+  std::vector<std::string> keepApart{};
 };
 
 struct SphereSetup {

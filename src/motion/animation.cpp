@@ -332,6 +332,14 @@ void AvatarAnimation::evaluateInverse(std::size_t f, double s, std::span<RigidTr
   for (std::size_t j = 0; j < joints_; ++j) out[j] = interpolate(a[j], b[j], s);
 }
 
+void AvatarAnimation::moveJoints(std::size_t f, std::span<const int> joints, const RigidTransform& motion) {
+  for (const int j : joints) {
+    const std::size_t i = f * joints_ + static_cast<std::size_t>(j);
+    world_[i] = motion * world_[i];
+    inverse_[i] = world_[i].inverse();
+  }
+}
+
 double maxJointSeparation(const AvatarAnimation& animation, const scene::Avatar& avatar, int substeps) {
   // Where each joint sits in its parent's frame (constant: bones are rigid).
   std::vector<Vec3> attach(avatar.joints.size(), Vec3::Zero());

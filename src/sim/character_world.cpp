@@ -43,6 +43,14 @@ AvatarPoses::AvatarPoses(const scene::Avatar& avatar, const motion::AvatarAnimat
   }
 }
 
+void AvatarPoses::useAnimation(const motion::AvatarAnimation* animation) {
+  animation_ = animation;
+  for (int c = 0; c < 2; ++c) {
+    cacheTime_[c] = std::numeric_limits<double>::quiet_NaN();
+    std::fill(cached_[c].begin(), cached_[c].end(), std::uint8_t{0});
+  }
+}
+
 double AvatarPoses::end_s() const { return leadIn_s_ + (animation_ ? animation_->duration() : 0.0); }
 
 AvatarPoses::When AvatarPoses::when(double t_s) const {
@@ -111,6 +119,7 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
     cloth::checkBendingStep(*models.back(), settings_.step);
   }
   buildFields(garments);
+  if (animation && !settings_.keepApart.parts.empty()) keepBodyApart(*animation, garments);
 
   for (std::size_t g = 0; g < garments.size(); ++g) {
     GarmentSpec& spec = garments[g];
@@ -179,6 +188,15 @@ void CharacterWorld::buildFields(const std::vector<GarmentSpec>& garments) {
     partMotions_.push_back(std::make_shared<SegmentMotion>(*poses_, segment.joint));
   }
   fieldBuild_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void CharacterWorld::keepBodyApart(const motion::AvatarAnimation& animation, const std::vector<GarmentSpec>& garments) {
+  KeepApartSettings keep = settings_.keepApart;
+  if (keep.margin_m <= 0)
+    for (const GarmentSpec& g : garments) keep.margin_m = std::max(keep.margin_m, 2.0 * g.offsets.t2_m);
+  keptApartMotion_ = std::make_unique<motion::AvatarAnimation>(animation);
+  keepApart_ = sim::keepBodyApart(avatar_, *keptApartMotion_, fields_, keep);
+  poses_->useAnimation(keptApartMotion_.get());
 }
 
 namespace {

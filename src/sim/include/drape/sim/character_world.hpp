@@ -23,6 +23,7 @@
 #include "drape/mesh/trimesh.hpp"
 #include "drape/motion/animation.hpp"
 #include "drape/scene/avatar.hpp"
+#include "drape/sim/keep_apart.hpp"
 
 namespace drape::sim {
 
@@ -47,6 +48,8 @@ struct WorldSettings {
   double voxel_m = 0.005;                   ///< distance-field voxel size
   field::FieldMethod fieldMethod = field::FieldMethod::Dvdp;
   double leadIn_s = 1.0;                    ///< rest pose -> first motion frame blend
+  /// Parts the motion is corrected to keep out of the collidable parts (sim/keep_apart.hpp).
+  KeepApartSettings keepApart;
 };
 
 /// Joint world transforms of an animated avatar at any simulation time (with the lead-in),
@@ -61,6 +64,8 @@ class AvatarPoses {
   /// All joints at time t into out (size = joint count).
   void evaluate(double t_s, std::span<RigidTransform> out) const;
   [[nodiscard]] double leadIn_s() const { return leadIn_s_; }
+  /// Plays `animation` from now on (same avatar, same joint count); forgets the cached poses.
+  void useAnimation(const motion::AvatarAnimation* animation);
   /// Simulation time at which the motion ends (its last frame).
   [[nodiscard]] double end_s() const;
 
@@ -122,6 +127,8 @@ class CharacterWorld {
   [[nodiscard]] double frameTime(long frame) const { return double(frame) / settings_.step.frameRate_hz; }
   /// Seconds spent building the distance fields.
   [[nodiscard]] double fieldBuild_s() const { return fieldBuild_s_; }
+  /// What keeping the body apart changed in the motion (empty unless settings asked).
+  [[nodiscard]] const KeepApartReport& keepApartReport() const { return keepApart_; }
 
  private:
   struct GarmentRun {
@@ -130,11 +137,16 @@ class CharacterWorld {
     std::unique_ptr<cloth::ClothSolver> solver;
   };
   void buildFields(const std::vector<GarmentSpec>& garments);
+  /// Corrects a copy of the motion so that settings_.keepApart's parts stay out of the fields'
+  /// parts, and plays that copy.
+  void keepBodyApart(const motion::AvatarAnimation& animation, const std::vector<GarmentSpec>& garments);
   [[nodiscard]] std::vector<cloth::PinGroup> bindMask(const GarmentSpec& spec, const std::vector<int>& parts) const;
 
   const scene::Avatar& avatar_;
   WorldSettings settings_;
   std::unique_ptr<AvatarPoses> poses_;
+  std::unique_ptr<motion::AvatarAnimation> keptApartMotion_;  ///< the corrected motion, when asked for
+  KeepApartReport keepApart_;
   std::vector<PartField> fields_;
   std::vector<std::shared_ptr<const cloth::FixtureMotion>> partMotions_;  ///< per field
   std::vector<GarmentRun> garments_;

@@ -1,0 +1,78 @@
+#pragma once
+// Keeping the body out of itself: a correction of the retargeted motion.
+//
+// Motion captured on another body can swing a forearm through the small of the back
+// (sim/body_overlap.hpp). Cloth caught there has no place, and no collision response mends
+// it. This pass changes the motion instead, before the simulation: frame by frame, each
+// part it is asked to keep apart is swung out of every collidable part it goes into (those
+// it does not meet at a joint) by rotating its limb about the joint above it (a forearm and
+// its hand about the shoulder, a shin about the hip), until its surface keeps a margin from
+// that part's surface, read from that part's distance field. Each step turns the limb by the
+// least angle that lifts its deepest vertex out along the field's gradient.
+//
+// Frame by frame alone, a correction would start and stop with a kink in the limb's path,
+// and the cloth on it would feel the jolt. So the corrections (one rotation per pivot joint
+// and frame, in its parent joint's frame so that it moves with the body) are smoothed over
+// time with a Gaussian and solved again for what the smoothing took off, three times; the
+// last solve is not smoothed, so every frame keeps the margin where the field can say so.
+//
+// What it does not do: it moves no part that carries the body's weight (it moves only the
+// parts named), it does not keep the legs apart (thighs of a segmented body press into each
+// other on every walk, as real ones do, and spreading them would move the feet), and it
+// does not search over joints: a limb the joint above cannot swing out (its deepest vertex
+// in line with the joint and the gradient) is left where it is and reported.
+
+#include <string>
+#include <vector>
+
+#include "drape/motion/animation.hpp"
+#include "drape/scene/avatar.hpp"
+
+namespace drape::sim {
+
+struct PartField;
+
+struct KeepApartSettings {
+  /// The avatar's segments to move out of the collidable parts they go into (any segment:
+  /// its own mesh is what must stay out). Empty: the motion is left as it is.
+  std::vector<std::string> parts;
+  /// Clearance to keep between a moved part's surface and the other part's (m), or the
+  /// pair's clearance at rest where that is less. 0: CharacterWorld takes twice the
+  /// garments' largest T2, room for cloth on both parts' collision surfaces.
+  double margin_m = 0;
+  /// Gaussian time constant (sigma, s) the corrections are smoothed with.
+  double smoothing_s = 0.1;
+};
+
+/// One moved part and a part it went into.
+struct KeptApart {
+  std::string part;        ///< the part moved
+  std::string from;        ///< the part it went into
+  std::string pivot;       ///< the joint it was swung about
+  double target_m = 0;     ///< the clearance kept: the margin, or the pair's at rest if less
+  double deepest_m = 0;    ///< before: the most the pair lacked of its clearance (m)
+  long deepestFrame = 0;   ///< motion frame of that
+  long frames = 0;         ///< motion frames in which it lacked clearance before
+  double remaining_m = 0;  ///< after: the most it still lacks, in any frame (m)
+  long framesRemaining = 0;  ///< frames that still lack more than a voxel's tenth
+};
+
+struct KeepApartReport {
+  std::vector<KeptApart> pairs;  ///< pairs that lacked clearance in some frame, deepest first
+  double largestAngle_deg = 0;   ///< the largest correction of any joint in any frame
+  long framesChanged = 0;        ///< motion frames with any correction
+  double seconds = 0;
+};
+
+/// Corrects `animation` (retargeted onto `avatar`) so that each of settings.parts keeps its
+/// clearance from every one of `fields`' parts it does not meet at a joint (sim::jointsMeet)
+/// and does not move with. Throws drape::Error naming an unknown part, or a part whose limb
+/// has no joint above it that can swing it (the root).
+[[nodiscard]] KeepApartReport keepBodyApart(const scene::Avatar& avatar, motion::AvatarAnimation& animation,
+                                            const std::vector<PartField>& fields, const KeepApartSettings& settings);
+
+/// "LeftForeArm out of LowerBack about LeftArm: 39.0 mm short of its 12 mm clearance at
+/// most, in 37 frames (most in frame 80); 0.0 mm after".
+[[nodiscard]] std::string describe(const KeptApart& kept);
+
+}  // namespace drape::sim

@@ -33,7 +33,7 @@ struct PaperBenchOptions {
   int bendEvery = 0;       // 0: as the scene says
   bool exactSliding = false;  // sliding pairs read the field on every test (no contact planes)
   bool freePinches = false;   // pinched points move freely between reduced-frequency tests
-  std::vector<std::string> keepApart;  // parts the motion is corrected to keep out of the others
+  std::optional<std::vector<std::string>> keepApart;  // parts kept out of the others, instead of the scene's
   bool noRestingBalls = false;  // every pair inside a part's volume goes through the per-pair test
   std::optional<std::vector<std::string>> faceSamplesWith;  // set: overrides the scene's
   bool json = false;
@@ -65,7 +65,7 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
   if (o.faceSamplesWith)
     for (GarmentSetup& g : setup.garments) g.faceSamplesWith = *o.faceSamplesWith;
   addMotion(setup, o.motion);
-  setup.character->keepApart = o.keepApart;
+  if (o.keepApart) setup.character->keepApart = keepApartParts(*o.keepApart);
   const std::unique_ptr<sim::CharacterWorld> worldPtr = buildWorld(setup);
   sim::CharacterWorld& world = *worldPtr;
   for (std::size_t g = 0; g < world.garmentCount(); ++g) {
@@ -125,8 +125,10 @@ RunFunction setupPaperBench(CLI::App& app) {
                "Points pinched between two or more parts keep their own velocity at a test and, with "
                "--collision-every K > 1, move freely until the next, instead of taking their parts' mean "
                "velocity and being held by them (the paper's collision response as it is)");
-  app.add_option("--keep-apart", o.keepApart,
-                 "Body parts whose motion is corrected to keep them out of the collidable parts, as in drape run")
+  app.add_option_function<std::vector<std::string>>(
+         "--keep-apart", [](const std::vector<std::string>& parts) { o.keepApart = parts; },
+         "Body parts whose motion is corrected to keep them out of the collidable parts, instead of the scene's "
+         "keepApart ('none' for none), as in drape run")
       ->delimiter(',');
   app.add_flag("--no-resting-balls", o.noRestingBalls,
                "Every pair whose point is inside a part's volume goes through the per-pair test, instead "

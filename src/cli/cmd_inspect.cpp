@@ -35,7 +35,11 @@ void inspectBodyOverlaps(const std::string& scenePath, const std::string& motion
   RunSetup setup = runSetupFromScene(scenePath);
   if (!setup.character) throw Error(fmt::format("--motion: {} has no avatar to move", scenePath));
   addMotion(setup, motionPath);
-  setup.character->keepApart = keepApart;
+  if (!keepApart.empty()) {
+    setup.character->keepApart = keepApartParts(keepApart);
+    if (const std::string bad = unknownKeepApartPart(*setup.character); !bad.empty())
+      throw Error("--keep-apart: " + bad);
+  }
   setup.frames = defaultFrames(setup);
   const std::unique_ptr<sim::CharacterWorld> world = buildWorld(setup);
   const std::vector<sim::BodyOverlap> found = bodyOverlaps(setup, *world);
@@ -54,7 +58,7 @@ RunFunction setupInspect(CLI::App& app) {
                  "inside each other (cloth between them has no place), without simulating");
   app.add_option("--keep-apart", keepApart,
                  "With --motion: first correct the motion to keep these parts out of the others, as `drape run "
-                 "--keep-apart` does, and list what is left")
+                 "--keep-apart` does, and list what is left (instead of the scene's keepApart; 'none' for none)")
       ->delimiter(',');
   app.footer([] {
     std::string text = "Understands:";

@@ -92,6 +92,8 @@ void inspectScene(const std::string& path, std::ostream& out) {
              sim.bendEvery, sim.bendEvery == 1 ? "" : "s");
   fmt::print(out, "  offsets T0..T3 {:g} {:g} {:g} {:g} m, voxel size {:g} m, unit scale {:g} m per file unit\n",
              sim.offsets[0], sim.offsets[1], sim.offsets[2], sim.offsets[3], sim.voxelSize, sim.unitScale);
+  if (!sim.keepApart.empty())
+    fmt::print(out, "  the motion is corrected to keep {} out of the collidable parts\n", fmt::join(sim.keepApart, ", "));
   if (!s.scenery.empty()) {
     std::size_t triangles = 0;
     for (const scene::Scenery& m : s.scenery) triangles += m.mesh.triangleCount();

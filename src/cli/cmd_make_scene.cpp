@@ -40,6 +40,7 @@ struct MakeSceneOptions {
   std::string title;
   std::vector<std::string> collidesWith;
   std::vector<std::string> faceSamplesWith;
+  std::vector<std::string> keepApart;  ///< --keep-apart: the scene's Simulation keepApart
   double reach_m = 0.03;
   double voxel_m = 0.005;
   std::vector<double> offsets;  ///< T0..T3, m; empty: 1, 2, 3 and 6 voxels
@@ -129,8 +130,9 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
   fmt::print(os,
              "DEF Simulation Simulation {{\n  gravity 0 -9.81 0\n  frameRate {:g}\n  stepsPerFrame {}\n"
              "  maxAddedMass {:g}\n  airViscosity 0.5\n  offsets [ {:g} {:g} {:g} {:g} ]\n  voxelSize {:g}\n"
-             "  integrator \"symplectic-euler\"\n  collisionEvery {}\n  bendEvery {}\n}}\n\n",
-             o.frameRate, o.stepsPerFrame, o.maxAddedMass, t[0], t[1], t[2], t[3], v, o.collisionEvery, o.bendEvery);
+             "  integrator \"symplectic-euler\"\n  collisionEvery {}\n  bendEvery {}\n{}}}\n\n",
+             o.frameRate, o.stepsPerFrame, o.maxAddedMass, t[0], t[1], t[2], t[3], v, o.collisionEvery, o.bendEvery,
+             o.keepApart.empty() ? "" : fmt::format("  keepApart [ \"{}\" ]\n", fmt::join(o.keepApart, "\", \"")));
   writeMaterial(os, o.material);
   fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n}}\n\n", o.avatarUrl);
   fmt::print(os,
@@ -178,6 +180,8 @@ int makeScene(MakeSceneOptions& o) {
     if (std::find(o.collidesWith.begin(), o.collidesWith.end(), s) == o.collidesWith.end())
       throw Error(fmt::format("--face-samples-with: '{}' is not one of the collidable segments ({})", s,
                               fmt::join(o.collidesWith, ", ")));
+  for (const std::string& s : o.keepApart)
+    if (avatar.findSegment(s) < 0) throw Error(fmt::format("--keep-apart: {} has no segment '{}'", o.avatar, s));
   // The fewest substeps per frame, at least the paper's 33, that mass scaling keeps stable
   // within the allowance; or the count asked for, and what it needs.
   const mesh::Topology topology = mesh::Topology::build(garment);
@@ -242,6 +246,10 @@ RunFunction setupMakeScene(CLI::App& app) {
   app.add_option("--face-samples-with", o.faceSamplesWith,
                  "Of the collidable segments, those the garment's triangle centroids collide with too, not only "
                  "its vertices (where its triangles are large against the segment's curvature)")
+      ->delimiter(',');
+  app.add_option("--keep-apart", o.keepApart,
+                 "Body parts whose motion is corrected to keep them out of the collidable parts they go into, "
+                 "written as the scene's keepApart (e.g. LeftForeArm,RightForeArm,LeftArm,RightArm)")
       ->delimiter(',');
   app.add_option("--reach", o.reach_m, "Distance from a segment's box that makes it collidable, m")->capture_default_str();
   app.add_option("--voxel", o.voxel_m, "Distance-field voxel, m; without --offsets, T0..T3 are 1, 2, 3 and 6 voxels")

@@ -219,14 +219,19 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     setup.spheres.push_back({c, r.z()});
   }
 
+  if (app.count("--keep-apart") && !keepApartParts(o.keepApart).empty() && o.motion.empty())
+    throw Error("--keep-apart corrects a motion: give --motion FILE too");
   if (setup.character) {
     CharacterSetup& ch = *setup.character;
     if (o.voxel_m > 0) ch.voxel_m = o.voxel_m;
     ch.fieldMethod = o.fieldMethod == "exact" ? field::FieldMethod::Exact : field::FieldMethod::Dvdp;
     if (!(o.leadIn_s >= 0)) throw Error(fmt::format("--lead-in must be >= 0 s, got {}", o.leadIn_s));
     ch.leadIn_s = o.leadIn_s;
+    if (app.count("--keep-apart")) {
+      ch.keepApart = keepApartParts(o.keepApart);
+      if (const std::string bad = unknownKeepApartPart(ch); !bad.empty()) throw Error("--keep-apart: " + bad);
+    }
     if (!o.motion.empty()) addMotion(setup, o.motion, o.motionScale, o.jointMap);
-    ch.keepApart = o.keepApart;
   }
 
   if (app.count("--substeps") || o.scene.empty()) {
@@ -279,7 +284,8 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--keep-apart", o->keepApart,
                  "Body parts whose motion is corrected, before simulating, to keep them out of the collidable parts "
                  "they go into (a forearm swung through the back): each is swung about the joint above it and "
-                 "keeps twice the garments' T2 from the other part's surface, e.g. LeftForeArm,RightForeArm")
+                 "keeps twice the garments' T2 from the other part's surface, e.g. LeftForeArm,RightForeArm; overrides the "
+                 "scene's keepApart, 'none' for none")
       ->delimiter(',');
   app.add_option("--lead-in", o->leadIn_s, "Seconds to blend from the rest pose into the motion")->capture_default_str();
   app.add_flag("--preview", o->preview, "Also render a contact sheet and, with ffmpeg, an MP4 into the output directory");

@@ -237,7 +237,12 @@ RunSetup runSetupFromScene(const std::string& scenePath) {
   const std::shared_ptr<const scene::Avatar> avatar = sim::sceneAvatar(sc);
   setup.settings = sim::toStepSettings(sc.simulation);
   setup.garments = sim::garmentSpecs(sc, avatar.get());
-  if (avatar) setup.character = CharacterSetup{avatar, nullptr, sc.simulation.voxelSize};
+  if (avatar) {
+    setup.character = CharacterSetup{avatar, nullptr, sc.simulation.voxelSize};
+    setup.character->keepApart = sc.simulation.keepApart;
+    if (const std::string bad = unknownKeepApartPart(*setup.character); !bad.empty())
+      throw Error::at(sc.simulation.source, "Simulation keepApart: " + bad);
+  }
   return setup;
 }
 
@@ -275,6 +280,24 @@ void logKeptApart(const sim::KeepApartReport& report, const std::vector<std::str
   for (const sim::KeptApart& k : report.pairs) spdlog::info("  {}", sim::describe(k));
 }
 
+/// stats.json's keep_apart: what the correction of the motion changed.
+nlohmann::json keepApartJson(const sim::KeepApartReport& report) {
+  nlohmann::json pairs = nlohmann::json::array();
+  for (const sim::KeptApart& k : report.pairs)
+    pairs.push_back({{"part", k.part},
+                     {"from", k.from},
+                     {"pivot", k.pivot},
+                     {"clearance_m", k.target_m},
+                     {"short_m", k.deepest_m},
+                     {"short_frame", k.deepestFrame},
+                     {"frames", k.frames},
+                     {"short_after_m", k.remaining_m}});
+  return {{"parts", report.parts},
+          {"frames_changed", report.framesChanged},
+          {"largest_turn_deg", report.largestAngle_deg},
+          {"pairs", pairs}};
+}
+
 }  // namespace
 
 std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup) {
@@ -284,15 +307,29 @@ std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup) {
   ws.voxel_m = setup.character->voxel_m;
   ws.fieldMethod = setup.character->fieldMethod;
   ws.leadIn_s = setup.character->leadIn_s;
-  ws.keepApart.parts = setup.character->keepApart;
-  if (!ws.keepApart.parts.empty() && !setup.character->animation)
-    throw Error("--keep-apart: there is no motion to correct (give --motion FILE)");
+  if (setup.character->animation) ws.keepApart.parts = setup.character->keepApart;
   spdlog::info("building distance fields ({:.4g} m voxels) and binding constraint masks", ws.voxel_m);
   auto world = std::make_unique<sim::CharacterWorld>(*setup.character->avatar, setup.character->animation.get(),
                                                      setup.garments, ws);
   spdlog::info("{} distance fields in {:.2f} s", world->fields().size(), world->fieldBuild_s());
   logKeptApart(world->keepApartReport(), ws.keepApart.parts);
   return world;
+}
+
+std::string unknownKeepApartPart(const CharacterSetup& character) {
+  const scene::Avatar& avatar = *character.avatar;
+  for (const std::string& part : character.keepApart)
+    if (avatar.findSegment(part) < 0)
+      return fmt::format("avatar '{}' has no part '{}' (it has: {})", avatar.name, part,
+                         fmt::join(avatar.segmentNames(), ", "));
+  return "";
+}
+
+std::vector<std::string> keepApartParts(const std::vector<std::string>& option) {
+  if (option.size() == 1 && option.front() == "none") return {};
+  for (const std::string& part : option)
+    if (part == "none") throw Error("--keep-apart: 'none' stands alone (no parts), not in a list");
+  return option;
 }
 
 std::vector<sim::BodyOverlap> bodyOverlaps(const RunSetup& setup, const sim::CharacterWorld& world) {
@@ -618,6 +655,7 @@ int simulateRun(const RunSetup& setup) {
                             {"last_frame", o.lastFrame},
                             {"frames", o.frames}});
   stats["body_overlaps"] = bodyOverlaps;
+  if (world && !world->keepApartReport().parts.empty()) stats["keep_apart"] = keepApartJson(world->keepApartReport());
   addCollisionStats(stats, runs, total, done, world.get());
   const std::string statsPath = (out / "stats.json").string();
   std::ofstream statsFile(statsPath);

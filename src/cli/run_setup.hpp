@@ -73,6 +73,13 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
 /// ready. Used by `drape run`, `drape play SCENE` and `drape bench paper` alike.
 [[nodiscard]] std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup);
 
+/// The parts --keep-apart names: the list, or none for 'none' (which overrides a scene's).
+[[nodiscard]] std::vector<std::string> keepApartParts(const std::vector<std::string>& option);
+
+/// "avatar 'A' has no part 'P' (it has: ...)" for a keepApart part the character's avatar
+/// does not have; "" when it has them all.
+[[nodiscard]] std::string unknownKeepApartPart(const CharacterSetup& character);
+
 /// Where the setup's motion puts the world's collidable parts inside each other over
 /// setup.frames, beyond their overlap at rest and deeper than a voxel (sim::findBodyOverlaps);
 /// none without a motion. `drape run` writes them into stats.json, `drape inspect --motion`

@@ -196,6 +196,7 @@ class Builder {
            [&] { s.collisionEvery = static_cast<int>(number(n, "collisionEvery", s.collisionEvery)); });
       take("bendEvery", [&] { s.bendEvery = static_cast<int>(number(n, "bendEvery", s.bendEvery)); });
       take("maxAddedMass", [&] { s.maxAddedMass = number(n, "maxAddedMass", s.maxAddedMass); });
+      take("keepApart", [&] { s.keepApart = strings(n, "keepApart"); });
       if (const Field* f = n.field("unitScale"); f != nullptr && !f->isDefault)
         take("unitScale", [&] { s.unitScale = number(n, "unitScale", 1.0); });
       s.source = nodePos;

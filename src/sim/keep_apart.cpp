@@ -15,7 +15,7 @@
 namespace drape::sim {
 namespace {
 
-constexpr int kSolves = 4;            // three smoothed, then one that is not
+constexpr int kSolves = 2;            // one smoothed, then one that is not
 constexpr int kTurnsPerFrame = 32;    // per frame and solve: enough for a limb against two parts
 constexpr double kMaxTurn_rad = 0.1;  // per turn, so that the first-order lift stays close
 constexpr double kMinLever_m = 0.01;  // a deepest vertex closer than this to the line of the lift cannot be swung
@@ -248,11 +248,28 @@ class Solver {
   std::vector<std::vector<int>> subtrees_;  // per pivot: it and every joint below it
 };
 
+double angleOf(const Quat& q) { return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w())); }
+
+/// Each frame takes the largest turn within `reach` frames of it: smoothed afterwards, a
+/// turn then stays about as large as each frame needed (a plain average would take the
+/// peaks off, and the last solve would put them back as kinks).
+void widen(std::vector<std::vector<Quat>>& turns, int reach) {
+  for (std::vector<Quat>& series : turns) {
+    const std::vector<Quat> in = series;
+    const int n = static_cast<int>(in.size());
+    for (int f = 0; f < n; ++f)
+      for (int k = std::max(0, f - reach); k <= std::min(n - 1, f + reach); ++k)
+        if (angleOf(in[static_cast<std::size_t>(k)]) > angleOf(series[static_cast<std::size_t>(f)]))
+          series[static_cast<std::size_t>(f)] = in[static_cast<std::size_t>(k)];
+  }
+}
+
 /// Gaussian smoothing over frames of each pivot's turns (the motion holds its first and
 /// last frames beyond its ends).
 void smooth(std::vector<std::vector<Quat>>& turns, double sigma_frames) {
   if (sigma_frames <= 0) return;
   const int reach = static_cast<int>(std::ceil(3 * sigma_frames));
+  widen(turns, static_cast<int>(std::ceil(2 * sigma_frames)));
   std::vector<double> w(static_cast<std::size_t>(2 * reach + 1));
   for (int k = -reach; k <= reach; ++k)
     w[static_cast<std::size_t>(k + reach)] = std::exp(-0.5 * k * k / (sigma_frames * sigma_frames));
@@ -274,8 +291,6 @@ void smooth(std::vector<std::vector<Quat>>& turns, double sigma_frames) {
     }
   }
 }
-
-double angleOf(const Quat& q) { return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w())); }
 
 /// Per pair: the most it lacks, in which frame, and in how many frames more than `over`.
 struct Lack {
@@ -299,6 +314,7 @@ std::vector<Lack> measure(const Solver& solver, const motion::AvatarAnimation& a
 KeepApartReport keepBodyApart(const scene::Avatar& avatar, motion::AvatarAnimation& animation,
                               const std::vector<PartField>& fields, const KeepApartSettings& settings) {
   KeepApartReport report;
+  report.parts = settings.parts;
   if (settings.parts.empty()) return report;
   const auto start = std::chrono::steady_clock::now();
   const Solver solver(avatar, fields, settings);

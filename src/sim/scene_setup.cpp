@@ -56,6 +56,7 @@ WorldSettings toWorldSettings(const scene::SimulationSettings& s) {
   WorldSettings w;
   w.step = toStepSettings(s);
   w.voxel_m = s.voxelSize;
+  w.keepApart.parts = s.keepApart;
   return w;
 }
 

@@ -37,7 +37,7 @@ TEST(MakeScene, DressOnTheWalkingBody) {
                                                   "--name dress --offsets 0.002,0.004,0.006,0.016 --collides-with "
                                                   "Hips,LowerBack,Spine,Spine1,Neck,LeftShoulder,RightShoulder,"
                                                   "LeftArm,RightArm,LeftUpLeg,RightUpLeg --face-samples-with "
-                                                  "LeftUpLeg,RightUpLeg",
+                                                  "LeftUpLeg,RightUpLeg --keep-apart LeftForeArm,RightForeArm",
                                                   sceneDir),
                                    dir);
   ASSERT_EQ(made.code, 0) << made.err;
@@ -48,6 +48,7 @@ TEST(MakeScene, DressOnTheWalkingBody) {
   EXPECT_EQ(sc.garments[0].mesh.triangleCount(), 4192u);
   EXPECT_EQ(sc.garments[0].maskVertices.size(), 222u);
   EXPECT_EQ(sc.garments[0].faceSamplesWith, (std::vector<std::string>{"LeftUpLeg", "RightUpLeg"}));
+  EXPECT_EQ(sc.simulation.keepApart, (std::vector<std::string>{"LeftForeArm", "RightForeArm"}));
   EXPECT_GT(sc.simulation.stepsPerFrame, 33) << "the dress's slivers need more substeps than the skirt";
   EXPECT_GT(sc.simulation.maxAddedMass, 0.0);
 

@@ -109,6 +109,9 @@ TEST(Run, BadInputsGiveOneLineAndExitCode2) {
   writeText(nonManifold, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 2 5\n");
   writeText(degenerate, "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n");
   const std::string dress = "--garment '" + kDress + "' --units dm --frames 1 --out '" + (dir / "o") + "'";
+  const std::string source = DRAPE_SOURCE_DIR;
+  const std::string skirt = "'" + source + "/examples/walking_skirt/scene.wrl' --motion '" + source +
+                            "/examples/walking_skirt/walk.bvh' --frames 1 --out '" + (dir / "o") + "'";
   const std::vector<BadCase> cases = {
       {"missing file", "--garment /no/such/garment.obj --frames 1 --out '" + (dir / "o") + "'", "no such file"},
       {"non-manifold", "--garment '" + nonManifold + "' --frames 1 --out '" + (dir / "o") + "'", "non-manifold edge"},
@@ -127,6 +130,9 @@ TEST(Run, BadInputsGiveOneLineAndExitCode2) {
       {"bad substeps", dress + " --substeps fast", "--substeps must be"},
       {"bad integrator", dress + " --integrator rk4", "--integrator must be"},
       {"no refinement", dress + " --max-refinement 0", "--max-refinement must be in [1, 64], got 0"},
+      {"keep apart without motion", dress + " --keep-apart LeftForeArm", "--keep-apart corrects a motion: give --motion"},
+      {"keep apart unknown part", skirt + " --keep-apart LeftForeArm,Tail", "has no part 'Tail' (it has: Hips, "},
+      {"keep apart none in a list", skirt + " --keep-apart none,LeftForeArm", "--keep-apart: 'none' stands alone"},
   };
   for (const BadCase& c : cases) {
     const CliResult r = runDrape("run " + c.args, dir);

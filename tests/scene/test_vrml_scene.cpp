@@ -92,7 +92,8 @@ TEST(VrmlScene, EveryFieldWithValues) {
   const Scene s = fromText(
       "#VRML V2.0 utf8\n"
       "Simulation { gravity 0 0 -9.8 frameRate 25 stepsPerFrame 40 airViscosity 0.05 wind 1 0 0.5\n"
-      "  offsets [ 0.001 0.002 0.003 0.004 ] voxelSize 0.005 integrator \"euler\" collisionEvery 2 bendEvery 4 unitScale 0.01 }\n"
+      "  offsets [ 0.001 0.002 0.003 0.004 ] voxelSize 0.005 integrator \"euler\" collisionEvery 2 bendEvery 4 unitScale 0.01\n"
+      "  keepApart [ \"LeftForeArm\", \"RightForeArm\" ] }\n"
       "DEF Body Humanoid { humanoidBody DEF Root Joint { name \"root\" children [ DEF Hips Segment { name \"hips\" "
       "children Shape { geometry Box { } } } ] } }\n"
       "DEF Silk ClothMaterial { name \"silk\" density 1300 thickness 0.0002 youngsModulus 2e6 poissonRatio 0.25 "
@@ -118,6 +119,7 @@ TEST(VrmlScene, EveryFieldWithValues) {
   EXPECT_EQ(sim.integrator, "euler");
   EXPECT_EQ(sim.collisionEvery, 2);
   EXPECT_EQ(sim.bendEvery, 4);
+  EXPECT_EQ(sim.keepApart, (std::vector<std::string>{"LeftForeArm", "RightForeArm"}));
   EXPECT_NEAR(sim.unitScale, 0.01, 1e-9);
 
   ASSERT_EQ(s.materials.size(), 1u);
@@ -172,6 +174,7 @@ TEST(VrmlScene, EveryFieldDefaults) {
   EXPECT_EQ(s.simulation.integrator, defaults.integrator);
   EXPECT_EQ(s.simulation.collisionEvery, defaults.collisionEvery);
   EXPECT_EQ(s.simulation.bendEvery, defaults.bendEvery);
+  EXPECT_TRUE(s.simulation.keepApart.empty());
   EXPECT_EQ(s.simulation.unitScale, 1.0);
   const ClothMaterial md;
   ASSERT_EQ(s.materials.size(), 1u);

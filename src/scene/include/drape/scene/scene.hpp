@@ -53,6 +53,9 @@ struct SimulationSettings {
   int bendEvery = 1;                            ///< bending forces every N substeps, as an impulse
   double maxAddedMass = 0.0;                    ///< mass scaling allowed, fraction of a garment's mass
   double unitScale = 1.0;                       ///< metres per file unit (applied to all geometry on load)
+  /// Body parts whose motion is corrected to keep them out of the collidable parts they go
+  /// into (a forearm swung through the back; sim/keep_apart.hpp).
+  std::vector<std::string> keepApart;
   SourcePos source;                             ///< where the node was written; empty when defaulted
 };
 

@@ -13,8 +13,10 @@
 // Frame by frame alone, a correction would start and stop with a kink in the limb's path,
 // and the cloth on it would feel the jolt. So the corrections (one rotation per pivot joint
 // and frame, in its parent joint's frame so that it moves with the body) are smoothed over
-// time with a Gaussian and solved again for what the smoothing took off, three times; the
-// last solve is not smoothed, so every frame keeps the margin where the field can say so.
+// time: each frame takes the largest turn within two sigmas of it, then a Gaussian blends
+// them, so the limb turns away before it would touch and back after, about as far as each
+// frame needed. A last solve, not smoothed, mends what the blend left short, so every
+// frame keeps the margin where the field can say so.
 //
 // What it does not do: it moves no part that carries the body's weight (it moves only the
 // parts named), it does not keep the legs apart (thighs of a segmented body press into each
@@ -58,6 +60,7 @@ struct KeptApart {
 };
 
 struct KeepApartReport {
+  std::vector<std::string> parts;  ///< the parts asked for
   std::vector<KeptApart> pairs;  ///< pairs that lacked clearance in some frame, deepest first
   double largestAngle_deg = 0;   ///< the largest correction of any joint in any frame
   long framesChanged = 0;        ///< motion frames with any correction

@@ -1,0 +1,234 @@
+// Keeping the body out of itself (sim/keep_apart): a real walk that swings the forearms
+// through the small of the back on the MakeHuman body, corrected, and checked frame by frame
+// with the distance reads done here, vertex by vertex; what must not move does not; the
+// correction eases in and out; bad names are refused.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "drape/core/error.hpp"
+#include "drape/motion/animation.hpp"
+#include "drape/scene/avatar_gltf.hpp"
+#include "drape/sim/body_overlap.hpp"
+#include "drape/sim/character_world.hpp"
+#include "drape/sim/keep_apart.hpp"
+
+namespace drape::sim {
+namespace {
+
+constexpr double kMargin = 0.012;
+
+struct Walk {
+  scene::Avatar avatar;
+  motion::AvatarAnimation animation;
+  std::vector<PartField> fields;
+};
+
+/// The walking dress's body, its torso and arm parts' fields (5 mm voxels), and the walk
+/// that puts the left forearm 27 mm into the lower back.
+const Walk& delfem2Walk() {
+  static const Walk walk = [] {
+    scene::Avatar avatar =
+        scene::loadAvatarFile(std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel");
+    motion::MotionOptions mo;
+    mo.clip.rate = 30.0;
+    mo.jointMapDirectory = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";
+    motion::AvatarAnimation animation =
+        motion::loadAnimation(avatar, std::string(DRAPE_DATA_DIR) + "/mocap/cmu_walk_delfem2.bvh", mo);
+    field::FieldSettings fs;
+    fs.voxelSize_m = 0.005;
+    fs.shell_m = 0.016;
+    std::vector<PartField> fields;
+    for (const char* name : {"Hips", "LowerBack", "Spine", "Spine1", "LeftArm", "RightArm", "LeftForeArm", "RightForeArm"}) {
+      const scene::Segment& s = avatar.segments[static_cast<std::size_t>(avatar.findSegment(name))];
+      fields.push_back({name, s.joint, field::DistanceField::build(s.mesh, fs)});
+    }
+    return Walk{std::move(avatar), std::move(animation), std::move(fields)};
+  }();
+  return walk;
+}
+
+const PartField& fieldOf(const Walk& w, const std::string& name) {
+  return *std::find_if(w.fields.begin(), w.fields.end(), [&](const PartField& f) { return f.segment == name; });
+}
+
+/// Least distance of part a's vertices from part b, read here vertex by vertex.
+double clearanceOf(const Walk& w, std::span<const RigidTransform> pose, const std::string& a, const std::string& b) {
+  const scene::Segment& s = w.avatar.segments[static_cast<std::size_t>(w.avatar.findSegment(a))];
+  const PartField& into = fieldOf(w, b);
+  const RigidTransform toB = pose[static_cast<std::size_t>(into.joint)].inverse() * pose[static_cast<std::size_t>(s.joint)];
+  double least = 1.0;
+  for (const Vec3& v : s.mesh.positions) {
+    const Vec3 p = toB.apply(v);
+    if (into.field.containsPoint(p)) least = std::min(least, into.field.distanceAt(p));
+  }
+  return least;
+}
+
+std::vector<RigidTransform> restPose(const scene::Avatar& avatar) {
+  std::vector<RigidTransform> rest;
+  for (const scene::Joint& j : avatar.joints) rest.push_back(j.restWorld());
+  return rest;
+}
+
+bool below(const scene::Avatar& avatar, int j, const std::string& joint) {
+  for (; j >= 0; j = avatar.joints[static_cast<std::size_t>(j)].parent)
+    if (avatar.joints[static_cast<std::size_t>(j)].name == joint) return true;
+  return false;
+}
+
+/// The angle (rad) between a joint's corrected and original world rotation, per frame.
+std::vector<double> correctionAngles(const motion::AvatarAnimation& before, const motion::AvatarAnimation& after,
+                                     int joint) {
+  std::vector<double> out;
+  for (std::size_t f = 0; f < before.frameCount(); ++f)
+    out.push_back(before.frame(f)[static_cast<std::size_t>(joint)].rotation.angularDistance(
+        after.frame(f)[static_cast<std::size_t>(joint)].rotation));
+  return out;
+}
+
+TEST(KeepApart, TheForearmsKeepTheirClearanceFromTheTorsoInEveryFrame) {
+  const Walk& w = delfem2Walk();
+  motion::AvatarAnimation corrected = w.animation;
+  KeepApartSettings keep;
+  keep.parts = {"LeftForeArm", "RightForeArm"};
+  keep.margin_m = kMargin;
+  const KeepApartReport report = keepBodyApart(w.avatar, corrected, w.fields, keep);
+
+  const std::vector<RigidTransform> rest = restPose(w.avatar);
+  double deepestBefore = 0;
+  int checked = 0;
+  for (const std::string forearm : {"LeftForeArm", "RightForeArm"})
+    for (const std::string torso : {"Hips", "LowerBack", "Spine"}) {
+      // The clearance kept: the margin, or the pair's own at rest if less (both ways round).
+      const double target = std::min({kMargin, clearanceOf(w, rest, forearm, torso), clearanceOf(w, rest, torso, forearm)});
+      for (std::size_t f = 0; f < corrected.frameCount(); ++f) {
+        deepestBefore = std::max(deepestBefore, -clearanceOf(w, w.animation.frame(f), forearm, torso));
+        EXPECT_GE(clearanceOf(w, corrected.frame(f), forearm, torso), target - 2e-4)
+            << forearm << " into " << torso << ", frame " << f;
+        EXPECT_GE(clearanceOf(w, corrected.frame(f), torso, forearm), target - 2e-4)
+            << torso << " into " << forearm << ", frame " << f;
+        ++checked;
+      }
+    }
+  EXPECT_GT(checked, 500);  // 86 motion frames
+  EXPECT_GT(deepestBefore, 0.02) << "the walk must put a forearm well into the torso";
+  ASSERT_FALSE(report.pairs.empty());
+  EXPECT_EQ(report.pairs.front().part, "LeftForeArm");
+  EXPECT_EQ(report.pairs.front().from, "LowerBack");
+  EXPECT_EQ(report.pairs.front().pivot, "LeftArm");  // swung about the shoulder
+  for (const KeptApart& k : report.pairs) EXPECT_LT(k.remaining_m, 2e-4) << describe(k);
+  EXPECT_GT(report.framesChanged, 30);
+  EXPECT_LT(report.largestAngle_deg, 30.0);
+}
+
+TEST(KeepApart, OnlyTheArmsBelowTheShouldersMoveAndTheirBonesKeepTheirLengths) {
+  const Walk& w = delfem2Walk();
+  motion::AvatarAnimation corrected = w.animation;
+  KeepApartSettings keep;
+  keep.parts = {"LeftForeArm", "RightForeArm"};
+  keep.margin_m = kMargin;
+  (void)keepBodyApart(w.avatar, corrected, w.fields, keep);
+  int moved = 0;
+  for (std::size_t f = 0; f < corrected.frameCount(); ++f)
+    for (std::size_t j = 0; j < w.avatar.joints.size(); ++j) {
+      const RigidTransform& a = w.animation.frame(f)[j];
+      const RigidTransform& b = corrected.frame(f)[j];
+      const int ji = static_cast<int>(j);
+      if (!below(w.avatar, ji, "LeftArm") && !below(w.avatar, ji, "RightArm")) {
+        ASSERT_EQ(a.translation, b.translation) << w.avatar.joints[j].name << ", frame " << f;
+        ASSERT_EQ(a.rotation.coeffs(), b.rotation.coeffs()) << w.avatar.joints[j].name << ", frame " << f;
+        continue;
+      }
+      moved += a.rotation.angularDistance(b.rotation) > 1e-6;
+      // Rigid: each joint keeps its distance from its parent, and the shoulder stays put.
+      const int p = w.avatar.joints[j].parent;
+      const double boneBefore = (a.translation - w.animation.frame(f)[static_cast<std::size_t>(p)].translation).norm();
+      const double boneAfter = (b.translation - corrected.frame(f)[static_cast<std::size_t>(p)].translation).norm();
+      EXPECT_NEAR(boneAfter, boneBefore, 1e-9) << w.avatar.joints[j].name << ", frame " << f;
+      if (w.avatar.joints[j].name == "LeftArm" || w.avatar.joints[j].name == "RightArm")
+        EXPECT_NEAR((a.translation - b.translation).norm(), 0.0, 1e-9);
+    }
+  EXPECT_GT(moved, 100);
+}
+
+TEST(KeepApart, TheCorrectionEasesInAndOut) {
+  // Frame by frame alone the shoulder turns from nothing to its correction in one frame;
+  // smoothed it starts turning before the first frame that needs it and its angular
+  // acceleration (second difference) is smaller, while every frame still keeps its clearance.
+  const Walk& w = delfem2Walk();
+  KeepApartSettings keep;
+  keep.parts = {"LeftForeArm"};
+  keep.margin_m = kMargin;
+  motion::AvatarAnimation smooth = w.animation, sharp = w.animation;
+  const KeepApartReport smoothed = keepBodyApart(w.avatar, smooth, w.fields, keep);
+  keep.smoothing_s = 0;
+  const KeepApartReport unsmoothed = keepBodyApart(w.avatar, sharp, w.fields, keep);
+  const int shoulder = w.avatar.findJoint("LeftArm");
+  ASSERT_GE(shoulder, 0);
+  const std::vector<double> a = correctionAngles(w.animation, smooth, shoulder);
+  const std::vector<double> b = correctionAngles(w.animation, sharp, shoulder);
+  const auto peakAcceleration = [](const std::vector<double>& x) {
+    double most = 0;
+    for (std::size_t f = 1; f + 1 < x.size(); ++f) most = std::max(most, std::abs(x[f + 1] - 2 * x[f] + x[f - 1]));
+    return most;
+  };
+  EXPECT_LT(peakAcceleration(a), 0.6 * peakAcceleration(b));
+  // Wherever the frame-by-frame correction starts, the smoothed one has started already.
+  int onsets = 0;
+  for (std::size_t f = 1; f < b.size(); ++f)
+    if (b[f - 1] < 1e-6 && b[f] > 1e-6) {
+      ++onsets;
+      EXPECT_GT(a[f - 1], 1e-4) << "frame " << f - 1 << ": the smoothed correction starts before it is needed";
+    }
+  EXPECT_GT(onsets, 0);
+  EXPECT_GT(smoothed.framesChanged, unsmoothed.framesChanged);
+  for (const KeptApart& k : smoothed.pairs) EXPECT_LT(k.remaining_m, 2e-4) << describe(k);
+}
+
+TEST(KeepApart, APartThatGoesIntoNothingLeavesTheMotionAsItIs) {
+  const Walk& w = delfem2Walk();
+  motion::AvatarAnimation corrected = w.animation;
+  KeepApartSettings keep;
+  keep.parts = {"Head"};
+  keep.margin_m = kMargin;
+  const KeepApartReport report = keepBodyApart(w.avatar, corrected, w.fields, keep);
+  EXPECT_TRUE(report.pairs.empty());
+  EXPECT_EQ(report.framesChanged, 0);
+  for (std::size_t f = 0; f < corrected.frameCount(); ++f)
+    for (std::size_t j = 0; j < w.avatar.joints.size(); ++j)
+      ASSERT_EQ(corrected.frame(f)[j].rotation.coeffs(), w.animation.frame(f)[j].rotation.coeffs());
+}
+
+TEST(KeepApart, RefusesAnUnknownPartAndTheRoot) {
+  const Walk& w = delfem2Walk();
+  motion::AvatarAnimation corrected = w.animation;
+  KeepApartSettings keep;
+  keep.parts = {"Tail"};
+  try {
+    (void)keepBodyApart(w.avatar, corrected, w.fields, keep);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("has no part 'Tail' (it has: "), std::string::npos) << e.what();
+  }
+  keep.parts = {"Hips"};
+  try {
+    (void)keepBodyApart(w.avatar, corrected, w.fields, keep);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("part 'Hips' moves with the avatar's root joint"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(KeepApart, Describes) {
+  KeptApart k{"LeftForeArm", "LowerBack", "LeftArm", 0.012, 0.0391, 66, 41, 0.00004, 0};
+  EXPECT_EQ(describe(k),
+            "LeftForeArm out of LowerBack about LeftArm: 39.1 mm short of its 12 mm clearance at most, in 41 frames "
+            "(most in frame 66); 0.0 mm after");
+}
+
+}  // namespace
+}  // namespace drape::sim

@@ -89,13 +89,26 @@ std::vector<double> correctionAngles(const motion::AvatarAnimation& before, cons
   return out;
 }
 
-TEST(KeepApart, TheForearmsKeepTheirClearanceFromTheTorsoInEveryFrame) {
-  const Walk& w = delfem2Walk();
-  motion::AvatarAnimation corrected = w.animation;
+/// The walk with both forearms kept apart (swung about the shoulders), and the report.
+struct Corrected {
+  motion::AvatarAnimation animation;
+  KeepApartReport report;
+};
+
+Corrected forearmsKeptApart(const Walk& w) {
+  Corrected c{w.animation, {}};
   KeepApartSettings keep;
   keep.parts = {"LeftForeArm", "RightForeArm"};
   keep.margin_m = kMargin;
-  const KeepApartReport report = keepBodyApart(w.avatar, corrected, w.fields, keep);
+  c.report = keepBodyApart(w.avatar, c.animation, w.fields, keep);
+  return c;
+}
+
+TEST(KeepApart, TheForearmsKeepTheirClearanceFromTheTorsoInEveryFrame) {
+  const Walk& w = delfem2Walk();
+  const Corrected c = forearmsKeptApart(w);
+  const motion::AvatarAnimation& corrected = c.animation;
+  const KeepApartReport& report = c.report;
 
   const std::vector<RigidTransform> rest = restPose(w.avatar);
   double deepestBefore = 0;
@@ -126,11 +139,7 @@ TEST(KeepApart, TheForearmsKeepTheirClearanceFromTheTorsoInEveryFrame) {
 
 TEST(KeepApart, OnlyTheArmsBelowTheShouldersMoveAndTheirBonesKeepTheirLengths) {
   const Walk& w = delfem2Walk();
-  motion::AvatarAnimation corrected = w.animation;
-  KeepApartSettings keep;
-  keep.parts = {"LeftForeArm", "RightForeArm"};
-  keep.margin_m = kMargin;
-  (void)keepBodyApart(w.avatar, corrected, w.fields, keep);
+  const motion::AvatarAnimation corrected = forearmsKeptApart(w).animation;
   int moved = 0;
   for (std::size_t f = 0; f < corrected.frameCount(); ++f)
     for (std::size_t j = 0; j < w.avatar.joints.size(); ++j) {

@@ -278,6 +278,12 @@ void logKeptApart(const sim::KeepApartReport& report, const std::vector<std::str
                fmt::join(parts, ","), report.framesChanged, report.largestAngle_deg, report.seconds,
                report.pairs.empty() ? "no part lacked its clearance" : fmt::format("{} pairs", report.pairs.size()));
   for (const sim::KeptApart& k : report.pairs) spdlog::info("  {}", sim::describe(k));
+  const auto short_ = std::count_if(report.pairs.begin(), report.pairs.end(),
+                                    [](const sim::KeptApart& k) { return k.framesRemaining > 0; });
+  if (short_ > 0)
+    spdlog::warn("--keep-apart: {} of these pairs still lack clearance in some frames: no joint is turned more than "
+                 "{:g} degrees from the captured motion, and a part in line with its joint cannot be turned away",
+                 short_, sim::KeepApartSettings{}.maxTurn_deg);
 }
 
 /// stats.json's keep_apart: what the correction of the motion changed.

@@ -77,6 +77,8 @@ Vec3 gradient(const field::DistanceField& f, const Vec3& p) {
   return n > 0 ? Vec3(g / n) : Vec3::Zero();
 }
 
+double angleOf(const Quat& q) { return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w())); }
+
 /// A moved part and a part it must keep clear of.
 struct Pair {
   int segment = -1;      // the moved part (avatar segment)
@@ -137,28 +139,38 @@ class Solver {
     return p.target_m - std::min(c.distance_m, back.distance_m);
   }
 
-  /// Swings the pivots of frame f until every pair keeps its clearance (or no turn helps),
-  /// composing each turn into `turns` (per pivot, in its parent's frame).
+  /// Swings the pivots of frame f until every pair keeps its clearance, or no turn can help
+  /// a pair (its deepest point in line with the pivot, or the pivot's correction at
+  /// settings.maxTurn_deg), composing each turn into `turns` (per pivot, in its parent's
+  /// frame).
   void solveFrame(motion::AvatarAnimation& animation, std::size_t f, std::vector<std::vector<Quat>>& turns) const {
+    const double maxTurn = settings_.maxTurn_deg * std::numbers::pi / 180.0;
+    std::vector<std::uint8_t> givenUp(pairs_.size(), 0);
     for (int t = 0; t < kTurnsPerFrame; ++t) {
       double worst = kTolerance_m;
-      const Pair* chosen = nullptr;
+      std::size_t chosenIndex = pairs_.size();
       Closest at;
-      for (const Pair& p : pairs_) {
+      for (std::size_t pi = 0; pi < pairs_.size(); ++pi) {
+        if (givenUp[pi]) continue;
         Closest c;
-        const double l = lack(animation, f, p, &c);
+        const double l = lack(animation, f, pairs_[pi], &c);
         if (l > worst) {
           worst = l;
-          chosen = &p;
+          chosenIndex = pi;
           at = c;
         }
       }
-      if (!chosen) return;
+      if (chosenIndex == pairs_.size()) return;
+      const Pair* chosen = &pairs_[chosenIndex];
       const Vec3 pivot = animation.frame(f)[static_cast<std::size_t>(chosen->pivot)].translation;
       const Vec3 axis = (at.point - pivot).cross(at.away);
       const double lever = axis.norm();
-      if (lever < kMinLever_m) return;
-      const double angle = std::min(worst / lever, kMaxTurn_rad);
+      const double room = maxTurn - angleOf(turns[chosen->pivotSlot][f]);
+      if (lever < kMinLever_m || room <= 1e-6) {
+        givenUp[chosenIndex] = 1;
+        continue;
+      }
+      const double angle = std::min({worst / lever, kMaxTurn_rad, room});
       const Quat turn(Eigen::AngleAxisd(angle, axis / lever));
       animation.moveJoints(f, subtrees_[chosen->pivotSlot], {turn, pivot - turn * pivot});
       const Quat parent = parentRotation(animation, f, chosen->pivot);
@@ -247,8 +259,6 @@ class Solver {
   std::vector<int> pivots_;
   std::vector<std::vector<int>> subtrees_;  // per pivot: it and every joint below it
 };
-
-double angleOf(const Quat& q) { return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w())); }
 
 /// Each frame takes the largest turn within `reach` frames of it: smoothed afterwards, a
 /// turn then stays about as large as each frame needed (a plain average would take the
@@ -363,9 +373,10 @@ KeepApartReport keepBodyApart(const scene::Avatar& avatar, motion::AvatarAnimati
 
 std::string describe(const KeptApart& k) {
   return fmt::format("{} out of {} about {}: {:.1f} mm short of its {:.0f} mm clearance at most, in {} frames (most "
-                     "in frame {}); {:.1f} mm after",
-                     k.part, k.from, k.pivot, 1e3 * k.deepest_m, std::round(1e3 * k.target_m) + 0.0, k.frames, k.deepestFrame,
-                     1e3 * k.remaining_m);
+                     "in frame {}); {:.1f} mm after{}",
+                     k.part, k.from, k.pivot, 1e3 * k.deepest_m, std::round(1e3 * k.target_m) + 0.0, k.frames,
+                     k.deepestFrame, 1e3 * k.remaining_m,
+                     k.framesRemaining > 0 ? fmt::format(", in {} frames", k.framesRemaining) : "");
 }
 
 }  // namespace drape::sim

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "drape/core/error.hpp"
 #include "drape/motion/animation.hpp"
@@ -157,8 +158,9 @@ TEST(KeepApart, OnlyTheArmsBelowTheShouldersMoveAndTheirBonesKeepTheirLengths) {
       const double boneBefore = (a.translation - w.animation.frame(f)[static_cast<std::size_t>(p)].translation).norm();
       const double boneAfter = (b.translation - corrected.frame(f)[static_cast<std::size_t>(p)].translation).norm();
       EXPECT_NEAR(boneAfter, boneBefore, 1e-9) << w.avatar.joints[j].name << ", frame " << f;
-      if (w.avatar.joints[j].name == "LeftArm" || w.avatar.joints[j].name == "RightArm")
+      if (w.avatar.joints[j].name == "LeftArm" || w.avatar.joints[j].name == "RightArm") {
         EXPECT_NEAR((a.translation - b.translation).norm(), 0.0, 1e-9);
+      }
     }
   EXPECT_GT(moved, 100);
 }
@@ -195,6 +197,27 @@ TEST(KeepApart, TheCorrectionEasesInAndOut) {
   EXPECT_GT(onsets, 0);
   EXPECT_GT(smoothed.framesChanged, unsmoothed.framesChanged);
   for (const KeptApart& k : smoothed.pairs) EXPECT_LT(k.remaining_m, 2e-4) << describe(k);
+}
+
+TEST(KeepApart, NoJointTurnsFurtherThanTheLimitAndWhatIsLeftShortIsReported) {
+  // The forearms need about 20 degrees at the shoulders on this walk; allowed 5, the
+  // shoulders stop there in every frame and the report says how far each pair stays short.
+  const Walk& w = delfem2Walk();
+  motion::AvatarAnimation corrected = w.animation;
+  KeepApartSettings keep;
+  keep.parts = {"LeftForeArm", "RightForeArm"};
+  keep.margin_m = kMargin;
+  keep.maxTurn_deg = 5;
+  const KeepApartReport report = keepBodyApart(w.avatar, corrected, w.fields, keep);
+  EXPECT_LE(report.largestAngle_deg, 5.0 + 1e-6);
+  for (const char* shoulder : {"LeftArm", "RightArm"})
+    for (const double a : correctionAngles(w.animation, corrected, w.avatar.findJoint(shoulder)))
+      ASSERT_LE(a, 5.0 * std::numbers::pi / 180.0 + 1e-9) << shoulder;
+  ASSERT_FALSE(report.pairs.empty());
+  const KeptApart& deepest = report.pairs.front();
+  EXPECT_GT(deepest.remaining_m, 0.005) << describe(deepest);
+  EXPECT_LT(deepest.remaining_m, deepest.deepest_m) << describe(deepest);
+  EXPECT_GT(deepest.framesRemaining, 0);
 }
 
 TEST(KeepApart, APartThatGoesIntoNothingLeavesTheMotionAsItIs) {
@@ -237,6 +260,11 @@ TEST(KeepApart, Describes) {
   EXPECT_EQ(describe(k),
             "LeftForeArm out of LowerBack about LeftArm: 39.1 mm short of its 12 mm clearance at most, in 41 frames "
             "(most in frame 66); 0.0 mm after");
+  k.remaining_m = 0.0154;
+  k.framesRemaining = 120;
+  EXPECT_EQ(describe(k),
+            "LeftForeArm out of LowerBack about LeftArm: 39.1 mm short of its 12 mm clearance at most, in 41 frames "
+            "(most in frame 66); 15.4 mm after, in 120 frames");
 }
 
 }  // namespace

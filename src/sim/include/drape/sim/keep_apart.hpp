@@ -18,11 +18,12 @@
 // frame needed. A last solve, not smoothed, mends what the blend left short, so every
 // frame keeps the margin where the field can say so.
 //
-// What it does not do: it moves no part that carries the body's weight (it moves only the
-// parts named), it does not keep the legs apart (thighs of a segmented body press into each
-// other on every walk, as real ones do, and spreading them would move the feet), and it
-// does not search over joints: a limb the joint above cannot swing out (its deepest vertex
-// in line with the joint and the gradient) is left where it is and reported.
+// What it does not do: it moves only the parts named (the walking dress names the arms; its
+// thighs press into each other on every walk, as real ones do, and spreading them would
+// move the feet), it turns no joint by more than maxTurn_deg from the captured motion, and
+// it does not search over joints: a limb the joint above cannot swing out (its deepest
+// vertex in line with the joint and the gradient) is left where it is; what is left short
+// is reported.
 
 #include <string>
 #include <vector>
@@ -44,6 +45,10 @@ struct KeepApartSettings {
   double margin_m = 0;
   /// Gaussian time constant (sigma, s) the corrections are smoothed with.
   double smoothing_s = 0.1;
+  /// The most a joint is turned from the captured motion (degrees): a part that would need
+  /// more is left short of its clearance and reported, rather than swung into a pose the
+  /// performer never took.
+  double maxTurn_deg = 30;
 };
 
 /// One moved part and a part it went into.

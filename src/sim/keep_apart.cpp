@@ -87,6 +87,7 @@ struct Pair {
   std::size_t pivotSlot = 0;
   double target_m = 0;   // clearance to keep
   int ownField = -1;     // the moved part's own field, if it collides
+  int intoSegment = -1;  // the other part's segment (its vertices, for the reverse read)
   Aabb box;              // the moved part's bounds in its joint frame
   Aabb intoBox;          // the other part's body bounds in its joint frame
 };
@@ -127,7 +128,7 @@ class Solver {
     const Clearance c = clearance(seg.mesh, a, into.field, b);
     Clearance back;
     if (p.ownField >= 0) {
-      const scene::Segment& other = avatar_.segments[static_cast<std::size_t>(avatar_.findSegment(into.segment))];
+      const scene::Segment& other = avatar_.segments[static_cast<std::size_t>(p.intoSegment)];
       back = clearance(other.mesh, b, fields_[static_cast<std::size_t>(p.ownField)].field, a);
     }
     if (where) {
@@ -230,9 +231,11 @@ class Solver {
       p.pivotSlot = slotOf(pivot);
       p.box = box;
       p.intoBox = fields_[k].field.bodyBounds();
+      p.intoSegment = avatar_.findSegment(fields_[k].segment);
       for (std::size_t own = 0; own < fields_.size(); ++own)
         if (fields_[own].segment == name) p.ownField = static_cast<int>(own);
-      // At rest: the pair keeps the margin, or what it has there if less.
+      // At rest: the pair keeps the margin, or what it has there if less (lack() reads the
+      // margin for its box test).
       p.target_m = settings_.margin_m;
       p.target_m = std::min(settings_.margin_m, settings_.margin_m - lack(rest, p));
       pairs_.push_back(p);

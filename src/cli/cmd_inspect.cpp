@@ -47,6 +47,9 @@ void inspectBodyOverlaps(const std::string& scenePath, const std::string& motion
                   "rest, deeper than a voxel): {}\n",
              setup.frames, motionPath, found.empty() ? "none" : std::to_string(found.size()));
   for (const sim::BodyOverlap& o : found) fmt::print(out, "  {}\n", sim::describe(o));
+  if (!found.empty() && setup.character->keepApart.empty())
+    fmt::print(out, "cloth caught between such parts has no place; `drape run --keep-apart PARTS` (or the scene's "
+                    "Simulation keepApart) turns the parts named out of the others before simulating\n");
 }
 
 RunFunction setupInspect(CLI::App& app) {

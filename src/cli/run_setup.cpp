@@ -353,8 +353,11 @@ std::vector<sim::BodyOverlap> findOverlaps(const RunSetup& setup, const sim::Cha
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!found.empty())
     spdlog::info("the motion puts collidable parts of the body inside each other beyond their overlap at rest, {} "
-                 "pairs (stats.json: body_overlaps; found in {:.2f} s); deepest: {}",
-                 found.size(), seconds, sim::describe(found.front()));
+                 "pairs (stats.json: body_overlaps; found in {:.2f} s); deepest: {}{}",
+                 found.size(), seconds, sim::describe(found.front()),
+                 setup.character->keepApart.empty()
+                     ? " (--keep-apart PARTS turns named parts out of the others before simulating)"
+                     : "");
   return found;
 }
 

@@ -143,6 +143,9 @@ TEST(WalkingDress, InspectListsWhereTheMotionPutsTheBodyInsideItself) {
   EXPECT_NE(r.out.find("body overlaps over 115 frames with "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("  LeftForeArm goes up to "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find(" mm into LowerBack (frames "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("`drape run --keep-apart PARTS` (or the scene's Simulation keepApart) turns the parts named"),
+            std::string::npos)
+      << r.out;
 
   // ... and as the scene plays it, the arms kept out of the body: the thighs still press
   // into each other (the scene does not move the legs), the arms no longer go anywhere.
@@ -158,6 +161,7 @@ TEST(WalkingDress, InspectListsWhereTheMotionPutsTheBodyInsideItself) {
       << kept.err;
   EXPECT_NE(kept.err.find("  LeftForeArm out of LowerBack about LeftArm: "), std::string::npos) << kept.err;
   EXPECT_NE(kept.out.find("  RightUpLeg goes up to "), std::string::npos) << kept.out;
+  EXPECT_EQ(kept.out.find("--keep-apart PARTS"), std::string::npos) << kept.out;
   for (const char* arm : {"  LeftForeArm goes", "  RightForeArm goes", "  LeftArm goes", "  RightArm goes",
                           "into LeftForeArm", "into RightForeArm", "into LeftArm", "into RightArm"})
     EXPECT_EQ(kept.out.find(arm), std::string::npos) << arm << "\n" << kept.out;

@@ -5,25 +5,6 @@
 #include <fmt/format.h>
 
 namespace drape::sim {
-namespace {
-
-/// The world box of a part's body at `pose` (its rest bounds' corners, moved).
-Aabb worldBounds(const field::DistanceField& f, const RigidTransform& pose) {
-  const Aabb& b = f.bodyBounds();
-  Aabb out;
-  for (int corner = 0; corner < 8; ++corner) {
-    const Vec3 c((corner & 1) ? b.max.x() : b.min.x(), (corner & 2) ? b.max.y() : b.min.y(),
-                 (corner & 4) ? b.max.z() : b.min.z());
-    out.extend(pose.apply(c));
-  }
-  return out;
-}
-
-bool overlaps(const Aabb& a, const Aabb& b) {
-  return (a.min.array() <= b.max.array()).all() && (b.min.array() <= a.max.array()).all();
-}
-
-}  // namespace
 
 double overlapDepth(const mesh::TriMesh& surface, const RigidTransform& pose, const PartField& into,
                     const RigidTransform& intoPose) {
@@ -76,10 +57,10 @@ std::vector<BodyOverlap> findBodyOverlaps(const scene::Avatar& avatar, const Ava
     const double t = static_cast<double>(frame) / frameRate_hz;
     for (std::size_t k = 0; k < n; ++k) {
       pose[k] = poses.jointAt(t, fields[k].joint);
-      box[k] = worldBounds(fields[k].field, pose[k]);
+      box[k] = moved(fields[k].field.bodyBounds(), pose[k]);
     }
     for (Pair& p : pairs) {
-      if (!overlaps(box[p.a], box[p.b])) continue;
+      if (!box[p.a].overlaps(box[p.b])) continue;
       const double beyond = overlapDepth(surfaceOf(p.a), pose[p.a], fields[p.b], pose[p.b]) - p.rest_m;
       if (beyond <= 0) continue;
       BodyOverlap& o = p.found;

@@ -26,24 +26,6 @@ bool isAncestorOrSelf(const scene::Avatar& avatar, int above, int j) {
   return false;
 }
 
-Aabb boundsOf(const mesh::TriMesh& mesh) {
-  Aabb b;
-  for (const Vec3& p : mesh.positions) b.extend(p);
-  return b;
-}
-
-Aabb moved(const Aabb& b, const RigidTransform& pose) {
-  Aabb out;
-  for (int corner = 0; corner < 8; ++corner)
-    out.extend(pose.apply(Vec3((corner & 1) ? b.max.x() : b.min.x(), (corner & 2) ? b.max.y() : b.min.y(),
-                               (corner & 4) ? b.max.z() : b.min.z())));
-  return out;
-}
-
-bool near(const Aabb& a, const Aabb& b, double gap) {
-  return (a.min.array() <= b.max.array() + gap).all() && (b.min.array() <= a.max.array() + gap).all();
-}
-
 /// The least distance of a surface's vertices from a part (read from its field, vertices
 /// in its grid only) and the vertex where it is least, in the part's frame.
 struct Clearance {
@@ -124,7 +106,7 @@ class Solver {
     const PartField& into = fields_[p.into];
     const RigidTransform& a = pose[static_cast<std::size_t>(seg.joint)];
     const RigidTransform& b = pose[static_cast<std::size_t>(into.joint)];
-    if (!near(moved(p.box, a), moved(p.intoBox, b), p.target_m)) return -std::numeric_limits<double>::infinity();
+    if (!moved(p.box, a).overlaps(moved(p.intoBox, b), p.target_m)) return -std::numeric_limits<double>::infinity();
     const Clearance c = clearance(seg.mesh, a, into.field, b);
     Clearance back;
     if (p.ownField >= 0) {
@@ -214,7 +196,7 @@ class Solver {
       throw Error(fmt::format("keep apart: part '{}' moves with the avatar's root joint '{}', which has no joint above "
                               "it to swing it about",
                               name, avatar_.joints[static_cast<std::size_t>(joint)].name));
-    const Aabb box = boundsOf(seg.mesh);
+    const Aabb box = seg.mesh.bounds();
     std::vector<RigidTransform> rest;
     for (const scene::Joint& j : avatar_.joints) rest.push_back(j.restWorld());
     for (std::size_t k = 0; k < fields_.size(); ++k) {

@@ -29,6 +29,10 @@ struct Aabb {
   [[nodiscard]] bool contains(const Vec3& p) const {
     return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
   }
+  /// Whether the boxes overlap, or come within `gap` of each other.
+  [[nodiscard]] bool overlaps(const Aabb& o, double gap = 0) const {
+    return (min.array() <= o.max.array() + gap).all() && (o.min.array() <= max.array() + gap).all();
+  }
 };
 
 /// A rigid transform x -> rotation * x + translation (no scale): a body part's pose,
@@ -49,5 +53,14 @@ struct RigidTransform {
     return {(rotation * b.rotation).normalized(), rotation * b.translation + translation};
   }
 };
+
+/// The axis-aligned box around `b`'s corners moved by `pose`.
+[[nodiscard]] inline Aabb moved(const Aabb& b, const RigidTransform& pose) {
+  Aabb out;
+  for (int corner = 0; corner < 8; ++corner)
+    out.extend(pose.apply(Vec3((corner & 1) ? b.max.x() : b.min.x(), (corner & 2) ? b.max.y() : b.min.y(),
+                               (corner & 4) ? b.max.z() : b.min.z())));
+  return out;
+}
 
 }  // namespace drape

@@ -64,8 +64,8 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
   if (o.bendEvery > 0) setup.settings.bendEvery = o.bendEvery;
   if (o.faceSamplesWith)
     for (GarmentSetup& g : setup.garments) g.faceSamplesWith = *o.faceSamplesWith;
+  if (o.keepApart) setKeepApart(*setup.character, *o.keepApart);
   addMotion(setup, o.motion);
-  if (o.keepApart) setup.character->keepApart = keepApartParts(*o.keepApart);
   const std::unique_ptr<sim::CharacterWorld> worldPtr = buildWorld(setup);
   sim::CharacterWorld& world = *worldPtr;
   for (std::size_t g = 0; g < world.garmentCount(); ++g) {

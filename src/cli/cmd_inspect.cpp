@@ -35,11 +35,7 @@ void inspectBodyOverlaps(const std::string& scenePath, const std::string& motion
   RunSetup setup = runSetupFromScene(scenePath);
   if (!setup.character) throw Error(fmt::format("--motion: {} has no avatar to move", scenePath));
   addMotion(setup, motionPath);
-  if (!keepApart.empty()) {
-    setup.character->keepApart = keepApartParts(keepApart);
-    if (const std::string bad = unknownKeepApartPart(*setup.character); !bad.empty())
-      throw Error("--keep-apart: " + bad);
-  }
+  if (!keepApart.empty()) setKeepApart(*setup.character, keepApart);
   setup.frames = defaultFrames(setup);
   const std::unique_ptr<sim::CharacterWorld> world = buildWorld(setup);
   const std::vector<sim::BodyOverlap> found = bodyOverlaps(setup, *world);

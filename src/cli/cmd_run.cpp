@@ -227,10 +227,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     ch.fieldMethod = o.fieldMethod == "exact" ? field::FieldMethod::Exact : field::FieldMethod::Dvdp;
     if (!(o.leadIn_s >= 0)) throw Error(fmt::format("--lead-in must be >= 0 s, got {}", o.leadIn_s));
     ch.leadIn_s = o.leadIn_s;
-    if (app.count("--keep-apart")) {
-      ch.keepApart = keepApartParts(o.keepApart);
-      if (const std::string bad = unknownKeepApartPart(ch); !bad.empty()) throw Error("--keep-apart: " + bad);
-    }
+    if (app.count("--keep-apart")) setKeepApart(ch, o.keepApart);
     if (!o.motion.empty()) addMotion(setup, o.motion, o.motionScale, o.jointMap);
   }
 

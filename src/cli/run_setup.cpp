@@ -272,10 +272,10 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
 namespace {
 
 /// What --keep-apart changed in the motion: one line, and one per pair it moved.
-void logKeptApart(const sim::KeepApartReport& report, const std::vector<std::string>& parts) {
-  if (parts.empty()) return;
+void logKeptApart(const sim::KeepApartReport& report) {
+  if (report.parts.empty()) return;
   spdlog::info("--keep-apart {}: the motion corrected in {} frames, turned by up to {:.1f} degrees, in {:.2f} s; {}",
-               fmt::join(parts, ","), report.framesChanged, report.largestAngle_deg, report.seconds,
+               fmt::join(report.parts, ","), report.framesChanged, report.largestAngle_deg, report.seconds,
                report.pairs.empty() ? "no part lacked its clearance" : fmt::format("{} pairs", report.pairs.size()));
   for (const sim::KeptApart& k : report.pairs) spdlog::info("  {}", sim::describe(k));
   const auto short_ = std::count_if(report.pairs.begin(), report.pairs.end(),
@@ -283,7 +283,7 @@ void logKeptApart(const sim::KeepApartReport& report, const std::vector<std::str
   if (short_ > 0)
     spdlog::warn("--keep-apart: {} of these pairs still lack clearance in some frames: no joint is turned more than "
                  "{:g} degrees from the captured motion, and a part in line with its joint cannot be turned away",
-                 short_, sim::KeepApartSettings{}.maxTurn_deg);
+                 short_, report.maxTurn_deg);
 }
 
 /// stats.json's keep_apart: what the correction of the motion changed.
@@ -318,7 +318,7 @@ std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup) {
   auto world = std::make_unique<sim::CharacterWorld>(*setup.character->avatar, setup.character->animation.get(),
                                                      setup.garments, ws);
   spdlog::info("{} distance fields in {:.2f} s", world->fields().size(), world->fieldBuild_s());
-  logKeptApart(world->keepApartReport(), ws.keepApart.parts);
+  logKeptApart(world->keepApartReport());
   return world;
 }
 
@@ -336,6 +336,11 @@ std::vector<std::string> keepApartParts(const std::vector<std::string>& option) 
   for (const std::string& part : option)
     if (part == "none") throw Error("--keep-apart: 'none' stands alone (no parts), not in a list");
   return option;
+}
+
+void setKeepApart(CharacterSetup& character, const std::vector<std::string>& option) {
+  character.keepApart = keepApartParts(option);
+  if (const std::string bad = unknownKeepApartPart(character); !bad.empty()) throw Error("--keep-apart: " + bad);
 }
 
 std::vector<sim::BodyOverlap> bodyOverlaps(const RunSetup& setup, const sim::CharacterWorld& world) {

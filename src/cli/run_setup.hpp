@@ -76,6 +76,10 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
 /// The parts --keep-apart names: the list, or none for 'none' (which overrides a scene's).
 [[nodiscard]] std::vector<std::string> keepApartParts(const std::vector<std::string>& option);
 
+/// --keep-apart given: the character keeps those parts apart instead of the scene's. Throws
+/// "--keep-apart: ..." for a part its avatar does not have, before any field is built.
+void setKeepApart(CharacterSetup& character, const std::vector<std::string>& option);
+
 /// "avatar 'A' has no part 'P' (it has: ...)" for a keepApart part the character's avatar
 /// does not have; "" when it has them all.
 [[nodiscard]] std::string unknownKeepApartPart(const CharacterSetup& character);

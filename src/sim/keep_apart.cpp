@@ -310,6 +310,7 @@ KeepApartReport keepBodyApart(const scene::Avatar& avatar, motion::AvatarAnimati
                               const std::vector<PartField>& fields, const KeepApartSettings& settings) {
   KeepApartReport report;
   report.parts = settings.parts;
+  report.maxTurn_deg = settings.maxTurn_deg;
   if (settings.parts.empty()) return report;
   const auto start = std::chrono::steady_clock::now();
   const Solver solver(avatar, fields, settings);

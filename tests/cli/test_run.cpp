@@ -253,6 +253,11 @@ TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
     const testing::CliResult bad = testing::runDrape(std::string("bench paper --json ") + option, dir);
     EXPECT_NE(bad.code, 0) << option;
   }
+  // --keep-apart names parts of the scene's avatar, checked before any field is built.
+  const testing::CliResult tail = testing::runDrape("bench paper --json --keep-apart LeftForeArm,Tail", dir);
+  EXPECT_EQ(tail.code, 2) << tail.err;
+  EXPECT_NE(tail.err.find("--keep-apart: avatar '"), std::string::npos) << tail.err;
+  EXPECT_EQ(tail.err.find("distance fields in"), std::string::npos) << tail.err;
 }
 
 }  // namespace

@@ -66,6 +66,7 @@ struct KeptApart {
 
 struct KeepApartReport {
   std::vector<std::string> parts;  ///< the parts asked for
+  double maxTurn_deg = 0;          ///< the limit the turns were held to
   std::vector<KeptApart> pairs;  ///< pairs that lacked clearance in some frame, deepest first
   double largestAngle_deg = 0;   ///< the largest correction of any joint in any frame
   long framesChanged = 0;        ///< motion frames with any correction

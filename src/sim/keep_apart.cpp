@@ -320,11 +320,12 @@ KeepApartReport keepBodyApart(const scene::Avatar& avatar, motion::AvatarAnimati
   const motion::AvatarAnimation original = animation;
   std::vector<std::vector<Quat>> turns(solver.pivotCount(), std::vector<Quat>(animation.frameCount(), Quat::Identity()));
   for (int solve = 0; solve < kSolves; ++solve) {
-    motion::AvatarAnimation current = solver.apply(original, turns);
-    for (std::size_t f = 0; f < current.frameCount(); ++f) solver.solveFrame(current, f, turns);
+    // Each solve turns the joints of its copy as it records the turns: the last copy is the
+    // corrected motion.
+    animation = solver.apply(original, turns);
+    for (std::size_t f = 0; f < animation.frameCount(); ++f) solver.solveFrame(animation, f, turns);
     if (solve + 1 < kSolves) smooth(turns, settings.smoothing_s * animation.rate());
   }
-  animation = solver.apply(original, turns);
 
   const std::vector<Lack> after = measure(solver, animation, 0.1 * voxel);
   for (std::size_t i = 0; i < before.size(); ++i) {

@@ -13,6 +13,7 @@
 #include "drape/render/follow.hpp"
 #include "drape/render/player.hpp"
 #include "drape/render/run_replay.hpp"
+#include "drape/sim/body_skin.hpp"
 #include "drape/sim/character_world.hpp"
 #include "render_options.hpp"
 #include "run_setup.hpp"
@@ -49,7 +50,11 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
   }
   for (const scene::Segment& seg : avatar->segments)
     meshes.push_back({seg.name, render::MeshRole::Segment, seg.mesh.vertexCount(), seg.mesh.triangles});
+  if (avatar->skin)
+    meshes.push_back({"body", render::MeshRole::Skin, avatar->skin->mesh.vertexCount(), avatar->skin->mesh.triangles});
 
+  std::unique_ptr<sim::BodySkin> skin;
+  if (avatar->skin) skin = std::make_unique<sim::BodySkin>(*avatar, world.fields(), leastT0(world));
   std::vector<RigidTransform> joints(avatar->joints.size());
   long frame = 0;
   render::CallbackSource source(meshes, step.frameRate_hz, [&](render::Frame& out) {
@@ -71,6 +76,7 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
       p.clear();
       for (const Vec3& v : seg.mesh.positions) p.push_back(joints[static_cast<std::size_t>(seg.joint)].apply(v));
     }
+    if (skin) skin->pose(joints, out.positions.back());
     ++frame;
     return true;
   });

@@ -24,6 +24,7 @@ struct PictureOptions {
   bool offsetSurfaces = false;
   bool distanceSlice = false;
   bool markers = false;
+  bool segments = false;
 
   void add(CLI::App& app) {
     app.add_option("--size", size, "Picture size WIDTHxHEIGHT in pixels")->capture_default_str();
@@ -40,6 +41,8 @@ struct PictureOptions {
     app.add_flag("--offset-surfaces", offsetSurfaces, "Draw the body parts' offset surfaces T1-T3");
     app.add_flag("--distance-slice", distanceSlice, "Draw a distance slice through the first body part");
     app.add_flag("--markers", markers, "Mark pinned and bound garment vertices");
+    app.add_flag("--segments", segments,
+                 "Draw the avatar as the rigid segments the cloth collides with instead of its skinned body");
   }
 
   /// WIDTHxHEIGHT; throws drape::Error naming --size otherwise.
@@ -73,6 +76,7 @@ struct PictureOptions {
     o.offsetSurfaces = offsetSurfaces;
     o.distanceSlice = distanceSlice;
     o.markers = markers;
+    o.segments = segments;
     return o;
   }
 };

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <array>
 #include <fstream>
+#include <limits>
 #include <span>
 
 #include <fmt/format.h>
@@ -28,6 +29,7 @@
 #include "drape/render/outputs.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/body_overlap.hpp"
+#include "drape/sim/body_skin.hpp"
 #include "drape/sim/scene_setup.hpp"
 #include "measure.hpp"
 
@@ -228,6 +230,13 @@ void writeResultFiles(const RunSetup& setup, const std::vector<GarmentRun>& runs
 }
 
 }  // namespace
+
+double leastT0(const sim::CharacterWorld& world) {
+  double t0 = std::numeric_limits<double>::infinity();
+  for (std::size_t g = 0; g < world.garmentCount(); ++g)
+    if (const cloth::FieldCollider* c = world.collider(g)) t0 = std::min(t0, c->offsets().t0_m);
+  return std::isfinite(t0) ? t0 : 0.0;
+}
 
 RunSetup runSetupFromScene(const std::string& scenePath) {
   const scene::Scene sc = scene::loadScene(scenePath);
@@ -512,6 +521,9 @@ int simulateRun(const RunSetup& setup) {
   std::vector<SegmentRun> segments;
   std::vector<RigidTransform> joints;
   std::vector<std::vector<RigidTransform>> jointFrames;  // per joint, per frame (result.wrl)
+  std::unique_ptr<sim::BodySkin> skin;                   // the skinned body, when the avatar has one
+  std::unique_ptr<formats::Pc2Writer> skinCache;
+  std::vector<Vec3> skinPositions;
   if (setup.character) {
     const scene::Avatar& avatar = *setup.character->avatar;
     joints.resize(avatar.joints.size());
@@ -519,6 +531,16 @@ int simulateRun(const RunSetup& setup) {
     world->poses().evaluate(0.0, joints);
     std::error_code ec;
     fs::create_directories(out / "segments", ec);
+    if (avatar.skin) {
+      // The skinned body, which players draw instead of the segments (the collision's own
+      // bodies, still written for the overlays and exporters).
+      skin = std::make_unique<sim::BodySkin>(avatar, world->fields(), leastT0(*world));
+      skin->pose(joints, skinPositions);
+      formats::writeObj((out / "body.obj").string(), skinPositions, avatar.skin->mesh.triangles,
+                        "drape run: the avatar's skinned body (m)");
+      skinCache = std::make_unique<formats::Pc2Writer>((out / "body.pc2").string(), skinPositions.size(), 0.0, 1.0);
+      manifest.meshes.push_back({"body", "skin", "body.obj", "body.pc2", ""});
+    }
     for (const scene::Segment& seg : avatar.segments) {
       SegmentRun sr;
       sr.name = seg.name;
@@ -572,6 +594,10 @@ int simulateRun(const RunSetup& setup) {
         for (const Vec3& p : sr.mesh->positions) positions.push_back(pose.apply(p));
         sr.cache->writeFrame(positions);
       }
+      if (skinCache) {
+        skin->pose(joints, skinPositions);
+        skinCache->writeFrame(skinPositions);
+      }
     }
     outputSeconds += std::chrono::duration<double>(Clock::now() - start).count();
   };
@@ -605,6 +631,7 @@ int simulateRun(const RunSetup& setup) {
     r.states->close();
   }
   for (SegmentRun& sr : segments) sr.cache->close();
+  if (skinCache) skinCache->close();
   manifest.frames = done + 1;
   formats::writeRunManifest(setup.outDir, manifest);
   writeResultFiles(setup, runs, segments, jointFrames);

@@ -72,6 +72,9 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
 /// The character's world of a setup with an avatar: fields built, masks bound, solvers
 /// ready. Used by `drape run`, `drape play SCENE` and `drape bench paper` alike.
 [[nodiscard]] std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup);
+/// The least T0 of the world's garments: how far the drawn skin may stand out of the body
+/// parts (sim::BodySkin).
+[[nodiscard]] double leastT0(const sim::CharacterWorld& world);
 
 /// The parts --keep-apart names: the list, or none for 'none' (which overrides a scene's).
 [[nodiscard]] std::vector<std::string> keepApartParts(const std::vector<std::string>& option);

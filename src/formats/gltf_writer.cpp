@@ -327,6 +327,9 @@ RunExportSummary exportRunToGlb(const std::string& runDirectory, const std::stri
   RunExportSummary summary;
   summary.frames = manifest.frames;
   for (const RunMesh& rm : manifest.meshes) {
+    // The skinned body is drawn by players; the file carries the body as its segments,
+    // rigid nodes a few kilobytes each, where the skin would be a morph target per frame.
+    if (rm.role == "skin") continue;
     const std::string objPath = (dir / rm.topology).string();
     const std::string pc2Path = (dir / rm.cache).string();
     mesh::TriMesh topology = readObj(objPath);
@@ -341,7 +344,7 @@ RunExportSummary exportRunToGlb(const std::string& runDirectory, const std::stri
     }
     cache.frames.resize(static_cast<std::size_t>(manifest.frames));
     if (rm.role != "garment" && rm.role != "segment") {
-      throw Error(fmt::format("{}: mesh '{}' has role '{}' (expected garment or segment)",
+      throw Error(fmt::format("{}: mesh '{}' has role '{}' (expected garment, segment or skin)",
                               (dir / "manifest.json").string(), rm.name, rm.role));
     }
 

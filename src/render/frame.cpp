@@ -9,7 +9,8 @@ namespace drape::render {
 MeshRole parseMeshRole(const std::string& role) {
   if (role == "garment") return MeshRole::Garment;
   if (role == "segment") return MeshRole::Segment;
-  throw Error(fmt::format("mesh role '{}' is not one of: garment, segment", role));
+  if (role == "skin") return MeshRole::Skin;
+  throw Error(fmt::format("mesh role '{}' is not one of: garment, segment, skin", role));
 }
 
 Aabb frameBounds(const Frame& frame) {

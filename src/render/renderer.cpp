@@ -445,7 +445,25 @@ struct Renderer::Impl {
 
   /// Planar shadows: every mesh flattened onto the floor along the light, blended once per
   /// pixel (the stencil goes from 1 to 2 on the first hit) so overlaps do not darken twice.
-  void drawShadows(const Mat4& viewProj, const CameraMatrices& cam, const V3& light, float floorY) {
+  /// Whether mesh m is drawn: the skinned body, or the segments when the run has no skin
+  /// or the overlay asks for them.
+  bool drawn(std::size_t m, const OverlaySettings& overlay) const {
+    switch (meshes[m].role) {
+      case MeshRole::Garment:
+        return true;
+      case MeshRole::Skin:
+        return !overlay.segments;
+      case MeshRole::Segment:
+        return overlay.segments || !hasSkin();
+    }
+    return true;
+  }
+  bool hasSkin() const {
+    return std::any_of(meshes.begin(), meshes.end(), [](const MeshInfo& m) { return m.role == MeshRole::Skin; });
+  }
+
+  void drawShadows(const Mat4& viewProj, const CameraMatrices& cam, const V3& light, float floorY,
+                   const OverlaySettings& overlay) {
     setMeshUniforms(viewProj, planarShadow(light, floorY + 1e-4f), cam, light);
     glUniform1i(glGetUniformLocation(meshProgram, "uMode"), 1);
     glUniform3f(glGetUniformLocation(meshProgram, "uColour"), 0.05f, 0.06f, 0.08f);
@@ -459,9 +477,10 @@ struct Renderer::Impl {
     glDepthMask(GL_FALSE);
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(-1.0f, -1.0f);
-    for (const GpuMesh& g : gpu) {
-      glBindVertexArray(g.vao);
-      glDrawElements(GL_TRIANGLES, g.indexCount, GL_UNSIGNED_INT, nullptr);
+    for (std::size_t m = 0; m < gpu.size(); ++m) {
+      if (!drawn(m, overlay)) continue;
+      glBindVertexArray(gpu[m].vao);
+      glDrawElements(GL_TRIANGLES, gpu[m].indexCount, GL_UNSIGNED_INT, nullptr);
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
     glDepthMask(GL_TRUE);
@@ -474,6 +493,7 @@ struct Renderer::Impl {
     glUniform1i(glGetUniformLocation(meshProgram, "uMode"), 0);
     glUniform1f(glGetUniformLocation(meshProgram, "uAlpha"), 1.0f);
     for (std::size_t m = 0; m < gpu.size(); ++m) {
+      if (!drawn(m, overlay)) continue;
       const bool garment = meshes[m].role == MeshRole::Garment;
       const V3 colour = srgbToLinear(garment ? kGarmentSrgb : kSegmentSrgb);
       glUniform3fv(glGetUniformLocation(meshProgram, "uColour"), 1, colour.data());
@@ -698,7 +718,7 @@ void Renderer::draw(int width, int height, const ViewSettings& view, const Overl
 
   s.drawBackground(height);                                  // sky gradient
   if (overlay.floor) s.drawFloor(viewProj, bounds, floorY);  // grid, marks stencil
-  if (overlay.floor && overlay.shadows) s.drawShadows(viewProj, cam, light, floorY);
+  if (overlay.floor && overlay.shadows) s.drawShadows(viewProj, cam, light, floorY, overlay);
   s.drawMeshes(viewProj, cam, light, overlay);                                      // bodies and cloth
   if (overlay.markers) s.drawMarkers(viewProj, height);                             // pinned / bound
   if (overlay.distanceSlice) s.drawDistanceSlice(viewProj, overlay);                // field slice

@@ -6,12 +6,14 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
+#include "drape/formats/obj.hpp"
 #include "drape/formats/pc2.hpp"
 #include "drape/formats/run_manifest.hpp"
 #include "drape/formats/state_cache.hpp"
@@ -165,6 +167,19 @@ TEST(RunScene, WalkingSkirtWritesEverything) {
   std::size_t segments = 0;
   for (const auto& m : manifest.meshes) segments += m.role == "segment";
   EXPECT_EQ(segments, 31u);
+  // The skinned body players draw: the MakeHuman mesh, one sample per frame, moving.
+  const auto skin = std::find_if(manifest.meshes.begin(), manifest.meshes.end(),
+                                 [](const formats::RunMesh& m) { return m.role == "skin"; });
+  ASSERT_NE(skin, manifest.meshes.end());
+  EXPECT_EQ(skin->topology, "body.obj");
+  const formats::Pc2Cache body = formats::readPc2(out + "/" + skin->cache);
+  ASSERT_EQ(body.frames.size(), 16u);
+  EXPECT_EQ(body.pointCount, formats::readObj(out + "/body.obj").vertexCount());
+  EXPECT_GT(body.pointCount, 10000u);
+  double moved = 0.0;
+  for (std::size_t v = 0; v < body.pointCount; ++v)
+    moved = std::max(moved, (body.frames.back()[v] - body.frames.front()[v]).norm());
+  EXPECT_GT(moved, 0.05);
 
   // The skirt's vertex states: one frame per cache frame, its waist bound to the body
   // (0x08) from the first frame, and points on the collision surface (2) once it walks.

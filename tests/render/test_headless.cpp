@@ -226,6 +226,50 @@ TEST_F(Headless, FloorAndShadowsLieBelowTheContent) {
   EXPECT_GT(changedBelow, kW * 5);
 }
 
+/// A square facing the camera (+Z), side `size`, centred at `centre`.
+std::pair<MeshInfo, std::vector<Vec3>> square(const std::string& name, MeshRole role, const Vec3& centre, double size) {
+  const double h = 0.5 * size;
+  return {MeshInfo{name, role, 4, {{0, 1, 2}, {0, 2, 3}}},
+          {centre + Vec3(-h, -h, 0), centre + Vec3(h, -h, 0), centre + Vec3(h, h, 0), centre + Vec3(-h, h, 0)}};
+}
+
+TEST(HeadlessBody, TheSkinIsDrawnInsteadOfTheSegmentsUnlessTheyAreAskedFor) {
+  // A segment on the left, the skin on the right: which one shows?
+  const auto [segment, segmentAt] = square("LeftUpLeg", MeshRole::Segment, Vec3(-0.3, 0, 0), 0.3);
+  const auto [skin, skinAt] = square("body", MeshRole::Skin, Vec3(0.3, 0, 0), 0.3);
+  HeadlessRenderer renderer({segment, skin}, kW, kH);
+  Frame f;
+  f.positions = {segmentAt, skinAt};
+  f.states = {{}, {}};
+  ViewSettings view;
+  view.azimuthDeg = 0.0;
+  view.elevationDeg = 0.0;
+  OverlaySettings overlay;
+  overlay.floor = false;
+  const Image drawnSkin = renderer.render(f, view, overlay);
+  overlay.segments = true;
+  const Image drawnSegments = renderer.render(f, view, overlay);
+  const CameraMatrices cam = renderer.renderer().camera(kW, kH, view);
+  const Box left = projectedBox(cam, segmentAt), right = projectedBox(cam, skinAt);
+  const auto centre = [](const Box& b) { return std::pair{(b.x0 + b.x1) / 2, (b.y0 + b.y1) / 2}; };
+  const auto [lx, ly] = centre(left);
+  const auto [rx, ry] = centre(right);
+  EXPECT_TRUE(isBackground(drawnSkin, lx, ly)) << "the segment is drawn beside the skin";
+  EXPECT_FALSE(isBackground(drawnSkin, rx, ry)) << "the skin is not drawn";
+  EXPECT_FALSE(isBackground(drawnSegments, lx, ly)) << "asked for, the segment is not drawn";
+  EXPECT_TRUE(isBackground(drawnSegments, rx, ry)) << "the skin is drawn with the segments";
+  // Without a skin in the run the segments are the body.
+  HeadlessRenderer segmentsOnly({segment}, kW, kH);
+  Frame g;
+  g.positions = {segmentAt};
+  g.states = {{}};
+  overlay.segments = false;
+  const Image bare = segmentsOnly.render(g, view, overlay);
+  const Box only = projectedBox(segmentsOnly.renderer().camera(kW, kH, view), segmentAt);
+  const auto [ox, oy] = centre(only);
+  EXPECT_FALSE(isBackground(bare, ox, oy));
+}
+
 TEST(HeadlessErrors, BadSizesAndTopologiesAreRefused) {
   MeshInfo bad{"bad", MeshRole::Garment, 3, {{0, 1, 7}}};
   EXPECT_THROW(HeadlessRenderer({bad}, 64, 64), Error);

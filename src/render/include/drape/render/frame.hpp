@@ -19,10 +19,13 @@
 namespace drape::render {
 
 /// How a mesh is drawn: garments in cloth colours with collision-state colouring and
-/// markers, segments (avatar body parts) in the body colour with offset surfaces.
-enum class MeshRole : std::uint8_t { Garment, Segment };
+/// markers, segments (the avatar's rigid body parts, what the cloth collides with) in the
+/// body colour with offset surfaces, and the skin (the avatar's skinned body) in the body
+/// colour instead of the segments when a run has one.
+enum class MeshRole : std::uint8_t { Garment, Segment, Skin };
 
-/// Parses "garment" / "segment" (the run manifest's role names); throws drape::Error otherwise.
+/// Parses "garment" / "segment" / "skin" (the run manifest's role names); throws
+/// drape::Error otherwise.
 [[nodiscard]] MeshRole parseMeshRole(const std::string& role);
 
 /// The optional per-vertex state channel (one byte per vertex, per frame). The collision

@@ -42,6 +42,9 @@ struct OverlaySettings {
   double sliceHeight = 0.5;        ///< 0 = bottom of the part, 1 = top
   DistanceFunction sliceDistance;  ///< optional real field for slicePart
   bool markers = false;            ///< mark pinned (yellow) and bound (cyan) vertices
+  /// Draw the avatar as the rigid segments the cloth collides with, also when the run has
+  /// its skinned body (which is drawn otherwise).
+  bool segments = false;
 };
 
 /// Text drawn over the picture with Dear ImGui.

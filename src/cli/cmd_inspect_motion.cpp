@@ -16,14 +16,34 @@
 namespace drape::cli {
 namespace {
 
+/// A joint tree (parents first) in depth-first order, each joint with its depth: indented
+/// so, every joint's children follow it, which a listing in the stored (breadth-first)
+/// order does not show.
+std::vector<std::pair<std::size_t, int>> depthFirst(const std::vector<int>& parents) {
+  std::vector<std::vector<std::size_t>> children(parents.size());
+  std::vector<std::size_t> stack;
+  for (std::size_t j = 0; j < parents.size(); ++j)
+    if (parents[j] >= 0) children[static_cast<std::size_t>(parents[j])].push_back(j);
+  for (std::size_t j = parents.size(); j-- > 0;)
+    if (parents[j] < 0) stack.push_back(j);  // the first root on top
+  std::vector<std::pair<std::size_t, int>> order;
+  std::vector<int> depth(parents.size(), 0);
+  while (!stack.empty()) {
+    const std::size_t j = stack.back();
+    stack.pop_back();
+    if (parents[j] >= 0) depth[j] = depth[static_cast<std::size_t>(parents[j])] + 1;
+    order.emplace_back(j, depth[j]);
+    for (auto c = children[j].rbegin(); c != children[j].rend(); ++c) stack.push_back(*c);  // the first child on top
+  }
+  return order;
+}
+
 void printSkeleton(std::ostream& out, const motion::Skeleton& s) {
   fmt::print(out, "  skeleton   {} joints\n", s.size());
-  std::vector<int> depth(s.size(), 0);
-  for (std::size_t j = 0; j < s.size(); ++j) {
-    const int p = s.joints[j].parent;
-    depth[j] = p < 0 ? 0 : depth[static_cast<std::size_t>(p)] + 1;
-    fmt::print(out, "    {}{}\n", std::string(static_cast<std::size_t>(depth[j]) * 2, ' '), s.joints[j].name);
-  }
+  std::vector<int> parents;
+  for (const auto& j : s.joints) parents.push_back(j.parent);
+  for (const auto& [j, depth] : depthFirst(parents))
+    fmt::print(out, "    {}{}\n", std::string(static_cast<std::size_t>(depth) * 2, ' '), s.joints[j].name);
 }
 
 void printClip(std::ostream& out, const std::string& path, const char* kind, const motion::Clip& clip,
@@ -71,12 +91,11 @@ void inspectAvatar(const std::string& path, std::ostream& out) {
   const scene::Avatar a = scene::loadAvatarFile(path);
   fmt::print(out, "{}: skinned avatar '{}'\n", path, a.name);
   fmt::print(out, "  joints     {}\n", a.joints.size());
-  std::vector<int> depth(a.joints.size(), 0);
-  for (std::size_t j = 0; j < a.joints.size(); ++j) {
-    const int p = a.joints[j].parent;
-    depth[j] = p < 0 ? 0 : depth[static_cast<std::size_t>(p)] + 1;
+  std::vector<int> parents;
+  for (const scene::Joint& j : a.joints) parents.push_back(j.parent);
+  for (const auto& [j, depth] : depthFirst(parents)) {
     const Vec3 c = a.joints[j].restCenter;
-    fmt::print(out, "    {}{} at [{:.3f} {:.3f} {:.3f}] m\n", std::string(static_cast<std::size_t>(depth[j]) * 2, ' '),
+    fmt::print(out, "    {}{} at [{:.3f} {:.3f} {:.3f}] m\n", std::string(static_cast<std::size_t>(depth) * 2, ' '),
                a.joints[j].name, c.x(), c.y(), c.z());
   }
   if (a.skin) {

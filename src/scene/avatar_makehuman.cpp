@@ -30,8 +30,8 @@ Vec3 jointPosition(const formats::MhSkeleton& skel, const std::string& joint, co
 }
 
 // Default-rig bone -> avatar joint index. The cmu_mb fold table names BVH joints, which are
-// cmu_mb bone names except the index fingers; other rigs fold through their "reference"
-// lists.
+// cmu_mb bone names except the index fingers; other rigs keep the bones they share with the
+// default rig and fold the others through their "reference" lists.
 std::map<std::string, int> foldTable(const formats::MhSkeleton& skel, const Avatar& avatar,
                                      const std::map<std::string, std::string>& bvhFold) {
   std::map<std::string, int> fold;
@@ -42,8 +42,11 @@ std::map<std::string, int> foldTable(const formats::MhSkeleton& skel, const Avat
     const int j = avatar.findJoint(name);
     if (j >= 0) fold[bone] = j;
   }
-  if (fold.size() < bvhFold.size() / 2) {  // not cmu_mb: use the rig's own references
+  if (fold.size() < bvhFold.size() / 2) {  // not cmu_mb: the rig's own bones, then their references
     fold.clear();
+    // The weights name the default rig's bones: a rig that has them (the default rig
+    // itself) takes its weights as they are.
+    for (std::size_t b = 0; b < skel.bones.size(); ++b) fold.emplace(skel.bones[b].name, static_cast<int>(b));
     for (std::size_t b = 0; b < skel.bones.size(); ++b) {
       const auto& refs = skel.bones[b].weightsReference.empty() ? skel.bones[b].reference : skel.bones[b].weightsReference;
       for (const std::string& r : refs) fold.emplace(r, static_cast<int>(b));

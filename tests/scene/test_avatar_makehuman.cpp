@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include "drape/scene/avatar_makehuman.hpp"
 #include "drape/scene/avatar_segment.hpp"
 
@@ -53,6 +55,27 @@ TEST(MakeHumanAvatar, ClosedSegmentsCoverTheBody) {
     const double y = shin.mesh.positions[v].y() + knee.y();
     EXPECT_GT(y, -0.76);
     EXPECT_LT(y, -0.35);
+  }
+}
+
+// MakeHuman's own rigs: the weights name the default rig's bones, so the default rig keeps
+// them as they are and the game-engine rig folds them through its references. Either way
+// every limb is a segment of its own (a rig whose weights all fell to the root would be one
+// rigid block that the motion only carries along).
+TEST(MakeHumanAvatar, TheDefaultAndGameEngineRigsAreSegmentedLimbByLimb) {
+  for (const auto& [file, thigh, shin, forearm] :
+       {std::tuple{"makehuman_rig_default.mhskel", "upperleg01.L", "lowerleg01.L", "lowerarm01.L"},
+        std::tuple{"makehuman_rig_game_engine.mhskel", "thigh_l", "calf_l", "lowerarm_l"}}) {
+    MakeHumanAvatarOptions options;
+    options.directory = std::string(DRAPE_DATA_DIR) + "/avatars";
+    options.skeletonFile = file;
+    const Avatar a = buildMakeHumanAvatar(options);
+    EXPECT_GE(a.segments.size(), 40u) << file;
+    for (const char* part : {thigh, shin, forearm}) {
+      const int s = a.findSegment(part);
+      ASSERT_GE(s, 0) << file << ": no segment " << part;
+      EXPECT_GT(a.segments[static_cast<std::size_t>(s)].mesh.triangleCount(), 200u) << file << ": " << part;
+    }
   }
 }
 

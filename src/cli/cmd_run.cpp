@@ -251,8 +251,9 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   setup.exactSliding = o.exactSliding;
   setup.freePinches = o.freePinches;
   const int code = simulateRun(setup);
-  fmt::print("results in {}/: garment caches (.pc2, .states), frames/, result.wrl, result.glb, stats.json{}\n", o.out,
-             o.preview ? ", preview.png" : "");
+  const bool skin = setup.character && setup.character->avatar->skin;
+  fmt::print("results in {}/: garment caches (.pc2, .states), {}frames/, result.wrl, result.glb, stats.json{}\n", o.out,
+             skin ? "the skinned body (body.pc2), " : "", o.preview ? ", preview.png" : "");
   return code;
 }
 

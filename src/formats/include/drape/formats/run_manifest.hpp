@@ -2,8 +2,8 @@
 // The manifest of a run's output directory (DIR/manifest.json): what `drape run` wrote and
 // what players, renderers and exporters read back. Every animated mesh is a topology file
 // (OBJ, its frame-0 positions) plus a PC2 point cache of world positions in metres, one
-// sample per frame, Y up. Garments and avatar segments are listed alike; `role` tells a
-// renderer how to draw them.
+// sample per frame, Y up. Garments, avatar segments and the avatar's skinned body are listed
+// alike; `role` tells a renderer how to draw them.
 //
 // A garment may also have a state cache (formats/state_cache.hpp): per vertex and frame,
 // its collision state and whether it is pinned or bound, for the overlays.
@@ -20,7 +20,7 @@ namespace drape::formats {
 
 struct RunMesh {
   std::string name;
-  std::string role;      ///< "garment" or "segment" (an avatar body part)
+  std::string role;      ///< "garment", "segment" (an avatar body part) or "skin" (the avatar's smooth body)
   std::string topology;  ///< OBJ file, relative to the run directory
   std::string cache;     ///< PC2 file, relative to the run directory
   std::string states;    ///< state cache, relative to the run directory; "": none (optional key)

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "drape/mesh/closest_point.hpp"
 #include "gl_util.hpp"
 
 namespace drape::render {
@@ -237,27 +238,6 @@ V3 srgbToLinear(const std::array<float, 3>& c) {
 V3 keyLight(const ViewSettings& view) {
   const double az = (view.azimuthDeg + 40.0) * std::numbers::pi / 180.0;
   return V3(static_cast<float>(std::sin(az) * 0.55), 1.0f, static_cast<float>(std::cos(az) * 0.55)).normalized();
-}
-
-/// Closest point on triangle abc to p (Ericson, Real-Time Collision Detection 5.1.5).
-Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const Vec3 bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
-  const Vec3 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-  const double denom = 1.0 / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
 struct GpuMesh {
@@ -560,7 +540,7 @@ struct Renderer::Impl {
     double best = std::numeric_limits<double>::infinity();
     double sign = 1.0;
     for (const mesh::Triangle& t : meshes[m].triangles) {
-      const Vec3 q = closestOnTriangle(p, x[t[0]], x[t[1]], x[t[2]]);
+      const Vec3 q = mesh::closestOnTriangle(p, x[t[0]], x[t[1]], x[t[2]]);
       const double d = (p - q).squaredNorm();
       if (d < best) {
         best = d;

@@ -9,11 +9,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "drape/mesh/closest_point.hpp"
 #include "drape/motion/animation.hpp"
 #include "drape/motion/skinning.hpp"
 #include "drape/scene/avatar_gltf.hpp"
 #include "drape/sim/body_skin.hpp"
 #include "drape/sim/character_world.hpp"
+#include "walk_fixture.hpp"
 
 namespace drape::sim {
 namespace {
@@ -21,54 +23,13 @@ namespace {
 constexpr double kAllowance = 0.005;  // the walking skirt's T0
 constexpr const char* kParts[] = {"Hips", "LowerBack", "LeftUpLeg", "RightUpLeg", "LeftLeg", "RightLeg"};
 
-struct Walk {
-  scene::Avatar avatar;
-  motion::AvatarAnimation animation;
-  std::vector<PartField> fields;
-};
+using fixture::Walk;
 
 /// The walking skirt's body, its six collidable parts' fields and its walk.
 const Walk& skirtWalk() {
-  static const Walk walk = [] {
-    scene::Avatar avatar =
-        scene::loadAvatarFile(std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel");
-    motion::MotionOptions mo;
-    mo.clip.rate = 30.0;
-    mo.jointMapDirectory = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";
-    motion::AvatarAnimation animation =
-        motion::loadAnimation(avatar, std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt/walk.bvh", mo);
-    field::FieldSettings fs;
-    fs.voxelSize_m = 0.005;
-    fs.shell_m = 0.03;
-    std::vector<PartField> fields;
-    for (const char* name : kParts) {
-      const scene::Segment& s = avatar.segments[static_cast<std::size_t>(avatar.findSegment(name))];
-      fields.push_back({name, s.joint, field::DistanceField::build(s.mesh, fs)});
-    }
-    return Walk{std::move(avatar), std::move(animation), std::move(fields)};
-  }();
+  static const Walk walk = fixture::loadWalk(std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt/walk.bvh",
+                                             {std::begin(kParts), std::end(kParts)}, 0.03);
   return walk;
-}
-
-/// Closest point to p on triangle abc (Ericson, Real-Time Collision Detection, 5.1.5).
-Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const Vec3 bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
-  const Vec3 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-  const double denom = 1.0 / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
 /// How far world point p stands out of part f posed at `pose`: 0 inside it (the voxelized
@@ -79,7 +40,7 @@ double outside(const Walk& w, const PartField& f, const RigidTransform& pose, co
   const mesh::TriMesh& m = w.avatar.segments[static_cast<std::size_t>(w.avatar.findSegment(f.segment))].mesh;
   double best = std::numeric_limits<double>::infinity();
   for (const mesh::Triangle& t : m.triangles)
-    best = std::min(best, (closestOnTriangle(local, m.positions[t[0]], m.positions[t[1]], m.positions[t[2]]) - local)
+    best = std::min(best, (mesh::closestOnTriangle(local, m.positions[t[0]], m.positions[t[1]], m.positions[t[2]]) - local)
                               .squaredNorm());
   return std::sqrt(best);
 }

@@ -15,39 +15,21 @@
 #include "drape/sim/body_overlap.hpp"
 #include "drape/sim/character_world.hpp"
 #include "drape/sim/keep_apart.hpp"
+#include "walk_fixture.hpp"
 
 namespace drape::sim {
 namespace {
 
 constexpr double kMargin = 0.012;
 
-struct Walk {
-  scene::Avatar avatar;
-  motion::AvatarAnimation animation;
-  std::vector<PartField> fields;
-};
+using fixture::Walk;
 
-/// The walking dress's body, its torso and arm parts' fields (5 mm voxels), and the walk
-/// that puts the left forearm 27 mm into the lower back.
+/// The walking dress's body, its torso and arm parts' fields, and the walk that puts the
+/// left forearm 27 mm into the lower back.
 const Walk& delfem2Walk() {
-  static const Walk walk = [] {
-    scene::Avatar avatar =
-        scene::loadAvatarFile(std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel");
-    motion::MotionOptions mo;
-    mo.clip.rate = 30.0;
-    mo.jointMapDirectory = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";
-    motion::AvatarAnimation animation =
-        motion::loadAnimation(avatar, std::string(DRAPE_DATA_DIR) + "/mocap/cmu_walk_delfem2.bvh", mo);
-    field::FieldSettings fs;
-    fs.voxelSize_m = 0.005;
-    fs.shell_m = 0.016;
-    std::vector<PartField> fields;
-    for (const char* name : {"Hips", "LowerBack", "Spine", "Spine1", "LeftArm", "RightArm", "LeftForeArm", "RightForeArm"}) {
-      const scene::Segment& s = avatar.segments[static_cast<std::size_t>(avatar.findSegment(name))];
-      fields.push_back({name, s.joint, field::DistanceField::build(s.mesh, fs)});
-    }
-    return Walk{std::move(avatar), std::move(animation), std::move(fields)};
-  }();
+  static const Walk walk = fixture::loadWalk(
+      std::string(DRAPE_DATA_DIR) + "/mocap/cmu_walk_delfem2.bvh",
+      {"Hips", "LowerBack", "Spine", "Spine1", "LeftArm", "RightArm", "LeftForeArm", "RightForeArm"}, 0.016);
   return walk;
 }
 

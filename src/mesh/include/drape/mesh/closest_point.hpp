@@ -1,0 +1,15 @@
+#pragma once
+// The closest point of a triangle to a point: what brute-force distances to a mesh (the
+// player's distance slice, the tests' exact references for the distance fields' uses) are
+// made of.
+
+#include "drape/core/math.hpp"
+
+namespace drape::mesh {
+
+/// Closest point on triangle abc to p (Ericson, Real-Time Collision Detection 5.1.5: the
+/// Voronoi regions of the vertices, then the edges, then the face). Degenerate triangles
+/// give a point of the triangle, not necessarily the closest.
+[[nodiscard]] Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
+}  // namespace drape::mesh

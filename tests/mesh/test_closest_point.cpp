@@ -1,0 +1,47 @@
+// The closest point of a triangle, against a brute-force search over a fine barycentric
+// grid of the triangle, on many random triangles and points (vertex, edge and face
+// regions all occur).
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "drape/mesh/closest_point.hpp"
+
+namespace drape::mesh {
+namespace {
+
+TEST(ClosestPoint, MatchesABruteForceSearchOverTheTriangle) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n;
+  const auto random = [&] { return Vec3(n(rng), n(rng), n(rng)); };
+  constexpr int kSteps = 200;  // grid spacing: the longest edge / 200
+  int onVertex = 0, onEdge = 0, inside = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const Vec3 a = random(), b = random(), c = random(), p = 2.0 * random();
+    const Vec3 q = closestOnTriangle(p, a, b, c);
+    // q lies on the triangle: its barycentric coordinates are in [0, 1] and it is in the plane.
+    const Vec3 normal = (b - a).cross(c - a);
+    EXPECT_NEAR(normal.normalized().dot(q - a), 0.0, 1e-9);
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = 0; i <= kSteps; ++i)
+      for (int j = 0; i + j <= kSteps; ++j) {
+        const Vec3 s = a + (b - a) * (double(i) / kSteps) + (c - a) * (double(j) / kSteps);
+        best = std::min(best, (p - s).norm());
+      }
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const double found = (p - q).norm();
+    EXPECT_LE(found, best + 1e-12) << "trial " << trial;              // nothing on the grid is nearer
+    EXPECT_GE(found, best - longest / kSteps) << "trial " << trial;  // and it is as near as the grid allows
+    const double eps = 1e-9;
+    if ((q - a).norm() < eps || (q - b).norm() < eps || (q - c).norm() < eps) ++onVertex;
+    else if (std::abs(normal.normalized().dot((p - q).normalized())) < 1.0 - 1e-6) ++onEdge;
+    else ++inside;
+  }
+  EXPECT_GT(onVertex, 10);
+  EXPECT_GT(onEdge, 10);
+  EXPECT_GT(inside, 10);
+}
+
+}  // namespace
+}  // namespace drape::mesh

@@ -12,13 +12,13 @@ function(drape_add_module name)
   add_library(drape::${name} ALIAS drape_${name})
 endfunction()
 
-# drape_add_test(MODULE [DEPS target...])
+# drape_add_test(MODULE [TIMEOUT S] [DEPS target...] [ENVIRONMENT VAR=VALUE...])
 #
 # Builds tests/MODULE/*.cpp into test_MODULE and registers each GoogleTest case with CTest.
 # Tests find the project's data through DRAPE_DATA_DIR, the source tree through
 # DRAPE_SOURCE_DIR and the built CLI through DRAPE_EXE.
 function(drape_add_test module)
-  cmake_parse_arguments(ARG "" "TIMEOUT" "DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "TIMEOUT" "DEPS;ENVIRONMENT" ${ARGN})
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.cpp")
   add_executable(test_${module} ${sources})
   target_link_libraries(test_${module} PRIVATE drape::${module} ${ARG_DEPS} GTest::gtest GTest::gtest_main)
@@ -31,5 +31,10 @@ function(drape_add_test module)
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
   endif()
-  gtest_discover_tests(test_${module} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT ${ARG_TIMEOUT})
+  if(ARG_ENVIRONMENT)
+    gtest_discover_tests(test_${module} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT ${ARG_TIMEOUT}
+                         ENVIRONMENT "${ARG_ENVIRONMENT}")
+  else()
+    gtest_discover_tests(test_${module} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT ${ARG_TIMEOUT})
+  endif()
 endfunction()

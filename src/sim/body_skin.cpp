@@ -47,21 +47,15 @@ void BodySkin::pose(std::span<const RigidTransform> jointWorld, std::vector<Vec3
   toLocal_.resize(fields_.size());
   for (std::size_t f = 0; f < fields_.size(); ++f)
     toLocal_[f] = jointWorld[static_cast<std::size_t>(fields_[f].joint)].inverse();
-  lastFitted_ = 0;
-  lastLargestFit_m_ = 0.0;
   for (std::size_t v = 0; v + 1 < first_.size(); ++v) {
     if (first_[v] == first_[v + 1]) continue;
-    bool fitted = false;
     // Steps towards the nearest part by the excess; where the field bends (a crease between
     // two parts, the nearest part changing) one step falls short, so repeat.
     for (int step = 0; step < kSteps; ++step) {
       const Nearest n = nearestPart(v, out[v], jointWorld);
       if (!(n.distance_m > allowance_m_) || !std::isfinite(n.distance_m)) break;
-      if (step == 0) lastLargestFit_m_ = std::max(lastLargestFit_m_, n.distance_m - allowance_m_);
       out[v] -= (n.distance_m - allowance_m_) * n.away;
-      fitted = true;
     }
-    lastFitted_ += fitted;
   }
 }
 

@@ -34,11 +34,6 @@ class BodySkin {
   /// The skin with the joints at `jointWorld`, fitted to the parts as above.
   void pose(std::span<const RigidTransform> jointWorld, std::vector<Vec3>& out);
 
-  /// Vertices drawn back onto a part by the last pose().
-  [[nodiscard]] std::size_t lastFitted() const { return lastFitted_; }
-  /// Farthest a vertex stood out of its parts beyond the allowance in the last pose(), m.
-  [[nodiscard]] double lastLargestFit_m() const { return lastLargestFit_m_; }
-
  private:
   struct Nearest {
     double distance_m = std::numeric_limits<double>::infinity();
@@ -54,8 +49,6 @@ class BodySkin {
   const scene::Avatar& avatar_;
   const std::vector<PartField>& fields_;
   double allowance_m_;
-  std::size_t lastFitted_ = 0;
-  double lastLargestFit_m_ = 0.0;
 };
 
 }  // namespace drape::sim

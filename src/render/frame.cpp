@@ -1,5 +1,7 @@
 #include "drape/render/frame.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
@@ -11,6 +13,10 @@ MeshRole parseMeshRole(const std::string& role) {
   if (role == "segment") return MeshRole::Segment;
   if (role == "skin") return MeshRole::Skin;
   throw Error(fmt::format("mesh role '{}' is not one of: garment, segment, skin", role));
+}
+
+bool hasSkin(const std::vector<MeshInfo>& meshes) {
+  return std::any_of(meshes.begin(), meshes.end(), [](const MeshInfo& m) { return m.role == MeshRole::Skin; });
 }
 
 Aabb frameBounds(const Frame& frame) {

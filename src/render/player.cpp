@@ -75,14 +75,12 @@ void drawPanel(OverlaySettings& overlay, const std::vector<MeshInfo>& meshes, bo
   ImGui::SetNextWindowCollapsed(io.DisplaySize.x < 800.0f,
                                 ImGuiCond_FirstUseEver);  // small windows: keep the picture clear
   ImGui::Begin("overlays", nullptr, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove);
-  const bool hasSkin =
-      std::any_of(meshes.begin(), meshes.end(), [](const MeshInfo& m) { return m.role == MeshRole::Skin; });
   ImGui::Checkbox("paused (space)", &paused);
   ImGui::Checkbox("follow the characters (F)", &following);
   ImGui::Checkbox("floor", &overlay.floor);
   ImGui::SameLine();
   ImGui::Checkbox("shadows", &overlay.shadows);
-  if (hasSkin) ImGui::Checkbox("collision segments, not the skinned body", &overlay.segments);
+  if (hasSkin(meshes)) ImGui::Checkbox("collision segments, not the skinned body", &overlay.segments);
   ImGui::Checkbox("collision states", &overlay.collisionColours);
   if (overlay.collisionColours && !hasStates) ImGui::TextDisabled("  (this run has no state data)");
   ImGui::Checkbox("pinned / bound markers", &overlay.markers);

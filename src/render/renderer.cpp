@@ -284,6 +284,7 @@ CameraMatrices cameraFor(const Aabb& boundsIn, const ViewSettings& view, double 
 
 struct Renderer::Impl {
   std::vector<MeshInfo> meshes;
+  bool skin = false;  ///< the run has the avatar's skinned body (hasSkin)
   std::vector<GpuMesh> gpu;
   std::vector<std::vector<float>> positions;  ///< per mesh, xyz float (uploaded)
   std::vector<std::vector<float>> normals;    ///< per mesh, xyz float, area-weighted, unit
@@ -434,12 +435,9 @@ struct Renderer::Impl {
       case MeshRole::Skin:
         return !overlay.segments;
       case MeshRole::Segment:
-        return overlay.segments || !hasSkin();
+        return overlay.segments || !skin;
     }
     return true;
-  }
-  bool hasSkin() const {
-    return std::any_of(meshes.begin(), meshes.end(), [](const MeshInfo& m) { return m.role == MeshRole::Skin; });
   }
 
   void drawShadows(const Mat4& viewProj, const CameraMatrices& cam, const V3& light, float floorY,
@@ -604,6 +602,7 @@ struct Renderer::Impl {
 Renderer::Renderer(std::vector<MeshInfo> meshes) : impl_(std::make_unique<Impl>()) {
   gl::requireGl33("renderer");
   impl_->meshes = std::move(meshes);
+  impl_->skin = hasSkin(impl_->meshes);
   impl_->createPrograms();
   impl_->createQuad();
   impl_->gpu.resize(impl_->meshes.size());

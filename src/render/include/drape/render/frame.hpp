@@ -48,6 +48,9 @@ struct MeshInfo {
   std::vector<mesh::Triangle> triangles;  ///< indices into the frame's positions
 };
 
+/// Whether the run has its avatar's skinned body (drawn instead of the segments).
+[[nodiscard]] bool hasSkin(const std::vector<MeshInfo>& meshes);
+
 /// Milliseconds one simulation stage took (forces, integrate, collide, ...).
 struct StageTime {
   std::string stage;

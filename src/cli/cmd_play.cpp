@@ -76,7 +76,12 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
       p.clear();
       for (const Vec3& v : seg.mesh.positions) p.push_back(joints[static_cast<std::size_t>(seg.joint)].apply(v));
     }
-    if (skin) skin->pose(joints, out.positions.back());
+    if (skin) {
+      std::vector<sim::GarmentSurface> garments;
+      for (std::size_t g = 0; g < world.garmentCount(); ++g)
+        garments.push_back({out.positions[g], world.garment(g).mesh.triangles});
+      skin->pose(joints, garments, out.positions.back());
+    }
     ++frame;
     return true;
   });

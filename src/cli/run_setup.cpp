@@ -595,7 +595,9 @@ int simulateRun(const RunSetup& setup) {
         sr.cache->writeFrame(positions);
       }
       if (skinCache) {
-        skin->pose(joints, skinPositions);
+        std::vector<sim::GarmentSurface> garments;
+        for (const GarmentRun& r : runs) garments.push_back({r.frames.back(), r.model->triangles()});
+        skin->pose(joints, garments, skinPositions);
         skinCache->writeFrame(skinPositions);
       }
     }

@@ -22,4 +22,15 @@ Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& 
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
+Vec3 barycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d00 = ab.dot(ab), d01 = ab.dot(ac), d11 = ac.dot(ac);
+  const double d20 = ap.dot(ab), d21 = ap.dot(ac);
+  const double denominator = d00 * d11 - d01 * d01;
+  if (!(denominator > 0)) return {1.0, 0.0, 0.0};
+  const double v = (d11 * d20 - d01 * d21) / denominator;
+  const double w = (d00 * d21 - d01 * d20) / denominator;
+  return {1.0 - v - w, v, w};
+}
+
 }  // namespace drape::mesh

@@ -43,5 +43,27 @@ TEST(ClosestPoint, MatchesABruteForceSearchOverTheTriangle) {
   EXPECT_GT(inside, 10);
 }
 
+// The weights rebuild the point's projection onto the plane, and a point of the triangle
+// has weights in [0, 1]; on many random triangles, points in and out of their plane.
+TEST(Barycentric, RebuildsTheProjectionOntoTheTrianglesPlane) {
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+  const auto point = [&] { return Vec3(coordinate(random), coordinate(random), coordinate(random)); };
+  for (int trial = 0; trial < 1000; ++trial) {
+    const Vec3 a = point(), b = point(), c = point();
+    const Vec3 n = (b - a).cross(c - a);
+    if (n.norm() < 1e-3) continue;
+    const Vec3 p = point();
+    const Vec3 w = barycentric(p, a, b, c);
+    EXPECT_NEAR(w.sum(), 1.0, 1e-9);
+    const Vec3 projection = p - (p - a).dot(n) / n.squaredNorm() * n;
+    EXPECT_LT((w.x() * a + w.y() * b + w.z() * c - projection).norm(), 1e-9);
+    const Vec3 onTriangle = closestOnTriangle(p, a, b, c);
+    const Vec3 u = barycentric(onTriangle, a, b, c);
+    EXPECT_GE(u.minCoeff(), -1e-9);
+  }
+  EXPECT_EQ(barycentric(Vec3(1, 2, 3), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()), Vec3(1, 0, 0));
+}
+
 }  // namespace
 }  // namespace drape::mesh

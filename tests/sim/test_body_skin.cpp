@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "drape/field/shapes.hpp"
 #include "drape/mesh/closest_point.hpp"
 #include "drape/motion/animation.hpp"
 #include "drape/motion/skinning.hpp"
@@ -109,6 +110,88 @@ TEST(BodySkin, NoVertexStandsOutOfTheCollidablePartsBeyondTheAllowance) {
   std::printf("hip creases: skinned up to %.1f mm out of the parts, fitted %.1f mm exactly and %.1f mm as the fields "
               "read (allowance %.1f mm), %zu checks\n",
               1e3 * worstSkinned, 1e3 * worstFitted, 1e3 * worstRead, 1e3 * kAllowance, checked);
+}
+
+// The tuck on concentric spheres, where every distance is known: a part of radius 5 cm, a
+// skin of radius 7 cm around it (standing out of the part by 2 cm, within the allowance
+// given, so the fit leaves it: the skin over a crease), and cloth caps of other radii.
+struct Spheres {
+  static constexpr double kPart = 0.05, kSkin = 0.07;
+  scene::Avatar avatar;
+  std::vector<PartField> fields;
+
+  /// `skinnedToThePart`: the skin's weights on the part's joint, or on a joint without a field.
+  explicit Spheres(bool skinnedToThePart) {
+    avatar.name = avatar.source = "spheres";
+    avatar.joints = {scene::Joint{"part", -1}, scene::Joint{"other", 0}};
+    scene::SkinnedMesh skin;
+    skin.mesh = field::makeSphere(kSkin, Vec3::Zero(), 32, 16);  // 1.4 cm triangles, as MakeHuman's
+    const std::uint16_t joint = skinnedToThePart ? 0 : 1;
+    skin.joints.assign(skin.mesh.vertexCount(), {joint, 0, 0, 0});
+    skin.weights.assign(skin.mesh.vertexCount(), {1.0f, 0.0f, 0.0f, 0.0f});
+    avatar.skin = std::move(skin);
+    field::FieldSettings fs;
+    fs.voxelSize_m = 0.005;
+    fs.shell_m = 0.03;
+    fields.push_back({"part", 0, field::DistanceField::build(field::makeSphere(kPart, Vec3::Zero(), 64, 32), fs)});
+  }
+
+  /// The skin, fitted (allowance 3 cm: it stays) and tucked under a cap of cloth of radius
+  /// r over the top (y above 2 cm).
+  [[nodiscard]] std::vector<Vec3> tuckedUnder(double r, mesh::TriMesh& cap) const {
+    const mesh::TriMesh ball = field::makeSphere(r, Vec3::Zero(), 64, 32);  // finer than the skin
+    cap.positions = ball.positions;
+    cap.triangles.clear();
+    for (const mesh::Triangle& t : ball.triangles)
+      if (ball.positions[t[0]].y() > 0.02 && ball.positions[t[1]].y() > 0.02 && ball.positions[t[2]].y() > 0.02)
+        cap.triangles.push_back(t);
+    BodySkin skin(avatar, fields, 0.03);
+    const std::vector<RigidTransform> pose(2, RigidTransform::identity());
+    const GarmentSurface garment{cap.positions, cap.triangles};
+    std::vector<Vec3> out;
+    skin.pose(pose, std::span(&garment, 1), out);
+    return out;
+  }
+};
+
+TEST(BodySkin, IsTuckedUnderClothThatIsOutsideThePartsButInsideTheSkin) {
+  const Spheres spheres(true);
+  mesh::TriMesh cap;
+  const std::vector<Vec3> tucked = spheres.tuckedUnder(0.065, cap);  // 5 mm into the skin, 15 mm out of the part
+  const std::vector<Vec3>& rest = spheres.avatar.skin->mesh.positions;
+  const std::vector<Vec3> normals = spheres.avatar.skin->mesh.vertexNormals();
+  std::size_t under = 0, away = 0;
+  for (std::size_t v = 0; v < rest.size(); ++v) {
+    const double height = rest[v].y() / Spheres::kSkin;
+    // Well under the cap (its edge is at 0.02 / 0.065 = 0.31), and off the pole, where the
+    // sphere's 32 thin triangles meet (no skin is made so).
+    if (height > 0.4 && height < 0.9) {
+      // Pushed in along its normal to 2 mm under the cloth; a little deeper where cloth
+      // points near a triangle's corner push it (by up to 1.2 times the depth they need).
+      const Vec3 moved = rest[v] - tucked[v];
+      EXPECT_LT(tucked[v].norm(), 0.065 - BodySkin::kTuckMargin_m + 1e-4) << v << " at height " << height;
+      EXPECT_GT(tucked[v].norm(), 0.065 - BodySkin::kTuckMargin_m - 4e-3) << v << " at height " << height;
+      EXPECT_LT((moved.normalized() - normals[v]).norm(), 1e-9) << "along its normal";
+      ++under;
+    } else if (height < 0.0) {  // far from the cap
+      EXPECT_EQ(tucked[v], rest[v]) << v;
+      ++away;
+    }
+  }
+  EXPECT_GT(under, 80u);
+  EXPECT_GT(away, 200u);
+}
+
+TEST(BodySkin, IsNotTuckedUnderClothInsideThePartsOrSkinnedElsewhere) {
+  mesh::TriMesh cap;
+  // Cloth the collision let into the part: the body shows through it, as it is.
+  const Spheres spheres(true);
+  EXPECT_EQ(spheres.tuckedUnder(0.045, cap), spheres.avatar.skin->mesh.positions);
+  // Skin skinned to a joint the cloth does not collide with (a hand on a skirt).
+  const Spheres elsewhere(false);
+  EXPECT_EQ(elsewhere.tuckedUnder(0.065, cap), elsewhere.avatar.skin->mesh.positions);
+  // Cloth out of the skin by more than the margin.
+  EXPECT_EQ(spheres.tuckedUnder(0.075, cap), spheres.avatar.skin->mesh.positions);
 }
 
 }  // namespace

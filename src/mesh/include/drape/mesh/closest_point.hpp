@@ -12,4 +12,8 @@ namespace drape::mesh {
 /// give a point of the triangle, not necessarily the closest.
 [[nodiscard]] Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
+/// Barycentric weights (of a, b, c) of the projection of p onto the plane of triangle abc
+/// (Ericson 3.4); a degenerate triangle gives (1, 0, 0).
+[[nodiscard]] Vec3 barycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
 }  // namespace drape::mesh

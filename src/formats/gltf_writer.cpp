@@ -134,12 +134,10 @@ std::vector<float> toFloats(const std::vector<Vec3>& points) {
 
 /// Unit area-weighted vertex normals; vertices no triangle uses get +Y (glTF wants unit normals).
 std::vector<Vec3> unitNormals(const std::vector<Vec3>& positions, const std::vector<mesh::Triangle>& triangles) {
-  std::vector<Vec3> n(positions.size(), Vec3::Zero());
-  for (const mesh::Triangle& t : triangles) {
-    const Vec3 fn = (positions[t[1]] - positions[t[0]]).cross(positions[t[2]] - positions[t[0]]);
-    for (std::uint32_t v : t) n[v] += fn;
-  }
-  for (Vec3& v : n) v = v.norm() > 1e-30 ? Vec3(v.normalized()) : Vec3::UnitY();
+  std::vector<Vec3> n;
+  mesh::vertexNormals(positions, triangles, n);
+  for (Vec3& v : n)
+    if (v.isZero()) v = Vec3::UnitY();
   return n;
 }
 

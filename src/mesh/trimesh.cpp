@@ -21,16 +21,19 @@ double TriMesh::totalArea() const {
 }
 
 std::vector<Vec3> TriMesh::vertexNormals() const {
-  std::vector<Vec3> normals(positions.size(), Vec3::Zero());
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
-    const Vec3 n = triangleNormalArea(t);
-    for (std::uint32_t v : triangles[t]) normals[v] += n;
-  }
-  for (Vec3& n : normals) {
-    const double len = n.norm();
-    if (len > 0) n /= len;
-  }
+  std::vector<Vec3> normals;
+  mesh::vertexNormals(positions, triangles, normals);
   return normals;
+}
+
+void vertexNormals(std::span<const Vec3> positions, std::span<const Triangle> triangles, std::vector<Vec3>& out) {
+  out.assign(positions.size(), Vec3::Zero());
+  for (const Triangle& t : triangles) {
+    const Vec3 n = (positions[t[1]] - positions[t[0]]).cross(positions[t[2]] - positions[t[0]]);
+    for (const std::uint32_t v : t) out[v] += n;
+  }
+  for (Vec3& n : out)
+    if (const double len = n.norm(); len > 0) n /= len;
 }
 
 void TriMesh::scale(double factor) {

@@ -76,7 +76,7 @@ void BodySkin::pose(std::span<const RigidTransform> jointWorld, std::span<const 
   sampleGarments(garments);
   // The fitted skin's normals for every pass: a vertex moves along its own normal only,
   // however its neighbours moved before it.
-  computeNormals(out);
+  mesh::vertexNormals(out, avatar_.skin->mesh.triangles, normals_);
   pushed_.assign(out.size(), 0.0);
   for (int pass = 0; pass < kTuckPasses; ++pass)
     if (!tuck(out)) break;
@@ -120,16 +120,6 @@ void BodySkin::sampleGarments(std::span<const GarmentSurface> garments) {
   }
   active_.resize(samples_.size());
   for (std::size_t i = 0; i < active_.size(); ++i) active_[i] = static_cast<std::uint32_t>(i);
-}
-
-void BodySkin::computeNormals(const std::vector<Vec3>& out) {
-  normals_.assign(out.size(), Vec3::Zero());
-  for (const mesh::Triangle& t : avatar_.skin->mesh.triangles) {
-    const Vec3 n = (out[t[1]] - out[t[0]]).cross(out[t[2]] - out[t[0]]);
-    for (const std::uint32_t v : t) normals_[v] += n;
-  }
-  for (Vec3& n : normals_)
-    if (const double len = n.norm(); len > 0) n /= len;
 }
 
 bool BodySkin::tuck(std::vector<Vec3>& out) {

@@ -54,13 +54,9 @@ class SkinCells {
  public:
   SkinCells(const std::vector<Vec3>& skin, const std::vector<mesh::Triangle>& triangles,
             const std::vector<std::uint8_t>& counted)
-      : skin_(skin), triangles_(triangles), counted_(counted), normals_(skin.size(), Vec3::Zero()) {
-    for (std::size_t t = 0; t < triangles.size(); ++t) {
-      const mesh::Triangle& c = triangles[t];
-      cells_[key(cellOf(skin[c[0]]))].push_back(t);
-      const Vec3 n = (skin[c[1]] - skin[c[0]]).cross(skin[c[2]] - skin[c[0]]);
-      for (const std::uint32_t v : c) normals_[v] += n;
-    }
+      : skin_(skin), triangles_(triangles), counted_(counted) {
+    for (std::size_t t = 0; t < triangles.size(); ++t) cells_[key(cellOf(skin[triangles[t][0]]))].push_back(t);
+    mesh::vertexNormals(skin, triangles, normals_);
   }
 
   /// How far p lies inside the skin: 0 when outside, or when its nearest triangle within
@@ -100,7 +96,7 @@ class SkinCells {
   const std::vector<Vec3>& skin_;
   const std::vector<mesh::Triangle>& triangles_;
   const std::vector<std::uint8_t>& counted_;
-  std::vector<Vec3> normals_;  ///< per vertex, area-weighted
+  std::vector<Vec3> normals_;  ///< per vertex, area-weighted, unit
   std::unordered_map<long, std::vector<std::size_t>> cells_;
 };
 

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,10 @@ struct TriMesh {
   void scale(double factor);
   void transform(const RigidTransform& t);
 };
+
+/// Area-weighted unit vertex normals of `triangles` over `positions`, into `out` (resized;
+/// zero for vertices no triangle uses). For meshes that move: no TriMesh to build per frame.
+void vertexNormals(std::span<const Vec3> positions, std::span<const Triangle> triangles, std::vector<Vec3>& out);
 
 /// Splits a polygon (vertex indices, in order) into a fan of triangles appended to `out`.
 void triangulatePolygon(const std::vector<std::uint32_t>& polygon, std::vector<Triangle>& out);

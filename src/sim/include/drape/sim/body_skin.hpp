@@ -78,7 +78,6 @@ class BodySkin {
   void fit(std::vector<Vec3>& out, std::span<const RigidTransform> jointWorld);
   /// The points of the cloth the tuck looks at, into samples_ (all active).
   void sampleGarments(std::span<const GarmentSurface> garments);
-  void computeNormals(const std::vector<Vec3>& out);
   /// One pass of the tuck over the active samples; false when nothing was pushed.
   bool tuck(std::vector<Vec3>& out);
   /// Pushes the skin under cloth point p; returns how far in it must go (negative: p

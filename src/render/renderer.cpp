@@ -69,7 +69,15 @@ void main() {
   if (uMode == 1) { fragColour = vec4(uColour, uAlpha); return; }
   vec3 n = normalize(vNormal);
   vec3 v = normalize(uEye - vWorld);
-  if (dot(n, v) < 0.0) n = -n;  // two-sided: light the side the camera sees
+  // Two-sided, by the triangle's own facing: cloth shows both sides. Flipping by the
+  // smoothed normal instead turned every fragment whose interpolated normal leans away from
+  // the camera (at silhouettes, in creases such as under the breasts) towards the key light,
+  // as bright specks among its neighbours.
+  if (!gl_FrontFacing) n = -n;
+  // Where the smoothed normal still leans away (a front face at a silhouette), shade it as
+  // the silhouette it is: the normal turned until it is square to the view.
+  float nv = dot(n, v);
+  if (nv < 0.0) n = normalize(n - nv * v);
   vec3 base = uStateColours ? stateColour(vState & 3u) : uColour;
   vec3 l = normalize(uLight);
   float key = max(dot(n, l), 0.0);

@@ -1,11 +1,12 @@
 // The headless renderer on a known scene (tests/formats/test_run_fixture.hpp): where the
 // garment's colour appears, where the background stays, what changes between frames and
-// what the per-vertex state channel does.
+// what the per-vertex state channel does; and the light on a closed body at its silhouette.
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "../formats/test_run_fixture.hpp"
 #include "drape/core/error.hpp"
@@ -268,6 +269,69 @@ TEST(HeadlessBody, TheSkinIsDrawnInsteadOfTheSegmentsUnlessTheyAreAskedFor) {
   const Box only = projectedBox(segmentsOnly.renderer().camera(kW, kH, view), segmentAt);
   const auto [ox, oy] = centre(only);
   EXPECT_FALSE(isBackground(bare, ox, oy));
+}
+
+/// A coarse closed UV sphere (outward winding), as a skinned body: its smoothed normals lean
+/// away from the camera on front faces near the silhouette.
+std::pair<MeshInfo, std::vector<Vec3>> coarseSphere(const Vec3& centre, double radius, int slices, int stacks) {
+  std::vector<Vec3> points;
+  points.push_back(centre + Vec3(0, radius, 0));
+  for (int j = 1; j < stacks; ++j) {
+    const double polar = std::numbers::pi * j / stacks;
+    for (int i = 0; i < slices; ++i) {
+      const double around = 2 * std::numbers::pi * i / slices;
+      points.push_back(centre + radius * Vec3(std::sin(polar) * std::sin(around), std::cos(polar),
+                                              std::sin(polar) * std::cos(around)));
+    }
+  }
+  points.push_back(centre - Vec3(0, radius, 0));
+  const auto ring = [&](int j, int i) { return static_cast<std::uint32_t>(1 + (j - 1) * slices + (i % slices)); };
+  const auto south = static_cast<std::uint32_t>(points.size() - 1);
+  std::vector<mesh::Triangle> triangles;
+  for (int i = 0; i < slices; ++i) {
+    triangles.push_back({0, ring(1, i), ring(1, i + 1)});
+    for (int j = 1; j + 1 < stacks; ++j) {
+      triangles.push_back({ring(j, i), ring(j + 1, i), ring(j + 1, i + 1)});
+      triangles.push_back({ring(j, i), ring(j + 1, i + 1), ring(j, i + 1)});
+    }
+    triangles.push_back({ring(stacks - 1, i), south, ring(stacks - 1, i + 1)});
+  }
+  return {MeshInfo{"body", MeshRole::Skin, points.size(), triangles}, points};
+}
+
+double luminance(const std::uint8_t* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
+
+TEST(HeadlessLight, TheUndersideOfABodyIsNoBrighterThanItsFrontAtTheSilhouette) {
+  // The key light comes from above: the underside of a sphere is in its shade. Near the
+  // lower silhouette the smoothed normals of the faces the camera sees lean away from it;
+  // turned towards the camera by their own sign they would face the light, as bright
+  // specks along every silhouette and crease.
+  const auto [sphere, at] = coarseSphere(Vec3::Zero(), 0.3, 10, 6);
+  HeadlessRenderer renderer({sphere}, kW, kH);
+  Frame f;
+  f.positions = {at};
+  f.states = {{}};
+  ViewSettings view;
+  view.azimuthDeg = 0.0;
+  view.elevationDeg = 0.0;
+  OverlaySettings overlay;
+  overlay.floor = false;
+  overlay.shadows = false;
+  const Image image = renderer.render(f, view, overlay);
+  const Box disc = projectedBox(renderer.renderer().camera(kW, kH, view), at);
+  const int cx = (disc.x0 + disc.x1) / 2, cy = (disc.y0 + disc.y1) / 2;
+  ASSERT_FALSE(isBackground(image, cx, cy));
+  const double front = luminance(image.pixel(cx, cy));
+  double brightestBelow = 0;
+  int drawnBelow = 0;
+  for (int y = cy + (disc.y1 - cy) / 2; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (!isBackground(image, x, y)) {
+        ++drawnBelow;
+        brightestBelow = std::max(brightestBelow, luminance(image.pixel(x, y)));
+      }
+  ASSERT_GT(drawnBelow, 100) << "the sphere's lower part is drawn";
+  EXPECT_LT(brightestBelow, front) << "a pixel of the underside is brighter than the front facing the camera";
 }
 
 TEST(HeadlessErrors, BadSizesAndTopologiesAreRefused) {

@@ -491,8 +491,11 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
   countNearest();  // not the penalty flags: those belong to the tests' responses
 }
 
-void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::size_t i, const Vec3& c1, double dt_s,
-                                 ClothState& io) {
+// Flattened: at -O3 GCC 12 left Eigen's fixed-size vector arithmetic and the sliding
+// response as calls in a function this large, a fifth of the walking dress's collision
+// time (docs/PERFORMANCE.md, ninth round).
+[[gnu::flatten]] void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::size_t i,
+                                                  const Vec3& c1, double dt_s, ClothState& io) {
   const field::DistanceField& f = *parts_[k].field;
   PointState& state = states_[k][i];
   Vec3& last = lastVoxel_[k][i];

@@ -1,8 +1,11 @@
 // `drape render OUTDIR --png DIR [--video out.mp4] [--contact-sheet sheet.png] [--size WxH]`:
 // pictures of a finished run, rendered headless (EGL surfaceless; no display needed).
 
+#include <cstdint>
+#include <exception>
 #include <filesystem>
 #include <iostream>
+#include <string>
 
 #include <unistd.h>
 
@@ -17,11 +20,37 @@
 namespace drape::cli {
 namespace {
 
+/// `--range FIRST:LAST`, `FIRST:` or `:LAST` into the job's first and last frame (-1: the end).
+void parseRange(const std::string& text, render::RenderJob& job) {
+  const auto bad = [&] {
+    return Error(fmt::format("--range {}: expected FIRST:LAST, frame numbers from 0 (FIRST: renders to the end)", text));
+  };
+  const std::size_t colon = text.find(':');
+  if (colon == std::string::npos) throw bad();
+  const auto number = [&](const std::string& part, std::int64_t fallback) -> std::int64_t {
+    if (part.empty()) return fallback;
+    std::size_t used = 0;
+    long long value = 0;
+    try {
+      value = std::stoll(part, &used);
+    } catch (const std::exception&) {
+      throw bad();
+    }
+    if (used != part.size() || value < 0) throw bad();
+    return value;
+  };
+  job.firstFrame = number(text.substr(0, colon), 0);
+  job.lastFrame = number(text.substr(colon + 1), -1);
+  if (job.lastFrame >= 0 && job.lastFrame < job.firstFrame)
+    throw Error(fmt::format("--range {}: the last frame comes before the first", text));
+}
+
 struct RenderOptions {
   std::string run;
   std::string motion;
   std::string runOut;
   long frames = 0;
+  std::string range;
   std::string png;
   std::string video;
   std::string sheet;
@@ -38,6 +67,9 @@ RunFunction setupRender(CLI::App& app) {
   app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc)");
   app.add_option("--frames", o.frames, "With a scene: frames to simulate (default: the lead-in and the whole motion)");
   app.add_option("--run-out", o.runOut, "With a scene: keep the simulated run in this directory (default: a temporary one)");
+  app.add_option("--range", o.range,
+                 "Only the run's frames FIRST:LAST (0-based, inclusive; FIRST: to the end), for every output; the "
+                 "camera frames the whole run");
   app.add_option("--png", o.png, "Write every frame as DIR/frame_00000.png ...");
   app.add_option("--video", o.video, "Encode every frame as an H.264 MP4 (needs the ffmpeg command)");
   app.add_option("--contact-sheet", o.sheet, "Write a 4x4 grid of evenly spaced frames with their time codes");
@@ -52,6 +84,8 @@ RunFunction setupRender(CLI::App& app) {
     if (o.png.empty() && o.video.empty() && o.sheet.empty()) {
       throw Error("drape render: nothing to write: give --png DIR, --video FILE.mp4 or --contact-sheet FILE.png");
     }
+    render::RenderJob job;
+    if (!o.range.empty()) parseRange(o.range, job);
     // A scene is simulated first, exactly as `drape run` does, into a run directory.
     std::string runDir = o.run;
     std::filesystem::path scratch;
@@ -70,8 +104,10 @@ RunFunction setupRender(CLI::App& app) {
       (void)simulateRun(setup);
     } else if (!o.motion.empty()) {
       throw Error("--motion: drape render takes a motion only with a scene file, not a run directory");
+    } else if (o.frames > 0) {
+      throw Error("--frames: drape render simulates frames only from a scene file; for some of a run's frames, "
+                  "--range FIRST:LAST");
     }
-    render::RenderJob job;
     std::tie(job.width, job.height) = o.picture.parsedSize();
     std::tie(job.sheetWidth, job.sheetHeight) = PictureOptions::parseSize(o.sheetSize, "--sheet-size");
     job.pngDirectory = o.png;

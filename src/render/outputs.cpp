@@ -138,6 +138,9 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
   checkSize(job.sheetWidth, job.sheetHeight, "contact sheet size");
   RunReplay replay(runDirectory);
   const std::int64_t frames = *replay.frameCount();
+  const std::int64_t first = job.firstFrame, last = job.lastFrame < 0 ? frames - 1 : job.lastFrame;
+  if (first < 0 || first > last || last >= frames)
+    throw Error(fmt::format("--range {}:{}: the run {} has frames 0 to {}", first, last, runDirectory, frames - 1));
   ViewSettings view = job.view;
   if (!view.bounds) view.bounds = replay.bounds();
   const std::vector<Aabb> follow = job.follow ? followFraming(replay) : std::vector<Aabb>{};
@@ -163,8 +166,8 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
 
   // Every frame, for PNG files and the video.
   if (!job.pngDirectory.empty() || video) {
-    Progress progress("render", frames);
-    for (std::int64_t i = 0; i < frames; ++i) {
+    Progress progress("render", last - first + 1);
+    for (std::int64_t i = first; i <= last; ++i) {
       replay.read(i, frame);
       HudInfo hud = hudFor(frame, replay);
       hud.show = job.hud;
@@ -173,7 +176,7 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
         writePng((fs::path(job.pngDirectory) / fmt::format("frame_{:05d}.png", i)).string(), image);
       if (video) video->write(image);
       ++summary.frames;
-      progress.update(i + 1);
+      progress.update(i - first + 1);
     }
     if (video) video->finish();
   }
@@ -190,7 +193,8 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
     sheet.rgb.resize(static_cast<std::size_t>(sheet.width) * static_cast<std::size_t>(sheet.height) * 3);
     for (std::size_t p = 0; p < sheet.rgb.size(); ++p) sheet.rgb[p] = kSheetBackground[p % 3];
     renderer.resize(tileW, tileH);
-    summary.sheetFrames = contactSheetFrames(frames);
+    summary.sheetFrames = contactSheetFrames(last - first + 1);
+    for (std::int64_t& index : summary.sheetFrames) index += first;
     for (int t = 0; t < kSheetTiles; ++t) {
       const std::int64_t index = summary.sheetFrames[static_cast<std::size_t>(t)];
       replay.read(index, frame);

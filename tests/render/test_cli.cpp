@@ -48,6 +48,35 @@ TEST(RenderCli, PngFramesAtTheAskedSize) {
   EXPECT_FALSE(fs::exists(dir + "/png/frame_00006.png"));
 }
 
+TEST(RenderCli, ARangeRendersThoseFramesAsTheWholeRunDoes) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_range"), 8);
+  Result r = run(drape() + " render " + dir + " --png " + dir + "/all --size 160x120 --follow");
+  ASSERT_EQ(r.status, 0) << r.output;
+  r = run(drape() + " render " + dir + " --png " + dir + "/part --size 160x120 --follow --range 3:5");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("wrote 3 frames"), std::string::npos) << r.output;
+  for (int i = 0; i < 8; ++i) {
+    const std::string name = "/frame_0000" + std::to_string(i) + ".png";
+    ASSERT_EQ(fs::exists(dir + "/part" + name), i >= 3 && i <= 5) << name;
+    if (i < 3 || i > 5) continue;
+    // The camera frames the whole run: the same picture as in the whole run's render.
+    EXPECT_EQ(readPng(dir + "/part" + name).rgb, readPng(dir + "/all" + name).rgb) << name;
+  }
+  // To the end, on a contact sheet: its tiles come from the range only.
+  r = run(drape() + " render " + dir + " --contact-sheet " + dir + "/sheet.png --range 6:");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("(frames 6 6 6 6 6 6 6 6 7 7 7 7 7 7 7 7)"), std::string::npos) << r.output;
+  // Ranges that are not in the run, or not ranges, and --frames without a scene.
+  for (const std::string bad : {"5:3", "0:8", "3", "a:4", "-1:2"}) {
+    r = run(drape() + " render " + dir + " --png " + dir + "/bad --range " + bad);
+    EXPECT_EQ(r.status, 2) << bad;
+    EXPECT_NE(r.output.find("--range " + bad), std::string::npos) << r.output;
+  }
+  r = run(drape() + " render " + dir + " --png " + dir + "/bad --frames 3");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("--range FIRST:LAST"), std::string::npos) << r.output;
+}
+
 TEST(RenderCli, VideoHasEveryFrame) {
   if (!have("ffmpeg") || !have("ffprobe")) GTEST_SKIP() << "ffmpeg is not installed (scripts/install-deps installs it)";
   const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_video"), 17);

@@ -22,6 +22,11 @@ struct RenderJob {
   bool hud = true;  ///< time code and frame on PNG and video frames
   double orbitDeg = 0.0;  ///< the camera turns this far about the vertical from first to last frame
   bool follow = false;    ///< the camera follows the characters (followFraming) instead of framing the whole run
+  /// The run's frames to render, 0-based and inclusive (`drape render --range`); the last
+  /// one negative: to the end. The camera frames the whole run either way, so a frame looks
+  /// the same whichever range it is rendered in, and PNG files keep the run's frame numbers.
+  std::int64_t firstFrame = 0;
+  std::int64_t lastFrame = -1;
   ViewSettings view;
   OverlaySettings overlay;
 };
@@ -34,7 +39,8 @@ struct RenderSummary {
 };
 
 /// Renders a run directory (see RunReplay) as the job asks. Throws drape::Error on a bad
-/// run, an unwritable path, or an ffmpeg failure (with its last message line).
+/// run, a range outside it, an unwritable path, or an ffmpeg failure (with its last message
+/// line).
 RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job);
 
 /// The 16 frame indices a contact sheet of `frames` frames shows: evenly spaced from the

@@ -1,11 +1,12 @@
 // `drape render OUTDIR --png DIR [--video out.mp4] [--contact-sheet sheet.png] [--size WxH]`:
 // pictures of a finished run, rendered headless (EGL surfaceless; no display needed).
 
+#include <charconv>
 #include <cstdint>
-#include <exception>
 #include <filesystem>
 #include <iostream>
 #include <string>
+#include <string_view>
 
 #include <unistd.h>
 
@@ -20,29 +21,24 @@
 namespace drape::cli {
 namespace {
 
-/// `--range FIRST:LAST`, `FIRST:` or `:LAST` into the job's first and last frame (-1: the end).
+/// `--range FIRST:LAST`, `FIRST:` or `:LAST` into the job's first and last frame (-1: the
+/// end); renderRun checks the range against the run.
 void parseRange(const std::string& text, render::RenderJob& job) {
   const auto bad = [&] {
     return Error(fmt::format("--range {}: expected FIRST:LAST, frame numbers from 0 (FIRST: renders to the end)", text));
   };
   const std::size_t colon = text.find(':');
   if (colon == std::string::npos) throw bad();
-  const auto number = [&](const std::string& part, std::int64_t fallback) -> std::int64_t {
+  const auto number = [&](std::string_view part, std::int64_t fallback) {
     if (part.empty()) return fallback;
-    std::size_t used = 0;
-    long long value = 0;
-    try {
-      value = std::stoll(part, &used);
-    } catch (const std::exception&) {
-      throw bad();
-    }
-    if (used != part.size() || value < 0) throw bad();
+    std::int64_t value = -1;
+    const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), value);
+    if (ec != std::errc{} || end != part.data() + part.size() || value < 0) throw bad();
     return value;
   };
-  job.firstFrame = number(text.substr(0, colon), 0);
-  job.lastFrame = number(text.substr(colon + 1), -1);
-  if (job.lastFrame >= 0 && job.lastFrame < job.firstFrame)
-    throw Error(fmt::format("--range {}: the last frame comes before the first", text));
+  const std::string_view all(text);
+  job.firstFrame = number(all.substr(0, colon), 0);
+  job.lastFrame = number(all.substr(colon + 1), -1);
 }
 
 struct RenderOptions {

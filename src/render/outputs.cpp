@@ -139,8 +139,10 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
   RunReplay replay(runDirectory);
   const std::int64_t frames = *replay.frameCount();
   const std::int64_t first = job.firstFrame, last = job.lastFrame < 0 ? frames - 1 : job.lastFrame;
-  if (first < 0 || first > last || last >= frames)
-    throw Error(fmt::format("--range {}:{}: the run {} has frames 0 to {}", first, last, runDirectory, frames - 1));
+  const std::string range = fmt::format("--range {}:{}", first, job.lastFrame < 0 ? "" : std::to_string(last));
+  if (first < 0 || first >= frames || last >= frames)
+    throw Error(fmt::format("{}: the run {} has frames 0 to {}", range, runDirectory, frames - 1));
+  if (first > last) throw Error(fmt::format("{}: the last frame comes before the first", range));
   ViewSettings view = job.view;
   if (!view.bounds) view.bounds = replay.bounds();
   const std::vector<Aabb> follow = job.follow ? followFraming(replay) : std::vector<Aabb>{};

@@ -67,7 +67,7 @@ TEST(RenderCli, ARangeRendersThoseFramesAsTheWholeRunDoes) {
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("(frames 6 6 6 6 6 6 6 6 7 7 7 7 7 7 7 7)"), std::string::npos) << r.output;
   // Ranges that are not in the run, or not ranges, and --frames without a scene.
-  for (const std::string bad : {"5:3", "0:8", "3", "a:4", "-1:2"}) {
+  for (const std::string bad : {"5:3", "0:8", "9:", "3", "a:4", "-1:2"}) {
     r = run(drape() + " render " + dir + " --png " + dir + "/bad --range " + bad);
     EXPECT_EQ(r.status, 2) << bad;
     EXPECT_NE(r.output.find("--range " + bad), std::string::npos) << r.output;

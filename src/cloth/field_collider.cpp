@@ -412,7 +412,7 @@ void FieldCollider::collide(const ClothModel& model, double t0_s, double t1_s, C
       if (ballR2[i] >= 0) wake(k, i);
       if (roundVoxel(c1) == settled[i]) {
         settle(k, i, c1);
-      } else {
+      } else if (!slideOnPlane(k, frame, i, c1, interval_s, io)) {
         collidePoint(k, frame, i, c1, interval_s, io);
       }
     }
@@ -617,9 +617,48 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
     state = PointState::InsideVol;
   }
 
+  if (moved) at = slidingSample(k, i, c);  // the response reads the field where the point is to be
+  moveAndRespond(k, frame, i, c, at, moved, state == PointState::OnSurf, dt_s, io);
+  last = c;
+  ++field_.transitions[toIndex(from)][toIndex(state)];
+  if (state == PointState::InsideVol && !moved) rest(k, i, c);
+}
+
+[[gnu::flatten]] bool FieldCollider::slideOnPlane(std::size_t k, const PartFrame& frame, std::size_t i, const Vec3& c1, double dt_s,
+                                 ClothState& io) {
+  if (states_[k][i] != PointState::OnSurf || embedded_[k][i] || !contactPlanes_ || !clearanceSkip_) return false;
+  const ContactPlane& plane = planes_[k][i];
+  if (!plane.reaches(c1)) return false;
+  const field::DistanceField& f = *parts_[k].field;
+  Vec3& last = lastVoxel_[k][i];
+  const Vec3i v1 = roundVoxel(c1), v0 = roundVoxel(last);
+  if (!walkable(f, v1) || !walkable(f, v0)) return false;
+  field::FieldSample at{plane.distanceAt(c1), plane.normal};
+  if (at.distance_m > offsets_.t3_m || at.distance_m < offsets_.t0_m) return false;  // released, or projected
+  Vec3 c = c1;
+  const bool moved = at.distance_m < offsets_.t2_m;
+  if (moved) {
+    c += (offsets_.t2_m - at.distance_m) / f.voxelSize() * at.normal;
+    if (!plane.reaches(c)) return false;  // the full test reads the field there
+    at = {plane.distanceAt(c), plane.normal};
+  }
+  // From here on, collidePoint's sliding branch step for step (a walk within the box counted
+  // as there, each plane answer counted as slidingSample counts it).
+  settledVoxel_[k][i] = kNotSettled;
+  ++field_.traces;
+  field_.traceVoxels += static_cast<std::uint64_t>((v1 - v0).cwiseAbs().maxCoeff());
+  field_.planeEstimates += moved ? 2 : 1;
+  moveAndRespond(k, frame, i, c, at, moved, true, dt_s, io);
+  last = c;
+  ++field_.transitions[toIndex(PointState::OnSurf)][toIndex(PointState::OnSurf)];
+  return true;
+}
+
+void FieldCollider::moveAndRespond(std::size_t k, const PartFrame& frame, std::size_t i, const Vec3& c,
+                                   const field::FieldSample& at, bool moved, bool onSurf, double dt_s,
+                                   ClothState& io) {
   Vec3 world1;  // where the point is to be, in the world at the interval's end
   if (moved) {
-    at = slidingSample(k, i, c);  // the response reads the field where the point is to be
     world1 = frame.toWorld1.apply(c);
     addCorrection(i, world1 - io.position(i));
     corrected_.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(i)});
@@ -627,13 +666,10 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
     nearest_[i] = std::min(nearest_[i], at.distance_m);  // corrected pairs: applyCorrections
   }
   // A sliding point left above T2 keeps its velocity: the response would change nothing.
-  if (state == PointState::OnSurf && (moved || inContact(at))) {
+  if (onSurf && (moved || inContact(at))) {
     if (!moved) world1 = frame.toWorld1.apply(c);
     respondOnSurface(frame, c, world1, at, i, dt_s, io);
   }
-  last = c;
-  ++field_.transitions[toIndex(from)][toIndex(state)];
-  if (state == PointState::InsideVol && !moved) rest(k, i, c);
 }
 
 field::FieldSample FieldCollider::slidingSample(std::size_t k, std::size_t i, const Vec3& c) {

@@ -326,6 +326,18 @@ class FieldCollider final : public Collider {
                        ClothState& io);
   void collidePoint(std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& endVoxel, double dt_s,
                     ClothState& io);
+  /// collidePoint for a pair sliding on its contact plane, where the plane answers both its
+  /// reads and the point neither leaves the walkable box nor T3 nor goes below T0 (most of
+  /// the pairs that need a test): the same, step for step, without the rest of the per-pair
+  /// test. False, with nothing changed, for any other pair. Part of the clearance skip (its
+  /// walk is counted, not walked): off with it, and tested against the full test with it.
+  bool slideOnPlane(std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& endVoxel, double dt_s,
+                    ClothState& io);
+  /// The end of a pair's test at voxel coordinates c, with the field `at` read there: a moved
+  /// point's correction (else its distance for the penetration figures), and the velocity
+  /// response of a point on the surface in contact.
+  void moveAndRespond(std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& c,
+                      const field::FieldSample& at, bool moved, bool onSurf, double dt_s, ClothState& io);
   /// Pair (k, vertex) ends at voxel coordinates c1 in a voxel clear of T2: InsideVol.
   void stayInside(std::size_t k, std::size_t vertex, const Vec3& c1);
   /// Pair (k, vertex), settled in its voxel by stayInside, ends in it again: the same.

@@ -624,8 +624,9 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
   if (state == PointState::InsideVol && !moved) rest(k, i, c);
 }
 
-[[gnu::flatten]] bool FieldCollider::slideOnPlane(std::size_t k, const PartFrame& frame, std::size_t i, const Vec3& c1, double dt_s,
-                                 ClothState& io) {
+// Flattened as collidePoint is, for the same reason.
+[[gnu::flatten]] bool FieldCollider::slideOnPlane(std::size_t k, const PartFrame& frame, std::size_t i,
+                                                  const Vec3& c1, double dt_s, ClothState& io) {
   if (states_[k][i] != PointState::OnSurf || embedded_[k][i] || !contactPlanes_ || !clearanceSkip_) return false;
   const ContactPlane& plane = planes_[k][i];
   if (!plane.reaches(c1)) return false;

@@ -141,8 +141,8 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
   const std::int64_t first = job.firstFrame, last = job.lastFrame < 0 ? frames - 1 : job.lastFrame;
   const std::string range = fmt::format("--range {}:{}", first, job.lastFrame < 0 ? "" : std::to_string(last));
   if (first < 0 || first >= frames || last >= frames)
-    throw Error(fmt::format("{}: the run {} has frames 0 to {}", range, runDirectory, frames - 1));
-  if (first > last) throw Error(fmt::format("{}: the last frame comes before the first", range));
+    throw Error(fmt::format("{} is outside the run {}, which has frames 0 to {}", range, runDirectory, frames - 1));
+  if (first > last) throw Error(fmt::format("{} ends before it starts", range));
   ViewSettings view = job.view;
   if (!view.bounds) view.bounds = replay.bounds();
   const std::vector<Aabb> follow = job.follow ? followFraming(replay) : std::vector<Aabb>{};

@@ -996,7 +996,9 @@ TEST(FieldCollider, RestingBallsAreClearOfT2AndInsideTheWalkableBox) {
 
 TEST(FieldCollider, ClearanceSkipChangesNothing) {
   // Without resting balls in either: the reference, reading every distance, would give balls
-  // to the pairs the skip settles in their voxels, and walk less.
+  // to the pairs the skip settles in their voxels, and walk less. The skip also sends the
+  // sliding pairs their contact planes answer through slideOnPlane instead of the general
+  // test, so this compares the two paths too.
   const FieldCollisionCounters c = expectSameAsReference(
       [](FieldCollider& full) { full.setClearanceSkip(false); }, true, true,
       [](FieldCollider& both) { both.setRestingBalls(false); });

@@ -15,6 +15,7 @@
 #include "drape/render/run_replay.hpp"
 #include "drape/sim/body_skin.hpp"
 #include "drape/sim/character_world.hpp"
+#include "frames_ahead.hpp"
 #include "render_options.hpp"
 #include "run_setup.hpp"
 
@@ -31,8 +32,8 @@ struct PlayOptions {
   PictureOptions picture;
 };
 
-/// The live source: each frame steps the character's world once and hands the player the
-/// garments (with their collision states) and the body parts where they are.
+/// The live source: the character's world steps frame by frame on its own thread and the
+/// player receives the garments (with their collision states) and the body where they are.
 int playScene(const PlayOptions& o, render::PlayerOptions options) {
   RunSetup setup = runSetupFromScene(o.run);
   if (!setup.character)
@@ -55,34 +56,47 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
 
   std::unique_ptr<sim::BodySkin> skin;
   if (avatar->skin) skin = std::make_unique<sim::BodySkin>(*avatar, world.fields(), leastT0(world));
-  std::vector<RigidTransform> joints(avatar->joints.size());
-  long frame = 0;
-  render::CallbackSource source(meshes, step.frameRate_hz, [&](render::Frame& out) {
+  // The simulation runs on a thread of its own, a few frames ahead of the window, which
+  // poses the segments and the skin (fitted and tucked under the cloth) and draws.
+  const auto prepare = [&](FrameTaken& slot) {
+    slot.positions.resize(world.garmentCount());
+    slot.states.resize(world.garmentCount());
+    slot.joints.resize(avatar->joints.size());
+  };
+  FramesAhead ahead(kFramesAhead, 0, -1, prepare, [&](long frame, FrameTaken& taken) {
     if (frame > 0 && !world.stepFrame(frame)) {
       spdlog::error("{}", world.instability());
       return false;
     }
-    out.time = TimeCode{frame, step.frameRate_hz};
+    taken.frame = frame;
+    for (std::size_t g = 0; g < world.garmentCount(); ++g) {
+      world.solver(g).state().copyPositions(taken.positions[g]);
+      garmentVertexStates(world.solver(g), world.collider(g), taken.states[g]);
+    }
+    world.poses().evaluate(world.frameTime(frame), taken.joints);
+    return true;
+  });
+  std::vector<sim::GarmentSurface> garments;
+  render::CallbackSource source(meshes, step.frameRate_hz, [&](render::Frame& out) {
+    const FrameTaken* taken = ahead.next();
+    if (!taken) return false;
+    out.time = TimeCode{taken->frame, step.frameRate_hz};
     out.positions.resize(meshes.size());
     out.states.resize(meshes.size());
+    garments.clear();
     for (std::size_t g = 0; g < world.garmentCount(); ++g) {
-      world.solver(g).state().copyPositions(out.positions[g]);
-      garmentVertexStates(world.solver(g), world.collider(g), out.states[g]);
+      out.positions[g] = taken->positions[g];
+      out.states[g] = taken->states[g];
+      garments.push_back({taken->positions[g], world.garment(g).mesh.triangles});
     }
-    world.poses().evaluate(world.frameTime(frame), joints);
     for (std::size_t s = 0; s < avatar->segments.size(); ++s) {
       const scene::Segment& seg = avatar->segments[s];
       std::vector<Vec3>& p = out.positions[world.garmentCount() + s];
       p.clear();
-      for (const Vec3& v : seg.mesh.positions) p.push_back(joints[static_cast<std::size_t>(seg.joint)].apply(v));
+      const RigidTransform& pose = taken->joints[static_cast<std::size_t>(seg.joint)];
+      for (const Vec3& v : seg.mesh.positions) p.push_back(pose.apply(v));
     }
-    if (skin) {
-      std::vector<sim::GarmentSurface> garments;
-      for (std::size_t g = 0; g < world.garmentCount(); ++g)
-        garments.push_back({out.positions[g], world.garment(g).mesh.triangles});
-      skin->pose(joints, garments, out.positions.back());
-    }
-    ++frame;
+    if (skin) skin->pose(taken->joints, garments, out.positions.back());
     return true;
   });
   options.loop = false;

@@ -74,8 +74,8 @@ TEST(Run, BundledExampleWritesEverything) {
   EXPECT_LT(moved, -1e-4);
 
   const nlohmann::json stats = statsOf(out);
-  for (const char* key : {"frames", "substeps_per_frame", "ms_per_frame", "ms_per_stage", "energy", "max_strain",
-                          "nan_detected"})
+  for (const char* key : {"frames", "substeps_per_frame", "ms_per_frame", "loop_wall_ms_per_frame", "ms_per_stage",
+                          "energy", "max_strain", "nan_detected"})
     EXPECT_TRUE(stats.contains(key)) << key;
   for (const char* stage : {"forces", "integrate", "collide", "fixtures", "output"})
     EXPECT_TRUE(stats["ms_per_stage"].contains(stage)) << stage;
@@ -158,6 +158,25 @@ TEST(Run, UnstableRunExits3AndKeepsWhatItWrote) {
   EXPECT_EQ(stats["frames"], 0);
   EXPECT_EQ(formats::readPc2(out + "/garment.pc2").frames.size(), 1u);
   EXPECT_EQ(formats::readRunManifest(out).frames, 1);
+}
+
+TEST(Run, AWriteThatFailsMidRunStopsItWithTheFileNamed) {
+  // Frames are written while the next ones are simulated: a write that fails in frame 2
+  // (its OBJ's name taken by a directory) must stop the run with that file named, not
+  // hang the simulation waiting for it or lose the message, and keep what was written.
+  ScratchDir dir("run-write-fails");
+  const std::string out = dir / "out";
+  std::filesystem::create_directories(out + "/frames/frame_00002.obj");
+  const CliResult r = runDrape("--quiet run --garment '" + kDress + "' --units dm --pin-mask '" + kMask +
+                                   "' --substeps auto --frames 6 --every 1 --out '" + out + "'",
+                               dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("frame_00002.obj: cannot be written"), std::string::npos) << r.err;
+  EXPECT_EQ(lineCount(r.err), 1) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(out + "/frames/frame_00001.obj"));
+  EXPECT_FALSE(std::filesystem::exists(out + "/frames/frame_00003.obj"));
+  // The cache holds the frames up to the failed one, whose cache frame came first.
+  EXPECT_EQ(formats::readPc2(out + "/garment.pc2").frames.size(), 3u);
 }
 
 TEST(Run, AnUnstableFrameIsComputedAgainWithMoreSubsteps) {

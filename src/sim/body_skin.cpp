@@ -5,6 +5,8 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "drape/core/error.hpp"
 #include "drape/mesh/closest_point.hpp"
@@ -20,6 +22,8 @@ constexpr float kLeastWeight = 0.05f;
 constexpr int kSteps = 8;
 /// Passes of the tuck: a pushed triangle's neighbours may then be nearest to the cloth.
 constexpr int kTuckPasses = 4;
+/// Vertices or cloth points per parallel task: a few microseconds of work each.
+constexpr std::size_t kGrain = 256;
 /// The tuck's grid cell: two cells around a point reach as deep as the tuck goes.
 constexpr double kCell_m = 0.5 * BodySkin::kTuckMost_m;
 
@@ -83,16 +87,20 @@ void BodySkin::pose(std::span<const RigidTransform> jointWorld, std::span<const 
 }
 
 void BodySkin::fit(std::vector<Vec3>& out, std::span<const RigidTransform> jointWorld) {
-  for (std::size_t v = 0; v + 1 < first_.size(); ++v) {
-    if (first_[v] == first_[v + 1]) continue;
-    // Steps towards the nearest part by the excess; where the field bends (a crease between
-    // two parts, the nearest part changing) one step falls short, so repeat.
-    for (int step = 0; step < kSteps; ++step) {
-      const Nearest n = nearestPart(v, out[v], jointWorld);
-      if (!(n.distance_m > allowance_m_) || !std::isfinite(n.distance_m)) break;
-      out[v] -= (n.distance_m - allowance_m_) * n.away;
+  // Each vertex moves by its own reads alone: in parallel, the same result on any number
+  // of threads.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, first_.size() - 1, kGrain), [&](const auto& range) {
+    for (std::size_t v = range.begin(); v != range.end(); ++v) {
+      if (first_[v] == first_[v + 1]) continue;
+      // Steps towards the nearest part by the excess; where the field bends (a crease
+      // between two parts, the nearest part changing) one step falls short, so repeat.
+      for (int step = 0; step < kSteps; ++step) {
+        const Nearest n = nearestPart(v, out[v], jointWorld);
+        if (!(n.distance_m > allowance_m_) || !std::isfinite(n.distance_m)) break;
+        out[v] -= (n.distance_m - allowance_m_) * n.away;
+      }
     }
-  }
+  });
 }
 
 void BodySkin::sampleGarments(std::span<const GarmentSurface> garments) {
@@ -128,9 +136,24 @@ bool BodySkin::tuck(std::vector<Vec3>& out) {
   // The skin only moves in, away from the cloth: the next pass looks again only where this
   // one pushed (a pushed triangle's neighbour may be the nearest now, or the push fell short
   // where the cloth's points pushed a triangle from its corners' sides).
+  // Where each point wants the skin, in parallel (reads only); then the pushes, in the
+  // points' order (a maximum per vertex: the same on any number of threads).
+  asks_.resize(active_.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, active_.size(), kGrain), [&](const auto& range) {
+    for (std::size_t j = range.begin(); j != range.end(); ++j) asks_[j] = tuckUnder(samples_[active_[j]], out);
+  });
+  const std::vector<mesh::Triangle>& triangles = avatar_.skin->mesh.triangles;
   std::size_t kept = 0;
-  for (const std::uint32_t i : active_)
-    if (tuckUnder(samples_[i], out) > 0) active_[kept++] = i;
+  for (std::size_t j = 0; j < active_.size(); ++j) {
+    const Ask& ask = asks_[j];
+    if (!(ask.depth > 0)) continue;
+    active_[kept++] = active_[j];
+    if (!ask.push) continue;
+    // The whole triangle in by the depth: the skin's triangles are about as large as the
+    // spacing of the cloth's points, so one point may be all that reaches a triangle.
+    for (const std::uint32_t corner : triangles[ask.face])
+      if (tuckable_[corner]) push_[corner] = std::max(push_[corner], ask.depth);
+  }
   active_.resize(kept);
   bool moved = false;
   for (std::size_t v = 0; v < out.size(); ++v) {
@@ -143,10 +166,10 @@ bool BodySkin::tuck(std::vector<Vec3>& out) {
   return moved;
 }
 
-double BodySkin::tuckUnder(const Vec3& p, std::vector<Vec3>& out) {
+BodySkin::Ask BodySkin::tuckUnder(const Vec3& p, const std::vector<Vec3>& out) const {
   constexpr double kFar = -std::numeric_limits<double>::infinity();
   const std::int64_t nearest = nearestTuckable(p);
-  if (nearest < 0) return kFar;
+  if (nearest < 0) return {kFar, 0, false};
   // The nearest skin triangle around the nearest tuckable vertex.
   const std::vector<mesh::Triangle>& triangles = avatar_.skin->mesh.triangles;
   const auto v = static_cast<std::size_t>(nearest);
@@ -170,12 +193,7 @@ double BodySkin::tuckUnder(const Vec3& p, std::vector<Vec3>& out) {
   const Vec3 n = w.x() * normals_[t[0]] + w.y() * normals_[t[1]] + w.z() * normals_[t[2]];
   const double distance = std::sqrt(best);
   const double depth = kTuckMargin_m - ((p - closest).dot(n) < 0 ? -distance : distance);  // how far to push in
-  if (!(depth > 0) || depth > kTuckMost_m || !outsideTheParts(p)) return depth;
-  // The whole triangle in by the depth: the skin's triangles are about as large as the
-  // spacing of the cloth's points, so one point may be all that reaches a triangle.
-  for (const std::uint32_t corner : t)
-    if (tuckable_[corner]) push_[corner] = std::max(push_[corner], depth);
-  return depth;
+  return {depth, face, depth > 0 && depth <= kTuckMost_m && outsideTheParts(p)};
 }
 
 void BodySkin::buildGrid(const std::vector<Vec3>& out) {

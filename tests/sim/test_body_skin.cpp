@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <tbb/global_control.h>
+
 #include "drape/field/shapes.hpp"
 #include "drape/mesh/closest_point.hpp"
 #include "drape/motion/animation.hpp"
@@ -110,6 +112,48 @@ TEST(BodySkin, NoVertexStandsOutOfTheCollidablePartsBeyondTheAllowance) {
   std::printf("hip creases: skinned up to %.1f mm out of the parts, fitted %.1f mm exactly and %.1f mm as the fields "
               "read (allowance %.1f mm), %zu checks\n",
               1e3 * worstSkinned, 1e3 * worstFitted, 1e3 * worstRead, 1e3 * kAllowance, checked);
+}
+
+TEST(BodySkin, TheSameOnOneThreadAsOnSeveral) {
+  // The fit and the tuck's reads run in parallel; the result may not depend on it. Cloth:
+  // the fitted skin itself from the waist to the knees, 1 mm out along its normals (inside
+  // the tuck's 2 mm margin), thousands of points for the tuck to look at.
+  const Walk& w = skirtWalk();
+  std::vector<RigidTransform> pose(w.avatar.joints.size());
+  w.animation.evaluate(60, 0.0, pose);
+  BodySkin fitter(w.avatar, w.fields, kAllowance);
+  std::vector<Vec3> fitted;
+  fitter.pose(pose, fitted);
+  const std::vector<mesh::Triangle>& triangles = w.avatar.skin->mesh.triangles;
+  std::vector<Vec3> normals;
+  mesh::vertexNormals(fitted, triangles, normals);
+  mesh::TriMesh cloth;
+  for (std::size_t v = 0; v < fitted.size(); ++v) cloth.positions.push_back(fitted[v] + 0.001 * normals[v]);
+  const double waist = pose[0].translation.y() + 0.1, knees = waist - 0.55;
+  for (const mesh::Triangle& t : triangles)
+    if (std::all_of(t.begin(), t.end(), [&](std::uint32_t v) { return fitted[v].y() < waist && fitted[v].y() > knees; }))
+      cloth.triangles.push_back(t);
+  ASSERT_GT(cloth.triangles.size(), 3000u);
+  const GarmentSurface garment{cloth.positions, cloth.triangles};
+  const auto tucked = [&] {
+    BodySkin skin(w.avatar, w.fields, kAllowance);
+    std::vector<Vec3> out;
+    skin.pose(pose, std::span(&garment, 1), out);
+    return out;
+  };
+  std::vector<Vec3> serial;
+  {
+    const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    serial = tucked();
+  }
+  for (int run = 0; run < 3; ++run) {  // a race shows in some runs only
+    const std::vector<Vec3> parallel = tucked();
+    ASSERT_EQ(parallel.size(), serial.size());
+    for (std::size_t v = 0; v < serial.size(); ++v) ASSERT_EQ(parallel[v], serial[v]) << "vertex " << v << ", run " << run;
+  }
+  std::size_t pushed = 0;
+  for (std::size_t v = 0; v < serial.size(); ++v) pushed += serial[v] != fitted[v];
+  EXPECT_GT(pushed, 500u) << "the tuck must have work to do for the comparison to mean anything";
 }
 
 // The tuck on concentric spheres, where every distance is known: a part of radius 5 cm, a

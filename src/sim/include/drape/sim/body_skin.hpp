@@ -80,9 +80,15 @@ class BodySkin {
   void sampleGarments(std::span<const GarmentSurface> garments);
   /// One pass of the tuck over the active samples; false when nothing was pushed.
   bool tuck(std::vector<Vec3>& out);
-  /// Pushes the skin under cloth point p; returns how far in it must go (negative: p
-  /// stands that much further out than the margin; -infinity: no skin within reach).
-  double tuckUnder(const Vec3& p, std::vector<Vec3>& out);
+  /// What cloth point p asks of the skin: how far in the skin must go under it (negative:
+  /// p stands that much further out than the margin; -infinity: no skin within reach), the
+  /// skin triangle nearest p, and whether that triangle is to be pushed in by the depth.
+  struct Ask {
+    double depth = 0.0;
+    std::uint32_t face = 0;
+    bool push = false;
+  };
+  [[nodiscard]] Ask tuckUnder(const Vec3& p, const std::vector<Vec3>& out) const;
   void buildGrid(const std::vector<Vec3>& out);
   /// The tuckable vertex nearest p within a grid cell's reach, or -1.
   [[nodiscard]] std::int64_t nearestTuckable(const Vec3& p) const;
@@ -106,6 +112,7 @@ class BodySkin {
   std::vector<Vec3> samples_;           ///< points of the cloth
   std::vector<std::uint8_t> used_;      ///< per garment vertex: in a triangle
   std::vector<std::uint32_t> active_;  ///< the samples a pass looks at
+  std::vector<Ask> asks_;               ///< per active sample, this pass
   std::vector<std::uint32_t> cellFirst_, cellVertices_, cellNext_;
   std::vector<double> cellX_, cellY_, cellZ_;  ///< the vertices' positions in cell order
   Vec3 gridOrigin_ = Vec3::Zero();

@@ -95,6 +95,7 @@ struct GarmentRun {
   std::unique_ptr<formats::Pc2Writer> cache;
   std::unique_ptr<formats::StateCacheWriter> states;  ///< per vertex and frame: collision state, pinned, bound
   std::vector<std::vector<Vec3>> frames;            ///< every frame, for result.wrl
+  std::vector<cloth::SphereCollider> spheres;       ///< its own static spheres (--sphere)
 };
 
 /// One avatar body part written as a deforming mesh: rest topology and a cache of world
@@ -463,8 +464,6 @@ int simulateRun(const RunSetup& setup) {
 
   // Build every garment (topology checks happen here: non-manifold, degenerate). On a
   // character, the world builds the part fields, binds the masks and owns the solvers.
-  std::vector<cloth::SphereCollider> spheres;
-  for (const SphereSetup& s : setup.spheres) spheres.emplace_back(s.centre_m, s.radius_m);
   for (const GarmentSetup& g : setup.garments) (void)mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
   std::unique_ptr<sim::CharacterWorld> world = setup.character ? buildWorld(setup) : nullptr;
   const std::vector<sim::BodyOverlap> overlaps = world ? findOverlaps(setup, *world) : std::vector<sim::BodyOverlap>{};
@@ -490,7 +489,9 @@ int simulateRun(const RunSetup& setup) {
       r.solver = r.ownedSolver.get();
     }
     r.model = &r.solver->model();
-    for (cloth::SphereCollider& s : spheres) r.solver->addCollider(s);
+    // Each garment its own spheres: garments step in parallel, and a collider keeps counts.
+    r.spheres.reserve(setup.spheres.size());  // the solver keeps references
+    for (const SphereSetup& s : setup.spheres) r.solver->addCollider(r.spheres.emplace_back(s.centre_m, s.radius_m));
     const double stable = r.model->estimatedStableStep_s();
     if (r.model->addedMass_kg() > 0.0)
       spdlog::info("{}: mass scaling added {:.2f} % of its mass ({:.1f} g) on {} of {} vertices to keep the "
@@ -628,11 +629,12 @@ int simulateRun(const RunSetup& setup) {
     FramesAhead ahead(kFramesAhead, 0, setup.frames, prepare, [&](long frame, FrameTaken& taken) {
       if (frame > 0) {
         const Clock::time_point start = Clock::now();
+        const std::vector<std::uint8_t> stable =
+            sim::stepInParallel(runs.size(), frame, [&](std::size_t g) -> cloth::ClothSolver& { return *runs[g].solver; });
         for (std::size_t g = 0; g < runs.size() && unstable.empty(); ++g) {
-          const bool stable = runs[g].solver->stepFrame(frame);
           if (runs[g].solver->lastRefinement() > 1)
             spdlog::info("{}", cloth::describeRefinedFrame(*runs[g].solver, setup.garments[g].name));
-          if (!stable) {
+          if (!stable[g]) {
             unstable = describeInstability(runs[g], settings.maxSpeed_m_s, overlaps, frame);
             unstableNan = runs[g].solver->instability().nan;
           }

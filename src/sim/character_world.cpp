@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include <fmt/format.h>
+#include <tbb/parallel_for.h>
 
 #include "drape/core/error.hpp"
 #include "drape/core/log.hpp"
@@ -129,17 +130,22 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
       const auto it = std::find_if(fields_.begin(), fields_.end(), [&](const PartField& p) { return p.segment == name; });
       parts.push_back(static_cast<int>(it - fields_.begin()));
     }
-    std::vector<cloth::PinGroup> pins = bindMask(spec, parts);
+    // The garment's own poses of the parts: garments step in parallel, and a pose cache
+    // serves one thread.
+    GarmentRun run;
+    run.poses = std::make_unique<AvatarPoses>(avatar, keptApartMotion_ ? keptApartMotion_.get() : animation,
+                                              settings.leadIn_s);
+    for (const PartField& f : fields_) run.motions.push_back(std::make_shared<SegmentMotion>(*run.poses, f.joint));
+    std::vector<cloth::PinGroup> pins = bindMask(spec, parts, run.motions);
     if (!spec.pinned.empty()) {
       const auto& m = *model;
       pins.push_back(cloth::PinGroup::atRest(spec.pinned, m.restX(), m.restY(), m.restZ()));
     }
-    GarmentRun run;
     std::vector<cloth::CollisionPart> collisionParts;
     for (int p : parts) {
       const bool faces = std::find(spec.faceSamplesWith.begin(), spec.faceSamplesWith.end(), fields_[p].segment) !=
                          spec.faceSamplesWith.end();
-      collisionParts.push_back({fields_[p].segment, &fields_[p].field, partMotions_[p], faces});
+      collisionParts.push_back({fields_[p].segment, &fields_[p].field, run.motions[static_cast<std::size_t>(p)], faces});
     }
     run.collider = std::make_unique<cloth::FieldCollider>(spec.name, std::move(collisionParts), spec.offsets,
                                                           spec.material.staticFriction, spec.material.dynamicFriction,
@@ -302,7 +308,8 @@ std::vector<double> maskBlendWeights(const std::vector<double>& distance, std::s
 
 }  // namespace
 
-std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, const std::vector<int>& parts) const {
+std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, const std::vector<int>& parts,
+                                                      const std::vector<std::shared_ptr<const cloth::FixtureMotion>>& motions) const {
   // Each mask vertex must lie within the threshold of a collidable part (measured with the
   // distance fields) and from then on moves rigidly with the body (section 4.1). The paper
   // binds each vertex to its nearest part. Where a mask spans a joint, that tears the cloth
@@ -384,7 +391,7 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
     if (groups[k].vertices.empty()) continue;
     spdlog::debug("garment '{}': {} mask vertices follow '{}'", spec.name, groups[k].vertices.size(),
                   fields_[static_cast<std::size_t>(parts[k])].segment);
-    groups[k].motion = partMotions_[static_cast<std::size_t>(parts[k])];
+    groups[k].motion = motions[static_cast<std::size_t>(parts[k])];
     out.push_back(std::move(groups[k]));
   }
   if (blended > 0)
@@ -394,10 +401,11 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
 }
 
 bool CharacterWorld::stepFrame(long frame) {
-  for (GarmentRun& g : garments_) {
-    const bool stable = g.solver->stepFrame(frame);
+  const std::vector<std::uint8_t> stables = stepGarments(frame);
+  for (std::size_t i = 0; i < garments_.size(); ++i) {
+    const GarmentRun& g = garments_[i];
     if (g.solver->lastRefinement() > 1) spdlog::info("{}", cloth::describeRefinedFrame(*g.solver, g.spec.name));
-    if (!stable) {
+    if (!stables[i]) {
       instability_ = g.solver->instability().describe(g.spec.name, settings_.step.maxSpeed_m_s);
       // Where the vertex was held: most garments that blow up on a body do it in a pinch,
       // between parts whose offset surfaces overlap (docs/PHYSICS.md, examples/walking_dress).
@@ -407,6 +415,19 @@ bool CharacterWorld::stepFrame(long frame) {
     }
   }
   return true;
+}
+
+std::vector<std::uint8_t> CharacterWorld::stepGarments(long frame) {
+  return stepInParallel(garments_.size(), frame, [&](std::size_t g) -> cloth::ClothSolver& { return *garments_[g].solver; });
+}
+
+std::vector<std::uint8_t> stepInParallel(std::size_t count, long frame,
+                                         const std::function<cloth::ClothSolver&(std::size_t)>& solver) {
+  // Garments do not touch each other: each steps on whichever thread is free, with its own
+  // poses and colliders, and comes out the same on any number of threads.
+  std::vector<std::uint8_t> stable(count, 0);
+  tbb::parallel_for(std::size_t{0}, count, [&](std::size_t g) { stable[g] = solver(g).stepFrame(frame) ? 1 : 0; });
+  return stable;
 }
 
 }  // namespace drape::sim

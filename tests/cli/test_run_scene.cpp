@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 
 #include <nlohmann/json.hpp>
 
@@ -234,6 +235,49 @@ TEST(RunScene, WalkingSkirtWritesEverything) {
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << text;
   const nlohmann::json report = nlohmann::json::parse(text);
   EXPECT_EQ(report["errors"].get<int>(), 0) << text;
+}
+
+// Two garments step in parallel, each with its own poses and colliders: the walking
+// skirt twice over (garments do not touch each other) gives each copy exactly the skirt
+// alone, so nothing passes between garments stepping at the same time.
+TEST(RunScene, TwoGarmentsInParallelComeOutAsEachAlone) {
+  ScratchDir dir("run-two-garments");
+  std::string scene = slurp(kSkirtDir + "/scene.wrl");
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const std::size_t at = scene.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    scene.replace(at, from.size(), to);
+  };
+  replace("url \"../../data/", "url \"" + std::string(DRAPE_DATA_DIR) + "/");
+  replace("constraintMask IndexedFaceSet {", "constraintMask DEF SkirtMask IndexedFaceSet {");
+  scene += R"(
+DEF Skirt2 ClothSet {
+  cloth Shape { geometry USE SkirtMesh }
+  constraintMask USE SkirtMask
+  material USE Knit
+  avatar USE Body
+  collidesWith [ "LowerBack", "Hips", "LeftUpLeg", "RightUpLeg", "LeftLeg", "RightLeg" ]
+  maskTolerance 0.0005
+  bindThreshold 0.040
+}
+)";
+  const std::string twoScene = dir / "two.wrl";
+  std::ofstream(twoScene) << scene;
+  const std::string motion = " --motion '" + kSkirtDir + "/walk.bvh' --frames 20 --out '";
+  const CliResult one = runDrape("run '" + kSkirtDir + "/scene.wrl'" + motion + (dir / "one") + "'", dir);
+  ASSERT_EQ(one.code, 0) << one.err;
+  const CliResult two = runDrape("run '" + twoScene + "'" + motion + (dir / "two") + "'", dir);
+  ASSERT_EQ(two.code, 0) << two.err;
+  const formats::Pc2Cache alone = formats::readPc2(dir / "one/garment.pc2");
+  ASSERT_EQ(alone.frames.size(), 21u);
+  for (const char* name : {"garment-Skirt.pc2", "garment-Skirt2.pc2"}) {
+    const formats::Pc2Cache copy = formats::readPc2(dir / ("two/" + std::string(name)));
+    ASSERT_EQ(copy.frames.size(), alone.frames.size()) << name;
+    for (std::size_t f = 0; f < alone.frames.size(); ++f)
+      ASSERT_EQ(copy.frames[f], alone.frames[f]) << name << ", frame " << f;
+  }
+  EXPECT_GT((alone.frames.back()[0] - alone.frames.front()[0]).norm(), 1e-3) << "the skirt must move";
+  EXPECT_EQ(statsOf(dir / "two")["garments"].size(), 2u);
 }
 
 TEST(RunScene, MotionWithoutAvatarIsABadInput) {

@@ -12,6 +12,7 @@
 //
 // Used alike by `drape run`, the benchmarks and (later) the cloth server role.
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -97,6 +98,11 @@ struct PartField {
   field::DistanceField field;
 };
 
+/// Steps `count` solvers to `frame` in parallel (TBB); per solver, whether it stayed stable.
+/// The solvers must share nothing that changes (each garment has its own poses and colliders).
+std::vector<std::uint8_t> stepInParallel(std::size_t count, long frame,
+                                         const std::function<cloth::ClothSolver&(std::size_t)>& solver);
+
 class CharacterWorld {
  public:
   /// Builds the part fields, binds every garment's mask and establishes the initial
@@ -108,9 +114,11 @@ class CharacterWorld {
   CharacterWorld(const CharacterWorld&) = delete;
   CharacterWorld& operator=(const CharacterWorld&) = delete;
 
-  /// Computes frame `frame` (1-based) of every garment. False when a garment went unstable
-  /// (see instability()).
+  /// Computes frame `frame` (1-based) of every garment, the garments in parallel. False
+  /// when a garment went unstable (see instability()).
   bool stepFrame(long frame);
+  /// Steps every garment to `frame` in parallel; per garment, whether it stayed stable.
+  std::vector<std::uint8_t> stepGarments(long frame);
 
   [[nodiscard]] std::size_t garmentCount() const { return garments_.size(); }
   [[nodiscard]] const GarmentSpec& garment(std::size_t g) const { return garments_[g].spec; }
@@ -133,6 +141,8 @@ class CharacterWorld {
  private:
   struct GarmentRun {
     GarmentSpec spec;
+    std::unique_ptr<AvatarPoses> poses;  ///< its own pose cache: garments step in parallel
+    std::vector<std::shared_ptr<const cloth::FixtureMotion>> motions;  ///< per field, from poses
     std::unique_ptr<cloth::FieldCollider> collider;
     std::unique_ptr<cloth::ClothSolver> solver;
   };
@@ -140,7 +150,9 @@ class CharacterWorld {
   /// Corrects a copy of the motion so that settings_.keepApart's parts stay out of the fields'
   /// parts, and plays that copy.
   void keepBodyApart(const motion::AvatarAnimation& animation, const std::vector<GarmentSpec>& garments);
-  [[nodiscard]] std::vector<cloth::PinGroup> bindMask(const GarmentSpec& spec, const std::vector<int>& parts) const;
+  [[nodiscard]] std::vector<cloth::PinGroup> bindMask(
+      const GarmentSpec& spec, const std::vector<int>& parts,
+      const std::vector<std::shared_ptr<const cloth::FixtureMotion>>& motions) const;
 
   const scene::Avatar& avatar_;
   WorldSettings settings_;

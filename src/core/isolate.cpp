@@ -15,11 +15,12 @@
 
 #include "drape/core/error.hpp"
 
-#if defined(__SANITIZE_ADDRESS__)
-#define DRAPE_ASAN 1
+// Address and thread sanitizers reserve terabytes of shadow address space.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define DRAPE_SHADOW_MEMORY 1
 #elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define DRAPE_ASAN 1
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define DRAPE_SHADOW_MEMORY 1
 #endif
 #endif
 
@@ -45,9 +46,8 @@ bool writeAll(int fd, const char* data, std::size_t size) {
 
 [[noreturn]] void runChild(int fd, const std::function<std::string()>& work,
                            const IsolationLimits& limits) {
-#ifndef DRAPE_ASAN
-  // AddressSanitizer reserves terabytes of shadow address space, so the address-space
-  // limit applies to ordinary builds only.
+#ifndef DRAPE_SHADOW_MEMORY
+  // The address-space limit applies to builds without a sanitizer's shadow memory only.
   rlimit mem{limits.memoryBytes, limits.memoryBytes};
   ::setrlimit(RLIMIT_AS, &mem);
 #endif

@@ -1,10 +1,11 @@
 // `drape render OUTDIR --png DIR [--video out.mp4] [--contact-sheet sheet.png] [--size WxH]`:
 // pictures of a finished run, rendered headless (EGL surfaceless; no display needed).
 
-#include <charconv>
 #include <cstdint>
 #include <filesystem>
 #include <iostream>
+#include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -25,16 +26,16 @@ namespace {
 /// end); renderRun checks the range against the run.
 void parseRange(const std::string& text, render::RenderJob& job) {
   const auto bad = [&] {
-    return Error(fmt::format("--range {}: expected FIRST:LAST, frame numbers from 0 (FIRST: renders to the end)", text));
+    return Error(fmt::format(
+        "--range {} is not a range: expected FIRST:LAST, frame numbers from 0 (FIRST: renders to the end)", text));
   };
   const std::size_t colon = text.find(':');
   if (colon == std::string::npos) throw bad();
   const auto number = [&](std::string_view part, std::int64_t fallback) {
     if (part.empty()) return fallback;
-    std::int64_t value = -1;
-    const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), value);
-    if (ec != std::errc{} || end != part.data() + part.size() || value < 0) throw bad();
-    return value;
+    const std::optional<long long> value = wholeNumber(part, 0, std::numeric_limits<std::int64_t>::max());
+    if (!value) throw bad();
+    return static_cast<std::int64_t>(*value);
   };
   const std::string_view all(text);
   job.firstFrame = number(all.substr(0, colon), 0);

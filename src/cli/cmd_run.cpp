@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -66,16 +67,9 @@ std::vector<std::uint32_t> parseIndexList(const std::string& text) {
   std::stringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
-    std::size_t used = 0;
-    long long value = -1;
-    try {
-      value = std::stoll(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size() || value < 0 || value > 0xfffffffell)
-      throw Error(fmt::format("--pin-vertices: '{}' is not a vertex index (0-based, comma-separated)", item));
-    out.push_back(static_cast<std::uint32_t>(value));
+    const std::optional<long long> value = wholeNumber(item, 0, 0xfffffffell);
+    if (!value) throw Error(fmt::format("--pin-vertices: '{}' is not a vertex index (0-based, comma-separated)", item));
+    out.push_back(static_cast<std::uint32_t>(*value));
   }
   if (out.empty()) throw Error("--pin-vertices: the list is empty");
   std::sort(out.begin(), out.end());
@@ -103,16 +97,9 @@ std::vector<std::uint32_t> matchMask(const mesh::TriMesh& garment, const mesh::T
 
 int substepsFrom(const std::string& text) {
   if (text == "auto") return 0;
-  std::size_t used = 0;
-  long value = 0;
-  try {
-    value = std::stol(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || value < 1 || value > 100000)
-    throw Error(fmt::format("--substeps must be a whole number in [1, 100000] or 'auto', got '{}'", text));
-  return static_cast<int>(value);
+  const std::optional<long long> value = wholeNumber(text, 1, 100000);
+  if (!value) throw Error(fmt::format("--substeps must be a whole number in [1, 100000] or 'auto', got '{}'", text));
+  return static_cast<int>(*value);
 }
 
 /// --offsets for every garment, checked.

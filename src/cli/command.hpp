@@ -8,9 +8,12 @@
 // (after CLI11 has parsed and checked the options). That function returns the exit code;
 // a drape::Error thrown from it is printed on one line and becomes its exit code.
 
+#include <charconv>
 #include <functional>
+#include <optional>
 #include <ostream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -41,6 +44,19 @@ struct InspectorEntry {
   Inspector inspect;
 };
 [[nodiscard]] const std::vector<InspectorEntry>& registeredInspectors();
+
+/// `text` as a whole number in [least, most] (decimal digits, an optional leading '-',
+/// spaces around it allowed), or nothing: the one parser behind the options CLI11 cannot
+/// type, such as lists and ranges, so that "12x", "" and "1.5" are refused alike.
+[[nodiscard]] inline std::optional<long long> wholeNumber(std::string_view text, long long least, long long most) {
+  while (!text.empty() && text.front() == ' ') text.remove_prefix(1);
+  while (!text.empty() && text.back() == ' ') text.remove_suffix(1);
+  long long value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || ec != std::errc{} || end != text.data() + text.size() || value < least || value > most)
+    return std::nullopt;
+  return value;
+}
 
 /// Global options shared by every subcommand.
 struct GlobalOptions {

@@ -4,6 +4,7 @@
 // --motion (BVH, ASF/AMC) and its body parts collide through distance fields.
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -33,6 +34,7 @@ struct RunOptions {
   bool preview = false, countEverySubstep = false, exactSliding = false, freePinches = false;
   std::vector<std::string> faceSamplesWith, keepApart;
   std::string garment, units = "m", pinVertices, pinMask, out, substeps = "33", integrator = "symplectic-euler";
+  std::string strainLimit = "auto";
   std::string wind, gravity;
   std::vector<std::string> spheres;
   double pinTolerance_m = 1e-4;
@@ -102,6 +104,29 @@ int substepsFrom(const std::string& text) {
   return static_cast<int>(*value);
 }
 
+/// --strain-limit: 'auto' (strain limiting only from a frame no substeps keep stable on),
+/// 'none' (never: the run stops on such a frame) or a stretch (from the first frame).
+void applyStrainLimit(const std::string& text, cloth::StepSettings& s) {
+  if (text == "auto") {
+    s.strainLimit = 0.0;
+    s.rescueStrainLimit = cloth::StepSettings{}.rescueStrainLimit;
+    return;
+  }
+  if (text == "none") {
+    s.strainLimit = 0.0;
+    s.rescueStrainLimit = 0.0;
+    return;
+  }
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || ec != std::errc{} || end != text.data() + text.size() || !(value > 0.0 && value <= 10.0))
+    throw Error(fmt::format("--strain-limit must be 'auto', 'none' or a stretch beyond the rest length in (0, 10] "
+                            "(0.5: edges at most 1.5 times as long), got '{}'",
+                            text));
+  s.strainLimit = value;
+  s.rescueStrainLimit = 0.0;
+}
+
 /// --offsets for every garment, checked.
 void applyOffsets(const RunOptions& o, RunSetup& setup) {
   if (o.offsets.empty()) return;
@@ -135,6 +160,7 @@ void applyOverrides(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   if (app.count("--max-added-mass")) s.maxAddedMass = o.settings.maxAddedMass;
   if (app.count("--bend-every")) s.bendEvery = o.settings.bendEvery;
   if (app.count("--max-refinement")) s.maxRefinement = o.settings.maxRefinement;
+  if (app.count("--strain-limit")) applyStrainLimit(o.strainLimit, s);
   if (app.count("--integrator")) s.integrator = cloth::parseIntegrator(o.integrator, "--integrator");
   if (app.count("--wind")) s.wind_m_s = parseVec3(o.wind, "--wind");
   if (app.count("--gravity")) s.gravity_m_s2 = parseVec3(o.gravity, "--gravity");
@@ -171,6 +197,7 @@ void setupFromGarment(const RunOptions& o, RunSetup& setup, bool onAvatar) {
   setup.settings.integrator = cloth::parseIntegrator(o.integrator, "--integrator");
   if (!o.wind.empty()) setup.settings.wind_m_s = parseVec3(o.wind, "--wind");
   if (!o.gravity.empty()) setup.settings.gravity_m_s2 = parseVec3(o.gravity, "--gravity");
+  applyStrainLimit(o.strainLimit, setup.settings);
   setup.garments.push_back(std::move(garment));
 }
 
@@ -343,7 +370,13 @@ RunFunction setupRun(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--max-refinement", s.maxRefinement,
                  "A frame that goes unstable is computed again with 2, 4, ... up to this many times the substeps "
-                 "before the run stops on it (1: stop at once)")
+                 "before strain limiting comes on for it (--strain-limit auto) or the run stops on it (1: at once)")
+      ->capture_default_str();
+  app.add_option("--strain-limit", o->strainLimit,
+                 "Largest stretch of an edge beyond its rest length, held after every substep (0.5: at most 1.5 "
+                 "times as long), from the first frame; 'auto': only from a frame that goes unstable even with "
+                 "--max-refinement times the substeps (cloth crushed in a pinch), at 0.5, for the rest of the run; "
+                 "'none': never, the run stops on such a frame")
       ->capture_default_str();
   app.add_option("--sphere", o->spheres, "A static sphere collider x,y,z,radius (m); repeatable");
   return [o, &app] { return runCommand(app, *o); };

@@ -634,6 +634,9 @@ int simulateRun(const RunSetup& setup) {
         for (std::size_t g = 0; g < runs.size() && unstable.empty(); ++g) {
           if (runs[g].solver->lastRefinement() > 1)
             spdlog::info("{}", cloth::describeRefinedFrame(*runs[g].solver, setup.garments[g].name));
+          const std::string rescue =
+              cloth::describeStrainLimitRescue(*runs[g].solver, setup.garments[g].name, frame);
+          if (!rescue.empty()) spdlog::warn("{}", rescue);
           if (!stable[g]) {
             unstable = describeInstability(runs[g], settings.maxSpeed_m_s, overlaps, frame);
             unstableNan = runs[g].solver->instability().nan;
@@ -671,6 +674,7 @@ int simulateRun(const RunSetup& setup) {
     total.collide_s += t.collide_s;
     total.fixtures_s += t.fixtures_s + t.stability_s;
     total.fixturePoses_s += t.fixturePoses_s;
+    total.strainLimit_s += t.strainLimit_s;
   }
   const double perFrame = 1e3 / static_cast<double>(std::max<long>(1, static_cast<long>(frameMs.size())));
   nlohmann::json stats;
@@ -686,6 +690,7 @@ int simulateRun(const RunSetup& setup) {
                            {"integrate", total.integrate_s * perFrame},
                            {"collide", total.collide_s * perFrame},
                            {"fixtures", total.fixtures_s * perFrame},
+                           {"strain_limit", total.strainLimit_s * perFrame},
                            {"output", outputSeconds * 1e3 / static_cast<double>(energy.size())}};
   stats["energy"] = energy;
   stats["max_strain"] = maxStrain;
@@ -703,7 +708,11 @@ int simulateRun(const RunSetup& setup) {
                             {"added_mass_kg", m.addedMass_kg()},
                             {"mass_scaled_vertices", m.massScaledVertexCount()},
                             {"estimated_stable_substep_s", m.estimatedStableStep_s()},
-                            {"frames_refined", runs[g].solver->refinedFrames()}};
+                            {"frames_refined", runs[g].solver->refinedFrames()},
+                            {"strain_limit", runs[g].solver->strainLimit()},
+                            {"strain_limit_corrections", runs[g].solver->strainLimitCorrections()}};
+    const long limitedFrom = runs[g].solver->strainLimitedFrom();
+    entry["strain_limited_from_frame"] = limitedFrom > 0 ? nlohmann::json(limitedFrom) : nlohmann::json(nullptr);
     if (runs[g].collider) {
       const cloth::OffsetSurfaces& o = runs[g].collider->offsets();
       entry["offsets_m"] = {o.t0_m, o.t1_m, o.t2_m, o.t3_m};

@@ -66,6 +66,10 @@ void StepSettings::validate(const std::string& prefix) const {
   require(bendEvery >= 1 && bendEvery <= substepsPerFrame, prefix, "bend-every",
           fmt::format("in [1, {}] (the substeps per frame)", substepsPerFrame), bendEvery);
   require(maxRefinement >= 1 && maxRefinement <= 64, prefix, "max-refinement", "in [1, 64]", maxRefinement);
+  require(strainLimit >= 0.0 && strainLimit <= 10.0, prefix, "strain-limit",
+          "in [0, 10] (a stretch beyond the rest length)", strainLimit);
+  require(rescueStrainLimit >= 0.0 && rescueStrainLimit <= 10.0, prefix, "strain-limit",
+          "in [0, 10] (a stretch beyond the rest length)", rescueStrainLimit);
   if (!finite(gravity_m_s2)) throw Error(fmt::format("{}gravity must be finite", prefix));
   if (!finite(wind_m_s)) throw Error(fmt::format("{}wind must be finite", prefix));
 }

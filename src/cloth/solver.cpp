@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "drape/cloth/forces.hpp"
+#include "drape/cloth/strain_limit.hpp"
 #include "drape/core/error.hpp"
 
 namespace drape::cloth {
@@ -26,10 +27,14 @@ std::string Instability::describe(const std::string& garment, double bound) cons
                         frame, substep)
           : fmt::format("garment '{}': vertex {} reached {:.4g} m/s (bound {:.4g} m/s) in frame {}, substep {}",
                         garment, vertex, speed_m_s, bound, frame, substep);
-  if (refinement <= 1) return what;
-  return fmt::format("{} of {} (the frame computed again with {} times the substeps, after it went unstable with "
+  const std::string limited =
+      strainLimit > 0.0 ? fmt::format("edges held to {:.3g} times their rest length{}", 1.0 + strainLimit,
+                                      rescued ? " since the frame went unstable without" : "")
+                        : "";
+  if (refinement <= 1) return limited.empty() ? what : fmt::format("{} (with {})", what, limited);
+  return fmt::format("{} of {} (the frame computed again with {} times the substeps{}, after it went unstable with "
                      "fewer)",
-                     what, substepsPerFrame, refinement);
+                     what, substepsPerFrame, refinement, limited.empty() ? "" : " and " + limited);
 }
 
 ClothSolver::ClothSolver(std::shared_ptr<const ClothModel> model, const StepSettings& settings,
@@ -44,6 +49,10 @@ ClothSolver::ClothSolver(std::shared_ptr<const ClothModel> model, const StepSett
   settings_.validate("--");
   checkBendingStep(*model_, settings_);
   checkPinGroups();
+  strainLimit_ = settings_.strainLimit;
+  strainWeight_ = model_->inverseMass();
+  for (const PinGroup& g : pins_)
+    for (const std::uint32_t v : g.vertices) strainWeight_[v] = 0.0;  // placed by their fixtures
   const bool forwardEuler = settings_.integrator == IntegratorKind::ForwardEuler;
   if (model_->material().damping_s > 0.0 || forwardEuler) {
     std::vector<std::uint8_t> fixed(model_->vertexCount(), 0);
@@ -141,12 +150,27 @@ bool ClothSolver::stepFrame(long frame) {
   // The copy is of positions and velocities, 48 bytes a vertex (the skirt 13 KB, the dress
   // 106 KB) per frame, with no allocation after the first; the benchmark's figures did not
   // move with it.
-  const std::array<std::vector<double>*, 6> motion{&state_.x, &state_.y, &state_.z, &state_.vx, &state_.vy, &state_.vz};
-  if (settings_.maxRefinement > 1) {
+  const bool rescuable = strainLimit_ == 0.0 && settings_.rescueStrainLimit > 0.0;
+  if (settings_.maxRefinement > 1 || rescuable) {
+    const std::array<const std::vector<double>*, 6> motion{&state_.x,  &state_.y,  &state_.z,
+                                                           &state_.vx, &state_.vy, &state_.vz};
     for (std::size_t k = 0; k < motion.size(); ++k) frameStart_[k] = *motion[k];
     frameStartSubsteps_ = substepCount_;
     for (Collider* c : colliders_) c->beginFrame();
   }
+  if (climbRefinements(frame)) return true;
+  if (!rescuable) return false;
+  // Cloth that no substep keeps stable is cloth stretched far beyond its rest length (its
+  // stiffness grows with the stretch squared): the frame once more, with the stretch held
+  // to a limit from now on (strain_limit.hpp).
+  strainLimitedBecause_ = instability_;
+  strainLimit_ = settings_.rescueStrainLimit;
+  strainLimitedFrom_ = frame;
+  restartFrame(frame);
+  return climbRefinements(frame);
+}
+
+bool ClothSolver::climbRefinements(long frame) {
   lastRefinement_ = 1;
   for (int refinement = 1;; refinement *= 2) {
     if (runFrame(frame, refinement)) {
@@ -156,12 +180,17 @@ bool ClothSolver::stepFrame(long frame) {
     }
     if (refinement * 2 > settings_.maxRefinement) return false;
     if (refinement == 1) refinedBecause_ = instability_;
-    for (std::size_t k = 0; k < motion.size(); ++k) *motion[k] = frameStart_[k];
-    substepCount_ = frameStartSubsteps_;
-    // The frame's start as its first unrefined substep has it (runFrame).
-    const double t0 = static_cast<double>((frame - 1) * settings_.substepsPerFrame) * settings_.substep_s();
-    for (Collider* c : colliders_) c->restartFrame(state_, t0);
+    restartFrame(frame);
   }
+}
+
+void ClothSolver::restartFrame(long frame) {
+  const std::array<std::vector<double>*, 6> motion{&state_.x, &state_.y, &state_.z, &state_.vx, &state_.vy, &state_.vz};
+  for (std::size_t k = 0; k < motion.size(); ++k) *motion[k] = frameStart_[k];
+  substepCount_ = frameStartSubsteps_;
+  // The frame's start as its first unrefined substep has it (runFrame).
+  const double t0 = static_cast<double>((frame - 1) * settings_.substepsPerFrame) * settings_.substep_s();
+  for (Collider* c : colliders_) c->restartFrame(state_, t0);
 }
 
 bool ClothSolver::runFrame(long frame, int refinement) {
@@ -208,6 +237,12 @@ bool ClothSolver::substep(double t0, double t1, long frame, int substepIndex) {
   applyFixtures(t0, t1, dt);  // pinned vertices follow their transforms
   times_.fixtures_s += secondsSince(start);
 
+  if (strainLimit_ > 0.0) {
+    start = Clock::now();
+    limitStrain();  // no edge beyond the limit (after the fixtures, whose vertices it leaves where they are)
+    times_.strainLimit_s += secondsSince(start);
+  }
+
   start = Clock::now();
   const bool stable = checkStability(frame, substepIndex);  // NaN or speed bound
   times_.stability_s += secondsSince(start);
@@ -224,6 +259,10 @@ void ClothSolver::accumulateForces() {
   const int every = settings_.bendEvery;
   if (substepCount_++ % every == 0) accumulateBendingForces(*model_, state_, static_cast<double>(every));
   accumulateDragForces(*model_, settings_, state_);
+}
+
+void ClothSolver::limitStrain() {
+  strainLimitCorrections_ += cloth::limitStrain(*model_, strainWeight_, strainLimit_, kStrainLimitSweeps, state_);
 }
 
 void ClothSolver::integrate(double dt) { integrator_->advance(*model_, settings_.gravity_m_s2, dt, state_); }
@@ -287,8 +326,9 @@ bool ClothSolver::checkStability(long frame, int substepIndex) {
     const double p = x[i] + y[i] + z[i];
     const bool nan = !std::isfinite(s2) || !std::isfinite(p);
     if (nan || s2 > bound2) {
-      instability_ = {true, nan, static_cast<std::uint32_t>(i), nan ? 0.0 : std::sqrt(s2), frame, substepIndex,
-                      substepsPerFrame_, refinement_};
+      instability_ = {true,         nan,          static_cast<std::uint32_t>(i), nan ? 0.0 : std::sqrt(s2),
+                      frame,        substepIndex, substepsPerFrame_,             refinement_,
+                      strainLimit_, strainLimitedFrom_ > 0};
       return false;
     }
   }
@@ -302,6 +342,14 @@ std::string describeRefinedFrame(const ClothSolver& solver, const std::string& g
   return fmt::format("{}; computed again with {} times the substeps ({} per frame)",
                      solver.refinedBecause().describe(garment, s.maxSpeed_m_s), refinement,
                      refinement * s.substepsPerFrame);
+}
+
+std::string describeStrainLimitRescue(const ClothSolver& solver, const std::string& garment, long frame) {
+  if (frame == 0 || solver.strainLimitedFrom() != frame) return "";
+  return fmt::format("{}; computed again with its edges held to {:.3g} times their rest length (strain limiting), "
+                     "which stays on for the rest of the run",
+                     solver.strainLimitedBecause().describe(garment, solver.settings().maxSpeed_m_s),
+                     1.0 + solver.strainLimit());
 }
 
 double ClothSolver::totalEnergy() const {

@@ -405,6 +405,8 @@ bool CharacterWorld::stepFrame(long frame) {
   for (std::size_t i = 0; i < garments_.size(); ++i) {
     const GarmentRun& g = garments_[i];
     if (g.solver->lastRefinement() > 1) spdlog::info("{}", cloth::describeRefinedFrame(*g.solver, g.spec.name));
+    const std::string rescue = cloth::describeStrainLimitRescue(*g.solver, g.spec.name, frame);
+    if (!rescue.empty()) spdlog::warn("{}", rescue);
     if (!stables[i]) {
       instability_ = g.solver->instability().describe(g.spec.name, settings_.step.maxSpeed_m_s);
       // Where the vertex was held: most garments that blow up on a body do it in a pinch,

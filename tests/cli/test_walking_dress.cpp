@@ -89,11 +89,12 @@ TEST(WalkingDress, AnInstabilitySaysWhichPartsPinchedTheCloth) {
   // keeps the arms out of the body; --keep-apart none plays the motion as it is), and one
   // vertex lies on four parts' offset surfaces at once, with no place outside them all; the
   // cloth around it runs away (examples/walking_dress) unless the frame is computed again
-  // with more substeps (not here). The report names the pinch, not only the vertex.
+  // with more substeps or with strain limiting (neither here). The report names the pinch,
+  // not only the vertex.
   ScratchDir dir("walking-dress-pinch");
   const CliResult r = runDrape("run '" + kDressScene + "' --motion '" + kSource +
-                                   "/data/mocap/cmu_walk_delfem2.bvh' --keep-apart none --max-refinement 1 --every "
-                                   "1000 --out '" +
+                                   "/data/mocap/cmu_walk_delfem2.bvh' --keep-apart none --max-refinement 1 "
+                                   "--strain-limit none --every 1000 --out '" +
                                    (dir / "out") + "'",
                                dir);
   ASSERT_EQ(r.code, 3) << r.err;
@@ -111,6 +112,31 @@ TEST(WalkingDress, AnInstabilitySaysWhichPartsPinchedTheCloth) {
   for (const auto& o : stats["body_overlaps"])
     forearmInBack |= o["part"] == "LeftForeArm" && o["into"] == "LowerBack" && o["depth_m"].get<double>() > 0.01;
   EXPECT_TRUE(forearmInBack);
+}
+
+TEST(WalkingDress, WhereNoSubstepsKeepTheFrameStableItsEdgesAreHeldToALimit) {
+  // The pinch above, with the frame not computed again with more substeps: the frame is
+  // computed again with strain limiting (--strain-limit auto, the default), which stays on.
+  ScratchDir dir("walking-dress-rescued");
+  const CliResult r = runDrape("run '" + kDressScene + "' --motion '" + kSource +
+                                   "/data/mocap/cmu_walk_delfem2.bvh' --keep-apart none --max-refinement 1 "
+                                   "--frames 30 --every 1000 --out '" +
+                                   (dir / "out") + "'",
+                               dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("in frame 26, substep"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("; computed again with its edges held to 1.5 times their rest length (strain limiting), "
+                       "which stays on for the rest of the run"),
+            std::string::npos)
+      << r.err;
+  const nlohmann::json stats = statsOf(dir / "out");
+  EXPECT_EQ(stats["frames"].get<int>(), 30);
+  EXPECT_FALSE(stats["unstable"].get<bool>());
+  const nlohmann::json& g = stats["garments"][0];
+  EXPECT_EQ(g["strain_limited_from_frame"].get<int>(), 26);
+  EXPECT_EQ(g["strain_limit"].get<double>(), 0.5);
+  EXPECT_GT(g["strain_limit_corrections"].get<long>(), 0);
+  EXPECT_GT(stats["ms_per_stage"]["strain_limit"].get<double>(), 0.0);
 }
 
 TEST(WalkingDress, ThePinchIsWeatheredByComputingItsFramesAgain) {

@@ -71,6 +71,15 @@ struct StepSettings {
   /// start with 2, 4, ... times the substeps, up to this factor, before the instability is
   /// reported (ClothSolver::stepFrame); 1: reported at once, the fixed step as it is.
   int maxRefinement = 8;
+  /// Strain limiting (strain_limit.hpp) from the first frame: after each substep's
+  /// collisions and fixtures, no edge stays longer than (1 + strainLimit) times its rest
+  /// length; 0: none.
+  double strainLimit = 0.0;
+  /// A frame that goes unstable even with maxRefinement times the substeps is computed once
+  /// more from its start with strain limiting at this limit, which then stays on for the rest
+  /// of the run (ClothSolver::stepFrame); 0: the instability is reported instead. Without
+  /// effect when strainLimit is already on.
+  double rescueStrainLimit = 0.5;
 
   [[nodiscard]] double substep_s() const { return 1.0 / (frameRate_hz * substepsPerFrame); }
   /// What ClothModel::build needs to honour maxAddedMass.

@@ -30,6 +30,7 @@ struct StageTimes {
   double collide_s = 0.0;
   double fixtures_s = 0.0;
   double fixturePoses_s = 0.0;  ///< the part of fixtures_s spent asking for the fixtures' poses
+  double strainLimit_s = 0.0;   ///< strain limiting, once on (StepSettings::strainLimit, rescueStrainLimit)
   double stability_s = 0.0;
 };
 
@@ -45,6 +46,9 @@ struct Instability {
   /// How many times the settings' substeps that attempt took (StepSettings::maxRefinement):
   /// 1 unless the frame had gone unstable with fewer.
   int refinement = 1;
+  /// The strain limit on in that attempt (0: none), and whether the run's rescue turned it on.
+  double strainLimit = 0.0;
+  bool rescued = false;
   /// "garment 'dress': vertex 12 reached 73.2 m/s (bound 50 m/s) in frame 4, substep 17".
   [[nodiscard]] std::string describe(const std::string& garment, double bound_m_s) const;
 };
@@ -79,9 +83,11 @@ class ClothSolver {
   /// settings.substepsPerFrame substeps covering [(frame - 1) / fps, frame / fps]. When the
   /// guard trips, the frame is computed again from its start with twice the substeps, and
   /// again, up to settings.maxRefinement times as many (the colliders start the frame over,
-  /// Collider::restartFrame); the next frame goes back to the settings' substeps. Returns
-  /// false and fills instability() when the guard trips on the last attempt (the state is
-  /// left as it was at that substep).
+  /// Collider::restartFrame); the next frame goes back to the settings' substeps. When that
+  /// fails too and strain limiting is off, the frame is computed again with strain limiting
+  /// at settings.rescueStrainLimit, which then stays on (strainLimitedFrom()). Returns false
+  /// and fills instability() when the guard trips on the last attempt (the state is left as
+  /// it was at that substep).
   bool stepFrame(long frame);
   /// How many times the settings' substeps the last frame took (1: it was stable with them).
   [[nodiscard]] int lastRefinement() const { return lastRefinement_; }
@@ -89,6 +95,14 @@ class ClothSolver {
   [[nodiscard]] long refinedFrames() const { return refinedFrames_; }
   /// Why the last refined frame was computed again: the first attempt's instability.
   [[nodiscard]] const Instability& refinedBecause() const { return refinedBecause_; }
+  /// The strain limit on now (StepSettings::strainLimit, or the rescue's once it came; 0: none).
+  [[nodiscard]] double strainLimit() const { return strainLimit_; }
+  /// The frame the rescue turned strain limiting on in (0: it has not), and why: the
+  /// instability of that frame's last attempt without it.
+  [[nodiscard]] long strainLimitedFrom() const { return strainLimitedFrom_; }
+  [[nodiscard]] const Instability& strainLimitedBecause() const { return strainLimitedBecause_; }
+  /// Edge corrections strain limiting made so far (limitStrain's count).
+  [[nodiscard]] std::size_t strainLimitCorrections() const { return strainLimitCorrections_; }
 
   /// One substep over [t0, t0 + dt] (exposed for tests); returns false on instability.
   bool substep(double t0_s, long frame, int substepIndex);
@@ -115,8 +129,14 @@ class ClothSolver {
   [[nodiscard]] double totalEnergy() const;
 
  private:
+  /// The frame at 1, 2, 4, ... times the settings' substeps up to maxRefinement, each attempt
+  /// from the frame's start; false when the last attempt trips the guard.
+  bool climbRefinements(long frame);
+  /// Puts back the state and the colliders as they were at the frame's start.
+  void restartFrame(long frame);
   /// The frame's substeps at `refinement` times the settings' count; false when the guard trips.
   bool runFrame(long frame, int refinement);
+  void limitStrain();
   void accumulateForces();
   void integrate(double dt_s);
   void collide(double t0_s, double t1_s);
@@ -145,6 +165,13 @@ class ClothSolver {
   int lastRefinement_ = 1;
   long refinedFrames_ = 0;
   Instability refinedBecause_;
+  /// Strain limiting: the limit on (0: none), the weights it moves vertices by (inverse
+  /// masses, 0 for the pinned and bound ones), since which frame the rescue has had it on.
+  double strainLimit_ = 0.0;
+  std::vector<double> strainWeight_;
+  long strainLimitedFrom_ = 0;
+  Instability strainLimitedBecause_;
+  std::size_t strainLimitCorrections_ = 0;
   double dampedOmega_ = 0.0;  ///< dampedMembraneFrequency_rad_s
 };
 
@@ -152,5 +179,10 @@ class ClothSolver {
 /// reached 74.08 m/s (bound 50 m/s) in frame 26, substep 115; computed again with 2 times
 /// the substeps (310 per frame)". Empty when the frame was stable at once.
 [[nodiscard]] std::string describeRefinedFrame(const ClothSolver& solver, const std::string& garment);
+
+/// When strain limiting came on in `frame` (StepSettings::rescueStrainLimit), for a log
+/// line: why, and what it does from then on. Empty otherwise.
+[[nodiscard]] std::string describeStrainLimitRescue(const ClothSolver& solver, const std::string& garment,
+                                                    long frame);
 
 }  // namespace drape::cloth

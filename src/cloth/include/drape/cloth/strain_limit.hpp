@@ -1,0 +1,30 @@
+#pragma once
+// Strain limiting (Provot 1995): the last resort of a frame that no number of substeps keeps
+// stable (ClothSolver::stepFrame). Cloth crushed where two body parts' offset surfaces
+// overlap can be stretched to two or three times its length; St Venant-Kirchhoff stiffens
+// with the square of the stretch, and the explicit step's stable substep shrinks with it
+// until even 8 or 32 times the substeps diverge. Holding every edge to a largest stretch
+// takes that stiffness away where forces alone cannot.
+
+#include <cstddef>
+#include <span>
+
+#include "drape/cloth/model.hpp"
+#include "drape/cloth/state.hpp"
+
+namespace drape::cloth {
+
+/// Gauss-Seidel passes over the edges per substep: the second catches most of what the
+/// first's corrections stretch again where edges share a vertex.
+inline constexpr int kStrainLimitSweeps = 2;
+
+/// Pulls every edge longer than (1 + limit) times its rest length back to that length, in
+/// `sweeps` passes over the model's edges, moving each end by its share of the weights
+/// (`weight`: the inverse masses, 0 for vertices a fixture holds), and takes away the ends'
+/// relative velocity along the edge where it stretches the edge further. Corrections are
+/// weighted by inverse mass, so linear momentum and the centre of mass are kept; edges within
+/// the limit are not touched. Returns how many edge corrections were made.
+std::size_t limitStrain(const ClothModel& model, std::span<const double> weight, double limit, int sweeps,
+                        ClothState& io);
+
+}  // namespace drape::cloth

@@ -391,8 +391,16 @@ TEST(Stability, GuardReportsVertexAndFrame) {
   EXPECT_TRUE(bad.detected);
   EXPECT_EQ(bad.frame, f - 1);
   EXPECT_EQ(bad.refinement, StepSettings{}.maxRefinement) << "unstable at every refinement too";
+  EXPECT_EQ(bad.strainLimit, StepSettings{}.rescueStrainLimit) << "and with strain limiting";
+  EXPECT_TRUE(bad.rescued);
+  EXPECT_EQ(solver.strainLimitedFrom(), bad.frame);
   EXPECT_LT(bad.vertex, model->vertexCount());
-  EXPECT_NE(bad.describe("sheet", 50).find("garment 'sheet': vertex"), std::string::npos);
+  const std::string what = bad.describe("sheet", 50);
+  EXPECT_NE(what.find("garment 'sheet': vertex"), std::string::npos) << what;
+  EXPECT_NE(what.find("8 times the substeps and edges held to 1.5 times their rest length since the frame went "
+                      "unstable without"),
+            std::string::npos)
+      << what;
 }
 
 TEST(Validation, MaterialAndSettingsNameTheOption) {

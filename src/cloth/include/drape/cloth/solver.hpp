@@ -2,9 +2,10 @@
 // ClothSolver: one garment instance stepping through time. The frame step is a visible loop
 // of substeps, each a short list of named phases (STYLE habit 2):
 //
-//   accumulate forces -> integrate -> collide -> apply fixtures -> check stability
+//   accumulate forces -> integrate -> collide -> apply fixtures -> [limit strain] -> check stability
 //
-// with wall-clock time per phase. Nothing allocates inside the loop, and the same input
+// with wall-clock time per phase (strain limiting only once on: StepSettings::strainLimit,
+// or the rescue of a frame no refinement keeps stable). Nothing allocates inside the loop, and the same input
 // gives bit-identical results. Instability (a NaN or a vertex faster than the bound) stops
 // the step and comes back as a report, never as an exception from inside the loop.
 

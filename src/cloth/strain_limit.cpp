@@ -4,6 +4,21 @@
 #include <cstdint>
 
 namespace drape::cloth {
+namespace {
+
+/// Moves vertex i by wi * amount along n and vertex j by wj * amount against it, in the
+/// arrays (x, y, z): positions or velocities.
+inline void drawTogether(double* x, double* y, double* z, std::uint32_t i, std::uint32_t j, double wi, double wj,
+                         double amount, double nx, double ny, double nz) {
+  x[i] += wi * amount * nx;
+  y[i] += wi * amount * ny;
+  z[i] += wi * amount * nz;
+  x[j] -= wj * amount * nx;
+  y[j] -= wj * amount * ny;
+  z[j] -= wj * amount * nz;
+}
+
+}  // namespace
 
 std::size_t limitStrain(const ClothModel& model, std::span<const double> weight, double limit, int sweeps,
                         ClothState& io) {
@@ -26,25 +41,11 @@ std::size_t limitStrain(const ClothModel& model, std::span<const double> weight,
       const double length = std::sqrt(length2);
       const double nx = dx / length, ny = dy / length, nz = dz / length;
       // Both ends move along the edge, inversely to their masses, until it is `most` long.
-      const double pull = (length - most) / w;
-      x[i] += wi * pull * nx;
-      y[i] += wi * pull * ny;
-      z[i] += wi * pull * nz;
-      x[j] -= wj * pull * nx;
-      y[j] -= wj * pull * ny;
-      z[j] -= wj * pull * nz;
+      drawTogether(x, y, z, i, j, wi, wj, (length - most) / w, nx, ny, nz);
       // A relative velocity that stretches the edge further would undo the pull in the next
       // substep: it goes, shared the same way (an inelastic impulse along the edge).
       const double apart = (vx[j] - vx[i]) * nx + (vy[j] - vy[i]) * ny + (vz[j] - vz[i]) * nz;
-      if (apart > 0.0) {
-        const double impulse = apart / w;
-        vx[i] += wi * impulse * nx;
-        vy[i] += wi * impulse * ny;
-        vz[i] += wi * impulse * nz;
-        vx[j] -= wj * impulse * nx;
-        vy[j] -= wj * impulse * ny;
-        vz[j] -= wj * impulse * nz;
-      }
+      if (apart > 0.0) drawTogether(vx, vy, vz, i, j, wi, wj, apart / w, nx, ny, nz);
       ++corrections;
     }
   }

@@ -84,6 +84,15 @@ TEST(WalkingDress, RunsTheDazStyleWalkToTheEnd) {
   EXPECT_LT(stats["vertex_substeps_inside_body"].get<double>() / stats["vertex_substeps"].get<double>(), 0.001);
 }
 
+/// `drape run` of the dress on cmu_walk_delfem2 as captured (--keep-apart none), writing into
+/// DIR/out, with `options`.
+CliResult runDelfem2AsCaptured(const ScratchDir& dir, const std::string& options) {
+  return runDrape("run '" + kDressScene + "' --motion '" + kSource +
+                      "/data/mocap/cmu_walk_delfem2.bvh' --keep-apart none --every 1000 " + options + " --out '" +
+                      (dir / "out") + "'",
+                  dir);
+}
+
 TEST(WalkingDress, AnInstabilitySaysWhichPartsPinchedTheCloth) {
   // On this walk, as captured, the left arm presses the sleeve against the back (the scene
   // keeps the arms out of the body; --keep-apart none plays the motion as it is), and one
@@ -92,11 +101,7 @@ TEST(WalkingDress, AnInstabilitySaysWhichPartsPinchedTheCloth) {
   // with more substeps or with strain limiting (neither here). The report names the pinch,
   // not only the vertex.
   ScratchDir dir("walking-dress-pinch");
-  const CliResult r = runDrape("run '" + kDressScene + "' --motion '" + kSource +
-                                   "/data/mocap/cmu_walk_delfem2.bvh' --keep-apart none --max-refinement 1 "
-                                   "--strain-limit none --every 1000 --out '" +
-                                   (dir / "out") + "'",
-                               dir);
+  const CliResult r = runDelfem2AsCaptured(dir, "--max-refinement 1 --strain-limit none");
   ASSERT_EQ(r.code, 3) << r.err;
   EXPECT_NE(r.err.find("garment 'dress': vertex "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("was pressed by LowerBack, Spine, LeftArm, LeftForeArm at once (a pinch"), std::string::npos)
@@ -118,11 +123,7 @@ TEST(WalkingDress, WhereNoSubstepsKeepTheFrameStableItsEdgesAreHeldToALimit) {
   // The pinch above, with the frame not computed again with more substeps: the frame is
   // computed again with strain limiting (--strain-limit auto, the default), which stays on.
   ScratchDir dir("walking-dress-rescued");
-  const CliResult r = runDrape("run '" + kDressScene + "' --motion '" + kSource +
-                                   "/data/mocap/cmu_walk_delfem2.bvh' --keep-apart none --max-refinement 1 "
-                                   "--frames 30 --every 1000 --out '" +
-                                   (dir / "out") + "'",
-                               dir);
+  const CliResult r = runDelfem2AsCaptured(dir, "--max-refinement 1 --frames 30");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("in frame 26, substep"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("; computed again with its edges held to 1.5 times their rest length (strain limiting), "
@@ -144,11 +145,7 @@ TEST(WalkingDress, ThePinchIsWeatheredByComputingItsFramesAgain) {
   // default): frames 26 and 29, where the pinch above stopped the run, take twice the
   // substeps, and the run goes on.
   ScratchDir dir("walking-dress-refined");
-  const CliResult r = runDrape("run '" + kDressScene + "' --motion '" + kSource +
-                                   "/data/mocap/cmu_walk_delfem2.bvh' --keep-apart none --frames 30 --every 1000 "
-                                   "--out '" +
-                                   (dir / "out") + "'",
-                               dir);
+  const CliResult r = runDelfem2AsCaptured(dir, "--frames 30");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("in frame 26, substep"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("; computed again with 2 times the substeps (310 per frame)"), std::string::npos) << r.err;

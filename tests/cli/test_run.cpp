@@ -135,6 +135,8 @@ TEST(Run, BadInputsGiveOneLineAndExitCode2) {
        "--substeps must be a whole number in [1, 100000] or 'auto', got '12x'"},
       {"bad integrator", dress + " --integrator rk4", "--integrator must be"},
       {"no refinement", dress + " --max-refinement 0", "--max-refinement must be in [1, 64], got 0"},
+      {"strain limit a word", dress + " --strain-limit some", "--strain-limit must be 'auto', 'none' or a stretch"},
+      {"strain limit zero", dress + " --strain-limit 0", "in (0, 10] (0.5: edges at most 1.5 times as long), got '0'"},
       {"keep apart without motion", dress + " --keep-apart LeftForeArm", "--keep-apart corrects a motion: give --motion"},
       {"keep apart unknown part", skirt + " --keep-apart LeftForeArm,Tail", "has no part 'Tail' (it has: Hips, "},
       {"keep apart none in a list", skirt + " --keep-apart none,LeftForeArm", "--keep-apart: 'none' stands alone"},

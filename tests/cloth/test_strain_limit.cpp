@@ -240,9 +240,9 @@ TEST(StrainLimit, AFrameNoSubstepsKeepStableIsComputedAgainWithTheLimitWhichStay
   EXPECT_EQ(rescued->strainLimit(), kLimit) << "on for the rest of the run";
   EXPECT_GT(rescued->strainLimitCorrections(), 0u);
   // The fixtures' vertices are where the fixtures put them: the limit moved the others.
+  const ClothModel& m = *with.model;
   for (const std::uint32_t v : testing::row(with.spec, 0))
-    EXPECT_EQ(rescued->state().position(v), Vec3(with.model->restX()[v], with.model->restY()[v], with.model->restZ()[v]))
-        << v;
+    EXPECT_EQ(rescued->state().position(v), Vec3(m.restX()[v], m.restY()[v], m.restZ()[v])) << v;
   // The strip that stopped had torn itself apart; the rescued one is whole.
   EXPECT_GT(largestStretch(stops->model(), stops->state()), 3.0);
   EXPECT_LT(largestStretch(rescued->model(), rescued->state()), 2.0);

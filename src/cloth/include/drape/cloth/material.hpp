@@ -72,8 +72,9 @@ struct StepSettings {
   /// reported (ClothSolver::stepFrame); 1: reported at once, the fixed step as it is.
   int maxRefinement = 8;
   /// Strain limiting (strain_limit.hpp) from the first frame: after each substep's
-  /// collisions and fixtures, no edge stays longer than (1 + strainLimit) times its rest
-  /// length; 0: none.
+  /// collisions and fixtures, edges longer than (1 + strainLimit) times their rest length
+  /// are pulled back to it (two sweeps, so a little may be left to the next substep where
+  /// edges share a vertex); 0: none.
   double strainLimit = 0.0;
   /// A frame that goes unstable even with maxRefinement times the substeps is computed once
   /// more from its start with strain limiting at this limit, which then stays on for the rest

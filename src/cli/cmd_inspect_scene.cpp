@@ -11,6 +11,15 @@
 namespace drape::cli {
 namespace {
 
+/// What the scene's strain limit does, as the end of a sentence.
+std::string strainLimitText(const scene::SimulationSettings& sim) {
+  const auto times = [](double stretch) { return fmt::format("{:g} times their rest length", 1.0 + stretch); };
+  if (sim.strainLimit > 0.0) return fmt::format("; edges are held to {} from the first frame", times(sim.strainLimit));
+  if (sim.rescueStrainLimit > 0.0)
+    return fmt::format(", then edges are held to {} from a frame that still goes unstable", times(sim.rescueStrainLimit));
+  return ", then the run stops on it";
+}
+
 void printJoint(std::ostream& out, const scene::Avatar& a, int joint, int depth) {
   const scene::Joint& j = a.joints[static_cast<std::size_t>(joint)];
   std::size_t triangles = 0;
@@ -92,6 +101,8 @@ void inspectScene(const std::string& path, std::ostream& out) {
              sim.bendEvery, sim.bendEvery == 1 ? "" : "s");
   fmt::print(out, "  offsets T0..T3 {:g} {:g} {:g} {:g} m, voxel size {:g} m, unit scale {:g} m per file unit\n",
              sim.offsets[0], sim.offsets[1], sim.offsets[2], sim.offsets[3], sim.voxelSize, sim.unitScale);
+  fmt::print(out, "  an unstable frame is computed again with up to {} times the steps{}\n", sim.maxRefinement,
+             strainLimitText(sim));
   if (!sim.keepApart.empty())
     fmt::print(out, "  the motion is corrected to keep {} out of the collidable parts\n", fmt::join(sim.keepApart, ", "));
   if (!s.scenery.empty()) {

@@ -682,6 +682,7 @@ int simulateRun(const RunSetup& setup) {
   stats["frames_requested"] = setup.frames;
   stats["frame_rate"] = settings.frameRate_hz;
   stats["substeps_per_frame"] = settings.substepsPerFrame;
+  stats["max_refinement"] = settings.maxRefinement;
   stats["integrator"] = cloth::integratorName(settings.integrator);
   stats["ms_per_frame"] = median(frameMs);
   // What a user waits for: simulation and output overlapped, per simulated frame.

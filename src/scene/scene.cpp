@@ -64,6 +64,17 @@ void validate(const SimulationSettings& s) {
     bad(s.source, node, fmt::format("bendEvery {} must be in [1, stepsPerFrame {}]", s.bendEvery, s.stepsPerFrame));
   if (!std::isfinite(s.maxAddedMass) || s.maxAddedMass < 0.0 || s.maxAddedMass > 10.0)
     bad(s.source, node, fmt::format("maxAddedMass {:g} must be a fraction in [0, 10]", s.maxAddedMass));
+  if (s.maxRefinement < 1 || s.maxRefinement > 64)
+    bad(s.source, node, fmt::format("maxRefinement {} must be in [1, 64]", s.maxRefinement));
+  const auto stretch = [&](double v, const char* field) {
+    if (!std::isfinite(v) || v < 0.0 || v > 10.0)
+      bad(s.source, node,
+          fmt::format("{} {:g} must be a stretch beyond the rest length in [0, 10] (0.5: edges at most 1.5 times "
+                      "as long; 0: none)",
+                      field, v));
+  };
+  stretch(s.strainLimit, "strainLimit");
+  stretch(s.rescueStrainLimit, "rescueStrainLimit");
   if (!std::isfinite(s.airViscosity) || s.airViscosity < 0.0)
     bad(s.source, node, fmt::format("airViscosity {:g} is negative", s.airViscosity));
   if (!s.gravity.allFinite() || !s.wind.allFinite()) bad(s.source, node, "gravity and wind must be finite");

@@ -196,6 +196,10 @@ class Builder {
            [&] { s.collisionEvery = static_cast<int>(number(n, "collisionEvery", s.collisionEvery)); });
       take("bendEvery", [&] { s.bendEvery = static_cast<int>(number(n, "bendEvery", s.bendEvery)); });
       take("maxAddedMass", [&] { s.maxAddedMass = number(n, "maxAddedMass", s.maxAddedMass); });
+      take("maxRefinement", [&] { s.maxRefinement = static_cast<int>(number(n, "maxRefinement", s.maxRefinement)); });
+      take("strainLimit", [&] { s.strainLimit = number(n, "strainLimit", s.strainLimit); });
+      take("rescueStrainLimit",
+           [&] { s.rescueStrainLimit = number(n, "rescueStrainLimit", s.rescueStrainLimit); });
       take("keepApart", [&] { s.keepApart = strings(n, "keepApart"); });
       if (const Field* f = n.field("unitScale"); f != nullptr && !f->isDefault)
         take("unitScale", [&] { s.unitScale = number(n, "unitScale", 1.0); });

@@ -48,6 +48,9 @@ cloth::StepSettings toStepSettings(const scene::SimulationSettings& s) {
   c.wind_m_s = s.wind;
   c.maxAddedMass = s.maxAddedMass;
   c.bendEvery = s.bendEvery;
+  c.maxRefinement = s.maxRefinement;
+  c.strainLimit = s.strainLimit;
+  c.rescueStrainLimit = s.rescueStrainLimit;
   c.integrator = cloth::parseIntegrator(s.integrator, "Simulation.integrator");
   return c;
 }

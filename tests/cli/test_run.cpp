@@ -2,6 +2,10 @@
 // unstable run.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
+
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
@@ -203,6 +207,28 @@ TEST(Run, AnUnstableFrameIsComputedAgainWithMoreSubsteps) {
   EXPECT_EQ(stats["frames"], 3);
   EXPECT_GE(stats["garments"][0]["frames_refined"].get<int>(), 1);
   EXPECT_LE(stats["garments"][0]["frames_refined"].get<int>(), 3);
+}
+
+TEST(Run, TheScenesLastResortsReachTheSolverAndTheCommandLineOverridesThem) {
+  // A scene's Simulation maxRefinement and strainLimit, as written, and as --max-refinement
+  // and --strain-limit replace them.
+  ScratchDir dir("run-scene-last-resorts");
+  std::ifstream in(std::string(DRAPE_SOURCE_DIR) + "/examples/dressed_avatar/scene.wrl");
+  std::string scene((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string anchor = "integrator \"symplectic-euler\"\n";
+  ASSERT_NE(scene.find(anchor), std::string::npos);
+  scene.insert(scene.find(anchor) + anchor.size(), "  maxRefinement 2\n  strainLimit 0.3\n");
+  const std::string path = dir / "scene.wrl";
+  std::ofstream(path) << scene;
+  const std::string quoted = fmt::format("'{}' --frames 2", path);
+  const nlohmann::json asWritten = statsOf(testing::runInto(dir, "scene", quoted));
+  EXPECT_EQ(asWritten["max_refinement"].get<int>(), 2);
+  EXPECT_NEAR(asWritten["garments"][0]["strain_limit"].get<double>(), 0.3, 1e-6);
+  EXPECT_TRUE(asWritten["garments"][0]["strain_limited_from_frame"].is_null());
+  const nlohmann::json overridden =
+      statsOf(testing::runInto(dir, "overridden", quoted + " --max-refinement 4 --strain-limit none"));
+  EXPECT_EQ(overridden["max_refinement"].get<int>(), 4);
+  EXPECT_EQ(overridden["garments"][0]["strain_limit"].get<double>(), 0.0);
 }
 
 }  // namespace

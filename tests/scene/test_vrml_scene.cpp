@@ -93,6 +93,7 @@ TEST(VrmlScene, EveryFieldWithValues) {
       "#VRML V2.0 utf8\n"
       "Simulation { gravity 0 0 -9.8 frameRate 25 stepsPerFrame 40 airViscosity 0.05 wind 1 0 0.5\n"
       "  offsets [ 0.001 0.002 0.003 0.004 ] voxelSize 0.005 integrator \"euler\" collisionEvery 2 bendEvery 4 unitScale 0.01\n"
+      "  maxRefinement 4 strainLimit 0.25 rescueStrainLimit 0.75\n"
       "  keepApart [ \"LeftForeArm\", \"RightForeArm\" ] }\n"
       "DEF Body Humanoid { humanoidBody DEF Root Joint { name \"root\" children [ DEF Hips Segment { name \"hips\" "
       "children Shape { geometry Box { } } } ] } }\n"
@@ -119,6 +120,9 @@ TEST(VrmlScene, EveryFieldWithValues) {
   EXPECT_EQ(sim.integrator, "euler");
   EXPECT_EQ(sim.collisionEvery, 2);
   EXPECT_EQ(sim.bendEvery, 4);
+  EXPECT_EQ(sim.maxRefinement, 4);
+  EXPECT_NEAR(sim.strainLimit, 0.25, 1e-7);
+  EXPECT_NEAR(sim.rescueStrainLimit, 0.75, 1e-7);
   EXPECT_EQ(sim.keepApart, (std::vector<std::string>{"LeftForeArm", "RightForeArm"}));
   EXPECT_NEAR(sim.unitScale, 0.01, 1e-9);
 
@@ -174,6 +178,9 @@ TEST(VrmlScene, EveryFieldDefaults) {
   EXPECT_EQ(s.simulation.integrator, defaults.integrator);
   EXPECT_EQ(s.simulation.collisionEvery, defaults.collisionEvery);
   EXPECT_EQ(s.simulation.bendEvery, defaults.bendEvery);
+  EXPECT_EQ(s.simulation.maxRefinement, defaults.maxRefinement);
+  EXPECT_EQ(s.simulation.strainLimit, defaults.strainLimit);
+  EXPECT_NEAR(s.simulation.rescueStrainLimit, defaults.rescueStrainLimit, 1e-7);
   EXPECT_TRUE(s.simulation.keepApart.empty());
   EXPECT_EQ(s.simulation.unitScale, 1.0);
   const ClothMaterial md;
@@ -335,6 +342,16 @@ TEST(VrmlScene, MoreDomainErrors) {
                              " material ClothMaterial { poissonRatio -0.1 } }\n");
             }).find("scene.wrl:2: ClothMaterial: poissonRatio -0.1 is outside [0, 0.5)"),
             std::string::npos);
+  // The solver's last resorts, each named with the line of its value.
+  EXPECT_NE(errorOf([&] { (void)fromText("#VRML V2.0 utf8\nSimulation {\n  maxRefinement 0 }\n"); })
+                .find("scene.wrl:3: Simulation: maxRefinement 0 must be in [1, 64]"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { (void)fromText("#VRML V2.0 utf8\nSimulation { strainLimit -0.5 }\n"); })
+                .find("scene.wrl:2: Simulation: strainLimit -0.5 must be a stretch beyond the rest length in [0, 10]"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { (void)fromText("#VRML V2.0 utf8\nSimulation { rescueStrainLimit 11 }\n"); })
+                .find("rescueStrainLimit 11 must be a stretch beyond the rest length in [0, 10]"),
+            std::string::npos);
 }
 
 // The CLI: `drape inspect` on a scene and on a bad file (exit code 2, one line).
@@ -356,6 +373,10 @@ TEST(VrmlScene, DrapeInspectSummarisesAScene) {
   EXPECT_NE(out.find("constraint mask 24 vertices"), std::string::npos) << out;
   EXPECT_NE(out.find("Cotton: density 300 kg/m^3"), std::string::npos) << out;
   EXPECT_NE(out.find("30 frames/s x 70 steps/frame"), std::string::npos) << out;
+  EXPECT_NE(out.find("an unstable frame is computed again with up to 8 times the steps, then edges are held to 1.5 "
+                     "times their rest length"),
+            std::string::npos)
+      << out;
 }
 
 TEST(VrmlScene, DrapeInspectRejectsABadFileWithExitCode2) {

@@ -52,6 +52,13 @@ struct SimulationSettings {
   int collisionEvery = 1;                       ///< collide every N substeps
   int bendEvery = 1;                            ///< bending forces every N substeps, as an impulse
   double maxAddedMass = 0.0;                    ///< mass scaling allowed, fraction of a garment's mass
+  /// A frame that goes unstable is computed again with up to this many times the substeps.
+  int maxRefinement = 8;
+  /// Largest stretch of an edge beyond its rest length, held from the first frame; 0: none.
+  double strainLimit = 0.0;
+  /// The same, from a frame no refinement keeps stable on, for the rest of the run; 0: such a
+  /// frame stops the run. Without effect while strainLimit is on.
+  double rescueStrainLimit = 0.5;
   double unitScale = 1.0;                       ///< metres per file unit (applied to all geometry on load)
   /// Body parts whose motion is corrected to keep them out of the collidable parts they go
   /// into (a forearm swung through the back; sim/keep_apart.hpp).

@@ -14,6 +14,7 @@
 #include "drape/core/error.hpp"
 #include "drape/field/distance_field.hpp"
 #include "drape/field/shapes.hpp"
+#include "drape/testing/temp_dir.hpp"
 
 namespace drape::field {
 namespace {
@@ -191,7 +192,7 @@ CommandResult run(const std::string& args) {
 }
 
 TEST(FieldCommand, BuildsTheProxyAvatarAndWritesSlices) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "drape_test_field";
+  const std::filesystem::path dir = testing::processTempDir("field");
   std::filesystem::remove_all(dir);
   const std::string obj = std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_female_generic_proxy.obj";
   const CommandResult r = run("field " + obj + " --units dm --voxel 0.02 --out " + dir.string());

@@ -9,14 +9,13 @@
 #include "drape/formats/units.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/testing/errors.hpp"
+#include "drape/testing/temp_dir.hpp"
 
 namespace drape::formats {
 namespace {
 
 std::string tempPath(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("drape_test_formats_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return (dir / name).string();
+  return (testing::processTempDir("formats") / name).string();
 }
 
 TEST(Obj, ReadsTheMakeHumanDressInDecimetres) {

@@ -5,8 +5,6 @@
 // (its left edge pinned, so that edge stays put), with a state cache for the overlays.
 // Units m, Y up.
 
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -20,6 +18,7 @@
 #include "drape/formats/run_manifest.hpp"
 #include "drape/formats/state_cache.hpp"
 #include "drape/mesh/trimesh.hpp"
+#include "drape/testing/temp_dir.hpp"
 
 namespace drape::testrun {
 
@@ -30,7 +29,7 @@ inline constexpr double kFlagLeft = 0.30, kFlagWidth = 0.60, kFlagBottom = 0.55,
 
 /// A fresh directory under the system's temporary directory.
 inline std::string freshDir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("drape_test_" + std::to_string(::getpid())) / name;
+  const std::filesystem::path dir = testing::processTempDir(name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();

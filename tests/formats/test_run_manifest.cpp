@@ -7,14 +7,13 @@
 #include "drape/core/error.hpp"
 #include "drape/formats/run_manifest.hpp"
 #include "drape/testing/errors.hpp"
+#include "drape/testing/temp_dir.hpp"
 
 namespace drape::formats {
 namespace {
 
 std::string tempDir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("drape_test_manifest_" + std::to_string(::getpid())) / name;
-  std::filesystem::create_directories(dir);
-  return dir.string();
+  return testing::processTempDir("manifest/" + name).string();
 }
 
 TEST(RunManifest, RoundTrips) {

@@ -3,8 +3,6 @@
 
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -12,14 +10,13 @@
 
 #include "drape/core/error.hpp"
 #include "drape/formats/state_cache.hpp"
+#include "drape/testing/temp_dir.hpp"
 
 namespace drape::formats {
 namespace {
 
 std::string tempPath(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("drape_state_cache_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return (dir / name).string();
+  return (testing::processTempDir("state_cache") / name).string();
 }
 
 std::string messageOf(std::string_view bytes) {

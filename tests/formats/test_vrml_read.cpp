@@ -12,6 +12,7 @@
 #include "drape/formats/vrml_scan.hpp"
 #include "drape/formats/vrml_write.hpp"
 #include "drape/testing/errors.hpp"
+#include "drape/testing/temp_dir.hpp"
 
 namespace drape::formats::vrml {
 namespace {
@@ -27,9 +28,7 @@ int count(const Document& d, const std::string& type) {
 using drape::testing::errorOf;
 
 std::string tempDir() {
-  const auto dir = std::filesystem::temp_directory_path() / ("drape_test_vrml_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return dir.string();
+  return drape::testing::processTempDir("vrml").string();
 }
 
 TEST(VrmlRead, Sr1HasThirtyJointsAndSegments) {

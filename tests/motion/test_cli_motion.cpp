@@ -10,6 +10,8 @@
 #include <sstream>
 #include <sys/wait.h>
 
+#include "drape/testing/temp_dir.hpp"
+
 namespace {
 
 struct Result {
@@ -70,8 +72,7 @@ TEST(CliMotion, BadBvhIsExitCode2WithItsLine) {
 }
 
 TEST(CliMotion, ConvertCesiumManToHanim) {
-  const auto dir = std::filesystem::temp_directory_path() / ("drape_test_convert_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  const std::filesystem::path dir = drape::testing::processTempDir("convert");
   const std::string out = (dir / "cesium.wrl").string();
   const Result r = run("convert " + data("avatars/CesiumMan.glb") + " --to " + out);
   ASSERT_EQ(r.code, 0) << r.out;

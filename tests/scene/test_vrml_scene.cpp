@@ -13,6 +13,7 @@
 #include "drape/scene/scene.hpp"
 #include "drape/scene/scene_build.hpp"
 #include "drape/testing/errors.hpp"
+#include "drape/testing/temp_dir.hpp"
 
 namespace drape::scene {
 namespace {
@@ -26,9 +27,7 @@ Scene fromText(const std::string& text, const std::string& name = "scene.wrl", c
 using drape::testing::errorOf;
 
 std::string tempDir() {
-  const auto dir = std::filesystem::temp_directory_path() / ("drape_test_scene_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return dir.string();
+  return drape::testing::processTempDir("scene").string();
 }
 
 const std::string kTriangle =

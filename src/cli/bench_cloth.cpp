@@ -12,13 +12,10 @@
 #include <limits>
 #include <memory>
 
-#include <BulletSoftBody/btSoftBodyHelpers.h>
-#include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
-#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
-#include <btBulletDynamicsCommon.h>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "bullet_sheet.hpp"
 #include "command.hpp"
 #include "measure.hpp"
 #include "drape/cloth/forces.hpp"
@@ -31,13 +28,13 @@
 namespace drape::cli {
 namespace {
 
-// The scenario (fixed before any measurement).
-constexpr double kFrameRate = 30.0;
-constexpr int kSubsteps = 33;
-constexpr double kSpeedBound_m_s = 50.0;
+// The scenario (fixed before any measurement; bullet_sheet.hpp).
+constexpr double kFrameRate = SheetScenario::kFrameRate;
+constexpr int kSubsteps = SheetScenario::kSubsteps;
+constexpr double kSpeedBound_m_s = SheetScenario::kSpeedBound_m_s;
 constexpr double kStrainBound = 0.10;
-const Vec3 kSphereCentre(0.55, -0.4, 0.55);  // sheet spans x, z in [0, 1] at y = 0
-constexpr double kSphereRadius = 0.25;
+const Vec3 kSphereCentre = SheetScenario::sphereCentre();
+constexpr double kSphereRadius = SheetScenario::kSphereRadius;
 
 /// A medium-heavy woven fabric: 1 mm thick, 1000 kg/m^3 (1 kg/m^2, so the sheet is 1 kg),
 /// E = 1 MPa (a tensile stiffness E t of 1000 N/m), nu = 0.3, D from E t^3 / (12 (1 - nu^2)).
@@ -181,7 +178,8 @@ int smallestStableSubsteps(const SheetSize& size, long frames) {
 }
 
 // ---------------------------------------------------------------------------------------
-// Bullet (btSoftBody, default solver: position-based links, two iterations per substep)
+// Bullet (btSoftBody, default solver: position-based links, two iterations per substep;
+// bullet_sheet.hpp)
 
 CaseResult measureBullet(const std::string& name, const SheetSize& size, long frames, int repeats,
                          double strainBound = kStrainBound) {
@@ -195,64 +193,11 @@ CaseResult measureBullet(const std::string& name, const SheetSize& size, long fr
   double strain = 0.0;
   std::string why;
   for (int k = 0; k < repeats; ++k) {
-    btSoftBodyRigidBodyCollisionConfiguration config;
-    btCollisionDispatcher dispatcher(&config);
-    btDbvtBroadphase broadphase;
-    btSequentialImpulseConstraintSolver solver;
-    btSoftRigidDynamicsWorld world(&dispatcher, &broadphase, &solver, &config);
-    world.setGravity(btVector3(0, -9.81f, 0));
-    btSoftBodyWorldInfo& info = world.getWorldInfo();
-    info.m_gravity = btVector3(0, -9.81f, 0);
-    info.air_density = 0;
-    info.m_sparsesdf.Initialize();
-
-    btSphereShape sphereShape(static_cast<btScalar>(kSphereRadius));
-    btTransform at;
-    at.setIdentity();
-    at.setOrigin(btVector3(kSphereCentre.x(), kSphereCentre.y(), kSphereCentre.z()));
-    btDefaultMotionState motion(at);
-    btRigidBody sphere(btRigidBody::btRigidBodyConstructionInfo(0, &motion, &sphereShape));
-    world.addRigidBody(&sphere);
-
-    // corner00 and corner10 (fixeds 1 + 2) are the two pinned corners of the z = 0 edge.
-    btSoftBody* sheet = btSoftBodyHelpers::CreatePatch(info, btVector3(0, 0, 0), btVector3(1, 0, 0),
-                                                       btVector3(0, 0, 1), btVector3(1, 0, 1), size.cellsU + 1,
-                                                       size.cellsV + 1, 1 + 2, true);
-    sheet->m_materials[0]->m_kLST = 1.0;
-    // Two position iterations per substep: with Bullet's default of one, the 10k and 40k
-    // sheets explode within the first frame (node speeds of 1e8 m/s).
-    sheet->m_cfg.piterations = 2;
-    sheet->m_cfg.kDF = 0.3;
-    sheet->setTotalMass(1.0);
-    world.addSoftBody(sheet);
-
-    // Bullet keeps running past a speed excess (it rarely reaches NaN); the case is then
-    // reported unstable with the first frame and speed, and timed over all frames.
-    const double start = threadCpuSeconds();
-    long f = 0;
-    bool nan = false;
-    for (; f < frames && !nan; ++f) {
-      world.stepSimulation(1.0f / kFrameRate, kSubsteps, 1.0f / (kFrameRate * kSubsteps));
-      for (int i = 0; i < sheet->m_nodes.size(); ++i) {
-        const btVector3& v = sheet->m_nodes[i].m_v;
-        const btVector3& x = sheet->m_nodes[i].m_x;
-        nan = nan || !std::isfinite(x.x() + x.y() + x.z() + v.x() + v.y() + v.z());
-        if (!diverged && (nan || v.length() > kSpeedBound_m_s)) {
-          diverged = true;
-          why = fmt::format("node {} reached {:.4g} m/s in frame {}", i, v.length(), f + 1);
-        }
-      }
-    }
-    ms.push_back(1e3 * (threadCpuSeconds() - start) / static_cast<double>(f));
-    strain = 0.0;
-    for (int i = 0; i < sheet->m_links.size(); ++i) {
-      const btSoftBody::Link& l = sheet->m_links[i];
-      const double len = (l.m_n[1]->m_x - l.m_n[0]->m_x).length();
-      strain = std::max(strain, std::abs(len - l.m_rl) / l.m_rl);
-    }
-    world.removeSoftBody(sheet);
-    delete sheet;
-    world.removeRigidBody(&sphere);
+    const BulletSheetRun run = runBulletSheet(size.cellsU, size.cellsV, frames);
+    ms.push_back(run.msPerFrame);
+    if (run.diverged && !diverged) why = run.why;
+    diverged = diverged || run.diverged;
+    strain = run.maxStrain;
   }
   c.runs = static_cast<int>(ms.size());
   c.msPerFrame = median(ms);
@@ -301,9 +246,8 @@ int runBench(const BenchOptions& o) {
       bullet.push_back(measureBullet(name, size, frames, size.cellsU > 100 ? 1 : repeats, strainBound).json());
     }
     peers.push_back({{"name", "bullet-softbody"},
-                     {"version", fmt::format("{}", btGetVersion())},
-                     {"settings", "btSoftRigidDynamicsWorld, CreatePatch with diagonals, kLST 1, 2 position iterations, "
-                                  "33 substeps, total mass 1 kg, float"},
+                     {"version", bulletVersion()},
+                     {"settings", kBulletSheetSettings},
                      {"cases", bullet}});
   }
   const cloth::Material m = benchMaterial();

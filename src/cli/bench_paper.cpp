@@ -1,7 +1,10 @@
 // `drape bench paper --json`: the paper's walking-skirt scenario (section 5, Table 3)
 // without rendering or output, single thread: a skirt of about 480 triangles bound at the
 // waist of a walking avatar whose hips, thighs and shins collide, 33 substeps per frame.
-// Prints our figures beside the paper's Table 3 (2.8 GHz Pentium 4, 2003).
+// Prints our figures beside the paper's Table 3 (2.8 GHz Pentium 4, 2003) and beside a fixed
+// reference workload timed in the same run, between the scenario's runs (Bullet's soft-body
+// sheet of `drape bench cloth`): a shared host's speed moves by a third from day to day, and
+// the ratio of the two is what a speed target can be held to.
 
 #include <algorithm>
 #include <chrono>
@@ -11,6 +14,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "bullet_sheet.hpp"
 #include "command.hpp"
 #include "measure.hpp"
 #include "drape/core/error.hpp"
@@ -104,6 +108,11 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
   return r;
 }
 
+// The reference workload: Bullet's sheet-480 of `drape bench cloth` (16 x 15 cells, 272
+// nodes), 300 frames: about as long as one run of the scenario.
+constexpr int kReferenceCellsU = 16, kReferenceCellsV = 15;
+constexpr long kReferenceFrames = 300;
+
 RunFunction setupPaperBench(CLI::App& app) {
   static PaperBenchOptions o;
   // The defaults live in the source tree; the help names them relative to it, not by the
@@ -143,9 +152,12 @@ RunFunction setupPaperBench(CLI::App& app) {
   app.add_flag("--json", o.json, "Print JSON (the only format)");
   return [] {
     std::vector<PaperRun> runs;
+    std::vector<double> referenceMs;
     for (int i = 0; i < o.runs; ++i) {
       runs.push_back(runOnce(o, false));
       spdlog::info("run {}: {} frames in {:.3f} s", i + 1, runs.back().frames, runs.back().simSeconds);
+      referenceMs.push_back(runBulletSheet(kReferenceCellsU, kReferenceCellsV, kReferenceFrames).msPerFrame);
+      spdlog::info("reference {}: {:.3f} ms per frame", i + 1, referenceMs.back());
     }
     std::sort(runs.begin(), runs.end(), [](const PaperRun& a, const PaperRun& b) { return a.simSeconds < b.simSeconds; });
     const PaperRun& r = runs[runs.size() / 2];
@@ -192,6 +204,20 @@ RunFunction setupPaperBench(CLI::App& app) {
     j["max_penetration_m"] = penetration.maxPenetration_m;
     j["distance_field_build_s"] = r.fieldBuildSeconds;
     j["runs"] = o.runs;
+    const double reference = median(referenceMs);
+    j["reference"] = {{"workload", fmt::format("Bullet's soft-body sheet of drape bench cloth (sheet-480: {} x {} cells, "
+                                               "{} nodes), {} frames at {} substeps, this thread's CPU time",
+                                               kReferenceCellsU, kReferenceCellsV,
+                                               (kReferenceCellsU + 1) * (kReferenceCellsV + 1), kReferenceFrames,
+                                               SheetScenario::kSubsteps)},
+                      {"bullet_version", bulletVersion()},
+                      {"settings", kBulletSheetSettings},
+                      {"ms_per_frame", reference},
+                      {"runs", referenceMs.size()}};
+    // How many of the scenario's frames the machine computes in the time it computes one
+    // frame of the reference, both in CPU time: a figure that moves with our code, not with
+    // the host's speed of the day.
+    j["speed_vs_reference"] = r.simCpuSeconds > 0 ? reference * 1e-3 * r.frames / r.simCpuSeconds : 0.0;
     j["paper_table3"] = {{"hardware", "Intel Pentium 4 2.8 GHz (2003)"},
                          {"frames", 203},
                          {"sim_fps", 30.2},

@@ -258,8 +258,8 @@ TEST(BenchCloth, QuickPrintsTheCases) {
 
 // `drape bench paper` on the first frames of the walking skirt, with the collision tests
 // every substep and every third (and bending every fourth): the benchmark's keys, the paper's
-// Table 3 beside them, the reduced frequency seen in the counters, and the penetration
-// figures still over every substep.
+// Table 3 and the reference workload beside them, the reduced frequency seen in the counters,
+// and the penetration figures still over every substep.
 TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
   testing::ScratchDir dir("bench-paper");
   const auto bench = [&](const std::string& extra) {
@@ -276,6 +276,13 @@ TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
     EXPECT_TRUE(every.contains(key)) << key;
   EXPECT_EQ(every["frames"], 40);
   EXPECT_EQ(every["paper_table3"]["sim_fps"], 30.2);
+  // The reference workload timed in the same run, and the scenario's speed read against it
+  // (CPU time over CPU time).
+  const double referenceMs = every["reference"]["ms_per_frame"].get<double>();
+  EXPECT_GT(referenceMs, 0.0);
+  EXPECT_EQ(every["reference"]["runs"], 1);
+  EXPECT_NEAR(every["speed_vs_reference"].get<double>(), referenceMs / every["cpu_ms_per_frame"].get<double>(),
+              1e-9 * referenceMs / every["cpu_ms_per_frame"].get<double>());
   EXPECT_EQ(every["collision_every"], 1);
   EXPECT_EQ(third["collision_every"], 3);
   EXPECT_EQ(every["bend_every"], 8);  // the scene's

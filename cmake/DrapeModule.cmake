@@ -12,16 +12,23 @@ function(drape_add_module name)
   add_library(drape::${name} ALIAS drape_${name})
 endfunction()
 
-# drape_add_test(MODULE [TIMEOUT S] [DEPS target...] [ENVIRONMENT VAR=VALUE...])
+# drape_add_test(MODULE [TIMEOUT S] [DEPS target...] [ENVIRONMENT VAR=VALUE])
 #
-# Builds tests/MODULE/*.cpp into test_MODULE and registers each GoogleTest case with CTest.
-# Tests find the project's data through DRAPE_DATA_DIR, the source tree through
-# DRAPE_SOURCE_DIR and the built CLI through DRAPE_EXE.
+# Builds tests/MODULE/*.cpp into test_MODULE, linked with the module's library (where there
+# is one: tests/cli has none, it runs the executable) and DEPS, and registers each
+# GoogleTest case with CTest. Tests find the project's data through DRAPE_DATA_DIR, the
+# source tree through DRAPE_SOURCE_DIR and the built CLI through DRAPE_EXE, which is built
+# before them.
 function(drape_add_test module)
-  cmake_parse_arguments(ARG "" "TIMEOUT" "DEPS;ENVIRONMENT" ${ARGN})
+  cmake_parse_arguments(ARG "" "TIMEOUT;ENVIRONMENT" "DEPS" ${ARGN})
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.cpp")
   add_executable(test_${module} ${sources})
-  target_link_libraries(test_${module} PRIVATE drape::${module} ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+  set(libraries ${ARG_DEPS})
+  if(TARGET drape::${module})
+    list(PREPEND libraries drape::${module})
+  endif()
+  target_link_libraries(test_${module} PRIVATE ${libraries} GTest::gtest GTest::gtest_main)
+  add_dependencies(test_${module} drape)
   target_include_directories(test_${module} PRIVATE "${PROJECT_SOURCE_DIR}/tests/support/include")
   target_compile_definitions(test_${module} PRIVATE
     DRAPE_DATA_DIR="${DRAPE_DATA_DIR}"

@@ -23,8 +23,9 @@ namespace {
 static_assert((vertex_state::kCollisionMask | vertex_state::kPinned | vertex_state::kBound) ==
               formats::kKnownStateBits);
 
-/// DIR/stats.json's "ms_per_stage" object ({"forces": 1.2, ...}), when the run wrote one.
-/// Anything else in the file is not the player's business; a malformed file is reported.
+/// DIR/stats.json's "ms_per_stage" object ({"forces": 1.2, ...}), when the run wrote one,
+/// without the stages that never ran (strain limiting, in a run that needed none). Anything
+/// else in the file is not the player's business; a malformed file is reported.
 std::vector<StageTime> readStageTimes(const std::filesystem::path& directory) {
   const std::filesystem::path path = directory / "stats.json";
   std::ifstream in(path, std::ios::binary);
@@ -34,7 +35,7 @@ std::vector<StageTime> readStageTimes(const std::filesystem::path& directory) {
   std::vector<StageTime> stages;
   if (!j.is_object() || !j.contains("ms_per_stage") || !j["ms_per_stage"].is_object()) return stages;
   for (const auto& [stage, value] : j["ms_per_stage"].items()) {
-    if (value.is_number()) stages.push_back({stage, value.get<double>()});
+    if (value.is_number() && value.get<double>() != 0.0) stages.push_back({stage, value.get<double>()});
   }
   return stages;
 }

@@ -370,13 +370,14 @@ RunFunction setupRun(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--max-refinement", s.maxRefinement,
                  "A frame that goes unstable is computed again with 2, 4, ... up to this many times the substeps "
-                 "before strain limiting comes on for it (--strain-limit auto) or the run stops on it (1: at once)")
+                 "before strain limiting comes on for it (--strain-limit auto) or the run stops on it (1: at once); "
+                 "overrides the scene's maxRefinement")
       ->capture_default_str();
   app.add_option("--strain-limit", o->strainLimit,
                  "Largest stretch of an edge beyond its rest length, held after every substep (0.5: at most 1.5 "
                  "times as long), from the first frame; 'auto': only from a frame that goes unstable even with "
                  "--max-refinement times the substeps (cloth crushed in a pinch), at 0.5, for the rest of the run; "
-                 "'none': never, the run stops on such a frame")
+                 "'none': never, the run stops on such a frame; overrides the scene's strainLimit and rescueStrainLimit")
       ->capture_default_str();
   app.add_option("--sphere", o->spheres, "A static sphere collider x,y,z,radius (m); repeatable");
   return [o, &app] { return runCommand(app, *o); };

@@ -205,18 +205,19 @@ RunFunction setupPaperBench(CLI::App& app) {
     j["distance_field_build_s"] = r.fieldBuildSeconds;
     j["runs"] = o.runs;
     const double reference = median(referenceMs);
-    j["reference"] = {{"workload", fmt::format("Bullet's soft-body sheet of drape bench cloth (sheet-480: {} x {} cells, "
-                                               "{} nodes), {} frames at {} substeps, this thread's CPU time",
-                                               kReferenceCellsU, kReferenceCellsV,
-                                               (kReferenceCellsU + 1) * (kReferenceCellsV + 1), kReferenceFrames,
-                                               SheetScenario::kSubsteps)},
+    const std::string workload = fmt::format(
+        "Bullet's soft-body sheet of drape bench cloth (sheet-480: {} x {} cells, {} nodes), {} frames at {} "
+        "substeps, this thread's CPU time",
+        kReferenceCellsU, kReferenceCellsV, (kReferenceCellsU + 1) * (kReferenceCellsV + 1), kReferenceFrames,
+        SheetScenario::kSubsteps);
+    j["reference"] = {{"workload", workload},
                       {"bullet_version", bulletVersion()},
                       {"settings", kBulletSheetSettings},
                       {"ms_per_frame", reference},
                       {"runs", referenceMs.size()}};
     // How many of the scenario's frames the machine computes in the time it computes one
-    // frame of the reference, both in CPU time: a figure that moves with our code, not with
-    // the host's speed of the day.
+    // frame of the reference, both in CPU time: a figure meant to move with our code more
+    // than with the host's speed of the day (docs/PERFORMANCE.md measures how far it does).
     j["speed_vs_reference"] = r.simCpuSeconds > 0 ? reference * 1e-3 * r.frames / r.simCpuSeconds : 0.0;
     j["paper_table3"] = {{"hardware", "Intel Pentium 4 2.8 GHz (2003)"},
                          {"frames", 203},

@@ -16,7 +16,8 @@ std::string strainLimitText(const scene::SimulationSettings& sim) {
   const auto times = [](double stretch) { return fmt::format("{:g} times their rest length", 1.0 + stretch); };
   if (sim.strainLimit > 0.0) return fmt::format("; edges are held to {} from the first frame", times(sim.strainLimit));
   if (sim.rescueStrainLimit > 0.0)
-    return fmt::format(", then edges are held to {} from a frame that still goes unstable", times(sim.rescueStrainLimit));
+    return fmt::format(", then edges are held to {} from a frame that still goes unstable",
+                       times(sim.rescueStrainLimit));
   return ", then the run stops on it";
 }
 

@@ -377,7 +377,8 @@ RunFunction setupRun(CLI::App& app) {
                  "Largest stretch of an edge beyond its rest length, held after every substep (0.5: at most 1.5 "
                  "times as long), from the first frame; 'auto': only from a frame that goes unstable even with "
                  "--max-refinement times the substeps (cloth crushed in a pinch), at 0.5, for the rest of the run; "
-                 "'none': never, the run stops on such a frame; overrides the scene's strainLimit and rescueStrainLimit")
+                 "'none': never, the run stops on such a frame; overrides the scene's strainLimit and "
+                 "rescueStrainLimit")
       ->capture_default_str();
   app.add_option("--sphere", o->spheres, "A static sphere collider x,y,z,radius (m); repeatable");
   return [o, &app] { return runCommand(app, *o); };

@@ -46,6 +46,13 @@ inline bool run(ClothSolver& solver, long steps) {
   return true;
 }
 
+/// Steps frames 1, 2, ... `frames`; the first that goes unstable (1-based), or 0 if none does.
+inline long firstUnstableFrame(ClothSolver& solver, long frames) {
+  for (long f = 1; f <= frames; ++f)
+    if (!solver.stepFrame(f)) return f;
+  return 0;
+}
+
 /// Settings with a given substep (frame rate 30, substeps chosen to give at most dt).
 inline StepSettings settingsWithStep(double dt, double air = 0.0, Vec3 gravity = Vec3(0, -9.81, 0)) {
   StepSettings s;

@@ -45,11 +45,7 @@ struct HangingSheet {
 constexpr long kFrames = 30;
 
 /// The first frame (1-based) at which the solver stops, or 0 if it runs kFrames frames.
-long firstUnstableFrame(ClothSolver& solver) {
-  for (long f = 1; f <= kFrames; ++f)
-    if (!solver.stepFrame(f)) return f;
-  return 0;
-}
+long firstUnstableFrame(ClothSolver& solver) { return testing::firstUnstableFrame(solver, kFrames); }
 
 /// The fewest substeps per frame at which the fixed step goes unstable within kFrames while
 /// twice as many keep it stable (the case refinement is for), found by trying; 0 if none.

@@ -149,7 +149,6 @@ TEST(StrainLimit, SettingsAreValidated) {
   EXPECT_THROW(s.validate("--"), Error);
 }
 
-
 // ---------------------------------------------------------------------------------------
 // In the solver: a strip whose bottom row is pulled down to `pull` times its height in the
 // first tenth of a second and then held there. St Venant-Kirchhoff stiffens as it stretches,
@@ -197,11 +196,7 @@ struct PulledStrip {
 constexpr long kPullFrames = 15;
 constexpr double kPull = 1.4;
 
-long firstUnstableFrame(ClothSolver& solver) {
-  for (long f = 1; f <= kPullFrames; ++f)
-    if (!solver.stepFrame(f)) return f;
-  return 0;
-}
+long firstUnstableFrame(ClothSolver& solver) { return testing::firstUnstableFrame(solver, kPullFrames); }
 
 /// The fewest substeps per frame that keep the strip stable at rest but not once pulled; 0 if none.
 int stableAtRestNotPulled() {

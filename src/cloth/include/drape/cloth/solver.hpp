@@ -6,8 +6,9 @@
 //
 // with wall-clock time per phase (strain limiting only once on: StepSettings::strainLimit,
 // or the rescue of a frame no refinement keeps stable). Nothing allocates inside the loop,
-// and the same input gives bit-identical results. Instability (a NaN or a vertex faster than the bound) stops
-// the step and comes back as a report, never as an exception from inside the loop.
+// and the same input gives bit-identical results. Instability (a NaN or a vertex faster
+// than the bound) stops the step and comes back as a report, never as an exception from
+// inside the loop.
 
 #include <array>
 #include <cstdint>

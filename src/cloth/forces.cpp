@@ -38,10 +38,9 @@ inline Sym2 softenCompression(Sym2 s, double scale) {
   const double ax = s.c, ay = s2 - s.a;
   const bool first = ax * ax + ay * ay >= 1e-300;
   const double nx = first ? ax : s2 - s.b, ny = first ? ay : s.c;
-  const double inv = 1.0 / std::sqrt(std::max(nx * nx + ny * ny, 1e-300));
-  const double ux = nx * inv, uy = ny * inv;
-  const double k = (scale - 1.0) * s2;
-  const Sym2 mixed{s.a + k * ux * ux, s.b + k * uy * uy, s.c + k * ux * uy};
+  // (scale - 1) s2 u u^T with u = n / |n|: the square root of |n| cancels.
+  const double k = (scale - 1.0) * s2 / std::max(nx * nx + ny * ny, 1e-300);
+  const Sym2 mixed{s.a + k * nx * nx, s.b + k * ny * ny, s.c + k * nx * ny};
   const Sym2 both{s.a * scale, s.b * scale, s.c * scale};
   const bool tension = s2 >= 0.0, compression = s1 <= 0.0;
   return {tension ? s.a : compression ? both.a : mixed.a, tension ? s.b : compression ? both.b : mixed.b,

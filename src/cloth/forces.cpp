@@ -173,8 +173,14 @@ void hingeCornerForces(std::size_t n, const double* __restrict x, const double* 
     const bool ok = n1sq > 1e-300 && n2sq > 1e-300 && esq > 1e-300;
     const double n1s = ok ? n1sq : 1.0, n2s = ok ? n2sq : 1.0, es = ok ? esq : 1.0;
 
+    // One division for the four reciprocals below (|N1| |N2|, |N1|^2, |N2|^2, |e|): divisions
+    // and square roots are what this kernel waits on.
+    const double q = std::sqrt(n1s * n2s);
+    const double inv = 1.0 / (q * es);
+    const double invQ = es * inv, invEs = q * inv;
+
     // cos(theta) and the sign of theta; psi = 2 sin(theta/2), dpsi/dtheta = cos(theta/2).
-    const double c = std::min(1.0, std::max(-1.0, dot(n1, n2) / std::sqrt(n1s * n2s)));
+    const double c = std::min(1.0, std::max(-1.0, dot(n1, n2) * invQ));
     const double psiAbs = std::sqrt(2.0 * (1.0 - c));
     const double psi = dot(cross(n1, n2), e) < 0.0 ? -psiAbs : psiAbs;
     const double cosHalf = std::sqrt(0.5 * (1.0 + c));
@@ -185,8 +191,8 @@ void hingeCornerForces(std::size_t n, const double* __restrict x, const double* 
     // f_i = -k (psi - psi0) dpsi/dx_i = k (psi - psi0) cos(theta/2) u_i.
     const double stiffness = k[i] * scale, rest = restPsi[i];  // loaded unconditionally: a select, not a masked load
     const double m = ok ? stiffness * (psi - rest) * cosHalf : 0.0;
-    const double elen = std::sqrt(es), invE = 1.0 / elen;
-    const double r1 = m / n1s, r2 = m / n2s;
+    const double elen = std::sqrt(es), invE = elen * invEs;
+    const double r1 = m * n2s * invQ * invQ, r2 = m * n1s * invQ * invQ;  // m / |N1|^2, m / |N2|^2
     const V3 fa = mul(n1, r1 * elen), fb = mul(n2, r2 * elen);
     const V3 fe0 = add(mul(n1, r1 * dot(sub(x1, x4), e) * invE), mul(n2, r2 * dot(sub(x2, x4), e) * invE));
     fax[i] = fa.x;

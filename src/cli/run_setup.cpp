@@ -632,11 +632,7 @@ int simulateRun(const RunSetup& setup) {
         const std::vector<std::uint8_t> stable =
             sim::stepInParallel(runs.size(), frame, [&](std::size_t g) -> cloth::ClothSolver& { return *runs[g].solver; });
         for (std::size_t g = 0; g < runs.size() && unstable.empty(); ++g) {
-          if (runs[g].solver->lastRefinement() > 1)
-            spdlog::info("{}", cloth::describeRefinedFrame(*runs[g].solver, setup.garments[g].name));
-          const std::string rescue =
-              cloth::describeStrainLimitRescue(*runs[g].solver, setup.garments[g].name, frame);
-          if (!rescue.empty()) spdlog::warn("{}", rescue);
+          sim::logFrameRecovery(*runs[g].solver, setup.garments[g].name, frame);
           if (!stable[g]) {
             unstable = describeInstability(runs[g], settings.maxSpeed_m_s, overlaps, frame);
             unstableNan = runs[g].solver->instability().nan;

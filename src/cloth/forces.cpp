@@ -28,19 +28,20 @@ struct Sym2 {
 
 /// Scales the compressive principal part of the stress S by `scale` (S and the strain share
 /// principal directions, so a tension direction keeps its full stress). Branch-free (every
-/// case computed, one selected) so that the membrane loop vectorises.
+/// case computed, one selected) so that the membrane loop vectorises. With principal
+/// stresses s1 >= s2, the compressive part s2 u2 u2^T uses the projector
+/// u2 u2^T = (S - s1 I) / (s2 - s1), and s2 (S - s1 I) = s2 S - det(S) I: no eigenvector to
+/// find and normalise, one square root and one division per element (they are what the
+/// loop waits on).
 inline Sym2 softenCompression(Sym2 s, double scale) {
   const double mean = 0.5 * (s.a + s.b);
   const double half = 0.5 * (s.a - s.b);
   const double radius = std::sqrt(half * half + s.c * s.c);
   const double s1 = mean + radius, s2 = mean - radius;
-  // Unit eigenvector of s2: (s.c, s2 - s.a) or (s2 - s.b, s.c), whichever is longer.
-  const double ax = s.c, ay = s2 - s.a;
-  const bool first = ax * ax + ay * ay >= 1e-300;
-  const double nx = first ? ax : s2 - s.b, ny = first ? ay : s.c;
-  // (scale - 1) s2 u u^T with u = n / |n|: the square root of |n| cancels.
-  const double k = (scale - 1.0) * s2 / std::max(nx * nx + ny * ny, 1e-300);
-  const Sym2 mixed{s.a + k * nx * nx, s.b + k * ny * ny, s.c + k * nx * ny};
+  const double det = s.a * s.b - s.c * s.c;
+  // Selected only where s2 < 0 < s1, so 2 radius > 0 there; the bound keeps other lanes finite.
+  const double f = (scale - 1.0) / std::max(2.0 * radius, 1e-300);
+  const Sym2 mixed{s.a - f * (s2 * s.a - det), s.b - f * (s2 * s.b - det), s.c - f * s2 * s.c};
   const Sym2 both{s.a * scale, s.b * scale, s.c * scale};
   const bool tension = s2 >= 0.0, compression = s1 <= 0.0;
   return {tension ? s.a : compression ? both.a : mixed.a, tension ? s.b : compression ? both.b : mixed.b,

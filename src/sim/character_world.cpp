@@ -404,9 +404,7 @@ bool CharacterWorld::stepFrame(long frame) {
   const std::vector<std::uint8_t> stables = stepGarments(frame);
   for (std::size_t i = 0; i < garments_.size(); ++i) {
     const GarmentRun& g = garments_[i];
-    if (g.solver->lastRefinement() > 1) spdlog::info("{}", cloth::describeRefinedFrame(*g.solver, g.spec.name));
-    const std::string rescue = cloth::describeStrainLimitRescue(*g.solver, g.spec.name, frame);
-    if (!rescue.empty()) spdlog::warn("{}", rescue);
+    logFrameRecovery(*g.solver, g.spec.name, frame);
     if (!stables[i]) {
       instability_ = g.solver->instability().describe(g.spec.name, settings_.step.maxSpeed_m_s);
       // Where the vertex was held: most garments that blow up on a body do it in a pinch,
@@ -421,6 +419,13 @@ bool CharacterWorld::stepFrame(long frame) {
 
 std::vector<std::uint8_t> CharacterWorld::stepGarments(long frame) {
   return stepInParallel(garments_.size(), frame, [&](std::size_t g) -> cloth::ClothSolver& { return *garments_[g].solver; });
+}
+
+void logFrameRecovery(const cloth::ClothSolver& solver, const std::string& garment, long frame) {
+  const std::string refined = cloth::describeRefinedFrame(solver, garment);
+  if (!refined.empty()) spdlog::info("{}", refined);
+  const std::string rescue = cloth::describeStrainLimitRescue(solver, garment, frame);
+  if (!rescue.empty()) spdlog::warn("{}", rescue);
 }
 
 std::vector<std::uint8_t> stepInParallel(std::size_t count, long frame,

@@ -276,6 +276,16 @@ TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
     EXPECT_TRUE(every.contains(key)) << key;
   EXPECT_EQ(every["frames"], 40);
   EXPECT_EQ(every["paper_table3"]["sim_fps"], 30.2);
+  // The paper's scenario is named so only when it is the bundled one.
+  EXPECT_EQ(every["scenario"].get<std::string>().rfind("walking skirt: ", 0), 0u) << every["scenario"];
+  const std::string otherWalk = std::string(DRAPE_DATA_DIR) + "/mocap/cmu_walk_delfem2.bvh";
+  const testing::CliResult otherRun =
+      testing::runDrape("bench paper --json --runs 1 --frames 5 --motion '" + otherWalk + "'", dir);
+  ASSERT_EQ(otherRun.code, 0) << otherRun.err;
+  const nlohmann::json other = nlohmann::json::parse(otherRun.out);
+  EXPECT_EQ(other["scenario"].get<std::string>(),
+            std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt/scene.wrl with " + otherWalk)
+      << other["scenario"];
   // The reference workload timed in the same run, and the scenario's speed read against it
   // (CPU time over CPU time).
   const double referenceMs = every["reference"]["ms_per_frame"].get<double>();

@@ -103,6 +103,10 @@ struct PartField {
 std::vector<std::uint8_t> stepInParallel(std::size_t count, long frame,
                                          const std::function<cloth::ClothSolver&(std::size_t)>& solver);
 
+/// Logs what a garment's solver did to get through `frame`: an info line when the frame
+/// was computed again with more substeps, a warning when strain limiting came on in it.
+void logFrameRecovery(const cloth::ClothSolver& solver, const std::string& garment, long frame);
+
 class CharacterWorld {
  public:
   /// Builds the part fields, binds every garment's mask and establishes the initial

@@ -180,19 +180,20 @@ void hingeCornerForces(std::size_t n, const double* __restrict x, const double* 
     const double inv = 1.0 / (q * es);
     const double invQ = es * inv, invEs = q * inv;
 
-    // cos(theta) and the sign of theta; psi = 2 sin(theta/2), dpsi/dtheta = cos(theta/2).
+    // cos(theta); psi = 2 sin(theta/2), dpsi/dtheta = cos(theta/2), so psi dpsi/dtheta =
+    // sin(theta), signed: N1 x N2 lies along e, and (N1 x N2).e = |N1| |N2| |e| sin(theta).
+    // No square root for psi, and no cancellation in 1 - cos(theta) at small angles.
     const double c = std::min(1.0, std::max(-1.0, dot(n1, n2) * invQ));
-    const double psiAbs = std::sqrt(2.0 * (1.0 - c));
-    const double psi = dot(cross(n1, n2), e) < 0.0 ? -psiAbs : psiAbs;
     const double cosHalf = std::sqrt(0.5 * (1.0 + c));
+    const double elen = std::sqrt(es), invE = elen * invEs;
+    const double sinTheta = dot(cross(n1, n2), e) * invQ * invE;
 
     // dtheta/dx_i = -u_i with Bridson et al. (2003)'s u_i, which sum to zero exactly:
     //   u_a = |e| N1 / |N1|^2, u_b = |e| N2 / |N2|^2,
     //   u_e0 = ((a - e1).e N1 / |N1|^2 + (b - e1).e N2 / |N2|^2) / |e|, u_e1 = -(u_a + u_b + u_e0).
-    // f_i = -k (psi - psi0) dpsi/dx_i = k (psi - psi0) cos(theta/2) u_i.
+    // f_i = -k (psi - psi0) dpsi/dx_i = k (psi - psi0) cos(theta/2) u_i = k (sin(theta) - psi0 cos(theta/2)) u_i.
     const double stiffness = k[i] * scale, rest = restPsi[i];  // loaded unconditionally: a select, not a masked load
-    const double m = ok ? stiffness * (psi - rest) * cosHalf : 0.0;
-    const double elen = std::sqrt(es), invE = elen * invEs;
+    const double m = ok ? stiffness * (sinTheta - rest * cosHalf) : 0.0;
     const double r1 = m * n2s * invQ * invQ, r2 = m * n1s * invQ * invQ;  // m / |N1|^2, m / |N2|^2
     const V3 fa = mul(n1, r1 * elen), fb = mul(n2, r2 * elen);
     const V3 fe0 = add(mul(n1, r1 * dot(sub(x1, x4), e) * invE), mul(n2, r2 * dot(sub(x2, x4), e) * invE));

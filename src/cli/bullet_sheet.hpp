@@ -5,6 +5,7 @@
 // a fixed reference workload, so that the scenario's speed can be read against what the
 // machine gives at that moment (a shared host's speed moves by a third from day to day).
 
+#include <memory>
 #include <string>
 
 #include "drape/core/math.hpp"
@@ -29,8 +30,34 @@ struct BulletSheetRun {
   double maxStrain = 0.0;   ///< the largest link strain at the end
 };
 
-/// Runs the sheet of cellsU x cellsV cells (with diagonals) for `frames` frames at 33
-/// substeps in Bullet's btSoftRigidDynamicsWorld.
+/// The sheet of cellsU x cellsV cells (with diagonals) in Bullet's btSoftRigidDynamicsWorld
+/// at 33 substeps per frame, stepped a few frames at a time: `drape bench paper` interleaves
+/// it with the scenario's frames, so that the two are timed on the host in the same state.
+class BulletSheet {
+ public:
+  BulletSheet(int cellsU, int cellsV);
+  ~BulletSheet();
+  BulletSheet(const BulletSheet&) = delete;
+  BulletSheet& operator=(const BulletSheet&) = delete;
+
+  /// Steps until `frames` frames in all have been stepped, or the sheet has gone NaN.
+  void stepTo(long frames);
+  [[nodiscard]] long frames() const { return frames_; }
+  /// This thread's CPU time in stepTo (the divergence checks included).
+  [[nodiscard]] double cpuSeconds() const { return cpuSeconds_; }
+  /// The run so far, with the links' largest strain now.
+  [[nodiscard]] BulletSheetRun result() const;
+
+ private:
+  struct World;
+  std::unique_ptr<World> world_;
+  long frames_ = 0;
+  double cpuSeconds_ = 0.0;
+  bool nan_ = false;
+  BulletSheetRun run_;
+};
+
+/// Runs the sheet for `frames` frames in one go.
 [[nodiscard]] BulletSheetRun runBulletSheet(int cellsU, int cellsV, long frames);
 
 /// Bullet's version and the soft body's settings, for the benchmarks' JSON.

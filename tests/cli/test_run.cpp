@@ -291,6 +291,9 @@ TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
   const double referenceMs = every["reference"]["ms_per_frame"].get<double>();
   EXPECT_GT(referenceMs, 0.0);
   EXPECT_EQ(every["reference"]["runs"], 1);
+  // All of the reference's frames, stepped in slices between blocks of the scenario's 40
+  // (34 and 6): the last slice takes it to its end.
+  EXPECT_EQ(every["reference"]["frames_per_run"], 300);
   EXPECT_NEAR(every["speed_vs_reference"].get<double>(), referenceMs / every["cpu_ms_per_frame"].get<double>(),
               1e-9 * referenceMs / every["cpu_ms_per_frame"].get<double>());
   EXPECT_EQ(every["collision_every"], 1);

@@ -65,9 +65,10 @@ struct PaperRun {
 // The reference workload: Bullet's sheet-480 of `drape bench cloth` (16 x 15 cells, 272
 // nodes), 300 frames per run of the scenario. It is stepped in slices between blocks of the
 // scenario's frames, so that both are timed on the host in the same state: five slices of
-// about 0.1 s on the bundled scenario, finer than the swings of a shared host's speed. Each
-// slice leaves the scenario's caches cold: blocks of 10 frames cost the scenario 5 % more
-// time per frame, blocks of 34 about a third of that (docs/PERFORMANCE.md).
+// about 0.1 s on the bundled scenario. Each slice leaves the scenario's caches cold: blocks
+// of 10 frames cost it about 10 % more CPU time per frame, blocks of 34 too little to see
+// beside the host's noise, with half the spread of the ratio that runs one after the other
+// gave (docs/PERFORMANCE.md).
 constexpr int kReferenceCellsU = 16, kReferenceCellsV = 15;
 constexpr long kReferenceFrames = 300;
 constexpr long kFramesPerSlice = 34;  ///< the scenario's frames between two slices of the reference

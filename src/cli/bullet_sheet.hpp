@@ -43,9 +43,8 @@ class BulletSheet {
   /// Steps until `frames` frames in all have been stepped, or the sheet has gone NaN.
   void stepTo(long frames);
   [[nodiscard]] long frames() const { return frames_; }
-  /// This thread's CPU time in stepTo (the divergence checks included).
-  [[nodiscard]] double cpuSeconds() const { return cpuSeconds_; }
-  /// The run so far, with the links' largest strain now.
+  /// The run so far (its CPU time in stepTo, the divergence checks included, per frame),
+  /// with the links' largest strain now.
   [[nodiscard]] BulletSheetRun result() const;
 
  private:

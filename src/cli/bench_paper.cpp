@@ -182,7 +182,8 @@ RunFunction setupPaperBench(CLI::App& app) {
       referenceMs.push_back(run.referenceMsPerFrame);
       speedVsReference.push_back(run.simCpuSeconds > 0 ? run.referenceMsPerFrame * 1e-3 * run.frames / run.simCpuSeconds
                                                        : 0.0);
-      spdlog::info("run {}: {} frames in {:.3f} s; the reference {:.3f} ms per frame, {:.3f} times the scenario's",
+      spdlog::info("run {}: {} frames in {:.3f} s; the reference {:.3f} ms per frame: {:.3f} of the scenario's "
+                   "frames per reference frame",
                    i + 1, run.frames, run.simSeconds, run.referenceMsPerFrame, speedVsReference.back());
     }
     std::sort(runs.begin(), runs.end(), [](const PaperRun& a, const PaperRun& b) { return a.simSeconds < b.simSeconds; });

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <optional>
 
 #include <fmt/format.h>
@@ -25,6 +26,48 @@ double hingePsi(const Vec3& e0, const Vec3& e1, const Vec3& a, const Vec3& b) {
   const double s = n1.cross(n2).dot(edge);
   const double psi = std::sqrt(2.0 * (1.0 - c));
   return s < 0.0 ? -psi : psi;
+}
+
+/// The kernel order of a list of elements given their corner indices (N per element): runs
+/// (kKernelRun elements whose every corner goes up by one from each to the next) first,
+/// then the other elements in the list's order. Returns the list's indices in kernel order;
+/// counts the runs in `runs`.
+template <std::size_t N>
+std::vector<std::uint32_t> kernelOrder(const std::vector<std::array<std::uint32_t, N>>& corners,
+                                       std::int32_t& runs) {
+  // Sorted by the corners' offsets from the first corner, then by the first corner, the
+  // elements of a run are neighbours.
+  const auto key = [&](std::uint32_t e) {
+    std::array<std::int64_t, N> k{};
+    for (std::size_t c = 1; c < N; ++c) k[c - 1] = std::int64_t{corners[e][c]} - corners[e][0];
+    k[N - 1] = corners[e][0];
+    return k;
+  };
+  std::vector<std::uint32_t> sorted(corners.size());
+  std::iota(sorted.begin(), sorted.end(), 0U);
+  std::sort(sorted.begin(), sorted.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+  const auto continues = [&](std::uint32_t previous, std::uint32_t next) {
+    const auto p = key(previous), q = key(next);
+    return std::equal(p.begin(), p.end() - 1, q.begin()) && q[N - 1] == p[N - 1] + 1;
+  };
+
+  std::vector<std::uint32_t> order;
+  std::vector<char> inRun(corners.size(), 0);
+  for (std::size_t i = 0; i < sorted.size();) {
+    std::size_t j = i + 1;
+    while (j < sorted.size() && continues(sorted[j - 1], sorted[j])) ++j;
+    // Whole runs; what the row leaves over goes with the other elements.
+    const std::size_t whole = (j - i) / kKernelRun * kKernelRun;
+    for (std::size_t r = i; r < i + whole; ++r) {
+      order.push_back(sorted[r]);
+      inRun[sorted[r]] = 1;
+    }
+    i = j;
+  }
+  runs = static_cast<std::int32_t>(order.size()) / kKernelRun;
+  for (std::uint32_t e = 0; e < corners.size(); ++e)
+    if (!inRun[e]) order.push_back(e);
+  return order;
 }
 
 }  // namespace
@@ -269,10 +312,18 @@ void ClothModel::buildEdges(const mesh::Topology& topology) {
   }
 }
 
-// The element lists as structure of arrays for the kernels (gathers vectorise; AoS would not).
+// The element lists as structure of arrays for the kernels (gathers vectorise; AoS would
+// not), runs first.
 void ClothModel::buildKernelData() {
   MembraneArrays& m = membraneArrays_;
-  for (const MembraneElement& el : membrane_) {
+  std::vector<std::array<std::uint32_t, 3>> triangleCorners;
+  for (const MembraneElement& el : membrane_) triangleCorners.push_back({el.v0, el.v1, el.v2});
+  const std::vector<std::uint32_t> triangleOrder = kernelOrder(triangleCorners, m.runs);
+  const std::size_t n = membrane_.size();
+  std::vector<std::int32_t> position(n);
+  for (std::size_t t = 0; t < n; ++t) {
+    const MembraneElement& el = membrane_[triangleOrder[t]];
+    position[triangleOrder[t]] = static_cast<std::int32_t>(t);
     m.v0.push_back(static_cast<std::int32_t>(el.v0));
     m.v1.push_back(static_cast<std::int32_t>(el.v1));
     m.v2.push_back(static_cast<std::int32_t>(el.v2));
@@ -282,8 +333,7 @@ void ClothModel::buildKernelData() {
     m.g2v.push_back(el.g2v);
     m.area.push_back(el.restArea_m2);
   }
-  // Corner incidences per vertex, in triangle order (a fixed summation order).
-  const std::size_t n = membrane_.size();
+  // Corner incidences per vertex, in the order of membrane_ (a fixed summation order).
   m.cornerStart.assign(vertexCount() + 1, 0);
   for (const MembraneElement& el : membrane_)
     for (const std::uint32_t v : {el.v0, el.v1, el.v2}) ++m.cornerStart[v + 1];
@@ -292,10 +342,18 @@ void ClothModel::buildKernelData() {
   std::vector<std::int32_t> next(m.cornerStart.begin(), m.cornerStart.end() - 1);
   for (std::size_t t = 0; t < n; ++t) {
     const std::array<std::uint32_t, 3> corners = {membrane_[t].v0, membrane_[t].v1, membrane_[t].v2};
-    for (std::size_t c = 0; c < 3; ++c) m.cornerOffset[next[corners[c]]++] = static_cast<std::int32_t>(3 * c * n + t);
+    for (std::size_t c = 0; c < 3; ++c)
+      m.cornerOffset[next[corners[c]]++] = static_cast<std::int32_t>(3 * c * n) + position[t];
   }
+
   BendArrays& b = bendArrays_;
-  for (const BendElement& h : bending_) {
+  std::vector<std::array<std::uint32_t, 4>> hingeCorners;
+  for (const BendElement& h : bending_) hingeCorners.push_back({h.e0, h.e1, h.a, h.b});
+  const std::vector<std::uint32_t> hingeOrder = kernelOrder(hingeCorners, b.runs);
+  b.order.assign(bending_.size(), 0);
+  for (std::size_t i = 0; i < hingeOrder.size(); ++i) {
+    const BendElement& h = bending_[hingeOrder[i]];
+    b.order[hingeOrder[i]] = static_cast<std::int32_t>(i);
     b.e0.push_back(static_cast<std::int32_t>(h.e0));
     b.e1.push_back(static_cast<std::int32_t>(h.e1));
     b.a.push_back(static_cast<std::int32_t>(h.a));

@@ -45,22 +45,36 @@ struct BendElement {
   double stiffness_Nm;   ///< k in W = k / 2 (psi - restPsi)^2, N m
 };
 
+/// The kernel lists begin with runs of kKernelRun elements whose every corner index goes up
+/// by one from one element to the next (rows of a structured mesh: a generated skirt, a
+/// grid): the kernels load those vertices as vectors instead of gathering them one
+/// coordinate at a time. A run is as long as a vector of doubles on AVX-512, so its loop has
+/// no remainder; what a row leaves over goes with the other elements.
+inline constexpr std::int32_t kKernelRun = 8;
+
 /// The membrane elements again as structure of arrays, what the vectorised kernel reads
-/// (filled by buildKernelData from the MembraneElement list; same order).
-/// Indices are signed 32-bit because that is what vector gather instructions take.
+/// (filled by buildKernelData from the MembraneElement list). `runs` runs of kKernelRun
+/// come first; the other elements follow in the list's order. Indices are signed 32-bit
+/// because that is what vector gather instructions take.
 struct MembraneArrays {
   std::vector<std::int32_t> v0, v1, v2;
   std::vector<double> g1u, g1v, g2u, g2v, area;
+  std::int32_t runs = 0;
   /// Per vertex (CSR: cornerStart[v] .. cornerStart[v + 1]) the offsets of its corner
-  /// forces in the kernel workspace (corner c of triangle t at 3 c n + t, x; y and z n and
-  /// 2 n further): the forces are summed per vertex, loads only, instead of scattered.
+  /// forces in the kernel workspace (corner c of kernel element t at 3 c n + t, x; y and z
+  /// n and 2 n further): the forces are summed per vertex, loads only, instead of
+  /// scattered, in the order of membrane(), so that the sums do not depend on the runs.
   std::vector<std::int32_t> cornerStart, cornerOffset;
 };
 
-/// The bending hinges as structure of arrays (buildKernelData; same order as bending()).
+/// The bending hinges as structure of arrays (buildKernelData), runs first as in
+/// MembraneArrays; `order[j]` is the kernel position of bending()[j], the order in which
+/// the hinge forces are added to the vertices.
 struct BendArrays {
   std::vector<std::int32_t> e0, e1, a, b;
   std::vector<double> restPsi, stiffness;
+  std::int32_t runs = 0;
+  std::vector<std::int32_t> order;
 };
 
 class ClothModel {

@@ -1,0 +1,135 @@
+// The force kernels' runs (MembraneArrays, BendArrays): elements whose corners are
+// consecutive vertices are loaded as vectors instead of gathered. The forces must not depend
+// on it: a structured mesh (runs) against the same mesh with its vertices renumbered at
+// random (no runs), on many random states.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <numeric>
+#include <random>
+
+#include "cloth_fixture.hpp"
+
+namespace drape::cloth {
+namespace {
+
+using testing::makeModel;
+
+/// A cylinder of `around` x `rows` cells, every cell split along the same diagonal, vertex
+/// (i, j) at j * around + i: the structure of a generated skirt, whose rows are runs.
+mesh::TriMesh tube(int around, int rows) {
+  mesh::TriMesh m;
+  m.name = "tube";
+  for (int j = 0; j <= rows; ++j)
+    for (int i = 0; i < around; ++i) {
+      const double a = 2.0 * 3.141592653589793 * i / around;
+      m.positions.emplace_back(0.2 * std::cos(a), -0.04 * j, 0.2 * std::sin(a));
+    }
+  const auto v = [&](int i, int j) { return static_cast<std::uint32_t>(j * around + i % around); };
+  for (int j = 0; j < rows; ++j)
+    for (int i = 0; i < around; ++i) {
+      m.triangles.push_back({v(i, j), v(i, j + 1), v(i + 1, j)});
+      m.triangles.push_back({v(i + 1, j), v(i, j + 1), v(i + 1, j + 1)});
+    }
+  return m;
+}
+
+Material dampedSoftKnit() {
+  Material m = testing::knit();
+  m.damping_s = 2e-4;
+  m.compressionScale = 0.1;
+  return m;
+}
+
+/// The kernel arrays hold every element once, and the runs are what they claim.
+TEST(KernelRuns, EveryElementOnceAndRunsConsecutive) {
+  auto model = makeModel(tube(24, 10), dampedSoftKnit());
+  const MembraneArrays& m = model->membraneArrays();
+  ASSERT_GT(m.runs, 0);
+  std::map<std::array<std::int32_t, 3>, int> kernel, listed;
+  for (std::size_t t = 0; t < m.v0.size(); ++t) ++kernel[{m.v0[t], m.v1[t], m.v2[t]}];
+  for (const MembraneElement& el : model->membrane())
+    ++listed[{static_cast<std::int32_t>(el.v0), static_cast<std::int32_t>(el.v1), static_cast<std::int32_t>(el.v2)}];
+  EXPECT_EQ(kernel, listed);
+  for (std::int32_t t = 0; t < m.runs * kKernelRun; ++t) {
+    if (t % kKernelRun == 0) continue;
+    EXPECT_EQ(m.v0[t], m.v0[t - 1] + 1) << t;
+    EXPECT_EQ(m.v1[t], m.v1[t - 1] + 1) << t;
+    EXPECT_EQ(m.v2[t], m.v2[t - 1] + 1) << t;
+  }
+
+  const BendArrays& b = model->bendArrays();
+  ASSERT_GT(b.runs, 0);
+  ASSERT_EQ(b.order.size(), model->bending().size());
+  for (std::size_t j = 0; j < b.order.size(); ++j) {
+    const BendElement& h = model->bending()[j];
+    const auto i = static_cast<std::size_t>(b.order[j]);
+    EXPECT_EQ(b.e0[i], static_cast<std::int32_t>(h.e0));
+    EXPECT_EQ(b.e1[i], static_cast<std::int32_t>(h.e1));
+    EXPECT_EQ(b.a[i], static_cast<std::int32_t>(h.a));
+    EXPECT_EQ(b.b[i], static_cast<std::int32_t>(h.b));
+    EXPECT_EQ(b.restPsi[i], h.restPsi);
+  }
+  for (std::int32_t i = 0; i < b.runs * kKernelRun; ++i) {
+    if (i % kKernelRun == 0) continue;
+    EXPECT_EQ(b.e0[i], b.e0[i - 1] + 1) << i;
+    EXPECT_EQ(b.b[i], b.b[i - 1] + 1) << i;
+  }
+}
+
+TEST(KernelRuns, ForcesDoNotDependOnTheRuns) {
+  const mesh::TriMesh structured = tube(24, 10);
+  // The same mesh with its vertices renumbered at random: no runs.
+  const std::size_t n = structured.vertexCount();
+  std::vector<std::uint32_t> renumber(n);
+  std::iota(renumber.begin(), renumber.end(), 0U);
+  std::mt19937 rng(7);
+  std::shuffle(renumber.begin(), renumber.end(), rng);
+  mesh::TriMesh shuffled = structured;
+  for (std::size_t v = 0; v < n; ++v) shuffled.positions[renumber[v]] = structured.positions[v];
+  for (mesh::Triangle& t : shuffled.triangles)
+    for (std::uint32_t& v : t) v = renumber[v];
+
+  auto a = makeModel(structured, dampedSoftKnit());
+  auto b = makeModel(shuffled, dampedSoftKnit());
+  ASSERT_GT(a->membraneArrays().runs, 0);
+  ASSERT_GT(a->bendArrays().runs, 0);
+  ASSERT_EQ(b->membraneArrays().runs, 0);
+  ASSERT_EQ(b->bendArrays().runs, 0);
+
+  std::normal_distribution<double> move(0.0, 0.01), speed(0.0, 0.5);
+  for (int trial = 0; trial < 50; ++trial) {
+    ClothState sa = ClothState::atRest(*a), sb = ClothState::atRest(*b);
+    for (std::size_t v = 0; v < n; ++v) {  // stretched, compressed and bent, and moving
+      const std::size_t w = renumber[v];
+      sb.x[w] = sa.x[v] += move(rng);
+      sb.y[w] = sa.y[v] += move(rng);
+      sb.z[w] = sa.z[v] += move(rng);
+      sb.vx[w] = sa.vx[v] = speed(rng);
+      sb.vy[w] = sa.vy[v] = speed(rng);
+      sb.vz[w] = sa.vz[v] = speed(rng);
+    }
+    for (auto [model, s] : {std::pair{a.get(), &sa}, std::pair{b.get(), &sb}}) {
+      clearForces(*s);
+      accumulateMembraneForces(*model, *s);
+      accumulateBendingForces(*model, *s, 1.0);
+    }
+    double largest = 0.0;
+    for (std::size_t v = 0; v < n; ++v) largest = std::max({largest, std::abs(sa.fx[v]), std::abs(sa.fy[v]), std::abs(sa.fz[v])});
+    ASSERT_GT(largest, 0.0);
+    // The renumbered mesh adds each vertex's contributions in another order and orients
+    // some hinges the other way: rounding, amplified where large element forces cancel
+    // (a wrong vertex in a run gives differences of the order of the forces).
+    const double tolerance = 1e-9 * largest;
+    for (std::size_t v = 0; v < n; ++v) {
+      const std::size_t w = renumber[v];
+      ASSERT_NEAR(sa.fx[v], sb.fx[w], tolerance) << "trial " << trial << " vertex " << v;
+      ASSERT_NEAR(sa.fy[v], sb.fy[w], tolerance) << "trial " << trial << " vertex " << v;
+      ASSERT_NEAR(sa.fz[v], sb.fz[w], tolerance) << "trial " << trial << " vertex " << v;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace drape::cloth

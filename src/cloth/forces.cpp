@@ -15,11 +15,6 @@ inline V3 mul(V3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
 inline double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 inline V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 inline V3 load(const double* x, const double* y, const double* z, std::int64_t i) { return {x[i], y[i], z[i]}; }
-inline void addTo(double* x, double* y, double* z, std::int64_t i, V3 f) {
-  x[i] += f.x;
-  y[i] += f.y;
-  z[i] += f.z;
-}
 
 /// Symmetric 2x2 tensor (11, 22, 12).
 struct Sym2 {
@@ -54,9 +49,9 @@ struct MembraneConstants {
 
 // The kernels run in two passes. Pass 1 (per element, gathers only, no scatter) computes
 // every element's corner forces into the workspace, one column per component; pass 2
-// (scalar) adds them to the vertices: the membrane, every substep, per vertex over its
-// corners (CSR: 4.1 instead of 4.3 us on a 480-triangle sheet); the hinges, every
-// bendEvery substeps, by a scatter. Pass 1 takes its arrays as restrict parameters: GCC 12
+// (scalar) adds them to the vertices per vertex over its corners (CSR): the membrane every
+// substep (4.1 instead of 4.3 us on a 480-triangle sheet against a scatter), the hinges
+// every bendEvery substeps. Pass 1 takes its arrays as restrict parameters: GCC 12
 // vectorises it so (gathers included), and not with the same pointers as function locals.
 // GCC builds each gathered vector from scalar loads and inserts; in a run (kKernelRun
 // elements whose corners are consecutive vertices, model.hpp) one vector load per
@@ -175,9 +170,9 @@ void membraneKernel(const ClothModel& model, ClothState& io) {
                  io.fz.data());
 }
 
-/// Bending pass 1: the forces on a, b and e0 of every hinge into w (columns fa, fb, fe0, x y z
-/// each); f_e1 = -(fa + fb + fe0). With kRuns the hinges come in runs of kKernelRun, as the
-/// membrane's triangles do.
+/// Bending pass 1: the forces on a, b, e0 and e1 of every hinge into w (columns fa, fb, fe0,
+/// fe1, x y z each; fe1 = -(fa + fb + fe0)). With kRuns the hinges come in runs of
+/// kKernelRun, as the membrane's triangles do.
 template <bool kRuns>
 void hingeCornerForces(std::size_t n, const double* __restrict x, const double* __restrict y,
                        const double* __restrict z, const std::int32_t* __restrict ie0,
@@ -186,7 +181,8 @@ void hingeCornerForces(std::size_t n, const double* __restrict x, const double* 
                        const double* __restrict k, double scale, double* __restrict fax, double* __restrict fay,
                        double* __restrict faz, double* __restrict fbx, double* __restrict fby,
                        double* __restrict fbz, double* __restrict fex, double* __restrict fey,
-                       double* __restrict fez) {
+                       double* __restrict fez, double* __restrict f1x, double* __restrict f1y,
+                       double* __restrict f1z) {
   const auto hinge = [&](std::size_t i, std::int64_t j3, std::int64_t j4, std::int64_t j1, std::int64_t j2)
                          __attribute__((always_inline)) {
     // Hinge normals with edge-local orientation (see BendElement) and the edge vector.
@@ -232,6 +228,10 @@ void hingeCornerForces(std::size_t n, const double* __restrict x, const double* 
     fex[i] = fe0.x;
     fey[i] = fe0.y;
     fez[i] = fe0.z;
+    const V3 fe1 = mul(add(add(fa, fb), fe0), -1.0);
+    f1x[i] = fe1.x;
+    f1y[i] = fe1.y;
+    f1z[i] = fe1.z;
   };
   if constexpr (kRuns) {
     for (std::size_t f = 0; f < n; f += kKernelRun) {
@@ -243,20 +243,22 @@ void hingeCornerForces(std::size_t n, const double* __restrict x, const double* 
   }
 }
 
-/// Bending pass 2: the hinge forces to the vertices, in the order of bending() (`order`: the
-/// kernel positions), so that the sums do not depend on the runs.
-void scatterHinges(std::size_t n, const std::int32_t* order, const std::int32_t* ie0, const std::int32_t* ie1,
-                   const std::int32_t* ia, const std::int32_t* ib, const double* w, double* fx, double* fy,
-                   double* fz) {
-  for (std::size_t j = 0; j < n; ++j) {
-    const std::size_t i = static_cast<std::size_t>(order[j]);
-    const V3 fa{w[i], w[n + i], w[2 * n + i]};
-    const V3 fb{w[3 * n + i], w[4 * n + i], w[5 * n + i]};
-    const V3 fe0{w[6 * n + i], w[7 * n + i], w[8 * n + i]};
-    addTo(fx, fy, fz, ia[i], fa);
-    addTo(fx, fy, fz, ib[i], fb);
-    addTo(fx, fy, fz, ie0[i], fe0);
-    addTo(fx, fy, fz, ie1[i], mul(add(add(fa, fb), fe0), -1.0));
+/// Bending pass 2: each vertex adds its hinge forces, loads only, in the order of
+/// bending(): the same sums, to the bit, as adding each hinge's four forces in turn.
+void gatherHinges(std::size_t vertices, std::size_t n, const std::int32_t* __restrict start,
+                  const std::int32_t* __restrict offset, const double* __restrict w, double* __restrict fx,
+                  double* __restrict fy, double* __restrict fz) {
+  for (std::size_t v = 0; v < vertices; ++v) {
+    double sx = fx[v], sy = fy[v], sz = fz[v];
+    for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
+      const double* c = w + offset[k];
+      sx += c[0];
+      sy += c[n];
+      sz += c[2 * n];
+    }
+    fx[v] = sx;
+    fy[v] = sy;
+    fz[v] = sz;
   }
 }
 
@@ -281,16 +283,17 @@ void accumulateBendingForces(const ClothModel& model, ClothState& io, double sca
   const BendArrays& h = model.bendArrays();
   const std::size_t n = h.stiffness.size();
   const double *x = io.x.data(), *y = io.y.data(), *z = io.z.data();
-  double* w = io.work.data();  // nine columns of n
+  double* w = io.work.data();  // twelve columns of n
   const std::size_t r = static_cast<std::size_t>(h.runs * kKernelRun);
   hingeCornerForces<true>(r, x, y, z, h.e0.data(), h.e1.data(), h.a.data(), h.b.data(), h.restPsi.data(),
                           h.stiffness.data(), scale, w, w + n, w + 2 * n, w + 3 * n, w + 4 * n, w + 5 * n, w + 6 * n,
-                          w + 7 * n, w + 8 * n);
+                          w + 7 * n, w + 8 * n, w + 9 * n, w + 10 * n, w + 11 * n);
   hingeCornerForces<false>(n - r, x, y, z, h.e0.data() + r, h.e1.data() + r, h.a.data() + r, h.b.data() + r,
                            h.restPsi.data() + r, h.stiffness.data() + r, scale, w + r, w + n + r, w + 2 * n + r,
-                           w + 3 * n + r, w + 4 * n + r, w + 5 * n + r, w + 6 * n + r, w + 7 * n + r, w + 8 * n + r);
-  scatterHinges(n, h.order.data(), h.e0.data(), h.e1.data(), h.a.data(), h.b.data(), w, io.fx.data(), io.fy.data(),
-                io.fz.data());
+                           w + 3 * n + r, w + 4 * n + r, w + 5 * n + r, w + 6 * n + r, w + 7 * n + r, w + 8 * n + r,
+                           w + 9 * n + r, w + 10 * n + r, w + 11 * n + r);
+  gatherHinges(io.size(), n, h.cornerStart.data(), h.cornerOffset.data(), w, io.fx.data(), io.fy.data(),
+               io.fz.data());
 }
 
 void accumulateDragForces(const ClothModel& model, const StepSettings& settings, ClothState& io) {

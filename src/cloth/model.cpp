@@ -350,10 +350,11 @@ void ClothModel::buildKernelData() {
   std::vector<std::array<std::uint32_t, 4>> hingeCorners;
   for (const BendElement& h : bending_) hingeCorners.push_back({h.e0, h.e1, h.a, h.b});
   const std::vector<std::uint32_t> hingeOrder = kernelOrder(hingeCorners, b.runs);
-  b.order.assign(bending_.size(), 0);
-  for (std::size_t i = 0; i < hingeOrder.size(); ++i) {
+  const std::size_t hinges = bending_.size();
+  std::vector<std::int32_t> hingePosition(hinges);
+  for (std::size_t i = 0; i < hinges; ++i) {
     const BendElement& h = bending_[hingeOrder[i]];
-    b.order[hingeOrder[i]] = static_cast<std::int32_t>(i);
+    hingePosition[hingeOrder[i]] = static_cast<std::int32_t>(i);
     b.e0.push_back(static_cast<std::int32_t>(h.e0));
     b.e1.push_back(static_cast<std::int32_t>(h.e1));
     b.a.push_back(static_cast<std::int32_t>(h.a));
@@ -361,6 +362,18 @@ void ClothModel::buildKernelData() {
     b.restPsi.push_back(h.restPsi);
     b.stiffness.push_back(h.stiffness_Nm);
   }
+  b.cornerStart.assign(vertexCount() + 1, 0);
+  for (const std::array<std::uint32_t, 4>& corners : hingeCorners)
+    for (const std::uint32_t v : corners) ++b.cornerStart[v + 1];
+  for (std::size_t v = 0; v < vertexCount(); ++v) b.cornerStart[v + 1] += b.cornerStart[v];
+  b.cornerOffset.assign(4 * hinges, 0);
+  std::vector<std::int32_t> nextHinge(b.cornerStart.begin(), b.cornerStart.end() - 1);
+  // Workspace columns fa, fb, fe0, fe1 (forces.cpp); hingeCorners holds e0, e1, a, b.
+  constexpr std::array<std::size_t, 4> kCorner = {2, 3, 0, 1};
+  for (std::size_t j = 0; j < hinges; ++j)
+    for (std::size_t column = 0; column < 4; ++column)
+      b.cornerOffset[nextHinge[hingeCorners[j][kCorner[column]]]++] =
+          static_cast<std::int32_t>(3 * column * hinges) + hingePosition[j];
 }
 
 double ClothModel::membraneWaveSpeed_m_s() const {

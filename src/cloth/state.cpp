@@ -19,7 +19,7 @@ ClothState ClothState::atRest(const ClothModel& model) {
   s.fx.assign(n, 0.0);
   s.fy.assign(n, 0.0);
   s.fz.assign(n, 0.0);
-  s.work.assign(9 * std::max(model.membrane().size(), model.bending().size()), 0.0);
+  s.work.assign(std::max(9 * model.membrane().size(), 12 * model.bending().size()), 0.0);
   return s;
 }
 

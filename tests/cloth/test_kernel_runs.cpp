@@ -61,16 +61,25 @@ TEST(KernelRuns, EveryElementOnceAndRunsConsecutive) {
 
   const BendArrays& b = model->bendArrays();
   ASSERT_GT(b.runs, 0);
-  ASSERT_EQ(b.order.size(), model->bending().size());
-  for (std::size_t j = 0; j < b.order.size(); ++j) {
-    const BendElement& h = model->bending()[j];
-    const auto i = static_cast<std::size_t>(b.order[j]);
-    EXPECT_EQ(b.e0[i], static_cast<std::int32_t>(h.e0));
-    EXPECT_EQ(b.e1[i], static_cast<std::int32_t>(h.e1));
-    EXPECT_EQ(b.a[i], static_cast<std::int32_t>(h.a));
-    EXPECT_EQ(b.b[i], static_cast<std::int32_t>(h.b));
-    EXPECT_EQ(b.restPsi[i], h.restPsi);
-  }
+  // Every hinge once, and each of its four corners once in its vertex's list.
+  std::map<std::array<std::int32_t, 4>, int> kernelHinges, listedHinges;
+  for (std::size_t i = 0; i < b.e0.size(); ++i) ++kernelHinges[{b.e0[i], b.e1[i], b.a[i], b.b[i]}];
+  for (const BendElement& h : model->bending())
+    ++listedHinges[{static_cast<std::int32_t>(h.e0), static_cast<std::int32_t>(h.e1), static_cast<std::int32_t>(h.a),
+                    static_cast<std::int32_t>(h.b)}];
+  EXPECT_EQ(kernelHinges, listedHinges);
+  const std::size_t hinges = b.e0.size();
+  std::vector<int> seen(4 * hinges, 0);
+  for (std::size_t v = 0; v + 1 < b.cornerStart.size(); ++v)
+    for (std::int32_t k = b.cornerStart[v]; k < b.cornerStart[v + 1]; ++k) {
+      const auto offset = static_cast<std::size_t>(b.cornerOffset[k]);
+      const std::size_t column = offset / (3 * hinges), i = offset % (3 * hinges);
+      ASSERT_LT(i, hinges);
+      const std::int32_t vertex = std::array{b.a[i], b.b[i], b.e0[i], b.e1[i]}[column];
+      EXPECT_EQ(vertex, static_cast<std::int32_t>(v)) << "hinge " << i << " corner " << column;
+      ++seen[column * hinges + i];
+    }
+  EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int c) { return c == 1; }));
   for (std::int32_t i = 0; i < b.runs * kKernelRun; ++i) {
     if (i % kKernelRun == 0) continue;
     EXPECT_EQ(b.e0[i], b.e0[i - 1] + 1) << i;

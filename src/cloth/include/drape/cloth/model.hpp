@@ -68,13 +68,15 @@ struct MembraneArrays {
 };
 
 /// The bending hinges as structure of arrays (buildKernelData), runs first as in
-/// MembraneArrays; `order[j]` is the kernel position of bending()[j], the order in which
-/// the hinge forces are added to the vertices.
+/// MembraneArrays.
 struct BendArrays {
   std::vector<std::int32_t> e0, e1, a, b;
   std::vector<double> restPsi, stiffness;
   std::int32_t runs = 0;
-  std::vector<std::int32_t> order;
+  /// Per vertex (CSR) the offsets of its hinge forces in the kernel workspace (corner c =
+  /// a, b, e0, e1 of kernel hinge i at 3 c n + i, x; y and z n and 2 n further), in the
+  /// order of bending(): summed per vertex, loads only.
+  std::vector<std::int32_t> cornerStart, cornerOffset;
 };
 
 class ClothModel {

@@ -70,6 +70,25 @@ std::vector<std::uint32_t> kernelOrder(const std::vector<std::array<std::uint32_
   return order;
 }
 
+
+/// Per vertex (CSR: start[v] .. start[v + 1]) the workspace offsets of the elements' corner
+/// forces, listed in the elements' order: column c of the element at kernel position p is
+/// at 3 c n + p (x; y and z n and 2 n further). columns[j][c] is the vertex of column c of
+/// element j; position[j] its kernel position.
+template <std::size_t N>
+void buildCornerLists(const std::vector<std::array<std::uint32_t, N>>& columns, const std::vector<std::int32_t>& position,
+                      std::size_t vertices, std::vector<std::int32_t>& start, std::vector<std::int32_t>& offset) {
+  const std::size_t n = columns.size();
+  start.assign(vertices + 1, 0);
+  for (const std::array<std::uint32_t, N>& element : columns)
+    for (const std::uint32_t v : element) ++start[v + 1];
+  for (std::size_t v = 0; v < vertices; ++v) start[v + 1] += start[v];
+  offset.assign(N * n, 0);
+  std::vector<std::int32_t> next(start.begin(), start.end() - 1);
+  for (std::size_t j = 0; j < n; ++j)
+    for (std::size_t c = 0; c < N; ++c) offset[next[columns[j][c]]++] = static_cast<std::int32_t>(3 * c * n) + position[j];
+}
+
 }  // namespace
 
 std::shared_ptr<const ClothModel> ClothModel::build(const mesh::TriMesh& mesh, const mesh::Topology& topology,
@@ -334,17 +353,7 @@ void ClothModel::buildKernelData() {
     m.area.push_back(el.restArea_m2);
   }
   // Corner incidences per vertex, in the order of membrane_ (a fixed summation order).
-  m.cornerStart.assign(vertexCount() + 1, 0);
-  for (const MembraneElement& el : membrane_)
-    for (const std::uint32_t v : {el.v0, el.v1, el.v2}) ++m.cornerStart[v + 1];
-  for (std::size_t v = 0; v < vertexCount(); ++v) m.cornerStart[v + 1] += m.cornerStart[v];
-  m.cornerOffset.assign(3 * n, 0);
-  std::vector<std::int32_t> next(m.cornerStart.begin(), m.cornerStart.end() - 1);
-  for (std::size_t t = 0; t < n; ++t) {
-    const std::array<std::uint32_t, 3> corners = {membrane_[t].v0, membrane_[t].v1, membrane_[t].v2};
-    for (std::size_t c = 0; c < 3; ++c)
-      m.cornerOffset[next[corners[c]]++] = static_cast<std::int32_t>(3 * c * n) + position[t];
-  }
+  buildCornerLists(triangleCorners, position, vertexCount(), m.cornerStart, m.cornerOffset);
 
   BendArrays& b = bendArrays_;
   std::vector<std::array<std::uint32_t, 4>> hingeCorners;
@@ -362,18 +371,10 @@ void ClothModel::buildKernelData() {
     b.restPsi.push_back(h.restPsi);
     b.stiffness.push_back(h.stiffness_Nm);
   }
-  b.cornerStart.assign(vertexCount() + 1, 0);
-  for (const std::array<std::uint32_t, 4>& corners : hingeCorners)
-    for (const std::uint32_t v : corners) ++b.cornerStart[v + 1];
-  for (std::size_t v = 0; v < vertexCount(); ++v) b.cornerStart[v + 1] += b.cornerStart[v];
-  b.cornerOffset.assign(4 * hinges, 0);
-  std::vector<std::int32_t> nextHinge(b.cornerStart.begin(), b.cornerStart.end() - 1);
-  // Workspace columns fa, fb, fe0, fe1 (forces.cpp); hingeCorners holds e0, e1, a, b.
-  constexpr std::array<std::size_t, 4> kCorner = {2, 3, 0, 1};
-  for (std::size_t j = 0; j < hinges; ++j)
-    for (std::size_t column = 0; column < 4; ++column)
-      b.cornerOffset[nextHinge[hingeCorners[j][kCorner[column]]]++] =
-          static_cast<std::int32_t>(3 * column * hinges) + hingePosition[j];
+  // Workspace columns fa, fb, fe0, fe1 (forces.cpp), in the order of bending_.
+  std::vector<std::array<std::uint32_t, 4>> hingeColumns;
+  for (const BendElement& h : bending_) hingeColumns.push_back({h.a, h.b, h.e0, h.e1});
+  buildCornerLists(hingeColumns, hingePosition, vertexCount(), b.cornerStart, b.cornerOffset);
 }
 
 double ClothModel::membraneWaveSpeed_m_s() const {

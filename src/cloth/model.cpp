@@ -70,14 +70,14 @@ std::vector<std::uint32_t> kernelOrder(const std::vector<std::array<std::uint32_
   return order;
 }
 
-
 /// Per vertex (CSR: start[v] .. start[v + 1]) the workspace offsets of the elements' corner
 /// forces, listed in the elements' order: column c of the element at kernel position p is
 /// at 3 c n + p (x; y and z n and 2 n further). columns[j][c] is the vertex of column c of
 /// element j; position[j] its kernel position.
 template <std::size_t N>
-void buildCornerLists(const std::vector<std::array<std::uint32_t, N>>& columns, const std::vector<std::int32_t>& position,
-                      std::size_t vertices, std::vector<std::int32_t>& start, std::vector<std::int32_t>& offset) {
+void buildCornerLists(const std::vector<std::array<std::uint32_t, N>>& columns,
+                      const std::vector<std::int32_t>& position, std::size_t vertices, std::vector<std::int32_t>& start,
+                      std::vector<std::int32_t>& offset) {
   const std::size_t n = columns.size();
   start.assign(vertices + 1, 0);
   for (const std::array<std::uint32_t, N>& element : columns)
@@ -86,7 +86,8 @@ void buildCornerLists(const std::vector<std::array<std::uint32_t, N>>& columns, 
   offset.assign(N * n, 0);
   std::vector<std::int32_t> next(start.begin(), start.end() - 1);
   for (std::size_t j = 0; j < n; ++j)
-    for (std::size_t c = 0; c < N; ++c) offset[next[columns[j][c]]++] = static_cast<std::int32_t>(3 * c * n) + position[j];
+    for (std::size_t c = 0; c < N; ++c)
+      offset[next[columns[j][c]]++] = static_cast<std::int32_t>(3 * c * n) + position[j];
 }
 
 }  // namespace
@@ -356,8 +357,9 @@ void ClothModel::buildKernelData() {
   buildCornerLists(triangleCorners, position, vertexCount(), m.cornerStart, m.cornerOffset);
 
   BendArrays& b = bendArrays_;
+  // In the order of the workspace columns fa, fb, fe0, fe1 (forces.cpp).
   std::vector<std::array<std::uint32_t, 4>> hingeCorners;
-  for (const BendElement& h : bending_) hingeCorners.push_back({h.e0, h.e1, h.a, h.b});
+  for (const BendElement& h : bending_) hingeCorners.push_back({h.a, h.b, h.e0, h.e1});
   const std::vector<std::uint32_t> hingeOrder = kernelOrder(hingeCorners, b.runs);
   const std::size_t hinges = bending_.size();
   std::vector<std::int32_t> hingePosition(hinges);
@@ -371,10 +373,7 @@ void ClothModel::buildKernelData() {
     b.restPsi.push_back(h.restPsi);
     b.stiffness.push_back(h.stiffness_Nm);
   }
-  // Workspace columns fa, fb, fe0, fe1 (forces.cpp), in the order of bending_.
-  std::vector<std::array<std::uint32_t, 4>> hingeColumns;
-  for (const BendElement& h : bending_) hingeColumns.push_back({h.a, h.b, h.e0, h.e1});
-  buildCornerLists(hingeColumns, hingePosition, vertexCount(), b.cornerStart, b.cornerOffset);
+  buildCornerLists(hingeCorners, hingePosition, vertexCount(), b.cornerStart, b.cornerOffset);
 }
 
 double ClothModel::membraneWaveSpeed_m_s() const {

@@ -125,7 +125,8 @@ TEST(KernelRuns, ForcesDoNotDependOnTheRuns) {
       accumulateBendingForces(*model, *s, 1.0);
     }
     double largest = 0.0;
-    for (std::size_t v = 0; v < n; ++v) largest = std::max({largest, std::abs(sa.fx[v]), std::abs(sa.fy[v]), std::abs(sa.fz[v])});
+    for (std::size_t v = 0; v < n; ++v)
+      largest = std::max({largest, std::abs(sa.fx[v]), std::abs(sa.fy[v]), std::abs(sa.fz[v])});
     ASSERT_GT(largest, 0.0);
     // The renumbered mesh adds each vertex's contributions in another order and orients
     // some hinges the other way: rounding, amplified where large element forces cancel

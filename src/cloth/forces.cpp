@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace drape::cloth {
 namespace {
@@ -64,7 +65,8 @@ struct MembraneConstants {
 /// triangles come in runs of kKernelRun (MembraneArrays), whose vertices are loaded as
 /// vectors from the run's first ones instead of gathered.
 template <bool kDamp, bool kSoften, bool kRuns>
-void membraneCornerForces(std::size_t n, const MembraneConstants& k, const double* __restrict x,
+void membraneCornerForces(std::size_t n, const std::int32_t* __restrict blocks, const MembraneConstants& k,
+                          const double* __restrict x,
                           const double* __restrict y, const double* __restrict z, const double* __restrict vx,
                           const double* __restrict vy, const double* __restrict vz, const std::int32_t* __restrict i0,
                           const std::int32_t* __restrict i1, const std::int32_t* __restrict i2,
@@ -120,7 +122,8 @@ void membraneCornerForces(std::size_t n, const MembraneConstants& k, const doubl
     f2z[t] = f2.z;
   };
   if constexpr (kRuns) {
-    for (std::size_t f = 0; f < n; f += kKernelRun) {
+    for (std::size_t k = 0; k < n; ++k) {
+      const auto f = static_cast<std::size_t>(blocks[k]);
       const std::int64_t a = i0[f], b = i1[f], c = i2[f];
       for (std::int64_t l = 0; l < kKernelRun; ++l) element(f + l, a + l, b + l, c + l);
     }
@@ -129,12 +132,44 @@ void membraneCornerForces(std::size_t n, const MembraneConstants& k, const doubl
   }
 }
 
+/// kKernelRun doubles as one vector (GCC's vector extension: AVX-512 here, pairs of SSE2
+/// registers in a portable build); GCC did not vectorise the loop over a block's lanes.
+using Lanes = double __attribute__((vector_size(kKernelRun * sizeof(double))));
+inline Lanes loadLanes(const double* p) {
+  Lanes v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void storeLanes(double* p, Lanes v) { std::memcpy(p, &v, sizeof v); }
+
 /// Membrane pass 2: each vertex sums its corners' forces (loads only: a scatter's
-/// read-modify-writes would chain through store forwarding where triangles share vertices).
-void gatherMembrane(std::size_t vertices, std::size_t n, const std::int32_t* __restrict start,
-                    const std::int32_t* __restrict offset, const double* __restrict w, double* __restrict fx,
-                    double* __restrict fy, double* __restrict fz) {
-  for (std::size_t v = 0; v < vertices; ++v) {
+/// read-modify-writes would chain through store forwarding where triangles share vertices):
+/// the vertex blocks (MembraneArrays) as vectors, the other vertices one by one.
+void gatherMembraneBlocks(std::size_t blocks, const std::int32_t* __restrict first,
+                          const std::int32_t* __restrict start, const std::int32_t* __restrict offset, std::size_t n,
+                          const double* __restrict w, double* __restrict fx, double* __restrict fy,
+                          double* __restrict fz) {
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::int32_t v = first[b];
+    Lanes sx{}, sy{}, sz{};
+    for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
+      const double* c = w + offset[k];
+      sx += loadLanes(c);
+      sy += loadLanes(c + n);
+      sz += loadLanes(c + 2 * n);
+    }
+    storeLanes(fx + v, loadLanes(fx + v) + sx);
+    storeLanes(fy + v, loadLanes(fy + v) + sy);
+    storeLanes(fz + v, loadLanes(fz + v) + sz);
+  }
+}
+
+void gatherMembraneSingles(std::size_t count, const std::int32_t* __restrict vertices,
+                           const std::int32_t* __restrict start, const std::int32_t* __restrict offset, std::size_t n,
+                           const double* __restrict w, double* __restrict fx, double* __restrict fy,
+                           double* __restrict fz) {
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::int32_t v = vertices[i];
     double sx = 0.0, sy = 0.0, sz = 0.0;
     for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
       const double* c = w + offset[k];
@@ -157,24 +192,27 @@ void membraneKernel(const ClothModel& model, ClothState& io) {
   const double *x = io.x.data(), *y = io.y.data(), *z = io.z.data();
   const double *vx = io.vx.data(), *vy = io.vy.data(), *vz = io.vz.data();
   double* w = io.work.data();  // nine columns of n
-  const std::size_t r = static_cast<std::size_t>(el.runs * kKernelRun);
-  membraneCornerForces<kDamp, kSoften, true>(r, k, x, y, z, vx, vy, vz, el.v0.data(), el.v1.data(), el.v2.data(),
-                                             el.g1u.data(), el.g1v.data(), el.g2u.data(), el.g2v.data(),
-                                             el.area.data(), w, w + n, w + 2 * n, w + 3 * n, w + 4 * n, w + 5 * n,
-                                             w + 6 * n, w + 7 * n, w + 8 * n);
+  const auto r = static_cast<std::size_t>(el.runEnd);
+  membraneCornerForces<kDamp, kSoften, true>(el.runBlocks.size(), el.runBlocks.data(), k, x, y, z, vx, vy, vz,
+                                             el.v0.data(), el.v1.data(), el.v2.data(), el.g1u.data(), el.g1v.data(),
+                                             el.g2u.data(), el.g2v.data(), el.area.data(), w, w + n, w + 2 * n,
+                                             w + 3 * n, w + 4 * n, w + 5 * n, w + 6 * n, w + 7 * n, w + 8 * n);
   membraneCornerForces<kDamp, kSoften, false>(
-      n - r, k, x, y, z, vx, vy, vz, el.v0.data() + r, el.v1.data() + r, el.v2.data() + r, el.g1u.data() + r,
-      el.g1v.data() + r, el.g2u.data() + r, el.g2v.data() + r, el.area.data() + r, w + r, w + n + r, w + 2 * n + r,
-      w + 3 * n + r, w + 4 * n + r, w + 5 * n + r, w + 6 * n + r, w + 7 * n + r, w + 8 * n + r);
-  gatherMembrane(io.size(), n, el.cornerStart.data(), el.cornerOffset.data(), w, io.fx.data(), io.fy.data(),
-                 io.fz.data());
+      n - r, nullptr, k, x, y, z, vx, vy, vz, el.v0.data() + r, el.v1.data() + r, el.v2.data() + r,
+      el.g1u.data() + r, el.g1v.data() + r, el.g2u.data() + r, el.g2v.data() + r, el.area.data() + r, w + r,
+      w + n + r, w + 2 * n + r, w + 3 * n + r, w + 4 * n + r, w + 5 * n + r, w + 6 * n + r, w + 7 * n + r,
+      w + 8 * n + r);
+  gatherMembraneBlocks(el.vertexBlocks.size(), el.vertexBlocks.data(), el.cornerStart.data(),
+                       el.cornerOffset.data(), n, w, io.fx.data(), io.fy.data(), io.fz.data());
+  gatherMembraneSingles(el.singleVertices.size(), el.singleVertices.data(), el.cornerStart.data(),
+                        el.cornerOffset.data(), n, w, io.fx.data(), io.fy.data(), io.fz.data());
 }
 
 /// Bending pass 1: the forces on a, b, e0 and e1 of every hinge into w (columns fa, fb, fe0,
 /// fe1, x y z each; fe1 = -(fa + fb + fe0)). With kRuns the hinges come in runs of
 /// kKernelRun, as the membrane's triangles do.
 template <bool kRuns>
-void hingeCornerForces(std::size_t n, const double* __restrict x, const double* __restrict y,
+void hingeCornerForces(std::size_t n, const std::int32_t* __restrict blocks, const double* __restrict x, const double* __restrict y,
                        const double* __restrict z, const std::int32_t* __restrict ie0,
                        const std::int32_t* __restrict ie1, const std::int32_t* __restrict ia,
                        const std::int32_t* __restrict ib, const double* __restrict restPsi,
@@ -234,7 +272,8 @@ void hingeCornerForces(std::size_t n, const double* __restrict x, const double* 
     f1z[i] = fe1.z;
   };
   if constexpr (kRuns) {
-    for (std::size_t f = 0; f < n; f += kKernelRun) {
+    for (std::size_t k = 0; k < n; ++k) {
+      const auto f = static_cast<std::size_t>(blocks[k]);
       const std::int64_t e0 = ie0[f], e1 = ie1[f], a = ia[f], b = ib[f];
       for (std::int64_t l = 0; l < kKernelRun; ++l) hinge(f + l, e0 + l, e1 + l, a + l, b + l);
     }
@@ -284,14 +323,14 @@ void accumulateBendingForces(const ClothModel& model, ClothState& io, double sca
   const std::size_t n = h.stiffness.size();
   const double *x = io.x.data(), *y = io.y.data(), *z = io.z.data();
   double* w = io.work.data();  // twelve columns of n
-  const std::size_t r = static_cast<std::size_t>(h.runs * kKernelRun);
-  hingeCornerForces<true>(r, x, y, z, h.e0.data(), h.e1.data(), h.a.data(), h.b.data(), h.restPsi.data(),
-                          h.stiffness.data(), scale, w, w + n, w + 2 * n, w + 3 * n, w + 4 * n, w + 5 * n, w + 6 * n,
-                          w + 7 * n, w + 8 * n, w + 9 * n, w + 10 * n, w + 11 * n);
-  hingeCornerForces<false>(n - r, x, y, z, h.e0.data() + r, h.e1.data() + r, h.a.data() + r, h.b.data() + r,
-                           h.restPsi.data() + r, h.stiffness.data() + r, scale, w + r, w + n + r, w + 2 * n + r,
-                           w + 3 * n + r, w + 4 * n + r, w + 5 * n + r, w + 6 * n + r, w + 7 * n + r, w + 8 * n + r,
-                           w + 9 * n + r, w + 10 * n + r, w + 11 * n + r);
+  const auto r = static_cast<std::size_t>(h.runEnd);
+  hingeCornerForces<true>(h.runBlocks.size(), h.runBlocks.data(), x, y, z, h.e0.data(), h.e1.data(), h.a.data(),
+                          h.b.data(), h.restPsi.data(), h.stiffness.data(), scale, w, w + n, w + 2 * n, w + 3 * n,
+                          w + 4 * n, w + 5 * n, w + 6 * n, w + 7 * n, w + 8 * n, w + 9 * n, w + 10 * n, w + 11 * n);
+  hingeCornerForces<false>(n - r, nullptr, x, y, z, h.e0.data() + r, h.e1.data() + r, h.a.data() + r,
+                           h.b.data() + r, h.restPsi.data() + r, h.stiffness.data() + r, scale, w + r, w + n + r,
+                           w + 2 * n + r, w + 3 * n + r, w + 4 * n + r, w + 5 * n + r, w + 6 * n + r, w + 7 * n + r,
+                           w + 8 * n + r, w + 9 * n + r, w + 10 * n + r, w + 11 * n + r);
   gatherHinges(io.size(), n, h.cornerStart.data(), h.cornerOffset.data(), w, io.fx.data(), io.fy.data(),
                io.fz.data());
 }

@@ -29,12 +29,15 @@ double hingePsi(const Vec3& e0, const Vec3& e1, const Vec3& a, const Vec3& b) {
 }
 
 /// The kernel order of a list of elements given their corner indices (N per element): runs
-/// (kKernelRun elements whose every corner goes up by one from each to the next) first,
-/// then the other elements in the list's order. Returns the list's indices in kernel order;
-/// counts the runs in `runs`.
+/// (at least kKernelRun elements whose every corner goes up by one from each to the next)
+/// first, then the other elements in the list's order. Returns the list's indices in kernel
+/// order; fills `blocks` (the first element of each block of kKernelRun the kernels take)
+/// and `runEnd` (the elements in runs). With `overlap` a run's last block ends where the
+/// run does and may overlap the one before; without, what a run leaves over after its whole
+/// blocks goes with the other elements.
 template <std::size_t N>
-std::vector<std::uint32_t> kernelOrder(const std::vector<std::array<std::uint32_t, N>>& corners,
-                                       std::int32_t& runs) {
+std::vector<std::uint32_t> kernelOrder(const std::vector<std::array<std::uint32_t, N>>& corners, bool overlap,
+                                       std::vector<std::int32_t>& blocks, std::int32_t& runEnd) {
   // Sorted by the corners' offsets from the first corner, then by the first corner, the
   // elements of a run are neighbours.
   const auto key = [&](std::uint32_t e) {
@@ -53,18 +56,23 @@ std::vector<std::uint32_t> kernelOrder(const std::vector<std::array<std::uint32_
 
   std::vector<std::uint32_t> order;
   std::vector<char> inRun(corners.size(), 0);
+  blocks.clear();
   for (std::size_t i = 0; i < sorted.size();) {
     std::size_t j = i + 1;
     while (j < sorted.size() && continues(sorted[j - 1], sorted[j])) ++j;
-    // Whole runs; what the row leaves over goes with the other elements.
-    const std::size_t whole = (j - i) / kKernelRun * kKernelRun;
-    for (std::size_t r = i; r < i + whole; ++r) {
-      order.push_back(sorted[r]);
-      inRun[sorted[r]] = 1;
+    const auto length = static_cast<std::int32_t>(j - i);
+    if (length >= kKernelRun) {
+      const auto first = static_cast<std::int32_t>(order.size());
+      const std::int32_t taken = overlap ? length : length / kKernelRun * kKernelRun;
+      for (std::int32_t b = 0; b < taken; b += kKernelRun) blocks.push_back(first + std::min(b, taken - kKernelRun));
+      for (std::size_t r = i; r < i + static_cast<std::size_t>(taken); ++r) {
+        order.push_back(sorted[r]);
+        inRun[sorted[r]] = 1;
+      }
     }
     i = j;
   }
-  runs = static_cast<std::int32_t>(order.size()) / kKernelRun;
+  runEnd = static_cast<std::int32_t>(order.size());
   for (std::uint32_t e = 0; e < corners.size(); ++e)
     if (!inRun[e]) order.push_back(e);
   return order;
@@ -338,7 +346,7 @@ void ClothModel::buildKernelData() {
   MembraneArrays& m = membraneArrays_;
   std::vector<std::array<std::uint32_t, 3>> triangleCorners;
   for (const MembraneElement& el : membrane_) triangleCorners.push_back({el.v0, el.v1, el.v2});
-  const std::vector<std::uint32_t> triangleOrder = kernelOrder(triangleCorners, m.runs);
+  const std::vector<std::uint32_t> triangleOrder = kernelOrder(triangleCorners, true, m.runBlocks, m.runEnd);
   const std::size_t n = membrane_.size();
   std::vector<std::int32_t> position(n);
   for (std::size_t t = 0; t < n; ++t) {
@@ -355,12 +363,35 @@ void ClothModel::buildKernelData() {
   }
   // Corner incidences per vertex, in the order of membrane_ (a fixed summation order).
   buildCornerLists(triangleCorners, position, vertexCount(), m.cornerStart, m.cornerOffset);
+  // Blocks of kKernelRun consecutive vertices whose corner lists run in parallel (as long,
+  // each offset one more than the previous vertex's): along a row of a structured mesh the
+  // vertices take their corners from the same runs.
+  const auto parallel = [&](std::size_t v) {
+    const std::int32_t count = m.cornerStart[v + 1] - m.cornerStart[v];
+    if (count == 0) return false;
+    for (std::int32_t l = 1; l < kKernelRun; ++l) {
+      const std::int32_t s = m.cornerStart[v + l];
+      if (m.cornerStart[v + l + 1] - s != count) return false;
+      for (std::int32_t k = 0; k < count; ++k)
+        if (m.cornerOffset[s + k] != m.cornerOffset[m.cornerStart[v] + k] + l) return false;
+    }
+    return true;
+  };
+  for (std::size_t v = 0; v < vertexCount();) {
+    if (v + kKernelRun <= vertexCount() && parallel(v)) {
+      m.vertexBlocks.push_back(static_cast<std::int32_t>(v));
+      v += kKernelRun;
+    } else {
+      if (m.cornerStart[v + 1] > m.cornerStart[v]) m.singleVertices.push_back(static_cast<std::int32_t>(v));
+      ++v;
+    }
+  }
 
   BendArrays& b = bendArrays_;
   // In the order of the workspace columns fa, fb, fe0, fe1 (forces.cpp).
   std::vector<std::array<std::uint32_t, 4>> hingeCorners;
   for (const BendElement& h : bending_) hingeCorners.push_back({h.a, h.b, h.e0, h.e1});
-  const std::vector<std::uint32_t> hingeOrder = kernelOrder(hingeCorners, b.runs);
+  const std::vector<std::uint32_t> hingeOrder = kernelOrder(hingeCorners, false, b.runBlocks, b.runEnd);
   const std::size_t hinges = bending_.size();
   std::vector<std::int32_t> hingePosition(hinges);
   for (std::size_t i = 0; i < hinges; ++i) {

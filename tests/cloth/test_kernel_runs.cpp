@@ -46,21 +46,40 @@ Material dampedSoftKnit() {
 TEST(KernelRuns, EveryElementOnceAndRunsConsecutive) {
   auto model = makeModel(tube(24, 10), dampedSoftKnit());
   const MembraneArrays& m = model->membraneArrays();
-  ASSERT_GT(m.runs, 0);
+  ASSERT_GT(m.runEnd, 0);
   std::map<std::array<std::int32_t, 3>, int> kernel, listed;
   for (std::size_t t = 0; t < m.v0.size(); ++t) ++kernel[{m.v0[t], m.v1[t], m.v2[t]}];
   for (const MembraneElement& el : model->membrane())
     ++listed[{static_cast<std::int32_t>(el.v0), static_cast<std::int32_t>(el.v1), static_cast<std::int32_t>(el.v2)}];
   EXPECT_EQ(kernel, listed);
-  for (std::int32_t t = 0; t < m.runs * kKernelRun; ++t) {
-    if (t % kKernelRun == 0) continue;
-    EXPECT_EQ(m.v0[t], m.v0[t - 1] + 1) << t;
-    EXPECT_EQ(m.v1[t], m.v1[t - 1] + 1) << t;
-    EXPECT_EQ(m.v2[t], m.v2[t - 1] + 1) << t;
+  // The blocks cover the runs, and within a block every corner goes up by one.
+  std::vector<int> covered(static_cast<std::size_t>(m.runEnd), 0);
+  for (const std::int32_t f : m.runBlocks) {
+    ASSERT_LE(f + kKernelRun, m.runEnd);
+    for (std::int32_t l = 0; l < kKernelRun; ++l) {
+      covered[static_cast<std::size_t>(f + l)] = 1;
+      if (l == 0) continue;
+      EXPECT_EQ(m.v0[f + l], m.v0[f + l - 1] + 1) << f + l;
+      EXPECT_EQ(m.v1[f + l], m.v1[f + l - 1] + 1) << f + l;
+      EXPECT_EQ(m.v2[f + l], m.v2[f + l - 1] + 1) << f + l;
+    }
   }
+  EXPECT_TRUE(std::all_of(covered.begin(), covered.end(), [](int c) { return c == 1; }));
+  // Vertex blocks: corner lists in parallel; every vertex in a block or among the singles.
+  ASSERT_FALSE(m.vertexBlocks.empty());
+  std::vector<int> summed(model->vertexCount(), 0);
+  for (const std::int32_t v : m.vertexBlocks)
+    for (std::int32_t l = 0; l < kKernelRun; ++l) {
+      ++summed[static_cast<std::size_t>(v + l)];
+      ASSERT_EQ(m.cornerStart[v + l + 1] - m.cornerStart[v + l], m.cornerStart[v + 1] - m.cornerStart[v]);
+      for (std::int32_t k = 0; k < m.cornerStart[v + 1] - m.cornerStart[v]; ++k)
+        EXPECT_EQ(m.cornerOffset[m.cornerStart[v + l] + k], m.cornerOffset[m.cornerStart[v] + k] + l);
+    }
+  for (const std::int32_t v : m.singleVertices) ++summed[static_cast<std::size_t>(v)];
+  EXPECT_TRUE(std::all_of(summed.begin(), summed.end(), [](int c) { return c == 1; }));
 
   const BendArrays& b = model->bendArrays();
-  ASSERT_GT(b.runs, 0);
+  ASSERT_GT(b.runEnd, 0);
   // Every hinge once, and each of its four corners once in its vertex's list.
   std::map<std::array<std::int32_t, 4>, int> kernelHinges, listedHinges;
   for (std::size_t i = 0; i < b.e0.size(); ++i) ++kernelHinges[{b.e0[i], b.e1[i], b.a[i], b.b[i]}];
@@ -80,11 +99,11 @@ TEST(KernelRuns, EveryElementOnceAndRunsConsecutive) {
       ++seen[column * hinges + i];
     }
   EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int c) { return c == 1; }));
-  for (std::int32_t i = 0; i < b.runs * kKernelRun; ++i) {
-    if (i % kKernelRun == 0) continue;
-    EXPECT_EQ(b.e0[i], b.e0[i - 1] + 1) << i;
-    EXPECT_EQ(b.b[i], b.b[i - 1] + 1) << i;
-  }
+  for (const std::int32_t f : b.runBlocks)
+    for (std::int32_t l = 1; l < kKernelRun; ++l) {
+      EXPECT_EQ(b.e0[f + l], b.e0[f + l - 1] + 1) << f + l;
+      EXPECT_EQ(b.a[f + l], b.a[f + l - 1] + 1) << f + l;
+    }
 }
 
 TEST(KernelRuns, ForcesDoNotDependOnTheRuns) {
@@ -102,10 +121,12 @@ TEST(KernelRuns, ForcesDoNotDependOnTheRuns) {
 
   auto a = makeModel(structured, dampedSoftKnit());
   auto b = makeModel(shuffled, dampedSoftKnit());
-  ASSERT_GT(a->membraneArrays().runs, 0);
-  ASSERT_GT(a->bendArrays().runs, 0);
-  ASSERT_EQ(b->membraneArrays().runs, 0);
-  ASSERT_EQ(b->bendArrays().runs, 0);
+  ASSERT_GT(a->membraneArrays().runEnd, 0);
+  ASSERT_FALSE(a->membraneArrays().vertexBlocks.empty());
+  ASSERT_GT(a->bendArrays().runEnd, 0);
+  ASSERT_EQ(b->membraneArrays().runEnd, 0);
+  ASSERT_TRUE(b->membraneArrays().vertexBlocks.empty());
+  ASSERT_EQ(b->bendArrays().runEnd, 0);
 
   std::normal_distribution<double> move(0.0, 0.01), speed(0.0, 0.5);
   for (int trial = 0; trial < 50; ++trial) {

@@ -59,12 +59,17 @@ inline constexpr std::int32_t kKernelRun = 8;
 struct MembraneArrays {
   std::vector<std::int32_t> v0, v1, v2;
   std::vector<double> g1u, g1v, g2u, g2v, area;
-  std::int32_t runs = 0;
+  std::vector<std::int32_t> runBlocks;
+  std::int32_t runEnd = 0;
   /// Per vertex (CSR: cornerStart[v] .. cornerStart[v + 1]) the offsets of its corner
   /// forces in the kernel workspace (corner c of kernel element t at 3 c n + t, x; y and z
   /// n and 2 n further): the forces are summed per vertex, loads only, instead of
   /// scattered, in the order of membrane(), so that the sums do not depend on the runs.
   std::vector<std::int32_t> cornerStart, cornerOffset;
+  /// The first vertices of blocks of kKernelRun consecutive vertices whose corner lists run
+  /// in parallel (as long, each offset one more than the previous vertex's): summed as
+  /// vectors. The other vertices with corners are `singleVertices`.
+  std::vector<std::int32_t> vertexBlocks, singleVertices;
 };
 
 /// The bending hinges as structure of arrays (buildKernelData), runs first as in
@@ -72,7 +77,8 @@ struct MembraneArrays {
 struct BendArrays {
   std::vector<std::int32_t> e0, e1, a, b;
   std::vector<double> restPsi, stiffness;
-  std::int32_t runs = 0;
+  std::vector<std::int32_t> runBlocks;
+  std::int32_t runEnd = 0;
   /// Per vertex (CSR) the offsets of its hinge forces in the kernel workspace (corner c =
   /// a, b, e0, e1 of kernel hinge i at 3 c n + i, x; y and z n and 2 n further), in the
   /// order of bending(): summed per vertex, loads only.

@@ -45,17 +45,21 @@ struct BendElement {
   double stiffness_Nm;   ///< k in W = k / 2 (psi - restPsi)^2, N m
 };
 
-/// The kernel lists begin with runs of kKernelRun elements whose every corner index goes up
-/// by one from one element to the next (rows of a structured mesh: a generated skirt, a
-/// grid): the kernels load those vertices as vectors instead of gathering them one
-/// coordinate at a time. A run is as long as a vector of doubles on AVX-512, so its loop has
-/// no remainder; what a row leaves over goes with the other elements.
+/// The kernel lists begin with runs: at least kKernelRun elements whose every corner index
+/// goes up by one from one element to the next (rows of a structured mesh: a generated
+/// skirt, a grid). The kernels load their vertices as vectors instead of gathering them one
+/// coordinate at a time, in blocks of kKernelRun elements (a vector of doubles on AVX-512).
+/// The membrane's last block of a run ends where the run does and may overlap the one
+/// before (computing some elements twice, to the same values), so that a row's triangles
+/// lie together and its vertices' sums can go as vectors too; the hinges take whole blocks
+/// only, and what a run leaves over goes with the other hinges.
 inline constexpr std::int32_t kKernelRun = 8;
 
 /// The membrane elements again as structure of arrays, what the vectorised kernel reads
-/// (filled by buildKernelData from the MembraneElement list). `runs` runs of kKernelRun
-/// come first; the other elements follow in the list's order. Indices are signed 32-bit
-/// because that is what vector gather instructions take.
+/// (filled by buildKernelData from the MembraneElement list). The runs come first
+/// (elements [0, runEnd), taken in the blocks that start at `runBlocks`); the other
+/// elements follow in the list's order. Indices are signed 32-bit because that is what
+/// vector gather instructions take.
 struct MembraneArrays {
   std::vector<std::int32_t> v0, v1, v2;
   std::vector<double> g1u, g1v, g2u, g2v, area;

@@ -134,13 +134,20 @@ void membraneCornerForces(std::size_t n, const std::int32_t* __restrict blocks, 
 
 /// kKernelRun doubles as one vector (GCC's vector extension: AVX-512 here, pairs of SSE2
 /// registers in a portable build); GCC did not vectorise the loop over a block's lanes.
+/// Passed by reference: by value, a build without AVX-512 would pass it another way than one
+/// with (GCC and Clang warn, -Wpsabi).
 using Lanes = double __attribute__((vector_size(kKernelRun * sizeof(double))));
-inline Lanes loadLanes(const double* p) {
+inline void addLanes(Lanes& sum, const double* p) {
   Lanes v;
   std::memcpy(&v, p, sizeof v);
-  return v;
+  sum += v;
 }
-inline void storeLanes(double* p, Lanes v) { std::memcpy(p, &v, sizeof v); }
+inline void addToLanes(double* p, const Lanes& sum) {
+  Lanes v;
+  std::memcpy(&v, p, sizeof v);
+  v += sum;
+  std::memcpy(p, &v, sizeof v);
+}
 
 /// Membrane pass 2: each vertex sums its corners' forces (loads only: a scatter's
 /// read-modify-writes would chain through store forwarding where triangles share vertices):
@@ -154,13 +161,13 @@ void gatherMembraneBlocks(std::size_t blocks, const std::int32_t* __restrict fir
     Lanes sx{}, sy{}, sz{};
     for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
       const double* c = w + offset[k];
-      sx += loadLanes(c);
-      sy += loadLanes(c + n);
-      sz += loadLanes(c + 2 * n);
+      addLanes(sx, c);
+      addLanes(sy, c + n);
+      addLanes(sz, c + 2 * n);
     }
-    storeLanes(fx + v, loadLanes(fx + v) + sx);
-    storeLanes(fy + v, loadLanes(fy + v) + sy);
-    storeLanes(fz + v, loadLanes(fz + v) + sz);
+    addToLanes(fx + v, sx);
+    addToLanes(fy + v, sy);
+    addToLanes(fz + v, sz);
   }
 }
 

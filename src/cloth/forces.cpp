@@ -61,20 +61,20 @@ struct MembraneConstants {
 // order, so the forces are the same to the bit with and without runs.
 
 /// Membrane pass 1: the corner forces of every triangle into w (columns f0x f0y f0z f1x f1y
-/// f1z f2x f2y f2z; f0 = -(f1 + f2)). Corner c of triangle t is vertex ic[t]; with kRuns the
-/// triangles come in runs of kKernelRun (MembraneArrays), whose vertices are loaded as
-/// vectors from the run's first ones instead of gathered.
+/// f1z f2x f2y f2z; f0 = -(f1 + f2)). Corner c of triangle t is vertex ic[t]. With kRuns, n
+/// blocks of kKernelRun triangles in runs (MembraneArrays), the first at blocks[k]: their
+/// vertices are loaded as vectors from the block's first ones instead of gathered.
 template <bool kDamp, bool kSoften, bool kRuns>
 void membraneCornerForces(std::size_t n, const std::int32_t* __restrict blocks, const MembraneConstants& k,
-                          const double* __restrict x,
-                          const double* __restrict y, const double* __restrict z, const double* __restrict vx,
-                          const double* __restrict vy, const double* __restrict vz, const std::int32_t* __restrict i0,
-                          const std::int32_t* __restrict i1, const std::int32_t* __restrict i2,
-                          const double* __restrict g1u, const double* __restrict g1v, const double* __restrict g2u,
-                          const double* __restrict g2v, const double* __restrict area, double* __restrict f0x,
-                          double* __restrict f0y, double* __restrict f0z, double* __restrict f1x,
-                          double* __restrict f1y, double* __restrict f1z, double* __restrict f2x,
-                          double* __restrict f2y, double* __restrict f2z) {
+                          const double* __restrict x, const double* __restrict y, const double* __restrict z,
+                          const double* __restrict vx, const double* __restrict vy, const double* __restrict vz,
+                          const std::int32_t* __restrict i0, const std::int32_t* __restrict i1,
+                          const std::int32_t* __restrict i2, const double* __restrict g1u,
+                          const double* __restrict g1v, const double* __restrict g2u, const double* __restrict g2v,
+                          const double* __restrict area, double* __restrict f0x, double* __restrict f0y,
+                          double* __restrict f0z, double* __restrict f1x, double* __restrict f1y,
+                          double* __restrict f1z, double* __restrict f2x, double* __restrict f2y,
+                          double* __restrict f2z) {
   const double lambda = k.lambda, mu = k.mu, beta = k.beta, softScale = k.softScale;
   const auto element = [&](std::size_t t, std::int64_t j0, std::int64_t j1, std::int64_t j2)
                            __attribute__((always_inline)) {
@@ -216,11 +216,11 @@ void membraneKernel(const ClothModel& model, ClothState& io) {
 }
 
 /// Bending pass 1: the forces on a, b, e0 and e1 of every hinge into w (columns fa, fb, fe0,
-/// fe1, x y z each; fe1 = -(fa + fb + fe0)). With kRuns the hinges come in runs of
-/// kKernelRun, as the membrane's triangles do.
+/// fe1, x y z each; fe1 = -(fa + fb + fe0)). With kRuns, n blocks of hinges in runs, as
+/// the membrane's triangles.
 template <bool kRuns>
-void hingeCornerForces(std::size_t n, const std::int32_t* __restrict blocks, const double* __restrict x, const double* __restrict y,
-                       const double* __restrict z, const std::int32_t* __restrict ie0,
+void hingeCornerForces(std::size_t n, const std::int32_t* __restrict blocks, const double* __restrict x,
+                       const double* __restrict y, const double* __restrict z, const std::int32_t* __restrict ie0,
                        const std::int32_t* __restrict ie1, const std::int32_t* __restrict ia,
                        const std::int32_t* __restrict ib, const double* __restrict restPsi,
                        const double* __restrict k, double scale, double* __restrict fax, double* __restrict fay,

@@ -98,6 +98,37 @@ void buildCornerLists(const std::vector<std::array<std::uint32_t, N>>& columns,
       offset[next[columns[j][c]]++] = static_cast<std::int32_t>(3 * c * n) + position[j];
 }
 
+
+/// Blocks of kKernelRun consecutive vertices whose corner lists (CSR `start`, `offset`) run
+/// in parallel: as long, each offset one more than the previous vertex's. Along a row of a
+/// structured mesh the vertices take their corners from the same runs. Every other vertex
+/// with corners goes to `singles`.
+void findVertexBlocks(const std::vector<std::int32_t>& start, const std::vector<std::int32_t>& offset,
+                      std::vector<std::int32_t>& blocks, std::vector<std::int32_t>& singles) {
+  const std::size_t vertices = start.size() - 1;
+  const auto parallel = [&](std::size_t v) {
+    const std::int32_t count = start[v + 1] - start[v];
+    if (count == 0) return false;
+    for (std::size_t l = 1; l < kKernelRun; ++l) {
+      if (start[v + l + 1] - start[v + l] != count) return false;
+      for (std::int32_t k = 0; k < count; ++k)
+        if (offset[start[v + l] + k] != offset[start[v] + k] + static_cast<std::int32_t>(l)) return false;
+    }
+    return true;
+  };
+  blocks.clear();
+  singles.clear();
+  for (std::size_t v = 0; v < vertices;) {
+    if (v + kKernelRun <= vertices && parallel(v)) {
+      blocks.push_back(static_cast<std::int32_t>(v));
+      v += kKernelRun;
+    } else {
+      if (start[v + 1] > start[v]) singles.push_back(static_cast<std::int32_t>(v));
+      ++v;
+    }
+  }
+}
+
 }  // namespace
 
 std::shared_ptr<const ClothModel> ClothModel::build(const mesh::TriMesh& mesh, const mesh::Topology& topology,
@@ -363,29 +394,7 @@ void ClothModel::buildKernelData() {
   }
   // Corner incidences per vertex, in the order of membrane_ (a fixed summation order).
   buildCornerLists(triangleCorners, position, vertexCount(), m.cornerStart, m.cornerOffset);
-  // Blocks of kKernelRun consecutive vertices whose corner lists run in parallel (as long,
-  // each offset one more than the previous vertex's): along a row of a structured mesh the
-  // vertices take their corners from the same runs.
-  const auto parallel = [&](std::size_t v) {
-    const std::int32_t count = m.cornerStart[v + 1] - m.cornerStart[v];
-    if (count == 0) return false;
-    for (std::int32_t l = 1; l < kKernelRun; ++l) {
-      const std::int32_t s = m.cornerStart[v + l];
-      if (m.cornerStart[v + l + 1] - s != count) return false;
-      for (std::int32_t k = 0; k < count; ++k)
-        if (m.cornerOffset[s + k] != m.cornerOffset[m.cornerStart[v] + k] + l) return false;
-    }
-    return true;
-  };
-  for (std::size_t v = 0; v < vertexCount();) {
-    if (v + kKernelRun <= vertexCount() && parallel(v)) {
-      m.vertexBlocks.push_back(static_cast<std::int32_t>(v));
-      v += kKernelRun;
-    } else {
-      if (m.cornerStart[v + 1] > m.cornerStart[v]) m.singleVertices.push_back(static_cast<std::int32_t>(v));
-      ++v;
-    }
-  }
+  findVertexBlocks(m.cornerStart, m.cornerOffset, m.vertexBlocks, m.singleVertices);
 
   BendArrays& b = bendArrays_;
   // In the order of the workspace columns fa, fb, fe0, fe1 (forces.cpp).

@@ -102,7 +102,9 @@ TEST(KernelRuns, EveryElementOnceAndRunsConsecutive) {
   for (const std::int32_t f : b.runBlocks)
     for (std::int32_t l = 1; l < kKernelRun; ++l) {
       EXPECT_EQ(b.e0[f + l], b.e0[f + l - 1] + 1) << f + l;
+      EXPECT_EQ(b.e1[f + l], b.e1[f + l - 1] + 1) << f + l;
       EXPECT_EQ(b.a[f + l], b.a[f + l - 1] + 1) << f + l;
+      EXPECT_EQ(b.b[f + l], b.b[f + l - 1] + 1) << f + l;
     }
 }
 

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <bit>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -272,6 +271,8 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   easeUntil_s_.assign(parts_.size(), std::vector<double>(n, 0.0));
   for (std::vector<double>* v : {&correctionX_, &correctionY_, &correctionZ_}) v->assign(n, 0.0);
   corrections_.assign(n, 0);
+  correctedPoints_.clear();
+  correctedPoints_.reserve(n);  // each point once per test: no allocation in the tests
   slidingParts_.assign(n, 0);
   for (std::vector<double>* v : {&faceDX_, &faceDY_, &faceDZ_, &faceDVX_, &faceDVY_, &faceDVZ_}) v->assign(n, 0.0);
   faceCount_.assign(n, 0);
@@ -366,9 +367,9 @@ void FieldCollider::collide(const ClothModel& model, double t0_s, double t1_s, C
   if ((calls_++ % every_) != 0) {  // reduced-frequency collision tests
     holdPinches(t0_s, t1_s, io);
     if (countEverySubstep_ && measurePenetration_) {
-      const auto start = std::chrono::steady_clock::now();
+      const StageClock::Ticks start = StageClock::now();
       countUntested(io, t1_s);
-      measureSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      StageClock::lap(measureTicks_, start);
     }
     return;
   }
@@ -376,15 +377,13 @@ void FieldCollider::collide(const ClothModel& model, double t0_s, double t1_s, C
   if (!(interval_s > 0)) return;
 
   if (measurePenetration_) std::fill(nearest_.begin(), nearest_.end(), std::numeric_limits<double>::infinity());
-  for (std::vector<double>* v : {&correctionX_, &correctionY_, &correctionZ_}) std::fill(v->begin(), v->end(), 0.0);
-  std::fill(corrections_.begin(), corrections_.end(), std::uint16_t{0});
   corrected_.clear();
-  const auto poseStart = std::chrono::steady_clock::now();
+  const StageClock::Ticks poseStart = StageClock::now();
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     poses_[2 * k] = parts_[k].motion->poseAt(lastTime_s_);
     poses_[2 * k + 1] = parts_[k].motion->poseAt(t1_s);
   }
-  poseSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - poseStart).count();
+  StageClock::lap(poseTicks_, poseStart);
   for (std::size_t k = 0; k < parts_.size(); ++k) frames_[k] = framePart(parts_[k], poses_[2 * k], poses_[2 * k + 1]);
   ++tests_;
   // Where the points are before this test's corrections: where the walks of the pairs
@@ -424,10 +423,10 @@ void FieldCollider::collide(const ClothModel& model, double t0_s, double t1_s, C
   if (faceParts_) collideFaces(model, interval_s, io);
   collectPinches(interval_s, io);
   if (measurePenetration_) {
-    const auto start = std::chrono::steady_clock::now();
+    const StageClock::Ticks start = StageClock::now();
     measureCorrected(io);
     countPenetration();
-    measureSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    StageClock::lap(measureTicks_, start);
   }
   lastTime_s_ = t1_s;
 }
@@ -837,13 +836,13 @@ void FieldCollider::holdPinches(double t0_s, double t1_s, ClothState& io) {
   if (held_.empty() || !(t1_s > t0_s)) return;
   // Each holding part's rigid motion over the substep, world to world:
   // x -> R1 R0^T (x - p0) + p1.
-  const auto poseStart = std::chrono::steady_clock::now();
+  const StageClock::Ticks poseStart = StageClock::now();
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     if (!holds_[k]) continue;
     poses_[2 * k] = parts_[k].motion->poseAt(t0_s);
     poses_[2 * k + 1] = parts_[k].motion->poseAt(t1_s);
   }
-  poseSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - poseStart).count();
+  StageClock::lap(poseTicks_, poseStart);
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     if (!holds_[k]) continue;
     const RigidTransform& a = poses_[2 * k];
@@ -913,17 +912,20 @@ void FieldCollider::addCorrection(std::size_t i, const Vec3& displacement) {
   correctionX_[i] += displacement.x();
   correctionY_[i] += displacement.y();
   correctionZ_[i] += displacement.z();
-  ++corrections_[i];
+  if (corrections_[i]++ == 0) correctedPoints_.push_back(static_cast<std::uint32_t>(i));
 }
 
 void FieldCollider::applyCorrections(ClothState& io) {
-  for (std::size_t i = 0; i < corrections_.size(); ++i) {
-    if (!corrections_[i]) continue;
+  // A few dozen points of hundreds: by their list, leaving the sums at zero for the next test.
+  for (const std::uint32_t i : correctedPoints_) {
     const double share = 1.0 / corrections_[i];
     io.x[i] += share * correctionX_[i];
     io.y[i] += share * correctionY_[i];
     io.z[i] += share * correctionZ_[i];
+    correctionX_[i] = correctionY_[i] = correctionZ_[i] = 0.0;
+    corrections_[i] = 0;
   }
+  correctedPoints_.clear();
 }
 
 void FieldCollider::buildFaceTopology(const ClothModel& model) {

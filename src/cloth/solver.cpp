@@ -1,7 +1,6 @@
 #include "drape/cloth/solver.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -12,12 +11,6 @@
 
 namespace drape::cloth {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 }  // namespace
 
@@ -221,31 +214,22 @@ bool ClothSolver::substep(double t0, long frame, int substepIndex) {
 
 bool ClothSolver::substep(double t0, double t1, long frame, int substepIndex) {
   const double dt = dt_;
-  Clock::time_point start = Clock::now();
+  // One clock reading per stage boundary (StageClock).
+  StageClock::Ticks t = StageClock::now();
   accumulateForces();  // membrane, bending, drag into state_.f*
-  times_.forces_s += secondsSince(start);
-
-  start = Clock::now();
+  t = StageClock::lap(ticks_.forces, t);
   integrate(dt);  // new velocities and positions
-  times_.integrate_s += secondsSince(start);
-
-  start = Clock::now();
+  t = StageClock::lap(ticks_.integrate, t);
   collide(t0, t1);  // colliders correct the end-of-substep state
-  times_.collide_s += secondsSince(start);
-
-  start = Clock::now();
+  t = StageClock::lap(ticks_.collide, t);
   applyFixtures(t0, t1, dt);  // pinned vertices follow their transforms
-  times_.fixtures_s += secondsSince(start);
-
+  t = StageClock::lap(ticks_.fixtures, t);
   if (strainLimit_ > 0.0) {
-    start = Clock::now();
     limitStrain();  // no edge beyond the limit (after the fixtures, whose vertices it leaves where they are)
-    times_.strainLimit_s += secondsSince(start);
+    t = StageClock::lap(ticks_.strainLimit, t);
   }
-
-  start = Clock::now();
   const bool stable = checkStability(frame, substepIndex);  // NaN or speed bound
-  times_.stability_s += secondsSince(start);
+  StageClock::lap(ticks_.stability, t);
   return stable;
 }
 
@@ -285,10 +269,10 @@ void ClothSolver::applyFixtures(double t0, double t1, double dt) {
 void ClothSolver::applyFixture(const PinGroup& g, double t0, double t1, double dt) {
   // Timed apart: on a moving body this is animation (the skeleton's evaluation and
   // interpolation, whoever asks first in a substep), which the collision share leaves out.
-  const Clock::time_point poseStart = Clock::now();
+  const StageClock::Ticks poseStart = StageClock::now();
   const RigidTransform now = g.motion ? g.motion->poseAt(t1) : RigidTransform::identity();
   const RigidTransform before = g.motion ? g.motion->poseAt(t0) : RigidTransform::identity();
-  times_.fixturePoses_s += secondsSince(poseStart);
+  StageClock::lap(ticks_.fixturePoses, poseStart);
   const Mat3 r1 = now.rotation.toRotationMatrix(), r0 = before.rotation.toRotationMatrix();
   const Vec3 p1 = now.translation, p0 = before.translation;
   const double invDt = 1.0 / dt;
@@ -333,6 +317,18 @@ bool ClothSolver::checkStability(long frame, int substepIndex) {
     }
   }
   return true;
+}
+
+StageTimes ClothSolver::stageTimes() const {
+  StageTimes s;
+  s.forces_s = StageClock::seconds(ticks_.forces);
+  s.integrate_s = StageClock::seconds(ticks_.integrate);
+  s.collide_s = StageClock::seconds(ticks_.collide);
+  s.fixtures_s = StageClock::seconds(ticks_.fixtures);
+  s.fixturePoses_s = StageClock::seconds(ticks_.fixturePoses);
+  s.strainLimit_s = StageClock::seconds(ticks_.strainLimit);
+  s.stability_s = StageClock::seconds(ticks_.stability);
+  return s;
 }
 
 std::string describeRefinedFrame(const ClothSolver& solver, const std::string& garment) {

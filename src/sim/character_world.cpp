@@ -433,6 +433,10 @@ std::vector<std::uint8_t> stepInParallel(std::size_t count, long frame,
   // Garments do not touch each other: each steps on whichever thread is free, with its own
   // poses and colliders, and comes out the same on any number of threads.
   std::vector<std::uint8_t> stable(count, 0);
+  if (count == 1) {  // one garment: on this thread, without a task
+    stable[0] = solver(0).stepFrame(frame) ? 1 : 0;
+    return stable;
+  }
   tbb::parallel_for(std::size_t{0}, count, [&](std::size_t g) { stable[g] = solver(g).stepFrame(frame) ? 1 : 0; });
   return stable;
 }

@@ -118,6 +118,7 @@
 #include "drape/cloth/collider.hpp"
 #include "drape/cloth/fixture.hpp"
 #include "drape/cloth/voxel_walk.hpp"
+#include "drape/core/stage_clock.hpp"
 #include "drape/field/distance_field.hpp"
 
 namespace drape::cloth {
@@ -287,10 +288,10 @@ class FieldCollider final : public Collider {
   /// animation and its micro-interpolation when the collider is the first to ask for a time
   /// (the transforms built from the poses count as collision).
   /// Part of collide()'s time; the paper's collision share leaves it out.
-  [[nodiscard]] double poseSeconds() const { return poseSeconds_; }
+  [[nodiscard]] double poseSeconds() const { return StageClock::seconds(poseTicks_); }
   /// Time spent measuring the penetration figures, s (setMeasurePenetration): part of
   /// collide()'s time, and not the collision's work.
-  [[nodiscard]] double measureSeconds() const { return measureSeconds_; }
+  [[nodiscard]] double measureSeconds() const { return StageClock::seconds(measureTicks_); }
 
   [[nodiscard]] const std::vector<CollisionPart>& parts() const { return parts_; }
   [[nodiscard]] const OffsetSurfaces& offsets() const { return offsets_; }
@@ -403,8 +404,8 @@ class FieldCollider final : public Collider {
   /// The counters when the frame began (beginFrame), for restartFrame.
   ColliderCounters frameStartCounters_;
   FieldCollisionCounters frameStartField_;
-  double poseSeconds_ = 0;
-  double measureSeconds_ = 0;
+  StageClock::Ticks poseTicks_ = 0;
+  StageClock::Ticks measureTicks_ = 0;
   std::vector<PartFrame> frames_;  ///< per part, this interval's transforms (collide)
   /// Per part, its poses at the interval's start and end (or the untested substep's: holdPinches).
   std::vector<RigidTransform> poses_;
@@ -421,6 +422,7 @@ class FieldCollider final : public Collider {
   /// their number (addCorrection); the (part, vertex) pairs that asked.
   std::vector<double> correctionX_, correctionY_, correctionZ_;
   std::vector<std::uint16_t> corrections_;
+  std::vector<std::uint32_t> correctedPoints_;  ///< the points with corrections this test, each once
   std::vector<std::pair<std::uint32_t, std::uint32_t>> corrected_;
   /// Per vertex, this test: the parts it slides on, one bit each (parts < 64), and the face
   /// samples' summed displacements (m) and velocity changes (m/s) and their number.

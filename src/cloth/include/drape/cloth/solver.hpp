@@ -22,8 +22,15 @@
 #include "drape/cloth/material.hpp"
 #include "drape/cloth/model.hpp"
 #include "drape/cloth/state.hpp"
+#include "drape/core/stage_clock.hpp"
 
 namespace drape::cloth {
+
+/// Stage clock ticks per phase, accumulated over the substeps run so far (StageTimes in seconds).
+struct StageTicks {
+  StageClock::Ticks forces = 0, integrate = 0, collide = 0, fixtures = 0, fixturePoses = 0, strainLimit = 0,
+                    stability = 0;
+};
 
 /// Seconds spent per phase, accumulated over the substeps run so far.
 struct StageTimes {
@@ -118,7 +125,7 @@ class ClothSolver {
   [[nodiscard]] const ClothState& state() const { return state_; }
   /// Mutable state for set-up (initial velocities, tests). Not during a step.
   [[nodiscard]] ClothState& mutableState() { return state_; }
-  [[nodiscard]] const StageTimes& stageTimes() const { return times_; }
+  [[nodiscard]] StageTimes stageTimes() const;
   [[nodiscard]] const Instability& instability() const { return instability_; }
   [[nodiscard]] const std::vector<Collider*>& colliders() const { return colliders_; }
   /// The pinned vertices (no motion) and the bound ones (following a body part).
@@ -154,7 +161,7 @@ class ClothSolver {
   std::unique_ptr<Integrator> integrator_;
   std::vector<Collider*> colliders_;
   ClothState state_;
-  StageTimes times_;
+  StageTicks ticks_;
   Instability instability_;
   long substepCount_ = 0;  ///< substeps taken, for the bending rhythm
   double dt_ = 0.0;        ///< the substep being taken, s (shorter in a refined frame)

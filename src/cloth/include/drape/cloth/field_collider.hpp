@@ -110,6 +110,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -319,6 +320,8 @@ class FieldCollider final : public Collider {
   struct PartFrame;  // one part's transforms over the interval (field_collider.cpp)
   struct PartStep;   // one part's rigid motion over an untested substep (field_collider.cpp)
   PartFrame framePart(const CollisionPart& part, const RigidTransform& pose0, const RigidTransform& pose1) const;
+  /// The interval's end transforms of `frame` (framePart's, the start's left as they are).
+  void framePartEnd(const CollisionPart& part, const RigidTransform& pose1, PartFrame& frame) const;
   /// Fills endVoxel* with every point's end position in part k's voxel coordinates and
   /// candidates_ with the points the per-pair test must see; returns their number.
   /// `resting`: how many of the points rest in their balls (left out).
@@ -407,6 +410,8 @@ class FieldCollider final : public Collider {
   StageClock::Ticks poseTicks_ = 0;
   StageClock::Ticks measureTicks_ = 0;
   std::vector<PartFrame> frames_;  ///< per part, this interval's transforms (collide)
+  /// The time at which frames_ end (the last test's end): a test from there reuses them.
+  double framesEnd_s_ = std::numeric_limits<double>::quiet_NaN();
   /// Per part, its poses at the interval's start and end (or the untested substep's: holdPinches).
   std::vector<RigidTransform> poses_;
   double lastTime_s_ = 0;

@@ -14,6 +14,8 @@
 namespace drape::cloth {
 
 /// Where a fixture group's frame is at time t. One virtual call per group per substep.
+/// A function of t alone: the same t gives the same pose, to the bit (the field collider
+/// keeps each test's end transforms as the next test's start).
 class FixtureMotion {
  public:
   virtual ~FixtureMotion() = default;

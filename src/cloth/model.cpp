@@ -98,7 +98,6 @@ void buildCornerLists(const std::vector<std::array<std::uint32_t, N>>& columns,
       offset[next[columns[j][c]]++] = static_cast<std::int32_t>(3 * c * n) + position[j];
 }
 
-
 /// Blocks of kKernelRun consecutive vertices whose corner lists (CSR `start`, `offset`) run
 /// in parallel: as long, each offset one more than the previous vertex's. Along a row of a
 /// structured mesh the vertices take their corners from the same runs. Every other vertex

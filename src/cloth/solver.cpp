@@ -10,9 +10,6 @@
 #include "drape/core/error.hpp"
 
 namespace drape::cloth {
-namespace {
-
-}  // namespace
 
 std::string Instability::describe(const std::string& garment, double bound) const {
   const std::string what =

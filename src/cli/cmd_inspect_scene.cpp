@@ -2,6 +2,7 @@
 // (vertices, triangles, boundary loops, mask size), materials with units, simulation
 // settings and warnings of a VRML97 scene.
 
+#include <algorithm>
 #include <fmt/ostream.h>
 
 #include "command.hpp"
@@ -62,6 +63,11 @@ void printGarment(std::ostream& out, const scene::Scene& s, const scene::Garment
       g.collidesWith.empty() ? std::string("every segment") : fmt::format("{}", fmt::join(g.collidesWith, ", ")));
   if (!g.faceSamplesWith.empty())
     fmt::print(out, "    triangle centroids collide too with {}\n", fmt::join(g.faceSamplesWith, ", "));
+  if (!g.stitches.empty()) {
+    double widest = 0.0;
+    for (const auto& [a, b] : g.stitches) widest = std::max(widest, (g.mesh.positions[a] - g.mesh.positions[b]).norm());
+    fmt::print(out, "    {} stitches, drawing together vertices up to {:.1f} mm apart\n", g.stitches.size(), 1e3 * widest);
+  }
 }
 
 void inspectScene(const std::string& path, std::ostream& out) {

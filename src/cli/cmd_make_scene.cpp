@@ -5,6 +5,7 @@
 // substeps per frame are the fewest that mass scaling keeps stable within --max-added-mass.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -50,6 +51,8 @@ struct MakeSceneOptions {
   int bendEvery = 0;  ///< --bend-every, or 0: chosen by makeScene from the garment
   int collisionEvery = 1;  ///< --collision-every
   double bindThreshold_m = 0.04;
+  double stitchGaps_m = 0.0;  ///< --stitch-gaps: sew boundary vertices facing each other within this, m (0: none)
+  std::vector<std::array<std::uint32_t, 2>> stitches;  ///< found from stitchGaps_m
   cloth::Material material = knit();
 
   /// The walking skirt's knit (examples/walking_skirt) with a tenth of its damping.
@@ -147,6 +150,13 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
   fmt::print(os, "  collidesWith [ \"{}\" ]\n", fmt::join(o.collidesWith, "\", \""));
   if (!o.faceSamplesWith.empty())
     fmt::print(os, "  faceSamplesWith [ \"{}\" ]\n", fmt::join(o.faceSamplesWith, "\", \""));
+  if (!o.stitches.empty()) {
+    fmt::print(os, "  stitches [");
+    for (std::size_t i = 0; i < o.stitches.size(); ++i)
+      fmt::print(os, "{}{} {}{}", i % 8 == 0 ? "\n    " : " ", o.stitches[i][0], o.stitches[i][1],
+                 i + 1 < o.stitches.size() ? "," : "");
+    fmt::print(os, "\n  ]\n");
+  }
   fmt::print(os, "  maskTolerance 0.0005\n  bindThreshold {:.3f}\n}}\n", o.bindThreshold_m);
   if (!os) throw Error(fmt::format("{}: cannot be written", path));
 }
@@ -209,6 +219,14 @@ int makeScene(MakeSceneOptions& o) {
     cloth::checkBendingStep(*unscaled, rhythm);
   }
 
+  if (o.stitchGaps_m > 0.0) {
+    o.stitches = mesh::facingBoundaryPairs(garment, topology, o.stitchGaps_m);
+    if (o.stitches.empty())
+      throw Error(fmt::format("--stitch-gaps {:g}: no two boundary vertices of the garment face each other within "
+                              "{:g} m (the edges of an opening, a few boundary edges apart or more); is it larger "
+                              "than the gap?", o.stitchGaps_m, o.stitchGaps_m));
+  }
+
   o.avatarUrl = prepareSceneDir(o.out, o.avatar, o.avatarUrl);
   const std::filesystem::path dir(o.out);
   writeScene((dir / "scene.wrl").string(), o, garment, mask);
@@ -221,6 +239,11 @@ int makeScene(MakeSceneOptions& o) {
   fmt::print("collides with {}\n", fmt::join(o.collidesWith, ", "));
   fmt::print("{} substeps per frame at {:g} frames/s (mass scaling adds {:.2f} % of the mass)\n", o.stepsPerFrame,
              o.frameRate, 100.0 * added);
+  if (!o.stitches.empty()) {
+    double widest = 0.0;
+    for (const auto& [a, b] : o.stitches) widest = std::max(widest, (garment.positions[a] - garment.positions[b]).norm());
+    fmt::print("{} stitches across gaps of up to {:.1f} mm\n", o.stitches.size(), 1e3 * widest);
+  }
   fmt::print("wrote {}/scene.wrl, {}.obj, {}_mask.obj\n", o.out, o.name, o.name);
   return 0;
 }
@@ -275,11 +298,17 @@ RunFunction setupMakeScene(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--youngs-modulus", o.material.youngsModulus_Pa, "The knit's Young's modulus, Pa")->capture_default_str();
   app.add_option("--bind-threshold", o.bindThreshold_m, "Written into the ClothSet, m")->capture_default_str();
+  app.add_option("--stitch-gaps", o.stitchGaps_m,
+                 "Sew the garment's openings shut: boundary vertices that face each other across a gap of at most "
+                 "this many m (a jacket's fronts) become the ClothSet's stitches, drawn together in the simulation "
+                 "(0: none)")
+      ->capture_default_str();
   return [] {
     o.material.validate("--");
     if (!(o.voxel_m > 0.0)) throw Error(fmt::format("--voxel must be > 0 m, got {}", o.voxel_m));
     if (!(o.frameRate > 0.0)) throw Error(fmt::format("--frame-rate must be > 0, got {}", o.frameRate));
     if (o.stepsPerFrame < 0) throw Error(fmt::format("--substeps must be >= 1, got {}", o.stepsPerFrame));
+    if (!(o.stitchGaps_m >= 0.0)) throw Error(fmt::format("--stitch-gaps must be >= 0 m, got {}", o.stitchGaps_m));
     return makeScene(o);
   };
 }

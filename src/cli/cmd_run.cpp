@@ -31,7 +31,7 @@ namespace {
 struct RunOptions {
   std::string scene, avatar, motion, jointMap, fieldMethod = "dvdp";
   double motionScale = 0.0, voxel_m = 0.0, leadIn_s = 1.0;
-  bool preview = false, countEverySubstep = false, exactSliding = false, freePinches = false;
+  bool preview = false, countEverySubstep = false, exactSliding = false, freePinches = false, noStitches = false;
   std::vector<std::string> faceSamplesWith, keepApart;
   std::string garment, units = "m", pinVertices, pinMask, out, substeps = "33", integrator = "symplectic-euler";
   std::string strainLimit = "auto";
@@ -138,7 +138,7 @@ void applyOffsets(const RunOptions& o, RunSetup& setup) {
   }
 }
 
-/// --collision-every and --face-samples-with for every garment (a scene's or --garment's).
+/// --collision-every, --face-samples-with and --no-stitches for every garment (a scene's or --garment's).
 void applyCollisionOptions(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   const bool faces = app.count("--face-samples-with") > 0;
   const std::vector<std::string> faceParts = facePartsOption(o.faceSamplesWith);
@@ -148,6 +148,7 @@ void applyCollisionOptions(const CLI::App& app, const RunOptions& o, RunSetup& s
   for (GarmentSetup& g : setup.garments) {
     if (app.count("--collision-every")) g.collisionEvery = o.collisionEvery;
     if (faces) g.faceSamplesWith = faceParts;
+    if (o.noStitches) g.stitches.clear();
   }
 }
 
@@ -325,6 +326,8 @@ RunFunction setupRun(CLI::App& app) {
                  "vertices, overriding the scene's faceSamplesWith (e.g. LeftUpLeg,RightUpLeg): the parts no "
                  "longer bulge through triangles that are large against their curvature; 'none' for none")
       ->delimiter(',');
+  app.add_flag("--no-stitches", o->noStitches,
+               "Leave the scene's stitches out: the openings they sew shut (a jacket's fronts) hang free");
   app.add_option("--units", o->units, "Length unit of the OBJ files: m, dm, cm, mm, in")->capture_default_str();
   auto* pins = app.add_option("--pin-vertices", o->pinVertices, "Vertices pinned in place, 0-based, e.g. 0,12,40");
   auto* mask = app.add_option("--pin-mask", o->pinMask, "OBJ whose vertices mark the pinned garment vertices");

@@ -486,6 +486,7 @@ int simulateRun(const RunSetup& setup) {
       const mesh::Topology topology = mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
       auto model = cloth::ClothModel::build(g.mesh, topology, g.material, settings.massScaling());
       r.ownedSolver = std::make_unique<cloth::ClothSolver>(model, settings, pinsOf(g, *model));
+      r.ownedSolver->setStitches(g.stitches, g.name);
       r.solver = r.ownedSolver.get();
     }
     r.model = &r.solver->model();
@@ -707,7 +708,9 @@ int simulateRun(const RunSetup& setup) {
                             {"estimated_stable_substep_s", m.estimatedStableStep_s()},
                             {"frames_refined", runs[g].solver->refinedFrames()},
                             {"strain_limit", runs[g].solver->strainLimit()},
-                            {"strain_limit_corrections", runs[g].solver->strainLimitCorrections()}};
+                            {"strain_limit_corrections", runs[g].solver->strainLimitCorrections()},
+                            {"stitches", runs[g].solver->stitches().size()},
+                            {"stitch_corrections", runs[g].solver->stitchCorrections()}};
     const long limitedFrom = runs[g].solver->strainLimitedFrom();
     entry["strain_limited_from_frame"] = limitedFrom > 0 ? nlohmann::json(limitedFrom) : nlohmann::json(nullptr);
     if (runs[g].collider) {

@@ -220,6 +220,8 @@ bool ClothSolver::substep(double t0, double t1, long frame, int substepIndex) {
   collide(t0, t1);  // colliders correct the end-of-substep state
   t = StageClock::lap(ticks_.collide, t);
   applyFixtures(t0, t1, dt);  // pinned vertices follow their transforms
+  if (!stitches_.empty())  // after the fixtures, whose vertices it leaves where they are
+    stitchCorrections_ += holdStitches(stitches_, strainWeight_, kStrainLimitSweeps, state_);
   t = StageClock::lap(ticks_.fixtures, t);
   if (strainLimit_ > 0.0) {
     limitStrain();  // no edge beyond the limit (after the fixtures, whose vertices it leaves where they are)
@@ -240,6 +242,20 @@ void ClothSolver::accumulateForces() {
   const int every = settings_.bendEvery;
   if (substepCount_++ % every == 0) accumulateBendingForces(*model_, state_, static_cast<double>(every));
   accumulateDragForces(*model_, settings_, state_);
+}
+
+void ClothSolver::setStitches(std::vector<Stitch> stitches, const std::string& garment) {
+  const std::size_t n = model_->vertexCount();
+  for (const Stitch& st : stitches) {
+    if (st.a >= n || st.b >= n)
+      throw Error(fmt::format("garment '{}': a stitch joins vertex {} and {}, but it has {} vertices", garment, st.a,
+                              st.b, n));
+    if (st.a == st.b) throw Error(fmt::format("garment '{}': a stitch joins vertex {} to itself", garment, st.a));
+    if (!(st.length_m >= 0.0) || !std::isfinite(st.length_m))
+      throw Error(fmt::format("garment '{}': the stitch of vertices {} and {} is {:g} m long", garment, st.a, st.b,
+                              st.length_m));
+  }
+  stitches_ = std::move(stitches);
 }
 
 void ClothSolver::limitStrain() {

@@ -142,4 +142,44 @@ std::size_t countNonManifoldEdges(const TriMesh& mesh) {
   return count;
 }
 
+std::vector<std::array<std::uint32_t, 2>> facingBoundaryPairs(const TriMesh& mesh, const Topology& topology,
+                                                              double maxGap_m, int minSeparation) {
+  struct Place {
+    std::uint32_t vertex, loop, index;  ///< the vertex, its loop and where along it
+  };
+  std::vector<Place> boundary;
+  for (std::size_t l = 0; l < topology.boundaryLoops.size(); ++l)
+    for (std::size_t i = 0; i < topology.boundaryLoops[l].size(); ++i)
+      boundary.push_back({topology.boundaryLoops[l][i], static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(i)});
+  const auto apartAlongBoundary = [&](const Place& p, const Place& q) {
+    if (p.loop != q.loop) return true;
+    const auto length = static_cast<std::uint32_t>(topology.boundaryLoops[p.loop].size());
+    const std::uint32_t d = p.index > q.index ? p.index - q.index : q.index - p.index;
+    return static_cast<int>(std::min(d, length - d)) >= minSeparation;
+  };
+  // Boundaries hold a small share of a garment's vertices: every pair is compared.
+  constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+  std::vector<std::size_t> nearest(boundary.size(), kNone);
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    double best = maxGap_m;
+    for (std::size_t j = 0; j < boundary.size(); ++j) {
+      if (j == i || !apartAlongBoundary(boundary[i], boundary[j])) continue;
+      const double d = (mesh.positions[boundary[j].vertex] - mesh.positions[boundary[i].vertex]).norm();
+      if (d <= best) {
+        best = d;
+        nearest[i] = j;
+      }
+    }
+  }
+  std::vector<std::array<std::uint32_t, 2>> pairs;
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    const std::size_t j = nearest[i];
+    if (j == kNone || j < i || nearest[j] != i) continue;  // each mutual pair once
+    const std::uint32_t a = boundary[i].vertex, b = boundary[j].vertex;
+    pairs.push_back({std::min(a, b), std::max(a, b)});
+  }
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
 }  // namespace drape::mesh

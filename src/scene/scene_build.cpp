@@ -442,10 +442,37 @@ class Builder {
         throw Error::at(where(n, "faceSamplesWith"),
                         fmt::format("ClothSet {}: faceSamplesWith names '{}', which is not in its collidesWith",
                                     g.name, s));
+    g.stitches = stitches(n, g);
     avatarOf(n, g);
     if (const std::int32_t mask = node(n, "constraintMask"); mask >= 0)
       g.maskVertices = matchMask(transformed(faceSet(mask, n, "constraintMask"), pending.world, g.name), g, n);
     scene_.garments.push_back(std::move(g));
+  }
+
+  /// The ClothSet's `stitches`: pairs of cloth vertex indices.
+  static std::vector<std::array<std::uint32_t, 2>> stitches(const Node& n, const Garment& g) {
+    const Field* f = n.field("stitches");
+    if (f == nullptr || f->numbers.empty()) return {};
+    const std::vector<double>& v = f->numbers;
+    if (v.size() % 2 != 0)
+      throw Error::at(where(n, "stitches"),
+                      fmt::format("ClothSet {}: stitches holds {} vertex indices; expected pairs (an even count)",
+                                  g.name, v.size()));
+    const std::size_t count = g.mesh.positions.size();
+    std::vector<std::array<std::uint32_t, 2>> out;
+    for (std::size_t i = 0; i < v.size(); i += 2) {
+      for (std::size_t k = i; k < i + 2; ++k)
+        if (!(v[k] >= 0.0 && v[k] < static_cast<double>(count)))
+          throw Error::at(where(n, "stitches"),
+                          fmt::format("ClothSet {}: stitch {} names vertex {}; expected a cloth vertex, 0 to {}",
+                                      g.name, i / 2 + 1, v[k], count - 1));
+      if (v[i] == v[i + 1])
+        throw Error::at(where(n, "stitches"),
+                        fmt::format("ClothSet {}: stitch {} joins vertex {} to itself; expected two vertices", g.name,
+                                    i / 2 + 1, v[i]));
+      out.push_back({static_cast<std::uint32_t>(v[i]), static_cast<std::uint32_t>(v[i + 1])});
+    }
+    return out;
   }
 
   void avatarOf(const Node& n, Garment& g) {

@@ -154,6 +154,7 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
     for (const cloth::PinGroup& g : pins) fixed.insert(fixed.end(), g.vertices.begin(), g.vertices.end());
     run.collider->setFixedVertices(fixed, model->vertexCount());
     run.solver = std::make_unique<cloth::ClothSolver>(model, settings_.step, std::move(pins));
+    run.solver->setStitches(spec.stitches, spec.name);
     run.collider->initialise(run.solver->state(), 0.0);
     run.solver->addCollider(*run.collider);
     run.spec = std::move(spec);

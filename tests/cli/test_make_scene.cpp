@@ -81,10 +81,12 @@ TEST(MakeScene, AMakeHumanGarmentIsRefittedWithItsMask) {
   ScratchDir dir("make-scene-mhclo");
   const std::string sceneDir = dir / "dress";
   const CliResult made =
-      runDrape(makeDressScene("mhclo", "--substeps 155 --bend-every 2 --collision-every 3 --collides-with Hips,Spine1",
+      runDrape(makeDressScene("mhclo", "--substeps 155 --bend-every 2 --collision-every 3 --collides-with Hips,Spine1 "
+                              "--stitch-gaps 0.02",
                               sceneDir),
                dir);
   ASSERT_EQ(made.code, 0) << made.err;
+  EXPECT_NE(made.out.find("16 stitches across gaps of up to 15.8 mm"), std::string::npos) << made.out;
   const scene::Scene sc = scene::loadScene(sceneDir + "/scene.wrl");
   ASSERT_EQ(sc.garments.size(), 1u);
   EXPECT_EQ(sc.garments[0].mesh.triangleCount(), 4192u);
@@ -97,6 +99,17 @@ TEST(MakeScene, AMakeHumanGarmentIsRefittedWithItsMask) {
   for (const Vec3& p : sc.garments[0].mesh.positions)
     if (std::abs(p.x()) > 0.39) highestCuff = std::max(highestCuff, p.y());
   EXPECT_GT(highestCuff, 0.25);
+  // The jacket's two fronts, modelled overlapping 5 to 16 mm apart, sewn shut: every stitch
+  // joins the edges of the fronts, on the body's midline, from the hem up to the breastbone.
+  const scene::Garment& dress = sc.garments[0];
+  ASSERT_EQ(dress.stitches.size(), 16u);
+  for (const auto& [a, b] : dress.stitches) {
+    const Vec3 pa = dress.mesh.positions[a], pb = dress.mesh.positions[b];
+    EXPECT_LT(std::abs(pa.x()), 0.01) << a;
+    EXPECT_LT(std::abs(pb.x()), 0.01) << b;
+    EXPECT_GT(std::min(pa.z(), pb.z()), 0.1) << "the front";
+    EXPECT_LE((pa - pb).norm(), 0.02);
+  }
 
   const CliResult wrong = runDrape("make-scene '" + kSource + "/data/avatars/CesiumMan.glb' --garment '" + kSource +
                                        "/data/garments/makehuman_female_elegantsuit01_dress.mhclo' --mask '" + kSource +
@@ -111,6 +124,15 @@ TEST(MakeScene, AMakeHumanGarmentIsRefittedWithItsMask) {
   EXPECT_EQ(tooSlow.code, 2) << tooSlow.err;
   EXPECT_NE(tooSlow.err.find("bending every 33 substeps spans 7.1 ms"), std::string::npos) << tooSlow.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "slow/scene.wrl"));
+
+  // Gaps narrower than any opening of the garment find nothing to sew, and say so.
+  const CliResult narrow = runDrape(
+      makeDressScene("mhclo", "--substeps 155 --collides-with Hips,Spine1 --stitch-gaps 0.001", dir / "narrow"), dir);
+  EXPECT_EQ(narrow.code, 2) << narrow.err;
+  EXPECT_NE(narrow.err.find("--stitch-gaps 0.001: no two boundary vertices of the garment face each other within "
+                            "0.001 m"),
+            std::string::npos)
+      << narrow.err;
 }
 
 TEST(MakeScene, TooFewSubstepsForTheAddedMassIsAClearError) {

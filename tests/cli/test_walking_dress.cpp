@@ -7,6 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
+#include "drape/formats/pc2.hpp"
+#include "drape/scene/scene.hpp"
 
 namespace drape {
 namespace {
@@ -42,6 +44,22 @@ TEST(WalkingDress, WalksStablyWithFewPointsInsideTheBody) {
   EXPECT_LT(stats["vertex_substeps_inside_body"].get<double>() / substeps, 0.001);
   EXPECT_LT(stats["max_penetration_m"].get<double>(), 0.005);
   EXPECT_LT(stats["max_strain"].get<double>(), 1.6);
+  // The jacket's fronts stay sewn shut: each stitch's two vertices meet (the scene's 16,
+  // from make-scene --stitch-gaps 0.02), where unsewn the fronts part within a few frames
+  // and show the body from the breastbone to the waist.
+  EXPECT_EQ(g["stitches"].get<int>(), 16);
+  EXPECT_GT(g["stitch_corrections"].get<long>(), 0);
+  const scene::Scene sc = scene::loadScene(kDressScene);
+  const formats::Pc2Cache cache = formats::readPc2(out + "/garment.pc2");
+  ASSERT_EQ(cache.frames.size(), 46u);
+  for (const auto& [a, b] : sc.garments.at(0).stitches)
+    EXPECT_LT((cache.frames.back()[a] - cache.frames.back()[b]).norm(), 1e-5) << a << " " << b;
+  const std::string unsewn = dir / "unsewn";
+  const CliResult open = runDrape("run '" + kDressScene + "' --motion '" + kSource +
+                                      "/examples/walking_skirt/walk.bvh' --frames 1 --no-stitches --out '" + unsewn + "'",
+                                  dir);
+  ASSERT_EQ(open.code, 0) << open.err;
+  EXPECT_EQ(statsOf(unsewn)["garments"][0]["stitches"].get<int>(), 0);
   // The sleeves, narrower than the arms' offset surfaces, hold some of the vertices that
   // start below T2 there: they collide as any other (and count above) once their easing
   // has had its time.

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -241,6 +242,134 @@ TEST(StrainLimit, AFrameNoSubstepsKeepStableIsComputedAgainWithTheLimitWhichStay
   // The strip that stopped had torn itself apart; the rescued one is whole.
   EXPECT_GT(largestStretch(stops->model(), stops->state()), 3.0);
   EXPECT_LT(largestStretch(rescued->model(), rescued->state()), 2.0);
+}
+
+// Stitches (holdStitches): the same projection as the strain limit's, to a length of its
+// own, over pairs of vertices that need not share an edge.
+
+TEST(Stitches, EveryStitchEndsWithinItsLengthKeepingMomentumAndTheCentreOfMass) {
+  Sheet s;
+  crumple(s.state, 0.05, 7);
+  std::mt19937 rng(11);
+  std::vector<std::uint32_t> order(s.state.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::shuffle(order.begin(), order.end(), rng);
+  std::vector<Stitch> stitches;  // disjoint: one sweep settles each exactly
+  std::uniform_real_distribution<double> length(0.0, 0.03);
+  for (std::size_t i = 0; i + 1 < order.size(); i += 2) stitches.push_back({order[i], order[i + 1], length(rng)});
+  s.weight[stitches[0].a] = 0.0;  // held by a fixture
+  const Vec3 held = s.state.position(stitches[0].a);
+  // Conserved over the other stitches' vertices (masses 1 / weight; the held vertex takes
+  // up its stitch's pull).
+  const auto sums = [&](const ClothState& st) {
+    Vec3 p = Vec3::Zero(), c = Vec3::Zero();
+    for (std::size_t i = 0; i < st.size(); ++i)
+      if (s.weight[i] > 0.0 && i != stitches[0].b) {
+        p += st.velocity(i) / s.weight[i];
+        c += st.position(i) / s.weight[i];
+      }
+    return std::pair{p, c};
+  };
+  const auto [p0, c0] = sums(s.state);
+  const ClothState before = s.state;
+  const std::size_t corrected = holdStitches(stitches, s.weight, 1, s.state);
+  EXPECT_GT(corrected, stitches.size() / 2) << "most random pairs start further apart than 3 cm";
+  for (const Stitch& st : stitches) {
+    const Vec3 d0 = before.position(st.b) - before.position(st.a);
+    const Vec3 d = s.state.position(st.b) - s.state.position(st.a);
+    if (d0.norm() <= st.length_m) {
+      EXPECT_EQ(s.state.position(st.a), before.position(st.a)) << "within its length: untouched";
+      continue;
+    }
+    EXPECT_NEAR(d.norm(), st.length_m, 1e-12);
+    // Drawn together along the line between them, which keeps its direction, and no longer
+    // moving apart along it.
+    EXPECT_NEAR(d.normalized().dot(d0.normalized()), 1.0, 1e-9);
+    EXPECT_LE((s.state.velocity(st.b) - s.state.velocity(st.a)).dot(d0.normalized()), 1e-12);
+  }
+  EXPECT_EQ(s.state.position(stitches[0].a), held);
+  const auto [p1, c1] = sums(s.state);
+  EXPECT_NEAR((p1 - p0).norm(), 0.0, 1e-12 * p0.norm() + 1e-15);
+  EXPECT_NEAR((c1 - c0).norm(), 0.0, 1e-9 * c0.norm());
+}
+
+/// Two sheets hanging side by side, 1 cm apart, pinned along their top rows and thrown
+/// apart out of their plane: the left one forwards, the right one backwards.
+struct TwoSheets {
+  SheetSpec left{0.2, 0.3, 4, 6, Vec3(0, -0.3, 0), Vec3::UnitX(), Vec3::UnitY(), "left"};
+  SheetSpec right{0.2, 0.3, 4, 6, Vec3(0.21, -0.3, 0), Vec3::UnitX(), Vec3::UnitY(), "right"};
+  mesh::TriMesh mesh = both();
+  std::shared_ptr<const ClothModel> model = makeModel(mesh, knit());
+  std::uint32_t offset = static_cast<std::uint32_t>(gridSheet(left).vertexCount());
+
+  [[nodiscard]] mesh::TriMesh both() const {
+    mesh::TriMesh m = gridSheet(left);
+    const mesh::TriMesh r = gridSheet(right);
+    const auto o = static_cast<std::uint32_t>(m.positions.size());
+    m.positions.insert(m.positions.end(), r.positions.begin(), r.positions.end());
+    for (const mesh::Triangle& t : r.triangles) m.triangles.push_back({t[0] + o, t[1] + o, t[2] + o});
+    return m;
+  }
+  [[nodiscard]] std::unique_ptr<ClothSolver> solver(bool stitched) const {
+    std::vector<std::uint32_t> top = testing::row(left, left.cellsV);
+    for (const std::uint32_t v : testing::row(right, right.cellsV)) top.push_back(v + offset);
+    auto s = std::make_unique<ClothSolver>(
+        model, testing::settingsWithStep(1e-3),
+        std::vector<PinGroup>{PinGroup::atRest(top, model->restX(), model->restY(), model->restZ())});
+    if (stitched) {
+      std::vector<Stitch> stitches;
+      for (const auto& [a, b] : mesh::facingBoundaryPairs(mesh, mesh::Topology::build(mesh), 0.015))
+        stitches.push_back({a, b, 0.0});
+      s->setStitches(std::move(stitches), "two sheets");
+    }
+    for (std::uint32_t v = 0; v < model->vertexCount(); ++v)
+      s->mutableState().setVelocity(v, Vec3(0, 0, v < offset ? 1.0 : -1.0));
+    return s;
+  }
+  /// The bottom corners that face each other.
+  [[nodiscard]] double bottomGap(const ClothSolver& s) const {
+    return (s.state().position(offset + sheetVertex(right, 0, 0)) - s.state().position(sheetVertex(left, left.cellsU, 0)))
+        .norm();
+  }
+};
+
+TEST(Stitches, HoldTwoSheetsTogetherAlongTheEdgesThatFaceEachOther) {
+  const TwoSheets sheets;
+  const auto free = sheets.solver(false);
+  const auto sewn = sheets.solver(true);
+  ASSERT_EQ(sewn->stitches().size(), 7u) << "one per row";
+  for (long f = 1; f <= 10; ++f) {
+    ASSERT_TRUE(free->stepFrame(f)) << free->instability().describe("two sheets", 50);
+    ASSERT_TRUE(sewn->stepFrame(f)) << sewn->instability().describe("two sheets", 50);
+    for (const Stitch& st : sewn->stitches()) {
+      if (sewn->pins()[0].vertices.end() !=
+          std::find(sewn->pins()[0].vertices.begin(), sewn->pins()[0].vertices.end(), st.a))
+        continue;  // the top row: both ends pinned where they were modelled
+      EXPECT_LT((sewn->state().position(st.b) - sewn->state().position(st.a)).norm(), 1e-9) << f;
+    }
+  }
+  EXPECT_GT(sheets.bottomGap(*free), 0.05) << "unsewn, the sheets swing apart";
+  EXPECT_LT(sheets.bottomGap(*sewn), 1e-9);
+  EXPECT_GT(sewn->stitchCorrections(), 0u);
+  // Thrown alike in opposite directions, the sewn edge stays in the plane it hung in.
+  for (const Stitch& st : sewn->stitches()) EXPECT_NEAR(sewn->state().position(st.a).z(), 0.0, 1e-3);
+}
+
+TEST(Stitches, AStitchOutOfRangeOrToItselfIsRefusedNamingTheGarment) {
+  const TwoSheets sheets;
+  ClothSolver s(sheets.model, testing::settingsWithStep(1e-3));
+  const auto refused = [&](Stitch st, const std::string& words) {
+    try {
+      s.setStitches({st}, "coat");
+      ADD_FAILURE() << "accepted " << st.a << " " << st.b;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  refused({0, 1000, 0.0}, "garment 'coat': a stitch joins vertex 0 and 1000, but it has 70 vertices");
+  refused({3, 3, 0.0}, "garment 'coat': a stitch joins vertex 3 to itself");
+  refused({3, 4, -1.0}, "garment 'coat': the stitch of vertices 3 and 4 is -1 m long");
+  EXPECT_TRUE(s.stitches().empty());
 }
 
 }  // namespace

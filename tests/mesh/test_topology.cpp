@@ -78,6 +78,63 @@ TEST(Topology, RejectsDegenerateAndOutOfRangeTriangles) {
   EXPECT_THROW((void)Topology::build(m), Error);
 }
 
+/// The grid with a slit up column c from the bottom edge to row s: the vertices of the
+/// column below row s are doubled, the copies `gap` to the right and taken by the cells
+/// right of the column.
+TriMesh slitGrid(int nx, int ny, int c, int s, double gap) {
+  TriMesh m = grid(nx, ny);
+  std::vector<std::uint32_t> copy(static_cast<std::size_t>(s));
+  for (int j = 0; j < s; ++j) {
+    copy[static_cast<std::size_t>(j)] = static_cast<std::uint32_t>(m.positions.size());
+    m.positions.emplace_back(c + gap, j, 0);
+  }
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const int cellI = static_cast<int>(t / 2) % nx;
+    if (cellI != c) continue;  // only the cells right of the column
+    for (std::uint32_t& v : m.triangles[t]) {
+      const int i = static_cast<int>(v) % (nx + 1), j = static_cast<int>(v) / (nx + 1);
+      if (i == c && j < s) v = copy[static_cast<std::size_t>(j)];
+    }
+  }
+  return m;
+}
+
+TEST(FacingBoundaryPairs, ASlitsTwoEdgesArePairedRowByRowAwayFromItsClosedEnd) {
+  const int nx = 6, ny = 8, c = 3, s = 6;
+  const TriMesh m = slitGrid(nx, ny, c, s, 0.1);
+  const Topology t = Topology::build(m);
+  ASSERT_EQ(t.boundaryLoops.size(), 1u);
+  const auto pairs = facingBoundaryPairs(m, t, 0.3);
+  // Row j's two vertices are 2 (s - j) boundary edges apart around the slit's end: rows
+  // s - 1 and s - 2 are neighbours along the boundary (fewer than 6 edges), the rest pair.
+  ASSERT_EQ(pairs.size(), static_cast<std::size_t>(s - 2));
+  for (int j = 0; j < s - 2; ++j) {
+    const auto original = static_cast<std::uint32_t>(j * (nx + 1) + c);
+    const auto copy = static_cast<std::uint32_t>((nx + 1) * (ny + 1) + j);
+    EXPECT_EQ(pairs[static_cast<std::size_t>(j)], (std::array<std::uint32_t, 2>{original, copy})) << j;
+  }
+  EXPECT_EQ(facingBoundaryPairs(m, t, 0.3, 2 * s + 2).size(), 0u) << "every row within the separation";
+  EXPECT_EQ(facingBoundaryPairs(m, t, 0.09).size(), 0u) << "the gap is wider";
+}
+
+TEST(FacingBoundaryPairs, TwoSheetsFacingEachOtherArePairedAlongTheirWholeEdges) {
+  const int n = 4;
+  TriMesh m = grid(n, n);
+  const TriMesh right = grid(n, n);
+  const auto offset = static_cast<std::uint32_t>(m.positions.size());
+  for (const Vec3& p : right.positions) m.positions.push_back(p + Vec3(n + 0.2, 0, 0));
+  for (const Triangle& tri : right.triangles) m.triangles.push_back({tri[0] + offset, tri[1] + offset, tri[2] + offset});
+  const Topology t = Topology::build(m);
+  ASSERT_EQ(t.boundaryLoops.size(), 2u);
+  const auto pairs = facingBoundaryPairs(m, t, 0.5);
+  ASSERT_EQ(pairs.size(), static_cast<std::size_t>(n + 1));
+  for (const auto& [a, b] : pairs) {
+    EXPECT_DOUBLE_EQ(m.positions[a].x(), n);
+    EXPECT_DOUBLE_EQ(m.positions[b].x(), n + 0.2);
+    EXPECT_DOUBLE_EQ(m.positions[a].y(), m.positions[b].y());
+  }
+}
+
 TEST(TriMesh, AreaAndNormals) {
   const TriMesh m = grid(2, 3);
   EXPECT_NEAR(m.totalArea(), 6.0, 1e-12);

@@ -100,7 +100,7 @@ TEST(VrmlScene, EveryFieldWithValues) {
       "bendingStiffness 1e-6\n"
       "  damping 0.1 staticFriction 0.4 dynamicFriction 0.2 compressionScale 0.5 }\n"
       "DEF Scarf ClothSet { name \"scarf\" material USE Silk avatar USE Body collidesWith [ \"hips\" ] faceSamplesWith "
-      "[ \"hips\" ] maskTolerance "
+      "[ \"hips\" ] stitches [ 0 2, 1 0 ] maskTolerance "
       "0.002 "
       "bindThreshold 0.03\n  cloth " +
       kTriangle + "\n  constraintMask " + kTriangle +
@@ -147,6 +147,7 @@ TEST(VrmlScene, EveryFieldWithValues) {
   EXPECT_EQ(g.avatar, 0);
   EXPECT_EQ(g.collidesWith, std::vector<std::string>{"hips"});
   EXPECT_EQ(g.faceSamplesWith, std::vector<std::string>{"hips"});
+  EXPECT_EQ(g.stitches, (std::vector<std::array<std::uint32_t, 2>>{{0, 2}, {1, 0}}));
   EXPECT_NEAR(g.maskTolerance, 0.002, 1e-9);
   EXPECT_NEAR(g.bindThreshold, 0.03, 1e-9);
   EXPECT_EQ(g.maskVertices, (std::vector<std::uint32_t>{0, 1, 2}));
@@ -201,6 +202,7 @@ TEST(VrmlScene, EveryFieldDefaults) {
   EXPECT_NEAR(s.garments[0].bindThreshold, gd.bindThreshold, 1e-9);
   EXPECT_TRUE(s.garments[0].maskVertices.empty());
   EXPECT_TRUE(s.garments[0].collidesWith.empty());
+  EXPECT_TRUE(s.garments[0].stitches.empty());
   EXPECT_EQ(s.garments[0].avatar, -1);
   // No Simulation node at all: the same defaults, flagged.
   EXPECT_FALSE(fromText("#VRML V2.0 utf8\nGroup { }\n").hasSimulationNode);
@@ -331,6 +333,18 @@ TEST(VrmlScene, MoreDomainErrors) {
                   "ClothSet { avatar USE H faceSamplesWith [ \"knee\" ] cloth " +
                   kTriangle + " }\n");
             }).find("faceSamplesWith names 'knee', which avatar H has no segment called"),
+            std::string::npos);
+  // Stitches: pairs of distinct cloth vertices.
+  const auto stitched = [&](const std::string& pairs) {
+    return errorOf([&] { (void)fromText("#VRML V2.0 utf8\nClothSet { cloth " + kTriangle + "\n  stitches [ " + pairs + " ] }\n"); });
+  };
+  EXPECT_NE(stitched("0 1, 2").find("scene.wrl:3: ClothSet garment 1: stitches holds 3 vertex indices; expected pairs"),
+            std::string::npos);
+  EXPECT_NE(stitched("0 1, 2 3").find("scene.wrl:3: ClothSet garment 1: stitch 2 names vertex 3; expected a cloth "
+                                      "vertex, 0 to 2"),
+            std::string::npos);
+  EXPECT_NE(stitched("-1 1").find("stitch 1 names vertex -1; expected a cloth vertex"), std::string::npos);
+  EXPECT_NE(stitched("1 1").find("scene.wrl:3: ClothSet garment 1: stitch 1 joins vertex 1 to itself"),
             std::string::npos);
   EXPECT_NE(errorOf([&] {
               (void)fromText("#VRML V2.0 utf8\nClothSet { cloth Shape { geometry Box { } } }\n");

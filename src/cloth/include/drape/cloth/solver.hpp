@@ -22,6 +22,7 @@
 #include "drape/cloth/material.hpp"
 #include "drape/cloth/model.hpp"
 #include "drape/cloth/state.hpp"
+#include "drape/cloth/strain_limit.hpp"
 #include "drape/core/stage_clock.hpp"
 
 namespace drape::cloth {
@@ -37,7 +38,7 @@ struct StageTimes {
   double forces_s = 0.0;
   double integrate_s = 0.0;
   double collide_s = 0.0;
-  double fixtures_s = 0.0;
+  double fixtures_s = 0.0;      ///< the fixtures, and the stitches held after them (ClothSolver::setStitches)
   double fixturePoses_s = 0.0;  ///< the part of fixtures_s spent asking for the fixtures' poses
   double strainLimit_s = 0.0;   ///< strain limiting, once on (StepSettings::strainLimit, rescueStrainLimit)
   double stability_s = 0.0;
@@ -87,6 +88,14 @@ class ClothSolver {
 
   /// Adds a collider (not owned; it must outlive the solver's steps).
   void addCollider(Collider& collider) { colliders_.push_back(&collider); }
+  /// The garment's stitches (holdStitches), held after the fixtures on every substep.
+  /// Throws drape::Error, naming the garment (StepSettings has no name: `garment`), on a
+  /// vertex out of range, a stitch from a vertex to itself or a length that is negative or
+  /// not finite.
+  void setStitches(std::vector<Stitch> stitches, const std::string& garment);
+  [[nodiscard]] const std::vector<Stitch>& stitches() const { return stitches_; }
+  /// Stitch corrections made so far (holdStitches's count).
+  [[nodiscard]] std::size_t stitchCorrections() const { return stitchCorrections_; }
 
   /// Computes frame `frame` (1-based: frame 0 is the initial state) from the current state:
   /// settings.substepsPerFrame substeps covering [(frame - 1) / fps, frame / fps]. When the
@@ -181,6 +190,8 @@ class ClothSolver {
   long strainLimitedFrom_ = 0;
   Instability strainLimitedBecause_;
   std::size_t strainLimitCorrections_ = 0;
+  std::vector<Stitch> stitches_;
+  std::size_t stitchCorrections_ = 0;
   double dampedOmega_ = 0.0;  ///< dampedMembraneFrequency_rad_s
 };
 

@@ -7,6 +7,7 @@
 // takes that stiffness away where forces alone cannot.
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
 
 #include "drape/cloth/model.hpp"
@@ -26,5 +27,19 @@ inline constexpr int kStrainLimitSweeps = 2;
 /// the limit are not touched. Returns how many edge corrections were made.
 std::size_t limitStrain(const ClothModel& model, std::span<const double> weight, double limit, int sweeps,
                         ClothState& io);
+
+/// Two vertices of a garment sewn together (a closure, a button, a seam the mesh leaves
+/// open): they stay at most `length_m` apart. Beyond the paper.
+struct Stitch {
+  std::uint32_t a = 0, b = 0;
+  double length_m = 0.0;  ///< as far apart as they may be: their distance as modelled
+};
+
+/// Pulls the two ends of every stitch longer than its length back to it, in `sweeps` passes,
+/// as limitStrain pulls an edge (by the inverse-mass weights, taking away the ends' velocity
+/// apart along the stitch), every substep: a stitch is a limit, not a spring, so it adds no
+/// stiffness the explicit step would have to resolve. Returns how many stitch corrections
+/// were made.
+std::size_t holdStitches(std::span<const Stitch> stitches, std::span<const double> weight, int sweeps, ClothState& io);
 
 }  // namespace drape::cloth

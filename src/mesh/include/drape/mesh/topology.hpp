@@ -3,6 +3,7 @@
 // its one or two faces and the vertices opposite it, plus boundary loops. Built once per
 // garment mesh (a Build* pass); the simulation only reads it.
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -39,5 +40,14 @@ struct Topology {
 /// Tolerant check used by loaders that may keep non-manifold meshes (body parts):
 /// the number of edges with more than two faces.
 [[nodiscard]] std::size_t countNonManifoldEdges(const TriMesh& mesh);
+
+/// Pairs of boundary vertices that face each other across a gap the mesh leaves open (the
+/// two fronts of a jacket, the edges of a slit): each boundary vertex's nearest boundary
+/// vertex within maxGap_m that is not its neighbour along the boundary (on another loop, or
+/// at least minSeparation boundary edges away along its own), kept where the two are each
+/// other's nearest. Each pair (a < b) once, sorted. The closures a garment's stitches sew.
+[[nodiscard]] std::vector<std::array<std::uint32_t, 2>> facingBoundaryPairs(const TriMesh& mesh,
+                                                                            const Topology& topology,
+                                                                            double maxGap_m, int minSeparation = 6);
 
 }  // namespace drape::mesh

@@ -39,6 +39,7 @@ struct GarmentSpec {
   std::vector<std::string> collidesWith;    ///< body segment names
   /// Of collidesWith, the parts the triangles' centroids collide with too (face samples).
   std::vector<std::string> faceSamplesWith;
+  std::vector<cloth::Stitch> stitches;      ///< vertices sewn together (ClothSolver::setStitches)
   cloth::OffsetSurfaces offsets;            ///< used when offsetsGiven, else from the voxel size
   bool offsetsGiven = false;
   int collisionEvery = 1;                   ///< collision tests every k substeps

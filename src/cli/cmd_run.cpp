@@ -19,6 +19,7 @@
 #include "drape/core/error.hpp"
 #include "drape/formats/obj.hpp"
 #include "drape/formats/units.hpp"
+#include "drape/mesh/topology.hpp"
 #include "drape/motion/animation.hpp"
 #include "drape/scene/avatar_gltf.hpp"
 #include "drape/scene/scene.hpp"
@@ -32,6 +33,7 @@ struct RunOptions {
   std::string scene, avatar, motion, jointMap, fieldMethod = "dvdp";
   double motionScale = 0.0, voxel_m = 0.0, leadIn_s = 1.0;
   bool preview = false, countEverySubstep = false, exactSliding = false, freePinches = false, noStitches = false;
+  double stitchGaps_m = 0.0;  ///< --stitch-gaps
   std::vector<std::string> faceSamplesWith, keepApart;
   std::string garment, units = "m", pinVertices, pinMask, out, substeps = "33", integrator = "symplectic-euler";
   std::string strainLimit = "auto";
@@ -138,7 +140,22 @@ void applyOffsets(const RunOptions& o, RunSetup& setup) {
   }
 }
 
-/// --collision-every, --face-samples-with and --no-stitches for every garment (a scene's or --garment's).
+/// --stitch-gaps: the garment's boundary vertices facing each other across at most gap_m,
+/// sewn together (mesh::facingBoundaryPairs, as drape make-scene finds them).
+std::vector<cloth::Stitch> stitchesAcrossGaps(const GarmentSetup& g, double gap_m) {
+  if (!(gap_m > 0.0)) throw Error(fmt::format("--stitch-gaps must be > 0 m, got {}", gap_m));
+  std::vector<cloth::Stitch> stitches;
+  for (const auto& [a, b] : mesh::facingBoundaryPairs(g.mesh, mesh::Topology::build(g.mesh), gap_m))
+    stitches.push_back({a, b, 0.0});
+  if (stitches.empty())
+    throw Error(fmt::format("--stitch-gaps {:g}: no two boundary vertices of garment '{}' face each other within {:g} m "
+                            "(the edges of an opening, a few boundary edges apart or more)",
+                            gap_m, g.name, gap_m));
+  spdlog::info("{}: {} stitches across gaps of up to {:g} m (--stitch-gaps)", g.name, stitches.size(), gap_m);
+  return stitches;
+}
+
+/// --collision-every, --face-samples-with, --no-stitches and --stitch-gaps for every garment (a scene's or --garment's).
 void applyCollisionOptions(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   const bool faces = app.count("--face-samples-with") > 0;
   const std::vector<std::string> faceParts = facePartsOption(o.faceSamplesWith);
@@ -149,6 +166,7 @@ void applyCollisionOptions(const CLI::App& app, const RunOptions& o, RunSetup& s
     if (app.count("--collision-every")) g.collisionEvery = o.collisionEvery;
     if (faces) g.faceSamplesWith = faceParts;
     if (o.noStitches) g.stitches.clear();
+    if (app.count("--stitch-gaps")) g.stitches = stitchesAcrossGaps(g, o.stitchGaps_m);
   }
 }
 
@@ -326,8 +344,13 @@ RunFunction setupRun(CLI::App& app) {
                  "vertices, overriding the scene's faceSamplesWith (e.g. LeftUpLeg,RightUpLeg): the parts no "
                  "longer bulge through triangles that are large against their curvature; 'none' for none")
       ->delimiter(',');
-  app.add_flag("--no-stitches", o->noStitches,
-               "Leave the scene's stitches out: the openings they sew shut (a jacket's fronts) hang free");
+  auto* unsewn = app.add_flag("--no-stitches", o->noStitches,
+                              "Leave the scene's stitches out: the openings they sew shut (a jacket's fronts) hang free");
+  app.add_option("--stitch-gaps", o->stitchGaps_m,
+                 "Sew the garments' openings shut, instead of the scene's stitches: boundary vertices that face each "
+                 "other across a gap of at most this many m (a jacket's fronts) are drawn together (as drape "
+                 "make-scene --stitch-gaps finds them)")
+      ->excludes(unsewn);
   app.add_option("--units", o->units, "Length unit of the OBJ files: m, dm, cm, mm, in")->capture_default_str();
   auto* pins = app.add_option("--pin-vertices", o->pinVertices, "Vertices pinned in place, 0-based, e.g. 0,12,40");
   auto* mask = app.add_option("--pin-mask", o->pinMask, "OBJ whose vertices mark the pinned garment vertices");

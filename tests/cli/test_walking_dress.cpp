@@ -60,6 +60,22 @@ TEST(WalkingDress, WalksStablyWithFewPointsInsideTheBody) {
                                   dir);
   ASSERT_EQ(open.code, 0) << open.err;
   EXPECT_EQ(statsOf(unsewn)["garments"][0]["stitches"].get<int>(), 0);
+  // --stitch-gaps finds them as make-scene does; a garment with no such opening says so.
+  const std::string resewn = dir / "resewn";
+  const CliResult sewn = runDrape("run '" + kDressScene + "' --motion '" + kSource +
+                                      "/examples/walking_skirt/walk.bvh' --frames 1 --stitch-gaps 0.02 --out '" + resewn +
+                                      "'",
+                                  dir);
+  ASSERT_EQ(sewn.code, 0) << sewn.err;
+  EXPECT_EQ(statsOf(resewn)["garments"][0]["stitches"].get<int>(), 16);
+  const CliResult none = runDrape("run '" + kSource + "/examples/walking_skirt/scene.wrl' --frames 1 --stitch-gaps 0.02 "
+                                  "--out '" + (dir / "skirt") + "'",
+                                  dir);
+  EXPECT_EQ(none.code, 2) << none.err;
+  EXPECT_NE(none.err.find("--stitch-gaps 0.02: no two boundary vertices of garment 'Skirt' face each other within "
+                          "0.02 m"),
+            std::string::npos)
+      << none.err;
   // The sleeves, narrower than the arms' offset surfaces, hold some of the vertices that
   // start below T2 there: they collide as any other (and count above) once their easing
   // has had its time.

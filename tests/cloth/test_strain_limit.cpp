@@ -355,6 +355,80 @@ TEST(Stitches, HoldTwoSheetsTogetherAlongTheEdgesThatFaceEachOther) {
   for (const Stitch& st : sewn->stitches()) EXPECT_NEAR(sewn->state().position(st.a).z(), 0.0, 1e-3);
 }
 
+/// A sheet hanging from its two top corners, its tension pulling across the middle, and the
+/// same sheet with a slit up its middle column from the bottom edge to row `slitTop`: the
+/// column's vertices below it doubled, the copies 1 mm to the right and taken by the cells
+/// right of the column. The copies are numbered after the sheet's own vertices.
+struct SlitSheet {
+  SheetSpec spec{0.4, 0.3, 8, 6, Vec3(-0.2, -0.3, 0), Vec3::UnitX(), Vec3::UnitY(), "sheet"};
+  static constexpr int kColumn = 4, kSlitTop = 4;
+  mesh::TriMesh whole = gridSheet(spec);
+  mesh::TriMesh slit = cut();
+  StepSettings settings = testing::settingsWithStep(1e-3, 2.0);
+
+  [[nodiscard]] mesh::TriMesh cut() const {
+    mesh::TriMesh m = whole;
+    const double columnX = m.positions[sheetVertex(spec, kColumn, 0)].x();
+    const double topY = m.positions[sheetVertex(spec, 0, kSlitTop)].y();
+    std::vector<std::uint32_t> copy(kSlitTop);
+    for (int j = 0; j < kSlitTop; ++j) {
+      copy[static_cast<std::size_t>(j)] = static_cast<std::uint32_t>(m.positions.size());
+      m.positions.push_back(m.positions[sheetVertex(spec, kColumn, j)] + Vec3(0.001, 0, 0));
+    }
+    for (mesh::Triangle& t : m.triangles) {
+      const Vec3 centroid = (m.positions[t[0]] + m.positions[t[1]] + m.positions[t[2]]) / 3.0;
+      if (centroid.x() < columnX || centroid.y() > topY) continue;  // left of the slit, or above it
+      for (std::uint32_t& v : t)
+        for (int j = 0; j < kSlitTop; ++j)
+          if (v == sheetVertex(spec, kColumn, j)) v = copy[static_cast<std::size_t>(j)];
+    }
+    return m;
+  }
+  [[nodiscard]] std::unique_ptr<ClothSolver> hang(const mesh::TriMesh& m, bool sewn) const {
+    const auto model = makeModel(m, knit());
+    const std::vector<std::uint32_t> corners{sheetVertex(spec, 0, spec.cellsV), sheetVertex(spec, spec.cellsU, spec.cellsV)};
+    auto s = std::make_unique<ClothSolver>(
+        model, settings, std::vector<PinGroup>{PinGroup::atRest(corners, model->restX(), model->restY(), model->restZ())});
+    if (sewn) {
+      std::vector<Stitch> stitches;
+      // Every row of the slit: row j's two vertices are 2 (kSlitTop - j) boundary edges apart.
+      for (const auto& [a, b] : mesh::facingBoundaryPairs(m, mesh::Topology::build(m), 0.002, 2))
+        stitches.push_back({a, b, 0.0});
+      s->setStitches(std::move(stitches), "sheet");
+    }
+    return s;
+  }
+};
+
+TEST(Stitches, ASlitSewnShutHangsAsTheUncutSheetDoes) {
+  const SlitSheet sheet;
+  const auto whole = sheet.hang(sheet.whole, false);
+  const auto sewn = sheet.hang(sheet.slit, true);
+  const auto open = sheet.hang(sheet.slit, false);
+  ASSERT_EQ(sewn->stitches().size(), static_cast<std::size_t>(SlitSheet::kSlitTop));
+  for (long f = 1; f <= 45; ++f)
+    for (ClothSolver* s : {whole.get(), sewn.get(), open.get()})
+      ASSERT_TRUE(s->stepFrame(f)) << s->instability().describe("sheet", 50);
+  const auto bottomGap = [&](const ClothSolver& s) {
+    const std::uint32_t left = sheetVertex(sheet.spec, SlitSheet::kColumn, 0);
+    const auto right = static_cast<std::uint32_t>(sheet.whole.vertexCount());  // row 0's copy
+    return (s.state().position(right) - s.state().position(left)).norm();
+  };
+  // Unsewn, the tension across the sheet opens the slit at the bottom (the sheet's vertices
+  // end up to 56 mm from the uncut sheet's); sewn, it hangs as the uncut one to 2.5 mm, the
+  // bending across the slit that the cut took away and the copies' 1 mm start aside.
+  EXPECT_GT(bottomGap(*open), 0.02);
+  EXPECT_LT(bottomGap(*sewn), 1e-9);
+  double farthest = 0.0, farthestOpen = 0.0;
+  for (std::uint32_t v = 0; v < sheet.whole.vertexCount(); ++v) {
+    farthest = std::max(farthest, (sewn->state().position(v) - whole->state().position(v)).norm());
+    farthestOpen = std::max(farthestOpen, (open->state().position(v) - whole->state().position(v)).norm());
+  }
+  EXPECT_LT(farthest, 0.1 * farthestOpen) << farthest << " against " << farthestOpen;
+  RecordProperty("sewn_vs_whole_mm", std::to_string(1e3 * farthest));
+  RecordProperty("open_vs_whole_mm", std::to_string(1e3 * farthestOpen));
+}
+
 TEST(Stitches, AStitchOutOfRangeOrToItselfIsRefusedNamingTheGarment) {
   const TwoSheets sheets;
   ClothSolver s(sheets.model, testing::settingsWithStep(1e-3));

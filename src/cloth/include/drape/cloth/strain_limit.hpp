@@ -5,6 +5,9 @@
 // with the square of the stretch, and the explicit step's stable substep shrinks with it
 // until even 8 or 32 times the substeps diverge. Holding every edge to a largest stretch
 // takes that stiffness away where forces alone cannot.
+//
+// Stitches (holdStitches) are the same projection over pairs of vertices that share no
+// edge: the openings a garment mesh leaves that the garment keeps shut.
 
 #include <cstddef>
 #include <cstdint>
@@ -32,7 +35,7 @@ std::size_t limitStrain(const ClothModel& model, std::span<const double> weight,
 /// open): they stay at most `length_m` apart. Beyond the paper.
 struct Stitch {
   std::uint32_t a = 0, b = 0;
-  double length_m = 0.0;  ///< as far apart as they may be: their distance as modelled
+  double length_m = 0.0;  ///< as far apart as they may be (a scene's stitches: 0, drawn together)
 };
 
 /// Pulls the two ends of every stitch longer than its length back to it, in `sweeps` passes,

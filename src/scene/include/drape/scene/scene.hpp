@@ -77,8 +77,8 @@ struct Garment {
   double bindThreshold = 0.02;              ///< m, farthest a mask vertex binds to a body part
   std::vector<std::string> collidesWith;    ///< segment names; empty: every segment
   std::vector<std::string> faceSamplesWith;  ///< of those, where triangle centroids collide too
-  /// Pairs of cloth vertices sewn together (a closure the mesh leaves open): they stay at
-  /// most as far apart as they are in the mesh. Indices into `mesh`, distinct, in range.
+  /// Pairs of cloth vertices sewn together (a closure the mesh leaves open): each pair is
+  /// drawn to one point and held there. Indices into `mesh`, two different ones, in range.
   std::vector<std::array<std::uint32_t, 2>> stitches;
   int avatar = -1;                          ///< index into Scene::avatars (a Humanoid), or -1
   int externalAvatar = -1;                  ///< index into Scene::externalAvatars, or -1

@@ -2,10 +2,10 @@
 // (vertices, triangles, boundary loops, mask size), materials with units, simulation
 // settings and warnings of a VRML97 scene.
 
-#include <algorithm>
 #include <fmt/ostream.h>
 
 #include "command.hpp"
+#include "stitch_gaps.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/scene/scene.hpp"
 
@@ -63,11 +63,9 @@ void printGarment(std::ostream& out, const scene::Scene& s, const scene::Garment
       g.collidesWith.empty() ? std::string("every segment") : fmt::format("{}", fmt::join(g.collidesWith, ", ")));
   if (!g.faceSamplesWith.empty())
     fmt::print(out, "    triangle centroids collide too with {}\n", fmt::join(g.faceSamplesWith, ", "));
-  if (!g.stitches.empty()) {
-    double widest = 0.0;
-    for (const auto& [a, b] : g.stitches) widest = std::max(widest, (g.mesh.positions[a] - g.mesh.positions[b]).norm());
-    fmt::print(out, "    {} stitches, drawing together vertices up to {:.1f} mm apart\n", g.stitches.size(), 1e3 * widest);
-  }
+  if (!g.stitches.empty())
+    fmt::print(out, "    {} stitches, drawing together vertices up to {:.1f} mm apart\n", g.stitches.size(),
+               1e3 * widestStitch_m(g.mesh, g.stitches));
 }
 
 void inspectScene(const std::string& path, std::ostream& out) {

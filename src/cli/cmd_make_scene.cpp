@@ -5,7 +5,6 @@
 // substeps per frame are the fewest that mass scaling keeps stable within --max-added-mass.
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -26,6 +25,7 @@
 #include "drape/scene/avatar_gltf.hpp"
 #include "drape/scene/garment_fit.hpp"
 #include "scene_text.hpp"
+#include "stitch_gaps.hpp"
 
 namespace drape::cli {
 namespace {
@@ -52,7 +52,7 @@ struct MakeSceneOptions {
   int collisionEvery = 1;  ///< --collision-every
   double bindThreshold_m = 0.04;
   double stitchGaps_m = 0.0;  ///< --stitch-gaps: sew boundary vertices facing each other within this, m (0: none)
-  std::vector<std::array<std::uint32_t, 2>> stitches;  ///< found from stitchGaps_m
+  StitchPairs stitches;        ///< found from stitchGaps_m
   cloth::Material material = knit();
 
   /// The walking skirt's knit (examples/walking_skirt) with a tenth of its damping.
@@ -219,13 +219,7 @@ int makeScene(MakeSceneOptions& o) {
     cloth::checkBendingStep(*unscaled, rhythm);
   }
 
-  if (o.stitchGaps_m > 0.0) {
-    o.stitches = mesh::facingBoundaryPairs(garment, topology, o.stitchGaps_m);
-    if (o.stitches.empty())
-      throw Error(fmt::format("--stitch-gaps {:g}: no two boundary vertices of the garment face each other within "
-                              "{:g} m (the edges of an opening, a few boundary edges apart or more); is it larger "
-                              "than the gap?", o.stitchGaps_m, o.stitchGaps_m));
-  }
+  if (o.stitchGaps_m > 0.0) o.stitches = openingsToSew(garment, topology, o.name, o.stitchGaps_m);
 
   o.avatarUrl = prepareSceneDir(o.out, o.avatar, o.avatarUrl);
   const std::filesystem::path dir(o.out);
@@ -239,11 +233,8 @@ int makeScene(MakeSceneOptions& o) {
   fmt::print("collides with {}\n", fmt::join(o.collidesWith, ", "));
   fmt::print("{} substeps per frame at {:g} frames/s (mass scaling adds {:.2f} % of the mass)\n", o.stepsPerFrame,
              o.frameRate, 100.0 * added);
-  if (!o.stitches.empty()) {
-    double widest = 0.0;
-    for (const auto& [a, b] : o.stitches) widest = std::max(widest, (garment.positions[a] - garment.positions[b]).norm());
-    fmt::print("{} stitches across gaps of up to {:.1f} mm\n", o.stitches.size(), 1e3 * widest);
-  }
+  if (!o.stitches.empty())
+    fmt::print("{} stitches across gaps of up to {:.1f} mm\n", o.stitches.size(), 1e3 * widestStitch_m(garment, o.stitches));
   fmt::print("wrote {}/scene.wrl, {}.obj, {}_mask.obj\n", o.out, o.name, o.name);
   return 0;
 }

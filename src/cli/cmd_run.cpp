@@ -19,12 +19,12 @@
 #include "drape/core/error.hpp"
 #include "drape/formats/obj.hpp"
 #include "drape/formats/units.hpp"
-#include "drape/mesh/topology.hpp"
 #include "drape/motion/animation.hpp"
 #include "drape/scene/avatar_gltf.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/scene_setup.hpp"
 #include "run_setup.hpp"
+#include "stitch_gaps.hpp"
 
 namespace drape::cli {
 namespace {
@@ -140,18 +140,14 @@ void applyOffsets(const RunOptions& o, RunSetup& setup) {
   }
 }
 
-/// --stitch-gaps: the garment's boundary vertices facing each other across at most gap_m,
-/// sewn together (mesh::facingBoundaryPairs, as drape make-scene finds them).
+/// --stitch-gaps: the garment's openings sewn shut, as drape make-scene finds them.
 std::vector<cloth::Stitch> stitchesAcrossGaps(const GarmentSetup& g, double gap_m) {
   if (!(gap_m > 0.0)) throw Error(fmt::format("--stitch-gaps must be > 0 m, got {}", gap_m));
+  const StitchPairs pairs = openingsToSew(g.mesh, mesh::Topology::build(g.mesh), g.name, gap_m);
   std::vector<cloth::Stitch> stitches;
-  for (const auto& [a, b] : mesh::facingBoundaryPairs(g.mesh, mesh::Topology::build(g.mesh), gap_m))
-    stitches.push_back({a, b, 0.0});
-  if (stitches.empty())
-    throw Error(fmt::format("--stitch-gaps {:g}: no two boundary vertices of garment '{}' face each other within {:g} m "
-                            "(the edges of an opening, a few boundary edges apart or more)",
-                            gap_m, g.name, gap_m));
-  spdlog::info("{}: {} stitches across gaps of up to {:g} m (--stitch-gaps)", g.name, stitches.size(), gap_m);
+  for (const auto& [a, b] : pairs) stitches.push_back({a, b, 0.0});  // drawn together
+  spdlog::info("{}: {} stitches across gaps of up to {:.1f} mm (--stitch-gaps {:g})", g.name, stitches.size(),
+               1e3 * widestStitch_m(g.mesh, pairs), gap_m);
   return stitches;
 }
 

@@ -183,8 +183,9 @@ class ClothSolver {
   int lastRefinement_ = 1;
   long refinedFrames_ = 0;
   Instability refinedBecause_;
-  /// Strain limiting: the limit on (0: none), the weights it moves vertices by (inverse
-  /// masses, 0 for the pinned and bound ones), since which frame the rescue has had it on.
+  /// Strain limiting: the limit on (0: none), the weights it and the stitches move vertices
+  /// by (inverse masses, 0 for the pinned and bound ones), since which frame the rescue has
+  /// had it on.
   double strainLimit_ = 0.0;
   std::vector<double> strainWeight_;
   long strainLimitedFrom_ = 0;

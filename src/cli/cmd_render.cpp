@@ -120,8 +120,9 @@ RunFunction setupRender(CLI::App& app) {
       std::error_code ec;
       std::filesystem::remove_all(scratch, ec);
     }
-    if (!o.png.empty()) std::cout << fmt::format("wrote {} frames to {}/\n", summary.frames, o.png);
-    if (!o.video.empty()) std::cout << fmt::format("wrote {} ({} frames)\n", o.video, summary.frames);
+    const char* frames = summary.frames == 1 ? "frame" : "frames";
+    if (!o.png.empty()) std::cout << fmt::format("wrote {} {} to {}/\n", summary.frames, frames, o.png);
+    if (!o.video.empty()) std::cout << fmt::format("wrote {} ({} {})\n", o.video, summary.frames, frames);
     if (!o.sheet.empty())
       std::cout << fmt::format("wrote {} (frames {})\n", o.sheet, fmt::join(summary.sheetFrames, " "));
     std::cerr << fmt::format("rendered in {:.1f} s with {}\n", summary.seconds, summary.glDescription);

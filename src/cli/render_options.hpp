@@ -17,6 +17,7 @@ struct PictureOptions {
   double azimuthDeg = 30.0;
   double elevationDeg = 12.0;
   double zoom = 1.0;
+  double aim = 0.5;
   bool follow = false;
   bool noFloor = false;
   bool noShadows = false;
@@ -32,6 +33,11 @@ struct PictureOptions {
         ->capture_default_str();
     app.add_option("--elevation", elevationDeg, "Camera angle above the horizon, degrees")->capture_default_str();
     app.add_option("--zoom", zoom, "Camera zoom (> 1 is closer)")->capture_default_str()->check(CLI::PositiveNumber);
+    app.add_option("--aim", aim,
+                   "Height the camera aims at, as a fraction of what it frames (0: the bottom, 1: the top); "
+                   "with --zoom, 0.85 keeps a standing person's shoulders in the picture")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1.0));
     app.add_flag("--follow", follow,
                  "The camera follows the characters (one size, centred on each frame, moving smoothly) "
                  "instead of framing the whole run");
@@ -65,6 +71,7 @@ struct PictureOptions {
     v.azimuthDeg = azimuthDeg;
     v.elevationDeg = elevationDeg;
     v.zoom = zoom;
+    v.aimHeight = aim;
     return v;
   }
 

@@ -269,7 +269,9 @@ std::array<float, 3> backgroundColour(double v) {
 
 CameraMatrices cameraFor(const Aabb& boundsIn, const ViewSettings& view, double aspect) {
   const Aabb bounds = boundsIn.empty() ? Aabb{Vec3(-0.5, 0, -0.5), Vec3(0.5, 1, 0.5)} : boundsIn;
-  const V3 centre = bounds.center().cast<float>();
+  Vec3 aim = bounds.center();
+  aim.y() = bounds.min.y() + std::clamp(view.aimHeight, 0.0, 1.0) * bounds.size().y();
+  const V3 centre = aim.cast<float>();
   const float radius = std::max(0.05f, 0.5f * static_cast<float>(bounds.size().norm()));
   const float fovY = static_cast<float>(view.fovYDeg * std::numbers::pi / 180.0);
   const float halfX = std::atan(std::tan(0.5f * fovY) * static_cast<float>(aspect));

@@ -140,6 +140,19 @@ TEST(RenderCli, FollowCameraFramesEachFrameNotTheWholeRun) {
   EXPECT_NE(a.rgb, b.rgb);
 }
 
+TEST(RenderCli, AimingAtTheTopWithAZoomIsAnotherPicture) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_aim"), 2);
+  const Result centre = run(drape() + " render " + dir + " --png " + dir + "/centre --size 160x120 --no-hud --range 1:1");
+  ASSERT_EQ(centre.status, 0) << centre.output;
+  EXPECT_NE(centre.output.find("wrote 1 frame to"), std::string::npos) << centre.output;
+  const Result top =
+      run(drape() + " render " + dir + " --png " + dir + "/top --size 160x120 --no-hud --range 1:1 --aim 1 --zoom 2");
+  ASSERT_EQ(top.status, 0) << top.output;
+  const Image a = readPng(dir + "/centre/frame_00001.png"), b = readPng(dir + "/top/frame_00001.png");
+  ASSERT_EQ(a.rgb.size(), b.rgb.size());
+  EXPECT_NE(a.rgb, b.rgb);
+}
+
 TEST(RenderCli, CollisionStatesComeFromTheRunsStateCache) {
   const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_states"), 4);
   const auto greenPixels = [](const Image& image) {
@@ -217,6 +230,9 @@ TEST(RenderCli, BadInputsExitWithTwoAndSayWhat) {
   EXPECT_NE(r.output.find("--size"), std::string::npos) << r.output;
   r = run(drape() + " render " + dir + " --png " + dir + "/png --size big");
   EXPECT_EQ(r.status, 2);
+  r = run(drape() + " render " + dir + " --png " + dir + "/png --aim 1.5");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("--aim"), std::string::npos) << r.output;
   r = run(drape() + " render " + dir);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.output.find("nothing to write"), std::string::npos) << r.output;

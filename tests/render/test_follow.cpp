@@ -150,5 +150,29 @@ TEST(FollowFraming, APersonWalkingSixMetresFillsThePictureInsteadOfCrossingIt) {
   }
 }
 
+TEST(CameraFor, AimsAtTheHeightItIsToldAsAFractionOfWhatItFrames) {
+  const Aabb framing{Vec3(-0.4, 0.0, -0.3), Vec3(0.6, 1.8, 0.5)};
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> angle(-60.0, 60.0), fraction(0.0, 1.0), zoom(0.5, 4.0);
+  for (int i = 0; i < 50; ++i) {
+    ViewSettings view;
+    view.azimuthDeg = 3.0 * angle(rng);
+    view.elevationDeg = angle(rng);
+    view.zoom = zoom(rng);
+    view.aimHeight = fraction(rng);
+    const CameraMatrices cam = cameraFor(framing, view, 16.0 / 9.0);
+    const Vec3 c = framing.center();
+    const double y = framing.min.y() + view.aimHeight * framing.size().y();
+    const Eigen::Vector4f q = cam.viewProjection() * Eigen::Vector4f(float(c.x()), float(y), float(c.z()), 1.0f);
+    EXPECT_NEAR(q.x() / q.w(), 0.0, 1e-4) << i;
+    EXPECT_NEAR(q.y() / q.w(), 0.0, 1e-4) << i << ": the aimed height is at the picture's centre";
+    // The camera keeps its distance: the aim moves it, it does not turn it closer or further.
+    ViewSettings centred = view;
+    centred.aimHeight = 0.5;
+    const CameraMatrices base = cameraFor(framing, centred, 16.0 / 9.0);
+    EXPECT_NEAR((cam.eye - base.eye).norm(), std::abs(view.aimHeight - 0.5) * framing.size().y(), 1e-4) << i;
+  }
+}
+
 }  // namespace
 }  // namespace drape::render

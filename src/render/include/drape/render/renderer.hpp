@@ -22,6 +22,9 @@ struct ViewSettings {
   double azimuthDeg = 30.0;    ///< orbit angle about +Y; 0 looks along -Z (from the front, +Z side)
   double elevationDeg = 12.0;  ///< angle above the horizon
   double zoom = 1.0;           ///< > 1 moves closer
+  /// Height the camera aims at, as a fraction of what it frames (0 its bottom, 1 its top):
+  /// with a zoom, what stays in the picture (0.85 keeps a standing person's shoulders).
+  double aimHeight = 0.5;
   double fovYDeg = 35.0;
   std::optional<Aabb> bounds;  ///< m; what to frame (a replay passes the whole run's bounds)
 };

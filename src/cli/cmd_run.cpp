@@ -144,8 +144,7 @@ void applyOffsets(const RunOptions& o, RunSetup& setup) {
 std::vector<cloth::Stitch> stitchesAcrossGaps(const GarmentSetup& g, double gap_m) {
   if (!(gap_m > 0.0)) throw Error(fmt::format("--stitch-gaps must be > 0 m, got {}", gap_m));
   const StitchPairs pairs = openingsToSew(g.mesh, mesh::Topology::build(g.mesh), g.name, gap_m);
-  std::vector<cloth::Stitch> stitches;
-  for (const auto& [a, b] : pairs) stitches.push_back({a, b, 0.0});  // drawn together
+  std::vector<cloth::Stitch> stitches = cloth::stitchesDrawnTogether(pairs);
   spdlog::info("{}: {} stitches across gaps of up to {:.1f} mm (--stitch-gaps {:g})", g.name, stitches.size(),
                1e3 * widestStitch_m(g.mesh, pairs), gap_m);
   return stitches;

@@ -59,6 +59,13 @@ std::size_t limitStrain(const ClothModel& model, std::span<const double> weight,
   return corrections;
 }
 
+std::vector<Stitch> stitchesDrawnTogether(std::span<const std::array<std::uint32_t, 2>> pairs) {
+  std::vector<Stitch> stitches;
+  stitches.reserve(pairs.size());
+  for (const auto& [a, b] : pairs) stitches.push_back({a, b, 0.0});
+  return stitches;
+}
+
 std::size_t holdStitches(std::span<const Stitch> stitches, std::span<const double> weight, int sweeps,
                          ClothState& io) {
   double *x = io.x.data(), *y = io.y.data(), *z = io.z.data();

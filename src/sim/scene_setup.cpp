@@ -71,8 +71,7 @@ std::vector<GarmentSpec> garmentSpecs(const scene::Scene& scene, const scene::Av
     spec.mesh = g.mesh;
     if (g.material >= 0) spec.material = toClothMaterial(scene.materials[static_cast<std::size_t>(g.material)]);
     spec.bindThreshold_m = g.bindThreshold;
-    for (const auto& [a, b] : g.stitches)  // drawn together
-      spec.stitches.push_back({a, b, 0.0});
+    spec.stitches = cloth::stitchesDrawnTogether(g.stitches);
     if (avatar) {
       spec.bound = g.maskVertices;
       spec.collidesWith = g.collidesWith;

@@ -9,9 +9,11 @@
 // Stitches (holdStitches) are the same projection over pairs of vertices that share no
 // edge: the openings a garment mesh leaves that the garment keeps shut.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "drape/cloth/model.hpp"
 #include "drape/cloth/state.hpp"
@@ -37,6 +39,10 @@ struct Stitch {
   std::uint32_t a = 0, b = 0;
   double length_m = 0.0;  ///< as far apart as they may be (a scene's stitches: 0, drawn together)
 };
+
+/// Stitches that draw each pair of vertices together (length 0): a scene's `stitches` and
+/// `drape run --stitch-gaps`.
+[[nodiscard]] std::vector<Stitch> stitchesDrawnTogether(std::span<const std::array<std::uint32_t, 2>> pairs);
 
 /// Pulls the two ends of every stitch longer than its length back to it, in `sweeps` passes,
 /// as limitStrain pulls an edge (by the inverse-mass weights, taking away the ends' velocity

@@ -1,6 +1,9 @@
 #include "drape/mesh/topology.hpp"
 
 #include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <unordered_map>
 
 #include <fmt/format.h>
 
@@ -157,19 +160,51 @@ std::vector<std::array<std::uint32_t, 2>> facingBoundaryPairs(const TriMesh& mes
     const std::uint32_t d = p.index > q.index ? p.index - q.index : q.index - p.index;
     return static_cast<int>(std::min(d, length - d)) >= minSeparation;
   };
-  // Boundaries hold a small share of a garment's vertices: every pair is compared.
+  // A uniform grid of cells at least maxGap wide: a vertex's candidates are in the 27 cells
+  // around its own. Cells are at most a million to a side (keys fit 21 bits an axis).
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::max());
+  Vec3 hi = -lo;
+  for (const Place& p : boundary) {
+    lo = lo.cwiseMin(mesh.positions[p.vertex]);
+    hi = hi.cwiseMax(mesh.positions[p.vertex]);
+  }
+  const double cell = boundary.empty() ? 1.0 : std::max(maxGap_m, 1e-6 * (hi - lo).maxCoeff());
+  const auto cellOf = [&](const Vec3& x) {
+    std::array<std::int64_t, 3> c{};
+    for (int k = 0; k < 3; ++k) c[static_cast<std::size_t>(k)] = static_cast<std::int64_t>((x[k] - lo[k]) / cell);
+    return c;
+  };
+  const auto key = [](std::int64_t x, std::int64_t y, std::int64_t z) {
+    return (static_cast<std::uint64_t>(x) << 42) | (static_cast<std::uint64_t>(y) << 21) | static_cast<std::uint64_t>(z);
+  };
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells;
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    const auto c = cellOf(mesh.positions[boundary[i].vertex]);
+    cells[key(c[0], c[1], c[2])].push_back(i);
+  }
   constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
   std::vector<std::size_t> nearest(boundary.size(), kNone);
   for (std::size_t i = 0; i < boundary.size(); ++i) {
+    const Vec3& x = mesh.positions[boundary[i].vertex];
+    const auto c = cellOf(x);
     double best = maxGap_m;
-    for (std::size_t j = 0; j < boundary.size(); ++j) {
-      if (j == i || !apartAlongBoundary(boundary[i], boundary[j])) continue;
-      const double d = (mesh.positions[boundary[j].vertex] - mesh.positions[boundary[i].vertex]).norm();
-      if (d <= best) {
-        best = d;
-        nearest[i] = j;
-      }
-    }
+    for (std::int64_t dx = -1; dx <= 1; ++dx)
+      for (std::int64_t dy = -1; dy <= 1; ++dy)
+        for (std::int64_t dz = -1; dz <= 1; ++dz) {
+          if (c[0] + dx < 0 || c[1] + dy < 0 || c[2] + dz < 0) continue;
+          const auto found = cells.find(key(c[0] + dx, c[1] + dy, c[2] + dz));
+          if (found == cells.end()) continue;
+          for (const std::size_t j : found->second) {
+            if (j == i || !apartAlongBoundary(boundary[i], boundary[j])) continue;
+            const double d = (mesh.positions[boundary[j].vertex] - x).norm();
+            // Of equally near ones, the last along the boundary: the choice does not hang on
+            // the order the cells are visited in.
+            if (d < best || (d == best && (nearest[i] == kNone || j > nearest[i]))) {
+              best = d;
+              nearest[i] = j;
+            }
+          }
+        }
   }
   std::vector<std::array<std::uint32_t, 2>> pairs;
   for (std::size_t i = 0; i < boundary.size(); ++i) {

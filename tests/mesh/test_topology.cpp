@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <random>
+
 #include "drape/core/error.hpp"
 #include "drape/mesh/topology.hpp"
 
@@ -133,6 +137,76 @@ TEST(FacingBoundaryPairs, TwoSheetsFacingEachOtherArePairedAlongTheirWholeEdges)
     EXPECT_DOUBLE_EQ(m.positions[b].x(), n + 0.2);
     EXPECT_DOUBLE_EQ(m.positions[a].y(), m.positions[b].y());
   }
+}
+
+/// facingBoundaryPairs by comparing every pair of boundary vertices: the reference.
+std::vector<std::array<std::uint32_t, 2>> facingPairsBruteForce(const TriMesh& m, const Topology& t, double gap,
+                                                                int minSeparation) {
+  std::vector<std::array<std::uint32_t, 3>> places;  // vertex, loop, index
+  for (std::uint32_t l = 0; l < t.boundaryLoops.size(); ++l)
+    for (std::uint32_t i = 0; i < t.boundaryLoops[l].size(); ++i) places.push_back({t.boundaryLoops[l][i], l, i});
+  const auto apart = [&](const auto& p, const auto& q) {
+    if (p[1] != q[1]) return true;
+    const auto n = static_cast<std::uint32_t>(t.boundaryLoops[p[1]].size());
+    const std::uint32_t d = p[2] > q[2] ? p[2] - q[2] : q[2] - p[2];
+    return static_cast<int>(std::min(d, n - d)) >= minSeparation;
+  };
+  const std::size_t none = places.size();
+  std::vector<std::size_t> nearest(places.size(), none);
+  for (std::size_t i = 0; i < places.size(); ++i) {
+    double best = gap;
+    for (std::size_t j = 0; j < places.size(); ++j) {
+      if (j == i || !apart(places[i], places[j])) continue;
+      const double d = (m.positions[places[j][0]] - m.positions[places[i][0]]).norm();
+      if (d <= best) {
+        best = d;
+        nearest[i] = j;
+      }
+    }
+  }
+  std::vector<std::array<std::uint32_t, 2>> pairs;
+  for (std::size_t i = 0; i < places.size(); ++i) {
+    const std::size_t j = nearest[i];
+    if (j == none || j < i || nearest[j] != i) continue;
+    pairs.push_back({std::min(places[i][0], places[j][0]), std::max(places[i][0], places[j][0])});
+  }
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+TEST(FacingBoundaryPairs, TheSameAsComparingEveryPairOnRandomSheets) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::size_t found = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    // A few sheets near each other; on even trials on the lattice (equally near vertices
+    // everywhere: the tie rule is tested), on odd ones jittered and turned.
+    const bool lattice = trial % 2 == 0;
+    TriMesh m;
+    const int sheets = 1 + trial % 4;
+    for (int k = 0; k < sheets; ++k) {
+      const int nx = 1 + static_cast<int>(5 * unit(rng)), ny = 1 + static_cast<int>(5 * unit(rng));
+      const TriMesh sheet = trial % 3 == 0 ? slitGrid(nx + 2, ny + 3, 1 + nx / 2, 1 + ny, lattice ? 0.0 : 0.3 * unit(rng))
+                                           : grid(nx, ny);
+      const Vec3 at = lattice ? Vec3(std::floor(8 * unit(rng)), std::floor(8 * unit(rng)), std::floor(2 * unit(rng)))
+                              : Vec3(8 * unit(rng), 8 * unit(rng), 2 * unit(rng));
+      const double turn = lattice ? 0.0 : 6.3 * unit(rng);
+      const auto offset = static_cast<std::uint32_t>(m.positions.size());
+      for (const Vec3& p : sheet.positions) {
+        Vec3 q(std::cos(turn) * p.x() - std::sin(turn) * p.y(), std::sin(turn) * p.x() + std::cos(turn) * p.y(), p.z());
+        if (!lattice) q += 0.05 * Vec3(unit(rng), unit(rng), unit(rng));
+        m.positions.push_back(q + at);
+      }
+      for (const Triangle& tri : sheet.triangles) m.triangles.push_back({tri[0] + offset, tri[1] + offset, tri[2] + offset});
+    }
+    const Topology t = Topology::build(m);
+    const double gap = lattice ? std::floor(1 + 3 * unit(rng)) : 3 * unit(rng);
+    const int separation = 1 + static_cast<int>(8 * unit(rng));
+    const auto pairs = facingBoundaryPairs(m, t, gap, separation);
+    EXPECT_EQ(pairs, facingPairsBruteForce(m, t, gap, separation)) << "trial " << trial;
+    found += pairs.size();
+  }
+  EXPECT_GT(found, 400u) << "the cases pair something";
 }
 
 TEST(TriMesh, AreaAndNormals) {

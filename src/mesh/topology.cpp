@@ -147,6 +147,8 @@ std::size_t countNonManifoldEdges(const TriMesh& mesh) {
 
 std::vector<std::array<std::uint32_t, 2>> facingBoundaryPairs(const TriMesh& mesh, const Topology& topology,
                                                               double maxGap_m, int minSeparation) {
+  // The grid's cells are the gap wide: a gap that is not a positive number has no cells.
+  if (!(maxGap_m > 0.0)) throw Error(fmt::format("facing boundary pairs: the gap must be > 0 m, got {}", maxGap_m));
   struct Place {
     std::uint32_t vertex, loop, index;  ///< the vertex, its loop and where along it
   };

@@ -119,6 +119,8 @@ TEST(FacingBoundaryPairs, ASlitsTwoEdgesArePairedRowByRowAwayFromItsClosedEnd) {
   }
   EXPECT_EQ(facingBoundaryPairs(m, t, 0.3, 2 * s + 2).size(), 0u) << "every row within the separation";
   EXPECT_EQ(facingBoundaryPairs(m, t, 0.09).size(), 0u) << "the gap is wider";
+  EXPECT_THROW((void)facingBoundaryPairs(m, t, 0.0), Error);
+  EXPECT_THROW((void)facingBoundaryPairs(m, t, std::nan("")), Error);
 }
 
 TEST(FacingBoundaryPairs, TwoSheetsFacingEachOtherArePairedAlongTheirWholeEdges) {

@@ -46,6 +46,7 @@ struct Topology {
 /// vertex within maxGap_m that is not its neighbour along the boundary (on another loop, or
 /// at least minSeparation boundary edges away along its own), kept where the two are each
 /// other's nearest. Each pair (a < b) once, sorted. The closures a garment's stitches sew.
+/// Throws drape::Error when maxGap_m is not a positive number.
 [[nodiscard]] std::vector<std::array<std::uint32_t, 2>> facingBoundaryPairs(const TriMesh& mesh,
                                                                             const Topology& topology,
                                                                             double maxGap_m, int minSeparation = 6);

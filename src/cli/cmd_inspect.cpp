@@ -1,5 +1,6 @@
-// `drape inspect FILE`: a readable summary of any file drape reads. The readers register
-// an inspector per file extension (registerInspector in their cmd_inspect_*.cpp).
+// `drape inspect FILE`: a readable summary of any file drape reads, or of a run directory
+// (inspect_run.hpp). The readers register an inspector per file extension
+// (registerInspector in their cmd_inspect_*.cpp).
 
 #include <algorithm>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include "command.hpp"
 #include "drape/core/error.hpp"
 #include "drape/sim/body_overlap.hpp"
+#include "inspect_run.hpp"
 #include "run_setup.hpp"
 
 namespace drape::cli {
@@ -51,7 +53,8 @@ void inspectBodyOverlaps(const std::string& scenePath, const std::string& motion
 RunFunction setupInspect(CLI::App& app) {
   static std::string path, motion;
   static std::vector<std::string> keepApart;
-  app.add_option("file", path, "The file to summarise")->required();
+  static RunQuery query;
+  app.add_option("file", path, "The file to summarise, or a run directory (what `drape run --out` wrote)")->required();
   app.add_option("--motion", motion,
                  "With a scene: also load this motion onto its avatar and list where it puts the collidable parts "
                  "inside each other (cloth between them has no place), without simulating");
@@ -59,13 +62,33 @@ RunFunction setupInspect(CLI::App& app) {
                  "With --motion: first correct the motion to keep these parts out of the others, as `drape run "
                  "--keep-apart` does, and list what is left (instead of the scene's keepApart; 'none' for none)")
       ->delimiter(',');
+  app.add_option("--deepest", query.deepest,
+                 "With a run directory: list the N garment vertices that go deepest into the body (its skin, as "
+                 "players draw it), each in its deepest frame, with its state and the collidable parts it is nearest")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--vertex", query.vertex,
+                 "With a run directory: follow this garment vertex frame by frame: its state, its distance to the "
+                 "skin and to the two nearest collidable parts (what it rests on)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--range", query.range,
+                 "With --deepest or --vertex: only the run's frames FIRST:LAST (0-based, inclusive; FIRST: to the "
+                 "end; one FRAME)");
+  app.add_option("--garment", query.garment, "With --deepest or --vertex: only this garment (by its name in the run)");
   app.footer([] {
     std::string text = "Understands:";
+    text += fmt::format("\n  {:<18} {}", "DIR", "a run directory (manifest.json): its meshes, figures and, with "
+                                                "--deepest or --vertex, where its garments lie against the body");
     for (const InspectorEntry& e : registeredInspectors()) text += fmt::format("\n  {:<18} {}", fmt::join(e.extensions, " "), e.what);
     return text;
   });
   return [] {
     if (!std::filesystem::exists(path)) throw Error(fmt::format("{}: no such file", path));
+    if (std::filesystem::is_directory(path)) {
+      if (!motion.empty() || !keepApart.empty()) throw Error("--motion and --keep-apart go with a scene, not a run");
+      inspectRun(path, query, std::cout);
+      return 0;
+    }
+    if (query.any()) throw Error(fmt::format("--deepest, --vertex, --range and --garment go with a run directory, not with {}", path));
     const std::string ext = lowerExtension(path);
     for (const InspectorEntry& e : registeredInspectors()) {
       if (std::find(e.extensions.begin(), e.extensions.end(), ext) != e.extensions.end()) {
@@ -81,7 +104,8 @@ RunFunction setupInspect(CLI::App& app) {
   };
 }
 
-const bool registered = registerCommand({"inspect", "Print a readable summary of a scene, avatar, motion or mesh file", "", 30, &setupInspect});
+const bool registered = registerCommand(
+    {"inspect", "Print a readable summary of a scene, avatar, motion or mesh file, or of a run", "", 30, &setupInspect});
 
 }  // namespace
 

@@ -16,31 +16,12 @@
 #include "command.hpp"
 #include "drape/core/error.hpp"
 #include "drape/render/outputs.hpp"
+#include "frame_range.hpp"
 #include "render_options.hpp"
 #include "run_setup.hpp"
 
 namespace drape::cli {
 namespace {
-
-/// `--range FIRST:LAST`, `FIRST:` or `:LAST` into the job's first and last frame (-1: the
-/// end); renderRun checks the range against the run.
-void parseRange(const std::string& text, render::RenderJob& job) {
-  const auto bad = [&] {
-    return Error(fmt::format(
-        "--range {} is not a range: expected FIRST:LAST, frame numbers from 0 (FIRST: renders to the end)", text));
-  };
-  const std::size_t colon = text.find(':');
-  if (colon == std::string::npos) throw bad();
-  const auto number = [&](std::string_view part, std::int64_t fallback) {
-    if (part.empty()) return fallback;
-    const std::optional<long long> value = wholeNumber(part, 0, std::numeric_limits<std::int64_t>::max());
-    if (!value) throw bad();
-    return static_cast<std::int64_t>(*value);
-  };
-  const std::string_view all(text);
-  job.firstFrame = number(all.substr(0, colon), 0);
-  job.lastFrame = number(all.substr(colon + 1), -1);
-}
 
 struct RenderOptions {
   std::string run;
@@ -65,7 +46,7 @@ RunFunction setupRender(CLI::App& app) {
   app.add_option("--frames", o.frames, "With a scene: frames to simulate (default: the lead-in and the whole motion)");
   app.add_option("--run-out", o.runOut, "With a scene: keep the simulated run in this directory (default: a temporary one)");
   app.add_option("--range", o.range,
-                 "Only the run's frames FIRST:LAST (0-based, inclusive; FIRST: to the end), for every output; the "
+                 "Only the run's frames FIRST:LAST (0-based, inclusive; FIRST: to the end; one FRAME), for every output; the "
                  "camera frames the whole run");
   app.add_option("--png", o.png, "Write every frame as DIR/frame_00000.png ...");
   app.add_option("--video", o.video, "Encode every frame as an H.264 MP4 (needs the ffmpeg command)");
@@ -82,7 +63,11 @@ RunFunction setupRender(CLI::App& app) {
       throw Error("drape render: nothing to write: give --png DIR, --video FILE.mp4 or --contact-sheet FILE.png");
     }
     render::RenderJob job;
-    if (!o.range.empty()) parseRange(o.range, job);
+    if (!o.range.empty()) {
+      const FrameRange range = parseFrameRange(o.range);
+      job.firstFrame = range.first;
+      job.lastFrame = range.last;
+    }
     // A scene is simulated first, exactly as `drape run` does, into a run directory.
     std::string runDir = o.run;
     std::filesystem::path scratch;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
 #include "drape/core/error.hpp"
 
@@ -175,21 +174,6 @@ Voxelization voxelize(const mesh::TriMesh& mesh, const GridPlacement& grid) {
   for (std::size_t i = 0; i < votes.size(); ++i)
     if (votes[i] >= 2 && !(out.flags[i] & kVoxelBorder)) out.flags[i] |= kVoxelInside;
   return out;
-}
-
-double windingNumber(const mesh::TriMesh& mesh, const Vec3& point) {
-  // Van Oosterom and Strackee's solid angle of each triangle seen from the point.
-  double total = 0;
-  for (const mesh::Triangle& tri : mesh.triangles) {
-    const Vec3 a = mesh.positions[tri[0]] - point;
-    const Vec3 b = mesh.positions[tri[1]] - point;
-    const Vec3 c = mesh.positions[tri[2]] - point;
-    const double la = a.norm(), lb = b.norm(), lc = c.norm();
-    const double det = a.dot(b.cross(c));
-    const double div = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
-    total += 2 * std::atan2(det, div);
-  }
-  return total / (4 * std::numbers::pi);
 }
 
 }  // namespace drape::field

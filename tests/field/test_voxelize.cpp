@@ -9,6 +9,7 @@
 #include "drape/field/shapes.hpp"
 #include "drape/field/voxelize.hpp"
 #include "drape/formats/obj.hpp"
+#include "drape/mesh/surface_distance.hpp"
 
 namespace drape::field {
 namespace {
@@ -44,7 +45,7 @@ void checkVoxelization(const mesh::TriMesh& m, double voxel, int randomPoints, i
     if (!d.contains(i.x(), i.y(), i.z())) continue;
     const std::uint8_t f = v.flags[d.index(i.x(), i.y(), i.z())];
     if (f & kVoxelSurface) continue;
-    const bool truth = windingNumber(m, p) > 0.5;
+    const bool truth = mesh::windingNumber(m.positions, m.triangles, p) > 0.5;
     ASSERT_EQ(static_cast<bool>(f & kVoxelInside), truth) << m.name;
     ++tested;
     inside += truth;
@@ -59,8 +60,8 @@ void checkVoxelization(const mesh::TriMesh& m, double voxel, int randomPoints, i
     const Vec3 n = v.normals[k].cast<double>();
     ASSERT_NEAR(n.norm(), 1.0, 1e-5);
     const double eps = 1e-4 * voxel;
-    ASSERT_LT(windingNumber(m, c + eps * n), 0.5) << m.name;
-    ASSERT_GT(windingNumber(m, c - eps * n), 0.5) << m.name;
+    ASSERT_LT(mesh::windingNumber(m.positions, m.triangles, c + eps * n), 0.5) << m.name;
+    ASSERT_GT(mesh::windingNumber(m.positions, m.triangles, c - eps * n), 0.5) << m.name;
   }
 }
 

@@ -37,6 +37,24 @@ TEST(ClosestPoint, MatchesABruteForceSearchOverTheTriangle) {
     if ((q - a).norm() < eps || (q - b).norm() < eps || (q - c).norm() < eps) ++onVertex;
     else if (std::abs(normal.normalized().dot((p - q).normalized())) < 1.0 - 1e-6) ++onEdge;
     else ++inside;
+    // The region it names holds the point: that corner, a point of that edge, or the face
+    // (p - q along the normal).
+    const TrianglePoint f = closestOnTriangleFeature(p, a, b, c);
+    EXPECT_EQ(f.point, q);
+    const auto onSegment = [&](const Vec3& u, const Vec3& v) {
+      return (q - closestOnTriangle(q, u, v, v)).norm() < 1e-9 * longest;
+    };
+    switch (f.feature) {
+      case TriangleFeature::CornerA: EXPECT_EQ(q, a); break;
+      case TriangleFeature::CornerB: EXPECT_EQ(q, b); break;
+      case TriangleFeature::CornerC: EXPECT_EQ(q, c); break;
+      case TriangleFeature::EdgeAB: EXPECT_TRUE(onSegment(a, b)) << trial; break;
+      case TriangleFeature::EdgeBC: EXPECT_TRUE(onSegment(b, c)) << trial; break;
+      case TriangleFeature::EdgeCA: EXPECT_TRUE(onSegment(c, a)) << trial; break;
+      case TriangleFeature::Face:
+        EXPECT_GT(std::abs(normal.normalized().dot((p - q).normalized())), 1.0 - 1e-6) << trial;
+        break;
+    }
   }
   EXPECT_GT(onVertex, 10);
   EXPECT_GT(onEdge, 10);

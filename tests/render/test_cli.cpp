@@ -66,8 +66,14 @@ TEST(RenderCli, ARangeRendersThoseFramesAsTheWholeRunDoes) {
   r = run(drape() + " render " + dir + " --contact-sheet " + dir + "/sheet.png --range 6:");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("(frames 6 6 6 6 6 6 6 6 7 7 7 7 7 7 7 7)"), std::string::npos) << r.output;
+  // One frame.
+  r = run(drape() + " render " + dir + " --png " + dir + "/one --size 160x120 --follow --range 4");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("wrote 1 frame"), std::string::npos) << r.output;
+  for (int i = 0; i < 8; ++i) EXPECT_EQ(fs::exists(dir + "/one/frame_0000" + std::to_string(i) + ".png"), i == 4) << i;
+  EXPECT_EQ(readPng(dir + "/one/frame_00004.png").rgb, readPng(dir + "/all/frame_00004.png").rgb);
   // Ranges that are not in the run, or not ranges, and --frames without a scene.
-  for (const std::string bad : {"5:3", "0:8", "9:", "3", "a:4", "-1:2"}) {
+  for (const std::string bad : {"5:3", "0:8", "9:", "9", "3x", "a:4", "-1:2"}) {
     r = run(drape() + " render " + dir + " --png " + dir + "/bad --range " + bad);
     EXPECT_EQ(r.status, 2) << bad;
     EXPECT_NE(r.output.find("--range " + bad), std::string::npos) << r.output;

@@ -56,8 +56,4 @@ struct Voxelization {
 /// small holes (a gap in a cap flips rays along one axis only).
 [[nodiscard]] Voxelization voxelize(const mesh::TriMesh& mesh, const GridPlacement& grid);
 
-/// Point-in-mesh test by the generalised winding number (sum of solid angles / 4 pi),
-/// robust and slow: the reference for tests.
-[[nodiscard]] double windingNumber(const mesh::TriMesh& mesh, const Vec3& point);
-
 }  // namespace drape::field

@@ -3,6 +3,7 @@
 // the garments' state caches and DIR/stats.json's `ms_per_stage` when present) as a
 // FrameSource.
 
+#include <span>
 #include <string>
 
 #include "drape/render/frame.hpp"
@@ -36,6 +37,11 @@ class RunReplay final : public FrameSource {
   /// World positions of mesh `m` at frame `f` (m).
   [[nodiscard]] const std::vector<Vec3>& positions(std::size_t m, std::int64_t f) const {
     return caches_[m][static_cast<std::size_t>(f)];
+  }
+  /// The vertex_state bytes of mesh `m` at frame `f`; empty for a mesh without a state cache.
+  [[nodiscard]] std::span<const std::uint8_t> states(std::size_t m, std::int64_t f) const {
+    if (states_[m].empty()) return {};
+    return states_[m][static_cast<std::size_t>(f)];
   }
 
  private:

@@ -1,0 +1,302 @@
+#include "inspect_run.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include <fmt/format.h>
+#include <fmt/ostream.h>
+#include <nlohmann/json.hpp>
+#include <tbb/parallel_for.h>
+
+#include "drape/core/error.hpp"
+#include "drape/core/progress.hpp"
+#include "drape/core/timecode.hpp"
+#include "drape/formats/json_text.hpp"
+#include "drape/mesh/surface_distance.hpp"
+#include "drape/render/run_replay.hpp"
+#include "frame_range.hpp"
+
+namespace drape::cli {
+namespace {
+
+using render::MeshRole;
+
+/// DIR/stats.json, or null when the run has none (runs cut short by a failed write).
+nlohmann::json readStats(const std::filesystem::path& directory) {
+  const std::filesystem::path path = directory / "stats.json";
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return nullptr;
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  nlohmann::json stats = formats::parseJsonText(text, path.string());
+  if (!stats.is_object()) throw Error(fmt::format("{}: expected a JSON object", path.string()));
+  return stats;
+}
+
+std::vector<std::size_t> meshesWithRole(const render::RunReplay& run, MeshRole role) {
+  std::vector<std::size_t> found;
+  for (std::size_t m = 0; m < run.meshes().size(); ++m)
+    if (run.meshes()[m].role == role) found.push_back(m);
+  return found;
+}
+
+/// The segments the garments collided with: those stats.json lists a distance field for,
+/// or every segment when it lists none.
+std::vector<std::size_t> collidableSegments(const render::RunReplay& run, const nlohmann::json& stats) {
+  std::vector<std::string> names;
+  if (stats.is_object() && stats.contains("distance_fields") && stats["distance_fields"].is_array())
+    for (const nlohmann::json& f : stats["distance_fields"])
+      if (f.is_object() && f.contains("segment") && f["segment"].is_string()) names.push_back(f["segment"]);
+  std::vector<std::size_t> segments = meshesWithRole(run, MeshRole::Segment);
+  if (names.empty()) return segments;
+  std::erase_if(segments, [&](std::size_t m) {
+    return std::find(names.begin(), names.end(), run.meshes()[m].name) == names.end();
+  });
+  return segments;
+}
+
+std::string stateText(std::span<const std::uint8_t> states, std::size_t vertex) {
+  if (states.empty()) return "-";
+  namespace vs = render::vertex_state;
+  const std::uint8_t s = states[vertex];
+  std::string text = (s & vs::kPinned) ? "pinned" : (s & vs::kBound) ? "bound" : "";
+  if (!text.empty()) return text;
+  switch (s & vs::kCollisionMask) {
+    case vs::kInsideVolume: return "inside a volume";
+    case vs::kOnSurface: return "on the surface";
+    case vs::kPenaltyZone: return "below T1";
+    default: return "outside";
+  }
+}
+
+std::string millimetres(double distance_m) {
+  return std::isinf(distance_m) ? "-" : fmt::format("{:+.1f}", distance_m * 1000.0);
+}
+
+/// What garment vertices are measured against in one frame: the skin as players draw it
+/// and each collidable segment, as the run recorded them.
+struct BodyAtFrame {
+  std::optional<mesh::SurfaceDistance> skin;
+  std::vector<std::pair<std::size_t, mesh::SurfaceDistance>> parts;  ///< (mesh, distance)
+};
+
+BodyAtFrame bodyAt(const render::RunReplay& run, std::int64_t f, std::optional<std::size_t> skin,
+                   const std::vector<std::size_t>& parts) {
+  BodyAtFrame body;
+  if (skin) body.skin.emplace(run.positions(*skin, f), run.meshes()[*skin].triangles);
+  for (const std::size_t m : parts) body.parts.emplace_back(m, mesh::SurfaceDistance(run.positions(m, f), run.meshes()[m].triangles));
+  return body;
+}
+
+/// The signed distance to the skin, and which segment (collidable or not: a hand, the
+/// head) the skin's nearest point belongs to, the one it is nearest to: "-15.6 RightHand".
+std::string skinText(const render::RunReplay& run, std::int64_t f, const BodyAtFrame& body, const Vec3& p) {
+  if (!body.skin) return "-";
+  const mesh::SurfacePoint onSkin = body.skin->at(p);
+  const std::vector<std::size_t> segments = meshesWithRole(run, MeshRole::Segment);
+  const BodyAtFrame all = bodyAt(run, f, std::nullopt, segments);
+  std::string part;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const auto& [m, distance] : all.parts)
+    if (const double d = std::abs(distance.at(onSkin.point).distance_m); d < nearest) {
+      nearest = d;
+      part = run.meshes()[m].name;
+    }
+  return part.empty() ? millimetres(onSkin.distance_m) : fmt::format("{} {}", millimetres(onSkin.distance_m), part);
+}
+
+struct PartDistance {
+  std::size_t mesh = 0;
+  double distance_m = std::numeric_limits<double>::infinity();
+};
+
+/// The collidable parts by signed distance from p, nearest first.
+std::vector<PartDistance> nearestParts(const BodyAtFrame& body, const Vec3& p) {
+  std::vector<PartDistance> found;
+  for (const auto& [m, distance] : body.parts) found.push_back({m, distance.at(p).distance_m});
+  std::sort(found.begin(), found.end(), [](const PartDistance& a, const PartDistance& b) { return a.distance_m < b.distance_m; });
+  return found;
+}
+
+std::string partText(const render::RunReplay& run, const std::vector<PartDistance>& parts, std::size_t i) {
+  if (i >= parts.size()) return "-";
+  return fmt::format("{} {}", run.meshes()[parts[i].mesh].name, millimetres(parts[i].distance_m));
+}
+
+struct Frames {
+  std::int64_t first = 0, last = 0;
+};
+
+Frames framesOf(const render::RunReplay& run, const std::string& text) {
+  const std::int64_t count = *run.frameCount();
+  FrameRange range;
+  if (!text.empty()) range = parseFrameRange(text);
+  const Frames frames{range.first, range.last < 0 ? count - 1 : range.last};
+  if (frames.first > frames.last || frames.last >= count)
+    throw Error(fmt::format("--range {}: the run has frames 0 to {}", text, count - 1));
+  return frames;
+}
+
+std::string timeCode(const render::RunReplay& run, std::int64_t f) {
+  return TimeCode{run.startFrame() + f, run.frameRate()}.smpte();
+}
+
+void printSummary(const std::string& directory, const render::RunReplay& run, const nlohmann::json& stats,
+                  const std::vector<std::size_t>& collidable, std::ostream& out) {
+  const std::int64_t frames = *run.frameCount();
+  fmt::print(out, "{}: a drape run, {} frames at {:g} fps ({} to {})\n", directory, frames, run.frameRate(),
+             timeCode(run, 0), timeCode(run, frames - 1));
+  for (const std::size_t m : meshesWithRole(run, MeshRole::Garment)) {
+    const render::MeshInfo& info = run.meshes()[m];
+    fmt::print(out, "  garment  {:<14} {} vertices, {} triangles{}\n", info.name, info.vertexCount, info.triangles.size(),
+               run.states(m, 0).empty() ? "" : ", collision states recorded");
+  }
+  for (const std::size_t m : meshesWithRole(run, MeshRole::Skin))
+    fmt::print(out, "  skin     {:<14} {} vertices, {} triangles\n", run.meshes()[m].name, run.meshes()[m].vertexCount,
+               run.meshes()[m].triangles.size());
+  const std::size_t segments = meshesWithRole(run, MeshRole::Segment).size();
+  if (segments > 0) {
+    std::vector<std::string> names;
+    for (const std::size_t m : collidable) names.push_back(run.meshes()[m].name);
+    fmt::print(out, "  segments {}, {} collidable: {}\n", segments, collidable.size(), fmt::join(names, ", "));
+  }
+  if (!stats.is_object()) return;
+  const auto number = [&](const char* key) {
+    return stats.contains(key) && stats[key].is_number() ? stats[key].get<double>() : 0.0;
+  };
+  const bool unstable = stats.contains("unstable") && stats["unstable"].is_boolean() && stats["unstable"].get<bool>();
+  fmt::print(out,
+             "  stats.json: {:.0f} frames simulated, {:.3f} ms per frame; vertex-substeps inside the body {:.0f} of {:.0f} "
+             "(deepest {:.1f} mm), below T1 {:.0f}; {}\n",
+             number("frames"), number("ms_per_frame"), number("vertex_substeps_inside_body"), number("vertex_substeps"),
+             number("max_penetration_m") * 1000.0, number("vertex_substeps_below_T1"),
+             unstable ? "went unstable (see its \"instability\")" : "stable");
+}
+
+/// The garments a query looks at: the one --garment names, or all of them.
+std::vector<std::size_t> selectedGarments(const render::RunReplay& run, const std::string& name) {
+  const std::vector<std::size_t> garments = meshesWithRole(run, MeshRole::Garment);
+  if (garments.empty()) throw Error("the run has no garment");
+  if (name.empty()) return garments;
+  std::vector<std::string> names;
+  for (const std::size_t m : garments) {
+    if (run.meshes()[m].name == name) return {m};
+    names.push_back(run.meshes()[m].name);
+  }
+  throw Error(fmt::format("--garment {}: the run's garments are {}", name, fmt::join(names, ", ")));
+}
+
+std::size_t garmentToFollow(const render::RunReplay& run, const std::string& name) {
+  const std::vector<std::size_t> garments = selectedGarments(run, name);
+  if (garments.size() > 1) {
+    std::vector<std::string> names;
+    for (const std::size_t m : garments) names.push_back(run.meshes()[m].name);
+    throw Error(fmt::format("--vertex: the run has {} garments; say which with --garment ({})", garments.size(),
+                            fmt::join(names, ", ")));
+  }
+  return garments.front();
+}
+
+void printVertexTrack(const render::RunReplay& run, const RunQuery& query, const Frames& frames,
+                      std::optional<std::size_t> skin, const std::vector<std::size_t>& collidable, std::ostream& out) {
+  const std::size_t g = garmentToFollow(run, query.garment);
+  const render::MeshInfo& garment = run.meshes()[g];
+  if (static_cast<std::size_t>(query.vertex) >= garment.vertexCount)
+    throw Error(fmt::format("--vertex {}: {} has vertices 0 to {}", query.vertex, garment.name, garment.vertexCount - 1));
+  const auto v = static_cast<std::size_t>(query.vertex);
+  fmt::print(out, "\n{} vertex {}, frames {} to {} (distances in mm, signed: negative is inside)\n", garment.name, v,
+             frames.first, frames.last);
+  fmt::print(out, "{:>6}  {:<11}  {:<15}  {:<22}  {:<24}  {}\n", "frame", "time code", "state", "skin (there)",
+             "nearest collidable part", "next");
+  for (std::int64_t f = frames.first; f <= frames.last; ++f) {
+    const BodyAtFrame body = bodyAt(run, f, skin, collidable);
+    const Vec3& p = run.positions(g, f)[v];
+    const std::vector<PartDistance> parts = nearestParts(body, p);
+    fmt::print(out, "{:>6}  {:<11}  {:<15}  {:<22}  {:<24}  {}\n", f, timeCode(run, f), stateText(run.states(g, f), v),
+               skinText(run, f, body, p), partText(run, parts, 0), partText(run, parts, 1));
+  }
+}
+
+struct Deepest {
+  std::size_t garment = 0, vertex = 0;
+  std::int64_t frame = 0;
+  double distance_m = std::numeric_limits<double>::infinity();
+};
+
+/// Per garment vertex, the frame it is deepest in (or nearest to) the body: the skin when
+/// the run has one, else the nearest collidable segment.
+std::vector<Deepest> deepestVertices(const render::RunReplay& run, const std::vector<std::size_t>& garments,
+                                     const Frames& frames, std::optional<std::size_t> skin,
+                                     const std::vector<std::size_t>& collidable) {
+  std::vector<Deepest> deepest;
+  for (const std::size_t g : garments)
+    for (std::size_t v = 0; v < run.meshes()[g].vertexCount; ++v) deepest.push_back({g, v, frames.first});
+  Progress progress("drape inspect", frames.last - frames.first + 1);
+  for (std::int64_t f = frames.first; f <= frames.last; ++f) {
+    const BodyAtFrame body = bodyAt(run, f, skin, collidable);
+    tbb::parallel_for(std::size_t{0}, deepest.size(), [&](std::size_t i) {
+      Deepest& d = deepest[i];
+      const Vec3& p = run.positions(d.garment, f)[d.vertex];
+      const double distance = body.skin ? body.skin->at(p).distance_m : nearestParts(body, p).front().distance_m;
+      if (distance < d.distance_m) {
+        d.distance_m = distance;
+        d.frame = f;
+      }
+    });
+    progress.update(f - frames.first + 1);
+  }
+  std::stable_sort(deepest.begin(), deepest.end(), [](const Deepest& a, const Deepest& b) { return a.distance_m < b.distance_m; });
+  return deepest;
+}
+
+void printDeepest(const render::RunReplay& run, const RunQuery& query, const Frames& frames,
+                  std::optional<std::size_t> skin, const std::vector<std::size_t>& collidable, std::ostream& out) {
+  if (!skin && collidable.empty()) throw Error("--deepest: the run has no body (neither a skin nor segments) to measure against");
+  const std::vector<std::size_t> garments = selectedGarments(run, query.garment);
+  const std::vector<Deepest> deepest = deepestVertices(run, garments, frames, skin, collidable);
+  const auto inside = std::count_if(deepest.begin(), deepest.end(), [](const Deepest& d) { return d.distance_m < 0; });
+  const char* against = skin ? "skin" : "nearest segment";
+  fmt::print(out, "\ngarment vertices deepest in the body over frames {} to {}: {} of {} are inside the {} in some frame\n",
+             frames.first, frames.last, inside, deepest.size(), against);
+  fmt::print(out, "{:<14}  {:>6}  {:>6}  {:<11}  {:<15}  {:<22}  {:<24}  {}\n", "garment", "vertex", "frame",
+             "time code", "state", skin ? "skin (there)" : "", "nearest collidable part", "next");
+  const std::size_t shown = std::min(deepest.size(), static_cast<std::size_t>(query.deepest));
+  for (std::size_t i = 0; i < shown; ++i) {
+    const Deepest& d = deepest[i];
+    const BodyAtFrame body = bodyAt(run, d.frame, skin, collidable);
+    const Vec3& p = run.positions(d.garment, d.frame)[d.vertex];
+    const std::vector<PartDistance> parts = nearestParts(body, p);
+    fmt::print(out, "{:<14}  {:>6}  {:>6}  {:<11}  {:<15}  {:<22}  {:<24}  {}\n", run.meshes()[d.garment].name,
+               d.vertex, d.frame, timeCode(run, d.frame), stateText(run.states(d.garment, d.frame), d.vertex),
+               skin ? skinText(run, d.frame, body, p) : "", partText(run, parts, 0), partText(run, parts, 1));
+  }
+  if (shown > 0)
+    fmt::print(out, "follow one: drape inspect RUN --vertex V{} --range FIRST:LAST\n",
+               garments.size() > 1 ? " --garment NAME" : "");
+}
+
+}  // namespace
+
+void inspectRun(const std::string& directory, const RunQuery& query, std::ostream& out) {
+  const render::RunReplay run(directory);
+  const nlohmann::json stats = readStats(directory);
+  const std::vector<std::size_t> collidable = collidableSegments(run, stats);
+  const std::vector<std::size_t> skins = meshesWithRole(run, MeshRole::Skin);
+  const std::optional<std::size_t> skin = skins.empty() ? std::nullopt : std::optional(skins.front());
+  printSummary(directory, run, stats, collidable, out);
+  if (query.vertex < 0 && query.deepest <= 0) {
+    if (query.any()) throw Error("--range and --garment go with --vertex V or --deepest N");
+    fmt::print(out, "look closer: --deepest N (the garment vertices deepest in the body), --vertex V --range FIRST:LAST "
+                    "(one vertex frame by frame)\n");
+    return;
+  }
+  const Frames frames = framesOf(run, query.range);
+  if (query.deepest > 0) printDeepest(run, query, frames, skin, collidable, out);
+  if (query.vertex >= 0) printVertexTrack(run, query, frames, skin, collidable, out);
+}
+
+}  // namespace drape::cli

@@ -1,0 +1,163 @@
+// `drape inspect RUN_DIR` on a real run of the bundled walking skirt (the first 60 frames,
+// in which the right hand, which is not collidable, swings into the skirt): the summary,
+// the deepest vertices against the skin measured here from the run's own files (brute-force
+// distance, winding number), a vertex followed frame by frame agreeing with the list, and
+// the errors.
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <regex>
+#include <sstream>
+
+#include "cli_runner.hpp"
+#include "drape/formats/obj.hpp"
+#include "drape/formats/pc2.hpp"
+#include "drape/mesh/closest_point.hpp"
+#include "drape/mesh/surface_distance.hpp"
+
+namespace drape {
+namespace {
+
+using testing::CliResult;
+using testing::runDrape;
+using testing::ScratchDir;
+
+const std::string kSkirtDir = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt";
+
+struct Row {
+  long vertex = 0, frame = 0;
+  double skin_mm = 0;
+  std::string there;  // the body part of the skin's nearest point
+};
+
+/// The rows of `--deepest`: "Skirt  VERTEX  FRAME  TIMECODE  STATE  SKIN PART  ...".
+std::vector<Row> deepestRows(const std::string& out) {
+  static const std::regex row(R"(^Skirt +(\d+) +(\d+) +\d\d:\d\d:\d\d:\d\d +[a-z ]+? +([-+][0-9.]+) (\w+) )");
+  std::vector<Row> rows;
+  std::istringstream lines(out);
+  for (std::string line; std::getline(lines, line);) {
+    std::smatch m;
+    if (std::regex_search(line, m, row)) rows.push_back({std::stol(m[1]), std::stol(m[2]), std::stod(m[3]), m[4]});
+  }
+  return rows;
+}
+
+/// The skin column of `--vertex` rows, by frame: "FRAME  TIMECODE  STATE  SKIN PART  ...".
+std::map<long, double> trackedSkin(const std::string& out) {
+  static const std::regex row(R"(^ +(\d+) +\d\d:\d\d:\d\d:\d\d +[a-z ]+? +([-+][0-9.]+) \w+ )");
+  std::map<long, double> skin;
+  std::istringstream lines(out);
+  for (std::string line; std::getline(lines, line);) {
+    std::smatch m;
+    if (std::regex_search(line, m, row)) skin[std::stol(m[1])] = std::stod(m[2]);
+  }
+  return skin;
+}
+
+class InspectRun : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    scratch_ = new ScratchDir("inspect-run");
+    run_ = testing::runInto(*scratch_, "skirt",
+                            "'" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir + "/walk.bvh' --frames 60");
+  }
+  static void TearDownTestSuite() { delete scratch_; }
+  static CliResult inspect(const std::string& args) { return runDrape("inspect '" + run_ + "' " + args, *scratch_); }
+
+  static inline ScratchDir* scratch_ = nullptr;
+  static inline std::string run_;
+};
+
+TEST_F(InspectRun, SummarisesTheRun) {
+  const CliResult r = inspect("");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("a drape run, 61 frames at 30 fps (00:00:00:00 to 00:00:02:00)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("garment  Skirt          264 vertices, 480 triangles, collision states recorded"),
+            std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("6 collidable: Hips, LowerBack, LeftUpLeg, RightUpLeg, LeftLeg, RightLeg"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("stats.json: 60 frames simulated"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("look closer: --deepest N"), std::string::npos) << r.out;
+}
+
+TEST_F(InspectRun, TheDeepestVerticesAreInsideTheSkinAsTheRunsFilesSay) {
+  const CliResult r = inspect("--deepest 6");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::vector<Row> rows = deepestRows(r.out);
+  ASSERT_EQ(rows.size(), 6u) << r.out;
+  // Measured here from the files the run wrote: the skin at that frame, the vertex there.
+  const mesh::TriMesh body = formats::readObj(run_ + "/body.obj");
+  const formats::Pc2Cache skin = formats::readPc2(run_ + "/body.pc2");
+  const formats::Pc2Cache garment = formats::readPc2(run_ + "/garment.pc2");
+  int inside = 0;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const Row& row = rows[i];
+    if (i > 0) {
+      EXPECT_LE(rows[i - 1].skin_mm, row.skin_mm) << "sorted, deepest first";
+    }
+    const std::vector<Vec3>& x = skin.frames.at(static_cast<std::size_t>(row.frame));
+    const Vec3 p = garment.frames.at(static_cast<std::size_t>(row.frame)).at(static_cast<std::size_t>(row.vertex));
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const mesh::Triangle& t : body.triangles)
+      nearest = std::min(nearest, (p - mesh::closestOnTriangle(p, x[t[0]], x[t[1]], x[t[2]])).norm());
+    EXPECT_NEAR(std::abs(row.skin_mm), nearest * 1000.0, 0.051) << "vertex " << row.vertex;
+    const bool in = mesh::windingNumber(x, body.triangles, p) > 0.5;
+    EXPECT_EQ(row.skin_mm < 0, in) << "vertex " << row.vertex << " frame " << row.frame;
+    inside += in;
+  }
+  // The right hand swings into the skirt in these frames; the hips and legs, which the skirt
+  // collides with, do not.
+  EXPECT_GT(inside, 0) << r.out;
+  EXPECT_NE(r.out.find("are inside the skin in some frame"), std::string::npos) << r.out;
+  const std::string& there = rows.front().there;
+  EXPECT_TRUE(there.starts_with("R") && there != "RightUpLeg" && there != "RightLeg") << r.out;
+}
+
+TEST_F(InspectRun, AVertexFollowedFrameByFrameAgreesWithTheDeepestList) {
+  const std::vector<Row> rows = deepestRows(inspect("--deepest 1").out);
+  ASSERT_EQ(rows.size(), 1u);
+  const CliResult r = inspect("--vertex " + std::to_string(rows[0].vertex));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::map<long, double> track = trackedSkin(r.out);
+  ASSERT_EQ(track.size(), 61u) << r.out;
+  const auto deepest = std::min_element(track.begin(), track.end(),
+                                        [](const auto& a, const auto& b) { return a.second < b.second; });
+  EXPECT_EQ(deepest->first, rows[0].frame);
+  EXPECT_DOUBLE_EQ(deepest->second, rows[0].skin_mm);
+  // One frame, by --range.
+  const CliResult one = inspect("--vertex " + std::to_string(rows[0].vertex) + " --range " + std::to_string(rows[0].frame));
+  ASSERT_EQ(one.code, 0) << one.err;
+  const std::map<long, double> single = trackedSkin(one.out);
+  ASSERT_EQ(single.size(), 1u) << one.out;
+  EXPECT_DOUBLE_EQ(single.begin()->second, rows[0].skin_mm);
+}
+
+TEST_F(InspectRun, WhatTheRunDoesNotHaveIsAnErrorThatSaysSo) {
+  const struct {
+    std::string args, says;
+  } cases[] = {
+      {"--vertex 264", "--vertex 264: Skirt has vertices 0 to 263"},
+      {"--vertex 3 --range 50:61", "--range 50:61: the run has frames 0 to 60"},
+      {"--vertex 3 --range 9:4", "--range 9:4: the run has frames 0 to 60"},
+      {"--vertex 3 --range x", "--range x is not a range"},
+      {"--deepest 2 --garment Cape", "--garment Cape: the run's garments are Skirt"},
+      {"--range 3", "--range and --garment go with --vertex V or --deepest N"},
+      {"--deepest 0", "--deepest"},
+      {"--motion '" + kSkirtDir + "/walk.bvh'", "--motion and --keep-apart go with a scene, not a run"},
+  };
+  for (const auto& c : cases) {
+    const CliResult r = inspect(c.args);
+    EXPECT_EQ(r.code, 2) << c.args;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << c.args << ": " << r.err;
+  }
+  const CliResult file = runDrape("inspect '" + kSkirtDir + "/walk.bvh' --deepest 3", *scratch_);
+  EXPECT_EQ(file.code, 2);
+  EXPECT_NE(file.err.find("go with a run directory"), std::string::npos) << file.err;
+  const CliResult notRun = runDrape("inspect '" + kSkirtDir + "'", *scratch_);
+  EXPECT_EQ(notRun.code, 2);
+  EXPECT_NE(notRun.err.find("manifest.json"), std::string::npos) << notRun.err;
+}
+
+}  // namespace
+}  // namespace drape

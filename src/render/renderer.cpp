@@ -3,12 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <tuple>
 
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
-#include "drape/mesh/closest_point.hpp"
+#include "drape/mesh/surface_distance.hpp"
 #include "gl_util.hpp"
 
 namespace drape::render {
@@ -541,24 +542,6 @@ struct Renderer::Impl {
     return -1;
   }
 
-  /// Signed distance to mesh m at p by brute force over its triangles; the sign comes from
-  /// the nearest triangle's outward normal (good enough for a picture of a closed part).
-  double bruteForceDistance(std::size_t m, const Vec3& p) const {
-    const std::vector<Vec3>& x = frame.positions[m];
-    double best = std::numeric_limits<double>::infinity();
-    double sign = 1.0;
-    for (const mesh::Triangle& t : meshes[m].triangles) {
-      const Vec3 q = mesh::closestOnTriangle(p, x[t[0]], x[t[1]], x[t[2]]);
-      const double d = (p - q).squaredNorm();
-      if (d < best) {
-        best = d;
-        const Vec3 n = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
-        sign = n.dot(p - q) < 0.0 ? -1.0 : 1.0;
-      }
-    }
-    return sign * std::sqrt(best);
-  }
-
   /// A horizontal plane through the chosen part, coloured by its distance (white: the
   /// surface, then T1, T2, T3 contours, dark bands every centimetre or so).
   void drawDistanceSlice(const Mat4& viewProj, const OverlaySettings& overlay) {
@@ -579,11 +562,14 @@ struct Renderer::Impl {
       sliceKey = key;
       constexpr int kCells = 96;
       std::vector<float> distance(kCells * kCells);
+      // Without the collision's field, the exact distance to the part's triangles as drawn.
+      std::optional<mesh::SurfaceDistance> surface;
+      if (!overlay.sliceDistance)
+        surface.emplace(frame.positions[static_cast<std::size_t>(part)], meshes[static_cast<std::size_t>(part)].triangles);
       for (int j = 0; j < kCells; ++j) {
         for (int i = 0; i < kCells; ++i) {
           const Vec3 p(lo.x() + (i + 0.5) / kCells * size.x(), y, lo.z() + (j + 0.5) / kCells * size.z());
-          const double d =
-              overlay.sliceDistance ? overlay.sliceDistance(p) : bruteForceDistance(static_cast<std::size_t>(part), p);
+          const double d = surface ? surface->at(p).distance_m : overlay.sliceDistance(p);
           distance[static_cast<std::size_t>(j * kCells + i)] = static_cast<float>(d);
         }
       }

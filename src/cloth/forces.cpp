@@ -132,11 +132,20 @@ void membraneCornerForces(std::size_t n, const std::int32_t* __restrict blocks, 
   }
 }
 
-/// kKernelRun doubles as one vector (GCC's vector extension: AVX-512 here, pairs of SSE2
-/// registers in a portable build); GCC did not vectorise the loop over a block's lanes.
+/// A vector of doubles as wide as the processor's (GCC's vector extension): eight on AVX-512,
+/// four on AVX2, four as pairs of SSE2 registers in a portable build. A block of kKernelRun
+/// vertices is summed kLanes at a time. Eight lanes as one vector on AVX2 compiled to
+/// spills through the stack: a third of the membrane's time on the walking skirt went to
+/// this pass (docs/PERFORMANCE.md). GCC did not vectorise the loop over a block's lanes.
 /// Passed by reference: by value, a build without AVX-512 would pass it another way than one
 /// with (GCC and Clang warn, -Wpsabi).
-using Lanes = double __attribute__((vector_size(kKernelRun * sizeof(double))));
+#ifdef __AVX512F__
+inline constexpr std::int32_t kLanes = 8;
+#else
+inline constexpr std::int32_t kLanes = 4;
+#endif
+static_assert(kKernelRun % kLanes == 0);
+using Lanes = double __attribute__((vector_size(kLanes * sizeof(double))));
 inline void addLanes(Lanes& sum, const double* p) {
   Lanes v;
   std::memcpy(&v, p, sizeof v);
@@ -151,23 +160,26 @@ inline void addToLanes(double* p, const Lanes& sum) {
 
 /// Membrane pass 2: each vertex sums its corners' forces (loads only: a scatter's
 /// read-modify-writes would chain through store forwarding where triangles share vertices):
-/// the vertex blocks (MembraneArrays) as vectors, the other vertices one by one.
+/// the vertex blocks (MembraneArrays) as vectors, the other vertices one by one. Each lane
+/// adds its vertex's corners in the same order as a vertex summed alone.
 void gatherMembraneBlocks(std::size_t blocks, const std::int32_t* __restrict first,
                           const std::int32_t* __restrict start, const std::int32_t* __restrict offset, std::size_t n,
                           const double* __restrict w, double* __restrict fx, double* __restrict fy,
                           double* __restrict fz) {
   for (std::size_t b = 0; b < blocks; ++b) {
     const std::int32_t v = first[b];
-    Lanes sx{}, sy{}, sz{};
-    for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
-      const double* c = w + offset[k];
-      addLanes(sx, c);
-      addLanes(sy, c + n);
-      addLanes(sz, c + 2 * n);
+    for (std::int32_t h = 0; h < kKernelRun; h += kLanes) {
+      Lanes sx{}, sy{}, sz{};
+      for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
+        const double* c = w + offset[k] + h;
+        addLanes(sx, c);
+        addLanes(sy, c + n);
+        addLanes(sz, c + 2 * n);
+      }
+      addToLanes(fx + v + h, sx);
+      addToLanes(fy + v + h, sy);
+      addToLanes(fz + v + h, sz);
     }
-    addToLanes(fx + v, sx);
-    addToLanes(fy + v, sy);
-    addToLanes(fz + v, sz);
   }
 }
 

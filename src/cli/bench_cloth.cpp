@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bullet_sheet.hpp"
+#include "bench_machine.hpp"
 #include "command.hpp"
 #include "measure.hpp"
 #include "drape/cloth/forces.hpp"
@@ -253,6 +254,7 @@ int runBench(const BenchOptions& o) {
   const cloth::Material m = benchMaterial();
   nlohmann::json out = {
       {"benchmark", "cloth"},
+      {"machine", benchMachine()},
       {"scenario",
        {{"sheet_m", 1.0},
         {"pinned", "two corners of one edge"},

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 
+#include "bench_machine.hpp"
 #include "command.hpp"
 #include "drape/field/shapes.hpp"
 #include "field_measure.hpp"
@@ -56,6 +57,7 @@ RunFunction setupBenchField(CLI::App& app) {
       grids.push_back(j);
     }
     nlohmann::json out = {{"benchmark", "field"},
+                          {"machine", benchMachine()},
                           {"threads", 1},
                           {"runs", options->runs},
                           {"statistic", "median"},

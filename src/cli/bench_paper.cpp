@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bullet_sheet.hpp"
+#include "bench_machine.hpp"
 #include "command.hpp"
 #include "measure.hpp"
 #include "drape/core/error.hpp"
@@ -234,6 +235,7 @@ RunFunction setupPaperBench(CLI::App& app) {
     j["max_penetration_m"] = penetration.maxPenetration_m;
     j["distance_field_build_s"] = r.fieldBuildSeconds;
     j["runs"] = o.runs;
+    j["machine"] = benchMachine();
     const double reference = median(referenceMs);
     const std::string workload = fmt::format(
         "Bullet's soft-body sheet of drape bench cloth (sheet-480: {} x {} cells, {} nodes), {} frames at {} "

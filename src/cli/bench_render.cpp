@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench_machine.hpp"
 #include "command.hpp"
 #include "drape/render/headless.hpp"
 #include "render_options.hpp"
@@ -94,6 +95,7 @@ RunFunction setupBenchRender(CLI::App& app) {
     std::filesystem::remove(png);
     nlohmann::json out;
     out["benchmark"] = "render";
+    out["machine"] = benchMachine();
     out["gl"] = renderer.description();
     out["width"] = w;
     out["height"] = h;

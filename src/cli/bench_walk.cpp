@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "bench_machine.hpp"
 #include "command.hpp"
 #include "measure.hpp"
 #include "drape/cloth/voxel_walk.hpp"
@@ -108,6 +109,7 @@ RunFunction setupBenchWalk(CLI::App& app) {
                          {"table_speedup", nsB / nsT}});
     }
     const nlohmann::json out = {{"benchmark", "walk"},
+                                {"machine", benchMachine()},
                                 {"grid", {kSide, kSide, kSide}},
                                 {"walks_per_length", kWalks},
                                 {"runs", o->runs},

@@ -2,8 +2,11 @@
 // unstable run.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <iterator>
+#include <string>
+#include <vector>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -296,6 +299,17 @@ TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
   EXPECT_EQ(every["reference"]["frames_per_run"], 300);
   EXPECT_NEAR(every["speed_vs_reference"].get<double>(), referenceMs / every["cpu_ms_per_frame"].get<double>(),
               1e-9 * referenceMs / every["cpu_ms_per_frame"].get<double>());
+  // What the figures were measured on: the build's vector instructions, which the processor
+  // that ran it must have (else it could not have run), and the processor's.
+  const std::vector<std::string> isas = {"none", "SSE2", "AVX", "AVX2", "AVX-512"};
+  const auto rank = [&](const nlohmann::json& isa) {
+    return std::find(isas.begin(), isas.end(), isa.get<std::string>()) - isas.begin();
+  };
+  ASSERT_TRUE(every.contains("machine"));
+  EXPECT_LT(rank(every["machine"]["build_vector_isa"]), std::ssize(isas)) << every["machine"];
+  EXPECT_LT(rank(every["machine"]["cpu_vector_isa"]), std::ssize(isas)) << every["machine"];
+  EXPECT_GE(rank(every["machine"]["cpu_vector_isa"]), rank(every["machine"]["build_vector_isa"])) << every["machine"];
+  EXPECT_FALSE(every["machine"]["cpu"].get<std::string>().empty());
   EXPECT_EQ(every["collision_every"], 1);
   EXPECT_EQ(third["collision_every"], 3);
   EXPECT_EQ(every["bend_every"], 8);  // the scene's

@@ -15,8 +15,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "bullet_sheet.hpp"
 #include "bench_machine.hpp"
+#include "bullet_sheet.hpp"
 #include "command.hpp"
 #include "measure.hpp"
 #include "drape/cloth/forces.hpp"

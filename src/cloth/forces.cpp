@@ -135,8 +135,8 @@ void membraneCornerForces(std::size_t n, const std::int32_t* __restrict blocks, 
 /// A vector of doubles as wide as the processor's (GCC's vector extension): eight on AVX-512,
 /// four on AVX2, four as pairs of SSE2 registers in a portable build. A block of kKernelRun
 /// vertices is summed kLanes at a time. Eight lanes as one vector on AVX2 compiled to
-/// spills through the stack: a third of the membrane's time on the walking skirt went to
-/// this pass (docs/PERFORMANCE.md). GCC did not vectorise the loop over a block's lanes.
+/// spills through the stack: about a fifth of the membrane's time on the walking skirt went
+/// to this pass (docs/PERFORMANCE.md). GCC did not vectorise the loop over a block's lanes.
 /// Passed by reference: by value, a build without AVX-512 would pass it another way than one
 /// with (GCC and Clang warn, -Wpsabi).
 #ifdef __AVX512F__

@@ -6,9 +6,15 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cctype>
 #include <limits>
-#include <regex>
+#include <map>
+#include <optional>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "cli_runner.hpp"
 #include "drape/formats/obj.hpp"
@@ -31,26 +37,61 @@ struct Row {
   std::string there;  // the body part of the skin's nearest point
 };
 
+/// A table row's words (split on spaces).
+std::vector<std::string> wordsOf(const std::string& line) {
+  std::istringstream in(line);
+  std::vector<std::string> words;
+  for (std::string w; in >> w;) words.push_back(w);
+  return words;
+}
+
+bool allDigits(const std::string& s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
+}
+
+/// HH:MM:SS:FF.
+bool isTimeCode(const std::string& s) {
+  return s.size() == 11 && s[2] == ':' && s[5] == ':' && s[8] == ':' &&
+         allDigits(s.substr(0, 2) + s.substr(3, 2) + s.substr(6, 2) + s.substr(9, 2));
+}
+
+/// The state's lower-case words from w[from], then "+D.D PART" and more: the signed skin
+/// distance (mm) and the part there; nothing if the row is not so.
+std::optional<std::pair<double, std::string>> skinAfterState(const std::vector<std::string>& w, std::size_t from) {
+  const auto lower = [](const std::string& s) {
+    return std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::islower(c) != 0; });
+  };
+  std::size_t i = from;
+  while (i < w.size() && lower(w[i])) ++i;
+  if (i == from || i + 2 >= w.size()) return std::nullopt;  // a state, the distance, the part, and more
+  const std::string& d = w[i];
+  if (d.size() < 2 || (d[0] != '+' && d[0] != '-') || d.find_first_not_of("0123456789.", 1) != std::string::npos)
+    return std::nullopt;
+  return std::pair{std::stod(d), w[i + 1]};
+}
+
 /// The rows of `--deepest`: "Skirt  VERTEX  FRAME  TIMECODE  STATE  SKIN PART  ...".
 std::vector<Row> deepestRows(const std::string& out) {
-  static const std::regex row(R"(^Skirt +(\d+) +(\d+) +\d\d:\d\d:\d\d:\d\d +[a-z ]+? +([-+][0-9.]+) (\w+) )");
   std::vector<Row> rows;
   std::istringstream lines(out);
   for (std::string line; std::getline(lines, line);) {
-    std::smatch m;
-    if (std::regex_search(line, m, row)) rows.push_back({std::stol(m[1]), std::stol(m[2]), std::stod(m[3]), m[4]});
+    const std::vector<std::string> w = wordsOf(line);
+    if (line.rfind("Skirt ", 0) != 0 || w.size() < 4 || !allDigits(w[1]) || !allDigits(w[2]) || !isTimeCode(w[3]))
+      continue;
+    if (const auto skin = skinAfterState(w, 4))
+      rows.push_back({std::stol(w[1]), std::stol(w[2]), skin->first, skin->second});
   }
   return rows;
 }
 
 /// The skin column of `--vertex` rows, by frame: "FRAME  TIMECODE  STATE  SKIN PART  ...".
 std::map<long, double> trackedSkin(const std::string& out) {
-  static const std::regex row(R"(^ +(\d+) +\d\d:\d\d:\d\d:\d\d +[a-z ]+? +([-+][0-9.]+) \w+ )");
   std::map<long, double> skin;
   std::istringstream lines(out);
   for (std::string line; std::getline(lines, line);) {
-    std::smatch m;
-    if (std::regex_search(line, m, row)) skin[std::stol(m[1])] = std::stod(m[2]);
+    const std::vector<std::string> w = wordsOf(line);
+    if (line.rfind(" ", 0) != 0 || w.size() < 2 || !allDigits(w[0]) || !isTimeCode(w[1])) continue;
+    if (const auto s = skinAfterState(w, 2)) skin[std::stol(w[0])] = s->first;
   }
   return skin;
 }

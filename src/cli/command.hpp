@@ -61,6 +61,7 @@ struct InspectorEntry {
 /// Global options shared by every subcommand.
 struct GlobalOptions {
   int verbosity = 0;
+  int threads = 0;  ///< --threads; 0: not given (every core, or one for `bench paper`)
 };
 [[nodiscard]] const GlobalOptions& globalOptions();
 

@@ -15,6 +15,13 @@ inline double threadCpuSeconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
+/// The process's CPU time, s: every thread's, for work spread over several.
+inline double processCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 /// The median of the values (the mean of the middle two of an even count); 0 for none.
 inline double median(std::vector<double> v) {
   if (v.empty()) return 0.0;

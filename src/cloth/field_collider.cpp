@@ -8,6 +8,10 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 
 #include "drape/core/error.hpp"
 
@@ -292,6 +296,7 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   for (std::vector<double>* v : {&endVoxelX_, &endVoxelY_, &endVoxelZ_, &nearest_}) v->assign(n, 0.0);
   keep_.assign(n + 8, 0);  // padded: the candidate scan reads eight flags at a time
   candidates_.assign(n, 0);
+  setRanges(n, rangeVertices_);
   settledVoxel_.assign(parts_.size(), std::vector<Vec3i>(n, kNotSettled));
   for (auto* b : {&ballX_, &ballY_, &ballZ_}) b->assign(parts_.size(), std::vector<double>(n, 0.0));
   ballR2_.assign(parts_.size(), std::vector<double>(n, -1.0));
@@ -410,31 +415,20 @@ void FieldCollider::collide(const ClothModel& model, double t0_s, double t1_s, C
   std::copy(io.x.begin(), io.x.end(), nextTestX_.begin());
   std::copy(io.y.begin(), io.y.end(), nextTestY_.begin());
   std::copy(io.z.begin(), io.z.end(), nextTestZ_.begin());
-  for (std::size_t k = 0; k < parts_.size(); ++k) {
-    const PartFrame& frame = frames_[k];
-    std::size_t resting = 0;
-    const std::size_t kept = selectCandidates(k, frame, io, resting);
-    // The culled pairs are OutsideVol -> OutsideVol without a trace; the resting ones
-    // InsideVol -> InsideVol, walked within their balls.
-    field_.tests += freeCount_;
-    counters_.pointsTested += freeCount_;
-    field_.transitions[0][0] += freeCount_ - kept - resting;
-    field_.transitions[1][1] += resting;
-    field_.traces += resting;
-    field_.restingSkips += resting;
-    const std::vector<Vec3i>& settled = settledVoxel_[k];
-    const std::vector<double>& ballR2 = ballR2_[k];
-    for (std::size_t j = 0; j < kept; ++j) {
-      const std::uint32_t i = candidates_[j];
-      const Vec3 c1(endVoxelX_[i], endVoxelY_[i], endVoxelZ_[i]);
-      if (ballR2[i] >= 0) wake(k, i);
-      if (roundVoxel(c1) == settled[i]) {
-        settle(k, i, c1);
-      } else if (!slideOnPlane(k, frame, i, c1, interval_s, io)) {
-        collidePoint(k, frame, i, c1, interval_s, io);
-      }
-    }
+  const std::size_t ranges = rangeStart_.size() - 1;
+  if (ranges == 1 || tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) < 2) {
+    for (std::size_t range = 0; range < ranges; ++range) collideRange(range, interval_s, io);
+  } else {
+    // Each range's pairs touch only its own vertices' data (a point's parts in part order,
+    // as one range would): the same result to the bit for any number of threads.
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, ranges, 1),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t range = r.begin(); range != r.end(); ++range) collideRange(range, interval_s, io);
+        },
+        tbb::simple_partitioner());
   }
+  mergeTallies(ranges);
   testX_.swap(nextTestX_);
   testY_.swap(nextTestY_);
   testZ_.swap(nextTestZ_);
@@ -450,27 +444,99 @@ void FieldCollider::collide(const ClothModel& model, double t0_s, double t1_s, C
   lastTime_s_ = t1_s;
 }
 
+void FieldCollider::collideRange(std::size_t range, double dt_s, ClothState& io) {
+  RangeTally& t = tallies_[range];
+  t.field = {};
+  t.contacts = t.kept = t.resting = 0;
+  t.corrected.clear();
+  t.correctedPoints.clear();
+  const std::size_t first = rangeStart_[range], last = rangeStart_[range + 1];
+  for (std::size_t k = 0; k < parts_.size(); ++k) {
+    const PartFrame& frame = frames_[k];
+    std::size_t resting = 0;
+    const std::size_t kept = selectCandidates(k, frame, io, first, last, resting);
+    t.kept += kept;
+    t.resting += resting;
+    const std::vector<Vec3i>& settled = settledVoxel_[k];
+    const std::vector<double>& ballR2 = ballR2_[k];
+    for (std::size_t j = first; j < first + kept; ++j) {
+      const std::uint32_t i = candidates_[j];
+      const Vec3 c1(endVoxelX_[i], endVoxelY_[i], endVoxelZ_[i]);
+      if (ballR2[i] >= 0) wake(k, i);
+      if (roundVoxel(c1) == settled[i]) {
+        settle(t, k, i, c1);
+      } else if (!slideOnPlane(t, k, frame, i, c1, dt_s, io)) {
+        collidePoint(t, k, frame, i, c1, dt_s, io);
+      }
+    }
+  }
+}
+
+void FieldCollider::mergeTallies(std::size_t ranges) {
+  std::size_t kept = 0, resting = 0;
+  for (std::size_t r = 0; r < ranges; ++r) {
+    const RangeTally& t = tallies_[r];
+    field_ += t.field;
+    counters_.contacts += t.contacts;
+    kept += t.kept;
+    resting += t.resting;
+    corrected_.insert(corrected_.end(), t.corrected.begin(), t.corrected.end());
+    correctedPoints_.insert(correctedPoints_.end(), t.correctedPoints.begin(), t.correctedPoints.end());
+  }
+  // corrected_ now lists the pairs range by range, not part by part as one range would;
+  // what reads it (collectPinches, measureCorrected) needs only each point's pairs in part
+  // order, and a point's pairs all come from its range, in part order.
+  // The culled pairs are OutsideVol -> OutsideVol without a trace; the resting ones
+  // InsideVol -> InsideVol, walked within their balls.
+  const std::size_t pairs = freeCount_ * parts_.size();
+  field_.tests += pairs;
+  counters_.pointsTested += pairs;
+  field_.transitions[0][0] += pairs - kept - resting;
+  field_.transitions[1][1] += resting;
+  field_.traces += resting;
+  field_.restingSkips += resting;
+}
+
+void FieldCollider::setRanges(std::size_t vertices, std::size_t rangeVertices) {
+  rangeStart_.assign(1, 0);
+  if (vertices >= parallelFrom_ && rangeVertices > 0) {
+    // Whole vectors of the cull's flags in every range but the last (its scan reads eight
+    // at a time).
+    const std::size_t step = std::max<std::size_t>(64, rangeVertices / 64 * 64);
+    for (std::size_t v = step; v + step / 2 < vertices; v += step) rangeStart_.push_back(static_cast<std::uint32_t>(v));
+  }
+  rangeStart_.push_back(static_cast<std::uint32_t>(vertices));
+  const std::size_t ranges = rangeStart_.size() - 1;
+  tallies_.resize(ranges);
+  for (std::size_t r = 0; r < ranges; ++r) {  // the step does not allocate
+    const std::size_t size = rangeStart_[r + 1] - rangeStart_[r];
+    tallies_[r].corrected.reserve(size * parts_.size());
+    tallies_[r].correctedPoints.reserve(size);
+  }
+}
+
 std::size_t FieldCollider::selectCandidates(std::size_t k, const PartFrame& frame, const ClothState& io,
-                                            std::size_t& resting) {
-  const std::size_t n = io.size();
-  mapPoints(frame.toVoxel1, n, io.x.data(), io.y.data(), io.z.data(), endVoxelX_.data(), endVoxelY_.data(),
-            endVoxelZ_.data());
+                                            std::size_t first, std::size_t last, std::size_t& resting) {
+  const std::size_t n = last - first;
+  double *cx = endVoxelX_.data() + first, *cy = endVoxelY_.data() + first, *cz = endVoxelZ_.data() + first;
+  mapPoints(frame.toVoxel1, n, io.x.data() + first, io.y.data() + first, io.z.data() + first, cx, cy, cz);
   // The walkable box: voxels 1 .. n-2 along each axis (the border layer is the outermost).
   const field::GridDims& d = parts_[k].field->dims();
   const Vec3 boxMax(d.nx - 1.5, d.ny - 1.5, d.nz - 1.5);
-  const Balls balls{ballX_[k].data(), ballY_[k].data(), ballZ_[k].data(), ballR2_[k].data()};
-  resting = markCandidates(n, endVoxelX_.data(), endVoxelY_.data(), endVoxelZ_.data(), boxMax,
-                           reinterpret_cast<const std::uint8_t*>(states_[k].data()), !boxCulling_, free_.data(), balls,
-                           keep_.data());
+  const Balls balls{ballX_[k].data() + first, ballY_[k].data() + first, ballZ_[k].data() + first,
+                    ballR2_[k].data() + first};
+  resting = markCandidates(n, cx, cy, cz, boxMax, reinterpret_cast<const std::uint8_t*>(states_[k].data()) + first,
+                           !boxCulling_, free_.data() + first, balls, keep_.data() + first);
   const std::uint8_t* keep = keep_.data();
+  std::uint32_t* candidates = candidates_.data() + first;
   // Most flags are zero: skip them eight at a time.
   std::size_t kept = 0;
-  for (std::size_t i = 0; i < n; i += 8) {
+  for (std::size_t i = first; i < last; i += 8) {
     std::uint64_t word;
     std::memcpy(&word, keep + i, sizeof word);
     if (word == 0) continue;
-    for (std::size_t j = i; j < std::min(n, i + 8); ++j) {
-      candidates_[kept] = static_cast<std::uint32_t>(j);
+    for (std::size_t j = i; j < std::min(last, i + 8); ++j) {
+      candidates[kept] = static_cast<std::uint32_t>(j);
       kept += keep[j];
     }
   }
@@ -512,7 +578,7 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
 // Flattened: at -O3 GCC 12 left Eigen's fixed-size vector arithmetic and the sliding
 // response as calls in a function this large, a fifth of the walking dress's collision
 // time (docs/PERFORMANCE.md, ninth round).
-[[gnu::flatten]] void FieldCollider::collidePoint(std::size_t k, const PartFrame& frame, std::size_t i,
+[[gnu::flatten]] void FieldCollider::collidePoint(RangeTally& __restrict t, std::size_t k, const PartFrame& frame, std::size_t i,
                                                   const Vec3& c1, double dt_s, ClothState& io) {
   const field::DistanceField& f = *parts_[k].field;
   PointState& state = states_[k][i];
@@ -520,7 +586,7 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
   const PointState from = state;
   settledVoxel_[k][i] = kNotSettled;  // stayInside sets it again
   if (embedded_[k][i]) {
-    releaseEmbedded(k, frame, i, c1, dt_s, io);
+    releaseEmbedded(t, k, frame, i, c1, dt_s, io);
     if (embedded_[k][i] && lastTime_s_ + dt_s >= easeUntil_s_[k][i]) {
       // Still below T2 when it should long have reached it: the garment holds it there (a
       // sleeve narrower than the arm's offset surface, a pinch, bound vertices inside).
@@ -528,16 +594,16 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
       // figures: it collides as any other from the next test.
       embedded_[k][i] = 0;
       state = PointState::OnSurf;
-      ++field_.embeddedTimedOut;
+      ++t.field.embeddedTimedOut;
     }
-    ++field_.transitions[toIndex(from)][toIndex(state)];
+    ++t.field.transitions[toIndex(from)][toIndex(state)];
     return;
   }
 
   const Vec3i v1 = roundVoxel(c1);
   const bool in1 = walkable(f, v1);
   if (state == PointState::OutsideVol && !in1) {
-    ++field_.transitions[0][0];
+    ++t.field.transitions[0][0];
     last = c1;
     return;
   }
@@ -550,8 +616,8 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
   if (state == PointState::InsideVol && in1 && v0 == v1 && clearOfT2(k, f.index(v1.x(), v1.y(), v1.z()))) {
     // The commonest pair: still in its voxel, far above T2. The walk would be that one
     // voxel, found clear, and would add no voxel step to the path.
-    ++field_.traces;
-    stayInside(k, i, c1);
+    ++t.field.traces;
+    stayInside(t, k, i, c1);
     return;
   }
 
@@ -580,17 +646,17 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
   // so it would visit one voxel per step of its longest axis: count them without walking.
   const bool slidesWithin = clearanceSkip_ && state == PointState::OnSurf && in1 && walkable(f, start);
   const int walked = slidesWithin ? (v1 - start).cwiseAbs().maxCoeff() + 1 : walk();
-  ++field_.traces;
-  field_.traceVoxels += static_cast<std::uint64_t>(walked - 1);
+  ++t.field.traces;
+  t.field.traceVoxels += static_cast<std::uint64_t>(walked - 1);
 
   if (!in1 && !hit) {  // left the volume
     state = PointState::OutsideVol;
     last = c1;
-    ++field_.transitions[toIndex(from)][toIndex(state)];
+    ++t.field.transitions[toIndex(from)][toIndex(state)];
     return;
   }
   if (state != PointState::OnSurf && !hit && clearOfT2(k, f.index(v1.x(), v1.y(), v1.z()))) {
-    stayInside(k, i, c1);
+    stayInside(t, k, i, c1);
     return;
   }
 
@@ -599,7 +665,7 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
   bool moved = false;
   // Most pairs are InsideVol far from the body: they need the distance only. The normal
   // comes with it (one gather) where a response will read it.
-  field::FieldSample at = state == PointState::OnSurf ? slidingSample(k, i, c)
+  field::FieldSample at = state == PointState::OnSurf ? slidingSample(t, k, i, c)
                           : hit                       ? f.sampleAtVoxel(c)
                                                       : field::FieldSample{f.distanceAtVoxel(c), Vec3::Zero()};
   if (state != PointState::OnSurf && (hit || at.distance_m < offsets_.t2_m)) {
@@ -615,16 +681,16 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
     c += (offsets_.t2_m - at.distance_m) / h * at.normal;
     moved = true;
     state = PointState::OnSurf;
-    ++field_.collisions;
-    ++counters_.contacts;
+    ++t.field.collisions;
+    ++t.contacts;
   } else if (state == PointState::OnSurf) {
     if (at.distance_m > offsets_.t3_m) {
       state = PointState::InsideVol;  // carried away by forces
     } else if (at.distance_m < offsets_.t0_m) {
       c += (offsets_.t2_m - at.distance_m) / h * at.normal;  // last resort
       moved = true;
-      ++field_.projections;
-      ++counters_.contacts;
+      ++t.field.projections;
+      ++t.contacts;
     } else if (at.distance_m < offsets_.t2_m) {
       // Sliding: the point stays on T2 while the part moves into it; the envelope down to
       // T1 absorbs what one substep's normal cannot (the penalty below).
@@ -635,15 +701,15 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
     state = PointState::InsideVol;
   }
 
-  if (moved) at = slidingSample(k, i, c);  // the response reads the field where the point is to be
-  moveAndRespond(k, frame, i, c, at, moved, state == PointState::OnSurf, dt_s, io);
+  if (moved) at = slidingSample(t, k, i, c);  // the response reads the field where the point is to be
+  moveAndRespond(t, k, frame, i, c, at, moved, state == PointState::OnSurf, dt_s, io);
   last = c;
-  ++field_.transitions[toIndex(from)][toIndex(state)];
+  ++t.field.transitions[toIndex(from)][toIndex(state)];
   if (state == PointState::InsideVol && !moved) rest(k, i, c);
 }
 
 // Flattened as collidePoint is, for the same reason.
-[[gnu::flatten]] bool FieldCollider::slideOnPlane(std::size_t k, const PartFrame& frame, std::size_t i,
+[[gnu::flatten]] bool FieldCollider::slideOnPlane(RangeTally& __restrict t, std::size_t k, const PartFrame& frame, std::size_t i,
                                                   const Vec3& c1, double dt_s, ClothState& io) {
   if (states_[k][i] != PointState::OnSurf || embedded_[k][i] || !contactPlanes_ || !clearanceSkip_) return false;
   const ContactPlane& plane = planes_[k][i];
@@ -664,23 +730,23 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
   // From here on, collidePoint's sliding branch step for step (a walk within the box counted
   // as there, each plane answer counted as slidingSample counts it).
   settledVoxel_[k][i] = kNotSettled;
-  ++field_.traces;
-  field_.traceVoxels += static_cast<std::uint64_t>((v1 - v0).cwiseAbs().maxCoeff());
-  field_.planeEstimates += moved ? 2 : 1;
-  moveAndRespond(k, frame, i, c, at, moved, true, dt_s, io);
+  ++t.field.traces;
+  t.field.traceVoxels += static_cast<std::uint64_t>((v1 - v0).cwiseAbs().maxCoeff());
+  t.field.planeEstimates += moved ? 2 : 1;
+  moveAndRespond(t, k, frame, i, c, at, moved, true, dt_s, io);
   last = c;
-  ++field_.transitions[toIndex(PointState::OnSurf)][toIndex(PointState::OnSurf)];
+  ++t.field.transitions[toIndex(PointState::OnSurf)][toIndex(PointState::OnSurf)];
   return true;
 }
 
-void FieldCollider::moveAndRespond(std::size_t k, const PartFrame& frame, std::size_t i, const Vec3& c,
+void FieldCollider::moveAndRespond(RangeTally& __restrict t, std::size_t k, const PartFrame& frame, std::size_t i, const Vec3& c,
                                    const field::FieldSample& at, bool moved, bool onSurf, double dt_s,
                                    ClothState& io) {
   Vec3 world1;  // where the point is to be, in the world at the interval's end
   if (moved) {
     world1 = frame.toWorld1.apply(c);
-    addCorrection(i, world1 - io.position(i));
-    corrected_.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(i)});
+    addCorrection(t, i, world1 - io.position(i));
+    t.corrected.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(i)});
   } else {
     nearest_[i] = std::min(nearest_[i], at.distance_m);  // corrected pairs: applyCorrections
   }
@@ -691,13 +757,13 @@ void FieldCollider::moveAndRespond(std::size_t k, const PartFrame& frame, std::s
   }
 }
 
-field::FieldSample FieldCollider::slidingSample(std::size_t k, std::size_t i, const Vec3& c) {
+field::FieldSample FieldCollider::slidingSample(RangeTally& __restrict t, std::size_t k, std::size_t i, const Vec3& c) {
   ContactPlane& plane = planes_[k][i];
   if (contactPlanes_ && plane.reaches(c)) {
-    ++field_.planeEstimates;
+    ++t.field.planeEstimates;
     return {plane.distanceAt(c), plane.normal};
   }
-  ++field_.planeReads;
+  ++t.field.planeReads;
   const field::FieldJet jet = parts_[k].field->jetAtVoxel(c);
   plane = {c, jet.gradient, jet.sample.normal, jet.sample.distance_m};
   return jet.sample;
@@ -706,12 +772,12 @@ field::FieldSample FieldCollider::slidingSample(std::size_t k, std::size_t i, co
 // A point that ends in a voxel marked clear of T2, without a collision on its way, is where
 // the trilinear distance would find it: above T2, so InsideVol. Its penetration figure is
 // left out: it cannot be below T1.
-void FieldCollider::stayInside(std::size_t k, std::size_t i, const Vec3& c1) {
+void FieldCollider::stayInside(RangeTally& __restrict t, std::size_t k, std::size_t i, const Vec3& c1) {
   PointState& state = states_[k][i];
-  ++field_.transitions[toIndex(state)][toIndex(PointState::InsideVol)];
+  ++t.field.transitions[toIndex(state)][toIndex(PointState::InsideVol)];
   state = PointState::InsideVol;
   lastVoxel_[k][i] = c1;
-  ++field_.clearanceSkips;
+  ++t.field.clearanceSkips;
   // Until the pair leaves this voxel its test is this one: settle() repeats it.
   settledVoxel_[k][i] = roundVoxel(c1);
   rest(k, i, c1);
@@ -720,11 +786,11 @@ void FieldCollider::stayInside(std::size_t k, std::size_t i, const Vec3& c1) {
 // Pair (k, vertex) stayed InsideVol in a voxel clear of T2 at its last test and ends this
 // one in the same voxel: collidePoint would walk that one voxel, find it clear and call
 // stayInside. The same, from the cached voxel: no range test, no clearance bit, no call.
-void FieldCollider::settle(std::size_t k, std::size_t i, const Vec3& c1) {
-  ++field_.traces;
-  ++field_.transitions[toIndex(PointState::InsideVol)][toIndex(PointState::InsideVol)];
+void FieldCollider::settle(RangeTally& __restrict t, std::size_t k, std::size_t i, const Vec3& c1) {
+  ++t.field.traces;
+  ++t.field.transitions[toIndex(PointState::InsideVol)][toIndex(PointState::InsideVol)];
   lastVoxel_[k][i] = c1;
-  ++field_.clearanceSkips;
+  ++t.field.clearanceSkips;
 }
 
 // The full test of a pair resting at the previous test would start its walk where the
@@ -927,11 +993,11 @@ std::string describePinch(const NearestPinch& near, std::uint32_t vertex) {
                      when, who, fmt::join(pinch.parts, ", "));
 }
 
-void FieldCollider::addCorrection(std::size_t i, const Vec3& displacement) {
+void FieldCollider::addCorrection(RangeTally& __restrict t, std::size_t i, const Vec3& displacement) {
   correctionX_[i] += displacement.x();
   correctionY_[i] += displacement.y();
   correctionZ_[i] += displacement.z();
-  if (corrections_[i]++ == 0) correctedPoints_.push_back(static_cast<std::uint32_t>(i));
+  if (corrections_[i]++ == 0) t.correctedPoints.push_back(static_cast<std::uint32_t>(i));
 }
 
 void FieldCollider::applyCorrections(ClothState& io) {
@@ -1079,7 +1145,7 @@ void FieldCollider::measureCorrected(const ClothState& io) {
 // first substep: up to T2 - T1 at once, which with offsets of 3, 6, 9 and 20 mm stopped the
 // walking dress in its first frame.)
 // Eased pairs stay out of the penetration counts: they are reported as pairs_embedded_at_start.
-void FieldCollider::releaseEmbedded(std::size_t k, const PartFrame& frame, std::size_t i, const Vec3& c1, double dt_s,
+void FieldCollider::releaseEmbedded(RangeTally& __restrict t, std::size_t k, const PartFrame& frame, std::size_t i, const Vec3& c1, double dt_s,
                                     ClothState& io) {
   const field::DistanceField& f = *parts_[k].field;
   PointState& state = states_[k][i];
@@ -1107,7 +1173,7 @@ void FieldCollider::releaseEmbedded(std::size_t k, const PartFrame& frame, std::
   const Vec3 v = io.velocity(i);
   const double vn = (v - partVelocity).dot(n);
   if (vn < 0) io.setVelocity(i, v - vn * n);
-  addCorrection(i, world - io.position(i));
+  addCorrection(t, i, world - io.position(i));
   if (step == rest) {  // on T2 now (to the field's accuracy): slide from here
     embedded_[k][i] = 0;
     state = PointState::OnSurf;

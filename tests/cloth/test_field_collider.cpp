@@ -556,6 +556,32 @@ TEST(FieldCollider, BoxCullingChangesNothing) {
   EXPECT_GT(c.transitions[0][0], c.tests / 4);  // culled pairs
 }
 
+TEST(FieldCollider, ParallelRangesChangeNothing) {
+  // Ranges of 64 of the 600 points (nine), run on TBB's threads, against one range.
+  expectSameAsReference([](FieldCollider& full) { full.setParallelRanges(0); }, true, true,
+                        [](FieldCollider& both) { both.setParallelRanges(64, 0); });
+}
+
+TEST(FieldCollider, LargeGarmentsSplitIntoRangesOfWholeVectors) {
+  const field::DistanceField sphere = buildField(field::makeSphere(0.06, Vec3::Zero(), 32, 16));
+  const std::vector<CollisionPart> parts = {{"sphere", &sphere, std::make_shared<StaticMotion>()}};
+  std::mt19937 rng(5);
+  const auto rangesFor = [&](std::size_t n, std::size_t rangeVertices, std::size_t from) {
+    FieldCollider c("test", parts, kOffsets, 0.5, 0.3);
+    c.setParallelRanges(rangeVertices, from);
+    c.initialise(cloudState(n, rng), 0.0);
+    return c.ranges();
+  };
+  const std::size_t from = FieldCollider::kParallelFrom_vertices, size = FieldCollider::kRange_vertices;
+  EXPECT_EQ(rangesFor(from - 1, size, from), 1u);
+  EXPECT_EQ(rangesFor(from, size, from), from / size);
+  EXPECT_EQ(rangesFor(2000, 256, from), 8u);   // 256 each, the last 208 (1792 .. 2000)
+  EXPECT_EQ(rangesFor(600, 64, 0), 9u);        // the last 88
+  EXPECT_EQ(rangesFor(600, 100, 0), 9u);       // rounded down to 64
+  EXPECT_EQ(rangesFor(600, 10, 0), 9u);        // at least 64
+  EXPECT_EQ(rangesFor(5000, 0, 0), 1u);        // 0: one range
+}
+
 TEST(FieldCollider, ClearanceBitsBoundTheTrilinearDistance) {
   // Anywhere in a voxel marked clear, the trilinear distance and the voxel's own are above
   // T2; and the marks reach down to within two voxels of T2 (the 3x3x3 neighbourhood).

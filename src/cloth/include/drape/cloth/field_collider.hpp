@@ -221,6 +221,22 @@ class FieldCollider final : public Collider {
   /// first step).
   void initialise(const ClothState& state, double t_s);
 
+  /// Garments of at least kParallelFrom_vertices vertices split each test's pairs into
+  /// ranges of kRange_vertices vertices, which run in parallel on TBB's threads.
+  static constexpr std::size_t kParallelFrom_vertices = 1024;
+  static constexpr std::size_t kRange_vertices = 256;
+  /// Splits each test's pairs into ranges of about `rangeVertices` vertices (rounded down to
+  /// a multiple of 64, at least 64) when the garment has at least `fromVertices`; else, or
+  /// with rangeVertices 0, one range. Each range's pairs touch only its own vertices' data
+  /// (a point meets its parts in part order, as in one range), and the ranges' counters and
+  /// corrections are merged in a fixed order: states, positions and counters are the same to
+  /// the bit with any ranges and any number of threads. Call before initialise.
+  void setParallelRanges(std::size_t rangeVertices, std::size_t fromVertices = kParallelFrom_vertices) {
+    rangeVertices_ = rangeVertices;
+    parallelFrom_ = fromVertices;
+  }
+  /// How many ranges a test splits into (1 until initialise).
+  [[nodiscard]] std::size_t ranges() const { return rangeStart_.size() > 1 ? rangeStart_.size() - 1 : 1; }
   /// Off: every (point, part) pair goes through the full per-pair test (the reference the
   /// culled path is tested against). On by default.
   void setBoxCulling(bool on) { boxCulling_ = on; }
@@ -322,30 +338,46 @@ class FieldCollider final : public Collider {
   PartFrame framePart(const CollisionPart& part, const RigidTransform& pose0, const RigidTransform& pose1) const;
   /// The interval's end transforms of `frame` (framePart's, the start's left as they are).
   void framePartEnd(const CollisionPart& part, const RigidTransform& pose1, PartFrame& frame) const;
-  /// Fills endVoxel* with every point's end position in part k's voxel coordinates and
-  /// candidates_ with the points the per-pair test must see; returns their number.
-  /// `resting`: how many of the points rest in their balls (left out).
-  std::size_t selectCandidates(std::size_t k, const PartFrame& frame, const ClothState& io, std::size_t& resting);
-  void releaseEmbedded(std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& endVoxel, double dt_s,
-                       ClothState& io);
-  void collidePoint(std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& endVoxel, double dt_s,
-                    ClothState& io);
+  /// What the pairs of one range of vertices add to a test: its counters and the
+  /// corrections it asked for, merged after all ranges (mergeTallies).
+  struct RangeTally {
+    FieldCollisionCounters field;
+    std::uint64_t contacts = 0;
+    std::size_t kept = 0, resting = 0;  ///< pairs the cull kept, and left resting, over the parts
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> corrected;  ///< (part, vertex)
+    std::vector<std::uint32_t> correctedPoints;
+  };
+  /// The ranges for a garment of `vertices` vertices (setParallelRanges), with their tallies.
+  void setRanges(std::size_t vertices, std::size_t rangeVertices);
+  /// One range's pairs against every part, in part order.
+  void collideRange(std::size_t range, double dt_s, ClothState& io);
+  /// The ranges' tallies into the collider's counters and correction lists, in range order.
+  void mergeTallies(std::size_t ranges);
+  /// Fills endVoxel* with the end positions of points [first, last) in part k's voxel
+  /// coordinates and candidates_ from `first` on with the points the per-pair test must see;
+  /// returns their number. `resting`: how many of the points rest in their balls (left out).
+  std::size_t selectCandidates(std::size_t k, const PartFrame& frame, const ClothState& io, std::size_t first,
+                               std::size_t last, std::size_t& resting);
+  void releaseEmbedded(RangeTally& t, std::size_t k, const PartFrame& frame, std::size_t vertex,
+                       const Vec3& endVoxel, double dt_s, ClothState& io);
+  void collidePoint(RangeTally& t, std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& endVoxel,
+                    double dt_s, ClothState& io);
   /// collidePoint for a pair sliding on its contact plane, where the plane answers both its
   /// reads and the point neither leaves the walkable box nor T3 nor goes below T0 (most of
   /// the pairs that need a test): the same, step for step, without the rest of the per-pair
   /// test. False, with nothing changed, for any other pair. Part of the clearance skip (its
   /// walk is counted, not walked): off with it, and tested against the full test with it.
-  bool slideOnPlane(std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& endVoxel, double dt_s,
-                    ClothState& io);
+  bool slideOnPlane(RangeTally& t, std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& endVoxel,
+                    double dt_s, ClothState& io);
   /// The end of a pair's test at voxel coordinates c, with the field `at` read there: a moved
   /// point's correction (else its distance for the penetration figures), and the velocity
   /// response of a point on the surface in contact.
-  void moveAndRespond(std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& c,
+  void moveAndRespond(RangeTally& t, std::size_t k, const PartFrame& frame, std::size_t vertex, const Vec3& c,
                       const field::FieldSample& at, bool moved, bool onSurf, double dt_s, ClothState& io);
   /// Pair (k, vertex) ends at voxel coordinates c1 in a voxel clear of T2: InsideVol.
-  void stayInside(std::size_t k, std::size_t vertex, const Vec3& c1);
+  void stayInside(RangeTally& t, std::size_t k, std::size_t vertex, const Vec3& c1);
   /// Pair (k, vertex), settled in its voxel by stayInside, ends in it again: the same.
-  void settle(std::size_t k, std::size_t vertex, const Vec3& c1);
+  void settle(RangeTally& t, std::size_t k, std::size_t vertex, const Vec3& c1);
   /// Pair (k, vertex) is about to be tested: if it rested in its ball at the previous test,
   /// its state and cached position become the full test's; its ball is dropped either way.
   void wake(std::size_t k, std::size_t vertex);
@@ -353,7 +385,7 @@ class FieldCollider final : public Collider {
   void rest(std::size_t k, std::size_t vertex, const Vec3& c1);
   /// The field at c for sliding pair (k, vertex): from its contact plane when the plane
   /// reaches c, else read (and the plane moved there).
-  [[nodiscard]] field::FieldSample slidingSample(std::size_t k, std::size_t vertex, const Vec3& c);
+  [[nodiscard]] field::FieldSample slidingSample(RangeTally& t, std::size_t k, std::size_t vertex, const Vec3& c);
   /// Whether a sliding point the collider did not move is in contact with its part: at or
   /// below T2 by the read `at`. A point just moved onto T2 is in contact whatever the read
   /// there says: the read (trilinear, or the contact plane) can put it a few micrometres
@@ -366,7 +398,7 @@ class FieldCollider final : public Collider {
   void respondOnSurface(const PartFrame& frame, const Vec3& voxel, const Vec3& world, const field::FieldSample& at,
                         std::size_t vertex, double dt_s, ClothState& io) const;
   /// A part asks to move the point by `displacement` (world, m) this collision step.
-  void addCorrection(std::size_t vertex, const Vec3& displacement);
+  void addCorrection(RangeTally& t, std::size_t vertex, const Vec3& displacement);
   /// Moves every point by the mean of its parts' displacements.
   void applyCorrections(ClothState& io);
   /// The lists collideFaces walks, from the garment's triangles (at its first call).
@@ -450,7 +482,11 @@ class FieldCollider final : public Collider {
   // Per-substep scratch, sized by initialise (the step does not allocate).
   std::vector<double> endVoxelX_, endVoxelY_, endVoxelZ_;  ///< per vertex, the current part's voxel coordinates
   std::vector<std::uint8_t> keep_;                ///< per vertex: the current part must test it
-  std::vector<std::uint32_t> candidates_;         ///< the vertices kept, ascending
+  std::vector<std::uint32_t> candidates_;         ///< the vertices kept, ascending, each range's from its first
+  std::size_t rangeVertices_ = kRange_vertices;   ///< setParallelRanges
+  std::size_t parallelFrom_ = kParallelFrom_vertices;
+  std::vector<std::uint32_t> rangeStart_{0, 0};   ///< the ranges' first vertices, and the vertex count
+  std::vector<RangeTally> tallies_;               ///< per range
   /// [part][vertex]: the voxel in which the pair's last test found it staying InsideVol,
   /// clear of T2 (stayInside); kNotSettled otherwise.
   std::vector<std::vector<Vec3i>> settledVoxel_;

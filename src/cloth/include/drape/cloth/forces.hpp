@@ -10,6 +10,11 @@
 
 namespace drape::cloth {
 
+/// Models with at least this many triangles (hinges) compute their membrane (bending)
+/// forces in pieces on TBB's threads. Each element's forces and each vertex's sums are
+/// computed as with one thread, in the same order: the same forces to the bit.
+inline constexpr std::size_t kParallelFrom_elements = 2048;
+
 /// Sets every force accumulator to zero.
 void clearForces(ClothState& io);
 
@@ -17,11 +22,13 @@ void clearForces(ClothState& io);
 ///   E = (F^T F - I) / 2,  S = lambda_t tr(E) I + 2 mu_t E (+ damping_s * same of dE/dt),
 ///   f_i = -A F S grad(N_i).
 /// Compressive principal stresses are scaled by material.compressionScale.
-void accumulateMembraneForces(const ClothModel& model, ClothState& io);
+void accumulateMembraneForces(const ClothModel& model, ClothState& io,
+                              std::size_t parallelFrom = kParallelFrom_elements);
 
 /// Dihedral hinges: W = k / 2 (psi - psi0)^2 with psi = 2 sin(theta / 2), f = -dW/dx,
 /// times `scale` (the multiple-time-stepping impulse: bendEvery substeps' worth at once).
-void accumulateBendingForces(const ClothModel& model, ClothState& io, double scale = 1.0);
+void accumulateBendingForces(const ClothModel& model, ClothState& io, double scale = 1.0,
+                             std::size_t parallelFrom = kParallelFrom_elements);
 
 /// Viscous air drag relative to the wind, per vertex: f = -c A_v (v - wind).
 void accumulateDragForces(const ClothModel& model, const StepSettings& settings, ClothState& io);

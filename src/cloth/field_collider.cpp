@@ -8,12 +8,9 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
-#include <tbb/blocked_range.h>
-#include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
-#include <tbb/partitioner.h>
 
 #include "drape/core/error.hpp"
+#include "drape/core/threads.hpp"
 
 namespace drape::cloth {
 namespace {
@@ -416,17 +413,14 @@ void FieldCollider::collide(const ClothModel& model, double t0_s, double t1_s, C
   std::copy(io.y.begin(), io.y.end(), nextTestY_.begin());
   std::copy(io.z.begin(), io.z.end(), nextTestZ_.begin());
   const std::size_t ranges = rangeStart_.size() - 1;
-  if (ranges == 1 || tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) < 2) {
-    for (std::size_t range = 0; range < ranges; ++range) collideRange(range, interval_s, io);
+  if (ranges == 1) {
+    collideRange(0, interval_s, io);
   } else {
-    // Each range's pairs touch only its own vertices' data (a point's parts in part order,
-    // as one range would): the same result to the bit for any number of threads.
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, ranges, 1),
-        [&](const tbb::blocked_range<std::size_t>& r) {
-          for (std::size_t range = r.begin(); range != r.end(); ++range) collideRange(range, interval_s, io);
-        },
-        tbb::simple_partitioner());
+    // Each range's pairs touch only its own vertices' data (a point meets its parts in part
+    // order, as in one range): the same result to the bit for any number of threads.
+    rangeLoop_(ranges, 1, [&](std::size_t first, std::size_t last) {
+      for (std::size_t range = first; range != last; ++range) collideRange(range, interval_s, io);
+    });
   }
   mergeTallies(ranges);
   testX_.swap(nextTestX_);
@@ -499,7 +493,7 @@ void FieldCollider::mergeTallies(std::size_t ranges) {
 
 void FieldCollider::setRanges(std::size_t vertices, std::size_t rangeVertices) {
   rangeStart_.assign(1, 0);
-  if (vertices >= parallelFrom_ && rangeVertices > 0) {
+  if (vertices >= parallelFrom_ && rangeVertices > 0 && threadsAllowed() > 1) {
     // Whole vectors of the cull's flags in every range but the last (its scan reads eight
     // at a time).
     const std::size_t step = std::max<std::size_t>(64, rangeVertices / 64 * 64);

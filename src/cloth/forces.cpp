@@ -4,10 +4,6 @@
 #include <cmath>
 #include <cstring>
 
-#include <tbb/blocked_range.h>
-#include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
-#include <tbb/partitioner.h>
 
 namespace drape::cloth {
 namespace {
@@ -49,20 +45,15 @@ inline Sym2 softenCompression(Sym2 s, double scale) {
           tension ? s.c : compression ? both.c : mixed.c};
 }
 
-/// body(begin, end) over [0, count): at once, or in pieces of `grain` to `grain` / 2 on
-/// TBB's threads when `parallel` and more than one thread may run (the pieces' work must
-/// not overlap). With one thread, TBB's pieces would cost about a tenth more on the walking
-/// dress than the loop at once.
+/// body(begin, end) over [0, count): at once without `loop`, else in pieces of at least
+/// `grain` on TBB's threads (the pieces' work must not overlap).
 template <typename Body>
-void forPieces(bool parallel, std::size_t count, std::size_t grain, const Body& body) {
-  if (!parallel || count <= grain ||
-      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) < 2) {
+void forPieces(PieceLoop* loop, std::size_t count, std::size_t grain, const Body& body) {
+  if (loop == nullptr || count <= grain) {
     if (count > 0) body(std::size_t{0}, count);
     return;
   }
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, count, grain),
-      [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); }, tbb::simple_partitioner());
+  (*loop)(count, grain, body);
 }
 
 /// Elements (vertices) per piece of a parallel pass: a few microseconds of work each.
@@ -227,7 +218,7 @@ void gatherMembraneSingles(std::size_t count, const std::int32_t* __restrict ver
 }
 
 template <bool kDamp, bool kSoften>
-void membraneKernel(const ClothModel& model, ClothState& io, bool parallel) {
+void membraneKernel(const ClothModel& model, ClothState& io, ForceLoops* loops) {
   const MembraneArrays& el = model.membraneArrays();
   const std::size_t n = el.area.size();
   const MembraneConstants k{model.lambdaT(), model.muT(), model.material().damping_s,
@@ -237,14 +228,14 @@ void membraneKernel(const ClothModel& model, ClothState& io, bool parallel) {
   double* w = io.work.data();  // nine columns of n
   const auto r = static_cast<std::size_t>(el.runEnd);
   constexpr std::size_t kPieceBlocks = kPieceElements / kKernelRun;
-  forPieces(parallel, el.runBlocks.size(), kPieceBlocks, [&](std::size_t b, std::size_t e) {
+  forPieces(loops ? &loops->membraneRuns : nullptr, el.runBlocks.size(), kPieceBlocks, [&](std::size_t b, std::size_t e) {
     membraneCornerForces<kDamp, kSoften, true>(e - b, el.runBlocks.data() + b, k, x, y, z, vx, vy, vz,
                                                el.v0.data(), el.v1.data(), el.v2.data(), el.g1u.data(),
                                                el.g1v.data(), el.g2u.data(), el.g2v.data(), el.area.data(), w,
                                                w + n, w + 2 * n, w + 3 * n, w + 4 * n, w + 5 * n, w + 6 * n,
                                                w + 7 * n, w + 8 * n);
   });
-  forPieces(parallel, n - r, kPieceElements, [&](std::size_t b, std::size_t e) {
+  forPieces(loops ? &loops->membraneElements : nullptr, n - r, kPieceElements, [&](std::size_t b, std::size_t e) {
     const std::size_t o = r + b;
     membraneCornerForces<kDamp, kSoften, false>(
         e - b, nullptr, k, x, y, z, vx, vy, vz, el.v0.data() + o, el.v1.data() + o, el.v2.data() + o,
@@ -252,11 +243,11 @@ void membraneKernel(const ClothModel& model, ClothState& io, bool parallel) {
         w + n + o, w + 2 * n + o, w + 3 * n + o, w + 4 * n + o, w + 5 * n + o, w + 6 * n + o, w + 7 * n + o,
         w + 8 * n + o);
   });
-  forPieces(parallel, el.vertexBlocks.size(), kPieceBlocks, [&](std::size_t b, std::size_t e) {
+  forPieces(loops ? &loops->membraneBlocks : nullptr, el.vertexBlocks.size(), kPieceBlocks, [&](std::size_t b, std::size_t e) {
     gatherMembraneBlocks(e - b, el.vertexBlocks.data() + b, el.cornerStart.data(), el.cornerOffset.data(), n, w,
                          io.fx.data(), io.fy.data(), io.fz.data());
   });
-  forPieces(parallel, el.singleVertices.size(), kPieceElements, [&](std::size_t b, std::size_t e) {
+  forPieces(loops ? &loops->membraneVertices : nullptr, el.singleVertices.size(), kPieceElements, [&](std::size_t b, std::size_t e) {
     gatherMembraneSingles(e - b, el.singleVertices.data() + b, el.cornerStart.data(), el.cornerOffset.data(), n, w,
                           io.fx.data(), io.fy.data(), io.fz.data());
   });
@@ -363,37 +354,37 @@ void clearForces(ClothState& io) {
   std::fill(io.fz.begin(), io.fz.end(), 0.0);
 }
 
-void accumulateMembraneForces(const ClothModel& model, ClothState& io, std::size_t parallelFrom) {
+void accumulateMembraneForces(const ClothModel& model, ClothState& io, ForceLoops* loops) {
   const bool damp = model.material().damping_s > 0.0;
   const bool soften = model.material().compressionScale < 1.0;
-  const bool parallel = model.membraneArrays().area.size() >= parallelFrom;
-  if (damp && soften) membraneKernel<true, true>(model, io, parallel);
-  else if (damp) membraneKernel<true, false>(model, io, parallel);
-  else if (soften) membraneKernel<false, true>(model, io, parallel);
-  else membraneKernel<false, false>(model, io, parallel);
+  if (model.membraneArrays().area.size() < kParallelFrom_elements) loops = nullptr;
+  if (damp && soften) membraneKernel<true, true>(model, io, loops);
+  else if (damp) membraneKernel<true, false>(model, io, loops);
+  else if (soften) membraneKernel<false, true>(model, io, loops);
+  else membraneKernel<false, false>(model, io, loops);
 }
 
-void accumulateBendingForces(const ClothModel& model, ClothState& io, double scale, std::size_t parallelFrom) {
+void accumulateBendingForces(const ClothModel& model, ClothState& io, double scale, ForceLoops* loops) {
   const BendArrays& h = model.bendArrays();
   const std::size_t n = h.stiffness.size();
-  const bool parallel = n >= parallelFrom;
+  if (n < kParallelFrom_elements) loops = nullptr;
   const double *x = io.x.data(), *y = io.y.data(), *z = io.z.data();
   double* w = io.work.data();  // twelve columns of n
   const auto r = static_cast<std::size_t>(h.runEnd);
-  forPieces(parallel, h.runBlocks.size(), kPieceElements / kKernelRun, [&](std::size_t b, std::size_t e) {
+  forPieces(loops ? &loops->hingeRuns : nullptr, h.runBlocks.size(), kPieceElements / kKernelRun, [&](std::size_t b, std::size_t e) {
     hingeCornerForces<true>(e - b, h.runBlocks.data() + b, x, y, z, h.e0.data(), h.e1.data(), h.a.data(),
                             h.b.data(), h.restPsi.data(), h.stiffness.data(), scale, w, w + n, w + 2 * n, w + 3 * n,
                             w + 4 * n, w + 5 * n, w + 6 * n, w + 7 * n, w + 8 * n, w + 9 * n, w + 10 * n,
                             w + 11 * n);
   });
-  forPieces(parallel, n - r, kPieceElements, [&](std::size_t b, std::size_t e) {
+  forPieces(loops ? &loops->hinges : nullptr, n - r, kPieceElements, [&](std::size_t b, std::size_t e) {
     const std::size_t o = r + b;
     hingeCornerForces<false>(e - b, nullptr, x, y, z, h.e0.data() + o, h.e1.data() + o, h.a.data() + o,
                              h.b.data() + o, h.restPsi.data() + o, h.stiffness.data() + o, scale, w + o, w + n + o,
                              w + 2 * n + o, w + 3 * n + o, w + 4 * n + o, w + 5 * n + o, w + 6 * n + o,
                              w + 7 * n + o, w + 8 * n + o, w + 9 * n + o, w + 10 * n + o, w + 11 * n + o);
   });
-  forPieces(parallel, io.size(), kPieceElements, [&](std::size_t b, std::size_t e) {
+  forPieces(loops ? &loops->hingeVertices : nullptr, io.size(), kPieceElements, [&](std::size_t b, std::size_t e) {
     gatherHinges(e - b, n, h.cornerStart.data() + b, h.cornerOffset.data(), w, io.fx.data() + b, io.fy.data() + b,
                  io.fz.data() + b);
   });

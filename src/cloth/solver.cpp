@@ -8,6 +8,7 @@
 #include "drape/cloth/forces.hpp"
 #include "drape/cloth/strain_limit.hpp"
 #include "drape/core/error.hpp"
+#include "drape/core/threads.hpp"
 
 namespace drape::cloth {
 
@@ -37,6 +38,7 @@ ClothSolver::ClothSolver(std::shared_ptr<const ClothModel> model, const StepSett
       dt_(settings_.substep_s()),
       substepsPerFrame_(settings_.substepsPerFrame) {
   settings_.validate("--");
+  parallelForces_ = threadsAllowed() > 1;
   checkBendingStep(*model_, settings_);
   checkPinGroups();
   strainLimit_ = settings_.strainLimit;
@@ -234,13 +236,13 @@ bool ClothSolver::substep(double t0, double t1, long frame, int substepIndex) {
 
 void ClothSolver::accumulateForces() {
   clearForces(state_);
-  accumulateMembraneForces(*model_, state_);
+  accumulateMembraneForces(*model_, state_, parallelForces_ ? &forceLoops_ : nullptr);
   // The impulse method (Verlet-I / r-RESPA) for the slow force: one kick of bendEvery
   // substeps' worth at the first of every bendEvery substeps. Symplectic with the
   // symplectic inner step; counted over the whole take so that the rhythm runs on across
   // frame boundaries.
   const int every = settings_.bendEvery;
-  if (substepCount_++ % every == 0) accumulateBendingForces(*model_, state_, static_cast<double>(every));
+  if (substepCount_++ % every == 0) accumulateBendingForces(*model_, state_, static_cast<double>(every), parallelForces_ ? &forceLoops_ : nullptr);
   accumulateDragForces(*model_, settings_, state_);
 }
 

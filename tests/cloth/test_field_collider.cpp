@@ -7,6 +7,8 @@
 #include <numbers>
 #include <random>
 
+#include <tbb/global_control.h>
+
 #include "drape/cloth/field_collider.hpp"
 #include "drape/cloth/model.hpp"
 #include "drape/core/error.hpp"
@@ -557,7 +559,8 @@ TEST(FieldCollider, BoxCullingChangesNothing) {
 }
 
 TEST(FieldCollider, ParallelRangesChangeNothing) {
-  // Ranges of 64 of the 600 points (nine), run on TBB's threads, against one range.
+  // Ranges of 64 of the 600 points (nine), run on two of TBB's threads, against one range.
+  const tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
   expectSameAsReference([](FieldCollider& full) { full.setParallelRanges(0); }, true, true,
                         [](FieldCollider& both) { both.setParallelRanges(64, 0); });
 }
@@ -573,6 +576,11 @@ TEST(FieldCollider, LargeGarmentsSplitIntoRangesOfWholeVectors) {
     return c.ranges();
   };
   const std::size_t from = FieldCollider::kParallelFrom_vertices, size = FieldCollider::kRange_vertices;
+  {
+    const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    EXPECT_EQ(rangesFor(600, 64, 0), 1u);  // one thread: one range
+  }
+  const tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
   EXPECT_EQ(rangesFor(from - 1, size, from), 1u);
   EXPECT_EQ(rangesFor(from, size, from), from / size);
   EXPECT_EQ(rangesFor(2000, 256, from), 8u);   // 256 each, the last 208 (1792 .. 2000)

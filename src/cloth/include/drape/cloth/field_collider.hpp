@@ -120,6 +120,7 @@
 #include "drape/cloth/fixture.hpp"
 #include "drape/cloth/voxel_walk.hpp"
 #include "drape/core/stage_clock.hpp"
+#include "drape/core/threads.hpp"
 #include "drape/field/distance_field.hpp"
 
 namespace drape::cloth {
@@ -487,6 +488,7 @@ class FieldCollider final : public Collider {
   std::size_t parallelFrom_ = kParallelFrom_vertices;
   std::vector<std::uint32_t> rangeStart_{0, 0};   ///< the ranges' first vertices, and the vertex count
   std::vector<RangeTally> tallies_;               ///< per range
+  PieceLoop rangeLoop_;                           ///< runs the ranges, each on the thread it had last
   /// [part][vertex]: the voxel in which the pair's last test found it staying InsideVol,
   /// clear of T2 (stayInside); kNotSettled otherwise.
   std::vector<std::vector<Vec3i>> settledVoxel_;

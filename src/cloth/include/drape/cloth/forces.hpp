@@ -7,13 +7,22 @@
 #include "drape/cloth/material.hpp"
 #include "drape/cloth/model.hpp"
 #include "drape/cloth/state.hpp"
+#include "drape/core/threads.hpp"
 
 namespace drape::cloth {
 
 /// Models with at least this many triangles (hinges) compute their membrane (bending)
-/// forces in pieces on TBB's threads. Each element's forces and each vertex's sums are
-/// computed as with one thread, in the same order: the same forces to the bit.
+/// forces in pieces on TBB's threads when given ForceLoops. Each element's forces and each
+/// vertex's sums are computed as with one thread, in the same order: the same forces to the
+/// bit.
 inline constexpr std::size_t kParallelFrom_elements = 2048;
+
+/// The force kernels' loops over threads, one set per garment, kept from call to call
+/// (PieceLoop: each piece stays on its thread).
+struct ForceLoops {
+  PieceLoop membraneRuns, membraneElements, membraneBlocks, membraneVertices;
+  PieceLoop hingeRuns, hinges, hingeVertices;
+};
 
 /// Sets every force accumulator to zero.
 void clearForces(ClothState& io);
@@ -22,13 +31,14 @@ void clearForces(ClothState& io);
 ///   E = (F^T F - I) / 2,  S = lambda_t tr(E) I + 2 mu_t E (+ damping_s * same of dE/dt),
 ///   f_i = -A F S grad(N_i).
 /// Compressive principal stresses are scaled by material.compressionScale.
-void accumulateMembraneForces(const ClothModel& model, ClothState& io,
-                              std::size_t parallelFrom = kParallelFrom_elements);
+/// With `loops`, a model of kParallelFrom_elements triangles or more runs on TBB's threads.
+void accumulateMembraneForces(const ClothModel& model, ClothState& io, ForceLoops* loops = nullptr);
 
 /// Dihedral hinges: W = k / 2 (psi - psi0)^2 with psi = 2 sin(theta / 2), f = -dW/dx,
 /// times `scale` (the multiple-time-stepping impulse: bendEvery substeps' worth at once).
+/// With `loops`, a model of kParallelFrom_elements hinges or more runs on TBB's threads.
 void accumulateBendingForces(const ClothModel& model, ClothState& io, double scale = 1.0,
-                             std::size_t parallelFrom = kParallelFrom_elements);
+                             ForceLoops* loops = nullptr);
 
 /// Viscous air drag relative to the wind, per vertex: f = -c A_v (v - wind).
 void accumulateDragForces(const ClothModel& model, const StepSettings& settings, ClothState& io);

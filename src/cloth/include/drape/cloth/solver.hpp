@@ -18,6 +18,7 @@
 
 #include "drape/cloth/collider.hpp"
 #include "drape/cloth/fixture.hpp"
+#include "drape/cloth/forces.hpp"
 #include "drape/cloth/integrator.hpp"
 #include "drape/cloth/material.hpp"
 #include "drape/cloth/model.hpp"
@@ -173,6 +174,10 @@ class ClothSolver {
   StageTicks ticks_;
   Instability instability_;
   long substepCount_ = 0;  ///< substeps taken, for the bending rhythm
+  /// Whether more than one thread was allowed when the solver was made (threadsAllowed):
+  /// the force kernels of a large model then run on TBB's threads, in forceLoops_.
+  bool parallelForces_ = false;
+  ForceLoops forceLoops_;
   double dt_ = 0.0;        ///< the substep being taken, s (shorter in a refined frame)
   int substepsPerFrame_ = 0;  ///< of the frame being computed
   int refinement_ = 1;        ///< of the frame being computed

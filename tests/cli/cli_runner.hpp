@@ -15,6 +15,9 @@
 
 namespace drape::testing {
 
+/// The bundled walking skirt's example directory (scene.wrl, walk.bvh).
+inline const std::string kSkirtDir = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt";
+
 struct CliResult {
   int code = -1;
   std::string out, err;

@@ -137,7 +137,7 @@ Deepest deepestInsideSkin(const std::string& out, const std::set<std::string>& c
 }
 
 
-const std::string kSkirtDir = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt";
+using testing::kSkirtDir;
 /// The skirt's collidesWith in examples/walking_skirt/scene.wrl.
 const std::set<std::string> kCollidable = {"LowerBack", "Hips", "LeftUpLeg", "RightUpLeg", "LeftLeg", "RightLeg"};
 

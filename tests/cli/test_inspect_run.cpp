@@ -29,7 +29,7 @@ using testing::CliResult;
 using testing::runDrape;
 using testing::ScratchDir;
 
-const std::string kSkirtDir = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt";
+using testing::kSkirtDir;
 
 struct Row {
   long vertex = 0, frame = 0;

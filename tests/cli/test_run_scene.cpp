@@ -29,7 +29,7 @@ using testing::ScratchDir;
 using testing::slurp;
 using testing::statsOf;
 
-const std::string kSkirtDir = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt";
+using testing::kSkirtDir;
 
 // The smallest bundled scene (an H-Anim humanoid of primitives, no motion: it stands) runs
 // as it is, without a warning, and its skirt stays out of the body.

@@ -12,13 +12,7 @@
 namespace drape {
 namespace {
 
-using testing::CliResult;
-using testing::runDrape;
-using testing::ScratchDir;
-using testing::slurp;
-using testing::statsOf;
-
-const std::string kSkirtDir = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt";
+using namespace testing;  // the CLI runner's helpers
 
 TEST(Threads, ALargeGarmentRunsTheSameWithOneThreadAndWithTwo) {
   ScratchDir dir("threads");

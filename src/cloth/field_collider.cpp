@@ -480,6 +480,7 @@ void FieldCollider::mergeTallies(std::size_t ranges) {
   // corrected_ now lists the pairs range by range, not part by part as one range would;
   // what reads it (collectPinches, measureCorrected) needs only each point's pairs in part
   // order, and a point's pairs all come from its range, in part order.
+
   // The culled pairs are OutsideVol -> OutsideVol without a trace; the resting ones
   // InsideVol -> InsideVol, walked within their balls.
   const std::size_t pairs = freeCount_ * parts_.size();
@@ -497,7 +498,8 @@ void FieldCollider::setRanges(std::size_t vertices, std::size_t rangeVertices) {
     // Whole vectors of the cull's flags in every range but the last (its scan reads eight
     // at a time).
     const std::size_t step = std::max<std::size_t>(64, rangeVertices / 64 * 64);
-    for (std::size_t v = step; v + step / 2 < vertices; v += step) rangeStart_.push_back(static_cast<std::uint32_t>(v));
+    for (std::size_t v = step; v + step / 2 < vertices; v += step)
+      rangeStart_.push_back(static_cast<std::uint32_t>(v));
   }
   rangeStart_.push_back(static_cast<std::uint32_t>(vertices));
   const std::size_t ranges = rangeStart_.size() - 1;
@@ -572,8 +574,8 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
 // Flattened: at -O3 GCC 12 left Eigen's fixed-size vector arithmetic and the sliding
 // response as calls in a function this large, a fifth of the walking dress's collision
 // time (docs/PERFORMANCE.md, ninth round).
-[[gnu::flatten]] void FieldCollider::collidePoint(RangeTally& __restrict t, std::size_t k, const PartFrame& frame, std::size_t i,
-                                                  const Vec3& c1, double dt_s, ClothState& io) {
+[[gnu::flatten]] void FieldCollider::collidePoint(RangeTally& __restrict t, std::size_t k, const PartFrame& frame,
+                                                  std::size_t i, const Vec3& c1, double dt_s, ClothState& io) {
   const field::DistanceField& f = *parts_[k].field;
   PointState& state = states_[k][i];
   Vec3& last = lastVoxel_[k][i];
@@ -703,8 +705,8 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
 }
 
 // Flattened as collidePoint is, for the same reason.
-[[gnu::flatten]] bool FieldCollider::slideOnPlane(RangeTally& __restrict t, std::size_t k, const PartFrame& frame, std::size_t i,
-                                                  const Vec3& c1, double dt_s, ClothState& io) {
+[[gnu::flatten]] bool FieldCollider::slideOnPlane(RangeTally& __restrict t, std::size_t k, const PartFrame& frame,
+                                                  std::size_t i, const Vec3& c1, double dt_s, ClothState& io) {
   if (states_[k][i] != PointState::OnSurf || embedded_[k][i] || !contactPlanes_ || !clearanceSkip_) return false;
   const ContactPlane& plane = planes_[k][i];
   if (!plane.reaches(c1)) return false;
@@ -733,8 +735,8 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
   return true;
 }
 
-void FieldCollider::moveAndRespond(RangeTally& __restrict t, std::size_t k, const PartFrame& frame, std::size_t i, const Vec3& c,
-                                   const field::FieldSample& at, bool moved, bool onSurf, double dt_s,
+void FieldCollider::moveAndRespond(RangeTally& __restrict t, std::size_t k, const PartFrame& frame, std::size_t i,
+                                   const Vec3& c, const field::FieldSample& at, bool moved, bool onSurf, double dt_s,
                                    ClothState& io) {
   Vec3 world1;  // where the point is to be, in the world at the interval's end
   if (moved) {
@@ -1139,8 +1141,8 @@ void FieldCollider::measureCorrected(const ClothState& io) {
 // first substep: up to T2 - T1 at once, which with offsets of 3, 6, 9 and 20 mm stopped the
 // walking dress in its first frame.)
 // Eased pairs stay out of the penetration counts: they are reported as pairs_embedded_at_start.
-void FieldCollider::releaseEmbedded(RangeTally& __restrict t, std::size_t k, const PartFrame& frame, std::size_t i, const Vec3& c1, double dt_s,
-                                    ClothState& io) {
+void FieldCollider::releaseEmbedded(RangeTally& __restrict t, std::size_t k, const PartFrame& frame, std::size_t i,
+                                    const Vec3& c1, double dt_s, ClothState& io) {
   const field::DistanceField& f = *parts_[k].field;
   PointState& state = states_[k][i];
   Vec3& last = lastVoxel_[k][i];

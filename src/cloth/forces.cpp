@@ -56,6 +56,9 @@ void forPieces(PieceLoop* loop, std::size_t count, std::size_t grain, const Body
   (*loop)(count, grain, body);
 }
 
+/// One of the loops, or none (one thread) without them.
+PieceLoop* loopOf(ForceLoops* loops, PieceLoop ForceLoops::*which) { return loops ? &(loops->*which) : nullptr; }
+
 /// Elements (vertices) per piece of a parallel pass: a few microseconds of work each.
 constexpr std::size_t kPieceElements = 256;
 
@@ -228,29 +231,33 @@ void membraneKernel(const ClothModel& model, ClothState& io, ForceLoops* loops) 
   double* w = io.work.data();  // nine columns of n
   const auto r = static_cast<std::size_t>(el.runEnd);
   constexpr std::size_t kPieceBlocks = kPieceElements / kKernelRun;
-  forPieces(loops ? &loops->membraneRuns : nullptr, el.runBlocks.size(), kPieceBlocks, [&](std::size_t b, std::size_t e) {
+  const auto membraneRunsPiece = [&](std::size_t b, std::size_t e) {
     membraneCornerForces<kDamp, kSoften, true>(e - b, el.runBlocks.data() + b, k, x, y, z, vx, vy, vz,
                                                el.v0.data(), el.v1.data(), el.v2.data(), el.g1u.data(),
                                                el.g1v.data(), el.g2u.data(), el.g2v.data(), el.area.data(), w,
                                                w + n, w + 2 * n, w + 3 * n, w + 4 * n, w + 5 * n, w + 6 * n,
                                                w + 7 * n, w + 8 * n);
-  });
-  forPieces(loops ? &loops->membraneElements : nullptr, n - r, kPieceElements, [&](std::size_t b, std::size_t e) {
+  };
+  forPieces(loopOf(loops, &ForceLoops::membraneRuns), el.runBlocks.size(), kPieceBlocks, membraneRunsPiece);
+  const auto membraneElementsPiece = [&](std::size_t b, std::size_t e) {
     const std::size_t o = r + b;
     membraneCornerForces<kDamp, kSoften, false>(
         e - b, nullptr, k, x, y, z, vx, vy, vz, el.v0.data() + o, el.v1.data() + o, el.v2.data() + o,
         el.g1u.data() + o, el.g1v.data() + o, el.g2u.data() + o, el.g2v.data() + o, el.area.data() + o, w + o,
         w + n + o, w + 2 * n + o, w + 3 * n + o, w + 4 * n + o, w + 5 * n + o, w + 6 * n + o, w + 7 * n + o,
         w + 8 * n + o);
-  });
-  forPieces(loops ? &loops->membraneBlocks : nullptr, el.vertexBlocks.size(), kPieceBlocks, [&](std::size_t b, std::size_t e) {
+  };
+  forPieces(loopOf(loops, &ForceLoops::membraneElements), n - r, kPieceElements, membraneElementsPiece);
+  const auto blocksPiece = [&](std::size_t b, std::size_t e) {
     gatherMembraneBlocks(e - b, el.vertexBlocks.data() + b, el.cornerStart.data(), el.cornerOffset.data(), n, w,
                          io.fx.data(), io.fy.data(), io.fz.data());
-  });
-  forPieces(loops ? &loops->membraneVertices : nullptr, el.singleVertices.size(), kPieceElements, [&](std::size_t b, std::size_t e) {
+  };
+  forPieces(loopOf(loops, &ForceLoops::membraneBlocks), el.vertexBlocks.size(), kPieceBlocks, blocksPiece);
+  const auto singlesPiece = [&](std::size_t b, std::size_t e) {
     gatherMembraneSingles(e - b, el.singleVertices.data() + b, el.cornerStart.data(), el.cornerOffset.data(), n, w,
                           io.fx.data(), io.fy.data(), io.fz.data());
-  });
+  };
+  forPieces(loopOf(loops, &ForceLoops::membraneVertices), el.singleVertices.size(), kPieceElements, singlesPiece);
 }
 
 /// Bending pass 1: the forces on a, b, e0 and e1 of every hinge into w (columns fa, fb, fe0,
@@ -371,23 +378,26 @@ void accumulateBendingForces(const ClothModel& model, ClothState& io, double sca
   const double *x = io.x.data(), *y = io.y.data(), *z = io.z.data();
   double* w = io.work.data();  // twelve columns of n
   const auto r = static_cast<std::size_t>(h.runEnd);
-  forPieces(loops ? &loops->hingeRuns : nullptr, h.runBlocks.size(), kPieceElements / kKernelRun, [&](std::size_t b, std::size_t e) {
+  const auto hingeRunsPiece = [&](std::size_t b, std::size_t e) {
     hingeCornerForces<true>(e - b, h.runBlocks.data() + b, x, y, z, h.e0.data(), h.e1.data(), h.a.data(),
                             h.b.data(), h.restPsi.data(), h.stiffness.data(), scale, w, w + n, w + 2 * n, w + 3 * n,
                             w + 4 * n, w + 5 * n, w + 6 * n, w + 7 * n, w + 8 * n, w + 9 * n, w + 10 * n,
                             w + 11 * n);
-  });
-  forPieces(loops ? &loops->hinges : nullptr, n - r, kPieceElements, [&](std::size_t b, std::size_t e) {
+  };
+  forPieces(loopOf(loops, &ForceLoops::hingeRuns), h.runBlocks.size(), kPieceElements / kKernelRun, hingeRunsPiece);
+  const auto hingesPiece = [&](std::size_t b, std::size_t e) {
     const std::size_t o = r + b;
     hingeCornerForces<false>(e - b, nullptr, x, y, z, h.e0.data() + o, h.e1.data() + o, h.a.data() + o,
                              h.b.data() + o, h.restPsi.data() + o, h.stiffness.data() + o, scale, w + o, w + n + o,
                              w + 2 * n + o, w + 3 * n + o, w + 4 * n + o, w + 5 * n + o, w + 6 * n + o,
                              w + 7 * n + o, w + 8 * n + o, w + 9 * n + o, w + 10 * n + o, w + 11 * n + o);
-  });
-  forPieces(loops ? &loops->hingeVertices : nullptr, io.size(), kPieceElements, [&](std::size_t b, std::size_t e) {
+  };
+  forPieces(loopOf(loops, &ForceLoops::hinges), n - r, kPieceElements, hingesPiece);
+  const auto hingeVerticesPiece = [&](std::size_t b, std::size_t e) {
     gatherHinges(e - b, n, h.cornerStart.data() + b, h.cornerOffset.data(), w, io.fx.data() + b, io.fy.data() + b,
                  io.fz.data() + b);
-  });
+  };
+  forPieces(loopOf(loops, &ForceLoops::hingeVertices), io.size(), kPieceElements, hingeVerticesPiece);
 }
 
 namespace {

@@ -242,7 +242,8 @@ void ClothSolver::accumulateForces() {
   // symplectic inner step; counted over the whole take so that the rhythm runs on across
   // frame boundaries.
   const int every = settings_.bendEvery;
-  if (substepCount_++ % every == 0) accumulateBendingForces(*model_, state_, static_cast<double>(every), parallelForces_ ? &forceLoops_ : nullptr);
+  if (substepCount_++ % every == 0)
+    accumulateBendingForces(*model_, state_, static_cast<double>(every), parallelForces_ ? &forceLoops_ : nullptr);
   accumulateDragForces(*model_, settings_, state_);
 }
 

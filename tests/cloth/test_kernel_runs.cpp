@@ -5,9 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <numeric>
 #include <random>
+
+#include <tbb/global_control.h>
 
 #include "cloth_fixture.hpp"
 
@@ -160,6 +163,51 @@ TEST(KernelRuns, ForcesDoNotDependOnTheRuns) {
       ASSERT_NEAR(sa.fx[v], sb.fx[w], tolerance) << "trial " << trial << " vertex " << v;
       ASSERT_NEAR(sa.fy[v], sb.fy[w], tolerance) << "trial " << trial << " vertex " << v;
       ASSERT_NEAR(sa.fz[v], sb.fz[w], tolerance) << "trial " << trial << " vertex " << v;
+    }
+  }
+}
+
+TEST(KernelRuns, PiecesOnThreadsGiveTheSameForcesToTheBit) {
+  // A model above kParallelFrom_elements, with runs and renumbered (no runs): its forces
+  // computed in pieces on two threads (ForceLoops) and at once must be equal, not close.
+  const tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
+  const mesh::TriMesh structured = tube(64, 20);
+  mesh::TriMesh shuffled = structured;
+  std::vector<std::uint32_t> renumber(structured.vertexCount());
+  std::iota(renumber.begin(), renumber.end(), 0U);
+  std::mt19937 rng(11);
+  std::shuffle(renumber.begin(), renumber.end(), rng);
+  for (std::size_t v = 0; v < renumber.size(); ++v) shuffled.positions[renumber[v]] = structured.positions[v];
+  for (mesh::Triangle& t : shuffled.triangles)
+    for (std::uint32_t& v : t) v = renumber[v];
+  std::normal_distribution<double> move(0.0, 0.01), speed(0.0, 0.5);
+  const std::array<const mesh::TriMesh*, 2> meshes{&structured, &shuffled};
+  for (const mesh::TriMesh* mesh : meshes) {
+    auto model = makeModel(*mesh, dampedSoftKnit());
+    ASSERT_GE(model->membraneArrays().area.size(), kParallelFrom_elements);
+    ASSERT_GE(model->bendArrays().stiffness.size(), kParallelFrom_elements);
+    ForceLoops loops;
+    for (int trial = 0; trial < 5; ++trial) {
+      ClothState once = ClothState::atRest(*model);
+      for (std::size_t v = 0; v < once.size(); ++v) {
+        once.x[v] += move(rng);
+        once.y[v] += move(rng);
+        once.z[v] += move(rng);
+        once.vx[v] = speed(rng);
+        once.vy[v] = speed(rng);
+        once.vz[v] = speed(rng);
+      }
+      ClothState pieces = once;
+      for (auto [s, l] : {std::pair{&once, static_cast<ForceLoops*>(nullptr)}, std::pair{&pieces, &loops}}) {
+        clearForces(*s);
+        accumulateMembraneForces(*model, *s, l);
+        accumulateBendingForces(*model, *s, 1.0, l);
+      }
+      for (std::size_t v = 0; v < once.size(); ++v) {
+        ASSERT_EQ(once.fx[v], pieces.fx[v]) << "trial " << trial << " vertex " << v;
+        ASSERT_EQ(once.fy[v], pieces.fy[v]) << "trial " << trial << " vertex " << v;
+        ASSERT_EQ(once.fz[v], pieces.fz[v]) << "trial " << trial << " vertex " << v;
+      }
     }
   }
 }

@@ -237,7 +237,7 @@ class FieldCollider final : public Collider {
     parallelFrom_ = fromVertices;
   }
   /// How many ranges a test splits into (1 until initialise).
-  [[nodiscard]] std::size_t ranges() const { return rangeStart_.size() > 1 ? rangeStart_.size() - 1 : 1; }
+  [[nodiscard]] std::size_t ranges() const { return rangeStart_.size() - 1; }
   /// Off: every (point, part) pair goes through the full per-pair test (the reference the
   /// culled path is tested against). On by default.
   void setBoxCulling(bool on) { boxCulling_ = on; }

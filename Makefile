@@ -1,7 +1,8 @@
 # drape: the two commands are `make demo` and `make test`.
 #   make build   install missing Debian packages, build the optimised binary build/release/drape
 #   make demo    build, then run the bundled example and print where its results are
-#   make test    install, build with AddressSanitizer + UBSan (build/asan), run every test with CTest
+#   make test    install, build with AddressSanitizer + UBSan (build/asan), run every test with CTest;
+#                then build as `make build` does, tests included (build/native), and run them again
 #   make fuzz    build the libFuzzer targets with clang and run each for FUZZ_SECONDS (default 60)
 #   make bench   run every benchmark on the optimised build and print their JSON
 
@@ -9,6 +10,7 @@ SHELL := /bin/bash
 JOBS ?= $(shell nproc)
 RELEASE_DIR := build/release
 ASAN_DIR := build/asan
+NATIVE_DIR := build/native
 FUZZ_DIR := build/fuzz
 FUZZ_SECONDS ?= 60
 DEMO_OUT ?= out/walking_skirt
@@ -31,6 +33,10 @@ test: deps
 	@cmake --build $(ASAN_DIR) -j $(JOBS)
 	@cd $(ASAN_DIR) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 		ctest --output-on-failure -j $(JOBS)
+	@echo "the suite again, built for this machine as build/release is (its vector and fused multiply-add paths)"
+	@cmake -S . -B $(NATIVE_DIR) -G Ninja -DCMAKE_BUILD_TYPE=Release -DDRAPE_NATIVE=ON -DDRAPE_BUILD_TESTS=ON >/dev/null
+	@cmake --build $(NATIVE_DIR) -j $(JOBS)
+	@cd $(NATIVE_DIR) && ctest --output-on-failure -j $(JOBS)
 
 fuzz: deps
 	@CC=clang CXX=clang++ cmake -S . -B $(FUZZ_DIR) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDRAPE_FUZZ=ON -DDRAPE_BUILD_TESTS=OFF >/dev/null

@@ -360,6 +360,8 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
                             firstUnbound));
   }
 
+  liftOutOfTheParts(spec, parts, local);
+
   std::vector<std::uint8_t> adjacent(np * np, 0);  // parts whose joints are parent and child
   for (std::size_t a = 0; a < np; ++a)
     for (std::size_t b = 0; b < np; ++b) {
@@ -399,6 +401,106 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
     spdlog::info("garment '{}': {} of {} constraint-mask vertices follow a blend of parts across a joint", spec.name,
                  blended, n);
   return out;
+}
+
+void CharacterWorld::liftOutOfTheParts(const GarmentSpec& spec, const std::vector<int>& parts,
+                                       std::vector<Vec3>& local) const {
+  // A bound vertex never collides (the collider leaves the fixtures' vertices out), so one
+  // the garment puts inside a part (a collar cut for another body's neck) would stay there,
+  // with the skin showing through the cloth around it for the whole run. The mask is moved
+  // out of the body, onto the parts' surfaces, as one piece:
+  // alternately each vertex is pushed out of the parts by a Newton step on their fields at
+  // rest (as BodySkin fits the skin) and each of the mask's own edges is given back its
+  // length (position-based projection), ending on the parts. Pushed one by one, two
+  // neighbours deep in a thin part went out through its opposite sides, and the edge
+  // between them stretched by 144 %.
+  constexpr int kRounds = 64;
+  constexpr double kTolerance_m = 1e-4;
+  // Not out to T0, where free vertices stay: a waistband modelled on the skin then stood
+  // off it, and the skin showed through the skirt below it on the Daz-style walk.
+  constexpr double target = 0.0;
+  const std::size_t np = parts.size(), n = spec.bound.size();
+  std::vector<RigidTransform> pose(np);
+  for (std::size_t k = 0; k < np; ++k) pose[k] = partMotions_[static_cast<std::size_t>(parts[k])]->poseAt(0.0);
+  std::vector<Vec3> p(n);
+  for (std::size_t i = 0; i < n; ++i) p[i] = spec.mesh.positions[spec.bound[i]];
+  const std::vector<Vec3> modelled = p;
+
+  // How far q lies inside part k (0 if not); l: q in the part's frame.
+  const auto below = [&](const Vec3& q, std::size_t k, Vec3& l) {
+    const field::DistanceField& f = fields_[static_cast<std::size_t>(parts[k])].field;
+    l = pose[k].inverse().apply(q);
+    const field::PointLocation at = f.locate(l);
+    return at.inVolume && at.distance_m < target - kTolerance_m ? target - at.distance_m : 0.0;
+  };
+  // Pushes p[i] out of every part it is inside. The gradient over its squared length
+  // meets the surface in one step where the trilinear field is linear; where it vanishes (a blend's
+  // flat middle), the offset-surface normal.
+  const auto pushOut = [&](std::size_t i) {
+    for (std::size_t k = 0; k < np; ++k) {
+      Vec3 l;
+      const double depth = below(p[i], k, l);
+      if (depth <= 0) continue;
+      const field::DistanceField& f = fields_[static_cast<std::size_t>(parts[k])].field;
+      const field::FieldJet jet = f.jetAtVoxel(f.toVoxel(l));
+      const Vec3 g = jet.gradient / f.voxelSize();
+      const Vec3 step = g.squaredNorm() > 0.25 ? Vec3(g / g.squaredNorm()) : jet.sample.normal;
+      p[i] += pose[k].rotation * (step * depth);
+    }
+  };
+  const auto deepestBelow = [&](const Vec3& q, std::size_t* part) {
+    double deepest = 0;
+    for (std::size_t k = 0; k < np; ++k) {
+      Vec3 l;
+      const double depth = below(q, k, l);
+      if (depth > deepest && part) *part = k;
+      deepest = std::max(deepest, depth);
+    }
+    return deepest;
+  };
+  std::size_t modelledBelow = 0, deepestPart = 0;
+  double deepest = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t part = 0;
+    const double depth = deepestBelow(p[i], &part);
+    modelledBelow += depth > 0;
+    if (depth > deepest) deepest = depth, deepestPart = part;
+  }
+  if (modelledBelow == 0) return;
+  const std::vector<std::vector<std::size_t>> next = maskNeighbours(spec.mesh, spec.bound);
+  for (int round = 0; round < kRounds; ++round) {
+    for (std::size_t i = 0; i < n; ++i) pushOut(i);
+    if (round + 1 == kRounds) break;
+    for (std::size_t i = 0; i < n; ++i)
+      for (const std::size_t j : next[i]) {
+        if (j < i) continue;
+        const double rest = (modelled[j] - modelled[i]).norm();
+        const Vec3 d = p[j] - p[i];
+        const double length = d.norm();
+        if (length <= 0) continue;
+        const Vec3 half = 0.5 * (length - rest) / length * d;
+        p[i] += half;
+        p[j] -= half;
+      }
+  }
+  std::size_t still = 0;
+  double furthest = 0, strain = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    still += deepestBelow(p[i], nullptr) > 0;
+    furthest = std::max(furthest, (p[i] - modelled[i]).norm());
+    for (const std::size_t j : next[i]) {
+      const double rest = (modelled[j] - modelled[i]).norm();
+      if (rest > 0) strain = std::max(strain, std::abs((p[j] - p[i]).norm() / rest - 1.0));
+    }
+    if (p[i] != modelled[i])
+      for (std::size_t k = 0; k < np; ++k) local[i * np + k] = pose[k].inverse().apply(p[i]);
+  }
+  spdlog::info("garment '{}': {} of {} constraint-mask vertices lay inside a collidable part, the deepest {:.1f} mm "
+               "in '{}'; the mask is bound lifted out onto the parts (moved {:.1f} mm at most, its edges {:.0f} % "
+               "longer or shorter at most{})",
+               spec.name, modelledBelow, n, 1e3 * deepest,
+               fields_[static_cast<std::size_t>(parts[deepestPart])].segment, 1e3 * furthest, 100 * strain,
+               still ? fmt::format("; {} still inside", still) : std::string());
 }
 
 bool CharacterWorld::stepFrame(long frame) {

@@ -158,6 +158,10 @@ class CharacterWorld {
   [[nodiscard]] std::vector<cloth::PinGroup> bindMask(
       const GarmentSpec& spec, const std::vector<int>& parts,
       const std::vector<std::shared_ptr<const cloth::FixtureMotion>>& motions) const;
+  /// Moves a constraint mask with vertices inside a collidable part at rest out onto the
+  /// parts' surfaces, keeping its edges' lengths as far as it can: `local` (per mask vertex and part, as
+  /// bindMask computes them) then places the mask there.
+  void liftOutOfTheParts(const GarmentSpec& spec, const std::vector<int>& parts, std::vector<Vec3>& local) const;
 
   const scene::Avatar& avatar_;
   WorldSettings settings_;

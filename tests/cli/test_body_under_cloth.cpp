@@ -168,24 +168,26 @@ TEST(BodyUnderCloth, TheSkinIsNowhereOutsideTheWalkingSkirt) {
 // The walking dress was modelled on a smoother body: its collar and yoke, which its mask
 // binds, lay up to 6 mm inside this body's chest, and bound there (bound vertices never
 // collide, and the tuck leaves skin under cloth inside a part) the skin showed through the
-// back of the collar in every frame: 1,083 of these points more than 3 mm inside the skin
-// before the mask was lifted out of the body (sim/character_world.cpp), 85 after. What
-// remains are single frames (a forearm passing the waist, a knee at the hem).
+// back of the collar in every frame. Over the lead-in and the walk's first second (frames
+// 5 to 60, every fifth; frame 0 is the suit as modelled, its chest inside the body), 447 of
+// these points lay more than 3 mm inside the skin before the mask was lifted out of the body
+// (sim/character_world.cpp), 3 after. Over the whole walk, 1,083 and 85: what remains are
+// single frames (a forearm passing the waist, a knee at the hem).
 TEST(BodyUnderCloth, TheSkinShowsThroughTheWalkingDressOnlyInPlaces) {
   const std::string dress = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_dress";
   testing::ScratchDir dir("body-under-dress");
   const std::string out = dir / "out";
-  const testing::CliResult r =
-      testing::runDrape("run '" + dress + "/scene.wrl' --motion '" + kSkirtDir + "/walk.bvh' --out '" + out + "'", dir);
+  const testing::CliResult r = testing::runDrape(
+      "run '" + dress + "/scene.wrl' --motion '" + kSkirtDir + "/walk.bvh' --frames 60 --out '" + out + "'", dir);
   ASSERT_EQ(r.code, 0) << r.err;
   const std::set<std::string> collidable = {"Hips",    "LowerBack", "Spine",       "Spine1",       "Neck",
                                             "LeftShoulder", "RightShoulder", "LeftArm", "RightArm",
                                             "LeftForeArm",  "RightForeArm",  "LeftUpLeg", "RightUpLeg",
                                             "LeftLeg",      "RightLeg"};
-  const Deepest d = deepestInsideSkin(out, collidable, 0, 5);
+  const Deepest d = deepestInsideSkin(out, collidable, 5, 5);
   std::printf("%zu points of the dress, %zu more than 3 mm inside the skin, at most %.2f mm (frame %zu)\n", d.points,
               d.beyond3mm, 1e3 * d.depth_m, d.frame);
-  EXPECT_GT(d.points, 400000u);
+  EXPECT_GT(d.points, 100000u);
   EXPECT_LT(d.beyond3mm, d.points / 2000) << "the skin shows through more than 0.05 % of the dress";
 }
 

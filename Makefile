@@ -33,7 +33,7 @@ test: deps
 	@cmake --build $(ASAN_DIR) -j $(JOBS)
 	@cd $(ASAN_DIR) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 		ctest --output-on-failure -j $(JOBS)
-	@echo "the suite again, built for this machine as build/release is (its vector and fused multiply-add paths)"
+	@echo "the suite again in $(NATIVE_DIR), optimised for this machine as $(RELEASE_DIR) is (its vector and fused multiply-add paths)"
 	@cmake -S . -B $(NATIVE_DIR) -G Ninja -DCMAKE_BUILD_TYPE=Release -DDRAPE_NATIVE=ON -DDRAPE_BUILD_TESTS=ON >/dev/null
 	@cmake --build $(NATIVE_DIR) -j $(JOBS)
 	@cd $(NATIVE_DIR) && ctest --output-on-failure -j $(JOBS)

@@ -420,8 +420,11 @@ void CharacterWorld::liftOutOfTheParts(const GarmentSpec& spec, const std::vecto
   // off it, and the skin showed through the skirt below it on the Daz-style walk.
   constexpr double target = 0.0;
   const std::size_t np = parts.size(), n = spec.bound.size();
-  std::vector<RigidTransform> pose(np);
-  for (std::size_t k = 0; k < np; ++k) pose[k] = partMotions_[static_cast<std::size_t>(parts[k])]->poseAt(0.0);
+  std::vector<RigidTransform> pose(np), toLocal(np);
+  for (std::size_t k = 0; k < np; ++k) {
+    pose[k] = partMotions_[static_cast<std::size_t>(parts[k])]->poseAt(0.0);
+    toLocal[k] = pose[k].inverse();
+  }
   std::vector<Vec3> p(n);
   for (std::size_t i = 0; i < n; ++i) p[i] = spec.mesh.positions[spec.bound[i]];
   const std::vector<Vec3> modelled = p;
@@ -429,7 +432,7 @@ void CharacterWorld::liftOutOfTheParts(const GarmentSpec& spec, const std::vecto
   // How far q lies inside part k (0 if not); l: q in the part's frame.
   const auto below = [&](const Vec3& q, std::size_t k, Vec3& l) {
     const field::DistanceField& f = fields_[static_cast<std::size_t>(parts[k])].field;
-    l = pose[k].inverse().apply(q);
+    l = toLocal[k].apply(q);
     const field::PointLocation at = f.locate(l);
     return at.inVolume && at.distance_m < target - kTolerance_m ? target - at.distance_m : 0.0;
   };
@@ -467,37 +470,40 @@ void CharacterWorld::liftOutOfTheParts(const GarmentSpec& spec, const std::vecto
     if (depth > deepest) deepest = depth, deepestPart = part;
   }
   if (modelledBelow == 0) return;
+  struct Edge {
+    std::size_t a, b;
+    double rest_m;
+  };
+  std::vector<Edge> edges;  // the mask's own, each once
   const std::vector<std::vector<std::size_t>> next = maskNeighbours(spec.mesh, spec.bound);
+  for (std::size_t i = 0; i < n; ++i)
+    for (const std::size_t j : next[i])
+      if (j > i) edges.push_back({i, j, (modelled[j] - modelled[i]).norm()});
   for (int round = 0; round < kRounds; ++round) {
     for (std::size_t i = 0; i < n; ++i) pushOut(i);
     if (round + 1 == kRounds) break;
-    for (std::size_t i = 0; i < n; ++i)
-      for (const std::size_t j : next[i]) {
-        if (j < i) continue;
-        const double rest = (modelled[j] - modelled[i]).norm();
-        const Vec3 d = p[j] - p[i];
-        const double length = d.norm();
-        if (length <= 0) continue;
-        const Vec3 half = 0.5 * (length - rest) / length * d;
-        p[i] += half;
-        p[j] -= half;
-      }
+    for (const Edge& e : edges) {
+      const Vec3 d = p[e.b] - p[e.a];
+      const double length = d.norm();
+      if (length <= 0) continue;
+      const Vec3 half = 0.5 * (length - e.rest_m) / length * d;
+      p[e.a] += half;
+      p[e.b] -= half;
+    }
   }
   std::size_t still = 0;
   double furthest = 0, strain = 0;
   for (std::size_t i = 0; i < n; ++i) {
     still += deepestBelow(p[i], nullptr) > 0;
     furthest = std::max(furthest, (p[i] - modelled[i]).norm());
-    for (const std::size_t j : next[i]) {
-      const double rest = (modelled[j] - modelled[i]).norm();
-      if (rest > 0) strain = std::max(strain, std::abs((p[j] - p[i]).norm() / rest - 1.0));
-    }
     if (p[i] != modelled[i])
-      for (std::size_t k = 0; k < np; ++k) local[i * np + k] = pose[k].inverse().apply(p[i]);
+      for (std::size_t k = 0; k < np; ++k) local[i * np + k] = toLocal[k].apply(p[i]);
   }
-  spdlog::info("garment '{}': {} of {} constraint-mask vertices lay inside a collidable part, the deepest {:.1f} mm "
-               "in '{}'; the mask is bound lifted out onto the parts (moved {:.1f} mm at most, its edges {:.0f} % "
-               "longer or shorter at most{})",
+  for (const Edge& e : edges)
+    if (e.rest_m > 0) strain = std::max(strain, std::abs((p[e.b] - p[e.a]).norm() / e.rest_m - 1.0));
+  spdlog::info("garment '{}': {} of {} constraint-mask vertices lie inside a collidable part where the garment was "
+               "modelled, the deepest {:.1f} mm inside '{}'; the mask is moved out onto the body before it is bound "
+               "(by {:.1f} mm at most, its edges {:.0f} % longer or shorter at most{})",
                spec.name, modelledBelow, n, 1e3 * deepest,
                fields_[static_cast<std::size_t>(parts[deepestPart])].segment, 1e3 * furthest, 100 * strain,
                still ? fmt::format("; {} still inside", still) : std::string());

@@ -352,6 +352,8 @@ class FieldCollider final : public Collider {
   void setRanges(std::size_t vertices, std::size_t rangeVertices);
   /// One range's pairs against every part, in part order.
   void collideRange(std::size_t range, double dt_s, ClothState& io);
+  /// slidingParts_ of points [first, last) from their states after the test (collideFaces).
+  void markSlidingParts(std::size_t first, std::size_t last);
   /// The ranges' tallies into the collider's counters and correction lists, in range order.
   void mergeTallies(std::size_t ranges);
   /// Fills endVoxel* with the end positions of points [first, last) in part k's voxel

@@ -285,14 +285,10 @@ BodySkin::Nearest BodySkin::nearestPart(std::size_t v, const Vec3& p, std::span<
     // Beyond the grid the distance is clamped, not measured: a vertex that far from a part
     // it is skinned to is left where skinning put it.
     if (!at.inVolume || at.distance_m >= n.distance_m) continue;
-    // A Newton step on the trilinear distance: the gradient, over its squared length, so
-    // that one step meets the allowance where the field is linear. Where the gradient
-    // vanishes (the blend's flat middle), the offset-surface normal.
-    const field::FieldJet jet = part.field.jetAtVoxel(part.field.toVoxel(local));
-    const Vec3 g = jet.gradient / part.field.voxelSize();
-    const Vec3 step = g.squaredNorm() > 0.25 ? Vec3(g / g.squaredNorm()) : jet.sample.normal;
+    // A Newton step on the trilinear distance: one step meets the allowance where the
+    // field is linear.
     n.distance_m = at.distance_m;
-    n.away = jointWorld[static_cast<std::size_t>(part.joint)].rotation * step;
+    n.away = jointWorld[static_cast<std::size_t>(part.joint)].rotation * part.field.newtonDirection(local);
   }
   return n;
 }

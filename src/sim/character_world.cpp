@@ -436,19 +436,15 @@ void CharacterWorld::liftOutOfTheParts(const GarmentSpec& spec, const std::vecto
     const field::PointLocation at = f.locate(l);
     return at.inVolume && at.distance_m < target - kTolerance_m ? target - at.distance_m : 0.0;
   };
-  // Pushes p[i] out of every part it is inside. The gradient over its squared length
-  // meets the surface in one step where the trilinear field is linear; where it vanishes (a blend's
-  // flat middle), the offset-surface normal.
+  // Pushes p[i] out of every part it is inside, by a Newton step on each one's field (as
+  // the skin's fit does).
   const auto pushOut = [&](std::size_t i) {
     for (std::size_t k = 0; k < np; ++k) {
       Vec3 l;
       const double depth = below(p[i], k, l);
       if (depth <= 0) continue;
       const field::DistanceField& f = fields_[static_cast<std::size_t>(parts[k])].field;
-      const field::FieldJet jet = f.jetAtVoxel(f.toVoxel(l));
-      const Vec3 g = jet.gradient / f.voxelSize();
-      const Vec3 step = g.squaredNorm() > 0.25 ? Vec3(g / g.squaredNorm()) : jet.sample.normal;
-      p[i] += pose[k].rotation * (step * depth);
+      p[i] += pose[k].rotation * (f.newtonDirection(l) * depth);
     }
   };
   const auto deepestBelow = [&](const Vec3& q, std::size_t* part) {

@@ -126,6 +126,36 @@ TEST(DistanceField, JetGradientIsTheTrilinearDerivative) {
   EXPECT_EQ(beyond.gradient.x(), 0.0);
 }
 
+TEST(DistanceField, NewtonStepsMeetTheSurface) {
+  // Random points within 3 cm of a sphere (r = 0.2 m, 1 cm voxels), moved by steps of
+  // newtonDirection times the distance the field reads: the first step points outwards (not
+  // along the radius: the trilinear gradient of distances stored within a voxel of the
+  // truth turns up to about 60 degrees from it), and eight leave the point within a
+  // twentieth of a voxel of the field's zero (not closer: a step can land in a cell whose
+  // gradient differs). Where the gradient vanishes (the centre, the distance's minimum) the
+  // direction is the offset-surface normal.
+  const double r = 0.2;
+  const DistanceField f = DistanceField::build(makeSphere(r, Vec3::Zero(), 96, 48), sphereSettings(FieldMethod::Exact));
+  const double h = f.voxelSize();
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> radius(r - 0.03, r + 0.03), unit(-1, 1);
+  double start = 0;
+  for (int k = 0; k < 2000; ++k) {
+    Vec3 direction(unit(rng), unit(rng), unit(rng));
+    if (direction.norm() < 0.1) continue;
+    direction.normalize();
+    Vec3 p = radius(rng) * direction;
+    const double d0 = f.distanceAt(p);
+    start = std::max(start, std::abs(d0));
+    ASSERT_GT(f.newtonDirection(p).dot(direction), 0.0) << "point " << p.transpose();
+    for (int step = 0; step < 8; ++step) p -= f.distanceAt(p) * f.newtonDirection(p);
+    ASSERT_LT(std::abs(f.distanceAt(p)), 0.05 * h) << "from " << d0;
+  }
+  EXPECT_GT(start, 0.025);
+  const Vec3 centre = Vec3::Constant(0.001);
+  EXPECT_TRUE(f.newtonDirection(centre).isApprox(f.normalAt(centre)));
+}
+
 TEST(DistanceField, DvdpAndExactAgreeWithinTheShellAndReferencesAreSurfaceVoxels) {
   const mesh::TriMesh tube = makeRoundedTube(0.05, 0.035, 0.3);
   const DistanceField a = DistanceField::build(tube, sphereSettings(FieldMethod::Dvdp));

@@ -143,6 +143,11 @@ class DistanceField {
   /// sampleAtVoxel and the trilinear distance's gradient (zero along an axis where the point
   /// lies beyond the grid, which clamps it there).
   [[nodiscard]] FieldJet jetAtVoxel(const Vec3& voxel) const;
+  /// A Newton step's direction at a local point, in local metres of motion per metre of
+  /// distance to gain: the trilinear distance's gradient over its squared length, so that
+  /// one step meets the level sought where the blend is linear; where the gradient nearly
+  /// vanishes (under 1/2 long: a blend's flat middle), the offset-surface normal.
+  [[nodiscard]] Vec3 newtonDirection(const Vec3& local_m) const;
 
   // --- Voronoi cells (cold: binary search) -----------------------------------------------------
   /// Surface voxels whose Voronoi cell holds this voxel (empty beyond the shell).
@@ -273,6 +278,12 @@ inline FieldJet DistanceField::jetAtVoxel(const Vec3& c) const {
                     (1 - fx) * fy * (v[6] - v[2]) + fx * fy * (v[7] - v[3]);
   const Vec3 gradient(g.clampedX ? 0.0 : dx, g.clampedY ? 0.0 : dy, g.clampedZ ? 0.0 : dz);
   return {{blendDistance(g), blendNormal(g, c)}, gradient * metresPerUnit_};
+}
+
+inline Vec3 DistanceField::newtonDirection(const Vec3& local_m) const {
+  const FieldJet jet = jetAtVoxel(toVoxel(local_m));
+  const Vec3 g = jet.gradient / voxelSize();
+  return g.squaredNorm() > 0.25 ? Vec3(g / g.squaredNorm()) : jet.sample.normal;
 }
 
 /// Grid placement for a part: its bounding box plus `border` voxels each side (cubic voxels

@@ -100,7 +100,8 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
     return true;
   });
   options.loop = false;
-  const render::PlayerStats stats = render::Player(options).run(source);
+  render::SubdividedSource shown(source, o.picture.subdivide);
+  const render::PlayerStats stats = render::Player(options).run(shown);
   std::cout << fmt::format("simulated and showed {} frames in {:.1f} s\n", stats.framesDrawn, stats.seconds);
   return 0;
 }
@@ -144,7 +145,8 @@ RunFunction setupPlay(CLI::App& app) {
     options.view.bounds = replay.bounds();
     options.overlay = o.picture.overlay();
     options.screenshot = o.screenshot;
-    const render::PlayerStats stats = render::Player(options).run(replay);
+    render::SubdividedSource shown(replay, o.picture.subdivide);
+    const render::PlayerStats stats = render::Player(options).run(shown);
     std::cout << fmt::format("showed {} frames in {:.1f} s\n", stats.framesDrawn, stats.seconds);
     return 0;
   };

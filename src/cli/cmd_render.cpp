@@ -98,6 +98,7 @@ RunFunction setupRender(CLI::App& app) {
     job.hud = !o.noHud;
     job.orbitDeg = o.orbit;
     job.follow = o.picture.follow;
+    job.subdivisionLevels = o.picture.subdivide;
     job.view = o.picture.view();
     job.overlay = o.picture.overlay();
     const render::RenderSummary summary = render::renderRun(runDir, job);

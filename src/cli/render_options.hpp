@@ -8,6 +8,7 @@
 
 #include "command.hpp"
 #include "drape/core/error.hpp"
+#include "drape/render/display_surface.hpp"
 #include "drape/render/renderer.hpp"
 
 namespace drape::cli {
@@ -26,6 +27,7 @@ struct PictureOptions {
   bool distanceSlice = false;
   bool markers = false;
   bool segments = false;
+  int subdivide = render::kDefaultSubdivisionLevels;
 
   void add(CLI::App& app) {
     app.add_option("--size", size, "Picture size WIDTHxHEIGHT in pixels")->capture_default_str();
@@ -49,6 +51,11 @@ struct PictureOptions {
     app.add_flag("--markers", markers, "Mark pinned and bound garment vertices");
     app.add_flag("--segments", segments,
                  "Draw the avatar as the rigid segments the cloth collides with instead of its skinned body");
+    app.add_option("--subdivide", subdivide,
+                   "Draw the garments as Loop subdivision surfaces of their simulated meshes, refined this many "
+                   "times (each time four triangles for one); 0: the simulated triangles as they are")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 4));
   }
 
   /// WIDTHxHEIGHT; throws drape::Error naming --size otherwise.

@@ -161,7 +161,8 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
   if (!job.videoPath.empty())
     video = std::make_unique<VideoEncoder>(job.videoPath, job.width, job.height, replay.frameRate());
 
-  HeadlessRenderer renderer(replay.meshes(), job.width, job.height);
+  SubdividedSource shown(replay, job.subdivisionLevels);
+  HeadlessRenderer renderer(shown.meshes(), job.width, job.height);
   RenderSummary summary;
   summary.glDescription = renderer.description();
   Frame frame;
@@ -170,7 +171,7 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
   if (!job.pngDirectory.empty() || video) {
     Progress progress("render", last - first + 1);
     for (std::int64_t i = first; i <= last; ++i) {
-      replay.read(i, frame);
+      shown.read(i, frame);
       HudInfo hud = hudFor(frame, replay);
       hud.show = job.hud;
       const Image image = renderer.render(frame, viewAt(view, job.orbitDeg, follow, i, frames), job.overlay, hud);
@@ -199,7 +200,7 @@ RenderSummary renderRun(const std::string& runDirectory, const RenderJob& job) {
     for (std::int64_t& index : summary.sheetFrames) index += first;
     for (int t = 0; t < kSheetTiles; ++t) {
       const std::int64_t index = summary.sheetFrames[static_cast<std::size_t>(t)];
-      replay.read(index, frame);
+      shown.read(index, frame);
       HudInfo hud = hudFor(frame, replay);
       hud.timeCodeOnly = true;
       const Image tile = renderer.render(frame, viewAt(view, job.orbitDeg, follow, index, frames), job.overlay, hud);

@@ -226,6 +226,28 @@ TEST(PlayCli, NoDisplayIsAClearError) {
   EXPECT_NE(r.output.find("needs a display"), std::string::npos) << r.output;
 }
 
+TEST(RenderCli, SubdividedGarmentsCoverAboutWhatTheSimulatedTrianglesCover) {
+  // The same frame drawn as simulated and as a surface of two refinements: other pictures,
+  // with about as many cloth-coloured pixels (the surface passes near the simulated points).
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_subdivide"), 3);
+  for (const char* levels : {"0", "2"}) {
+    const Result r = run(drape() + " render " + dir + " --png " + dir + "/png" + levels + " --size 320x240 --no-hud" +
+                         " --range 1 --subdivide " + levels);
+    ASSERT_EQ(r.status, 0) << r.output;
+  }
+  const Image flat = readPng(dir + "/png0/frame_00001.png"), smooth = readPng(dir + "/png2/frame_00001.png");
+  const auto clothPixels = [](const Image& image) {
+    std::size_t n = 0;
+    for (std::size_t p = 0; p + 2 < image.rgb.size(); p += 3)
+      n += image.rgb[p] > 120 && image.rgb[p + 1] < 110 && image.rgb[p + 2] < 110;  // the garments' red
+    return n;
+  };
+  EXPECT_NE(flat.rgb, smooth.rgb);
+  const double a = static_cast<double>(clothPixels(flat)), b = static_cast<double>(clothPixels(smooth));
+  ASSERT_GT(a, 500);
+  EXPECT_NEAR(b / a, 1.0, 0.1) << a << " and " << b << " cloth pixels";
+}
+
 TEST(RenderCli, BadInputsExitWithTwoAndSayWhat) {
   const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_bad"), 2);
   Result r = run(drape() + " render " + dir + "/nowhere --png " + dir + "/png");
@@ -239,6 +261,9 @@ TEST(RenderCli, BadInputsExitWithTwoAndSayWhat) {
   r = run(drape() + " render " + dir + " --png " + dir + "/png --aim 1.5");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.output.find("--aim"), std::string::npos) << r.output;
+  r = run(drape() + " render " + dir + " --png " + dir + "/png --subdivide 5");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("--subdivide"), std::string::npos) << r.output;
   r = run(drape() + " render " + dir);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.output.find("nothing to write"), std::string::npos) << r.output;

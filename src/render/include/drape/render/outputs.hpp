@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "drape/render/display_surface.hpp"
 #include "drape/render/frame.hpp"
 #include "drape/render/renderer.hpp"
 
@@ -27,6 +28,9 @@ struct RenderJob {
   /// the same whichever range it is rendered in, and PNG files keep the run's frame numbers.
   std::int64_t firstFrame = 0;
   std::int64_t lastFrame = -1;
+  /// Garments drawn as Loop subdivision surfaces of this many refinements (0: the simulated
+  /// meshes as they are; display_surface.hpp).
+  int subdivisionLevels = kDefaultSubdivisionLevels;
   ViewSettings view;
   OverlaySettings overlay;
 };

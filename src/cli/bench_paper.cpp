@@ -31,9 +31,12 @@
 namespace drape::cli {
 namespace {
 
+/// The threads the benchmark runs on: one, as the paper's figures, unless --threads says otherwise.
+int benchThreads() { return globalOptions().threads > 0 ? globalOptions().threads : 1; }
+
 /// CPU time, s: the calling thread's with one thread (other processes inflate it less), all
 /// threads' with --threads above one.
-double cpuSeconds() { return globalOptions().threads > 1 ? processCpuSeconds() : threadCpuSeconds(); }
+double cpuSeconds() { return benchThreads() > 1 ? processCpuSeconds() : threadCpuSeconds(); }
 
 const std::string kBundledScene = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt/scene.wrl";
 const std::string kBundledMotion = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt/walk.bvh";
@@ -181,8 +184,7 @@ RunFunction setupPaperBench(CLI::App& app) {
       ->delimiter(',');
   app.add_flag("--json", o.json, "Print JSON (the only format)");
   return [] {
-    // One thread, as the paper's figures, unless --threads says otherwise.
-    const int threads = globalOptions().threads > 0 ? globalOptions().threads : 1;
+    const int threads = benchThreads();
     const tbb::global_control threadLimit(tbb::global_control::max_allowed_parallelism,
                                           static_cast<std::size_t>(threads));
     std::vector<PaperRun> runs;

@@ -185,6 +185,21 @@ TEST(LoopSurface, RefusesWhatIsNotATriangleMesh) {
   EXPECT_THROW(one.positions(std::vector<Vec3>(2, Vec3::Zero()), out), Error);
 }
 
+TEST(LoopSurface, AVertexOfNoTriangleIsLeftOut) {
+  // Vertex 3 belongs to no triangle (a stray vertex of an OBJ): the surface is the one of
+  // the triangle alone, and its own points are not moved by it.
+  const std::vector<mesh::Triangle> one{{0, 1, 2}};
+  const std::vector<Vec3> withStray{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(5, 5, 5)};
+  const std::vector<Vec3> without(withStray.begin(), withStray.begin() + 3);
+  const LoopSurface a(4, one, 2), b(3, one, 2);
+  std::vector<Vec3> pa, pb;
+  a.positions(withStray, pa);
+  b.positions(without, pb);
+  for (const Vec3& p : pb) EXPECT_NE(std::find(pa.begin(), pa.end(), p), pa.end()) << p.transpose();
+  for (const mesh::Triangle& t : a.triangles())
+    for (const std::uint32_t v : t) EXPECT_LT(pa[v].norm(), 2.0);
+}
+
 TEST(SubdividedSource, RefinesTheGarmentsAndPassesTheBodyThrough) {
   std::mt19937 rng(5);
   const mesh::TriMesh sheet = jitteredSheet(rng);

@@ -200,6 +200,26 @@ TEST(LoopSurface, AVertexOfNoTriangleIsLeftOut) {
     for (const std::uint32_t v : t) EXPECT_LT(pa[v].norm(), 2.0);
 }
 
+TEST(LoopSurface, NonManifoldMeshesAreDrawnWithoutHarm) {
+  // Three triangles on one edge (a fin) and two fans meeting at one vertex (a bow tie):
+  // what an imported garment may hold. Each is refined, every position finite and near the
+  // mesh.
+  const std::vector<Vec3> fin{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, 1, 0), Vec3(0.5, -1, 0), Vec3(0.5, 0, 1)};
+  const std::vector<mesh::Triangle> finTriangles{{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
+  const std::vector<Vec3> bowTie{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(-1, 0, 0), Vec3(-1, -1, 0)};
+  const std::vector<mesh::Triangle> bowTieTriangles{{0, 1, 2}, {0, 3, 4}};
+  for (const auto& [points, triangles] : {std::pair{fin, finTriangles}, std::pair{bowTie, bowTieTriangles}}) {
+    const LoopSurface surface(points.size(), triangles, 3);
+    std::vector<Vec3> refined;
+    surface.positions(points, refined);
+    ASSERT_EQ(refined.size(), surface.vertexCount());
+    for (const Vec3& p : refined) {
+      ASSERT_TRUE(p.allFinite());
+      ASSERT_LT(p.norm(), 2.0);
+    }
+  }
+}
+
 TEST(SubdividedSource, RefinesTheGarmentsAndPassesTheBodyThrough) {
   std::mt19937 rng(5);
   const mesh::TriMesh sheet = jitteredSheet(rng);

@@ -30,7 +30,7 @@ double hingePsi(const Vec3& e0, const Vec3& e1, const Vec3& a, const Vec3& b) {
 
 /// The kernel order of a list of elements given their corner indices (N per element): runs
 /// (at least kKernelRun elements whose every corner goes up by one from each to the next)
-/// first, then the other elements in the list's order. Returns the list's indices in kernel
+/// first, then the other elements by their lowest corner. Returns the list's indices in kernel
 /// order; fills `blocks` (the first element of each block of kKernelRun the kernels take)
 /// and `runEnd` (the elements in runs). With `overlap` a run's last block ends where the
 /// run does and may overlap the one before; without, what a run leaves over after its whole
@@ -73,8 +73,15 @@ std::vector<std::uint32_t> kernelOrder(const std::vector<std::array<std::uint32_
     i = j;
   }
   runEnd = static_cast<std::int32_t>(order.size());
+  const std::size_t rest = order.size();
   for (std::uint32_t e = 0; e < corners.size(); ++e)
     if (!inRun[e]) order.push_back(e);
+  // By their lowest corner, so that the pieces the threads take (element ranges) read about
+  // the vertices the same threads sum (vertex ranges) where the vertex order keeps neighbours
+  // together. The sums do not change: each vertex adds its corners in the list's order.
+  const auto lowest = [&](std::uint32_t e) { return *std::min_element(corners[e].begin(), corners[e].end()); };
+  std::stable_sort(order.begin() + static_cast<std::ptrdiff_t>(rest), order.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return lowest(a) < lowest(b); });
   return order;
 }
 

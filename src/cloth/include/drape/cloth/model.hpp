@@ -58,7 +58,7 @@ inline constexpr std::int32_t kKernelRun = 8;
 /// The membrane elements again as structure of arrays, what the vectorised kernel reads
 /// (filled by buildKernelData from the MembraneElement list). The runs come first
 /// (elements [0, runEnd), taken in the blocks that start at `runBlocks`); the other
-/// elements follow in the list's order. Indices are signed 32-bit because that is what
+/// elements follow by their lowest corner (the threads' pieces, docs/PERFORMANCE.md). Indices are signed 32-bit because that is what
 /// vector gather instructions take.
 struct MembraneArrays {
   std::vector<std::int32_t> v0, v1, v2;

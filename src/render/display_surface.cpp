@@ -50,11 +50,10 @@ struct LoopSurface::Impl {
   std::unique_ptr<osd::TopologyRefiner> refiner;
   std::vector<std::size_t> levelStart;  ///< first vertex of each level in the one buffer of all levels
   std::vector<mesh::Triangle> triangles;
-  std::vector<char> ownChild;  ///< per refined vertex: the child of a simulated vertex (keeps its flags)
-  std::vector<std::int32_t> childOf;  ///< per simulated vertex: its own child in the last level
-  mutable std::vector<Point> points;
-  mutable std::vector<State> states;
-  mutable std::vector<Point> limit;
+  std::vector<std::int32_t> childOf;  ///< per simulated vertex: its own child in the last level, or -1
+  std::vector<Point> points;  ///< every level's vertices, one level after the other
+  std::vector<State> states;
+  std::vector<Point> limit;
 
   [[nodiscard]] int levels() const { return refiner->GetMaxLevel(); }
   [[nodiscard]] std::size_t refinedCount() const {
@@ -109,13 +108,11 @@ LoopSurface::LoopSurface(std::size_t vertexCount, std::span<const mesh::Triangle
                                                      static_cast<std::uint32_t>(v[2])};
   }
   // Each simulated vertex's child of its child ... down to the last level.
-  impl_->ownChild.assign(impl_->refinedCount(), 0);
   impl_->childOf.assign(vertexCount, -1);
   for (std::size_t v = 0; v < vertexCount; ++v) {
     int child = static_cast<int>(v);
     for (int l = 0; l < levels && child >= 0; ++l) child = impl_->refiner->GetLevel(l).GetVertexChildVertex(child);
     impl_->childOf[v] = child;
-    if (child >= 0) impl_->ownChild[static_cast<std::size_t>(child)] = 1;
   }
 }
 
@@ -126,7 +123,7 @@ LoopSurface& LoopSurface::operator=(LoopSurface&&) noexcept = default;
 std::size_t LoopSurface::vertexCount() const { return impl_->refinedCount(); }
 const std::vector<mesh::Triangle>& LoopSurface::triangles() const { return impl_->triangles; }
 
-void LoopSurface::positions(std::span<const Vec3> coarse, std::vector<Vec3>& out) const {
+void LoopSurface::positions(std::span<const Vec3> coarse, std::vector<Vec3>& out) {
   Impl& s = *impl_;
   const std::size_t n0 = s.levelStart[1];
   if (coarse.size() != n0)
@@ -160,7 +157,7 @@ void LoopSurface::positions(std::span<const Vec3> coarse, std::vector<Vec3>& out
   for (std::size_t v = 0; v < s.limit.size(); ++v) out[v] = Vec3(s.limit[v].x, s.limit[v].y, s.limit[v].z);
 }
 
-void LoopSurface::states(std::span<const std::uint8_t> coarse, std::vector<std::uint8_t>& out) const {
+void LoopSurface::states(std::span<const std::uint8_t> coarse, std::vector<std::uint8_t>& out) {
   Impl& s = *impl_;
   const std::size_t n0 = s.levelStart[1];
   if (coarse.size() != n0)
@@ -175,7 +172,10 @@ void LoopSurface::states(std::span<const std::uint8_t> coarse, std::vector<std::
   const State* lastLevel = s.states.data() + s.levelStart[static_cast<std::size_t>(s.levels())];
   out.resize(s.refinedCount());
   for (std::size_t v = 0; v < out.size(); ++v)
-    out[v] = s.ownChild[v] ? lastLevel[v].bits : static_cast<std::uint8_t>(lastLevel[v].bits & vertex_state::kCollisionMask);
+    out[v] = static_cast<std::uint8_t>(lastLevel[v].bits & vertex_state::kCollisionMask);
+  // The simulated vertices' own children keep their pin and bound flags too.
+  for (std::size_t v = 0; v < n0; ++v)
+    if (s.childOf[v] >= 0) out[static_cast<std::size_t>(s.childOf[v])] = coarse[v];
 }
 
 SubdividedSource::SubdividedSource(FrameSource& inner, int levels) : inner_(inner), meshes_(inner.meshes()) {

@@ -35,10 +35,10 @@ std::size_t edgeCount(const mesh::TriMesh& m) {
 TEST(LoopSurface, EachLevelSplitsEveryTriangleInFour) {
   std::mt19937 rng(1);
   const mesh::TriMesh sheet = jitteredSheet(rng);
-  const LoopSurface one(sheet.vertexCount(), sheet.triangles, 1);
+  LoopSurface one(sheet.vertexCount(), sheet.triangles, 1);
   EXPECT_EQ(one.triangles().size(), 4 * sheet.triangleCount());
   EXPECT_EQ(one.vertexCount(), sheet.vertexCount() + edgeCount(sheet));  // a vertex per vertex and per edge
-  const LoopSurface three(sheet.vertexCount(), sheet.triangles, 3);
+  LoopSurface three(sheet.vertexCount(), sheet.triangles, 3);
   EXPECT_EQ(three.triangles().size(), 64 * sheet.triangleCount());
   for (const mesh::Triangle& t : three.triangles())
     for (const std::uint32_t v : t) ASSERT_LT(v, three.vertexCount());
@@ -58,7 +58,7 @@ TEST(LoopSurface, CommutesWithAffineMaps) {
     const Vec3 b(unit(rng), unit(rng), unit(rng));
     std::vector<Vec3> mapped;
     for (const Vec3& p : sheet.positions) mapped.push_back(a * p + b);
-    const LoopSurface surface(sheet.vertexCount(), sheet.triangles, 2);
+    LoopSurface surface(sheet.vertexCount(), sheet.triangles, 2);
     std::vector<Vec3> refined, refinedOfMapped;
     surface.positions(sheet.positions, refined);
     surface.positions(mapped, refinedOfMapped);
@@ -75,7 +75,7 @@ TEST(LoopSurface, AFlatSheetStaysInItsPlaneAndItsOutline) {
   // jittered vertex by a few millimetres.
   std::mt19937 rng(3);
   const mesh::TriMesh sheet = jitteredSheet(rng);
-  const LoopSurface surface(sheet.vertexCount(), sheet.triangles, 3);
+  LoopSurface surface(sheet.vertexCount(), sheet.triangles, 3);
   std::vector<Vec3> refined;
   surface.positions(sheet.positions, refined);
   for (const Vec3& p : refined) {
@@ -126,7 +126,7 @@ TEST(LoopSurface, ASphereComesOutRound) {
   for (const mesh::Triangle& t : sphere.triangles)
     coarseLow = std::min(coarseLow, ((sphere.positions[t[0]] + sphere.positions[t[1]] + sphere.positions[t[2]]) / 3).norm());
   EXPECT_GT(r - coarseLow, 0.012);
-  const LoopSurface surface(sphere.vertexCount(), sphere.triangles, 3);
+  LoopSurface surface(sphere.vertexCount(), sphere.triangles, 3);
   std::vector<Vec3> refined;
   surface.positions(sphere.positions, refined);
   double low = 1e9, high = 0;
@@ -155,7 +155,7 @@ TEST(LoopSurface, StatesKeepTheirFlagsOnTheSimulatedVerticesOnly) {
       states[v] = vertex_state::kPenaltyZone;
     }
   }
-  const LoopSurface surface(sheet.vertexCount(), sheet.triangles, 2);
+  LoopSurface surface(sheet.vertexCount(), sheet.triangles, 2);
   std::vector<std::uint8_t> refined;
   surface.states(states, refined);
   ASSERT_EQ(refined.size(), surface.vertexCount());
@@ -180,7 +180,7 @@ TEST(LoopSurface, RefusesWhatIsNotATriangleMesh) {
   EXPECT_THROW(LoopSurface(3, outside, 1), Error);
   const std::vector<mesh::Triangle> fine{{0, 1, 2}};
   EXPECT_THROW(LoopSurface(3, fine, 0), Error);
-  const LoopSurface one(3, fine, 1);
+  LoopSurface one(3, fine, 1);
   std::vector<Vec3> out;
   EXPECT_THROW(one.positions(std::vector<Vec3>(2, Vec3::Zero()), out), Error);
 }
@@ -191,7 +191,7 @@ TEST(LoopSurface, AVertexOfNoTriangleIsLeftOut) {
   const std::vector<mesh::Triangle> one{{0, 1, 2}};
   const std::vector<Vec3> withStray{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(5, 5, 5)};
   const std::vector<Vec3> without(withStray.begin(), withStray.begin() + 3);
-  const LoopSurface a(4, one, 2), b(3, one, 2);
+  LoopSurface a(4, one, 2), b(3, one, 2);
   std::vector<Vec3> pa, pb;
   a.positions(withStray, pa);
   b.positions(without, pb);
@@ -209,7 +209,7 @@ TEST(LoopSurface, NonManifoldMeshesAreDrawnWithoutHarm) {
   const std::vector<Vec3> bowTie{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(-1, 0, 0), Vec3(-1, -1, 0)};
   const std::vector<mesh::Triangle> bowTieTriangles{{0, 1, 2}, {0, 3, 4}};
   for (const auto& [points, triangles] : {std::pair{fin, finTriangles}, std::pair{bowTie, bowTieTriangles}}) {
-    const LoopSurface surface(points.size(), triangles, 3);
+    LoopSurface surface(points.size(), triangles, 3);
     std::vector<Vec3> refined;
     surface.positions(points, refined);
     ASSERT_EQ(refined.size(), surface.vertexCount());
@@ -233,7 +233,7 @@ TEST(SubdividedSource, RefinesTheGarmentsAndPassesTheBodyThrough) {
     return out.index < 3;
   });
   SubdividedSource shown(live, 2);
-  const LoopSurface surface(sheet.vertexCount(), sheet.triangles, 2);
+  LoopSurface surface(sheet.vertexCount(), sheet.triangles, 2);
   ASSERT_EQ(shown.meshes().size(), 2U);
   EXPECT_EQ(shown.meshes()[0].vertexCount, surface.vertexCount());
   EXPECT_EQ(shown.meshes()[0].triangles, surface.triangles());

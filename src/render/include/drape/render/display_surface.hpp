@@ -36,12 +36,12 @@ class LoopSurface {
   [[nodiscard]] std::size_t vertexCount() const;
   [[nodiscard]] const std::vector<mesh::Triangle>& triangles() const;
   /// The refined positions, on the limit surface (out is resized to vertexCount()).
-  void positions(std::span<const Vec3> coarse, std::vector<Vec3>& out) const;
+  void positions(std::span<const Vec3> coarse, std::vector<Vec3>& out);
   /// The refined vertex states (frame.hpp, vertex_state): a vertex that a simulated vertex
   /// becomes keeps its state; the others take the collision state of the simulated vertex
   /// they are nearest to in the mesh (the heaviest in their subdivision rule) and no pin or
   /// bound flag, so that markers stay on the simulated vertices.
-  void states(std::span<const std::uint8_t> coarse, std::vector<std::uint8_t>& out) const;
+  void states(std::span<const std::uint8_t> coarse, std::vector<std::uint8_t>& out);
 
  private:
   struct Impl;

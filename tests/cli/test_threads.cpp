@@ -26,7 +26,8 @@ TEST(Threads, ALargeGarmentRunsTheSameWithOneThreadAndWithTwo) {
   const auto runWith = [&](int threads) {
     const std::string out = dir / ("run" + std::to_string(threads));
     const CliResult r = runDrape("--threads " + std::to_string(threads) + " run '" + made + "/scene.wrl' --motion '" +
-                                     kSkirtDir + "/walk.bvh' --lead-in 0.1 --frames 12 --every 12 --out '" + out + "'",
+                                     kSkirtDir + "/walk.bvh' --lead-in 0.1 --frames 12 --every 12 --face-samples-with LeftUpLeg,RightUpLeg --out '" +
+                                     out + "'",
                                  dir);
     EXPECT_EQ(r.code, 0) << r.err;
     return out;
@@ -39,10 +40,12 @@ TEST(Threads, ALargeGarmentRunsTheSameWithOneThreadAndWithTwo) {
   const nlohmann::json a = statsOf(one), b = statsOf(two);
   for (const char* key : {"collisions_registered", "vertex_substeps", "vertex_substeps_below_T1",
                           "vertex_substeps_inside_body", "mean_collision_path_voxels", "max_penetration_m",
-                          "max_strain", "vertex_tests_pinched"})
+                          "max_strain", "vertex_tests_pinched", "face_tests", "face_contacts"})
     EXPECT_EQ(a[key], b[key]) << key;
   // The walk must reach the body: what is compared includes collisions.
   EXPECT_GT(a["collisions_registered"].get<long>(), 0);
+  // ... and the face samples, whose parts each range marks (FieldCollider::markSlidingParts).
+  EXPECT_GT(a["face_contacts"].get<long>(), 0);
 }
 
 TEST(Threads, TheCountIsChecked) {

@@ -1,5 +1,6 @@
 // libFuzzer target: glTF/GLB bytes through the skinned-avatar reader (in process, so the
-// fuzzer sees crashes the isolation child would hide) and the segmentation that follows.
+// fuzzer sees crashes the isolation child would hide) and the segmentation that follows,
+// and through the animation sampler (at 1 Hz: the fuzzer's animations may be a day long).
 // No folder is given: only data: URIs may load.
 
 #include <cstddef>
@@ -11,9 +12,15 @@
 #include "drape/scene/avatar_gltf.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string_view bytes(reinterpret_cast<const char*>(data), size);
+  try {
+    const drape::formats::GltfJointMotion motion = drape::formats::parseGltfJointMotion(bytes, "fuzz.glb", "", 1.0);
+    (void)motion.frameCount();
+  } catch (const drape::Error&) {
+  }
   try {
     const drape::formats::GltfSkinnedModel model =
-        drape::formats::parseGltfSkinnedModel(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.glb", "");
+        drape::formats::parseGltfSkinnedModel(bytes, "fuzz.glb", "");
     (void)drape::scene::buildAvatarFromSkinnedModel(model);
     (void)drape::formats::deserialiseSkinnedModel(drape::formats::serialise(model), "fuzz.glb");
   } catch (const drape::Error&) {

@@ -1,14 +1,17 @@
 // `drape inspect FILE.bvh|.amc|.asf|.glb|.gltf|.dae|.fbx|.mhskel`: skeleton, frame count, rate,
 // duration and the units guess of motion files; joints and segments of avatars.
 
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 
 #include <fmt/ostream.h>
 
 #include "command.hpp"
+#include "drape/core/error.hpp"
 #include "drape/formats/asf_amc.hpp"
 #include "drape/formats/bvh.hpp"
+#include "drape/formats/gltf_avatar.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/motion/clip_io.hpp"
 #include "drape/scene/avatar_gltf.hpp"
@@ -87,6 +90,19 @@ void inspectAcclaim(const std::string& path, std::ostream& out) {
   printClip(out, path, "Acclaim AMC", clip, report);
 }
 
+/// A glTF avatar's own animations: what `drape run --motion FILE` plays.
+void inspectGltfMotion(const std::string& path, std::ostream& out) {
+  try {
+    const formats::GltfJointMotion m = formats::readGltfJointMotion(path, 30.0);
+    fmt::print(out, "  motion     {} animation{}; the first, '{}': {:.3f} s ({:.3f} to {:.3f} s of key times), {} frames "
+               "at 30 Hz; drape run --motion {} plays it on this avatar\n",
+               m.animationCount, m.animationCount == 1 ? "" : "s", m.animation, m.end_s - m.start_s, m.start_s, m.end_s,
+               m.frameCount(), path);
+  } catch (const Error& e) {
+    fmt::print(out, "  motion     none: {}\n", e.what());
+  }
+}
+
 void inspectAvatar(const std::string& path, std::ostream& out) {
   const scene::Avatar a = scene::loadAvatarFile(path);
   fmt::print(out, "{}: skinned avatar '{}'\n", path, a.name);
@@ -106,6 +122,9 @@ void inspectAvatar(const std::string& path, std::ostream& out) {
   fmt::print(out, "  segments   {} (closed, by dominant skin weight)\n", a.segments.size());
   for (const scene::Segment& s : a.segments)
     fmt::print(out, "    {:<18} {:>6} triangles\n", s.name, s.mesh.triangleCount());
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".glb" || ext == ".gltf") inspectGltfMotion(path, out);
 }
 
 const bool bvh = registerInspector({".bvh"}, "BVH motion: skeleton, frames, rate, duration, units guess", &inspectBvh);

@@ -110,7 +110,7 @@ RunFunction setupPlay(CLI::App& app) {
   static PlayOptions o;
   app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes, or a scene to simulate live")
       ->required();
-  app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc)");
+  app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc; or the avatar's own .glb/.gltf, its first animation)");
   app.add_option("--frames", o.frames, "Close by itself after showing N frames")->check(CLI::PositiveNumber);
   app.add_flag("--once", o.once, "Stop at the last frame instead of starting over");
   app.add_flag("--fast", o.fast, "Show a new frame on every redraw instead of at the run's frame rate");

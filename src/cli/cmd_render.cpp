@@ -42,7 +42,7 @@ RunFunction setupRender(CLI::App& app) {
   static RenderOptions o;
   app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes, or a scene to simulate")
       ->required();
-  app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc)");
+  app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc; or the avatar's own .glb/.gltf, its first animation)");
   app.add_option("--frames", o.frames, "With a scene: frames to simulate (default: the lead-in and the whole motion)");
   app.add_option("--run-out", o.runOut, "With a scene: keep the simulated run in this directory (default: a temporary one)");
   app.add_option("--range", o.range,

@@ -300,7 +300,7 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("scene", o->scene, "VRML97 scene with ClothSet garments (and an avatar)");
   app.add_option("--garment", o->garment, "Garment mesh (OBJ), instead of a scene");
   app.add_option("--avatar", o->avatar, "Avatar to wear --garment (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel)");
-  app.add_option("--motion", o->motion, "Motion for the avatar (.bvh, .amc)");
+  app.add_option("--motion", o->motion, "Motion for the avatar (.bvh, .amc; or the avatar's own .glb/.gltf file, whose first animation it plays)");
   app.add_option("--joint-map", o->jointMap, "JSON map from the motion's joint names to the avatar's");
   app.add_option("--motion-scale", o->motionScale, "Metres per motion-file unit (default: guessed from the skeleton)");
   app.add_option("--voxel", o->voxel_m, "Distance-field voxel size, m (default: the scene's, or 0.005)");

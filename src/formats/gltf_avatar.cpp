@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
+#include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
 
 #include <fmt/format.h>
@@ -11,6 +13,7 @@
 
 #include "drape/core/error.hpp"
 #include "drape/formats/json_text.hpp"
+#include "plain_data.hpp"
 #include "text_scan.hpp"
 
 namespace drape::formats {
@@ -50,7 +53,21 @@ struct GPrimitive {
   std::map<std::string, int> attributes;
   int indices = -1, mode = kModeTriangles;
 };
+struct GChannel {
+  int sampler = -1, node = -1;
+  std::string path;  ///< "translation", "rotation", "scale" or "weights"
+};
+struct GSampler {
+  int input = -1, output = -1;
+  std::string interpolation = "LINEAR";
+};
+struct GAnimation {
+  std::string name;
+  std::vector<GChannel> channels;
+  std::vector<GSampler> samplers;
+};
 struct GModel {
+  std::vector<GAnimation> animations;
   std::vector<std::vector<unsigned char>> buffers;
   std::vector<GBufferView> bufferViews;
   std::vector<GAccessor> accessors;
@@ -268,6 +285,22 @@ GModel parseDocument(std::string_view bytes, const std::string& name, const std:
       m.nodes.push_back(std::move(node));
     }
     for (const json& s : arrayOf(doc, "skins")) m.skins.push_back({indices(s, "joints"), intOr(s, "inverseBindMatrices", -1)});
+    for (const json& a : arrayOf(doc, "animations")) {
+      GAnimation anim;
+      anim.name = a.contains("name") && a["name"].is_string() ? a["name"].get<std::string>() : "";
+      for (const json& c : arrayOf(a, "channels")) {
+        GChannel channel;
+        channel.sampler = intOr(c, "sampler", -1);
+        const auto target = c.find("target");
+        if (target == c.end() || !target->is_object()) throw Error(fmt::format("animation {} has a channel without a \"target\" object", m.animations.size()));
+        channel.node = intOr(*target, "node", -1);
+        channel.path = target->value("path", std::string());
+        anim.channels.push_back(std::move(channel));
+      }
+      for (const json& sm : arrayOf(a, "samplers"))
+        anim.samplers.push_back({intOr(sm, "input", -1), intOr(sm, "output", -1), sm.value("interpolation", std::string("LINEAR"))});
+      m.animations.push_back(std::move(anim));
+    }
     for (const json& mesh : arrayOf(doc, "meshes")) {
       std::vector<GPrimitive> prims;
       for (const json& p : arrayOf(mesh, "primitives")) {
@@ -373,20 +406,28 @@ Eigen::Matrix4d localMatrix(const GNode& node) {
   return t.matrix();
 }
 
-// World matrices of every node in the rest pose (the file's node transforms).
-std::vector<Eigen::Matrix4d> nodeWorlds(const GModel& model, std::vector<int>& parent, const Reader& r) {
+// Each node's parent (-1 for a root), checked: children exist, no node has two parents.
+std::vector<int> nodeParents(const GModel& model, const Reader& r) {
   const std::size_t n = model.nodes.size();
-  parent.assign(n, -1);
+  std::vector<int> parent(n, -1);
   for (std::size_t i = 0; i < n; ++i)
     for (int c : model.nodes[i].children) {
       if (c < 0 || static_cast<std::size_t>(c) >= n) r.fail(fmt::format("node {} has a child {} that does not exist", i, c));
       if (parent[static_cast<std::size_t>(c)] >= 0 || static_cast<std::size_t>(c) == i) r.fail(fmt::format("node {} has two parents", c));
       parent[static_cast<std::size_t>(c)] = static_cast<int>(i);
     }
+  return parent;
+}
+
+// World matrices of every node from their local matrices.
+std::vector<Eigen::Matrix4d> worldsOf(const std::vector<int>& parent, const std::vector<Eigen::Matrix4d>& local,
+                                      const Reader& r) {
+  const std::size_t n = parent.size();
   std::vector<Eigen::Matrix4d> world(n, Eigen::Matrix4d::Identity());
   std::vector<int> state(n, 0);  // 0 todo, 1 visiting, 2 done
-  std::function<void(std::size_t)> visit = [&](std::size_t i) {
-    std::vector<std::size_t> chain;  // iterative walk up to a finished ancestor (no deep recursion)
+  std::vector<std::size_t> chain;
+  for (std::size_t i = 0; i < n; ++i) {
+    chain.clear();  // iterative walk up to a finished ancestor (no deep recursion)
     for (std::size_t k = i;;) {
       if (state[k] == 2) break;
       if (state[k] == 1) r.fail(fmt::format("the node hierarchy has a cycle at node {}", k));
@@ -397,24 +438,36 @@ std::vector<Eigen::Matrix4d> nodeWorlds(const GModel& model, std::vector<int>& p
     }
     for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
       const int p = parent[*it];
-      world[*it] = (p < 0 ? Eigen::Matrix4d::Identity() : world[static_cast<std::size_t>(p)]) * localMatrix(model.nodes[*it]);
+      world[*it] = (p < 0 ? Eigen::Matrix4d::Identity() : world[static_cast<std::size_t>(p)]) * local[*it];
       state[*it] = 2;
     }
-  };
-  for (std::size_t i = 0; i < n; ++i) visit(i);
+  }
   return world;
 }
 
-SkinnedModel extract(const GModel& model, const std::string& name) {
-  const Reader r{model, name};
+// World matrices of every node in the rest pose (the file's node transforms).
+std::vector<Eigen::Matrix4d> nodeWorlds(const GModel& model, std::vector<int>& parent, const Reader& r) {
+  parent = nodeParents(model, r);
+  std::vector<Eigen::Matrix4d> local;
+  for (const GNode& node : model.nodes) local.push_back(localMatrix(node));
+  return worldsOf(parent, local, r);
+}
+
+// The first skin's joints in parent-first order (by depth in the node tree), named and
+// parented as SkinnedModel has them.
+struct SkinJoints {
+  std::vector<int> node;          ///< k -> the joint's node
+  std::vector<int> skinIndex;     ///< k -> its index in the skin's list
+  std::vector<int> newIndex;      ///< index in the skin's list -> k
+  std::vector<std::string> name;  ///< k -> its name
+  std::vector<int> parent;        ///< k -> the nearest ancestor that is a joint, or -1
+};
+
+SkinJoints skinJoints(const GModel& model, const std::vector<int>& nodeParent, const Reader& r) {
   if (model.skins.empty()) r.fail("has no skin (a skinned character is needed)");
   const GSkin& skin = model.skins.front();
   if (skin.joints.empty()) r.fail("its skin has no joints");
   if (skin.joints.size() > 65535) r.fail("its skin has too many joints");
-  std::vector<int> nodeParent;
-  const std::vector<Eigen::Matrix4d> world = nodeWorlds(model, nodeParent, r);
-
-  // Joints in parent-first order: sort by depth in the node tree.
   const std::size_t jn = skin.joints.size();
   std::vector<int> jointOfNode(model.nodes.size(), -1);
   for (std::size_t j = 0; j < jn; ++j) {
@@ -431,22 +484,43 @@ SkinnedModel extract(const GModel& model, const std::string& name) {
   std::vector<std::size_t> order(jn);
   for (std::size_t j = 0; j < jn; ++j) order[j] = j;
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return depth(skin.joints[a]) < depth(skin.joints[b]); });
-  std::vector<int> newIndex(jn);
-  for (std::size_t k = 0; k < jn; ++k) newIndex[order[k]] = static_cast<int>(k);
+  SkinJoints out;
+  out.newIndex.resize(jn);
+  for (std::size_t k = 0; k < jn; ++k) out.newIndex[order[k]] = static_cast<int>(k);
+  for (std::size_t k = 0; k < jn; ++k) {
+    const int node = skin.joints[order[k]];
+    out.node.push_back(node);
+    out.skinIndex.push_back(static_cast<int>(order[k]));
+    out.name.push_back(model.nodes[static_cast<std::size_t>(node)].name.empty()
+                           ? fmt::format("joint{}", order[k])
+                           : model.nodes[static_cast<std::size_t>(node)].name);
+    int parent = -1;
+    for (int a = nodeParent[static_cast<std::size_t>(node)]; a >= 0; a = nodeParent[static_cast<std::size_t>(a)])
+      if (jointOfNode[static_cast<std::size_t>(a)] >= 0) {
+        parent = out.newIndex[static_cast<std::size_t>(jointOfNode[static_cast<std::size_t>(a)])];
+        break;
+      }
+    out.parent.push_back(parent);
+  }
+  return out;
+}
+
+SkinnedModel extract(const GModel& model, const std::string& name) {
+  const Reader r{model, name};
+  std::vector<int> nodeParent;
+  const std::vector<Eigen::Matrix4d> world = nodeWorlds(model, nodeParent, r);
+  const SkinJoints sj = skinJoints(model, nodeParent, r);
+  const GSkin& skin = model.skins.front();
+  const std::size_t jn = skin.joints.size();
+  const std::vector<int>& newIndex = sj.newIndex;
 
   SkinnedModel out;
   out.source = name;
   for (std::size_t k = 0; k < jn; ++k) {
-    const int node = skin.joints[order[k]];
     SkinnedJoint joint;
-    joint.name = model.nodes[static_cast<std::size_t>(node)].name.empty() ? fmt::format("joint{}", order[k])
-                                                                           : model.nodes[static_cast<std::size_t>(node)].name;
-    for (int a = nodeParent[static_cast<std::size_t>(node)]; a >= 0; a = nodeParent[static_cast<std::size_t>(a)])
-      if (jointOfNode[static_cast<std::size_t>(a)] >= 0) {
-        joint.parent = newIndex[static_cast<std::size_t>(jointOfNode[static_cast<std::size_t>(a)])];
-        break;
-      }
-    joint.restWorld = world[static_cast<std::size_t>(node)];
+    joint.name = sj.name[k];
+    joint.parent = sj.parent[k];
+    joint.restWorld = world[static_cast<std::size_t>(sj.node[k])];
     out.joints.push_back(joint);
   }
   // Inverse bind matrices; identity when absent, as the glTF spec says.
@@ -524,10 +598,254 @@ SkinnedModel extract(const GModel& model, const std::string& name) {
   return out;
 }
 
+// ---- animations ---------------------------------------------------------------------
+
+constexpr std::size_t kMaxMotionTransforms = 10'000'000;  ///< frames x joints sampled (560 MB)
+constexpr double kMaxAnimationSeconds = 24.0 * 3600.0;
+
+/// One channel's sampler, read and checked: key times and values (`components` per key,
+/// three times as many for CUBICSPLINE: in-tangent, value, out-tangent).
+struct Track {
+  enum class Interpolation { Linear, Step, CubicSpline };
+  int node = -1;
+  std::string path;
+  Interpolation interpolation = Interpolation::Linear;
+  int components = 0;
+  std::vector<double> times, values;
+
+  /// The channel's value at time t (clamped to the key times), `components` numbers.
+  void sample(double t, double* out) const {
+    const std::size_t keys = times.size();
+    const std::size_t stride = interpolation == Interpolation::CubicSpline ? 3 : 1;
+    const auto value = [&](std::size_t k, std::size_t part, int c) {
+      return values[(k * stride + part) * static_cast<std::size_t>(components) + static_cast<std::size_t>(c)];
+    };
+    const std::size_t mid = stride == 3 ? 1 : 0;
+    if (keys == 1 || t <= times.front()) {
+      for (int c = 0; c < components; ++c) out[c] = value(0, mid, c);
+      return;
+    }
+    if (t >= times.back()) {
+      for (int c = 0; c < components; ++c) out[c] = value(keys - 1, mid, c);
+      return;
+    }
+    const std::size_t k = static_cast<std::size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin()) - 1;
+    const double span = times[k + 1] - times[k];
+    const double u = span > 0 ? (t - times[k]) / span : 0.0;
+    switch (interpolation) {
+      case Interpolation::Step:
+        for (int c = 0; c < components; ++c) out[c] = value(k, 0, c);
+        return;
+      case Interpolation::Linear:
+        if (components == 4) {  // a rotation: SLERP, as the glTF spec asks
+          const Quat a(value(k, 0, 3), value(k, 0, 0), value(k, 0, 1), value(k, 0, 2));
+          const Quat b(value(k + 1, 0, 3), value(k + 1, 0, 0), value(k + 1, 0, 1), value(k + 1, 0, 2));
+          const Quat q = a.normalized().slerp(u, b.normalized());
+          out[0] = q.x(), out[1] = q.y(), out[2] = q.z(), out[3] = q.w();
+          return;
+        }
+        for (int c = 0; c < components; ++c) out[c] = (1.0 - u) * value(k, 0, c) + u * value(k + 1, 0, c);
+        return;
+      case Interpolation::CubicSpline: {  // Hermite, tangents scaled by the key interval
+        const double u2 = u * u, u3 = u2 * u;
+        const double h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u, h01 = -2 * u3 + 3 * u2, h11 = u3 - u2;
+        for (int c = 0; c < components; ++c)
+          out[c] = h00 * value(k, 1, c) + h10 * span * value(k, 2, c) + h01 * value(k + 1, 1, c) +
+                   h11 * span * value(k + 1, 0, c);
+        return;
+      }
+    }
+  }
+};
+
+/// The tracks of animation `index` that move nodes (weights channels left out), checked.
+std::vector<Track> readTracks(const GModel& model, std::size_t index, const Reader& r) {
+  const GAnimation& anim = model.animations[index];
+  std::vector<Track> tracks;
+  for (std::size_t ci = 0; ci < anim.channels.size(); ++ci) {
+    const GChannel& ch = anim.channels[ci];
+    const std::string where = fmt::format("animation {} channel {}", index, ci);
+    if (ch.path == "weights") continue;  // morph targets: not part of the skeleton's motion
+    if (ch.path != "translation" && ch.path != "rotation" && ch.path != "scale")
+      r.fail(fmt::format("{}: target path '{}' (expected translation, rotation, scale or weights)", where, ch.path));
+    if (ch.node < 0) continue;  // no node: the spec lets an extension say; nothing moves here
+    if (static_cast<std::size_t>(ch.node) >= model.nodes.size())
+      r.fail(fmt::format("{}: target node {} does not exist", where, ch.node));
+    if (model.nodes[static_cast<std::size_t>(ch.node)].matrix.size() == 16)
+      r.fail(fmt::format("{}: node {} has a matrix, and a node an animation targets must not", where, ch.node));
+    if (ch.sampler < 0 || static_cast<std::size_t>(ch.sampler) >= anim.samplers.size())
+      r.fail(fmt::format("{}: sampler {} does not exist", where, ch.sampler));
+    const GSampler& sm = anim.samplers[static_cast<std::size_t>(ch.sampler)];
+    Track t;
+    t.node = ch.node;
+    t.path = ch.path;
+    t.components = ch.path == "rotation" ? 4 : 3;
+    if (sm.interpolation == "LINEAR") t.interpolation = Track::Interpolation::Linear;
+    else if (sm.interpolation == "STEP") t.interpolation = Track::Interpolation::Step;
+    else if (sm.interpolation == "CUBICSPLINE") t.interpolation = Track::Interpolation::CubicSpline;
+    else r.fail(fmt::format("{}: interpolation '{}' (expected LINEAR, STEP or CUBICSPLINE)", where, sm.interpolation));
+    t.times = r.read(sm.input, 1, (where + " input").c_str());
+    if (t.times.empty()) r.fail(fmt::format("{}: its sampler has no key times", where));
+    for (std::size_t k = 0; k < t.times.size(); ++k) {
+      if (!std::isfinite(t.times[k]) || t.times[k] < 0 || t.times[k] > kMaxAnimationSeconds)
+        r.fail(fmt::format("{}: key time {} is {} (expected seconds from 0 to {:g})", where, k, t.times[k], kMaxAnimationSeconds));
+      if (k > 0 && t.times[k] < t.times[k - 1])
+        r.fail(fmt::format("{}: key times go back, from {} s to {} s at key {}", where, t.times[k - 1], t.times[k], k));
+    }
+    t.values = r.read(sm.output, t.components, (where + " output").c_str());
+    const std::size_t perKey = t.interpolation == Track::Interpolation::CubicSpline ? 3 : 1;
+    if (t.values.size() != t.times.size() * perKey * static_cast<std::size_t>(t.components))
+      r.fail(fmt::format("{}: {} output values for {} key times (expected {})", where,
+                         t.values.size() / static_cast<std::size_t>(t.components), t.times.size(), t.times.size() * perKey));
+    for (double v : t.values)
+      if (!std::isfinite(v)) r.fail(fmt::format("{}: an output value is not finite", where));
+    tracks.push_back(std::move(t));
+  }
+  return tracks;
+}
+
+/// The rotation nearest a 3x3 linear map (its polar factor): a node chain with scale
+/// leaves W(t) W_rest^-1 a rotation only up to rounding, or a shear where scales animate.
+Quat nearestRotation(const Eigen::Matrix3d& m) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d r = svd.matrixU() * svd.matrixV().transpose();
+  if (r.determinant() < 0) {
+    Eigen::Matrix3d u = svd.matrixU();
+    u.col(2) = -u.col(2);
+    r = u * svd.matrixV().transpose();
+  }
+  return Quat(r).normalized();
+}
+
+GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, double rate, std::size_t index) {
+  const Reader r{model, name};
+  if (!(rate > 0) || !std::isfinite(rate)) r.fail(fmt::format("a motion rate of {} frames per second", rate));
+  if (model.animations.empty()) r.fail("has no animation");
+  if (index >= model.animations.size())
+    r.fail(fmt::format("has {} animations, so there is no animation {}", model.animations.size(), index));
+  std::vector<int> nodeParent;
+  const std::vector<Eigen::Matrix4d> restWorld = nodeWorlds(model, nodeParent, r);
+  const SkinJoints sj = skinJoints(model, nodeParent, r);
+  const std::vector<Track> tracks = readTracks(model, index, r);
+  if (tracks.empty()) r.fail(fmt::format("animation {} moves no node", index));
+
+  GltfJointMotion out;
+  const GAnimation& anim = model.animations[index];
+  out.animation = anim.name.empty() ? fmt::format("animation {}", index) : anim.name;
+  out.animationCount = model.animations.size();
+  out.rate = rate;
+  out.start_s = std::numeric_limits<double>::infinity();
+  out.end_s = 0.0;
+  for (const Track& t : tracks) {
+    out.start_s = std::min(out.start_s, t.times.front());
+    out.end_s = std::max(out.end_s, t.times.back());
+  }
+  const std::size_t jn = sj.node.size();
+  const double frames = std::floor((out.end_s - out.start_s) * rate + 1e-9) + 1.0;
+  if (frames * static_cast<double>(jn) > static_cast<double>(kMaxMotionTransforms))
+    r.fail(fmt::format("animation {} lasts {:g} s: {:g} frames of {} joints at {:g} Hz are more than drape samples ({})",
+                       index, out.end_s - out.start_s, frames, jn, rate, kMaxMotionTransforms));
+  const auto frameCount = static_cast<std::size_t>(frames);
+  out.joints = sj.name;
+  std::vector<Eigen::Matrix4d> restInverse(jn);
+  for (std::size_t k = 0; k < jn; ++k) {
+    const Eigen::Matrix4d& w = restWorld[static_cast<std::size_t>(sj.node[k])];
+    out.restCenters.push_back(w.block<3, 1>(0, 3));
+    restInverse[k] = w.inverse();
+    if (!restInverse[k].allFinite()) r.fail(fmt::format("joint '{}' has a singular rest transform", sj.name[k]));
+  }
+  out.frames.reserve(frameCount * jn);
+  std::vector<GNode> nodes = model.nodes;
+  std::vector<Eigen::Matrix4d> local(nodes.size());
+  double value[4];
+  for (std::size_t f = 0; f < frameCount; ++f) {
+    const double t = out.start_s + static_cast<double>(f) / rate;
+    for (const Track& track : tracks) {
+      track.sample(t, value);
+      GNode& node = nodes[static_cast<std::size_t>(track.node)];
+      std::vector<double>& target = track.path == "translation" ? node.translation
+                                    : track.path == "rotation"  ? node.rotation
+                                                                : node.scale;
+      target.assign(value, value + track.components);
+    }
+    for (std::size_t i = 0; i < nodes.size(); ++i) local[i] = localMatrix(nodes[i]);
+    const std::vector<Eigen::Matrix4d> world = worldsOf(nodeParent, local, r);
+    for (std::size_t k = 0; k < jn; ++k) {
+      const Eigen::Matrix4d& w = world[static_cast<std::size_t>(sj.node[k])];
+      const Eigen::Matrix4d motion = w * restInverse[k];
+      RigidTransform joint{nearestRotation(motion.topLeftCorner<3, 3>()), w.block<3, 1>(0, 3)};
+      if (!joint.translation.allFinite() || !joint.rotation.coeffs().allFinite())
+        r.fail(fmt::format("joint '{}' is not finite at {:g} s of animation {}", sj.name[k], t, index));
+      out.frames.push_back(joint);
+    }
+  }
+  return out;
+}
+
+std::string serialise(const GltfJointMotion& m) {
+  std::string s;
+  detail::putVector(s, std::vector<char>(m.animation.begin(), m.animation.end()));
+  detail::put<std::uint64_t>(s, m.animationCount);
+  detail::put(s, m.rate);
+  detail::put(s, m.start_s);
+  detail::put(s, m.end_s);
+  detail::put<std::uint64_t>(s, m.joints.size());
+  for (const std::string& j : m.joints) detail::putVector(s, std::vector<char>(j.begin(), j.end()));
+  std::vector<double> numbers;
+  for (const Vec3& c : m.restCenters) numbers.insert(numbers.end(), {c.x(), c.y(), c.z()});
+  detail::putVector(s, numbers);
+  numbers.clear();
+  for (const RigidTransform& t : m.frames)
+    numbers.insert(numbers.end(), {t.rotation.w(), t.rotation.x(), t.rotation.y(), t.rotation.z(), t.translation.x(),
+                                   t.translation.y(), t.translation.z()});
+  detail::putVector(s, numbers);
+  return s;
+}
+
+GltfJointMotion deserialiseJointMotion(std::string_view bytes, const std::string& name) {
+  detail::Cursor c{bytes, 0, name};
+  GltfJointMotion m;
+  const std::vector<char> animation = c.getVector<char>();
+  m.animation.assign(animation.begin(), animation.end());
+  m.animationCount = c.get<std::uint64_t>();
+  m.rate = c.get<double>();
+  m.start_s = c.get<double>();
+  m.end_s = c.get<double>();
+  const auto joints = c.get<std::uint64_t>();
+  if (joints > 65535) throw Error(fmt::format("{}: the reader returned bad data", name));
+  for (std::uint64_t k = 0; k < joints; ++k) {
+    const std::vector<char> chars = c.getVector<char>();
+    m.joints.emplace_back(chars.begin(), chars.end());
+  }
+  const std::vector<double> centres = c.getVector<double>();
+  const std::vector<double> frames = c.getVector<double>();
+  if (centres.size() != 3 * joints || (joints > 0 && frames.size() % (7 * joints) != 0))
+    throw Error(fmt::format("{}: the reader returned bad data", name));
+  for (std::size_t i = 0; i + 2 < centres.size(); i += 3) m.restCenters.emplace_back(centres[i], centres[i + 1], centres[i + 2]);
+  for (std::size_t i = 0; i + 6 < frames.size(); i += 7)
+    m.frames.push_back({Quat(frames[i], frames[i + 1], frames[i + 2], frames[i + 3]),
+                        Vec3(frames[i + 4], frames[i + 5], frames[i + 6])});
+  return m;
+}
+
 }  // namespace
 
 SkinnedModel parseGltfSkinnedModel(std::string_view bytes, const std::string& name, const std::string& baseDir) {
   return extract(parseDocument(bytes, name, baseDir), name);
+}
+
+GltfJointMotion parseGltfJointMotion(std::string_view bytes, const std::string& name, const std::string& baseDir,
+                                     double rate, std::size_t index) {
+  return sampleJointMotion(parseDocument(bytes, name, baseDir), name, rate, index);
+}
+
+GltfJointMotion readGltfJointMotion(const std::string& path, double rate, std::size_t index,
+                                    const IsolationLimits& limits) {
+  const std::string bytes = detail::readWholeFile(path, std::size_t{1} << 30);
+  const std::string baseDir = std::filesystem::absolute(path).parent_path().string();
+  const std::string result = runIsolated(
+      path, "glTF reader", [&] { return serialise(parseGltfJointMotion(bytes, path, baseDir, rate, index)); }, limits);
+  return deserialiseJointMotion(result, path);
 }
 
 SkinnedModel readGltfSkinnedModel(const std::string& path, const IsolationLimits& limits) {

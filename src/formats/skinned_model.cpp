@@ -6,46 +6,12 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "plain_data.hpp"
 
 namespace drape::formats {
-namespace {
-
-// ---- plain-data serialisation across the process boundary --------------------------
-
-template <typename T>
-void put(std::string& s, const T& v) {
-  s.append(reinterpret_cast<const char*>(&v), sizeof(T));
-}
-template <typename T>
-void putVector(std::string& s, const std::vector<T>& v) {
-  put<std::uint64_t>(s, v.size());
-  s.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
-}
-
-struct Cursor {
-  std::string_view bytes;
-  std::size_t at = 0;
-  std::string name;
-  template <typename T>
-  T get() {
-    if (bytes.size() - at < sizeof(T)) throw Error(fmt::format("{}: the reader returned truncated data", name));
-    T v;
-    std::memcpy(&v, bytes.data() + at, sizeof(T));
-    at += sizeof(T);
-    return v;
-  }
-  template <typename T>
-  std::vector<T> getVector() {
-    const auto n = get<std::uint64_t>();
-    if (n > (bytes.size() - at) / std::max<std::size_t>(sizeof(T), 1)) throw Error(fmt::format("{}: the reader returned truncated data", name));
-    std::vector<T> v(n);
-    std::memcpy(v.data(), bytes.data() + at, n * sizeof(T));
-    at += n * sizeof(T);
-    return v;
-  }
-};
-
-}  // namespace
+using detail::Cursor;
+using detail::put;
+using detail::putVector;
 
 std::string serialise(const SkinnedModel& model) {
   std::string s;

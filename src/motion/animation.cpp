@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "drape/core/error.hpp"
 #include "drape/motion/interpolate.hpp"
@@ -362,8 +364,124 @@ double maxJointSeparation(const AvatarAnimation& animation, const scene::Avatar&
   return largest;
 }
 
+namespace {
+
+/// Where a scene put the avatar of a file: world = rotation (scale x) + translation.
+struct Placement {
+  Quat rotation = Quat::Identity();
+  double scale = 1.0;
+  Vec3 translation = Vec3::Zero();
+  [[nodiscard]] Vec3 apply(const Vec3& x) const { return rotation * (scale * x) + translation; }
+};
+
+/// The placement that takes the file's rest joint positions onto the avatar's: the
+/// rotation the scene gave every joint frame (a glTF avatar's joints rest unrotated in its
+/// file), the ratio of the two skeletons' spreads about their centroids, and the shift of
+/// the centroids.
+Placement placementOf(const scene::Avatar& avatar, const std::vector<int>& motionJoint,
+                      const formats::GltfJointMotion& motion) {
+  Placement p;
+  p.rotation = avatar.joints.front().restOrientation;
+  Vec3 meanAvatar = Vec3::Zero(), meanFile = Vec3::Zero();
+  for (std::size_t a = 0; a < avatar.joints.size(); ++a) {
+    meanAvatar += avatar.joints[a].restCenter;
+    meanFile += motion.restCenters[static_cast<std::size_t>(motionJoint[a])];
+  }
+  const auto n = static_cast<double>(avatar.joints.size());
+  meanAvatar /= n;
+  meanFile /= n;
+  double spreadAvatar = 0.0, spreadFile = 0.0;
+  for (std::size_t a = 0; a < avatar.joints.size(); ++a) {
+    spreadAvatar += (avatar.joints[a].restCenter - meanAvatar).norm();
+    spreadFile += (motion.restCenters[static_cast<std::size_t>(motionJoint[a])] - meanFile).norm();
+  }
+  if (spreadFile > 0.0 && spreadAvatar > 0.0) p.scale = spreadAvatar / spreadFile;
+  p.translation = meanAvatar - p.rotation * (p.scale * meanFile);
+  return p;
+}
+
+}  // namespace
+
+AvatarAnimation AvatarAnimation::fromJointMotion(const scene::Avatar& avatar, const formats::GltfJointMotion& motion,
+                                                 const std::string& source) {
+  const std::size_t n = avatar.joints.size();
+  if (n == 0) throw Error(fmt::format("{}: the avatar has no joints to animate", avatar.source));
+  if (motion.frameCount() == 0) throw Error(fmt::format("{}: the motion has no frames", source));
+  std::vector<int> motionJoint(n, -1);
+  std::vector<std::string> missing;
+  for (std::size_t a = 0; a < n; ++a) {
+    const auto it = std::find(motion.joints.begin(), motion.joints.end(), avatar.joints[a].name);
+    if (it == motion.joints.end()) missing.push_back(avatar.joints[a].name);
+    else motionJoint[a] = static_cast<int>(it - motion.joints.begin());
+  }
+  if (!missing.empty())
+    throw Error(fmt::format("{}: its skin has no joint named {} of avatar '{}' ({} of {} missing): a glTF animation "
+                            "drives the avatar of its own file; other avatars take BVH or ASF/AMC motion",
+                            source, fmt::join(missing.begin(), missing.begin() + std::min<std::size_t>(missing.size(), 4), ", "),
+                            avatar.name, missing.size(), n));
+  const Placement place = placementOf(avatar, motionJoint, motion);
+  // The same skeleton at rest, or a different one with the same joint names.
+  double spread = 0.0;
+  for (const scene::Joint& j : avatar.joints) spread = std::max(spread, (j.restCenter - avatar.joints.front().restCenter).norm());
+  const double tolerance = std::max(1e-3 * spread, 1e-6);
+  for (std::size_t a = 0; a < n; ++a) {
+    const double off = (place.apply(motion.restCenters[static_cast<std::size_t>(motionJoint[a])]) - avatar.joints[a].restCenter).norm();
+    if (off > tolerance)
+      throw Error(fmt::format("{}: the skeleton of its animation does not rest as avatar '{}' does (joint '{}' {:.1f} mm "
+                              "away once placed): a glTF animation drives the avatar of its own file",
+                              source, avatar.name, avatar.joints[a].name, 1e3 * off));
+  }
+
+  AvatarAnimation anim;
+  anim.frames_ = motion.frameCount();
+  anim.joints_ = n;
+  anim.rate_ = motion.rate;
+  anim.rootScale_ = place.scale;
+  anim.driving_ = motionJoint;
+  anim.world_.resize(anim.frames_ * n);
+  anim.inverse_.resize(anim.frames_ * n);
+  anim.rootPath_.resize(anim.frames_);
+  anim.ground_.assign(anim.frames_, 0.0);
+  const Quat toScene = place.rotation, fromScene = place.rotation.conjugate();
+  for (std::size_t f = 0; f < anim.frames_; ++f) {
+    const RigidTransform* file = motion.frames.data() + f * motion.joints.size();
+    for (std::size_t a = 0; a < n; ++a) {
+      // The file's motion from rest, conjugated into the scene's axes and applied after the
+      // joint's rest orientation; the joint's position is its file position placed.
+      const RigidTransform& m = file[motionJoint[a]];
+      RigidTransform& t = anim.world_[f * n + a];
+      t.rotation = (toScene * m.rotation * fromScene * avatar.joints[a].restOrientation).normalized();
+      t.translation = place.apply(m.translation);
+      anim.inverse_[f * n + a] = t.inverse();
+    }
+    anim.rootPath_[f] = anim.world_[f * n].translation;
+  }
+  return anim;
+}
+
 AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& motionPath, const MotionOptions& options,
                               ClipLoadReport* report, JointMap* chosenMap) {
+  std::string ext = std::filesystem::path(motionPath).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".glb" || ext == ".gltf") {
+    if (!options.jointMapPath.empty())
+      throw Error(fmt::format("--joint-map: {} is a glTF animation, which drives the joints of its own skin by name", motionPath));
+    const double rate = options.clip.rate > 0 ? options.clip.rate : 30.0;
+    const formats::GltfJointMotion motion = formats::readGltfJointMotion(motionPath, rate);
+    AvatarAnimation anim = AvatarAnimation::fromJointMotion(avatar, motion, motionPath);
+    if (report) {
+      *report = {};
+      report->units.metresPerUnit = 1.0;
+      report->units.name = "m (glTF)";
+      report->sourceFrames = motion.frameCount();
+      report->sourceRate = rate;
+    }
+    if (chosenMap) {
+      *chosenMap = {};
+      chosenMap->name = fmt::format("its own skin's joints ({})", motion.animation);
+    }
+    return anim;
+  }
   const Clip clip = loadClip(motionPath, options.clip, report);
   JointMap map;
   if (!options.jointMapPath.empty()) {

@@ -337,7 +337,7 @@ Clip loadClip(const std::string& path, const ClipLoadOptions& options, ClipLoadR
     throw Error(fmt::format("{}: an ASF file holds a skeleton, not motion; give one of its .amc motions (drape "
                             "reads the .asf beside it, or the one --asf names)",
                             path));
-  throw Error(fmt::format("{}: unknown motion format '{}' (expected .bvh or .amc)", path, ext));
+  throw Error(fmt::format("{}: unknown motion format '{}' (expected .bvh or .amc, or a glTF avatar's own .glb or .gltf)", path, ext));
 }
 
 }  // namespace drape::motion

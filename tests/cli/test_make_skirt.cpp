@@ -1,6 +1,6 @@
 // `drape make-skirt` end to end: a skirt fitted to the bundled MakeHuman body, to another
 // rig's avatar, whose segments it names itself, and to a small glTF character; the scenes it
-// writes load and run.
+// writes load and run, the glTF character's on its own walk.
 
 #include <gtest/gtest.h>
 
@@ -92,6 +92,36 @@ TEST(MakeSkirt, ASmallCharactersSkirtGetsTheSubstepsItNeeds) {
   EXPECT_NE(made.out.find(std::to_string(sc.simulation.stepsPerFrame) + " substeps per frame"), std::string::npos)
       << made.out;
   runsClean(dir, out);
+}
+
+TEST(MakeSkirt, CesiumMansSkirtWalksOnItsOwnAnimation) {
+  // The glTF file's own walk drives the avatar it was loaded from: no joint map, no
+  // retargeting; 1 s of lead-in and the 2 s walk (61 frames at 30 Hz).
+  ScratchDir dir("make-skirt-cesium-walk");
+  const std::string cesium = kAvatars + "/CesiumMan.glb";
+  const std::string out = dir / "skirt";
+  ASSERT_EQ(runDrape("make-skirt '" + cesium + "' --waist-segment joint1 --hip-segments joint0 " +
+                         "--leg-segments joint11,joint12,joint13,joint14 --out '" + out + "'",
+                     dir)
+                .code,
+            0);
+  const std::string run = dir / "walk";
+  const CliResult r = runDrape("run '" + out + "/scene.wrl' --motion '" + cesium + "' --out '" + run + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("61 frames at 30 Hz in m (glTF); joint map 'its own skin's joints (animation 0)' drives 19 "
+                       "of the avatar's 19 joints"),
+            std::string::npos)
+      << r.err;
+  const nlohmann::json stats = statsOf(run);
+  EXPECT_EQ(stats["frames"], 90);
+  EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
+
+  // Another avatar's file: refused, saying why.
+  const CliResult other = runDrape("run '" + testing::kSkirtDir + "/scene.wrl' --motion '" + cesium + "' --frames 2 --out '" +
+                                       (dir / "other") + "'",
+                                   dir);
+  EXPECT_EQ(other.code, 2);
+  EXPECT_NE(other.err.find("a glTF animation drives the avatar of its own file"), std::string::npos) << other.err;
 }
 
 }  // namespace

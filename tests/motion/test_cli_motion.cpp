@@ -64,6 +64,15 @@ TEST(CliMotion, InspectAmcAndAvatars) {
   EXPECT_NE(r.out.find("segments   19"), std::string::npos) << r.out;
 }
 
+TEST(CliMotion, InspectGltfAvatarsNameTheirAnimation) {
+  Result r = run("inspect " + data("avatars/CesiumMan.glb"));
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("motion     1 animation; the first, 'animation 0': 2.000 s (0.000 to 2.000 s of key times), "
+                       "61 frames at 30 Hz; drape run --motion " + data("avatars/CesiumMan.glb") + " plays it on this avatar"),
+            std::string::npos)
+      << r.out;
+}
+
 TEST(CliMotion, BadBvhIsExitCode2WithItsLine) {
   const std::string path = std::string(DRAPE_TEST_DATA_DIR) + "/bad/motion/huge_frames.bvh";
   const Result r = run("inspect " + path);

@@ -255,7 +255,8 @@ TEST(ClipIo, TheWrongFileSaysWhatToGive) {
     (void)loadClip("walk.fbx", {});
     FAIL() << "expected an error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "walk.fbx: unknown motion format '.fbx' (expected .bvh or .amc)");
+    EXPECT_STREQ(e.what(), "walk.fbx: unknown motion format '.fbx' (expected .bvh or .amc, or a glTF avatar's own .glb or "
+                           ".gltf)");
   }
 }
 

@@ -31,4 +31,33 @@ using GltfSkinnedModel = SkinnedModel;
 /// Reads a .gltf/.glb file in a limited child process. Throws drape::Error naming the file.
 [[nodiscard]] GltfSkinnedModel readGltfSkinnedModel(const std::string& path, const IsolationLimits& limits = {});
 
+/// One of a glTF file's animations as the motion of its first skin's joints, sampled at a
+/// fixed rate from the animation's first key time to its last. Channels follow the glTF
+/// 2.0 rules: translation, rotation and scale of nodes, LINEAR (rotations by SLERP), STEP
+/// and CUBICSPLINE samplers, each node's own transform where no channel drives it; morph
+/// target weights are ignored.
+struct GltfJointMotion {
+  std::string animation;                  ///< its name, or "animation <index>"
+  std::size_t animationCount = 0;         ///< how many animations the file has
+  double rate = 30.0;                     ///< frames per second
+  double start_s = 0.0, end_s = 0.0;      ///< the animation's first and last key times
+  std::vector<std::string> joints;        ///< the skin's joints, parent-first and named as in GltfSkinnedModel
+  std::vector<Vec3> restCenters;          ///< m, each joint's world position in the file's rest pose
+  /// Frame-major, joint j of frame f at [f * joints.size() + j]: `rotation` turns the joint
+  /// from its rest orientation (the rotation of W(t) W_rest^-1, W its node's world
+  /// matrix), `translation` is its world position.
+  std::vector<RigidTransform> frames;
+  [[nodiscard]] std::size_t frameCount() const { return joints.empty() ? 0 : frames.size() / joints.size(); }
+};
+
+/// Samples animation `index` of glTF/GLB bytes in this process (for the fuzz target and the
+/// child). Throws drape::Error naming the file and what is wrong; a file without
+/// animations is an error.
+[[nodiscard]] GltfJointMotion parseGltfJointMotion(std::string_view bytes, const std::string& name,
+                                                   const std::string& baseDir, double rate, std::size_t index = 0);
+
+/// Reads and samples animation `index` of a .gltf/.glb file in a limited child process.
+[[nodiscard]] GltfJointMotion readGltfJointMotion(const std::string& path, double rate, std::size_t index = 0,
+                                                  const IsolationLimits& limits = {});
+
 }  // namespace drape::formats

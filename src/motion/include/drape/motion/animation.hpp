@@ -39,6 +39,7 @@
 
 #include "drape/core/math.hpp"
 #include "drape/core/timecode.hpp"
+#include "drape/formats/gltf_avatar.hpp"
 #include "drape/motion/clip_io.hpp"
 #include "drape/motion/jointmap.hpp"
 #include "drape/motion/skeleton.hpp"
@@ -64,6 +65,15 @@ class AvatarAnimation {
   /// Throws drape::Error if the avatar's root joint is driven by no motion joint.
   [[nodiscard]] static AvatarAnimation build(const scene::Avatar& avatar, const Clip& clip, const JointMap& map,
                                              const RetargetOptions& options = {});
+
+  /// The avatar's own motion from the file it was loaded from (a glTF animation of its
+  /// skin): each avatar joint follows the joint of the same name, no retargeting. The
+  /// file's rest pose must be the avatar's, up to the placement and uniform scale a scene
+  /// gives the avatar (found from the joints' rest positions and applied to the motion).
+  /// Throws drape::Error naming `source` when a joint is missing or rests elsewhere.
+  [[nodiscard]] static AvatarAnimation fromJointMotion(const scene::Avatar& avatar,
+                                                       const formats::GltfJointMotion& motion,
+                                                       const std::string& source);
 
   [[nodiscard]] std::size_t frameCount() const { return frames_; }
   [[nodiscard]] std::size_t jointCount() const { return joints_; }
@@ -126,8 +136,10 @@ struct MotionOptions {
   RetargetOptions retarget;
 };
 
-/// Loads FILE.bvh / FILE.amc, picks or reads the joint map, and retargets onto `avatar`.
-/// Throws drape::Error (exit code 2) naming the file, line and problem.
+/// Loads FILE.bvh / FILE.amc, picks or reads the joint map, and retargets onto `avatar`;
+/// or takes FILE.glb / FILE.gltf's first animation as the avatar's own motion
+/// (AvatarAnimation::fromJointMotion; `report` then gives the file's key rate as 0 and its
+/// frames as sampled). Throws drape::Error (exit code 2) naming the file, line and problem.
 [[nodiscard]] AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& motionPath,
                                             const MotionOptions& options, ClipLoadReport* report = nullptr,
                                             JointMap* chosenMap = nullptr);

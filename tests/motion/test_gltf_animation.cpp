@@ -1,0 +1,137 @@
+// A glTF avatar's own animation as its motion (AvatarAnimation::fromJointMotion):
+// CesiumMan's walk skins its mesh as the file's joint motions say, wherever and at whatever
+// scale a scene places the avatar; its walk is a cycle on the floor; an avatar of another
+// file is refused.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "drape/formats/gltf_avatar.hpp"
+#include "drape/motion/animation.hpp"
+#include "drape/motion/skinning.hpp"
+#include "drape/scene/avatar_gltf.hpp"
+#include "drape/testing/errors.hpp"
+
+namespace drape::motion {
+namespace {
+
+using drape::testing::errorOf;
+
+std::string cesiumPath() { return std::string(DRAPE_DATA_DIR) + "/avatars/CesiumMan.glb"; }
+
+const scene::Avatar& cesiumMan() {
+  static const scene::Avatar avatar = scene::loadAvatarFile(cesiumPath());
+  return avatar;
+}
+
+const formats::GltfJointMotion& cesiumWalk() {
+  static const formats::GltfJointMotion motion = formats::readGltfJointMotion(cesiumPath(), 30.0);
+  return motion;
+}
+
+/// Where a scene's Avatar node puts an avatar: scaled, then turned and moved (as
+/// sim/scene_setup does it).
+scene::Avatar placed(scene::Avatar avatar, const RigidTransform& placement, double scale) {
+  for (scene::Joint& j : avatar.joints) {
+    j.restCenter = placement.apply(scale * j.restCenter);
+    j.restOrientation = (placement.rotation * j.restOrientation).normalized();
+  }
+  for (scene::Segment& s : avatar.segments) s.mesh.scale(scale);
+  avatar.skin->mesh.scale(scale);
+  avatar.skin->mesh.transform(placement);
+  return avatar;
+}
+
+TEST(GltfAnimation, CesiumMansWalkSkinsItsMeshAsTheFileMovesItsJoints) {
+  const scene::Avatar& avatar = cesiumMan();
+  const formats::GltfJointMotion& walk = cesiumWalk();
+  const AvatarAnimation anim = loadAnimation(avatar, cesiumPath(), MotionOptions{});
+  ASSERT_EQ(anim.frameCount(), 61u);
+  ASSERT_EQ(anim.jointCount(), 19u);
+  EXPECT_DOUBLE_EQ(anim.rate(), 30.0);
+  for (const int j : anim.drivingJoint()) EXPECT_GE(j, 0);
+  const std::vector<Vec3>& rest = avatar.skin->mesh.positions;
+  std::vector<Vec3> posed;
+  for (const std::size_t f : {0u, 17u, 30u, 60u}) {
+    poseSkin(avatar, anim.frame(f), posed);
+    double worst = 0.0;
+    for (std::size_t v = 0; v < rest.size(); ++v) {
+      // Each joint k moves a point rigidly: p -> R_k (p - c_k) + c_k(t), blended by weight.
+      Vec3 expected = Vec3::Zero();
+      for (int i = 0; i < 4; ++i) {
+        const std::size_t k = avatar.skin->joints[v][static_cast<std::size_t>(i)];
+        const RigidTransform& m = walk.frames[f * walk.joints.size() + k];
+        expected += static_cast<double>(avatar.skin->weights[v][static_cast<std::size_t>(i)]) *
+                    (m.rotation * (rest[v] - walk.restCenters[k]) + m.translation);
+      }
+      worst = std::max(worst, (posed[v] - expected).norm());
+    }
+    EXPECT_LT(worst, 1e-6) << "frame " << f;  // the weights are floats
+  }
+}
+
+TEST(GltfAnimation, APlacedAvatarWalksThePlacedWalk) {
+  const RigidTransform placement{Quat(Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitY())), Vec3(1.0, 0.0, 3.0)};
+  const double scale = 2.0;
+  const scene::Avatar there = placed(cesiumMan(), placement, scale);
+  const AvatarAnimation here = AvatarAnimation::fromJointMotion(cesiumMan(), cesiumWalk(), "CesiumMan.glb");
+  const AvatarAnimation moved = AvatarAnimation::fromJointMotion(there, cesiumWalk(), "CesiumMan.glb");
+  EXPECT_NEAR(moved.rootScale(), scale, 1e-12);
+  std::vector<Vec3> a, b;
+  for (const std::size_t f : {0u, 25u, 60u}) {
+    poseSkin(cesiumMan(), here.frame(f), a);
+    poseSkin(there, moved.frame(f), b);
+    double worst = 0.0;
+    for (std::size_t v = 0; v < a.size(); ++v) worst = std::max(worst, (placement.apply(scale * a[v]) - b[v]).norm());
+    EXPECT_LT(worst, 1e-6) << "frame " << f;  // float weights sum to 1 within 1e-7
+  }
+}
+
+TEST(GltfAnimation, CesiumMansWalkIsACycleOnTheFloor) {
+  const AvatarAnimation anim = AvatarAnimation::fromJointMotion(cesiumMan(), cesiumWalk(), "CesiumMan.glb");
+  std::vector<Vec3> posed;
+  double lowest = 1e9, highestLowest = -1e9;
+  for (std::size_t f = 0; f < anim.frameCount(); ++f) {
+    poseSkin(cesiumMan(), anim.frame(f), posed);
+    double low = 1e9;
+    for (const Vec3& p : posed) low = std::min(low, p.y());
+    lowest = std::min(lowest, low);
+    highestLowest = std::max(highestLowest, low);
+  }
+  // The feet stay on the floor the avatar stands on at rest (y = 0) within the walk's bob:
+  // a wrong unit, placement or joint order would float or sink the body by decimetres.
+  EXPECT_GT(lowest, -0.03);
+  EXPECT_LT(highestLowest, 0.05);
+  // The 2 s walk is a cycle: its last frame is its first.
+  for (std::size_t j = 0; j < anim.jointCount(); ++j) {
+    EXPECT_LT((anim.frame(0)[j].translation - anim.frame(60)[j].translation).norm(), 1e-12) << j;
+    EXPECT_LT(anim.frame(0)[j].rotation.angularDistance(anim.frame(60)[j].rotation), 1e-9) << j;
+  }
+}
+
+TEST(GltfAnimation, AvatarsOfOtherFilesAreRefused) {
+  const scene::Avatar makeHuman =
+      scene::loadAvatarFile(std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel");
+  const std::string e = errorOf([&] { (void)AvatarAnimation::fromJointMotion(makeHuman, cesiumWalk(), "walk.glb"); });
+  EXPECT_EQ(e.rfind("walk.glb: its skin has no joint named Hips, ", 0), 0u) << e;
+  EXPECT_NE(e.find("(31 of 31 missing): a glTF animation drives the avatar of its own file"), std::string::npos) << e;
+
+  scene::Avatar moved = cesiumMan();
+  moved.joints[3].restCenter.x() += 0.05;  // the same names, another skeleton
+  const std::string rests = errorOf([&] { (void)AvatarAnimation::fromJointMotion(moved, cesiumWalk(), "walk.glb"); });
+  EXPECT_EQ(rests.rfind("walk.glb: the skeleton of its animation does not rest as avatar 'CesiumMan' does (joint '", 0), 0u)
+      << rests;
+
+  EXPECT_EQ(errorOf([&] {
+              MotionOptions o;
+              o.jointMapPath = "map.json";
+              (void)loadAnimation(cesiumMan(), cesiumPath(), o);
+            }),
+            "--joint-map: " + cesiumPath() + " is a glTF animation, which drives the joints of its own skin by name");
+}
+
+}  // namespace
+}  // namespace drape::motion

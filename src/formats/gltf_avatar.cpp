@@ -1,10 +1,9 @@
 #include "drape/formats/gltf_avatar.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <cmath>
-#include <functional>
 #include <limits>
 #include <map>
 

@@ -2,8 +2,9 @@
 // Skinned characters from glTF 2.0 (.gltf, .glb), read by drape's own reader (GLB chunks,
 // then the JSON through nlohmann_json) inside a limited child process (core/isolate.hpp),
 // handed back as plain data. Only the first skin and the triangle primitives of the nodes
-// that use it are read. (Debian's compiled tinygltf did not match its own header's struct
-// layout in our build: AddressSanitizer caught a bad free in Model's destructor.)
+// that use it are read, and on request one animation as the motion of that skin's joints.
+// (Debian's compiled tinygltf did not match its own header's struct layout in our build:
+// AddressSanitizer caught a bad free in Model's destructor.)
 //
 // Safety rules for files from outside: only glTF is parsed (no other importer to fall
 // through to); buffer URIs may be base64 `data:` URIs or files inside the model's own
@@ -13,6 +14,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "drape/core/isolate.hpp"
 #include "drape/formats/skinned_model.hpp"

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include <fmt/ostream.h>
+#include <fmt/ranges.h>
 
 #include "command.hpp"
 #include "drape/core/error.hpp"
@@ -94,10 +95,14 @@ void inspectAcclaim(const std::string& path, std::ostream& out) {
 void inspectGltfMotion(const std::string& path, std::ostream& out) {
   try {
     const formats::GltfJointMotion m = formats::readGltfJointMotion(path, 30.0);
-    fmt::print(out, "  motion     {} animation{}; the first, '{}': {:.3f} s ({:.3f} to {:.3f} s of key times), {} frames "
-               "at 30 Hz; drape run --motion {} plays it on this avatar\n",
-               m.animationCount, m.animationCount == 1 ? "" : "s", m.animation, m.end_s - m.start_s, m.start_s, m.end_s,
-               m.frameCount(), path);
+    std::vector<std::string> names;
+    for (std::size_t i = 0; i < m.animationNames.size(); ++i) names.push_back(fmt::format("{} '{}'", i, m.animationNames[i]));
+    const bool several = m.animationCount > 1;
+    fmt::print(out, "  motion     {} animation{}{}; the first, '{}': {:.3f} s ({:.3f} to {:.3f} s of key times), {} frames "
+               "at 30 Hz; drape run --motion {}{} plays {} on this avatar\n",
+               m.animationCount, several ? "s" : "", several ? fmt::format(" ({})", fmt::join(names, ", ")) : "",
+               m.animation, m.end_s - m.start_s, m.start_s, m.end_s, m.frameCount(), path,
+               several ? " --animation NAME|INDEX" : "", several ? "one" : "it");
   } catch (const Error& e) {
     fmt::print(out, "  motion     none: {}\n", e.what());
   }

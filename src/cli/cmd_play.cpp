@@ -24,7 +24,7 @@ namespace {
 
 struct PlayOptions {
   std::string run;
-  std::string motion;
+  std::string motion, animation;
   long frames = 0;
   bool once = false;
   bool fast = false;
@@ -38,7 +38,7 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
   RunSetup setup = runSetupFromScene(o.run);
   if (!setup.character)
     throw Error(fmt::format("{}: drape play simulates scenes with an avatar (replay a run directory otherwise)", o.run));
-  if (!o.motion.empty()) addMotion(setup, o.motion);
+  if (!o.motion.empty()) addMotion(setup, o.motion, 0.0, "", o.animation);
   const std::unique_ptr<sim::CharacterWorld> worldPtr = buildWorld(setup);
   sim::CharacterWorld& world = *worldPtr;
   const scene::Avatar* avatar = setup.character->avatar.get();
@@ -110,7 +110,9 @@ RunFunction setupPlay(CLI::App& app) {
   static PlayOptions o;
   app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes, or a scene to simulate live")
       ->required();
-  app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc; or the avatar's own .glb/.gltf, its first animation)");
+  CLI::Option* motionOption = app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc; or the avatar's own .glb/.gltf and its animation)");
+  app.add_option("--animation", o.animation, "With a glTF --motion: which of the file's animations plays, by name or by index from 0 (default: the first; drape inspect FILE lists them)")
+      ->needs(motionOption);
   app.add_option("--frames", o.frames, "Close by itself after showing N frames")->check(CLI::PositiveNumber);
   app.add_flag("--once", o.once, "Stop at the last frame instead of starting over");
   app.add_flag("--fast", o.fast, "Show a new frame on every redraw instead of at the run's frame rate");

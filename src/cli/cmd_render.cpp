@@ -25,7 +25,7 @@ namespace {
 
 struct RenderOptions {
   std::string run;
-  std::string motion;
+  std::string motion, animation;
   std::string runOut;
   long frames = 0;
   std::string range;
@@ -42,7 +42,9 @@ RunFunction setupRender(CLI::App& app) {
   static RenderOptions o;
   app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes, or a scene to simulate")
       ->required();
-  app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc; or the avatar's own .glb/.gltf, its first animation)");
+  CLI::Option* motionOption = app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc; or the avatar's own .glb/.gltf and its animation)");
+  app.add_option("--animation", o.animation, "With a glTF --motion: which of the file's animations plays, by name or by index from 0 (default: the first; drape inspect FILE lists them)")
+      ->needs(motionOption);
   app.add_option("--frames", o.frames, "With a scene: frames to simulate (default: the lead-in and the whole motion)");
   app.add_option("--run-out", o.runOut, "With a scene: keep the simulated run in this directory (default: a temporary one)");
   app.add_option("--range", o.range,
@@ -73,7 +75,7 @@ RunFunction setupRender(CLI::App& app) {
     std::filesystem::path scratch;
     if (std::filesystem::is_regular_file(o.run)) {
       RunSetup setup = runSetupFromScene(o.run);
-      if (!o.motion.empty()) addMotion(setup, o.motion);
+      if (!o.motion.empty()) addMotion(setup, o.motion, 0.0, "", o.animation);
       setup.frames = o.frames > 0 ? o.frames : defaultFrames(setup);
       if (o.runOut.empty()) {
         scratch = std::filesystem::temp_directory_path() / fmt::format("drape-render-{}", ::getpid());

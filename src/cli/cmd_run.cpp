@@ -30,7 +30,7 @@ namespace drape::cli {
 namespace {
 
 struct RunOptions {
-  std::string scene, avatar, motion, jointMap, fieldMethod = "dvdp";
+  std::string scene, avatar, motion, jointMap, animation, fieldMethod = "dvdp";
   double motionScale = 0.0, voxel_m = 0.0, leadIn_s = 1.0;
   bool preview = false, countEverySubstep = false, exactSliding = false, freePinches = false, noStitches = false;
   double stitchGaps_m = 0.0;  ///< --stitch-gaps
@@ -256,7 +256,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     if (!(o.leadIn_s >= 0)) throw Error(fmt::format("--lead-in must be >= 0 s, got {}", o.leadIn_s));
     ch.leadIn_s = o.leadIn_s;
     if (app.count("--keep-apart")) setKeepApart(ch, o.keepApart);
-    if (!o.motion.empty()) addMotion(setup, o.motion, o.motionScale, o.jointMap);
+    if (!o.motion.empty()) addMotion(setup, o.motion, o.motionScale, o.jointMap, o.animation);
   }
 
   if (app.count("--substeps") || o.scene.empty()) {
@@ -300,8 +300,10 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("scene", o->scene, "VRML97 scene with ClothSet garments (and an avatar)");
   app.add_option("--garment", o->garment, "Garment mesh (OBJ), instead of a scene");
   app.add_option("--avatar", o->avatar, "Avatar to wear --garment (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel)");
-  app.add_option("--motion", o->motion, "Motion for the avatar (.bvh, .amc; or the avatar's own .glb/.gltf file, whose first animation it plays)");
+  CLI::Option* motionOption = app.add_option("--motion", o->motion, "Motion for the avatar (.bvh, .amc; or the avatar's own .glb/.gltf file, whose animation it plays)");
   app.add_option("--joint-map", o->jointMap, "JSON map from the motion's joint names to the avatar's");
+  app.add_option("--animation", o->animation, "With a glTF --motion: which of the file's animations plays, by name or by index from 0 (default: the first; drape inspect FILE lists them)")
+      ->needs(motionOption);
   app.add_option("--motion-scale", o->motionScale, "Metres per motion-file unit (default: guessed from the skeleton)");
   app.add_option("--voxel", o->voxel_m, "Distance-field voxel size, m (default: the scene's, or 0.005)");
   app.add_option("--field-method", o->fieldMethod, "dvdp (the paper's) or exact")

@@ -257,13 +257,15 @@ RunSetup runSetupFromScene(const std::string& scenePath) {
   return setup;
 }
 
-void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerUnit, const std::string& jointMap) {
+void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerUnit, const std::string& jointMap,
+               const std::string& animation) {
   if (!setup.character)
     throw Error("--motion: there is no avatar to move (the scene has none; without a scene, give --avatar FILE)");
   motion::MotionOptions mo;
   mo.clip.rate = setup.settings.frameRate_hz;
   if (metresPerUnit > 0) mo.clip.metresPerUnit = metresPerUnit;
   mo.jointMapPath = jointMap;
+  mo.animation = animation;
   mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
   motion::ClipLoadReport report;
   motion::JointMap map;

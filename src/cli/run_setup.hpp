@@ -65,9 +65,10 @@ struct RunSetup {
 [[nodiscard]] RunSetup runSetupFromScene(const std::string& scenePath);
 
 /// Loads a motion file onto the setup's avatar (rate = the setup's frame rate). `metresPerUnit`
-/// > 0 overrides the units guess; `jointMap` "" picks one of the shipped maps.
+/// > 0 overrides the units guess; `jointMap` "" picks one of the shipped maps; `animation`
+/// chooses one of a glTF motion file's animations ("" the first).
 void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerUnit = 0.0,
-               const std::string& jointMap = "");
+               const std::string& jointMap = "", const std::string& animation = "");
 
 /// The character's world of a setup with an avatar: fields built, masks bound, solvers
 /// ready. Used by `drape run`, `drape play SCENE` and `drape bench paper` alike.

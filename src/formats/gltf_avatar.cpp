@@ -8,6 +8,7 @@
 #include <map>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "drape/core/error.hpp"
@@ -716,12 +717,28 @@ Quat nearestRotation(const Eigen::Matrix3d& m) {
   return Quat(r).normalized();
 }
 
-GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, double rate, std::size_t index) {
+std::string animationName(const GModel& model, std::size_t index) {
+  const std::string& name = model.animations[index].name;
+  return name.empty() ? fmt::format("animation {}", index) : name;
+}
+
+/// The animation `which` names: its name, its index in decimal digits, or "" for the first.
+std::size_t chooseAnimation(const GModel& model, const std::string& which, const Reader& r) {
+  if (model.animations.empty()) r.fail("has no animation");
+  if (which.empty()) return 0;
+  for (std::size_t i = 0; i < model.animations.size(); ++i)
+    if (model.animations[i].name == which) return i;
+  const bool digits = which.size() <= 9 && std::all_of(which.begin(), which.end(), [](char c) { return c >= '0' && c <= '9'; });
+  if (digits && std::stoul(which) < model.animations.size()) return std::stoul(which);
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < model.animations.size(); ++i) names.push_back(fmt::format("{} '{}'", i, animationName(model, i)));
+  r.fail(fmt::format("has no animation '{}' (it has {}: {})", which, model.animations.size(), fmt::join(names, ", ")));
+}
+
+GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, double rate, const std::string& which) {
   const Reader r{model, name};
   if (!(rate > 0) || !std::isfinite(rate)) r.fail(fmt::format("a motion rate of {} frames per second", rate));
-  if (model.animations.empty()) r.fail("has no animation");
-  if (index >= model.animations.size())
-    r.fail(fmt::format("has {} animations, so there is no animation {}", model.animations.size(), index));
+  const std::size_t index = chooseAnimation(model, which, r);
   std::vector<int> nodeParent;
   const std::vector<Eigen::Matrix4d> restWorld = nodeWorlds(model, nodeParent, r);
   const SkinJoints sj = skinJoints(model, nodeParent, r);
@@ -729,9 +746,9 @@ GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, 
   if (tracks.empty()) r.fail(fmt::format("animation {} moves no node", index));
 
   GltfJointMotion out;
-  const GAnimation& anim = model.animations[index];
-  out.animation = anim.name.empty() ? fmt::format("animation {}", index) : anim.name;
+  out.animation = animationName(model, index);
   out.animationCount = model.animations.size();
+  for (std::size_t i = 0; i < model.animations.size(); ++i) out.animationNames.push_back(animationName(model, i));
   out.rate = rate;
   out.start_s = std::numeric_limits<double>::infinity();
   out.end_s = 0.0;
@@ -785,6 +802,8 @@ std::string serialise(const GltfJointMotion& m) {
   std::string s;
   detail::putVector(s, std::vector<char>(m.animation.begin(), m.animation.end()));
   detail::put<std::uint64_t>(s, m.animationCount);
+  detail::put<std::uint64_t>(s, m.animationNames.size());
+  for (const std::string& a : m.animationNames) detail::putVector(s, std::vector<char>(a.begin(), a.end()));
   detail::put(s, m.rate);
   detail::put(s, m.start_s);
   detail::put(s, m.end_s);
@@ -807,6 +826,12 @@ GltfJointMotion deserialiseJointMotion(std::string_view bytes, const std::string
   const std::vector<char> animation = c.getVector<char>();
   m.animation.assign(animation.begin(), animation.end());
   m.animationCount = c.get<std::uint64_t>();
+  const auto names = c.get<std::uint64_t>();
+  if (names > 1'000'000) throw Error(fmt::format("{}: the reader returned bad data", name));
+  for (std::uint64_t k = 0; k < names; ++k) {
+    const std::vector<char> chars = c.getVector<char>();
+    m.animationNames.emplace_back(chars.begin(), chars.end());
+  }
   m.rate = c.get<double>();
   m.start_s = c.get<double>();
   m.end_s = c.get<double>();
@@ -834,16 +859,16 @@ SkinnedModel parseGltfSkinnedModel(std::string_view bytes, const std::string& na
 }
 
 GltfJointMotion parseGltfJointMotion(std::string_view bytes, const std::string& name, const std::string& baseDir,
-                                     double rate, std::size_t index) {
-  return sampleJointMotion(parseDocument(bytes, name, baseDir), name, rate, index);
+                                     double rate, const std::string& animation) {
+  return sampleJointMotion(parseDocument(bytes, name, baseDir), name, rate, animation);
 }
 
-GltfJointMotion readGltfJointMotion(const std::string& path, double rate, std::size_t index,
+GltfJointMotion readGltfJointMotion(const std::string& path, double rate, const std::string& animation,
                                     const IsolationLimits& limits) {
   const std::string bytes = detail::readWholeFile(path, std::size_t{1} << 30);
   const std::string baseDir = std::filesystem::absolute(path).parent_path().string();
   const std::string result = runIsolated(
-      path, "glTF reader", [&] { return serialise(parseGltfJointMotion(bytes, path, baseDir, rate, index)); }, limits);
+      path, "glTF reader", [&] { return serialise(parseGltfJointMotion(bytes, path, baseDir, rate, animation)); }, limits);
   return deserialiseJointMotion(result, path);
 }
 

@@ -467,7 +467,7 @@ AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& mo
     if (!options.jointMapPath.empty())
       throw Error(fmt::format("--joint-map: {} is a glTF animation, which drives the joints of its own skin by name", motionPath));
     const double rate = options.clip.rate > 0 ? options.clip.rate : 30.0;
-    const formats::GltfJointMotion motion = formats::readGltfJointMotion(motionPath, rate);
+    const formats::GltfJointMotion motion = formats::readGltfJointMotion(motionPath, rate, options.animation);
     AvatarAnimation anim = AvatarAnimation::fromJointMotion(avatar, motion, motionPath);
     if (report) {
       *report = {};
@@ -482,6 +482,9 @@ AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& mo
     }
     return anim;
   }
+  if (!options.animation.empty())
+    throw Error(fmt::format("--animation: {} is not a glTF file; animations are chosen from a glTF avatar's own file",
+                            motionPath));
   const Clip clip = loadClip(motionPath, options.clip, report);
   JointMap map;
   if (!options.jointMapPath.empty()) {

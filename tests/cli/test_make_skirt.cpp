@@ -116,6 +116,21 @@ TEST(MakeSkirt, CesiumMansSkirtWalksOnItsOwnAnimation) {
   EXPECT_EQ(stats["frames"], 90);
   EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
 
+  // An animation the file does not have; --animation with a BVH.
+  const CliResult jog = runDrape("run '" + out + "/scene.wrl' --motion '" + cesium + "' --animation jog --frames 2 --out '" +
+                                     (dir / "jog") + "'",
+                                 dir);
+  EXPECT_EQ(jog.code, 2);
+  EXPECT_NE(jog.err.find(cesium + ": has no animation 'jog' (it has 1: 0 'animation 0')"), std::string::npos) << jog.err;
+  const CliResult bvh = runDrape("run '" + testing::kSkirtDir + "/scene.wrl' --motion '" + testing::kSkirtDir +
+                                     "/walk.bvh' --animation 1 --frames 2 --out '" + (dir / "bvh") + "'",
+                                 dir);
+  EXPECT_EQ(bvh.code, 2);
+  EXPECT_NE(bvh.err.find("--animation: " + testing::kSkirtDir +
+                         "/walk.bvh is not a glTF file; animations are chosen from a glTF avatar's own file"),
+            std::string::npos)
+      << bvh.err;
+
   // Another avatar's file: refused, saying why.
   const CliResult other = runDrape("run '" + testing::kSkirtDir + "/scene.wrl' --motion '" + cesium + "' --frames 2 --out '" +
                                        (dir / "other") + "'",

@@ -45,6 +45,7 @@ struct Doc {
   std::string buffer;  ///< float32 data of every accessor
   std::vector<std::string> accessors, samplers, channels;
   std::string hipExtra;  ///< more JSON members of the hip node
+  std::string animationExtra, moreAnimations;  ///< more members of the animation, more animations
 
   int floats(const std::vector<float>& v, const char* type) {
     const std::size_t offset = buffer.size();
@@ -63,8 +64,10 @@ struct Doc {
                                    node, path));
   }
   [[nodiscard]] std::string text() const {
-    const std::string animations = channels.empty() ? "" : fmt::format(R"(, "animations": [{{"channels": [{}], "samplers": [{}]}}])",
-                                                                       fmt::join(channels, ", "), fmt::join(samplers, ", "));
+    const std::string animations =
+        channels.empty() ? "" : fmt::format(R"(, "animations": [{{"channels": [{}], "samplers": [{}]{}}}{}])",
+                                            fmt::join(channels, ", "), fmt::join(samplers, ", "), animationExtra,
+                                            moreAnimations);
     return fmt::format(R"({{"asset": {{"version": "2.0"}},
  "nodes": [{{"name": "hip", "translation": [0, 1, 0], "children": [1]{}}}, {{"name": "knee", "translation": [0, -0.5, 0]}}],
  "skins": [{{"joints": [0, 1]}}],
@@ -215,8 +218,33 @@ TEST(GltfMotion, BadAnimationsAreRefused) {
   Doc rate;
   rate.channel(0, "rotation", {0.0f}, {0, 0, 0, 1});
   EXPECT_EQ(errorOf([&] { (void)rate.motion(0); }), "t.gltf: a motion rate of 0 frames per second");
-  EXPECT_EQ(errorOf([&] { (void)parseGltfJointMotion(rate.text(), "t.gltf", "", 30, 1); }),
-            "t.gltf: has 1 animations, so there is no animation 1");
+  EXPECT_EQ(errorOf([&] { (void)parseGltfJointMotion(rate.text(), "t.gltf", "", 30, "1"); }),
+            "t.gltf: has no animation '1' (it has 1: 0 'animation 0')");
+}
+
+TEST(GltfMotion, AnAnimationIsChosenByNameOrIndex) {
+  Doc doc;
+  doc.channel(0, "rotation", {0.0f, 1.0f}, {0, 0, 0, 1, 0, 0, kHalf, kHalf});
+  doc.animationExtra = R"(, "name": "walk")";
+  // "run" turns the knee with the same sampler.
+  doc.moreAnimations = R"(, {"name": "run", "channels": [{"sampler": 0, "target": {"node": 1, "path": "rotation"}}],
+    "samplers": [)" + doc.samplers[0] + "]}";
+  const auto turned = [&](const std::string& which, std::size_t joint) {
+    const GltfJointMotion m = parseGltfJointMotion(doc.text(), "t.gltf", "", 1.0, which);
+    EXPECT_EQ(m.animationNames, (std::vector<std::string>{"walk", "run"}));
+    return angleBetween(m.frames[2 + joint].rotation, aboutZ(90)) < 1e-6;  // frame 1 (1 s)
+  };
+  EXPECT_TRUE(turned("", 0));
+  EXPECT_TRUE(turned("walk", 0));
+  EXPECT_TRUE(turned("0", 0));
+  EXPECT_FALSE(turned("run", 0));
+  EXPECT_TRUE(turned("run", 1));
+  EXPECT_TRUE(turned("1", 1));
+  EXPECT_EQ(parseGltfJointMotion(doc.text(), "t.gltf", "", 1.0, "run").animation, "run");
+  EXPECT_EQ(errorOf([&] { (void)parseGltfJointMotion(doc.text(), "t.gltf", "", 1.0, "jog"); }),
+            "t.gltf: has no animation 'jog' (it has 2: 0 'walk', 1 'run')");
+  EXPECT_EQ(errorOf([&] { (void)parseGltfJointMotion(doc.text(), "t.gltf", "", 1.0, "2"); }),
+            "t.gltf: has no animation '2' (it has 2: 0 'walk', 1 'run')");
 }
 
 TEST(GltfMotion, CesiumManWalksWithBonesOfConstantLength) {

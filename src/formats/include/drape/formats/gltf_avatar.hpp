@@ -41,6 +41,7 @@ using GltfSkinnedModel = SkinnedModel;
 struct GltfJointMotion {
   std::string animation;                  ///< its name, or "animation <index>"
   std::size_t animationCount = 0;         ///< how many animations the file has
+  std::vector<std::string> animationNames;  ///< every animation's name ("animation <index>" if it has none)
   double rate = 30.0;                     ///< frames per second
   double start_s = 0.0, end_s = 0.0;      ///< the animation's first and last key times
   std::vector<std::string> joints;        ///< the skin's joints, parent-first and named as in GltfSkinnedModel
@@ -52,14 +53,17 @@ struct GltfJointMotion {
   [[nodiscard]] std::size_t frameCount() const { return joints.empty() ? 0 : frames.size() / joints.size(); }
 };
 
-/// Samples animation `index` of glTF/GLB bytes in this process (for the fuzz target and the
-/// child). Throws drape::Error naming the file and what is wrong; a file without
-/// animations is an error.
+/// Samples one animation of glTF/GLB bytes in this process (for the fuzz target and the
+/// child): `animation` is its name, or its index from 0 in decimal digits, or "" for the
+/// first. Throws drape::Error naming the file and what is wrong; a file without
+/// animations, or without the one asked for, is an error.
 [[nodiscard]] GltfJointMotion parseGltfJointMotion(std::string_view bytes, const std::string& name,
-                                                   const std::string& baseDir, double rate, std::size_t index = 0);
+                                                   const std::string& baseDir, double rate,
+                                                   const std::string& animation = "");
 
-/// Reads and samples animation `index` of a .gltf/.glb file in a limited child process.
-[[nodiscard]] GltfJointMotion readGltfJointMotion(const std::string& path, double rate, std::size_t index = 0,
+/// Reads and samples one animation of a .gltf/.glb file in a limited child process.
+[[nodiscard]] GltfJointMotion readGltfJointMotion(const std::string& path, double rate,
+                                                  const std::string& animation = "",
                                                   const IsolationLimits& limits = {});
 
 }  // namespace drape::formats

@@ -133,11 +133,13 @@ struct MotionOptions {
   ClipLoadOptions clip;            ///< rate (default 30 Hz), --motion-scale, ASF path
   std::string jointMapPath;        ///< --joint-map FILE (checked strictly); "" = choose
   std::string jointMapDirectory;   ///< the shipped maps (share/drape/jointmaps)
+  std::string animation;           ///< --animation: which of a glTF file's animations ("" the first)
   RetargetOptions retarget;
 };
 
 /// Loads FILE.bvh / FILE.amc, picks or reads the joint map, and retargets onto `avatar`;
-/// or takes FILE.glb / FILE.gltf's first animation as the avatar's own motion
+/// or takes one of FILE.glb / FILE.gltf's animations (options.animation, by default the
+/// first) as the avatar's own motion
 /// (AvatarAnimation::fromJointMotion; `report` then gives the file's key rate as 0 and its
 /// frames as sampled). Throws drape::Error (exit code 2) naming the file, line and problem.
 [[nodiscard]] AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& motionPath,

@@ -21,6 +21,7 @@
 
 #include "command.hpp"
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
 #include "drape/field/distance_field.hpp"
 #include "drape/formats/obj.hpp"
 #include "drape/formats/units.hpp"
@@ -36,8 +37,7 @@ struct NamedPart {
 };
 
 std::vector<NamedPart> loadParts(const std::string& path, const std::string& units, const std::string& part) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lowerExtension(path);
   if (ext != ".obj") throw Error(path + ": drape field reads OBJ meshes (.obj)");
   formats::ObjReadOptions options;
   options.metresPerUnit = formats::metresPerUnit(units);

@@ -12,6 +12,7 @@
 
 #include "command.hpp"
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
 #include "drape/sim/body_overlap.hpp"
 #include "inspect_run.hpp"
 #include "run_setup.hpp"
@@ -22,12 +23,6 @@ namespace {
 std::vector<InspectorEntry>& inspectors() {
   static std::vector<InspectorEntry> entries;
   return entries;
-}
-
-std::string lowerExtension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
 }
 
 /// With a scene and its avatar's motion: where the motion puts the collidable parts inside

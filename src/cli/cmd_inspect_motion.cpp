@@ -10,6 +10,7 @@
 
 #include "command.hpp"
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
 #include "drape/formats/asf_amc.hpp"
 #include "drape/formats/bvh.hpp"
 #include "drape/formats/gltf_avatar.hpp"
@@ -76,8 +77,7 @@ void inspectBvh(const std::string& path, std::ostream& out) {
 }
 
 void inspectAcclaim(const std::string& path, std::ostream& out) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = lowerExtension(path);
   if (ext == ".asf") {
     const formats::AsfSkeleton asf = formats::readAsf(path);
     fmt::print(out, "{}: Acclaim ASF skeleton '{}'\n  bones      {}\n", path, asf.name, asf.bones.size());
@@ -97,10 +97,10 @@ void inspectGltfMotion(const std::string& path, std::ostream& out) {
     const formats::GltfJointMotion m = formats::readGltfJointMotion(path, 30.0);
     std::vector<std::string> names;
     for (std::size_t i = 0; i < m.animationNames.size(); ++i) names.push_back(fmt::format("{} '{}'", i, m.animationNames[i]));
-    const bool several = m.animationCount > 1;
+    const bool several = m.animationNames.size() > 1;
     fmt::print(out, "  motion     {} animation{}{}; the first, '{}': {:.3f} s ({:.3f} to {:.3f} s of key times), {} frames "
                "at 30 Hz; drape run --motion {}{} plays {} on this avatar\n",
-               m.animationCount, several ? "s" : "", several ? fmt::format(" ({})", fmt::join(names, ", ")) : "",
+               m.animationNames.size(), several ? "s" : "", several ? fmt::format(" ({})", fmt::join(names, ", ")) : "",
                m.animation, m.end_s - m.start_s, m.start_s, m.end_s, m.frameCount(), path,
                several ? " --animation NAME|INDEX" : "", several ? "one" : "it");
   } catch (const Error& e) {
@@ -127,8 +127,7 @@ void inspectAvatar(const std::string& path, std::ostream& out) {
   fmt::print(out, "  segments   {} (closed, by dominant skin weight)\n", a.segments.size());
   for (const scene::Segment& s : a.segments)
     fmt::print(out, "    {:<18} {:>6} triangles\n", s.name, s.mesh.triangleCount());
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lowerExtension(path);
   if (ext == ".glb" || ext == ".gltf") inspectGltfMotion(path, out);
 }
 

@@ -21,6 +21,7 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
 #include "text_scan.hpp"
 
 namespace drape::formats {
@@ -31,12 +32,6 @@ constexpr std::size_t kMaxJoints = 1024;
 constexpr std::size_t kMaxFileBytes = std::size_t{1} << 30;
 
 enum class Format { Collada, Fbx };
-
-std::string lowerExtension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
 
 Format formatOf(const std::string& name) {
   const std::string ext = lowerExtension(name);

@@ -747,7 +747,6 @@ GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, 
 
   GltfJointMotion out;
   out.animation = animationName(model, index);
-  out.animationCount = model.animations.size();
   for (std::size_t i = 0; i < model.animations.size(); ++i) out.animationNames.push_back(animationName(model, i));
   out.rate = rate;
   out.start_s = std::numeric_limits<double>::infinity();
@@ -801,7 +800,6 @@ GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, 
 std::string serialise(const GltfJointMotion& m) {
   std::string s;
   detail::putVector(s, std::vector<char>(m.animation.begin(), m.animation.end()));
-  detail::put<std::uint64_t>(s, m.animationCount);
   detail::put<std::uint64_t>(s, m.animationNames.size());
   for (const std::string& a : m.animationNames) detail::putVector(s, std::vector<char>(a.begin(), a.end()));
   detail::put(s, m.rate);
@@ -825,7 +823,6 @@ GltfJointMotion deserialiseJointMotion(std::string_view bytes, const std::string
   GltfJointMotion m;
   const std::vector<char> animation = c.getVector<char>();
   m.animation.assign(animation.begin(), animation.end());
-  m.animationCount = c.get<std::uint64_t>();
   const auto names = c.get<std::uint64_t>();
   if (names > 1'000'000) throw Error(fmt::format("{}: the reader returned bad data", name));
   for (std::uint64_t k = 0; k < names; ++k) {

@@ -9,6 +9,7 @@
 #include <fmt/ranges.h>
 
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
 #include "drape/motion/interpolate.hpp"
 
 namespace drape::motion {
@@ -461,8 +462,7 @@ AvatarAnimation AvatarAnimation::fromJointMotion(const scene::Avatar& avatar, co
 
 AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& motionPath, const MotionOptions& options,
                               ClipLoadReport* report, JointMap* chosenMap) {
-  std::string ext = std::filesystem::path(motionPath).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lowerExtension(motionPath);
   if (ext == ".glb" || ext == ".gltf") {
     if (!options.jointMapPath.empty())
       throw Error(fmt::format("--joint-map: {} is a glTF animation, which drives the joints of its own skin by name", motionPath));

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
 #include "drape/formats/asf_amc.hpp"
 #include "drape/motion/interpolate.hpp"
 
@@ -312,8 +313,7 @@ Clip clipFromAsfAmc(const formats::AsfSkeleton& asf, const formats::AmcMotion& a
 }
 
 Clip loadClip(const std::string& path, const ClipLoadOptions& options, ClipLoadReport* report) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lowerExtension(path);
   if (ext == ".bvh") return clipFromBvh(formats::readBvh(path), options, report);
   if (ext == ".amc") {
     std::string asfPath = options.asfPath;

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
 #include "drape/formats/assimp_avatar.hpp"
 #include "drape/scene/avatar_makehuman.hpp"
 #include "drape/scene/avatar_segment.hpp"
@@ -64,8 +65,7 @@ formats::SkinnedModel skinnedModelOf(const Avatar& avatar) {
 }
 
 Avatar loadAvatarFile(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lowerExtension(path);
   if (ext == ".glb" || ext == ".gltf") return loadGltfAvatar(path);
   if (ext == ".dae" || ext == ".fbx") return loadAssimpAvatar(path);
   if (ext == ".mhskel") return loadMakeHumanAvatar(path);

@@ -92,7 +92,7 @@ TEST(GltfMotion, LinearRotationsAreSlerpedAndCarryTheChild) {
   ASSERT_EQ(m.joints, (std::vector<std::string>{"hip", "knee"}));
   ASSERT_EQ(m.frameCount(), 5u);  // 0, 0.25, 0.5, 0.75, 1 s
   EXPECT_EQ(m.animation, "animation 0");
-  EXPECT_EQ(m.animationCount, 1u);
+  EXPECT_EQ(m.animationNames, (std::vector<std::string>{"animation 0"}));
   EXPECT_NEAR(m.restCenters[1].y(), 0.5, 1e-12);
   for (std::size_t f = 0; f < 5; ++f) {
     const double degrees = 22.5 * static_cast<double>(f);
@@ -161,6 +161,7 @@ TEST(GltfMotion, TheChildProcessReturnsWhatTheParserFinds) {
   const GltfJointMotion parsed = doc.motion(4.0);
   EXPECT_EQ(read.joints, parsed.joints);
   EXPECT_EQ(read.animation, parsed.animation);
+  EXPECT_EQ(read.animationNames, parsed.animationNames);
   EXPECT_EQ(read.restCenters, parsed.restCenters);
   ASSERT_EQ(read.frames.size(), parsed.frames.size());
   for (std::size_t i = 0; i < read.frames.size(); ++i) {

@@ -40,7 +40,6 @@ using GltfSkinnedModel = SkinnedModel;
 /// target weights are ignored.
 struct GltfJointMotion {
   std::string animation;                  ///< its name, or "animation <index>"
-  std::size_t animationCount = 0;         ///< how many animations the file has
   std::vector<std::string> animationNames;  ///< every animation's name ("animation <index>" if it has none)
   double rate = 30.0;                     ///< frames per second
   double start_s = 0.0, end_s = 0.0;      ///< the animation's first and last key times

@@ -1,14 +1,17 @@
 // `drape convert AVATAR --to avatar.wrl|.dae|.fbx`: writes any avatar drape loads (.glb,
 // .gltf, .dae, .fbx, MakeHuman .mhskel) as a segmented H-Anim 1.1 VRML97 humanoid, or its
-// skinned mesh and skeleton as Collada or (ASCII) FBX through Assimp.
+// skinned mesh and skeleton, with the animations the file carries, as Collada or (ASCII)
+// FBX through Assimp.
 
 #include <filesystem>
 
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
 #include "drape/core/error.hpp"
 #include "drape/formats/assimp_avatar.hpp"
+#include "drape/formats/avatar_motion.hpp"
 #include "drape/formats/hanim_writer.hpp"
 #include "drape/scene/avatar_gltf.hpp"
 
@@ -37,6 +40,7 @@ formats::HanimHumanoidData toHanim(const scene::Avatar& a) {
 
 RunFunction setupConvert(CLI::App& app) {
   static std::string input, output;
+  static double rate = 30.0;
   app.add_option("avatar", input,
                  "The avatar to convert: .glb, .gltf, .dae, .fbx or MakeHuman .mhskel (mesh and weights beside it)")
       ->required();
@@ -44,6 +48,11 @@ RunFunction setupConvert(CLI::App& app) {
                  "Output file: a segmented H-Anim 1.1 VRML97 humanoid (.wrl), or the skinned mesh and skeleton as "
                  "Collada (.dae, metres) or ASCII FBX (.fbx, centimetres)")
       ->required();
+  app.add_option("--rate", rate,
+                 "With --to .dae or .fbx: frames per second at which the avatar file's animations are sampled into "
+                 "keys (every animation it carries is written)")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 1000.0));
   return [] {
     const std::string ext = std::filesystem::path(output).extension().string();
     const bool skinned = formats::isAssimpAvatarPath(output);
@@ -51,9 +60,16 @@ RunFunction setupConvert(CLI::App& app) {
       throw Error(fmt::format("--to {}: drape converts avatars to H-Anim VRML97 (.wrl), Collada (.dae) or FBX (.fbx)", output));
     const scene::Avatar avatar = scene::loadAvatarFile(input);
     if (skinned) {
-      formats::writeAssimpSkinnedModel(output, scene::skinnedModelOf(avatar));
+      const std::vector<formats::SkinnedJointMotion> animations =
+          formats::isAvatarMotionPath(input) ? formats::readAvatarMotions(input, rate) : std::vector<formats::SkinnedJointMotion>{};
+      formats::writeAssimpSkinnedModel(output, scene::skinnedModelOf(avatar), animations);
       spdlog::info("{}: {} joints, {} skinned vertices written to {}", input, avatar.joints.size(),
                    avatar.skin->mesh.vertexCount(), output);
+      std::vector<std::string> names;
+      for (const formats::SkinnedJointMotion& m : animations) names.push_back(fmt::format("'{}', {} frames", m.animation, m.frameCount()));
+      if (!animations.empty())
+        spdlog::info("{}: {} animation{} sampled at {:g} Hz written with it ({})", output, animations.size(),
+                     animations.size() > 1 ? "s" : "", rate, fmt::join(names, "; "));
       return 0;
     }
     writeHanim(output, toHanim(avatar));

@@ -13,7 +13,7 @@
 #include "drape/core/files.hpp"
 #include "drape/formats/asf_amc.hpp"
 #include "drape/formats/bvh.hpp"
-#include "drape/formats/gltf_avatar.hpp"
+#include "drape/formats/avatar_motion.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/motion/clip_io.hpp"
 #include "drape/scene/avatar_gltf.hpp"
@@ -91,20 +91,26 @@ void inspectAcclaim(const std::string& path, std::ostream& out) {
   printClip(out, path, "Acclaim AMC", clip, report);
 }
 
-/// A glTF avatar's own animations: what `drape run --motion FILE` plays.
-void inspectGltfMotion(const std::string& path, std::ostream& out) {
+/// An avatar file's own animations: what `drape run --motion FILE` plays.
+void inspectAvatarMotion(const std::string& path, std::ostream& out) {
+  std::vector<formats::SkinnedJointMotion> motions;
   try {
-    const formats::GltfJointMotion m = formats::readGltfJointMotion(path, 30.0);
-    std::vector<std::string> names;
-    for (std::size_t i = 0; i < m.animationNames.size(); ++i) names.push_back(fmt::format("{} '{}'", i, m.animationNames[i]));
-    const bool several = m.animationNames.size() > 1;
-    fmt::print(out, "  motion     {} animation{}{}; the first, '{}': {:.3f} s ({:.3f} to {:.3f} s of key times), {} frames "
-               "at 30 Hz; drape run --motion {}{} plays {} on this avatar\n",
-               m.animationNames.size(), several ? "s" : "", several ? fmt::format(" ({})", fmt::join(names, ", ")) : "",
-               m.animation, m.end_s - m.start_s, m.start_s, m.end_s, m.frameCount(), path,
-               several ? " --animation NAME|INDEX" : "", several ? "one" : "it");
+    motions = formats::readAvatarMotions(path, 30.0);
   } catch (const Error& e) {
     fmt::print(out, "  motion     none: {}\n", e.what());
+    return;
+  }
+  if (motions.empty()) {
+    fmt::print(out, "  motion     none (the file has no animation)\n");
+    return;
+  }
+  const bool several = motions.size() > 1;
+  fmt::print(out, "  motion     {} animation{}; drape run --motion {}{} plays {} on this avatar\n", motions.size(),
+             several ? "s" : "", path, several ? " --animation NAME|INDEX" : "", several ? "one" : "it");
+  for (std::size_t i = 0; i < motions.size(); ++i) {
+    const formats::SkinnedJointMotion& m = motions[i];
+    fmt::print(out, "    {} '{}': {:.3f} s ({:.3f} to {:.3f} s of key times), {} frames at 30 Hz\n", i, m.animation,
+               m.end_s - m.start_s, m.start_s, m.end_s, m.frameCount());
   }
 }
 
@@ -127,8 +133,7 @@ void inspectAvatar(const std::string& path, std::ostream& out) {
   fmt::print(out, "  segments   {} (closed, by dominant skin weight)\n", a.segments.size());
   for (const scene::Segment& s : a.segments)
     fmt::print(out, "    {:<18} {:>6} triangles\n", s.name, s.mesh.triangleCount());
-  const std::string ext = lowerExtension(path);
-  if (ext == ".glb" || ext == ".gltf") inspectGltfMotion(path, out);
+  if (formats::isAvatarMotionPath(path)) inspectAvatarMotion(path, out);
 }
 
 const bool bvh = registerInspector({".bvh"}, "BVH motion: skeleton, frames, rate, duration, units guess", &inspectBvh);

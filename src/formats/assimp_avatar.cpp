@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <unordered_map>
@@ -174,7 +175,7 @@ void keepOnlyImporterFor(Assimp::Importer& importer, const char* extension) {
   if (importer.GetImporterCount() != 1) throw Error("could not restrict Assimp to one importer", ExitCode::Internal);
 }
 
-void configure(Assimp::Importer& importer) {
+void configure(Assimp::Importer& importer, bool animations) {
   importer.SetPropertyInteger(AI_CONFIG_PP_LBW_MAX_WEIGHTS, 4);
   importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
   // Helper nodes for FBX pivots would sit between bones and become joints of their own.
@@ -183,7 +184,7 @@ void configure(Assimp::Importer& importer) {
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_TEXTURES, false);
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_CAMERAS, false);
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_LIGHTS, false);
-  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_ANIMATIONS, false);
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_ANIMATIONS, animations);
 }
 
 constexpr unsigned kPostProcess = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
@@ -411,17 +412,33 @@ void appendMesh(const SceneReader& r, const aiMesh& mesh, const aiNode& meshNode
   }
 }
 
-SkinnedModel extract(const aiScene& scene, Format format, const std::string& name) {
+SceneReader readerFor(const aiScene& scene, Format format, const std::string& name) {
   const Eigen::Matrix4d toMetres = format == Format::Fbx ? fbxToMetresYUp(scene, name) : Eigen::Matrix4d::Identity();
   SceneReader r{scene, name, toMetres, {}};
   if (scene.mRootNode == nullptr) r.fail("has no node tree");
   r.computeWorlds();
-  const auto meshes = r.skinnedMeshes();
+  return r;
+}
+
+// The skin's skeleton (parents first) and the skinned meshes with the nodes that place them.
+std::vector<const aiNode*> skinSkeleton(const SceneReader& r,
+                                        std::vector<std::pair<const aiMesh*, const aiNode*>>& meshes) {
+  meshes = r.skinnedMeshes();
   if (meshes.empty()) r.fail("has no skinned triangle mesh (a mesh with bones is needed)");
   std::vector<const aiNode*> bones;
   for (const auto& [mesh, node] : meshes)
     for (unsigned b = 0; b < mesh->mNumBones; ++b) bones.push_back(r.boneNode(*mesh->mBones[b]));
-  const std::vector<const aiNode*> skeleton = skeletonNodes(r, bones);
+  return skeletonNodes(r, bones);
+}
+
+std::string jointName(const aiNode& node, std::size_t index) {
+  return node.mName.length > 0 ? node.mName.C_Str() : fmt::format("joint{}", index);
+}
+
+SkinnedModel extract(const aiScene& scene, Format format, const std::string& name) {
+  const SceneReader r = readerFor(scene, format, name);
+  std::vector<std::pair<const aiMesh*, const aiNode*>> meshes;
+  const std::vector<const aiNode*> skeleton = skinSkeleton(r, meshes);
 
   SkinnedModel out;
   out.source = name;
@@ -430,13 +447,207 @@ SkinnedModel extract(const aiScene& scene, Format format, const std::string& nam
     const aiNode* node = skeleton[j];
     jointOf[node] = static_cast<std::uint16_t>(j);
     SkinnedJoint joint;
-    joint.name = node->mName.length > 0 ? node->mName.C_Str() : fmt::format("joint{}", j);
+    joint.name = jointName(*node, j);
     joint.parent = j == 0 ? -1 : jointOf.at(node->mParent);
     joint.restWorld = r.world.at(node);
     out.joints.push_back(std::move(joint));
   }
   for (const auto& [mesh, node] : meshes) appendMesh(r, *mesh, *node, jointOf, out);
   if (out.triangles.empty()) r.fail("its skinned meshes have no triangles");
+  return out;
+}
+
+// ---- animations -------------------------------------------------------------------------
+
+// Assimp's key times are ticks. Where a file gives no rate it leaves mTicksPerSecond 0, and
+// its own viewer then plays 25 ticks per second.
+double secondsPerTick(const aiAnimation& a) {
+  return a.mTicksPerSecond > 0 && std::isfinite(a.mTicksPerSecond) ? 1.0 / a.mTicksPerSecond : 1.0 / 25.0;
+}
+
+// The value at `t` of keys at `times` (seconds, ascending): held before the first key and
+// after the last, `mix`ed between the two around t.
+template <typename V, typename Mix>
+V sampleKeys(const std::vector<double>& times, const std::vector<V>& values, double t, Mix mix) {
+  if (t <= times.front()) return values.front();
+  if (t >= times.back()) return values.back();
+  const auto next = static_cast<std::size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin());
+  const double span = times[next] - times[next - 1];
+  return span > 0 ? mix(values[next - 1], values[next], (t - times[next - 1]) / span) : values[next];
+}
+
+// One node's channel of an animation: translation and scale keys linear, rotations by
+// SLERP; a part without keys stays as the node's own transform has it.
+struct NodeTrack {
+  std::size_t node = 0;  // index into MotionNodes::nodes
+  std::vector<double> positionTimes, rotationTimes, scaleTimes;
+  std::vector<Vec3> positions, scales;
+  std::vector<Quat> rotations;
+
+  [[nodiscard]] Eigen::Matrix4d local(double t, const Eigen::Matrix4d& own) const {
+    Vec3 position = own.block<3, 1>(0, 3);
+    Eigen::Matrix3d linear = own.topLeftCorner<3, 3>();
+    Vec3 scale(linear.col(0).norm(), linear.col(1).norm(), linear.col(2).norm());
+    const auto lerp = [](const Vec3& a, const Vec3& b, double u) -> Vec3 { return a + u * (b - a); };
+    if (!positions.empty()) position = sampleKeys(positionTimes, positions, t, lerp);
+    if (!scales.empty()) scale = sampleKeys(scaleTimes, scales, t, lerp);
+    Eigen::Matrix3d rotation;
+    if (!rotations.empty()) {
+      rotation = sampleKeys(rotationTimes, rotations, t, [](const Quat& a, const Quat& b, double u) { return a.slerp(u, b); })
+                     .toRotationMatrix();
+    } else {
+      for (int c = 0; c < 3; ++c) linear.col(c) /= scale[c] > 0 ? scale[c] : 1.0;
+      rotation = linear;
+    }
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    m.topLeftCorner<3, 3>() = rotation * scale.asDiagonal();
+    m.block<3, 1>(0, 3) = position;
+    return m;
+  }
+};
+
+// The nodes whose transforms place the skin's joints: the joints and every ancestor of the
+// skeleton root, parents first.
+struct MotionNodes {
+  std::vector<const aiNode*> nodes;
+  std::vector<int> parent;
+  std::vector<std::size_t> joint;  // the node index of each skeleton joint
+
+  MotionNodes(const aiScene& scene, const std::vector<const aiNode*>& skeleton) {
+    std::unordered_set<const aiNode*> member(skeleton.begin(), skeleton.end());
+    for (const aiNode* n = skeleton.front(); n != nullptr; n = n->mParent) member.insert(n);
+    std::unordered_map<const aiNode*, std::size_t> index;
+    std::vector<const aiNode*> stack{scene.mRootNode};
+    while (!stack.empty()) {
+      const aiNode* node = stack.back();
+      stack.pop_back();
+      index[node] = nodes.size();
+      parent.push_back(node->mParent != nullptr && index.count(node->mParent) != 0 ? static_cast<int>(index.at(node->mParent)) : -1);
+      nodes.push_back(node);
+      for (unsigned i = node->mNumChildren; i-- > 0;)
+        if (member.count(node->mChildren[i]) != 0) stack.push_back(node->mChildren[i]);
+    }
+    for (const aiNode* j : skeleton) joint.push_back(index.at(j));
+  }
+};
+
+template <typename Key>
+std::vector<double> keyTimes(const Key* keys, unsigned count, double perTick, const std::string& where, const SceneReader& r) {
+  std::vector<double> times;
+  for (unsigned k = 0; k < count; ++k) {
+    const double t = keys[k].mTime * perTick;
+    if (!std::isfinite(t) || std::abs(t) > 86400.0)
+      r.fail(fmt::format("{}: key time {} is not a time within a day", where, keys[k].mTime));
+    if (!times.empty() && t < times.back()) r.fail(fmt::format("{}: key {} comes before key {} in time", where, k, k - 1));
+    times.push_back(t);
+  }
+  return times;
+}
+
+std::vector<NodeTrack> readTracks(const SceneReader& r, const aiAnimation& anim, const std::string& animName,
+                                  const MotionNodes& motionNodes) {
+  std::unordered_map<const aiNode*, std::size_t> index;
+  for (std::size_t i = 0; i < motionNodes.nodes.size(); ++i) index[motionNodes.nodes[i]] = i;
+  const double perTick = secondsPerTick(anim);
+  std::vector<NodeTrack> tracks;
+  std::unordered_set<const aiNode*> driven;
+  for (unsigned c = 0; c < anim.mNumChannels; ++c) {
+    const aiNodeAnim* channel = anim.mChannels[c];
+    if (channel == nullptr) continue;
+    const std::string where = fmt::format("animation '{}' channel '{}'", animName, channel->mNodeName.C_Str());
+    const aiNode* node = r.scene.mRootNode->FindNode(channel->mNodeName);
+    if (node == nullptr) r.fail(fmt::format("{}: names no node of the scene", where));
+    if (!driven.insert(node).second) r.fail(fmt::format("{}: a second channel drives the same node", where));
+    const auto at = index.find(node);
+    if (at == index.end()) continue;  // a node that places no joint
+    NodeTrack t;
+    t.node = at->second;
+    t.positionTimes = keyTimes(channel->mPositionKeys, channel->mNumPositionKeys, perTick, where, r);
+    t.rotationTimes = keyTimes(channel->mRotationKeys, channel->mNumRotationKeys, perTick, where, r);
+    t.scaleTimes = keyTimes(channel->mScalingKeys, channel->mNumScalingKeys, perTick, where, r);
+    for (unsigned k = 0; k < channel->mNumPositionKeys; ++k) {
+      const aiVector3D& v = channel->mPositionKeys[k].mValue;
+      t.positions.emplace_back(v.x, v.y, v.z);
+    }
+    for (unsigned k = 0; k < channel->mNumScalingKeys; ++k) {
+      const aiVector3D& v = channel->mScalingKeys[k].mValue;
+      t.scales.emplace_back(v.x, v.y, v.z);
+    }
+    for (unsigned k = 0; k < channel->mNumRotationKeys; ++k) {
+      const aiQuaternion& q = channel->mRotationKeys[k].mValue;
+      const Quat rotation(q.w, q.x, q.y, q.z);
+      if (!rotation.coeffs().allFinite() || rotation.norm() < 1e-6)
+        r.fail(fmt::format("{}: rotation key {} is not a rotation", where, k));
+      t.rotations.push_back(rotation.normalized());
+    }
+    for (const Vec3& v : t.positions)
+      if (!v.allFinite()) r.fail(fmt::format("{}: a translation key is not finite", where));
+    for (const Vec3& v : t.scales)
+      if (!v.allFinite()) r.fail(fmt::format("{}: a scale key is not finite", where));
+    if (!t.positions.empty() || !t.rotations.empty() || !t.scales.empty()) tracks.push_back(std::move(t));
+  }
+  return tracks;
+}
+
+std::vector<std::string> animationNames(const aiScene& scene) {
+  std::vector<std::string> names;
+  for (unsigned a = 0; a < scene.mNumAnimations; ++a)
+    names.push_back(detail::animationName(scene.mAnimations[a] == nullptr ? "" : scene.mAnimations[a]->mName.C_Str(), a));
+  return names;
+}
+
+SkinnedJointMotion sampleMotion(const aiScene& scene, Format format, const std::string& name, double rate,
+                                std::size_t index) {
+  const SceneReader r = readerFor(scene, format, name);
+  std::vector<std::pair<const aiMesh*, const aiNode*>> meshes;
+  const std::vector<const aiNode*> skeleton = skinSkeleton(r, meshes);
+  const MotionNodes motionNodes(scene, skeleton);
+  const aiAnimation* anim = scene.mAnimations[index];
+  SkinnedJointMotion out;
+  out.animationNames = animationNames(scene);
+  out.animation = out.animationNames[index];
+  out.rate = rate;
+  if (anim == nullptr) r.fail(fmt::format("animation '{}' is missing", out.animation));
+  const std::vector<NodeTrack> tracks = readTracks(r, *anim, out.animation, motionNodes);
+  if (tracks.empty()) r.fail(fmt::format("animation '{}' moves no joint of the skin", out.animation));
+  out.start_s = std::numeric_limits<double>::infinity();
+  out.end_s = -std::numeric_limits<double>::infinity();
+  for (const NodeTrack& t : tracks)
+    for (const std::vector<double>* times : {&t.positionTimes, &t.rotationTimes, &t.scaleTimes})
+      if (!times->empty()) {
+        out.start_s = std::min(out.start_s, times->front());
+        out.end_s = std::max(out.end_s, times->back());
+      }
+  const std::size_t jn = skeleton.size();
+  const std::size_t frameCount = detail::motionFrameCount(out.start_s, out.end_s, rate, jn, out.animation, name);
+
+  std::vector<Eigen::Matrix4d> restInverse(jn);
+  for (std::size_t k = 0; k < jn; ++k) {
+    out.joints.push_back(jointName(*skeleton[k], k));
+    const Eigen::Matrix4d& w = r.world.at(skeleton[k]);
+    out.restCenters.push_back(w.block<3, 1>(0, 3));
+    restInverse[k] = w.inverse();
+    if (!restInverse[k].allFinite()) r.fail(fmt::format("joint '{}' has a singular rest transform", out.joints[k]));
+  }
+  const std::size_t nn = motionNodes.nodes.size();
+  std::vector<Eigen::Matrix4d> own(nn), local(nn), world(nn);
+  for (std::size_t i = 0; i < nn; ++i) own[i] = toEigen(motionNodes.nodes[i]->mTransformation);
+  out.frames.reserve(frameCount * jn);
+  for (std::size_t f = 0; f < frameCount; ++f) {
+    const double t = out.start_s + static_cast<double>(f) / rate;
+    local = own;
+    for (const NodeTrack& track : tracks) local[track.node] = track.local(t, own[track.node]);
+    for (std::size_t i = 0; i < nn; ++i) {
+      const int p = motionNodes.parent[i];
+      world[i] = (p < 0 ? r.toMetres : world[static_cast<std::size_t>(p)]) * local[i];
+    }
+    for (std::size_t k = 0; k < jn; ++k) {
+      const RigidTransform joint = detail::jointMotionOf(world[motionNodes.joint[k]], restInverse[k]);
+      if (!joint.translation.allFinite() || !joint.rotation.coeffs().allFinite())
+        r.fail(fmt::format("joint '{}' is not finite at {:g} s of animation '{}'", out.joints[k], t, out.animation));
+      out.frames.push_back(joint);
+    }
+  }
   return out;
 }
 
@@ -531,7 +742,68 @@ aiNode* buildNodes(const SkinnedModel& model, const std::vector<Eigen::Matrix4d>
   return root;
 }
 
-std::unique_ptr<aiScene> buildScene(const SkinnedModel& model, double unitsPerMetre) {
+// The skinned joints' frames of one animation as keys of their nodes' local transforms.
+// Assimp 5.2's Collada and FBX exporters write a key's mTime as seconds whatever
+// mTicksPerSecond says, so the animation runs at one tick per second.
+aiAnimation* buildAnimation(const SkinnedModel& model, const std::vector<Eigen::Matrix4d>& jointWorld,
+                            const SkinnedJointMotion& motion, double unitsPerMetre, const std::string& path) {
+  const std::size_t jn = model.joints.size(), frames = motion.frameCount();
+  if (frames == 0) throw Error(fmt::format("{}: animation '{}' has no frames", path, motion.animation));
+  std::vector<std::size_t> source(jn);
+  for (std::size_t j = 0; j < jn; ++j) {
+    const auto it = std::find(motion.joints.begin(), motion.joints.end(), model.joints[j].name);
+    if (it == motion.joints.end())
+      throw Error(fmt::format("{}: animation '{}' does not move joint '{}' of the avatar", path, motion.animation,
+                              model.joints[j].name));
+    source[j] = static_cast<std::size_t>(it - motion.joints.begin());
+  }
+  auto anim = std::make_unique<aiAnimation>();
+  anim->mName = aiString(motion.animation);
+  anim->mTicksPerSecond = 1.0;
+  anim->mDuration = motion.start_s + static_cast<double>(frames - 1) / motion.rate;
+  anim->mNumChannels = static_cast<unsigned>(jn);
+  anim->mChannels = new aiNodeAnim*[jn]();
+  for (std::size_t j = 0; j < jn; ++j) {
+    auto* channel = new aiNodeAnim();
+    anim->mChannels[j] = channel;
+    channel->mNodeName = aiString(model.joints[j].name);
+    channel->mNumPositionKeys = channel->mNumRotationKeys = channel->mNumScalingKeys = static_cast<unsigned>(frames);
+    channel->mPositionKeys = new aiVectorKey[frames];
+    channel->mRotationKeys = new aiQuatKey[frames];
+    channel->mScalingKeys = new aiVectorKey[frames];
+  }
+  std::vector<Eigen::Matrix4d> world(jn);
+  for (std::size_t f = 0; f < frames; ++f) {
+    const double t = motion.start_s + static_cast<double>(f) / motion.rate;
+    const RigidTransform* frame = motion.frames.data() + f * motion.joints.size();
+    for (std::size_t j = 0; j < jn; ++j) {
+      const RigidTransform& m = frame[source[j]];
+      world[j].setIdentity();
+      world[j].topLeftCorner<3, 3>() = m.rotation.toRotationMatrix() * jointWorld[j].topLeftCorner<3, 3>();
+      world[j].block<3, 1>(0, 3) = unitsPerMetre * m.translation;
+      const int p = model.joints[j].parent;
+      const Eigen::Matrix4d local = p < 0 ? world[j] : Eigen::Matrix4d(world[static_cast<std::size_t>(p)].inverse() * world[j]);
+      Eigen::Matrix3d linear = local.topLeftCorner<3, 3>();
+      const Vec3 scale(linear.col(0).norm(), linear.col(1).norm(), linear.col(2).norm());
+      for (int c = 0; c < 3; ++c) linear.col(c) /= scale[c];
+      const Quat q = Quat(linear).normalized();
+      const Vec3 position = local.block<3, 1>(0, 3);
+      aiNodeAnim& channel = *anim->mChannels[j];
+      channel.mPositionKeys[f] = aiVectorKey(t, aiVector3D(static_cast<ai_real>(position.x()), static_cast<ai_real>(position.y()),
+                                                           static_cast<ai_real>(position.z())));
+      channel.mRotationKeys[f] = aiQuatKey(t, aiQuaternion(static_cast<ai_real>(q.w()), static_cast<ai_real>(q.x()),
+                                                           static_cast<ai_real>(q.y()), static_cast<ai_real>(q.z())));
+      channel.mScalingKeys[f] = aiVectorKey(t, aiVector3D(static_cast<ai_real>(scale.x()), static_cast<ai_real>(scale.y()),
+                                                          static_cast<ai_real>(scale.z())));
+    }
+  }
+  return anim.release();
+}
+
+std::unique_ptr<aiScene> buildScene(const SkinnedModel& model, bool fbx,
+                                    const std::vector<SkinnedJointMotion>& animations, const std::string& path) {
+  // FBX is written in centimetres: Assimp's FBX exporter declares UnitScaleFactor 1.
+  const double unitsPerMetre = fbx ? 100.0 : 1.0;
   // Joint frames in the written units: the same rotation, translations scaled.
   Eigen::Matrix4d scale = Eigen::Matrix4d::Identity();
   scale.topLeftCorner<3, 3>() *= unitsPerMetre;
@@ -548,6 +820,12 @@ std::unique_ptr<aiScene> buildScene(const SkinnedModel& model, double unitsPerMe
   scene->mMeshes = new aiMesh*[1];
   scene->mMeshes[0] = buildMesh(model, jointWorld, unitsPerMetre);
   scene->mRootNode = buildNodes(model, jointWorld, std::string(scene->mMeshes[0]->mName.C_Str()) + "_mesh");
+  if (!animations.empty()) {
+    scene->mNumAnimations = static_cast<unsigned>(animations.size());
+    scene->mAnimations = new aiAnimation*[animations.size()]();
+    for (std::size_t a = 0; a < animations.size(); ++a)
+      scene->mAnimations[a] = buildAnimation(model, jointWorld, animations[a], unitsPerMetre, path);
+  }
   return scene;
 }
 
@@ -558,13 +836,16 @@ bool isAssimpAvatarPath(const std::string& path) {
   return ext == ".dae" || ext == ".fbx";
 }
 
-SkinnedModel parseAssimpSkinnedModel(std::string_view bytes, const std::string& name) {
+namespace {
+
+// Imports Collada or FBX bytes (with their animations or without) under the safety rules of
+// the header; the scene lives as long as `importer`.
+const aiScene& importScene(Assimp::Importer& importer, std::string_view bytes, const std::string& name, bool animations) {
   const Format format = formatOf(name);
   checkSignature(bytes, format, name);
   if (format == Format::Collada) checkColladaArrays(bytes, name);
-  Assimp::Importer importer;
   keepOnlyImporterFor(importer, extensionOf(format));
-  configure(importer);
+  configure(importer, animations);
   const std::string internalName = std::string("avatar") + extensionOf(format);
   auto* io = new OwnBytesOnly(bytes, internalName);
   importer.SetIOHandler(io);  // the importer owns and deletes it
@@ -578,7 +859,46 @@ SkinnedModel parseAssimpSkinnedModel(std::string_view bytes, const std::string& 
     throw Error(fmt::format("{}: Assimp's {} importer failed: {}{}", name, formatName(format), importer.GetErrorString(), refusalNote(*io)));
   if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0)
     throw Error(fmt::format("{}: has no mesh (Assimp reports the {} scene as incomplete)", name, formatName(format)));
-  return extract(*scene, format, name);
+  return *scene;
+}
+
+}  // namespace
+
+SkinnedModel parseAssimpSkinnedModel(std::string_view bytes, const std::string& name) {
+  Assimp::Importer importer;
+  return extract(importScene(importer, bytes, name, false), formatOf(name), name);
+}
+
+SkinnedJointMotion parseAssimpJointMotion(std::string_view bytes, const std::string& name, double rate,
+                                          const std::string& animation) {
+  Assimp::Importer importer;
+  const aiScene& scene = importScene(importer, bytes, name, true);
+  const std::size_t index = detail::chooseAnimation(animationNames(scene), animation, name);
+  return sampleMotion(scene, formatOf(name), name, rate, index);
+}
+
+std::vector<SkinnedJointMotion> parseAssimpJointMotions(std::string_view bytes, const std::string& name, double rate) {
+  Assimp::Importer importer;
+  const aiScene& scene = importScene(importer, bytes, name, true);
+  std::vector<SkinnedJointMotion> motions;
+  for (std::size_t a = 0; a < scene.mNumAnimations; ++a) motions.push_back(sampleMotion(scene, formatOf(name), name, rate, a));
+  return motions;
+}
+
+SkinnedJointMotion readAssimpJointMotion(const std::string& path, double rate, const std::string& animation,
+                                         const IsolationLimits& limits) {
+  const std::string bytes = detail::readWholeFile(path, kMaxFileBytes);
+  const std::string reader = fmt::format("{} reader (Assimp)", formatName(formatOf(path)));
+  const std::string result =
+      runIsolated(path, reader, [&] { return serialise(parseAssimpJointMotion(bytes, path, rate, animation)); }, limits);
+  return deserialiseJointMotion(result, path);
+}
+
+std::vector<SkinnedJointMotion> readAssimpJointMotions(const std::string& path, double rate, const IsolationLimits& limits) {
+  const std::string bytes = detail::readWholeFile(path, kMaxFileBytes);
+  const std::string reader = fmt::format("{} reader (Assimp)", formatName(formatOf(path)));
+  const std::string result = runIsolated(path, reader, [&] { return serialise(parseAssimpJointMotions(bytes, path, rate)); }, limits);
+  return deserialiseJointMotions(result, path);
 }
 
 SkinnedModel readAssimpSkinnedModel(const std::string& path, const IsolationLimits& limits) {
@@ -589,14 +909,14 @@ SkinnedModel readAssimpSkinnedModel(const std::string& path, const IsolationLimi
   return deserialiseSkinnedModel(result, path);
 }
 
-void writeAssimpSkinnedModel(const std::string& path, const SkinnedModel& model) {
+void writeAssimpSkinnedModel(const std::string& path, const SkinnedModel& model,
+                             const std::vector<SkinnedJointMotion>& animations) {
   const std::string ext = lowerExtension(path);
   if (ext != ".dae" && ext != ".fbx")
     throw Error(fmt::format("{}: drape writes skinned avatars as Collada (.dae) or FBX (.fbx), not '{}'", path, ext));
   checkWritable(model, path);
   const bool fbx = ext == ".fbx";
-  // FBX is written in centimetres: Assimp's FBX exporter declares UnitScaleFactor 1.
-  const std::unique_ptr<aiScene> scene = buildScene(model, fbx ? 100.0 : 1.0);
+  const std::unique_ptr<aiScene> scene = buildScene(model, fbx, animations, path);
   const char* formatId = fbx ? "fbxa" : "collada";
   // In the limited child too: the exporter is Assimp code, and a crash there must not end drape.
   (void)runIsolated(path, fmt::format("{} writer (Assimp)", fbx ? "FBX" : "Collada"), [&] {

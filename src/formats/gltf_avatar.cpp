@@ -600,7 +600,6 @@ SkinnedModel extract(const GModel& model, const std::string& name) {
 
 // ---- animations ---------------------------------------------------------------------
 
-constexpr std::size_t kMaxMotionTransforms = 10'000'000;  ///< frames x joints sampled (560 MB)
 constexpr double kMaxAnimationSeconds = 24.0 * 3600.0;
 
 /// One channel's sampler, read and checked: key times and values (`components` per key,
@@ -704,41 +703,16 @@ std::vector<Track> readTracks(const GModel& model, std::size_t index, const Read
   return tracks;
 }
 
-/// The rotation nearest a 3x3 linear map (its polar factor): a node chain with scale
-/// leaves W(t) W_rest^-1 a rotation only up to rounding, or a shear where scales animate.
-Quat nearestRotation(const Eigen::Matrix3d& m) {
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d r = svd.matrixU() * svd.matrixV().transpose();
-  if (r.determinant() < 0) {
-    Eigen::Matrix3d u = svd.matrixU();
-    u.col(2) = -u.col(2);
-    r = u * svd.matrixV().transpose();
-  }
-  return Quat(r).normalized();
-}
-
-std::string animationName(const GModel& model, std::size_t index) {
-  const std::string& name = model.animations[index].name;
-  return name.empty() ? fmt::format("animation {}", index) : name;
-}
-
-/// The animation `which` names: its name, its index in decimal digits, or "" for the first.
-std::size_t chooseAnimation(const GModel& model, const std::string& which, const Reader& r) {
-  if (model.animations.empty()) r.fail("has no animation");
-  if (which.empty()) return 0;
-  for (std::size_t i = 0; i < model.animations.size(); ++i)
-    if (model.animations[i].name == which) return i;
-  const bool digits = which.size() <= 9 && std::all_of(which.begin(), which.end(), [](char c) { return c >= '0' && c <= '9'; });
-  if (digits && std::stoul(which) < model.animations.size()) return std::stoul(which);
+std::vector<std::string> animationNames(const GModel& model) {
   std::vector<std::string> names;
-  for (std::size_t i = 0; i < model.animations.size(); ++i) names.push_back(fmt::format("{} '{}'", i, animationName(model, i)));
-  r.fail(fmt::format("has no animation '{}' (it has {}: {})", which, model.animations.size(), fmt::join(names, ", ")));
+  for (std::size_t i = 0; i < model.animations.size(); ++i) names.push_back(detail::animationName(model.animations[i].name, i));
+  return names;
 }
 
 GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, double rate, const std::string& which) {
   const Reader r{model, name};
-  if (!(rate > 0) || !std::isfinite(rate)) r.fail(fmt::format("a motion rate of {} frames per second", rate));
-  const std::size_t index = chooseAnimation(model, which, r);
+  const std::vector<std::string> names = animationNames(model);
+  const std::size_t index = detail::chooseAnimation(names, which, name);
   std::vector<int> nodeParent;
   const std::vector<Eigen::Matrix4d> restWorld = nodeWorlds(model, nodeParent, r);
   const SkinJoints sj = skinJoints(model, nodeParent, r);
@@ -746,8 +720,8 @@ GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, 
   if (tracks.empty()) r.fail(fmt::format("animation {} moves no node", index));
 
   GltfJointMotion out;
-  out.animation = animationName(model, index);
-  for (std::size_t i = 0; i < model.animations.size(); ++i) out.animationNames.push_back(animationName(model, i));
+  out.animation = names[index];
+  out.animationNames = names;
   out.rate = rate;
   out.start_s = std::numeric_limits<double>::infinity();
   out.end_s = 0.0;
@@ -756,11 +730,7 @@ GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, 
     out.end_s = std::max(out.end_s, t.times.back());
   }
   const std::size_t jn = sj.node.size();
-  const double frames = std::floor((out.end_s - out.start_s) * rate + 1e-9) + 1.0;
-  if (frames * static_cast<double>(jn) > static_cast<double>(kMaxMotionTransforms))
-    r.fail(fmt::format("animation {} lasts {:g} s: {:g} frames of {} joints at {:g} Hz are more than drape samples ({})",
-                       index, out.end_s - out.start_s, frames, jn, rate, kMaxMotionTransforms));
-  const auto frameCount = static_cast<std::size_t>(frames);
+  const std::size_t frameCount = detail::motionFrameCount(out.start_s, out.end_s, rate, jn, out.animation, name);
   out.joints = sj.name;
   std::vector<Eigen::Matrix4d> restInverse(jn);
   for (std::size_t k = 0; k < jn; ++k) {
@@ -787,66 +757,13 @@ GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, 
     const std::vector<Eigen::Matrix4d> world = worldsOf(nodeParent, local, r);
     for (std::size_t k = 0; k < jn; ++k) {
       const Eigen::Matrix4d& w = world[static_cast<std::size_t>(sj.node[k])];
-      const Eigen::Matrix4d motion = w * restInverse[k];
-      RigidTransform joint{nearestRotation(motion.topLeftCorner<3, 3>()), w.block<3, 1>(0, 3)};
+      const RigidTransform joint = detail::jointMotionOf(w, restInverse[k]);
       if (!joint.translation.allFinite() || !joint.rotation.coeffs().allFinite())
         r.fail(fmt::format("joint '{}' is not finite at {:g} s of animation {}", sj.name[k], t, index));
       out.frames.push_back(joint);
     }
   }
   return out;
-}
-
-std::string serialise(const GltfJointMotion& m) {
-  std::string s;
-  detail::putVector(s, std::vector<char>(m.animation.begin(), m.animation.end()));
-  detail::put<std::uint64_t>(s, m.animationNames.size());
-  for (const std::string& a : m.animationNames) detail::putVector(s, std::vector<char>(a.begin(), a.end()));
-  detail::put(s, m.rate);
-  detail::put(s, m.start_s);
-  detail::put(s, m.end_s);
-  detail::put<std::uint64_t>(s, m.joints.size());
-  for (const std::string& j : m.joints) detail::putVector(s, std::vector<char>(j.begin(), j.end()));
-  std::vector<double> numbers;
-  for (const Vec3& c : m.restCenters) numbers.insert(numbers.end(), {c.x(), c.y(), c.z()});
-  detail::putVector(s, numbers);
-  numbers.clear();
-  for (const RigidTransform& t : m.frames)
-    numbers.insert(numbers.end(), {t.rotation.w(), t.rotation.x(), t.rotation.y(), t.rotation.z(), t.translation.x(),
-                                   t.translation.y(), t.translation.z()});
-  detail::putVector(s, numbers);
-  return s;
-}
-
-GltfJointMotion deserialiseJointMotion(std::string_view bytes, const std::string& name) {
-  detail::Cursor c{bytes, 0, name};
-  GltfJointMotion m;
-  const std::vector<char> animation = c.getVector<char>();
-  m.animation.assign(animation.begin(), animation.end());
-  const auto names = c.get<std::uint64_t>();
-  if (names > 1'000'000) throw Error(fmt::format("{}: the reader returned bad data", name));
-  for (std::uint64_t k = 0; k < names; ++k) {
-    const std::vector<char> chars = c.getVector<char>();
-    m.animationNames.emplace_back(chars.begin(), chars.end());
-  }
-  m.rate = c.get<double>();
-  m.start_s = c.get<double>();
-  m.end_s = c.get<double>();
-  const auto joints = c.get<std::uint64_t>();
-  if (joints > 65535) throw Error(fmt::format("{}: the reader returned bad data", name));
-  for (std::uint64_t k = 0; k < joints; ++k) {
-    const std::vector<char> chars = c.getVector<char>();
-    m.joints.emplace_back(chars.begin(), chars.end());
-  }
-  const std::vector<double> centres = c.getVector<double>();
-  const std::vector<double> frames = c.getVector<double>();
-  if (centres.size() != 3 * joints || (joints > 0 && frames.size() % (7 * joints) != 0))
-    throw Error(fmt::format("{}: the reader returned bad data", name));
-  for (std::size_t i = 0; i + 2 < centres.size(); i += 3) m.restCenters.emplace_back(centres[i], centres[i + 1], centres[i + 2]);
-  for (std::size_t i = 0; i + 6 < frames.size(); i += 7)
-    m.frames.push_back({Quat(frames[i], frames[i + 1], frames[i + 2], frames[i + 3]),
-                        Vec3(frames[i + 4], frames[i + 5], frames[i + 6])});
-  return m;
 }
 
 }  // namespace
@@ -858,6 +775,22 @@ SkinnedModel parseGltfSkinnedModel(std::string_view bytes, const std::string& na
 GltfJointMotion parseGltfJointMotion(std::string_view bytes, const std::string& name, const std::string& baseDir,
                                      double rate, const std::string& animation) {
   return sampleJointMotion(parseDocument(bytes, name, baseDir), name, rate, animation);
+}
+
+std::vector<GltfJointMotion> parseGltfJointMotions(std::string_view bytes, const std::string& name, const std::string& baseDir,
+                                                   double rate) {
+  const GModel model = parseDocument(bytes, name, baseDir);
+  std::vector<GltfJointMotion> motions;
+  for (std::size_t a = 0; a < model.animations.size(); ++a) motions.push_back(sampleJointMotion(model, name, rate, std::to_string(a)));
+  return motions;
+}
+
+std::vector<GltfJointMotion> readGltfJointMotions(const std::string& path, double rate, const IsolationLimits& limits) {
+  const std::string bytes = detail::readWholeFile(path, std::size_t{1} << 30);
+  const std::string baseDir = std::filesystem::absolute(path).parent_path().string();
+  const std::string result = runIsolated(
+      path, "glTF reader", [&] { return serialise(parseGltfJointMotions(bytes, path, baseDir, rate)); }, limits);
+  return deserialiseJointMotions(result, path);
 }
 
 GltfJointMotion readGltfJointMotion(const std::string& path, double rate, const std::string& animation,

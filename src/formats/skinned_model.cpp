@@ -1,9 +1,12 @@
 #include "drape/formats/skinned_model.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
+#include <Eigen/SVD>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "drape/core/error.hpp"
 #include "plain_data.hpp"
@@ -52,4 +55,121 @@ SkinnedModel deserialiseSkinnedModel(std::string_view bytes, const std::string& 
   return model;
 }
 
+std::string serialise(const SkinnedJointMotion& m) {
+  std::string s;
+  putVector(s, std::vector<char>(m.animation.begin(), m.animation.end()));
+  put<std::uint64_t>(s, m.animationNames.size());
+  for (const std::string& a : m.animationNames) putVector(s, std::vector<char>(a.begin(), a.end()));
+  put(s, m.rate);
+  put(s, m.start_s);
+  put(s, m.end_s);
+  put<std::uint64_t>(s, m.joints.size());
+  for (const std::string& j : m.joints) putVector(s, std::vector<char>(j.begin(), j.end()));
+  std::vector<double> numbers;
+  for (const Vec3& c : m.restCenters) numbers.insert(numbers.end(), {c.x(), c.y(), c.z()});
+  putVector(s, numbers);
+  numbers.clear();
+  for (const RigidTransform& t : m.frames)
+    numbers.insert(numbers.end(), {t.rotation.w(), t.rotation.x(), t.rotation.y(), t.rotation.z(), t.translation.x(),
+                                   t.translation.y(), t.translation.z()});
+  putVector(s, numbers);
+  return s;
+}
+
+SkinnedJointMotion deserialiseJointMotion(std::string_view bytes, const std::string& name) {
+  Cursor c{bytes, 0, name};
+  SkinnedJointMotion m;
+  const std::vector<char> animation = c.getVector<char>();
+  m.animation.assign(animation.begin(), animation.end());
+  const auto names = c.get<std::uint64_t>();
+  if (names > 1'000'000) throw Error(fmt::format("{}: the reader returned bad data", name));
+  for (std::uint64_t k = 0; k < names; ++k) {
+    const std::vector<char> chars = c.getVector<char>();
+    m.animationNames.emplace_back(chars.begin(), chars.end());
+  }
+  m.rate = c.get<double>();
+  m.start_s = c.get<double>();
+  m.end_s = c.get<double>();
+  const auto joints = c.get<std::uint64_t>();
+  if (joints > 65535) throw Error(fmt::format("{}: the reader returned bad data", name));
+  for (std::uint64_t k = 0; k < joints; ++k) {
+    const std::vector<char> chars = c.getVector<char>();
+    m.joints.emplace_back(chars.begin(), chars.end());
+  }
+  const std::vector<double> centres = c.getVector<double>();
+  const std::vector<double> frames = c.getVector<double>();
+  if (centres.size() != 3 * joints || (joints > 0 && frames.size() % (7 * joints) != 0))
+    throw Error(fmt::format("{}: the reader returned bad data", name));
+  for (std::size_t i = 0; i + 2 < centres.size(); i += 3) m.restCenters.emplace_back(centres[i], centres[i + 1], centres[i + 2]);
+  for (std::size_t i = 0; i + 6 < frames.size(); i += 7)
+    m.frames.push_back({Quat(frames[i], frames[i + 1], frames[i + 2], frames[i + 3]),
+                        Vec3(frames[i + 4], frames[i + 5], frames[i + 6])});
+  return m;
+}
+
+
+std::string serialise(const std::vector<SkinnedJointMotion>& motions) {
+  std::string s;
+  put<std::uint64_t>(s, motions.size());
+  for (const SkinnedJointMotion& m : motions) {
+    const std::string one = serialise(m);
+    putVector(s, std::vector<char>(one.begin(), one.end()));
+  }
+  return s;
+}
+
+std::vector<SkinnedJointMotion> deserialiseJointMotions(std::string_view bytes, const std::string& name) {
+  Cursor c{bytes, 0, name};
+  const auto count = c.get<std::uint64_t>();
+  if (count > 1'000'000) throw Error(fmt::format("{}: the reader returned bad data", name));
+  std::vector<SkinnedJointMotion> motions;
+  for (std::uint64_t k = 0; k < count; ++k) {
+    const std::vector<char> one = c.getVector<char>();
+    motions.push_back(deserialiseJointMotion(std::string_view(one.data(), one.size()), name));
+  }
+  return motions;
+}
+
+namespace detail {
+
+std::string animationName(const std::string& own, std::size_t index) {
+  return own.empty() ? fmt::format("animation {}", index) : own;
+}
+
+std::size_t chooseAnimation(const std::vector<std::string>& names, const std::string& which, const std::string& file) {
+  if (names.empty()) throw Error(fmt::format("{}: has no animation", file));
+  if (which.empty()) return 0;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i] == which) return i;
+  const bool digits = which.size() <= 9 && std::all_of(which.begin(), which.end(), [](char c) { return c >= '0' && c <= '9'; });
+  if (digits && std::stoul(which) < names.size()) return std::stoul(which);
+  std::vector<std::string> listed;
+  for (std::size_t i = 0; i < names.size(); ++i) listed.push_back(fmt::format("{} '{}'", i, names[i]));
+  throw Error(fmt::format("{}: has no animation '{}' (it has {}: {})", file, which, names.size(), fmt::join(listed, ", ")));
+}
+
+std::size_t motionFrameCount(double start_s, double end_s, double rate, std::size_t joints, const std::string& animation,
+                             const std::string& file) {
+  if (!(rate > 0) || !std::isfinite(rate)) throw Error(fmt::format("{}: a motion rate of {} frames per second", file, rate));
+  const double frames = std::floor((end_s - start_s) * rate + 1e-9) + 1.0;
+  if (!std::isfinite(frames) || frames * static_cast<double>(joints) > static_cast<double>(kMaxMotionTransforms))
+    throw Error(fmt::format("{}: animation '{}' lasts {:g} s: {:g} frames of {} joints at {:g} Hz are more than drape "
+                            "samples ({})",
+                            file, animation, end_s - start_s, frames, joints, rate, kMaxMotionTransforms));
+  return static_cast<std::size_t>(frames);
+}
+
+RigidTransform jointMotionOf(const Eigen::Matrix4d& world, const Eigen::Matrix4d& restInverse) {
+  const Eigen::Matrix3d m = (world * restInverse).topLeftCorner<3, 3>();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d r = svd.matrixU() * svd.matrixV().transpose();
+  if (r.determinant() < 0) {
+    Eigen::Matrix3d u = svd.matrixU();
+    u.col(2) = -u.col(2);
+    r = u * svd.matrixV().transpose();
+  }
+  return {Quat(r).normalized(), world.block<3, 1>(0, 3)};
+}
+
+}  // namespace detail
 }  // namespace drape::formats

@@ -367,6 +367,14 @@ double maxJointSeparation(const AvatarAnimation& animation, const scene::Avatar&
 
 namespace {
 
+/// What the run's log calls an avatar file's format.
+std::string formatLabel(const std::string& path) {
+  const std::string ext = lowerExtension(path);
+  if (ext == ".dae") return "Collada";
+  if (ext == ".fbx") return "FBX";
+  return "glTF";
+}
+
 /// Where a scene put the avatar of a file: world = rotation (scale x) + translation.
 struct Placement {
   Quat rotation = Quat::Identity();
@@ -376,11 +384,11 @@ struct Placement {
 };
 
 /// The placement that takes the file's rest joint positions onto the avatar's: the
-/// rotation the scene gave every joint frame (a glTF avatar's joints rest unrotated in its
+/// rotation the scene gave every joint frame (a skinned avatar's joints rest unrotated in its
 /// file), the ratio of the two skeletons' spreads about their centroids, and the shift of
 /// the centroids.
 Placement placementOf(const scene::Avatar& avatar, const std::vector<int>& motionJoint,
-                      const formats::GltfJointMotion& motion) {
+                      const formats::SkinnedJointMotion& motion) {
   Placement p;
   p.rotation = avatar.joints.front().restOrientation;
   Vec3 meanAvatar = Vec3::Zero(), meanFile = Vec3::Zero();
@@ -403,7 +411,7 @@ Placement placementOf(const scene::Avatar& avatar, const std::vector<int>& motio
 
 }  // namespace
 
-AvatarAnimation AvatarAnimation::fromJointMotion(const scene::Avatar& avatar, const formats::GltfJointMotion& motion,
+AvatarAnimation AvatarAnimation::fromJointMotion(const scene::Avatar& avatar, const formats::SkinnedJointMotion& motion,
                                                  const std::string& source) {
   const std::size_t n = avatar.joints.size();
   if (n == 0) throw Error(fmt::format("{}: the avatar has no joints to animate", avatar.source));
@@ -416,8 +424,8 @@ AvatarAnimation AvatarAnimation::fromJointMotion(const scene::Avatar& avatar, co
     else motionJoint[a] = static_cast<int>(it - motion.joints.begin());
   }
   if (!missing.empty())
-    throw Error(fmt::format("{}: its skin has no joint named {} of avatar '{}' ({} of {} missing): a glTF animation "
-                            "drives the avatar of its own file; other avatars take BVH or ASF/AMC motion",
+    throw Error(fmt::format("{}: its skin has no joint named {} of avatar '{}' ({} of {} missing): an avatar file's "
+                            "animation drives the avatar of its own file; other avatars take BVH or ASF/AMC motion",
                             source, fmt::join(missing.begin(), missing.begin() + std::min<std::size_t>(missing.size(), 4), ", "),
                             avatar.name, missing.size(), n));
   const Placement place = placementOf(avatar, motionJoint, motion);
@@ -429,7 +437,7 @@ AvatarAnimation AvatarAnimation::fromJointMotion(const scene::Avatar& avatar, co
     const double off = (place.apply(motion.restCenters[static_cast<std::size_t>(motionJoint[a])]) - avatar.joints[a].restCenter).norm();
     if (off > tolerance)
       throw Error(fmt::format("{}: the skeleton of its animation does not rest as avatar '{}' does (joint '{}' {:.1f} mm "
-                              "away once placed): a glTF animation drives the avatar of its own file",
+                              "away once placed): an avatar file's animation drives the avatar of its own file",
                               source, avatar.name, avatar.joints[a].name, 1e3 * off));
   }
 
@@ -462,17 +470,17 @@ AvatarAnimation AvatarAnimation::fromJointMotion(const scene::Avatar& avatar, co
 
 AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& motionPath, const MotionOptions& options,
                               ClipLoadReport* report, JointMap* chosenMap) {
-  const std::string ext = lowerExtension(motionPath);
-  if (ext == ".glb" || ext == ".gltf") {
+  if (formats::isAvatarMotionPath(motionPath)) {
     if (!options.jointMapPath.empty())
-      throw Error(fmt::format("--joint-map: {} is a glTF animation, which drives the joints of its own skin by name", motionPath));
+      throw Error(fmt::format("--joint-map: {} is an avatar file's animation, which drives the joints of its own skin by name",
+                              motionPath));
     const double rate = options.clip.rate > 0 ? options.clip.rate : 30.0;
-    const formats::GltfJointMotion motion = formats::readGltfJointMotion(motionPath, rate, options.animation);
+    const formats::SkinnedJointMotion motion = formats::readAvatarMotion(motionPath, rate, options.animation);
     AvatarAnimation anim = AvatarAnimation::fromJointMotion(avatar, motion, motionPath);
     if (report) {
       *report = {};
       report->units.metresPerUnit = 1.0;
-      report->units.name = "m (glTF)";
+      report->units.name = fmt::format("m ({})", formatLabel(motionPath));
       report->sourceFrames = motion.frameCount();
       report->sourceRate = rate;
     }
@@ -483,7 +491,8 @@ AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& mo
     return anim;
   }
   if (!options.animation.empty())
-    throw Error(fmt::format("--animation: {} is not a glTF file; animations are chosen from a glTF avatar's own file",
+    throw Error(fmt::format("--animation: {} is not an avatar file (.glb, .gltf, .dae, .fbx); animations are chosen "
+                            "from an avatar's own file",
                             motionPath));
   const Clip clip = loadClip(motionPath, options.clip, report);
   JointMap map;

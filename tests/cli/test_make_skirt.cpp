@@ -127,7 +127,7 @@ TEST(MakeSkirt, CesiumMansSkirtWalksOnItsOwnAnimation) {
                                  dir);
   EXPECT_EQ(bvh.code, 2);
   EXPECT_NE(bvh.err.find("--animation: " + testing::kSkirtDir +
-                         "/walk.bvh is not a glTF file; animations are chosen from a glTF avatar's own file"),
+                         "/walk.bvh is not an avatar file (.glb, .gltf, .dae, .fbx); animations are chosen from an avatar's own file"),
             std::string::npos)
       << bvh.err;
 
@@ -136,7 +136,7 @@ TEST(MakeSkirt, CesiumMansSkirtWalksOnItsOwnAnimation) {
                                        (dir / "other") + "'",
                                    dir);
   EXPECT_EQ(other.code, 2);
-  EXPECT_NE(other.err.find("a glTF animation drives the avatar of its own file"), std::string::npos) << other.err;
+  EXPECT_NE(other.err.find("an avatar file's animation drives the avatar of its own file"), std::string::npos) << other.err;
 }
 
 }  // namespace

@@ -213,7 +213,7 @@ TEST(GltfMotion, BadAnimationsAreRefused) {
   Doc long_;
   long_.channel(0, "rotation", {0.0f, 86000.0f}, {0, 0, 0, 1, 0, 0, 0, 1});
   EXPECT_EQ(errorOf([&] { (void)long_.motion(60); }),
-            "t.gltf: animation 0 lasts 86000 s: 5.16e+06 frames of 2 joints at 60 Hz are more than drape samples "
+            "t.gltf: animation 'animation 0' lasts 86000 s: 5.16e+06 frames of 2 joints at 60 Hz are more than drape samples "
             "(10000000)");
 
   Doc rate;

@@ -117,7 +117,7 @@ TEST(GltfAnimation, AvatarsOfOtherFilesAreRefused) {
       scene::loadAvatarFile(std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel");
   const std::string e = errorOf([&] { (void)AvatarAnimation::fromJointMotion(makeHuman, cesiumWalk(), "walk.glb"); });
   EXPECT_EQ(e.rfind("walk.glb: its skin has no joint named Hips, ", 0), 0u) << e;
-  EXPECT_NE(e.find("(31 of 31 missing): a glTF animation drives the avatar of its own file"), std::string::npos) << e;
+  EXPECT_NE(e.find("(31 of 31 missing): an avatar file's animation drives the avatar of its own file"), std::string::npos) << e;
 
   scene::Avatar moved = cesiumMan();
   moved.joints[3].restCenter.x() += 0.05;  // the same names, another skeleton
@@ -130,7 +130,7 @@ TEST(GltfAnimation, AvatarsOfOtherFilesAreRefused) {
               o.jointMapPath = "map.json";
               (void)loadAnimation(cesiumMan(), cesiumPath(), o);
             }),
-            "--joint-map: " + cesiumPath() + " is a glTF animation, which drives the joints of its own skin by name");
+            "--joint-map: " + cesiumPath() + " is an avatar file's animation, which drives the joints of its own skin by name");
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "drape/core/isolate.hpp"
 #include "drape/formats/skinned_model.hpp"
@@ -37,11 +38,34 @@ namespace drape::formats {
 /// Reads a .dae/.fbx file in a limited child process. Throws drape::Error naming the file.
 [[nodiscard]] SkinnedModel readAssimpSkinnedModel(const std::string& path, const IsolationLimits& limits = {});
 
+/// One animation of Collada or FBX bytes as the motion of the skin's joints (the skeleton
+/// parseAssimpSkinnedModel reads), sampled at `rate` from its first key time to its last:
+/// translation and scale keys linear, rotation keys by SLERP, each held before its first
+/// key and after its last, each node's own transform where no key drives it; key times
+/// in Assimp's ticks at the file's ticks per second (25 where it gives none). `animation`
+/// is a name, an index from 0 in decimal digits, or "" for the first. Throws drape::Error
+/// naming the file; a file without animations, or without the one asked for, is an error.
+[[nodiscard]] SkinnedJointMotion parseAssimpJointMotion(std::string_view bytes, const std::string& name, double rate,
+                                                        const std::string& animation = "");
+/// Every animation of the bytes, sampled the same way (none: an empty list).
+[[nodiscard]] std::vector<SkinnedJointMotion> parseAssimpJointMotions(std::string_view bytes, const std::string& name,
+                                                                      double rate);
+
+/// The same from a .dae/.fbx file, in a limited child process.
+[[nodiscard]] SkinnedJointMotion readAssimpJointMotion(const std::string& path, double rate,
+                                                       const std::string& animation = "",
+                                                       const IsolationLimits& limits = {});
+[[nodiscard]] std::vector<SkinnedJointMotion> readAssimpJointMotions(const std::string& path, double rate,
+                                                                     const IsolationLimits& limits = {});
+
 /// Writes `model` (metres, Y up) as Collada 1.4 (.dae, in metres) or as ASCII FBX 7.5
 /// (.fbx, in centimetres as its UnitScaleFactor 1 says): the skeleton as a node tree, one
-/// skinned mesh, one bone per weighted joint. Binary FBX is not written: what Assimp
+/// skinned mesh, one bone per weighted joint, and each of `animations` (motions of the
+/// model's joints, every joint named in each) as keys of its joints' local translation,
+/// rotation and scale at every sampled frame. Binary FBX is not written: what Assimp
 /// 5.2's binary FBX exporter writes, its own FBX importer cannot read back. Throws
 /// drape::Error naming the path.
-void writeAssimpSkinnedModel(const std::string& path, const SkinnedModel& model);
+void writeAssimpSkinnedModel(const std::string& path, const SkinnedModel& model,
+                             const std::vector<SkinnedJointMotion>& animations = {});
 
 }  // namespace drape::formats

@@ -33,24 +33,11 @@ using GltfSkinnedModel = SkinnedModel;
 /// Reads a .gltf/.glb file in a limited child process. Throws drape::Error naming the file.
 [[nodiscard]] GltfSkinnedModel readGltfSkinnedModel(const std::string& path, const IsolationLimits& limits = {});
 
-/// One of a glTF file's animations as the motion of its first skin's joints, sampled at a
-/// fixed rate from the animation's first key time to its last. Channels follow the glTF
-/// 2.0 rules: translation, rotation and scale of nodes, LINEAR (rotations by SLERP), STEP
-/// and CUBICSPLINE samplers, each node's own transform where no channel drives it; morph
-/// target weights are ignored.
-struct GltfJointMotion {
-  std::string animation;                  ///< its name, or "animation <index>"
-  std::vector<std::string> animationNames;  ///< every animation's name ("animation <index>" if it has none)
-  double rate = 30.0;                     ///< frames per second
-  double start_s = 0.0, end_s = 0.0;      ///< the animation's first and last key times
-  std::vector<std::string> joints;        ///< the skin's joints, parent-first and named as in GltfSkinnedModel
-  std::vector<Vec3> restCenters;          ///< m, each joint's world position in the file's rest pose
-  /// Frame-major, joint j of frame f at [f * joints.size() + j]: `rotation` turns the joint
-  /// from its rest orientation (the rotation of W(t) W_rest^-1, W its node's world
-  /// matrix), `translation` is its world position.
-  std::vector<RigidTransform> frames;
-  [[nodiscard]] std::size_t frameCount() const { return joints.empty() ? 0 : frames.size() / joints.size(); }
-};
+/// One of a glTF file's animations: channels follow the glTF 2.0 rules (translation,
+/// rotation and scale of nodes, LINEAR with rotations by SLERP, STEP and CUBICSPLINE
+/// samplers, each node's own transform where no channel drives it); morph target weights
+/// are ignored.
+using GltfJointMotion = SkinnedJointMotion;
 
 /// Samples one animation of glTF/GLB bytes in this process (for the fuzz target and the
 /// child): `animation` is its name, or its index from 0 in decimal digits, or "" for the
@@ -64,5 +51,11 @@ struct GltfJointMotion {
 [[nodiscard]] GltfJointMotion readGltfJointMotion(const std::string& path, double rate,
                                                   const std::string& animation = "",
                                                   const IsolationLimits& limits = {});
+
+/// Every animation of a glTF file, sampled the same way (none: an empty list).
+[[nodiscard]] std::vector<GltfJointMotion> parseGltfJointMotions(std::string_view bytes, const std::string& name,
+                                                                 const std::string& baseDir, double rate);
+[[nodiscard]] std::vector<GltfJointMotion> readGltfJointMotions(const std::string& path, double rate,
+                                                                const IsolationLimits& limits = {});
 
 }  // namespace drape::formats

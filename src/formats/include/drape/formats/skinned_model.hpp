@@ -1,7 +1,8 @@
 #pragma once
 // A skinned character as plain data: what every skinned-avatar reader (glTF through
 // drape's own reader, Collada and FBX through Assimp) hands back across the isolation
-// child's pipe, and what the avatar writers take.
+// child's pipe, and what the avatar writers take; and one of its animations as the sampled
+// motion of its joints.
 
 #include <array>
 #include <cstdint>
@@ -29,9 +30,48 @@ struct SkinnedModel {
   std::vector<std::array<float, 4>> vertexWeights;         ///< normalised to sum 1
 };
 
-/// Plain-data round trip used across the process boundary. `name` is the file the bytes
+/// One of an avatar file's animations as the motion of its skin's joints, sampled at a
+/// fixed rate from the animation's first key time to its last.
+struct SkinnedJointMotion {
+  std::string animation;                  ///< its name, or "animation <index>"
+  std::vector<std::string> animationNames;  ///< every animation's name ("animation <index>" if it has none)
+  double rate = 30.0;                     ///< frames per second
+  double start_s = 0.0, end_s = 0.0;      ///< the animation's first and last key times
+  std::vector<std::string> joints;        ///< the skin's joints, parent-first and named as in SkinnedModel
+  std::vector<Vec3> restCenters;          ///< m, each joint's world position in the file's rest pose
+  /// Frame-major, joint j of frame f at [f * joints.size() + j]: `rotation` turns the joint
+  /// from its rest orientation (the rotation of W(t) W_rest^-1, W its node's world
+  /// matrix), `translation` is its world position.
+  std::vector<RigidTransform> frames;
+  [[nodiscard]] std::size_t frameCount() const { return joints.empty() ? 0 : frames.size() / joints.size(); }
+};
+
+/// Plain-data round trips used across the process boundary. `name` is the file the bytes
 /// came from, for messages.
 [[nodiscard]] std::string serialise(const SkinnedModel& model);
 [[nodiscard]] SkinnedModel deserialiseSkinnedModel(std::string_view bytes, const std::string& name);
+[[nodiscard]] std::string serialise(const SkinnedJointMotion& motion);
+[[nodiscard]] SkinnedJointMotion deserialiseJointMotion(std::string_view bytes, const std::string& name);
+[[nodiscard]] std::string serialise(const std::vector<SkinnedJointMotion>& motions);
+[[nodiscard]] std::vector<SkinnedJointMotion> deserialiseJointMotions(std::string_view bytes, const std::string& name);
+
+namespace detail {
+/// The most frames x joints a motion reader samples (560 MB of transforms).
+constexpr std::size_t kMaxMotionTransforms = 10'000'000;
+/// The name an animation is called by: its own, or "animation <index>".
+[[nodiscard]] std::string animationName(const std::string& own, std::size_t index);
+/// The index of the animation `which` names among `names`: by name, by its index in decimal
+/// digits, or the first for "". Throws drape::Error("FILE: has no animation ...") listing them.
+[[nodiscard]] std::size_t chooseAnimation(const std::vector<std::string>& names, const std::string& which,
+                                          const std::string& file);
+/// Frames of an animation from start_s to end_s at `rate`, both ends included; throws
+/// naming the file when the rate is unusable or the sample would exceed kMaxMotionTransforms.
+[[nodiscard]] std::size_t motionFrameCount(double start_s, double end_s, double rate, std::size_t joints,
+                                           const std::string& animation, const std::string& file);
+/// A joint's motion from its world matrix now and the inverse of its rest world matrix:
+/// the rotation nearest W(t) W_rest^-1 (its polar factor, since scaled chains leave it a
+/// rotation only up to rounding, or a shear where scales animate) and its world position.
+[[nodiscard]] RigidTransform jointMotionOf(const Eigen::Matrix4d& world, const Eigen::Matrix4d& restInverse);
+}  // namespace detail
 
 }  // namespace drape::formats

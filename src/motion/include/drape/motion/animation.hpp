@@ -39,7 +39,7 @@
 
 #include "drape/core/math.hpp"
 #include "drape/core/timecode.hpp"
-#include "drape/formats/gltf_avatar.hpp"
+#include "drape/formats/avatar_motion.hpp"
 #include "drape/motion/clip_io.hpp"
 #include "drape/motion/jointmap.hpp"
 #include "drape/motion/skeleton.hpp"
@@ -66,13 +66,13 @@ class AvatarAnimation {
   [[nodiscard]] static AvatarAnimation build(const scene::Avatar& avatar, const Clip& clip, const JointMap& map,
                                              const RetargetOptions& options = {});
 
-  /// The avatar's own motion from the file it was loaded from (a glTF animation of its
-  /// skin): each avatar joint follows the joint of the same name, no retargeting. The
+  /// The avatar's own motion from the file it was loaded from (a glTF, Collada or FBX
+  /// animation of its skin): each avatar joint follows the joint of the same name, no retargeting. The
   /// file's rest pose must be the avatar's, up to the placement and uniform scale a scene
   /// gives the avatar (found from the joints' rest positions and applied to the motion).
   /// Throws drape::Error naming `source` when a joint is missing or rests elsewhere.
   [[nodiscard]] static AvatarAnimation fromJointMotion(const scene::Avatar& avatar,
-                                                       const formats::GltfJointMotion& motion,
+                                                       const formats::SkinnedJointMotion& motion,
                                                        const std::string& source);
 
   [[nodiscard]] std::size_t frameCount() const { return frames_; }
@@ -133,13 +133,13 @@ struct MotionOptions {
   ClipLoadOptions clip;            ///< rate (default 30 Hz), --motion-scale, ASF path
   std::string jointMapPath;        ///< --joint-map FILE (checked strictly); "" = choose
   std::string jointMapDirectory;   ///< the shipped maps (share/drape/jointmaps)
-  std::string animation;           ///< --animation: which of a glTF file's animations ("" the first)
+  std::string animation;           ///< --animation: which of an avatar file's animations ("" the first)
   RetargetOptions retarget;
 };
 
 /// Loads FILE.bvh / FILE.amc, picks or reads the joint map, and retargets onto `avatar`;
-/// or takes one of FILE.glb / FILE.gltf's animations (options.animation, by default the
-/// first) as the avatar's own motion
+/// or takes one of FILE.glb / .gltf / .dae / .fbx's animations (options.animation, by
+/// default the first) as the avatar's own motion
 /// (AvatarAnimation::fromJointMotion; `report` then gives the file's key rate as 0 and its
 /// frames as sampled). Throws drape::Error (exit code 2) naming the file, line and problem.
 [[nodiscard]] AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& motionPath,

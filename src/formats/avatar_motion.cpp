@@ -1,0 +1,38 @@
+#include "drape/formats/avatar_motion.hpp"
+
+#include <fmt/format.h>
+
+#include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
+#include "drape/formats/assimp_avatar.hpp"
+#include "drape/formats/gltf_avatar.hpp"
+
+namespace drape::formats {
+namespace {
+
+bool isGltfPath(const std::string& path) {
+  const std::string ext = lowerExtension(path);
+  return ext == ".glb" || ext == ".gltf";
+}
+
+void checkPath(const std::string& path) {
+  if (!isAvatarMotionPath(path))
+    throw Error(fmt::format("{}: drape reads an avatar's own animations from .glb, .gltf, .dae and .fbx files, not '{}'",
+                            path, lowerExtension(path)));
+}
+
+}  // namespace
+
+bool isAvatarMotionPath(const std::string& path) { return isGltfPath(path) || isAssimpAvatarPath(path); }
+
+SkinnedJointMotion readAvatarMotion(const std::string& path, double rate, const std::string& animation) {
+  checkPath(path);
+  return isGltfPath(path) ? readGltfJointMotion(path, rate, animation) : readAssimpJointMotion(path, rate, animation);
+}
+
+std::vector<SkinnedJointMotion> readAvatarMotions(const std::string& path, double rate) {
+  checkPath(path);
+  return isGltfPath(path) ? readGltfJointMotions(path, rate) : readAssimpJointMotions(path, rate);
+}
+
+}  // namespace drape::formats

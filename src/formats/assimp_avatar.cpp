@@ -760,7 +760,9 @@ aiAnimation* buildAnimation(const SkinnedModel& model, const std::vector<Eigen::
   auto anim = std::make_unique<aiAnimation>();
   anim->mName = aiString(motion.animation);
   anim->mTicksPerSecond = 1.0;
-  anim->mDuration = motion.start_s + static_cast<double>(frames - 1) / motion.rate;
+  // Assimp's FBX writer stores the stack's stop time in whole ticks, rounded down, and its
+  // reader drops the keys after it: rounded up, the last key stays in.
+  anim->mDuration = std::ceil(motion.start_s + static_cast<double>(frames - 1) / motion.rate);
   anim->mNumChannels = static_cast<unsigned>(jn);
   anim->mChannels = new aiNodeAnim*[jn]();
   for (std::size_t j = 0; j < jn; ++j) {

@@ -1,5 +1,5 @@
-// `drape convert` to and from Collada and FBX, and `drape inspect` on them: real files
-// exit 0, a bad file exits 2 with a message naming it.
+// `drape convert` to and from Collada and FBX (with the glTF's animation), and `drape
+// inspect` on them: real files exit 0, a bad file exits 2 with a message naming it.
 
 #include <gtest/gtest.h>
 
@@ -21,12 +21,17 @@ TEST_P(ConvertAssimp, GlbToSkinnedFileThenInspectAndToHanim) {
   const std::string skinned = dir / (std::string("CesiumMan") + GetParam());
   CliResult r = runDrape("convert '" + cesiumMan() + "' --to '" + skinned + "'", dir);
   ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find(skinned + ": 1 animation sampled at 30 Hz written with it ("), std::string::npos) << r.err;
 
   r = runDrape("inspect '" + skinned + "'", dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("joints     19"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("segments   19"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("4672 triangles"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("motion     1 animation; drape run --motion " + skinned + " plays it on this avatar"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("2.000 s (0.000 to 2.000 s of key times), 61 frames at 30 Hz"), std::string::npos) << r.out;
 
   const std::string wrl = dir / "CesiumMan.wrl";
   r = runDrape("convert '" + skinned + "' --to '" + wrl + "'", dir);

@@ -1,12 +1,14 @@
 // `drape make-skirt` end to end: a skirt fitted to the bundled MakeHuman body, to another
 // rig's avatar, whose segments it names itself, and to a small glTF character; the scenes it
-// writes load and run, the glTF character's on its own walk.
+// writes load and run, the glTF character's on its own walk, read from the glTF file or
+// from the Collada and FBX files `drape convert` writes of it.
 
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
+#include "drape/formats/pc2.hpp"
 #include "drape/scene/scene.hpp"
 
 namespace drape {
@@ -137,6 +139,42 @@ TEST(MakeSkirt, CesiumMansSkirtWalksOnItsOwnAnimation) {
                                    dir);
   EXPECT_EQ(other.code, 2);
   EXPECT_NE(other.err.find("an avatar file's animation drives the avatar of its own file"), std::string::npos) << other.err;
+}
+
+TEST(MakeSkirt, CesiumMansWalkAsColladaAndFbxDrivesTheSameBody) {
+  // The walk converted with the character into Collada and FBX, played on the skirt scene
+  // made from the glTF file: the skinned body moves as the glTF walk moves it, to within
+  // what each file's keys keep (single-precision Collada; six digits in ASCII FBX).
+  ScratchDir dir("make-skirt-cesium-formats");
+  const std::string cesium = kAvatars + "/CesiumMan.glb";
+  const std::string out = dir / "skirt";
+  ASSERT_EQ(runDrape("make-skirt '" + cesium + "' --waist-segment joint1 --hip-segments joint0 " +
+                         "--leg-segments joint11,joint12,joint13,joint14 --out '" + out + "'",
+                     dir)
+                .code,
+            0);
+  const auto bodyOf = [&](const std::string& motion, const std::string& name) {
+    const std::string run = dir / name;
+    const CliResult r = runDrape("run '" + out + "/scene.wrl' --motion '" + motion + "' --frames 45 --out '" + run + "'", dir);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(statsOf(run)["vertex_substeps_inside_body"], 0) << name;
+    return formats::readPc2(run + "/body.pc2");
+  };
+  const formats::Pc2Cache gltf = bodyOf(cesium, "glb");
+  ASSERT_EQ(gltf.frames.size(), 46u);  // the first frame and 45 simulated
+  for (const std::string ext : {".dae", ".fbx"}) {
+    const std::string converted = dir / ("CesiumMan" + ext);
+    const CliResult c = runDrape("convert '" + cesium + "' --to '" + converted + "'", dir);
+    ASSERT_EQ(c.code, 0) << c.err;
+    const formats::Pc2Cache other = bodyOf(converted, ext.substr(1));
+    ASSERT_EQ(other.frames.size(), gltf.frames.size()) << ext;
+    double worst = 0.0;
+    for (std::size_t f = 0; f < gltf.frames.size(); ++f) {
+      ASSERT_EQ(other.frames[f].size(), gltf.frames[f].size());
+      for (std::size_t v = 0; v < gltf.frames[f].size(); ++v) worst = std::max(worst, (other.frames[f][v] - gltf.frames[f][v]).norm());
+    }
+    EXPECT_LT(worst, ext == ".fbx" ? 5e-5 : 1e-5) << ext << ": the body moved up to " << worst << " m away";
+  }
 }
 
 }  // namespace

@@ -152,6 +152,21 @@ TEST_P(AssimpMotion, CesiumMansWalkReadsBackAsTheGltfReaderSamplesIt) {
   EXPECT_LT(worstPosition, positionTolerance);
 }
 
+TEST_P(AssimpMotion, RiggedSimplesConvertedWalkReadsBack) {
+  // tests/data/avatars/rigged_simple_animated.*: `drape convert` of the bundled RiggedSimple.
+  const std::string gltf = std::string(DRAPE_DATA_DIR) + "/avatars/RiggedSimple.glb";
+  const std::string converted = std::string(DRAPE_TEST_DATA_DIR) + "/avatars/rigged_simple_animated" + GetParam();
+  const std::vector<SkinnedJointMotion> all = readAvatarMotions(converted, 30.0);
+  ASSERT_EQ(all.size(), 1u);
+  const SkinnedJointMotion walk = readAvatarMotion(gltf, 30.0);
+  ASSERT_EQ(all[0].frameCount(), walk.frameCount());
+  ASSERT_EQ(all[0].joints, walk.joints);
+  for (std::size_t i = 0; i < walk.frames.size(); ++i) {
+    EXPECT_LT(all[0].frames[i].rotation.angularDistance(walk.frames[i].rotation), 1e-3) << i;
+    EXPECT_LT((all[0].frames[i].translation - walk.frames[i].translation).norm(), 1e-4) << i;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Formats, AssimpMotion, ::testing::Values(".dae", ".fbx"),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param == ".dae" ? "Collada" : "Fbx"; });
 

@@ -883,7 +883,8 @@ std::vector<SkinnedJointMotion> parseAssimpJointMotions(std::string_view bytes, 
   Assimp::Importer importer;
   const aiScene& scene = importScene(importer, bytes, name, true);
   std::vector<SkinnedJointMotion> motions;
-  for (std::size_t a = 0; a < scene.mNumAnimations; ++a) motions.push_back(sampleMotion(scene, formatOf(name), name, rate, a));
+  for (std::size_t a = 0; a < scene.mNumAnimations; ++a)
+    detail::appendWithinCap(motions, sampleMotion(scene, formatOf(name), name, rate, a), name);
   return motions;
 }
 

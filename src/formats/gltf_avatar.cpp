@@ -781,7 +781,8 @@ std::vector<GltfJointMotion> parseGltfJointMotions(std::string_view bytes, const
                                                    double rate) {
   const GModel model = parseDocument(bytes, name, baseDir);
   std::vector<GltfJointMotion> motions;
-  for (std::size_t a = 0; a < model.animations.size(); ++a) motions.push_back(sampleJointMotion(model, name, rate, std::to_string(a)));
+  for (std::size_t a = 0; a < model.animations.size(); ++a)
+    detail::appendWithinCap(motions, sampleJointMotion(model, name, rate, std::to_string(a)), name);
   return motions;
 }
 

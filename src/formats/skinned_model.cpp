@@ -159,6 +159,15 @@ std::size_t motionFrameCount(double start_s, double end_s, double rate, std::siz
   return static_cast<std::size_t>(frames);
 }
 
+void appendWithinCap(std::vector<SkinnedJointMotion>& motions, SkinnedJointMotion motion, const std::string& file) {
+  std::size_t total = motion.frames.size();
+  for (const SkinnedJointMotion& m : motions) total += m.frames.size();
+  if (total > kMaxMotionTransforms)
+    throw Error(fmt::format("{}: its animations together hold more than the {} joint transforms drape samples at {:g} Hz",
+                            file, kMaxMotionTransforms, motion.rate));
+  motions.push_back(std::move(motion));
+}
+
 RigidTransform jointMotionOf(const Eigen::Matrix4d& world, const Eigen::Matrix4d& restInverse) {
   const Eigen::Matrix3d m = (world * restInverse).topLeftCorner<3, 3>();
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);

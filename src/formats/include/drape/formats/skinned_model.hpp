@@ -68,6 +68,9 @@ constexpr std::size_t kMaxMotionTransforms = 10'000'000;
 /// naming the file when the rate is unusable or the sample would exceed kMaxMotionTransforms.
 [[nodiscard]] std::size_t motionFrameCount(double start_s, double end_s, double rate, std::size_t joints,
                                            const std::string& animation, const std::string& file);
+/// Appends `motion` to `motions`; throws naming the file when all of them together would
+/// hold more than kMaxMotionTransforms joint transforms.
+void appendWithinCap(std::vector<SkinnedJointMotion>& motions, SkinnedJointMotion motion, const std::string& file);
 /// A joint's motion from its world matrix now and the inverse of its rest world matrix:
 /// the rotation nearest W(t) W_rest^-1 (its polar factor, since scaled chains leave it a
 /// rotation only up to rounding, or a shear where scales animate) and its world position.

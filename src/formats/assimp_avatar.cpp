@@ -178,8 +178,10 @@ void keepOnlyImporterFor(Assimp::Importer& importer, const char* extension) {
 void configure(Assimp::Importer& importer, bool animations) {
   importer.SetPropertyInteger(AI_CONFIG_PP_LBW_MAX_WEIGHTS, 4);
   importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
-  // Helper nodes for FBX pivots would sit between bones and become joints of their own.
-  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
+  // Helper nodes for FBX pivots would sit between bones and become joints of their own; but
+  // Assimp splits the animation of a node with pivots into channels of those helpers
+  // (translation, rotation, scale), so the scene an animation is read from keeps them.
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, animations);
   // Less to parse from untrusted bytes: nothing of these is used.
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_TEXTURES, false);
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_CAMERAS, false);
@@ -506,16 +508,18 @@ struct NodeTrack {
   }
 };
 
-// The nodes whose transforms place the skin's joints: the joints and every ancestor of the
-// skeleton root, parents first.
+// The nodes of the animated scene whose transforms place the skin's joints: every node from
+// the root down to a joint (FBX's pivot helpers between joints included), parents first.
 struct MotionNodes {
   std::vector<const aiNode*> nodes;
   std::vector<int> parent;
-  std::vector<std::size_t> joint;  // the node index of each skeleton joint
+  std::vector<std::size_t> joint;  // the node index of each skin joint
 
-  MotionNodes(const aiScene& scene, const std::vector<const aiNode*>& skeleton) {
-    std::unordered_set<const aiNode*> member(skeleton.begin(), skeleton.end());
-    for (const aiNode* n = skeleton.front(); n != nullptr; n = n->mParent) member.insert(n);
+  MotionNodes(const aiScene& scene, const std::vector<const aiNode*>& jointNodes) {
+    std::unordered_set<const aiNode*> member;
+    for (const aiNode* j : jointNodes)
+      for (const aiNode* n = j; n != nullptr && member.insert(n).second; n = n->mParent) {
+      }
     std::unordered_map<const aiNode*, std::size_t> index;
     std::vector<const aiNode*> stack{scene.mRootNode};
     while (!stack.empty()) {
@@ -527,7 +531,7 @@ struct MotionNodes {
       for (unsigned i = node->mNumChildren; i-- > 0;)
         if (member.count(node->mChildren[i]) != 0) stack.push_back(node->mChildren[i]);
     }
-    for (const aiNode* j : skeleton) joint.push_back(index.at(j));
+    for (const aiNode* j : jointNodes) joint.push_back(index.at(j));
   }
 };
 
@@ -544,8 +548,8 @@ std::vector<double> keyTimes(const Key* keys, unsigned count, double perTick, co
   return times;
 }
 
-std::vector<NodeTrack> readTracks(const SceneReader& r, const aiAnimation& anim, const std::string& animName,
-                                  const MotionNodes& motionNodes) {
+std::vector<NodeTrack> readTracks(const aiScene& scene, const aiAnimation& anim, const std::string& animName,
+                                  const MotionNodes& motionNodes, const SceneReader& r) {
   std::unordered_map<const aiNode*, std::size_t> index;
   for (std::size_t i = 0; i < motionNodes.nodes.size(); ++i) index[motionNodes.nodes[i]] = i;
   const double perTick = secondsPerTick(anim);
@@ -555,7 +559,7 @@ std::vector<NodeTrack> readTracks(const SceneReader& r, const aiAnimation& anim,
     const aiNodeAnim* channel = anim.mChannels[c];
     if (channel == nullptr) continue;
     const std::string where = fmt::format("animation '{}' channel '{}'", animName, channel->mNodeName.C_Str());
-    const aiNode* node = r.scene.mRootNode->FindNode(channel->mNodeName);
+    const aiNode* node = scene.mRootNode->FindNode(channel->mNodeName);
     if (node == nullptr) r.fail(fmt::format("{}: names no node of the scene", where));
     if (!driven.insert(node).second) r.fail(fmt::format("{}: a second channel drives the same node", where));
     const auto at = index.find(node);
@@ -596,60 +600,92 @@ std::vector<std::string> animationNames(const aiScene& scene) {
   return names;
 }
 
-SkinnedJointMotion sampleMotion(const aiScene& scene, Format format, const std::string& name, double rate,
-                                std::size_t index) {
-  const SceneReader r = readerFor(scene, format, name);
-  std::vector<std::pair<const aiMesh*, const aiNode*>> meshes;
-  const std::vector<const aiNode*> skeleton = skinSkeleton(r, meshes);
-  const MotionNodes motionNodes(scene, skeleton);
-  const aiAnimation* anim = scene.mAnimations[index];
-  SkinnedJointMotion out;
-  out.animationNames = animationNames(scene);
-  out.animation = out.animationNames[index];
-  out.rate = rate;
-  if (anim == nullptr) r.fail(fmt::format("animation '{}' is missing", out.animation));
-  const std::vector<NodeTrack> tracks = readTracks(r, *anim, out.animation, motionNodes);
-  if (tracks.empty()) r.fail(fmt::format("animation '{}' moves no joint of the skin", out.animation));
-  out.start_s = std::numeric_limits<double>::infinity();
-  out.end_s = -std::numeric_limits<double>::infinity();
-  for (const NodeTrack& t : tracks)
-    for (const std::vector<double>* times : {&t.positionTimes, &t.rotationTimes, &t.scaleTimes})
-      if (!times->empty()) {
-        out.start_s = std::min(out.start_s, times->front());
-        out.end_s = std::max(out.end_s, times->back());
-      }
-  const std::size_t jn = skeleton.size();
-  const std::size_t frameCount = detail::motionFrameCount(out.start_s, out.end_s, rate, jn, out.animation, name);
+// What every animation of a file is sampled against: the skin's joints and rest pose as the
+// avatar reader finds them (in the scene read without animations, pivots collapsed), and
+// the same joints, found by name, in the scene read with its animations.
+struct MotionRig {
+  SceneReader skin;
+  const aiScene& animated;
+  Eigen::Matrix4d toMetres;
+  std::vector<std::string> joints;
+  std::vector<Vec3> restCenters;
+  std::vector<Eigen::Matrix4d> restInverse;
+  MotionNodes nodes;
 
-  std::vector<Eigen::Matrix4d> restInverse(jn);
-  for (std::size_t k = 0; k < jn; ++k) {
-    out.joints.push_back(jointName(*skeleton[k], k));
-    const Eigen::Matrix4d& w = r.world.at(skeleton[k]);
-    out.restCenters.push_back(w.block<3, 1>(0, 3));
-    restInverse[k] = w.inverse();
-    if (!restInverse[k].allFinite()) r.fail(fmt::format("joint '{}' has a singular rest transform", out.joints[k]));
+  static std::vector<const aiNode*> skeletonOf(const SceneReader& r) {
+    std::vector<std::pair<const aiMesh*, const aiNode*>> meshes;
+    return skinSkeleton(r, meshes);
   }
-  const std::size_t nn = motionNodes.nodes.size();
-  std::vector<Eigen::Matrix4d> own(nn), local(nn), world(nn);
-  for (std::size_t i = 0; i < nn; ++i) own[i] = toEigen(motionNodes.nodes[i]->mTransformation);
-  out.frames.reserve(frameCount * jn);
-  for (std::size_t f = 0; f < frameCount; ++f) {
-    const double t = out.start_s + static_cast<double>(f) / rate;
-    local = own;
-    for (const NodeTrack& track : tracks) local[track.node] = track.local(t, own[track.node]);
-    for (std::size_t i = 0; i < nn; ++i) {
-      const int p = motionNodes.parent[i];
-      world[i] = (p < 0 ? r.toMetres : world[static_cast<std::size_t>(p)]) * local[i];
+  static std::vector<const aiNode*> findJoints(const aiScene& animated, const std::vector<const aiNode*>& skeleton,
+                                               const SceneReader& r) {
+    std::vector<const aiNode*> found;
+    for (const aiNode* j : skeleton) {
+      const aiNode* node = animated.mRootNode == nullptr ? nullptr : animated.mRootNode->FindNode(j->mName);
+      if (node == nullptr) r.fail(fmt::format("joint '{}' is missing from the scene read with its animations", j->mName.C_Str()));
+      found.push_back(node);
     }
-    for (std::size_t k = 0; k < jn; ++k) {
-      const RigidTransform joint = detail::jointMotionOf(world[motionNodes.joint[k]], restInverse[k]);
-      if (!joint.translation.allFinite() || !joint.rotation.coeffs().allFinite())
-        r.fail(fmt::format("joint '{}' is not finite at {:g} s of animation '{}'", out.joints[k], t, out.animation));
-      out.frames.push_back(joint);
+    return found;
+  }
+
+  MotionRig(const aiScene& skinScene, const aiScene& animatedScene, Format format, const std::string& name)
+      : skin(readerFor(skinScene, format, name)),
+        animated(animatedScene),
+        toMetres(format == Format::Fbx ? fbxToMetresYUp(animatedScene, name) : Eigen::Matrix4d::Identity()),
+        nodes(animatedScene, findJoints(animatedScene, skeletonOf(skin), skin)) {
+    const std::vector<const aiNode*> skeleton = skeletonOf(skin);
+    for (std::size_t k = 0; k < skeleton.size(); ++k) {
+      joints.push_back(jointName(*skeleton[k], k));
+      const Eigen::Matrix4d& w = skin.world.at(skeleton[k]);
+      restCenters.push_back(w.block<3, 1>(0, 3));
+      restInverse.push_back(w.inverse());
+      if (!restInverse.back().allFinite()) skin.fail(fmt::format("joint '{}' has a singular rest transform", joints.back()));
     }
   }
-  return out;
-}
+
+  [[nodiscard]] SkinnedJointMotion sample(std::size_t index, double rate) const {
+    const std::string& name = skin.name;
+    SkinnedJointMotion out;
+    out.animationNames = animationNames(animated);
+    out.animation = out.animationNames[index];
+    out.rate = rate;
+    const aiAnimation* anim = animated.mAnimations[index];
+    if (anim == nullptr) skin.fail(fmt::format("animation '{}' is missing", out.animation));
+    const std::vector<NodeTrack> tracks = readTracks(animated, *anim, out.animation, nodes, skin);
+    if (tracks.empty()) skin.fail(fmt::format("animation '{}' moves no joint of the skin", out.animation));
+    out.start_s = std::numeric_limits<double>::infinity();
+    out.end_s = -std::numeric_limits<double>::infinity();
+    for (const NodeTrack& t : tracks)
+      for (const std::vector<double>* times : {&t.positionTimes, &t.rotationTimes, &t.scaleTimes})
+        if (!times->empty()) {
+          out.start_s = std::min(out.start_s, times->front());
+          out.end_s = std::max(out.end_s, times->back());
+        }
+    const std::size_t jn = joints.size();
+    const std::size_t frameCount = detail::motionFrameCount(out.start_s, out.end_s, rate, jn, out.animation, name);
+    out.joints = joints;
+    out.restCenters = restCenters;
+    const std::size_t nn = nodes.nodes.size();
+    std::vector<Eigen::Matrix4d> own(nn), local(nn), world(nn);
+    for (std::size_t i = 0; i < nn; ++i) own[i] = toEigen(nodes.nodes[i]->mTransformation);
+    out.frames.reserve(frameCount * jn);
+    for (std::size_t f = 0; f < frameCount; ++f) {
+      const double t = out.start_s + static_cast<double>(f) / rate;
+      local = own;
+      for (const NodeTrack& track : tracks) local[track.node] = track.local(t, own[track.node]);
+      for (std::size_t i = 0; i < nn; ++i) {
+        const int p = nodes.parent[i];
+        world[i] = (p < 0 ? toMetres : world[static_cast<std::size_t>(p)]) * local[i];
+      }
+      for (std::size_t k = 0; k < jn; ++k) {
+        const RigidTransform joint = detail::jointMotionOf(world[nodes.joint[k]], restInverse[k]);
+        if (!joint.translation.allFinite() || !joint.rotation.coeffs().allFinite())
+          skin.fail(fmt::format("joint '{}' is not finite at {:g} s of animation '{}'", joints[k], t, out.animation));
+        out.frames.push_back(joint);
+      }
+    }
+    return out;
+  }
+};
 
 // ---- writing ----------------------------------------------------------------------------
 
@@ -873,18 +909,20 @@ SkinnedModel parseAssimpSkinnedModel(std::string_view bytes, const std::string& 
 
 SkinnedJointMotion parseAssimpJointMotion(std::string_view bytes, const std::string& name, double rate,
                                           const std::string& animation) {
-  Assimp::Importer importer;
-  const aiScene& scene = importScene(importer, bytes, name, true);
-  const std::size_t index = detail::chooseAnimation(animationNames(scene), animation, name);
-  return sampleMotion(scene, formatOf(name), name, rate, index);
+  Assimp::Importer skinImporter, animatedImporter;
+  const aiScene& animated = importScene(animatedImporter, bytes, name, true);
+  const std::size_t index = detail::chooseAnimation(animationNames(animated), animation, name);
+  const MotionRig rig(importScene(skinImporter, bytes, name, false), animated, formatOf(name), name);
+  return rig.sample(index, rate);
 }
 
 std::vector<SkinnedJointMotion> parseAssimpJointMotions(std::string_view bytes, const std::string& name, double rate) {
-  Assimp::Importer importer;
-  const aiScene& scene = importScene(importer, bytes, name, true);
+  Assimp::Importer skinImporter, animatedImporter;
+  const aiScene& animated = importScene(animatedImporter, bytes, name, true);
   std::vector<SkinnedJointMotion> motions;
-  for (std::size_t a = 0; a < scene.mNumAnimations; ++a)
-    detail::appendWithinCap(motions, sampleMotion(scene, formatOf(name), name, rate, a), name);
+  if (animated.mNumAnimations == 0) return motions;
+  const MotionRig rig(importScene(skinImporter, bytes, name, false), animated, formatOf(name), name);
+  for (std::size_t a = 0; a < animated.mNumAnimations; ++a) detail::appendWithinCap(motions, rig.sample(a, rate), name);
   return motions;
 }
 

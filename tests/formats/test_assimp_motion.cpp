@@ -9,6 +9,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
 #include <set>
 #include <numbers>
 #include <string>
@@ -150,6 +153,44 @@ TEST_P(AssimpMotion, CesiumMansWalkReadsBackAsTheGltfReaderSamplesIt) {
   }
   EXPECT_LT(worstAngle, angleTolerance);
   EXPECT_LT(worstPosition, positionTolerance);
+}
+
+TEST(AssimpMotionFbx, PivotsAndPreRotationsMoveTheJointsAsFbxSays) {
+  // The turning hip of turnAndStride, as ASCII FBX with a pre-rotation of 30 degrees about
+  // z and a rotation pivot 0.5 m up added to it, as Maya and the tools that export for it
+  // write: FBX places it at T(t) Rp Rpre R(t) Rp^-1, so its frame turns by Rz(30 + 90 u)
+  // about the pivot, and the knee, 1 m up the hip's frame, follows. (Assimp hands such a
+  // node's animation over as channels of helper nodes, one per part of that product.)
+  const std::string path = (drape::testing::processTempDir("assimp-motion") / "pivot.fbx").string();
+  writeAssimpSkinnedModel(path, twoJoints(), {turnAndStride("turn")});
+  std::string text;
+  {
+    std::ifstream in(path);
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::size_t model = text.find("\"Model::hip\", \"LimbNode\"");
+  ASSERT_NE(model, std::string::npos);
+  const std::size_t props = text.find("Properties70:  {\n", model);
+  ASSERT_NE(props, std::string::npos);
+  text.insert(props + std::strlen("Properties70:  {\n"),
+              "\t\t\tP: \"PreRotation\", \"Vector3D\", \"Vector\", \"\",0,0,30\n"
+              "\t\t\tP: \"RotationPivot\", \"Vector3D\", \"Vector\", \"\",0,50,0\n");
+  std::ofstream(path, std::ios::trunc) << text;
+
+  const SkinnedJointMotion m = readAssimpJointMotion(path, 4.0);
+  ASSERT_EQ(m.frameCount(), 5u);
+  const Vec3 pivot(0, 0.5, 0);
+  const auto frame = [&](double degrees) { return Quat(Eigen::AngleAxisd(degrees * std::numbers::pi / 180, Vec3::UnitZ())); };
+  for (std::size_t f = 0; f < 5; ++f) {
+    const double u = static_cast<double>(f) / 4.0;
+    const Quat turn = frame(30 + 90 * u);
+    const Vec3 hip = Vec3(2.0 * u, 0, 0) + pivot - turn * pivot;
+    const Vec3 knee = hip + turn * Vec3(0, 1, 0);
+    SCOPED_TRACE("frame " + std::to_string(f));
+    EXPECT_LT(m.frames[2 * f].rotation.angularDistance(frame(90 * u)), 1e-5);  // from the rest turn of 30
+    EXPECT_LT((m.frames[2 * f].translation - hip).norm(), 1e-5);
+    EXPECT_LT((m.frames[2 * f + 1].translation - knee).norm(), 1e-5);
+  }
 }
 
 TEST_P(AssimpMotion, RiggedSimplesConvertedWalkReadsBack) {

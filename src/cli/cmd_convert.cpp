@@ -13,6 +13,7 @@
 #include "drape/formats/assimp_avatar.hpp"
 #include "drape/formats/avatar_motion.hpp"
 #include "drape/formats/hanim_writer.hpp"
+#include "drape/motion/animation.hpp"
 #include "drape/scene/avatar_gltf.hpp"
 
 namespace drape::cli {
@@ -38,9 +39,27 @@ formats::HanimHumanoidData toHanim(const scene::Avatar& a) {
   return h;
 }
 
+// The command line (CLI11 binds options to variables that outlive setupConvert).
+std::string input, output, motionPath, jointMap;
+double rate = 30.0, motionScale = 0.0;
+
+// --motion: the motion as `drape run --motion` plays it on this avatar (retargeted,
+// grounded), the lead-in left out, as one animation named after the motion file.
+formats::SkinnedJointMotion retargeted(const scene::Avatar& avatar) {
+  motion::MotionOptions options;
+  options.clip.rate = rate;
+  if (motionScale > 0) options.clip.metresPerUnit = motionScale;
+  options.jointMapPath = jointMap;
+  options.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
+  motion::ClipLoadReport report;
+  motion::JointMap map;
+  const motion::AvatarAnimation animation = motion::loadAnimation(avatar, motionPath, options, &report, &map);
+  spdlog::info("{}: {} frames at {:g} Hz in {}; joint map '{}'", motionPath, report.sourceFrames, report.sourceRate,
+               report.units.name, map.name);
+  return animation.toJointMotion(avatar, std::filesystem::path(motionPath).stem().string());
+}
+
 RunFunction setupConvert(CLI::App& app) {
-  static std::string input, output;
-  static double rate = 30.0;
   app.add_option("avatar", input,
                  "The avatar to convert: .glb, .gltf, .dae, .fbx or MakeHuman .mhskel (mesh and weights beside it)")
       ->required();
@@ -53,15 +72,30 @@ RunFunction setupConvert(CLI::App& app) {
                  "keys (every animation it carries is written)")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 1000.0));
+  CLI::Option* motionOption =
+      app.add_option("--motion", motionPath,
+                     "With --to .dae or .fbx: motion the avatar is written with instead of its file's own animations "
+                     "(.bvh, .amc, retargeted as drape run does; or an avatar file's animation), sampled at --rate");
+  app.add_option("--joint-map", jointMap, "With --motion: the joint map (JSON) from the motion's joints to the avatar's")
+      ->needs(motionOption);
+  app.add_option("--motion-scale", motionScale, "With --motion: metres per motion-file unit (default: guessed)")
+      ->needs(motionOption)
+      ->check(CLI::PositiveNumber);
   return [] {
     const std::string ext = std::filesystem::path(output).extension().string();
     const bool skinned = formats::isAssimpAvatarPath(output);
     if (ext != ".wrl" && !skinned)
       throw Error(fmt::format("--to {}: drape converts avatars to H-Anim VRML97 (.wrl), Collada (.dae) or FBX (.fbx)", output));
     const scene::Avatar avatar = scene::loadAvatarFile(input);
+    if (!motionPath.empty() && !skinned)
+      throw Error(fmt::format("--motion: {} is an H-Anim VRML97 humanoid, which drape writes without motion; write "
+                              ".dae or .fbx to carry it",
+                              output));
     if (skinned) {
       const std::vector<formats::SkinnedJointMotion> animations =
-          formats::isAvatarMotionPath(input) ? formats::readAvatarMotions(input, rate) : std::vector<formats::SkinnedJointMotion>{};
+          !motionPath.empty()                  ? std::vector<formats::SkinnedJointMotion>{retargeted(avatar)}
+          : formats::isAvatarMotionPath(input) ? formats::readAvatarMotions(input, rate)
+                                               : std::vector<formats::SkinnedJointMotion>{};
       formats::writeAssimpSkinnedModel(output, scene::skinnedModelOf(avatar), animations);
       spdlog::info("{}: {} joints, {} skinned vertices written to {}", input, avatar.joints.size(),
                    avatar.skin->mesh.vertexCount(), output);

@@ -151,7 +151,10 @@ std::size_t chooseAnimation(const std::vector<std::string>& names, const std::st
 std::size_t motionFrameCount(double start_s, double end_s, double rate, std::size_t joints, const std::string& animation,
                              const std::string& file) {
   if (!(rate > 0) || !std::isfinite(rate)) throw Error(fmt::format("{}: a motion rate of {} frames per second", file, rate));
-  const double frames = std::floor((end_s - start_s) * rate + 1e-9) + 1.0;
+  // Key times are single precision in every format read here: an animation of 140 frames at
+  // 30 Hz ends at 4.6666665 s. A thousandth of a frame of slack keeps its last frame (past
+  // the last key, which then holds).
+  const double frames = std::floor((end_s - start_s) * rate + 1e-3) + 1.0;
   if (!std::isfinite(frames) || frames * static_cast<double>(joints) > static_cast<double>(kMaxMotionTransforms))
     throw Error(fmt::format("{}: animation '{}' lasts {:g} s: {:g} frames of {} joints at {:g} Hz are more than drape "
                             "samples ({})",

@@ -468,6 +468,29 @@ AvatarAnimation AvatarAnimation::fromJointMotion(const scene::Avatar& avatar, co
   return anim;
 }
 
+formats::SkinnedJointMotion AvatarAnimation::toJointMotion(const scene::Avatar& avatar, const std::string& name) const {
+  if (avatar.joints.size() != joints_)
+    throw Error(fmt::format("{}: the animation has {} joints, the avatar {}", avatar.source, joints_, avatar.joints.size()),
+                ExitCode::Internal);
+  formats::SkinnedJointMotion out;
+  out.animation = name;
+  out.animationNames = {name};
+  out.rate = rate_;
+  out.start_s = 0.0;
+  out.end_s = duration();
+  for (const scene::Joint& j : avatar.joints) {
+    out.joints.push_back(j.name);
+    out.restCenters.push_back(j.restCenter);
+  }
+  out.frames.reserve(world_.size());
+  for (std::size_t f = 0; f < frames_; ++f)
+    for (std::size_t a = 0; a < joints_; ++a) {
+      const RigidTransform& w = world_[f * joints_ + a];
+      out.frames.push_back({(w.rotation * avatar.joints[a].restOrientation.conjugate()).normalized(), w.translation});
+    }
+  return out;
+}
+
 AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& motionPath, const MotionOptions& options,
                               ClipLoadReport* report, JointMap* chosenMap) {
   if (formats::isAvatarMotionPath(motionPath)) {

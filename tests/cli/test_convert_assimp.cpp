@@ -1,5 +1,6 @@
-// `drape convert` to and from Collada and FBX (with the glTF's animation), and `drape
-// inspect` on them: real files exit 0, a bad file exits 2 with a message naming it.
+// `drape convert` to and from Collada and FBX (with the glTF's animation, or a BVH walk
+// retargeted onto the avatar), and `drape inspect` on them: real files exit 0, a bad file
+// exits 2 with a message naming it.
 
 #include <gtest/gtest.h>
 
@@ -41,6 +42,37 @@ TEST_P(ConvertAssimp, GlbToSkinnedFileThenInspectAndToHanim) {
 
 INSTANTIATE_TEST_SUITE_P(Formats, ConvertAssimp, ::testing::Values(".dae", ".fbx"),
                          [](const auto& info) { return std::string(info.param + 1); });
+
+TEST_P(ConvertAssimp, MakeHumanWithTheWalkThenRunsOnIt) {
+  // The MakeHuman body with the bundled CMU walk retargeted onto it, written as one file; the
+  // walking skirt's scene then walks on that file's animation.
+  ScratchDir dir(std::string("convert-assimp-walker-") + (GetParam() + 1));
+  const std::string walker = dir / (std::string("walker") + GetParam());
+  const std::string body = std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel";
+  CliResult r = runDrape("convert '" + body + "' --motion '" + testing::kSkirtDir + "/walk.bvh' --to '" + walker + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find(walker + ": 1 animation sampled at 30 Hz written with it ('walk', 141 frames)"), std::string::npos)
+      << r.err;
+  const std::string run = dir / "run";
+  r = runDrape("run '" + testing::kSkirtDir + "/scene.wrl' --motion '" + walker + "' --frames 40 --out '" + run + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("joint map 'its own skin's joints ("), std::string::npos) << r.err;
+  EXPECT_EQ(testing::statsOf(run)["vertex_substeps_inside_body"], 0);
+}
+
+TEST(ConvertAssimp, MotionNeedsASkinnedOutput) {
+  ScratchDir dir("convert-assimp-motion-errors");
+  const std::string body = std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel";
+  const std::string wrl = dir / "walker.wrl";
+  CliResult r = runDrape("convert '" + body + "' --motion '" + testing::kSkirtDir + "/walk.bvh' --to '" + wrl + "'", dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--motion: " + wrl + " is an H-Anim VRML97 humanoid, which drape writes without motion"),
+            std::string::npos)
+      << r.err;
+  r = runDrape("convert '" + body + "' --joint-map x.json --to '" + (dir / "walker.dae") + "'", dir);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("--joint-map requires --motion"), std::string::npos) << r.err;
+}
 
 TEST(ConvertAssimp, HandWrittenColladaToHanim) {
   ScratchDir dir("convert-assimp-tube");

@@ -75,6 +75,12 @@ class AvatarAnimation {
                                                        const formats::SkinnedJointMotion& motion,
                                                        const std::string& source);
 
+  /// The other way: this animation of `avatar` (the one it was built for) as the motion of
+  /// its joints, each frame's rotations from the joints' rest orientations and their world
+  /// positions, named `name`: what a skinned-avatar writer takes to write the avatar with
+  /// its motion (`drape convert --motion`).
+  [[nodiscard]] formats::SkinnedJointMotion toJointMotion(const scene::Avatar& avatar, const std::string& name) const;
+
   [[nodiscard]] std::size_t frameCount() const { return frames_; }
   [[nodiscard]] std::size_t jointCount() const { return joints_; }
   [[nodiscard]] double rate() const { return rate_; }          ///< frames per second

@@ -608,8 +608,10 @@ struct MotionRig {
   const aiScene& animated;
   Eigen::Matrix4d toMetres;
   std::vector<std::string> joints;
+  std::vector<int> parents;
   std::vector<Vec3> restCenters;
   std::vector<Eigen::Matrix4d> restInverse;
+  double floor_m = 0.0;
   MotionNodes nodes;
 
   static std::vector<const aiNode*> skeletonOf(const SceneReader& r) {
@@ -631,10 +633,13 @@ struct MotionRig {
       : skin(readerFor(skinScene, format, name)),
         animated(animatedScene),
         toMetres(format == Format::Fbx ? fbxToMetresYUp(animatedScene, name) : Eigen::Matrix4d::Identity()),
+        floor_m(detail::lowestOf(extract(skinScene, format, name).positions, {})),
         nodes(animatedScene, findJoints(animatedScene, skeletonOf(skin), skin)) {
     const std::vector<const aiNode*> skeleton = skeletonOf(skin);
     for (std::size_t k = 0; k < skeleton.size(); ++k) {
       joints.push_back(jointName(*skeleton[k], k));
+      const auto parent = std::find(skeleton.begin(), skeleton.begin() + static_cast<std::ptrdiff_t>(k), skeleton[k]->mParent);
+      parents.push_back(k == 0 ? -1 : static_cast<int>(parent - skeleton.begin()));
       const Eigen::Matrix4d& w = skin.world.at(skeleton[k]);
       restCenters.push_back(w.block<3, 1>(0, 3));
       restInverse.push_back(w.inverse());
@@ -663,6 +668,8 @@ struct MotionRig {
     const std::size_t jn = joints.size();
     const std::size_t frameCount = detail::motionFrameCount(out.start_s, out.end_s, rate, jn, out.animation, name);
     out.joints = joints;
+    out.parents = parents;
+    out.floor_m = floor_m;
     out.restCenters = restCenters;
     const std::size_t nn = nodes.nodes.size();
     std::vector<Eigen::Matrix4d> own(nn), local(nn), world(nn);

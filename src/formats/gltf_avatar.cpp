@@ -703,6 +703,16 @@ std::vector<Track> readTracks(const GModel& model, std::size_t index, const Read
   return tracks;
 }
 
+/// The skin's rest positions, or none for a file whose skin no mesh uses (an animation
+/// without a character); the floor then comes from the joints.
+std::vector<Vec3> skinPositions(const GModel& model, const std::string& name) {
+  try {
+    return extract(model, name).positions;
+  } catch (const Error&) {
+    return {};
+  }
+}
+
 std::vector<std::string> animationNames(const GModel& model) {
   std::vector<std::string> names;
   for (std::size_t i = 0; i < model.animations.size(); ++i) names.push_back(detail::animationName(model.animations[i].name, i));
@@ -732,6 +742,8 @@ GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, 
   const std::size_t jn = sj.node.size();
   const std::size_t frameCount = detail::motionFrameCount(out.start_s, out.end_s, rate, jn, out.animation, name);
   out.joints = sj.name;
+  out.parents = sj.parent;
+
   std::vector<Eigen::Matrix4d> restInverse(jn);
   for (std::size_t k = 0; k < jn; ++k) {
     const Eigen::Matrix4d& w = restWorld[static_cast<std::size_t>(sj.node[k])];
@@ -739,6 +751,7 @@ GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, 
     restInverse[k] = w.inverse();
     if (!restInverse[k].allFinite()) r.fail(fmt::format("joint '{}' has a singular rest transform", sj.name[k]));
   }
+  out.floor_m = detail::lowestOf(skinPositions(model, name), out.restCenters);
   out.frames.reserve(frameCount * jn);
   std::vector<GNode> nodes = model.nodes;
   std::vector<Eigen::Matrix4d> local(nodes.size());

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include <Eigen/SVD>
 #include <fmt/format.h>
@@ -63,8 +64,10 @@ std::string serialise(const SkinnedJointMotion& m) {
   put(s, m.rate);
   put(s, m.start_s);
   put(s, m.end_s);
+  put(s, m.floor_m);
   put<std::uint64_t>(s, m.joints.size());
   for (const std::string& j : m.joints) putVector(s, std::vector<char>(j.begin(), j.end()));
+  putVector(s, std::vector<std::int32_t>(m.parents.begin(), m.parents.end()));
   std::vector<double> numbers;
   for (const Vec3& c : m.restCenters) numbers.insert(numbers.end(), {c.x(), c.y(), c.z()});
   putVector(s, numbers);
@@ -90,15 +93,20 @@ SkinnedJointMotion deserialiseJointMotion(std::string_view bytes, const std::str
   m.rate = c.get<double>();
   m.start_s = c.get<double>();
   m.end_s = c.get<double>();
+  m.floor_m = c.get<double>();
   const auto joints = c.get<std::uint64_t>();
   if (joints > 65535) throw Error(fmt::format("{}: the reader returned bad data", name));
   for (std::uint64_t k = 0; k < joints; ++k) {
     const std::vector<char> chars = c.getVector<char>();
     m.joints.emplace_back(chars.begin(), chars.end());
   }
+  const std::vector<std::int32_t> parents = c.getVector<std::int32_t>();
+  m.parents.assign(parents.begin(), parents.end());
+  for (std::size_t k = 0; k < m.parents.size(); ++k)
+    if (m.parents[k] >= static_cast<int>(k) || m.parents[k] < -1) throw Error(fmt::format("{}: the reader returned bad data", name));
   const std::vector<double> centres = c.getVector<double>();
   const std::vector<double> frames = c.getVector<double>();
-  if (centres.size() != 3 * joints || (joints > 0 && frames.size() % (7 * joints) != 0))
+  if (m.parents.size() != joints || centres.size() != 3 * joints || (joints > 0 && frames.size() % (7 * joints) != 0))
     throw Error(fmt::format("{}: the reader returned bad data", name));
   for (std::size_t i = 0; i + 2 < centres.size(); i += 3) m.restCenters.emplace_back(centres[i], centres[i + 1], centres[i + 2]);
   for (std::size_t i = 0; i + 6 < frames.size(); i += 7)
@@ -169,6 +177,12 @@ void appendWithinCap(std::vector<SkinnedJointMotion>& motions, SkinnedJointMotio
     throw Error(fmt::format("{}: its animations together hold more than the {} joint transforms drape samples at {:g} Hz",
                             file, kMaxMotionTransforms, motion.rate));
   motions.push_back(std::move(motion));
+}
+
+double lowestOf(const std::vector<Vec3>& positions, const std::vector<Vec3>& joints) {
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const Vec3& p : positions.empty() ? joints : positions) lowest = std::min(lowest, p.y());
+  return std::isfinite(lowest) ? lowest : 0.0;
 }
 
 RigidTransform jointMotionOf(const Eigen::Matrix4d& world, const Eigen::Matrix4d& restInverse) {

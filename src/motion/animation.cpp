@@ -478,8 +478,10 @@ formats::SkinnedJointMotion AvatarAnimation::toJointMotion(const scene::Avatar& 
   out.rate = rate_;
   out.start_s = 0.0;
   out.end_s = duration();
+  out.floor_m = avatarFloor(avatar);
   for (const scene::Joint& j : avatar.joints) {
     out.joints.push_back(j.name);
+    out.parents.push_back(j.parent);
     out.restCenters.push_back(j.restCenter);
   }
   out.frames.reserve(world_.size());
@@ -491,15 +493,69 @@ formats::SkinnedJointMotion AvatarAnimation::toJointMotion(const scene::Avatar& 
   return out;
 }
 
+namespace {
+
+bool namesEveryJoint(const formats::SkinnedJointMotion& motion, const scene::Avatar& avatar) {
+  return std::all_of(avatar.joints.begin(), avatar.joints.end(), [&](const scene::Joint& j) {
+    return std::find(motion.joints.begin(), motion.joints.end(), j.name) != motion.joints.end();
+  });
+}
+
+/// A skinned file's joint motion as a clip of its skeleton, for retargeting onto another
+/// avatar. The file's rest pose with every joint frame turned to the world's axes is the
+/// clip's rest (all its rotations identity): the offsets are the rest positions'
+/// differences, a joint's local rotation is its parent's motion undone from its own, and the
+/// root's path is its world position, its height taken from the file's floor (the lowest
+/// point of its skin at rest), as a BVH's from the capture's floor.
+Clip clipOfJointMotion(const formats::SkinnedJointMotion& m, const std::string& source) {
+  const std::size_t n = m.joints.size();
+  if (m.parents.size() != n || m.restCenters.size() != n || n == 0)
+    throw Error(fmt::format("{}: the motion's skeleton is incomplete", source), ExitCode::Internal);
+  for (std::size_t k = 1; k < n; ++k)
+    if (m.parents[k] < 0)
+      throw Error(fmt::format("{}: its skin's skeleton has more than one root ('{}' and '{}'); drape retargets a "
+                              "skeleton with one",
+                              source, m.joints.front(), m.joints[k]));
+  Clip clip;
+  clip.name = m.animation;
+  clip.source = source;
+  clip.rate = m.rate;
+  for (std::size_t k = 0; k < n; ++k) {
+    const int p = m.parents[k];
+    clip.skeleton.joints.push_back(
+        {m.joints[k], p, p < 0 ? Vec3::Zero() : Vec3(m.restCenters[k] - m.restCenters[static_cast<std::size_t>(p)]), {}});
+  }
+  const std::size_t frames = m.frameCount();
+  clip.rotations.reserve(frames * n);
+  clip.rootTranslations.reserve(frames);
+  for (std::size_t f = 0; f < frames; ++f) {
+    const RigidTransform* frame = m.frames.data() + f * n;
+    for (std::size_t k = 0; k < n; ++k) {
+      const int p = m.parents[k];
+      clip.rotations.push_back(p < 0 ? frame[k].rotation
+                                     : (frame[static_cast<std::size_t>(p)].rotation.conjugate() * frame[k].rotation).normalized());
+    }
+    clip.rootTranslations.push_back(frame[0].translation - Vec3(0, m.floor_m, 0));
+  }
+  return clip;
+}
+
+/// The user's joint map (checked strictly), or the shipped map that pairs the most joints.
+JointMap mapFor(const Clip& clip, const scene::Avatar& avatar, const MotionOptions& options) {
+  if (options.jointMapPath.empty())
+    return chooseJointMap(readJointMapDirectory(options.jointMapDirectory), clip.skeleton, avatar);
+  JointMap map = readJointMap(options.jointMapPath);
+  checkJointMap(map, clip.skeleton, avatar);
+  return map;
+}
+
+}  // namespace
+
 AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& motionPath, const MotionOptions& options,
                               ClipLoadReport* report, JointMap* chosenMap) {
   if (formats::isAvatarMotionPath(motionPath)) {
-    if (!options.jointMapPath.empty())
-      throw Error(fmt::format("--joint-map: {} is an avatar file's animation, which drives the joints of its own skin by name",
-                              motionPath));
     const double rate = options.clip.rate > 0 ? options.clip.rate : 30.0;
     const formats::SkinnedJointMotion motion = formats::readAvatarMotion(motionPath, rate, options.animation);
-    AvatarAnimation anim = AvatarAnimation::fromJointMotion(avatar, motion, motionPath);
     if (report) {
       *report = {};
       report->units.metresPerUnit = 1.0;
@@ -507,24 +563,26 @@ AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& mo
       report->sourceFrames = motion.frameCount();
       report->sourceRate = rate;
     }
-    if (chosenMap) {
-      *chosenMap = {};
-      chosenMap->name = fmt::format("its own skin's joints ({})", motion.animation);
+    // The avatar of the file itself (every joint of it named in the skin): its own motion, no
+    // retargeting. Any other avatar: the file's skeleton retargeted like a BVH's.
+    if (options.jointMapPath.empty() && namesEveryJoint(motion, avatar)) {
+      if (chosenMap) {
+        *chosenMap = {};
+        chosenMap->name = fmt::format("its own skin's joints ({})", motion.animation);
+      }
+      return AvatarAnimation::fromJointMotion(avatar, motion, motionPath);
     }
-    return anim;
+    const Clip clip = clipOfJointMotion(motion, motionPath);
+    const JointMap map = mapFor(clip, avatar, options);
+    if (chosenMap) *chosenMap = map;
+    return AvatarAnimation::build(avatar, clip, map, options.retarget);
   }
   if (!options.animation.empty())
     throw Error(fmt::format("--animation: {} is not an avatar file (.glb, .gltf, .dae, .fbx); animations are chosen "
                             "from an avatar's own file",
                             motionPath));
   const Clip clip = loadClip(motionPath, options.clip, report);
-  JointMap map;
-  if (!options.jointMapPath.empty()) {
-    map = readJointMap(options.jointMapPath);
-    checkJointMap(map, clip.skeleton, avatar);
-  } else {
-    map = chooseJointMap(readJointMapDirectory(options.jointMapDirectory), clip.skeleton, avatar);
-  }
+  const JointMap map = mapFor(clip, avatar, options);
   if (chosenMap) *chosenMap = map;
   return AvatarAnimation::build(avatar, clip, map, options.retarget);
 }

@@ -125,12 +125,23 @@ TEST(GltfAnimation, AvatarsOfOtherFilesAreRefused) {
   EXPECT_EQ(rests.rfind("walk.glb: the skeleton of its animation does not rest as avatar 'CesiumMan' does (joint '", 0), 0u)
       << rests;
 
+  // With a joint map the file's skeleton is retargeted, even onto its own avatar: the map
+  // is read.
   EXPECT_EQ(errorOf([&] {
               MotionOptions o;
               o.jointMapPath = "map.json";
               (void)loadAnimation(cesiumMan(), cesiumPath(), o);
             }),
-            "--joint-map: " + cesiumPath() + " is an avatar file's animation, which drives the joints of its own skin by name");
+            "map.json: no such file");
+  // Onto another avatar without a map, none of the shipped ones pairing its joints: the
+  // retargeting says what to give.
+  const std::string unmapped = errorOf([&] {
+    MotionOptions o;
+    o.jointMapDirectory = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";
+    (void)loadAnimation(makeHuman, cesiumPath(), o);
+  });
+  EXPECT_NE(unmapped.find("drives the avatar's root joint 'Hips'"), std::string::npos) << unmapped;
+  EXPECT_NE(unmapped.find("give a joint map naming the motion's joints (--joint-map FILE"), std::string::npos) << unmapped;
 }
 
 }  // namespace

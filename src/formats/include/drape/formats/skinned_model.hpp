@@ -37,7 +37,9 @@ struct SkinnedJointMotion {
   std::vector<std::string> animationNames;  ///< every animation's name ("animation <index>" if it has none)
   double rate = 30.0;                     ///< frames per second
   double start_s = 0.0, end_s = 0.0;      ///< the animation's first and last key times
+  double floor_m = 0.0;                   ///< m, the lowest point of the skin at rest: the file's floor
   std::vector<std::string> joints;        ///< the skin's joints, parent-first and named as in SkinnedModel
+  std::vector<int> parents;               ///< each joint's parent joint (-1: a root), earlier in the list
   std::vector<Vec3> restCenters;          ///< m, each joint's world position in the file's rest pose
   /// Frame-major, joint j of frame f at [f * joints.size() + j]: `rotation` turns the joint
   /// from its rest orientation (the rotation of W(t) W_rest^-1, W its node's world
@@ -71,6 +73,8 @@ constexpr std::size_t kMaxMotionTransforms = 10'000'000;
 /// Appends `motion` to `motions`; throws naming the file when all of them together would
 /// hold more than kMaxMotionTransforms joint transforms.
 void appendWithinCap(std::vector<SkinnedJointMotion>& motions, SkinnedJointMotion motion, const std::string& file);
+/// The lowest height of `positions` (the skin at rest), or of `joints` where there are none.
+[[nodiscard]] double lowestOf(const std::vector<Vec3>& positions, const std::vector<Vec3>& joints);
 /// A joint's motion from its world matrix now and the inverse of its rest world matrix:
 /// the rotation nearest W(t) W_rest^-1 (its polar factor, since scaled chains leave it a
 /// rotation only up to rounding, or a shear where scales animate) and its world position.

@@ -515,6 +515,7 @@ struct MotionNodes {
   std::vector<int> parent;
   std::vector<std::size_t> joint;  // the node index of each skin joint
 
+  MotionNodes() = default;
   MotionNodes(const aiScene& scene, const std::vector<const aiNode*>& jointNodes) {
     std::unordered_set<const aiNode*> member;
     for (const aiNode* j : jointNodes)
@@ -633,9 +634,9 @@ struct MotionRig {
       : skin(readerFor(skinScene, format, name)),
         animated(animatedScene),
         toMetres(format == Format::Fbx ? fbxToMetresYUp(animatedScene, name) : Eigen::Matrix4d::Identity()),
-        floor_m(detail::lowestOf(extract(skinScene, format, name).positions, {})),
-        nodes(animatedScene, findJoints(animatedScene, skeletonOf(skin), skin)) {
+        floor_m(detail::lowestOf(extract(skinScene, format, name).positions, {})) {
     const std::vector<const aiNode*> skeleton = skeletonOf(skin);
+    nodes = MotionNodes(animatedScene, findJoints(animatedScene, skeleton, skin));
     for (std::size_t k = 0; k < skeleton.size(); ++k) {
       joints.push_back(jointName(*skeleton[k], k));
       const auto parent = std::find(skeleton.begin(), skeleton.begin() + static_cast<std::ptrdiff_t>(k), skeleton[k]->mParent);

@@ -411,35 +411,62 @@ Placement placementOf(const scene::Avatar& avatar, const std::vector<int>& motio
 
 }  // namespace
 
+namespace {
+
+/// How an avatar file's motion fits `avatar` as the avatar of that file: the motion joint
+/// of each avatar joint (by name), the placement, and what does not fit ("" if it all does).
+struct OwnFit {
+  std::vector<int> motionJoint;
+  Placement place;
+  std::string mismatch;
+};
+
+OwnFit fitAsOwn(const scene::Avatar& avatar, const formats::SkinnedJointMotion& motion) {
+  const std::size_t n = avatar.joints.size();
+  OwnFit fit;
+  fit.motionJoint.assign(n, -1);
+  std::vector<std::string> missing;
+  for (std::size_t a = 0; a < n; ++a) {
+    const auto it = std::find(motion.joints.begin(), motion.joints.end(), avatar.joints[a].name);
+    if (it == motion.joints.end()) missing.push_back(avatar.joints[a].name);
+    else fit.motionJoint[a] = static_cast<int>(it - motion.joints.begin());
+  }
+  if (!missing.empty()) {
+    fit.mismatch = fmt::format("its skin has no joint named {} of avatar '{}' ({} of {} missing)",
+                               fmt::join(missing.begin(), missing.begin() + std::min<std::size_t>(missing.size(), 4), ", "),
+                               avatar.name, missing.size(), n);
+    return fit;
+  }
+  fit.place = placementOf(avatar, fit.motionJoint, motion);
+  // The same skeleton at rest, or a different one with the same joint names.
+  double spread = 0.0;
+  for (const scene::Joint& j : avatar.joints) spread = std::max(spread, (j.restCenter - avatar.joints.front().restCenter).norm());
+  const double tolerance = std::max(1e-3 * spread, 1e-6);
+  for (std::size_t a = 0; a < n && fit.mismatch.empty(); ++a) {
+    const double off =
+        (fit.place.apply(motion.restCenters[static_cast<std::size_t>(fit.motionJoint[a])]) - avatar.joints[a].restCenter).norm();
+    if (off > tolerance)
+      fit.mismatch = fmt::format("the skeleton of its animation does not rest as avatar '{}' does (joint '{}' {:.1f} mm "
+                                 "away once placed)",
+                                 avatar.name, avatar.joints[a].name, 1e3 * off);
+  }
+  return fit;
+}
+
+}  // namespace
+
 AvatarAnimation AvatarAnimation::fromJointMotion(const scene::Avatar& avatar, const formats::SkinnedJointMotion& motion,
                                                  const std::string& source) {
   const std::size_t n = avatar.joints.size();
   if (n == 0) throw Error(fmt::format("{}: the avatar has no joints to animate", avatar.source));
   if (motion.frameCount() == 0) throw Error(fmt::format("{}: the motion has no frames", source));
-  std::vector<int> motionJoint(n, -1);
-  std::vector<std::string> missing;
-  for (std::size_t a = 0; a < n; ++a) {
-    const auto it = std::find(motion.joints.begin(), motion.joints.end(), avatar.joints[a].name);
-    if (it == motion.joints.end()) missing.push_back(avatar.joints[a].name);
-    else motionJoint[a] = static_cast<int>(it - motion.joints.begin());
-  }
-  if (!missing.empty())
-    throw Error(fmt::format("{}: its skin has no joint named {} of avatar '{}' ({} of {} missing): an avatar file's "
-                            "animation drives the avatar of its own file; other avatars take BVH or ASF/AMC motion",
-                            source, fmt::join(missing.begin(), missing.begin() + std::min<std::size_t>(missing.size(), 4), ", "),
-                            avatar.name, missing.size(), n));
-  const Placement place = placementOf(avatar, motionJoint, motion);
-  // The same skeleton at rest, or a different one with the same joint names.
-  double spread = 0.0;
-  for (const scene::Joint& j : avatar.joints) spread = std::max(spread, (j.restCenter - avatar.joints.front().restCenter).norm());
-  const double tolerance = std::max(1e-3 * spread, 1e-6);
-  for (std::size_t a = 0; a < n; ++a) {
-    const double off = (place.apply(motion.restCenters[static_cast<std::size_t>(motionJoint[a])]) - avatar.joints[a].restCenter).norm();
-    if (off > tolerance)
-      throw Error(fmt::format("{}: the skeleton of its animation does not rest as avatar '{}' does (joint '{}' {:.1f} mm "
-                              "away once placed): an avatar file's animation drives the avatar of its own file",
-                              source, avatar.name, avatar.joints[a].name, 1e3 * off));
-  }
+  const OwnFit fit = fitAsOwn(avatar, motion);
+  if (!fit.mismatch.empty())
+    throw Error(fmt::format("{}: {}: an avatar file's animation drives the avatar of its own file as it is; "
+                            "loadAnimation retargets it onto any other",
+                            source, fit.mismatch));
+  const std::vector<int>& motionJoint = fit.motionJoint;
+  const Placement& place = fit.place;
 
   AvatarAnimation anim;
   anim.frames_ = motion.frameCount();
@@ -494,12 +521,6 @@ formats::SkinnedJointMotion AvatarAnimation::toJointMotion(const scene::Avatar& 
 }
 
 namespace {
-
-bool namesEveryJoint(const formats::SkinnedJointMotion& motion, const scene::Avatar& avatar) {
-  return std::all_of(avatar.joints.begin(), avatar.joints.end(), [&](const scene::Joint& j) {
-    return std::find(motion.joints.begin(), motion.joints.end(), j.name) != motion.joints.end();
-  });
-}
 
 /// A skinned file's joint motion as a clip of its skeleton, for retargeting onto another
 /// avatar. The file's rest pose with every joint frame turned to the world's axes is the
@@ -563,9 +584,10 @@ AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& mo
       report->sourceFrames = motion.frameCount();
       report->sourceRate = rate;
     }
-    // The avatar of the file itself (every joint of it named in the skin): its own motion, no
-    // retargeting. Any other avatar: the file's skeleton retargeted like a BVH's.
-    if (options.jointMapPath.empty() && namesEveryJoint(motion, avatar)) {
+    // The avatar of the file itself (every joint of it named in the skin, resting where the
+    // skin's does): its own motion, no retargeting. Any other avatar, a skeleton of the same
+    // names and other proportions too: the file's skeleton retargeted like a BVH's.
+    if (options.jointMapPath.empty() && fitAsOwn(avatar, motion).mismatch.empty()) {
       if (chosenMap) {
         *chosenMap = {};
         chosenMap->name = fmt::format("its own skin's joints ({})", motion.animation);

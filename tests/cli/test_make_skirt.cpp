@@ -32,6 +32,17 @@ void runsClean(const ScratchDir& scratch, const std::string& dir) {
   EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
 }
 
+/// CesiumMan's skirt (his glTF names his segments joint0, joint1, ...), in `dir`/skirt; ""
+/// (with the failure recorded) if make-skirt fails.
+std::string makeCesiumSkirt(const ScratchDir& dir) {
+  const std::string out = dir / "skirt";
+  const CliResult r = runDrape("make-skirt '" + kAvatars + "/CesiumMan.glb' --waist-segment joint1 --hip-segments joint0 " +
+                                   "--leg-segments joint11,joint12,joint13,joint14 --out '" + out + "'",
+                               dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  return r.code == 0 ? out : "";
+}
+
 TEST(MakeSkirt, FitsTheMakeHumanBodyWithItsDefaultSegments) {
   ScratchDir dir("make-skirt-makehuman");
   const std::string out = dir / "skirt";
@@ -101,12 +112,8 @@ TEST(MakeSkirt, CesiumMansSkirtWalksOnItsOwnAnimation) {
   // retargeting; 1 s of lead-in and the 2 s walk (61 frames at 30 Hz).
   ScratchDir dir("make-skirt-cesium-walk");
   const std::string cesium = kAvatars + "/CesiumMan.glb";
-  const std::string out = dir / "skirt";
-  ASSERT_EQ(runDrape("make-skirt '" + cesium + "' --waist-segment joint1 --hip-segments joint0 " +
-                         "--leg-segments joint11,joint12,joint13,joint14 --out '" + out + "'",
-                     dir)
-                .code,
-            0);
+  const std::string out = makeCesiumSkirt(dir);
+  ASSERT_FALSE(out.empty());
   const std::string run = dir / "walk";
   const CliResult r = runDrape("run '" + out + "/scene.wrl' --motion '" + cesium + "' --out '" + run + "'", dir);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -148,12 +155,8 @@ TEST(MakeSkirt, CesiumMansWalkAsColladaAndFbxDrivesTheSameBody) {
   // what each file's keys keep (single-precision Collada; six digits in ASCII FBX).
   ScratchDir dir("make-skirt-cesium-formats");
   const std::string cesium = kAvatars + "/CesiumMan.glb";
-  const std::string out = dir / "skirt";
-  ASSERT_EQ(runDrape("make-skirt '" + cesium + "' --waist-segment joint1 --hip-segments joint0 " +
-                         "--leg-segments joint11,joint12,joint13,joint14 --out '" + out + "'",
-                     dir)
-                .code,
-            0);
+  const std::string out = makeCesiumSkirt(dir);
+  ASSERT_FALSE(out.empty());
   const auto bodyOf = [&](const std::string& motion, const std::string& name) {
     const std::string run = dir / name;
     const CliResult r = runDrape("run '" + out + "/scene.wrl' --motion '" + motion + "' --frames 45 --out '" + run + "'", dir);

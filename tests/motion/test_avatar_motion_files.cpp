@@ -13,16 +13,11 @@
 #include "drape/formats/avatar_motion.hpp"
 #include "drape/motion/animation.hpp"
 #include "drape/scene/avatar_gltf.hpp"
+#include "makehuman.hpp"
 #include "drape/testing/temp_dir.hpp"
 
 namespace drape::motion {
 namespace {
-
-const scene::Avatar& makeHuman() {
-  static const scene::Avatar avatar =
-      scene::loadAvatarFile(std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel");
-  return avatar;
-}
 
 const AvatarAnimation& walk() {
   static const AvatarAnimation animation = [] {

@@ -144,5 +144,31 @@ TEST(GltfAnimation, AvatarsOfOtherFilesAreRefused) {
   EXPECT_NE(unmapped.find("give a joint map naming the motion's joints (--joint-map FILE"), std::string::npos) << unmapped;
 }
 
+TEST(GltfAnimation, ASkeletonOfTheSameNamesRestingOtherwiseIsRetargeted) {
+  // CesiumMan with one arm bone 5 cm longer: the file's walk does not fit it as its own,
+  // so it is retargeted through the pairing of equal names, and the avatar keeps its bones.
+  scene::Avatar longer = cesiumMan();
+  const auto joint = [&](const char* name) { return static_cast<std::size_t>(longer.findJoint(name)); };
+  const std::size_t elbow = joint("joint7"), shoulder = joint("joint5");
+  const Vec3 bone = longer.joints[elbow].restCenter - longer.joints[shoulder].restCenter;
+  for (scene::Joint& j : longer.joints)
+    for (int p = j.parent; p >= 0; p = longer.joints[static_cast<std::size_t>(p)].parent)
+      if (static_cast<std::size_t>(p) == shoulder && &j != &longer.joints[shoulder]) {
+        j.restCenter += 0.05 * bone.normalized();
+        break;
+      }
+  const double length = (longer.joints[elbow].restCenter - longer.joints[shoulder].restCenter).norm();
+  ASSERT_NEAR(length, bone.norm() + 0.05, 1e-12);
+
+  MotionOptions o;
+  o.jointMapDirectory = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";
+  JointMap map;
+  const AvatarAnimation anim = loadAnimation(longer, cesiumPath(), o, nullptr, &map);
+  EXPECT_EQ(map.name, "same names");
+  ASSERT_EQ(anim.frameCount(), cesiumWalk().frameCount());
+  for (std::size_t f = 0; f < anim.frameCount(); ++f)
+    EXPECT_NEAR((anim.frame(f)[elbow].translation - anim.frame(f)[shoulder].translation).norm(), length, 1e-9) << f;
+}
+
 }  // namespace
 }  // namespace drape::motion

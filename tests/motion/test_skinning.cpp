@@ -10,15 +10,10 @@
 #include "drape/core/error.hpp"
 #include "drape/motion/skinning.hpp"
 #include "drape/scene/avatar_gltf.hpp"
+#include "makehuman.hpp"
 
 namespace drape::motion {
 namespace {
-
-const scene::Avatar& makeHuman() {
-  static const scene::Avatar avatar =
-      scene::loadAvatarFile(std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel");
-  return avatar;
-}
 
 std::vector<RigidTransform> restPose(const scene::Avatar& avatar) {
   std::vector<RigidTransform> rest;

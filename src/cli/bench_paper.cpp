@@ -106,6 +106,7 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
     world.collider(g)->setRestingBalls(!o.noRestingBalls);
     world.collider(g)->setCountEverySubstep(measure);
   }
+  (void)settleWorld(setup, world);  // before the frames timed: the solvers' clocks start after it
 
   PaperRun r;
   r.substeps = setup.settings.substepsPerFrame;

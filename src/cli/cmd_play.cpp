@@ -41,6 +41,7 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
   if (!o.motion.empty()) addMotion(setup, o.motion, 0.0, "", o.animation);
   const std::unique_ptr<sim::CharacterWorld> worldPtr = buildWorld(setup);
   sim::CharacterWorld& world = *worldPtr;
+  (void)settleWorld(setup, world);
   const scene::Avatar* avatar = setup.character->avatar.get();
   const cloth::StepSettings& step = setup.settings;
 

@@ -31,7 +31,7 @@ namespace {
 
 struct RunOptions {
   std::string scene, avatar, motion, jointMap, animation, fieldMethod = "dvdp";
-  double motionScale = 0.0, voxel_m = 0.0, leadIn_s = 1.0;
+  double motionScale = 0.0, voxel_m = 0.0, leadIn_s = 1.0, settle_s = 1.0;
   bool preview = false, countEverySubstep = false, exactSliding = false, freePinches = false, noStitches = false;
   double stitchGaps_m = 0.0;  ///< --stitch-gaps
   std::vector<std::string> faceSamplesWith, keepApart;
@@ -255,6 +255,8 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     ch.fieldMethod = o.fieldMethod == "exact" ? field::FieldMethod::Exact : field::FieldMethod::Dvdp;
     if (!(o.leadIn_s >= 0)) throw Error(fmt::format("--lead-in must be >= 0 s, got {}", o.leadIn_s));
     ch.leadIn_s = o.leadIn_s;
+    if (!(o.settle_s >= 0)) throw Error(fmt::format("--settle must be >= 0 s, got {}", o.settle_s));
+    ch.settle_s = o.settle_s;
     if (app.count("--keep-apart")) setKeepApart(ch, o.keepApart);
     if (!o.motion.empty()) addMotion(setup, o.motion, o.motionScale, o.jointMap, o.animation);
   }
@@ -316,6 +318,11 @@ RunFunction setupRun(CLI::App& app) {
                  "scene's keepApart, 'none' for none")
       ->delimiter(',');
   app.add_option("--lead-in", o->leadIn_s, "Seconds to blend from the rest pose into the motion")->capture_default_str();
+  app.add_option("--settle", o->settle_s,
+                 "Longest time the garments settle at the rest pose before frame 0, so that cloth modelled "
+                 "tighter than the offset surfaces starts the run out of them (only as long as that takes; 0: "
+                 "frame 0 is the garment as modelled)")
+      ->capture_default_str();
   app.add_flag("--preview", o->preview, "Also render a contact sheet and, with ffmpeg, an MP4 into the output directory");
   app.add_option("--offsets", o->offsets,
                  "The offset surfaces T0,T1,T2,T3 in m, overriding the scene's (default: 1, 2, 3 and 6 voxels); "

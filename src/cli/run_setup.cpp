@@ -335,6 +335,23 @@ std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup) {
   return world;
 }
 
+sim::SettleReport settleWorld(const RunSetup& setup, sim::CharacterWorld& world) {
+  sim::SettleReport report;
+  if (!world.settle(setup.character ? setup.character->settle_s : 0.0, report))
+    throw Error(world.instability(), ExitCode::Unstable);
+  if (report.frames == 0) return report;
+  std::string outcome = fmt::format("{} of the {} eased pairs reached T2", report.pairsEased - report.pairsTimedOut -
+                                                                              report.pairsLeft, report.pairsEased);
+  if (report.pairsTimedOut > 0)
+    outcome += fmt::format(", {} held below it by the garment collide as any other", report.pairsTimedOut);
+  if (report.pairsLeft > 0)
+    outcome += fmt::format(", {} are still being eased out (a longer --settle lets them out before frame 0)",
+                           report.pairsLeft);
+  spdlog::info("settled the garments at the rest pose for {:.3g} s before frame 0 ({} frames in {:.2f} s): {}",
+               report.seconds, report.frames, report.wall_s, outcome);
+  return report;
+}
+
 std::string unknownKeepApartPart(const CharacterSetup& character) {
   const scene::Avatar& avatar = *character.avatar;
   for (const std::string& part : character.keepApart)
@@ -625,6 +642,7 @@ int simulateRun(const RunSetup& setup) {
     outputSeconds += std::chrono::duration<double>(Clock::now() - start).count();
   };
 
+  const sim::SettleReport settled = world ? settleWorld(setup, *world) : sim::SettleReport{};
   Progress progress("drape run", setup.frames);
   long done = 0;
   const Clock::time_point loopStart = Clock::now();
@@ -679,6 +697,12 @@ int simulateRun(const RunSetup& setup) {
   nlohmann::json stats;
   stats["frames"] = done;
   stats["frames_requested"] = setup.frames;
+  stats["settle"] = {{"frames", settled.frames},
+                     {"seconds", settled.seconds},
+                     {"wall_s", settled.wall_s},
+                     {"pairs_eased", settled.pairsEased},
+                     {"pairs_timed_out", settled.pairsTimedOut},
+                     {"pairs_left", settled.pairsLeft}};
   stats["frame_rate"] = settings.frameRate_hz;
   stats["substeps_per_frame"] = settings.substepsPerFrame;
   stats["max_refinement"] = settings.maxRefinement;

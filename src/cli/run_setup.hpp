@@ -32,6 +32,8 @@ struct CharacterSetup {
   double voxel_m = 0.005;                                     ///< distance-field voxel size
   field::FieldMethod fieldMethod = field::FieldMethod::Dvdp;
   double leadIn_s = 1.0;                                      ///< rest pose -> first motion frame
+  /// Longest settling at the rest pose before frame 0 (sim::CharacterWorld::settle; 0: none).
+  double settle_s = 1.0;
   /// Parts whose motion is corrected to keep them out of the collidable parts (--keep-apart).
   std::vector<std::string> keepApart{};
 };
@@ -73,6 +75,10 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
 /// The character's world of a setup with an avatar: fields built, masks bound, solvers
 /// ready. Used by `drape run`, `drape play SCENE` and `drape bench paper` alike.
 [[nodiscard]] std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup);
+/// Settles the world's garments before frame 0 for at most the character's settle_s
+/// (sim::CharacterWorld::settle) and logs what it did. Call after the colliders' settings,
+/// before the first frame. Throws drape::Error (Unstable) when a garment goes unstable.
+sim::SettleReport settleWorld(const RunSetup& setup, sim::CharacterWorld& world);
 /// The least T0 of the world's garments: how far the drawn skin may stand out of the body
 /// parts (sim::BodySkin).
 [[nodiscard]] double leastT0(const sim::CharacterWorld& world);

@@ -1217,6 +1217,14 @@ std::vector<std::size_t> FieldCollider::easedPairsPerPart() const {
   return counts;
 }
 
+std::optional<double> FieldCollider::easingEnds_s() const {
+  std::optional<double> last;
+  for (std::size_t k = 0; k < embedded_.size(); ++k)
+    for (std::size_t i = 0; i < embedded_[k].size(); ++i)
+      if (embedded_[k][i]) last = std::max(last.value_or(easeUntil_s_[k][i]), easeUntil_s_[k][i]);
+  return last;
+}
+
 std::array<std::size_t, 3> FieldCollider::pointsPerState() const {
   std::array<std::size_t, 3> counts{};
   for (const auto& part : states_)

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <unordered_map>
 
 #include <fmt/format.h>
@@ -505,13 +506,45 @@ void CharacterWorld::liftOutOfTheParts(const GarmentSpec& spec, const std::vecto
                still ? fmt::format("; {} still inside", still) : std::string());
 }
 
-bool CharacterWorld::stepFrame(long frame) {
-  const std::vector<std::uint8_t> stables = stepGarments(frame);
+bool CharacterWorld::settle(double max_s, SettleReport& report) {
+  report = {};
+  std::optional<double> ends;
+  for (const GarmentRun& g : garments_) {
+    if (const std::optional<double> e = g.collider->easingEnds_s()) ends = std::max(ends.value_or(*e), *e);
+    for (std::size_t pairs : g.collider->easedPairsPerPart()) report.pairsEased += pairs;
+  }
+  if (!ends || !(max_s > 0.0)) return true;
+  // Whole frames that end at time 0, so frame 1 follows the last of them as it would the
+  // initial state; the colliders start again from the earlier time (the garment has not
+  // moved, and the rest pose holds for any time before 0), so each eased pair gets its
+  // easing time from there.
+  const double rate = settings_.step.frameRate_hz;
+  const double span_s = std::min(*ends, max_s);
+  const long frames = std::max(1L, static_cast<long>(std::ceil(span_s * rate - 1e-9)));
+  for (GarmentRun& g : garments_) g.collider->initialise(g.solver->state(), -static_cast<double>(frames) / rate);
+  const auto start = std::chrono::steady_clock::now();
+  for (long frame = 1 - frames; frame <= 0; ++frame)
+    if (!checkStable(stepGarments(frame), frame, "settling at the rest pose before frame 0: ")) return false;
+  report.frames = frames;
+  report.seconds = static_cast<double>(frames) / rate;
+  report.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (GarmentRun& g : garments_) {
+    for (std::size_t pairs : g.collider->easedPairsPerPart()) report.pairsLeft += pairs;
+    report.pairsTimedOut += g.collider->fieldCounters().embeddedTimedOut;
+    g.solver->resetStageTimes();
+    g.collider->resetTimes();
+  }
+  return true;
+}
+
+bool CharacterWorld::stepFrame(long frame) { return checkStable(stepGarments(frame), frame, ""); }
+
+bool CharacterWorld::checkStable(const std::vector<std::uint8_t>& stables, long frame, const std::string& when) {
   for (std::size_t i = 0; i < garments_.size(); ++i) {
     const GarmentRun& g = garments_[i];
     logFrameRecovery(*g.solver, g.spec.name, frame);
     if (!stables[i]) {
-      instability_ = g.solver->instability().describe(g.spec.name, settings_.step.maxSpeed_m_s);
+      instability_ = when + g.solver->instability().describe(g.spec.name, settings_.step.maxSpeed_m_s);
       // Where the vertex was held: most garments that blow up on a body do it in a pinch,
       // between parts whose offset surfaces overlap (docs/PHYSICS.md, examples/walking_dress).
       instability_ += cloth::pinchNear(g.solver->model(), *g.collider, g.solver->instability().vertex,

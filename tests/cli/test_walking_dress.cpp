@@ -88,6 +88,42 @@ TEST(WalkingDress, WalksStablyWithFewPointsInsideTheBody) {
                                    stats["pairs_embedded_timed_out"].get<long>())),
             std::string::npos)
       << r.err;
+  // They are eased out before frame 0, at the rest pose (frame 0 showed the chest through
+  // the jacket before): all of them, in whole frames ending at time 0.
+  const nlohmann::json& settle = stats["settle"];
+  EXPECT_GT(settle["frames"].get<int>(), 0);
+  EXPECT_LE(settle["frames"].get<int>(), 30);  // --settle 1 s at most
+  EXPECT_DOUBLE_EQ(settle["seconds"].get<double>(), settle["frames"].get<double>() / 30.0);
+  EXPECT_EQ(settle["pairs_eased"].get<long>(), stats["pairs_embedded_at_start"].get<long>());
+  EXPECT_EQ(settle["pairs_left"].get<long>(), 0);
+  EXPECT_EQ(settle["pairs_timed_out"].get<long>(), stats["pairs_embedded_timed_out"].get<long>());
+  EXPECT_NE(r.err.find(fmt::format("settled the garments at the rest pose for {:.3g} s before frame 0 ({} frames",
+                                   settle["seconds"].get<double>(), settle["frames"].get<int>())),
+            std::string::npos)
+      << r.err;
+  // --settle 0: frame 0 is the dress as modelled, eased out in the walk's first frames.
+  const std::string unsettled = dir / "unsettled";
+  const CliResult asModelled = runDrape("run '" + kDressScene + "' --motion '" + kSource +
+                                            "/examples/walking_skirt/walk.bvh' --frames 1 --settle 0 --out '" +
+                                            unsettled + "'",
+                                        dir);
+  ASSERT_EQ(asModelled.code, 0) << asModelled.err;
+  EXPECT_EQ(statsOf(unsettled)["settle"]["frames"].get<int>(), 0);
+  EXPECT_EQ(statsOf(unsettled)["settle"]["pairs_eased"].get<long>(), settle["pairs_eased"].get<long>());
+  const formats::Pc2Cache modelled = formats::readPc2(unsettled + "/garment.pc2");
+  const mesh::TriMesh& rest = sc.garments.at(0).mesh;
+  ASSERT_EQ(modelled.frames.at(0).size(), rest.vertexCount());
+  double moved = 0, settledMoved = 0;
+  for (std::size_t i = 0; i < rest.vertexCount(); ++i) {
+    moved = std::max(moved, (modelled.frames[0][i] - rest.positions[i]).norm());
+    settledMoved = std::max(settledMoved, (cache.frames[0][i] - rest.positions[i]).norm());
+  }
+  EXPECT_LT(moved, 1e-6);
+  EXPECT_GT(settledMoved, 1e-3);
+  const CliResult negative = runDrape("run '" + kDressScene + "' --frames 1 --settle -1 --out '" + (dir / "neg") + "'",
+                                      dir);
+  EXPECT_EQ(negative.code, 2) << negative.err;
+  EXPECT_NE(negative.err.find("--settle must be >= 0 s, got -1"), std::string::npos) << negative.err;
 }
 
 TEST(WalkingDress, AnUnstableBendingStepIsRefusedBeforeTheFieldsAreBuilt) {

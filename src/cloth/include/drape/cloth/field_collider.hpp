@@ -113,6 +113,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -310,6 +311,8 @@ class FieldCollider final : public Collider {
   /// Time spent measuring the penetration figures, s (setMeasurePenetration): part of
   /// collide()'s time, and not the collision's work.
   [[nodiscard]] double measureSeconds() const { return StageClock::seconds(measureTicks_); }
+  /// Starts poseSeconds and measureSeconds again from zero (work before the frames timed).
+  void resetTimes() { poseTicks_ = measureTicks_ = 0; }
 
   [[nodiscard]] const std::vector<CollisionPart>& parts() const { return parts_; }
   [[nodiscard]] const OffsetSurfaces& offsets() const { return offsets_; }
@@ -327,6 +330,9 @@ class FieldCollider final : public Collider {
   /// Per part, the (vertex, part) pairs being eased out onto T2 now: right after initialise,
   /// those that start below T2.
   [[nodiscard]] std::vector<std::size_t> easedPairsPerPart() const;
+  /// When the last pair being eased out is due to have reached T2 or to time out (collide
+  /// as any other from then on), s; nothing when no pair is being eased.
+  [[nodiscard]] std::optional<double> easingEnds_s() const;
   /// Points per state now, summed over parts: [OutsideVol, InsideVol, OnSurf].
   [[nodiscard]] std::array<std::size_t, 3> pointsPerState() const;
   /// Per vertex, for display: 0 outside every volume, 1 inside a volume, 2 on a surface,

@@ -98,7 +98,8 @@ class ClothSolver {
   /// Stitch corrections made so far (holdStitches's count).
   [[nodiscard]] std::size_t stitchCorrections() const { return stitchCorrections_; }
 
-  /// Computes frame `frame` (1-based: frame 0 is the initial state) from the current state:
+  /// Computes frame `frame` (1-based: frame 0 is the initial state; frames up to 0 settle
+  /// a garment before it, CharacterWorld::settle) from the current state:
   /// settings.substepsPerFrame substeps covering [(frame - 1) / fps, frame / fps]. When the
   /// guard trips, the frame is computed again from its start with twice the substeps, and
   /// again, up to settings.maxRefinement times as many (the colliders start the frame over,
@@ -136,6 +137,8 @@ class ClothSolver {
   /// Mutable state for set-up (initial velocities, tests). Not during a step.
   [[nodiscard]] ClothState& mutableState() { return state_; }
   [[nodiscard]] StageTimes stageTimes() const;
+  /// Starts stageTimes again from zero (work before the frames timed, such as settling).
+  void resetStageTimes() { ticks_ = {}; }
   [[nodiscard]] const Instability& instability() const { return instability_; }
   [[nodiscard]] const std::vector<Collider*>& colliders() const { return colliders_; }
   /// The pinned vertices (no motion) and the bound ones (following a body part).

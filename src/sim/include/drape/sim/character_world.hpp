@@ -108,6 +108,16 @@ std::vector<std::uint8_t> stepInParallel(std::size_t count, long frame,
 /// was computed again with more substeps, a warning when strain limiting came on in it.
 void logFrameRecovery(const cloth::ClothSolver& solver, const std::string& garment, long frame);
 
+/// What settling the garments before frame 0 did (CharacterWorld::settle).
+struct SettleReport {
+  long frames = 0;              ///< frames stepped at the rest pose, numbered up to 0
+  double seconds = 0.0;         ///< their length: simulation time -seconds .. 0
+  double wall_s = 0.0;          ///< what they took
+  std::size_t pairsEased = 0;   ///< (vertex, part) pairs being eased out onto T2 when it began
+  std::size_t pairsTimedOut = 0;  ///< of those, held below T2 by the garment: they collide as any other
+  std::size_t pairsLeft = 0;    ///< of those, still being eased at frame 0 (the settling's cap came first)
+};
+
 class CharacterWorld {
  public:
   /// Builds the part fields, binds every garment's mask and establishes the initial
@@ -119,6 +129,16 @@ class CharacterWorld {
   CharacterWorld(const CharacterWorld&) = delete;
   CharacterWorld& operator=(const CharacterWorld&) = delete;
 
+  /// Before frame 0, steps the garments with the avatar at its rest pose (the pose they are
+  /// modelled on) until every (vertex, part) pair that started below T2 has been eased out
+  /// onto it or has timed out, for at most max_s: frame 0 then shows each garment out of the
+  /// body's offset surfaces instead of as modelled, tighter than them (the MakeHuman suit
+  /// starts inside the chest). Whole frames, numbered up to 0, from simulation time
+  /// -report.seconds; nothing when no pair is eased or max_s is 0. The colliders' counters
+  /// keep the settling's substeps; the solvers' and colliders' clocks start again after it.
+  /// Call once, before the first stepFrame. False when a garment went unstable (see
+  /// instability()).
+  bool settle(double max_s, SettleReport& report);
   /// Computes frame `frame` (1-based) of every garment, the garments in parallel. False
   /// when a garment went unstable (see instability()).
   bool stepFrame(long frame);
@@ -152,6 +172,9 @@ class CharacterWorld {
     std::unique_ptr<cloth::ClothSolver> solver;
   };
   void buildFields(const std::vector<GarmentSpec>& garments);
+  /// After stepping `frame`: logs each garment's recovery, and false (instability_ set, with
+  /// `when` before it) at the first that went unstable.
+  bool checkStable(const std::vector<std::uint8_t>& stables, long frame, const std::string& when);
   /// Corrects a copy of the motion so that settings_.keepApart's parts stay out of the fields'
   /// parts, and plays that copy.
   void keepBodyApart(const motion::AvatarAnimation& animation, const std::vector<GarmentSpec>& garments);

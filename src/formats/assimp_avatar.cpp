@@ -75,7 +75,10 @@ int lineAt(std::string_view bytes, std::size_t offset) {
 
 // Position of the next start tag `<tag ...>` or `<tag>` at or after `from` (not `<tagx`).
 std::size_t findStartTag(std::string_view bytes, std::string_view tag, std::size_t from) {
-  const std::string open = "<" + std::string(tag);
+  // Appended rather than "<" + std::string(tag): GCC 12 warns (-Wrestrict) on the inlined
+  // operator+ of a literal and a temporary.
+  std::string open(1, '<');
+  open.append(tag);
   for (std::size_t at = bytes.find(open, from); at != std::string_view::npos; at = bytes.find(open, at + 1)) {
     const std::size_t after = at + open.size();
     if (after < bytes.size() && (bytes[after] == '>' || std::isspace(static_cast<unsigned char>(bytes[after])))) return at;

@@ -170,12 +170,13 @@ std::size_t motionFrameCount(double start_s, double end_s, double rate, std::siz
   return static_cast<std::size_t>(frames);
 }
 
-void appendWithinCap(std::vector<SkinnedJointMotion>& motions, SkinnedJointMotion motion, const std::string& file) {
+void appendWithinCap(std::vector<SkinnedJointMotion>& motions, SkinnedJointMotion motion, const std::string& file,
+                     std::size_t cap) {
   std::size_t total = motion.frames.size();
   for (const SkinnedJointMotion& m : motions) total += m.frames.size();
-  if (total > kMaxMotionTransforms)
+  if (total > cap)
     throw Error(fmt::format("{}: its animations together hold more than the {} joint transforms drape samples at {:g} Hz",
-                            file, kMaxMotionTransforms, motion.rate));
+                            file, cap, motion.rate));
   motions.push_back(std::move(motion));
 }
 

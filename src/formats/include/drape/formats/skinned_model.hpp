@@ -71,8 +71,9 @@ constexpr std::size_t kMaxMotionTransforms = 10'000'000;
 [[nodiscard]] std::size_t motionFrameCount(double start_s, double end_s, double rate, std::size_t joints,
                                            const std::string& animation, const std::string& file);
 /// Appends `motion` to `motions`; throws naming the file when all of them together would
-/// hold more than kMaxMotionTransforms joint transforms.
-void appendWithinCap(std::vector<SkinnedJointMotion>& motions, SkinnedJointMotion motion, const std::string& file);
+/// hold more than `cap` joint transforms.
+void appendWithinCap(std::vector<SkinnedJointMotion>& motions, SkinnedJointMotion motion, const std::string& file,
+                     std::size_t cap = kMaxMotionTransforms);
 /// The lowest height of `positions` (the skin at rest), or of `joints` where there are none.
 [[nodiscard]] double lowestOf(const std::vector<Vec3>& positions, const std::vector<Vec3>& joints);
 /// A joint's motion from its world matrix now and the inverse of its rest world matrix:

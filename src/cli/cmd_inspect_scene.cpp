@@ -81,8 +81,9 @@ void inspectScene(const std::string& path, std::ostream& out) {
       if (a.joints[j].parent < 0) printJoint(out, a, static_cast<int>(j), 0);
   }
   for (const scene::ExternalAvatar& a : s.externalAvatars)
-    fmt::print(out, "  {} (from {}){}\n", a.name, fmt::join(a.urls, ", "),
-               a.jointMap.empty() ? "" : fmt::format(", joint map {}", fmt::join(a.jointMap, ", ")));
+    fmt::print(out, "  {} (from {}){}{}\n", a.name, fmt::join(a.urls, ", "),
+               a.jointMap.empty() ? "" : fmt::format(", joint map {}", fmt::join(a.jointMap, ", ")),
+               a.cutAtJoints.empty() ? "" : fmt::format(", parts cut across joints {}", fmt::join(a.cutAtJoints, ", ")));
   fmt::print(out, "garments: {}\n", s.garments.size());
   for (const scene::Garment& g : s.garments) printGarment(out, s, g);
   fmt::print(out, "materials: {}\n", s.materials.size());

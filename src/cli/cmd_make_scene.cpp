@@ -23,6 +23,7 @@
 #include "drape/formats/units.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/scene/avatar_gltf.hpp"
+#include "drape/scene/avatar_segment.hpp"
 #include "drape/scene/garment_fit.hpp"
 #include "scene_text.hpp"
 #include "stitch_gaps.hpp"
@@ -42,6 +43,7 @@ struct MakeSceneOptions {
   std::vector<std::string> collidesWith;
   std::vector<std::string> faceSamplesWith;
   std::vector<std::string> keepApart;  ///< --keep-apart: the scene's Simulation keepApart
+  std::vector<std::string> cutAtJoints;  ///< --cut-at-joints: the Avatar node's cutAtJoints
   double reach_m = 0.03;
   double voxel_m = 0.005;
   std::vector<double> offsets;  ///< T0..T3, m; empty: 1, 2, 3 and 6 voxels
@@ -137,7 +139,8 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
              o.frameRate, o.stepsPerFrame, o.maxAddedMass, t[0], t[1], t[2], t[3], v, o.collisionEvery, o.bendEvery,
              o.keepApart.empty() ? "" : fmt::format("  keepApart [ \"{}\" ]\n", fmt::join(o.keepApart, "\", \"")));
   writeMaterial(os, o.material);
-  fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n}}\n\n", o.avatarUrl);
+  fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n{}}}\n\n", o.avatarUrl,
+             o.cutAtJoints.empty() ? "" : fmt::format("  cutAtJoints [ \"{}\" ]\n", fmt::join(o.cutAtJoints, "\", \"")));
   fmt::print(os,
              "DEF Garment ClothSet {{\n  name \"{}\"\n  cloth Shape {{\n"
              "    appearance Appearance {{ material Material {{ diffuseColor 0.15 0.25 0.55 }} }}\n"
@@ -162,7 +165,9 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
 }
 
 int makeScene(MakeSceneOptions& o) {
-  const scene::Avatar avatar = scene::loadAvatarFile(o.avatar);
+  scene::Avatar avatar = scene::loadAvatarFile(o.avatar);
+  // The parts as the scene will cut them: which are within reach of the garment may change.
+  if (!o.cutAtJoints.empty()) scene::segmentSkinnedAvatar(avatar, o.cutAtJoints);
   formats::ObjReadOptions read;
   read.metresPerUnit = formats::metresPerUnit(o.units, "--units");
   mesh::TriMesh garment, mask = formats::readObj(o.mask, read);
@@ -264,6 +269,10 @@ RunFunction setupMakeScene(CLI::App& app) {
   app.add_option("--keep-apart", o.keepApart,
                  "Body parts whose motion is corrected to keep them out of the collidable parts they go into, "
                  "written as the scene's keepApart (e.g. LeftForeArm,RightForeArm,LeftArm,RightArm)")
+      ->delimiter(',');
+  app.add_option("--cut-at-joints", o.cutAtJoints,
+                 "Joints whose rigid parts are cut across the joint, what lies behind it going to the parent's part, "
+                 "written as the Avatar node's cutAtJoints (e.g. LeftArm,RightArm; see drape run --help)")
       ->delimiter(',');
   app.add_option("--reach", o.reach_m, "Distance from a segment's box that makes it collidable, m")->capture_default_str();
   app.add_option("--voxel", o.voxel_m, "Distance-field voxel, m; without --offsets, T0..T3 are 1, 2, 3 and 6 voxels")

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "drape/core/log.hpp"
 
@@ -21,6 +22,7 @@
 #include "drape/formats/units.hpp"
 #include "drape/motion/animation.hpp"
 #include "drape/scene/avatar_gltf.hpp"
+#include "drape/scene/avatar_segment.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/scene_setup.hpp"
 #include "run_setup.hpp"
@@ -34,7 +36,7 @@ struct RunOptions {
   double motionScale = 0.0, voxel_m = 0.0, leadIn_s = 1.0, settle_s = 1.0;
   bool preview = false, countEverySubstep = false, exactSliding = false, freePinches = false, noStitches = false;
   double stitchGaps_m = 0.0;  ///< --stitch-gaps
-  std::vector<std::string> faceSamplesWith, keepApart;
+  std::vector<std::string> faceSamplesWith, keepApart, cutAtJoints;
   std::string garment, units = "m", pinVertices, pinMask, out, substeps = "33", integrator = "symplectic-euler";
   std::string strainLimit = "auto";
   std::string wind, gravity;
@@ -215,19 +217,34 @@ void setupFromGarment(const RunOptions& o, RunSetup& setup, bool onAvatar) {
   setup.garments.push_back(std::move(garment));
 }
 
+/// The avatar file's, its parts cut across the joints named (none: as segmented on load).
+std::shared_ptr<const scene::Avatar> loadAvatarCut(const std::string& path, const std::vector<std::string>& cutAtJoints) {
+  scene::Avatar avatar = scene::loadAvatarFile(path);
+  if (!cutAtJoints.empty()) {
+    std::size_t moved = 0;
+    scene::segmentSkinnedAvatar(avatar, cutAtJoints, &moved);
+    spdlog::info("{}: the parts of {} cut across their joints, {} triangles behind them given to their parents", path,
+                 fmt::join(cutAtJoints, ", "), moved);
+  }
+  return std::make_shared<const scene::Avatar>(std::move(avatar));
+}
+
 int runCommand(const CLI::App& app, RunOptions& o) {
   if (o.scene.empty() == o.garment.empty())
     throw Error("drape run: give either a scene file (drape run SCENE.wrl) or --garment FILE.obj");
   RunSetup setup;
   std::shared_ptr<const scene::Avatar> avatar;
   if (!o.scene.empty()) {
-    setup = runSetupFromScene(o.scene);
+    setup = runSetupFromScene(o.scene, app.count("--cut-at-joints")
+                                           ? std::optional<std::vector<std::string>>(keepApartParts(o.cutAtJoints))
+                                           : std::nullopt);
     if (setup.character) avatar = setup.character->avatar;
     applyOverrides(app, o, setup);
     applyOffsets(o, setup);
     applyCollisionOptions(app, o, setup);
   } else {
-    if (!o.avatar.empty()) avatar = std::make_shared<const scene::Avatar>(scene::loadAvatarFile(o.avatar));
+    if (!o.avatar.empty()) avatar = loadAvatarCut(o.avatar, keepApartParts(o.cutAtJoints));
+    else if (app.count("--cut-at-joints")) throw Error("--cut-at-joints cuts an avatar's parts: give a scene or --avatar FILE");
     setupFromGarment(o, setup, avatar != nullptr);
     if (avatar) {
       setup.character = CharacterSetup{avatar, nullptr, 0.005};
@@ -311,6 +328,12 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--field-method", o->fieldMethod, "dvdp (the paper's) or exact")
       ->capture_default_str()
       ->check(CLI::IsMember({"dvdp", "exact"}));
+  app.add_option("--cut-at-joints", o->cutAtJoints,
+                 "Joints whose rigid body parts are cut across the joint, what lies behind it going to the parent's "
+                 "part, so that the part's end does not swing out through its neighbour as the joint turns (an upper "
+                 "arm's over the shoulder), e.g. LeftArm,RightArm; needs a skinned avatar; overrides the Avatar node's "
+                 "cutAtJoints, 'none' for none")
+      ->delimiter(',');
   app.add_option("--keep-apart", o->keepApart,
                  "Body parts whose motion is corrected, before simulating, to keep them out of the collidable parts "
                  "they go into (a forearm swung through the back): each is swung about the joint above it and "

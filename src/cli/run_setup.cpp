@@ -240,10 +240,17 @@ double leastT0(const sim::CharacterWorld& world) {
   return std::isfinite(t0) ? t0 : 0.0;
 }
 
-RunSetup runSetupFromScene(const std::string& scenePath) {
-  const scene::Scene sc = scene::loadScene(scenePath);
+RunSetup runSetupFromScene(const std::string& scenePath, const std::optional<std::vector<std::string>>& cutAtJoints) {
+  scene::Scene sc = scene::loadScene(scenePath);
   for (const std::string& w : sc.warnings) spdlog::warn("{}", w);
   if (sc.garments.empty()) throw Error(fmt::format("{}: the scene has no ClothSet to simulate", scenePath));
+  if (cutAtJoints) {
+    if (!cutAtJoints->empty() && sc.externalAvatars.empty())
+      throw Error(fmt::format("--cut-at-joints cuts a skinned avatar's parts again; {} has no Avatar node (an H-Anim "
+                              "Humanoid's parts are rigid as written)",
+                              scenePath));
+    for (scene::ExternalAvatar& a : sc.externalAvatars) a.cutAtJoints = *cutAtJoints;
+  }
   RunSetup setup;
   const std::shared_ptr<const scene::Avatar> avatar = sim::sceneAvatar(sc);
   setup.settings = sim::toStepSettings(sc.simulation);

@@ -64,7 +64,10 @@ struct RunSetup {
 
 /// Garments, materials, settings and the avatar (as the setup's character, without motion)
 /// from a VRML97 scene. Throws drape::Error on a bad scene or one with no ClothSet.
-[[nodiscard]] RunSetup runSetupFromScene(const std::string& scenePath);
+/// `cutAtJoints`, when given, replaces the Avatar node's cutAtJoints (drape run
+/// --cut-at-joints; empty: parts by dominant weight alone).
+[[nodiscard]] RunSetup runSetupFromScene(const std::string& scenePath,
+                                         const std::optional<std::vector<std::string>>& cutAtJoints = std::nullopt);
 
 /// Loads a motion file onto the setup's avatar (rate = the setup's frame rate). `metresPerUnit`
 /// > 0 overrides the units guess; `jointMap` "" picks one of the shipped maps; `animation`

@@ -5,6 +5,11 @@
 #include <numeric>
 #include <unordered_map>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "drape/core/error.hpp"
+
 namespace drape::scene {
 namespace {
 
@@ -104,12 +109,73 @@ std::size_t capOpenings(mesh::TriMesh& mesh) {
   return sums.size();
 }
 
-std::vector<int> segmentSkinnedAvatar(Avatar& avatar) {
+namespace {
+
+/// Each joint's bone direction at rest: towards the mean of its children's centres (zero
+/// for a joint without children).
+std::vector<Vec3> boneDirections(const Avatar& avatar) {
+  std::vector<Vec3> sum(avatar.joints.size(), Vec3::Zero());
+  for (const Joint& j : avatar.joints)
+    if (j.parent >= 0) sum[static_cast<std::size_t>(j.parent)] += j.restCenter - avatar.joints[static_cast<std::size_t>(j.parent)].restCenter;
+  for (Vec3& d : sum)
+    if (d.norm() > 0) d.normalize();
+  return sum;
+}
+
+/// The joints `names` names, checked: each one of the avatar's, with a parent to give the
+/// cut triangles to and children to say which way its bone runs.
+std::vector<int> jointsToCut(const Avatar& avatar, const std::vector<std::string>& names,
+                             const std::vector<Vec3>& bones) {
+  std::vector<int> joints;
+  for (const std::string& name : names) {
+    const int j = avatar.findJoint(name);
+    if (j < 0) {
+      std::vector<std::string> all;
+      for (const Joint& joint : avatar.joints) all.push_back(joint.name);
+      throw Error(fmt::format("{}: cutAtJoints names '{}', which is not a joint of avatar '{}' (it has: {})",
+                              avatar.source, name, avatar.name, fmt::join(all, ", ")));
+    }
+    if (avatar.joints[static_cast<std::size_t>(j)].parent < 0)
+      throw Error(fmt::format("{}: cutAtJoints names '{}', the root joint: there is no parent part to give what lies "
+                              "behind it to",
+                              avatar.source, name));
+    if (bones[static_cast<std::size_t>(j)].norm() == 0)
+      throw Error(fmt::format("{}: cutAtJoints names '{}', a joint without children: its bone has no direction to "
+                              "cut across",
+                              avatar.source, name));
+    joints.push_back(j);
+  }
+  return joints;
+}
+
+}  // namespace
+
+std::vector<int> segmentSkinnedAvatar(Avatar& avatar, const std::vector<std::string>& cutAtJoints,
+                                      std::size_t* cutTriangles) {
+  if (cutTriangles != nullptr) *cutTriangles = 0;
+  if (!cutAtJoints.empty() && !avatar.skin)
+    throw Error(fmt::format("{}: cutAtJoints: avatar '{}' came as rigid parts, without a skinned mesh to cut them from "
+                            "again",
+                            avatar.source, avatar.name));
   avatar.segments.clear();
   std::vector<int> segmentOfTriangle;
   if (!avatar.skin) return segmentOfTriangle;
   const SkinnedMesh& skin = *avatar.skin;
-  const std::vector<int> label = dominantJointPerTriangle(skin, avatar.joints.size());
+  std::vector<int> label = dominantJointPerTriangle(skin, avatar.joints.size());
+  if (!cutAtJoints.empty()) {
+    const std::vector<Vec3> bones = boneDirections(avatar);
+    std::vector<bool> cut(avatar.joints.size(), false);
+    for (int j : jointsToCut(avatar, cutAtJoints, bones)) cut[static_cast<std::size_t>(j)] = true;
+    for (std::size_t t = 0; t < label.size(); ++t) {
+      const auto j = static_cast<std::size_t>(label[t]);
+      if (!cut[j]) continue;
+      const mesh::Triangle& tri = skin.mesh.triangles[t];
+      const Vec3 centroid = (skin.mesh.positions[tri[0]] + skin.mesh.positions[tri[1]] + skin.mesh.positions[tri[2]]) / 3.0;
+      if ((centroid - avatar.joints[j].restCenter).dot(bones[j]) >= 0) continue;
+      label[t] = avatar.joints[j].parent;
+      if (cutTriangles != nullptr) ++*cutTriangles;
+    }
+  }
   const std::vector<std::uint32_t> weld = weldByPosition(skin.mesh);
   segmentOfTriangle.assign(label.size(), -1);
   std::vector<std::uint32_t> local(skin.mesh.positions.size(), mesh::kNoVertex);

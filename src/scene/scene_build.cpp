@@ -344,6 +344,7 @@ class Builder {
     a.name = nameOf(n);
     a.urls = strings(n, "url");
     a.jointMap = strings(n, "jointMap");
+    a.cutAtJoints = strings(n, "cutAtJoints");
     a.source = where(n);
     if (a.urls.empty())
       throw Error::at(where(n),

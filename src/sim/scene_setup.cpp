@@ -3,9 +3,12 @@
 #include <filesystem>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
 
 #include "drape/core/error.hpp"
 #include "drape/scene/avatar_gltf.hpp"
+#include "drape/scene/avatar_segment.hpp"
 
 namespace drape::sim {
 namespace {
@@ -21,6 +24,15 @@ void place(scene::Avatar& avatar, const RigidTransform& placement, double scale)
     avatar.skin->mesh.scale(scale);
     avatar.skin->mesh.transform(placement);
   }
+}
+
+/// Cuts the parts of the joints the Avatar node's cutAtJoints names across their joints
+/// (scene::segmentSkinnedAvatar), after placing: the cut runs through the placed skin.
+void cutAtJoints(scene::Avatar& avatar, const scene::ExternalAvatar& ext) {
+  std::size_t moved = 0;
+  scene::segmentSkinnedAvatar(avatar, ext.cutAtJoints, &moved);
+  spdlog::info("avatar '{}': the parts of {} cut across their joints, {} triangles behind them given to their parents",
+               ext.name.empty() ? avatar.name : ext.name, fmt::join(ext.cutAtJoints, ", "), moved);
 }
 
 }  // namespace
@@ -117,6 +129,7 @@ std::unique_ptr<scene::Avatar> sceneAvatar(const scene::Scene& scene) {
     try {
       auto avatar = std::make_unique<scene::Avatar>(scene::loadAvatarFile(path));
       place(*avatar, ext.placement, ext.scale);
+      if (!ext.cutAtJoints.empty()) cutAtJoints(*avatar, ext);
       return avatar;
     } catch (const Error& e) {
       lastError = e.what();

@@ -30,6 +30,26 @@ std::string makeDressScene(const std::string& garment, const std::string& option
          "/examples/hanging_dress/shoulders_mask.obj' " + options + " --out '" + out + "'";
 }
 
+TEST(MakeScene, WritesWhereTheAvatarsPartsAreCut) {
+  // --cut-at-joints is written as the Avatar node's cutAtJoints, and the collidable parts
+  // are found on the parts as cut; a joint the avatar lacks is an error before anything is
+  // written.
+  ScratchDir dir("make-scene-cut");
+  const std::string sceneDir = dir / "dress";
+  const CliResult made =
+      runDrape(makeDressScene("mhclo", "--name dress --cut-at-joints LeftArm,RightArm", sceneDir), dir);
+  ASSERT_EQ(made.code, 0) << made.err;
+  const scene::Scene sc = scene::loadScene(sceneDir + "/scene.wrl");
+  ASSERT_EQ(sc.externalAvatars.size(), 1u);
+  EXPECT_EQ(sc.externalAvatars[0].cutAtJoints, (std::vector<std::string>{"LeftArm", "RightArm"}));
+  const std::vector<std::string>& parts = sc.garments.at(0).collidesWith;
+  EXPECT_NE(std::find(parts.begin(), parts.end(), "LeftShoulder"), parts.end());
+  const CliResult bad = runDrape(makeDressScene("mhclo", "--name dress --cut-at-joints Tail", dir / "bad"), dir);
+  EXPECT_EQ(bad.code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("cutAtJoints names 'Tail', which is not a joint of avatar"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad/scene.wrl"));
+}
+
 TEST(MakeScene, DressOnTheWalkingBody) {
   ScratchDir dir("make-scene-dress");
   const std::string sceneDir = dir / "dress";
@@ -49,6 +69,8 @@ TEST(MakeScene, DressOnTheWalkingBody) {
   EXPECT_EQ(sc.garments[0].maskVertices.size(), 222u);
   EXPECT_EQ(sc.garments[0].faceSamplesWith, (std::vector<std::string>{"LeftUpLeg", "RightUpLeg"}));
   EXPECT_EQ(sc.simulation.keepApart, (std::vector<std::string>{"LeftForeArm", "RightForeArm"}));
+  ASSERT_EQ(sc.externalAvatars.size(), 1u);
+  EXPECT_TRUE(sc.externalAvatars[0].cutAtJoints.empty());
   EXPECT_GT(sc.simulation.stepsPerFrame, 33) << "the dress's slivers need more substeps than the skirt";
   EXPECT_GT(sc.simulation.maxAddedMass, 0.0);
 

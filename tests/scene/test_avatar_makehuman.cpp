@@ -3,8 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
 #include <tuple>
 
+#include "drape/core/error.hpp"
 #include "drape/scene/avatar_makehuman.hpp"
 #include "drape/scene/avatar_segment.hpp"
 
@@ -55,6 +57,81 @@ TEST(MakeHumanAvatar, ClosedSegmentsCoverTheBody) {
     const double y = shin.mesh.positions[v].y() + knee.y();
     EXPECT_GT(y, -0.76);
     EXPECT_LT(y, -0.35);
+  }
+}
+
+/// Highest point of `segment` with its joint turned by `turn` about the joint's centre (the
+/// rest of the avatar at rest), in world.
+double highestTurned(const Avatar& a, const Segment& segment, const Quat& turn) {
+  const RigidTransform rest = a.joints[static_cast<std::size_t>(segment.joint)].restWorld();
+  const RigidTransform posed{(turn * rest.rotation).normalized(), rest.translation};
+  double top = -1e9;
+  for (const Vec3& p : segment.mesh.positions) top = std::max(top, posed.apply(p).y());
+  return top;
+}
+
+TEST(MakeHumanAvatar, ArmsCutAtTheShouldersNoLongerRiseThroughThemAsTheyLower) {
+  const Avatar& a = makeHuman();
+  Avatar cut = a;
+  std::size_t moved = 0;
+  const std::vector<int> segmentOf = segmentSkinnedAvatar(cut, {"LeftArm", "RightArm"}, &moved);
+  Avatar uncut = a;
+  const std::vector<int> before = segmentSkinnedAvatar(uncut);
+  ASSERT_EQ(segmentOf.size(), before.size());
+
+  // Only arm triangles changed part, each to its shoulder, and every part is still closed.
+  std::size_t changed = 0;
+  for (std::size_t t = 0; t < before.size(); ++t) {
+    const std::string from = uncut.segments[static_cast<std::size_t>(before[t])].name;
+    const std::string to = cut.segments[static_cast<std::size_t>(segmentOf[t])].name;
+    if (from == to) continue;
+    ++changed;
+    EXPECT_TRUE((from == "LeftArm" && to == "LeftShoulder") || (from == "RightArm" && to == "RightShoulder"))
+        << from << " -> " << to;
+  }
+  EXPECT_EQ(changed, moved);
+  EXPECT_GT(moved, 40u) << "the deltoids' tops, over the shoulder joints";
+  EXPECT_EQ(cut.segments.size(), uncut.segments.size());
+  for (const Segment& s : cut.segments) EXPECT_EQ(countBoundaryEdges(s.mesh), 0u) << s.name;
+
+  // The rest pose holds the arms 45 degrees out; the walk lowers them to the sides. Turned
+  // down by 40 degrees about the joint, the uncut upper arm's end behind the joint swings
+  // up over the top of the shoulder: the peak the jacket used to show. Cut, it stays below.
+  for (const char* side : {"Left", "Right"}) {
+    const std::string arm = std::string(side) + "Arm", shoulder = std::string(side) + "Shoulder";
+    const double sign = side[0] == 'L' ? 1.0 : -1.0;  // the left arm lowers turning about -z
+    const Quat lower(Eigen::AngleAxisd(-sign * 40.0 * M_PI / 180.0, Vec3::UnitZ()));
+    const auto top = [&](const Avatar& avatar, const std::string& part, const Quat& q) {
+      return highestTurned(avatar, avatar.segments[static_cast<std::size_t>(avatar.findSegment(part))], q);
+    };
+    const double shoulderTop = top(uncut, shoulder, Quat::Identity());
+    const double uncutArm = top(uncut, arm, lower), cutArm = top(cut, arm, lower);
+    // Measured: the uncut arm 10.9 mm over the shoulder's top, the cut one 36 mm under it.
+    EXPECT_GT(uncutArm, shoulderTop + 0.008) << side;
+    EXPECT_LT(cutArm, top(cut, shoulder, Quat::Identity()) - 0.02) << side;
+  }
+}
+
+TEST(MakeHumanAvatar, CuttingAtJointsNamesWhatItCannotCut) {
+  Avatar a = makeHuman();
+  const auto errorOf = [&](const std::vector<std::string>& joints) {
+    try {
+      segmentSkinnedAvatar(a, joints);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_NE(errorOf({"LeftArm", "Wing"}).find("cutAtJoints names 'Wing', which is not a joint of avatar"), std::string::npos);
+  EXPECT_NE(errorOf({"Hips"}).find("names 'Hips', the root joint"), std::string::npos);
+  EXPECT_NE(errorOf({"LeftHandFinger1"}).find("'LeftHandFinger1', a joint without children"), std::string::npos);
+  Avatar rigid = makeHuman();
+  rigid.skin.reset();
+  try {
+    segmentSkinnedAvatar(rigid, {"LeftArm"});
+    ADD_FAILURE() << "an avatar of rigid parts has no skin to cut";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("came as rigid parts, without a skinned mesh"), std::string::npos) << e.what();
   }
 }
 

@@ -5,6 +5,7 @@
 // joint's frame (unit scale, axes of the rest frame).
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "drape/mesh/trimesh.hpp"
@@ -31,6 +32,17 @@ std::size_t capOpenings(mesh::TriMesh& mesh);
 /// Builds avatar.segments from avatar.skin (replacing any): one closed segment per joint
 /// that dominates at least one triangle, named after the joint, in the joint's frame.
 /// Returns, for each triangle of the skin, the index of the segment it went to.
-std::vector<int> segmentSkinnedAvatar(Avatar& avatar);
+///
+/// `cutAtJoints` names joints whose segments are cut across their joint: a triangle the
+/// joint dominates whose centroid lies behind the plane through the joint's centre, normal
+/// to its bone (towards the mean of its children), goes to the parent joint's segment
+/// instead. A rigid segment that reaches behind its joint (an upper arm's, over the top of
+/// the shoulder) swings that part the other way as the joint turns, out through the skin of
+/// its neighbour, where the skin itself, blended between the two bones, stays; so cut, the
+/// parent carries it. `cutTriangles`, when given, receives how many triangles went to a
+/// parent. Throws drape::Error naming the joint when one is not the avatar's, is the root
+/// or has no children, and when the avatar has no skinned mesh to cut.
+std::vector<int> segmentSkinnedAvatar(Avatar& avatar, const std::vector<std::string>& cutAtJoints = {},
+                                      std::size_t* cutTriangles = nullptr);
 
 }  // namespace drape::scene

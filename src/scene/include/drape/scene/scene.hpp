@@ -90,6 +90,9 @@ struct ExternalAvatar {
   std::string name;
   std::vector<std::string> urls;      ///< resolved against the scene's directory
   std::vector<std::string> jointMap;  ///< URL(s) of a joint-name map, or empty
+  /// Joints whose rigid parts are cut across the joint, what lies behind it going to the
+  /// parent's part (scene::segmentSkinnedAvatar); empty: parts by dominant weight alone.
+  std::vector<std::string> cutAtJoints;
   RigidTransform placement;           ///< m, world placement of the character's root
   double scale = 1.0;                 ///< the node's scale times unitScale
   SourcePos source;

@@ -64,12 +64,16 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
     slot.states.resize(world.garmentCount());
     slot.joints.resize(avatar->joints.size());
   };
+  StageLaps stageLaps;
   FramesAhead ahead(kFramesAhead, 0, -1, prepare, [&](long frame, FrameTaken& taken) {
     if (frame > 0 && !world.stepFrame(frame)) {
       spdlog::error("{}", world.instability());
       return false;
     }
     taken.frame = frame;
+    StageMs totals{};
+    for (std::size_t g = 0; g < world.garmentCount(); ++g) totals += stageTotalsMs(world.solver(g).stageTimes());
+    taken.stageMs = stageLaps.lap(totals);
     for (std::size_t g = 0; g < world.garmentCount(); ++g) {
       world.solver(g).state().copyPositions(taken.positions[g]);
       garmentVertexStates(world.solver(g), world.collider(g), taken.states[g]);
@@ -82,6 +86,7 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
     const FrameTaken* taken = ahead.next();
     if (!taken) return false;
     out.time = TimeCode{taken->frame, step.frameRate_hz};
+    out.stages = stagesTaken(taken->stageMs);
     out.positions.resize(meshes.size());
     out.states.resize(meshes.size());
     garments.clear();

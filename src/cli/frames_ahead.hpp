@@ -8,6 +8,7 @@
 
 #include "drape/core/math.hpp"
 #include "drape/core/run_ahead.hpp"
+#include "stage_laps.hpp"
 
 namespace drape::cli {
 
@@ -18,6 +19,7 @@ struct FrameTaken {
   std::vector<std::vector<Vec3>> positions;       ///< per garment
   std::vector<std::vector<std::uint8_t>> states;  ///< per garment, as the state caches store them
   std::vector<RigidTransform> joints;             ///< the avatar's joints in the world
+  StageMs stageMs{};                              ///< what each stage took for this frame
 };
 
 using FramesAhead = RunAhead<FrameTaken>;

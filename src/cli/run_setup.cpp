@@ -33,6 +33,7 @@
 #include "drape/sim/scene_setup.hpp"
 #include "frames_ahead.hpp"
 #include "measure.hpp"
+#include "stage_laps.hpp"
 
 namespace drape::cli {
 namespace {
@@ -586,8 +587,18 @@ int simulateRun(const RunSetup& setup) {
     }
   }
 
-  // Per-frame records for stats.json.
+  // Per-frame records for stats.json: each frame's own stage times (frame 0, the initial
+  // state, simulates nothing: the settling's times are not the run's), and the output's,
+  // which the writing thread fills by frame.
   std::vector<double> frameMs, energy;
+  std::vector<StageMs> frameStageMs;
+  std::vector<double> frameOutputMs(static_cast<std::size_t>(std::max(0L, setup.frames)) + 1, 0.0);
+  StageLaps stageLaps;
+  const auto stageTotals = [&] {
+    StageMs sum{};
+    for (const GarmentRun& r : runs) sum += stageTotalsMs(r.solver->stageTimes());
+    return sum;
+  };
   double maxStrain = 0.0, outputSeconds = 0.0;
   std::string unstable;
   bool unstableNan = false;
@@ -646,7 +657,9 @@ int simulateRun(const RunSetup& setup) {
         skinCache->writeFrame(skinPositions);
       }
     }
-    outputSeconds += std::chrono::duration<double>(Clock::now() - start).count();
+    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    outputSeconds += seconds;
+    frameOutputMs[static_cast<std::size_t>(taken.frame)] = 1e3 * seconds;
   };
 
   const sim::SettleReport settled = world ? settleWorld(setup, *world) : sim::SettleReport{};
@@ -669,6 +682,7 @@ int simulateRun(const RunSetup& setup) {
         frameMs.push_back(1e3 * std::chrono::duration<double>(Clock::now() - start).count());
         if (!unstable.empty()) return false;
       }
+      frameStageMs.push_back(stageLaps.lap(stageTotals()));
       take(frame, taken);
       done = frame;
       progress.update(frame);
@@ -723,6 +737,14 @@ int simulateRun(const RunSetup& setup) {
                            {"fixtures", total.fixtures_s * perFrame},
                            {"strain_limit", total.strainLimit_s * perFrame},
                            {"output", outputSeconds * 1e3 / static_cast<double>(energy.size())}};
+  frameOutputMs.resize(frameStageMs.size());
+  nlohmann::json byFrame;
+  for (std::size_t i = 0; i < kStageNames.size(); ++i) {
+    nlohmann::json& column = byFrame[kStageNames[i]] = nlohmann::json::array();
+    for (const StageMs& frame : frameStageMs) column.push_back(frame[i]);
+  }
+  byFrame["output"] = frameOutputMs;
+  stats["frame_ms_per_stage"] = std::move(byFrame);
   stats["energy"] = energy;
   stats["max_strain"] = maxStrain;
   stats["nan_detected"] = unstableNan;

@@ -92,7 +92,9 @@ void ImGuiLayer::drawHud(const HudInfo& hud, int width, int height) {
   std::string lines =
       hud.frames ? fmt::format("frame {} / {}", hud.frame, *hud.frames) : fmt::format("frame {}", hud.frame);
   if (hud.fps > 0.0) lines += fmt::format("\n{:.1f} fps", hud.fps);
-  for (const StageTime& s : hud.stages) lines += fmt::format("\n{:<10} {:7.3f} ms", s.stage, s.ms);
+  std::size_t column = 10;  // "mean collide" and the like (a run's means) widen it
+  for (const StageTime& s : hud.stages) column = std::max(column, s.stage.size());
+  for (const StageTime& s : hud.stages) lines += fmt::format("\n{:<{}} {:7.3f} ms", s.stage, column, s.ms);
   boxedText(list, small_, small, ImVec2(margin, margin + big * 1.5f), IM_COL32(225, 228, 235, 255), lines,
             small * 0.3f);
   (void)width;

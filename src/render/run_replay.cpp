@@ -23,21 +23,40 @@ namespace {
 static_assert((vertex_state::kCollisionMask | vertex_state::kPinned | vertex_state::kBound) ==
               formats::kKnownStateBits);
 
-/// DIR/stats.json's "ms_per_stage" object ({"forces": 1.2, ...}), when the run wrote one,
-/// without the stages that never ran (strain limiting, in a run that needed none). Anything
-/// else in the file is not the player's business; a malformed file is reported.
-std::vector<StageTime> readStageTimes(const std::filesystem::path& directory) {
+/// What each frame's overlay shows of the simulation's stages, from DIR/stats.json when the
+/// run wrote one: `frame_ms_per_stage` (each stage's milliseconds per frame) or, in a run
+/// made before drape wrote those, `ms_per_stage`'s means over the run, named as means.
+/// Stages that took no time that frame are left out (strain limiting, in a run that needed
+/// none; frame 0, the initial state). Anything else in the file is not the player's
+/// business; a malformed file, or columns that do not hold a value per frame, is reported.
+std::vector<std::vector<StageTime>> readStageTimes(const std::filesystem::path& directory, std::int64_t frames) {
   const std::filesystem::path path = directory / "stats.json";
   std::ifstream in(path, std::ios::binary);
   if (!in) return {};
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const nlohmann::json j = formats::parseJsonText(text, path.string());
-  std::vector<StageTime> stages;
-  if (!j.is_object() || !j.contains("ms_per_stage") || !j["ms_per_stage"].is_object()) return stages;
-  for (const auto& [stage, value] : j["ms_per_stage"].items()) {
-    if (value.is_number() && value.get<double>() != 0.0) stages.push_back({stage, value.get<double>()});
+  if (!j.is_object()) return {};
+  if (j.contains("frame_ms_per_stage") && j["frame_ms_per_stage"].is_object()) {
+    std::vector<std::vector<StageTime>> stages(static_cast<std::size_t>(frames));
+    for (const auto& [stage, column] : j["frame_ms_per_stage"].items()) {
+      if (!column.is_array() || static_cast<std::int64_t>(column.size()) != frames)
+        throw Error(fmt::format("{}: frame_ms_per_stage.{} should be an array of a number per frame ({}), got {}",
+                                path.string(), stage, frames,
+                                column.is_array() ? fmt::format("{} values", column.size()) : column.type_name()));
+      for (std::size_t f = 0; f < stages.size(); ++f) {
+        if (!column[f].is_number())
+          throw Error(fmt::format("{}: frame_ms_per_stage.{}[{}] should be a number, got {}", path.string(), stage, f,
+                                  column[f].type_name()));
+        if (const double ms = column[f].get<double>(); ms != 0.0) stages[f].push_back({stage, ms});
+      }
+    }
+    return stages;
   }
-  return stages;
+  std::vector<StageTime> means;
+  if (!j.contains("ms_per_stage") || !j["ms_per_stage"].is_object()) return {};
+  for (const auto& [stage, value] : j["ms_per_stage"].items())
+    if (value.is_number() && value.get<double>() != 0.0) means.push_back({"mean " + stage, value.get<double>()});
+  return {std::move(means)};
 }
 
 }  // namespace
@@ -97,7 +116,7 @@ RunReplay::RunReplay(const std::string& directory) : directory_(directory) {
     states_.push_back(std::move(states));
   }
   if (meshes_.empty()) throw Error(fmt::format("{}: the run lists no meshes", (dir / "manifest.json").string()));
-  stages_ = readStageTimes(dir);
+  stages_ = readStageTimes(dir, frames_);
 }
 
 Aabb RunReplay::frameBounds(std::int64_t f) const {
@@ -116,7 +135,9 @@ bool RunReplay::read(std::int64_t index, Frame& out) {
   out.states.assign(meshes_.size(), {});
   for (std::size_t m = 0; m < meshes_.size(); ++m)
     if (!states_[m].empty()) out.states[m] = states_[m][static_cast<std::size_t>(index)];
-  out.stages = stages_;
+  if (stages_.size() == 1) out.stages = stages_[0];  // the run's means
+  else if (!stages_.empty()) out.stages = stages_[static_cast<std::size_t>(index)];
+  else out.stages.clear();
   return true;
 }
 

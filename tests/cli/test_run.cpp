@@ -89,6 +89,28 @@ TEST(Run, BundledExampleWritesEverything) {
   EXPECT_GT(stats["substeps_per_frame"].get<int>(), 33);  // auto: the stable count for this mesh
   EXPECT_GT(stats["ms_per_frame"].get<double>(), 0.0);
   EXPECT_EQ(stats["energy"].size(), 4u);
+  // Each frame's own stage times add up to the run's means: frame 0, the initial state,
+  // simulated nothing but was written. (To 1e-4: the stage clock's counter rate is measured
+  // from the program's start to each reading, so an early frame's ticks become seconds at a
+  // slightly different rate than the run's total's.)
+  for (const char* stage : {"forces", "integrate", "collide", "fixtures", "strain_limit", "output"}) {
+    const nlohmann::json& column = stats["frame_ms_per_stage"][stage];
+    ASSERT_EQ(column.size(), 4u) << stage;
+    double sum = 0.0;
+    for (const nlohmann::json& ms : column) {
+      EXPECT_GE(ms.get<double>(), 0.0) << stage;
+      sum += ms.get<double>();
+    }
+    const double mean = stats["ms_per_stage"][stage].get<double>();
+    if (std::string(stage) == "output") {
+      EXPECT_GT(column[0].get<double>(), 0.0);
+      EXPECT_NEAR(sum / 4.0, mean, 1e-4 * mean) << stage;  // the output's mean counts every frame written
+    } else {
+      EXPECT_EQ(column[0].get<double>(), 0.0) << stage;
+      EXPECT_NEAR(sum / 3.0, mean, 1e-4 * mean) << stage;
+    }
+  }
+  EXPECT_GT(stats["frame_ms_per_stage"]["forces"][1].get<double>(), 0.0);
   EXPECT_LT(stats["energy"].back().get<double>(), stats["energy"].front().get<double>());  // falling, drag
   EXPECT_GE(stats["max_strain"].get<double>(), 0.0);
   EXPECT_LT(stats["max_strain"].get<double>(), 0.5);

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <fmt/format.h>
+
 #include "../formats/test_run_fixture.hpp"
 #include "drape/core/error.hpp"
 #include "drape/render/headless.hpp"
@@ -30,14 +32,53 @@ TEST(RunReplay, ReadsFramesTimeCodesAndStageTimes) {
   EXPECT_EQ(f.time.smpte(), "00:00:01:05");  // 29 frames at 24 fps
   const std::vector<Vec3> expected = testrun::flagPositions(29);
   for (std::size_t v = 0; v < expected.size(); ++v) ASSERT_LT((f.positions[1][v] - expected[v]).norm(), 1e-6);
+  // A run made before drape wrote each frame's stage times shows the run's means, named so.
   ASSERT_EQ(f.stages.size(), 2u);
-  EXPECT_EQ(f.stages[0].stage, "collide");  // JSON objects come back in key order
+  EXPECT_EQ(f.stages[0].stage, "mean collide");  // JSON objects come back in key order
   EXPECT_DOUBLE_EQ(f.stages[1].ms, 1.5);
   EXPECT_FALSE(replay.read(30, f));
   EXPECT_FALSE(replay.read(-1, f));
   // The run's bounds hold every frame: the flag's wave reaches 12 cm in z.
   EXPECT_GT(replay.bounds().max.z(), 0.1);
   EXPECT_NEAR(replay.bounds().min.y(), 0.35, 1e-6);
+}
+
+// Each frame shows its own stage times: frame 0 (the initial state) none, a frame computed
+// again its greater cost, a stage that took no time that frame nothing.
+TEST(RunReplay, EachFrameShowsItsOwnStageTimes) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("replay_frame_stages"), 4);
+  std::ofstream(dir + "/stats.json") << R"({"ms_per_stage": {"forces": 2.0},
+    "frame_ms_per_stage": {"forces": [0, 1.0, 4.5, 0.5], "strain_limit": [0, 0, 0.25, 0], "output": [0.1, 0.2, 0.3, 0.4]}})";
+  RunReplay replay(dir);
+  Frame f;
+  const auto shown = [&](std::int64_t index) {
+    EXPECT_TRUE(replay.read(index, f));
+    std::string text;
+    for (const StageTime& s : f.stages) text += fmt::format("{}={} ", s.stage, s.ms);
+    return text;
+  };
+  EXPECT_EQ(shown(0), "output=0.1 ");
+  EXPECT_EQ(shown(1), "forces=1 output=0.2 ");
+  EXPECT_EQ(shown(2), "forces=4.5 output=0.3 strain_limit=0.25 ");
+  EXPECT_EQ(shown(3), "forces=0.5 output=0.4 ");
+  // Columns that do not hold a number per frame are refused, naming the file and the column.
+  const std::pair<const char*, const char*> cases[] = {
+      {R"({"frame_ms_per_stage": {"forces": [0, 1, 2]}})",
+       "stats.json: frame_ms_per_stage.forces should be an array of a number per frame (4), got 3 values"},
+      {R"({"frame_ms_per_stage": {"collide": 1.5}})",
+       "stats.json: frame_ms_per_stage.collide should be an array of a number per frame (4), got number"},
+      {R"({"frame_ms_per_stage": {"collide": [0, 1, "2", 3]}})",
+       "stats.json: frame_ms_per_stage.collide[2] should be a number, got string"},
+  };
+  for (const auto& [text, expected] : cases) {
+    std::ofstream(dir + "/stats.json", std::ios::trunc) << text;
+    try {
+      RunReplay bad(dir);
+      ADD_FAILURE() << "accepted " << text;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(RunReplay, ReadsTheGarmentsVertexStates) {

@@ -1,6 +1,6 @@
 #pragma once
 // Replays a finished run directory (DIR/manifest.json, its OBJ topologies and PC2 caches,
-// the garments' state caches and DIR/stats.json's `ms_per_stage` when present) as a
+// the garments' state caches and DIR/stats.json's stage times when present) as a
 // FrameSource.
 
 #include <span>
@@ -49,7 +49,8 @@ class RunReplay final : public FrameSource {
   std::vector<MeshInfo> meshes_;
   std::vector<std::vector<std::vector<Vec3>>> caches_;  ///< [mesh][frame][vertex], m
   std::vector<std::vector<std::vector<std::uint8_t>>> states_;  ///< [mesh][frame][vertex], or [mesh] empty
-  std::vector<StageTime> stages_;                       ///< from stats.json, per run
+  /// From stats.json: [frame][stage], or one list of the run's means, or none.
+  std::vector<std::vector<StageTime>> stages_;
   double frameRate_ = 30.0;
   std::int64_t frames_ = 0;
   std::int64_t startFrame_ = 0;

@@ -145,6 +145,33 @@ std::string timeCode(const render::RunReplay& run, std::int64_t f) {
   return TimeCode{run.startFrame() + f, run.frameRate()}.smpte();
 }
 
+/// The frame whose simulation stages took longest (stats.json's frame_ms_per_stage, which
+/// RunReplay has checked: a number per frame), and what each stage took in it: where a run's
+/// time went when some frames cost more than the rest (a frame computed again, a pinch).
+void printSlowestFrame(const render::RunReplay& run, const nlohmann::json& stats, std::ostream& out) {
+  if (!stats.contains("frame_ms_per_stage") || !stats["frame_ms_per_stage"].is_object()) return;
+  const nlohmann::json& byFrame = stats["frame_ms_per_stage"];
+  const auto simulated = [&](std::size_t f) {
+    double ms = 0.0;
+    for (const auto& [stage, column] : byFrame.items())
+      if (stage != "output") ms += column[f].get<double>();
+    return ms;
+  };
+  const auto frames = static_cast<std::size_t>(*run.frameCount());
+  std::size_t slowest = 0;
+  for (std::size_t f = 1; f < frames; ++f)
+    if (simulated(f) > simulated(slowest)) slowest = f;
+  if (!(simulated(slowest) > 0.0)) return;
+  std::vector<std::pair<std::string, double>> stages;
+  for (const auto& [stage, column] : byFrame.items())
+    if (stage != "output" && column[slowest].get<double>() > 0.0) stages.emplace_back(stage, column[slowest].get<double>());
+  std::sort(stages.begin(), stages.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
+  std::vector<std::string> parts;
+  for (const auto& [stage, ms] : stages) parts.push_back(fmt::format("{} {:.3f}", stage, ms));
+  fmt::print(out, "  slowest frame {} ({}): {:.3f} ms in the simulation's stages ({})\n", slowest,
+             timeCode(run, static_cast<std::int64_t>(slowest)), simulated(slowest), fmt::join(parts, ", "));
+}
+
 void printSummary(const std::string& directory, const render::RunReplay& run, const nlohmann::json& stats,
                   const std::vector<std::size_t>& collidable, std::ostream& out) {
   const std::int64_t frames = *run.frameCount();
@@ -175,6 +202,7 @@ void printSummary(const std::string& directory, const render::RunReplay& run, co
              number("frames"), number("ms_per_frame"), number("vertex_substeps_inside_body"), number("vertex_substeps"),
              number("max_penetration_m") * 1000.0, number("vertex_substeps_below_T1"),
              unstable ? "went unstable (see its \"instability\")" : "stable");
+  printSlowestFrame(run, stats, out);
 }
 
 /// The garments a query looks at: the one --garment names, or all of them.

@@ -16,6 +16,8 @@
 #include <utility>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "cli_runner.hpp"
 #include "drape/formats/obj.hpp"
 #include "drape/formats/pc2.hpp"
@@ -119,6 +121,23 @@ TEST_F(InspectRun, SummarisesTheRun) {
   EXPECT_NE(r.out.find("6 collidable: Hips, LowerBack, LeftUpLeg, RightUpLeg, LeftLeg, RightLeg"), std::string::npos)
       << r.out;
   EXPECT_NE(r.out.find("stats.json: 60 frames simulated"), std::string::npos) << r.out;
+  // The slowest frame is one of those simulated, its stages add up to what it says, and no
+  // frame's stages took longer.
+  const std::size_t at = r.out.find("  slowest frame ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const nlohmann::json stats = testing::statsOf(run_);
+  const auto simulated = [&](int f) {
+    double ms = 0.0;
+    for (const char* stage : {"forces", "integrate", "collide", "fixtures", "strain_limit"})
+      ms += stats["frame_ms_per_stage"][stage][f].get<double>();
+    return ms;
+  };
+  const int frame = std::stoi(r.out.substr(at + 16));
+  ASSERT_GE(frame, 1);
+  ASSERT_LE(frame, 60);
+  EXPECT_NE(r.out.find(fmt::format("{:.3f} ms in the simulation's stages (", simulated(frame)), at), std::string::npos)
+      << r.out;
+  for (int f = 0; f <= 60; ++f) EXPECT_LE(simulated(f), simulated(frame)) << "frame " << f;
   EXPECT_NE(r.out.find("look closer: --deepest N"), std::string::npos) << r.out;
 }
 

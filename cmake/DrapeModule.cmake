@@ -12,15 +12,18 @@ function(drape_add_module name)
   add_library(drape::${name} ALIAS drape_${name})
 endfunction()
 
-# drape_add_test(MODULE [TIMEOUT S] [DEPS target...] [ENVIRONMENT VAR=VALUE])
+# drape_add_test(MODULE [TIMEOUT S] [COST C] [DEPS target...] [ENVIRONMENT VAR=VALUE])
 #
 # Builds tests/MODULE/*.cpp into test_MODULE, linked with the module's library (where there
 # is one: tests/cli has none, it runs the executable) and DEPS, and registers each
 # GoogleTest case with CTest. Tests find the project's data through DRAPE_DATA_DIR, the
 # source tree through DRAPE_SOURCE_DIR and the built CLI through DRAPE_EXE, which is built
-# before them.
+# before them. COST: CTest starts the tests of higher cost first when it runs several at once
+# and has no times of its own yet (a clean build directory, as in CI), so modules that hold
+# minutes-long scenarios say so and the short tests fill in at the end instead of one long
+# test running alone.
 function(drape_add_test module)
-  cmake_parse_arguments(ARG "" "TIMEOUT;ENVIRONMENT" "DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "TIMEOUT;COST;ENVIRONMENT" "DEPS" ${ARGN})
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.cpp")
   add_executable(test_${module} ${sources})
   set(libraries ${ARG_DEPS})
@@ -38,10 +41,12 @@ function(drape_add_test module)
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
   endif()
-  if(ARG_ENVIRONMENT)
-    gtest_discover_tests(test_${module} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT ${ARG_TIMEOUT}
-                         ENVIRONMENT "${ARG_ENVIRONMENT}")
-  else()
-    gtest_discover_tests(test_${module} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT ${ARG_TIMEOUT})
+  set(properties TIMEOUT ${ARG_TIMEOUT})
+  if(ARG_COST)
+    list(APPEND properties COST ${ARG_COST})
   endif()
+  if(ARG_ENVIRONMENT)
+    list(APPEND properties ENVIRONMENT "${ARG_ENVIRONMENT}")
+  endif()
+  gtest_discover_tests(test_${module} DISCOVERY_TIMEOUT 60 PROPERTIES ${properties})
 endfunction()

@@ -1,9 +1,10 @@
 // `drape convert AVATAR --to avatar.wrl|.dae|.fbx`: writes any avatar drape loads (.glb,
-// .gltf, .dae, .fbx, MakeHuman .mhskel) as a segmented H-Anim 1.1 VRML97 humanoid, or its
-// skinned mesh and skeleton, with the animations the file carries, as Collada or (ASCII)
-// FBX through Assimp.
+// .gltf, .dae, .fbx, MakeHuman .mhskel) as a segmented H-Anim 1.1 VRML97 humanoid with one
+// motion, or its skinned mesh and skeleton with the animations the file carries, as Collada
+// or (ASCII) FBX through Assimp; or with a motion file's walk retargeted onto it instead.
 
 #include <filesystem>
+#include <span>
 
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
@@ -39,24 +40,87 @@ formats::HanimHumanoidData toHanim(const scene::Avatar& a) {
   return h;
 }
 
+// The motion as H-Anim Joint fields: a joint's segment points are in humanoid coordinates
+// at rest, so in frame f joint j must move them by D_j = W_j(f) W_j,rest^-1 (W its world
+// transform); under its parent's D_p, the Joint's own transform is L_j = D_p^-1 D_j, which
+// a Joint writes as a rotation R about its centre c and a translation t:
+// L_j(x) = R x + (t + c - R c).
+formats::HanimMotion hanimMotion(const scene::Avatar& a, const motion::AvatarAnimation& animation,
+                                 const std::string& name) {
+  formats::HanimMotion m;
+  m.name = name;
+  m.frameRate = animation.rate();
+  std::vector<RigidTransform> restInverse;
+  for (const scene::Joint& j : a.joints) restInverse.push_back(j.restWorld().inverse());
+  std::vector<RigidTransform> moved(a.joints.size());
+  for (std::size_t f = 0; f < animation.frameCount(); ++f) {
+    const std::span<const RigidTransform> world = animation.frame(f);
+    std::vector<RigidTransform>& fields = m.frames.emplace_back(a.joints.size());
+    for (std::size_t j = 0; j < a.joints.size(); ++j) {
+      moved[j] = world[j] * restInverse[j];
+      const int p = a.joints[j].parent;
+      const RigidTransform local =
+          p >= 0 && static_cast<std::size_t>(p) < j ? moved[static_cast<std::size_t>(p)].inverse() * moved[j] : moved[j];
+      const Vec3& c = a.joints[j].restCenter;
+      fields[j] = {local.rotation, local.translation - c + local.rotation * c};
+    }
+  }
+  return m;
+}
+
 // The command line (CLI11 binds options to variables that outlive setupConvert).
-std::string input, output, motionPath, jointMap;
+std::string input, output, motionPath, jointMap, animationName;
 double rate = 30.0, motionScale = 0.0;
 
 // --motion: the motion as `drape run --motion` plays it on this avatar (retargeted,
-// grounded), the lead-in left out, as one animation named after the motion file.
-formats::SkinnedJointMotion retargeted(const scene::Avatar& avatar) {
+// grounded), the lead-in left out.
+motion::AvatarAnimation retargeted(const scene::Avatar& avatar) {
   motion::MotionOptions options;
   options.clip.rate = rate;
   if (motionScale > 0) options.clip.metresPerUnit = motionScale;
   options.jointMapPath = jointMap;
   options.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
+  options.animation = animationName;
   motion::ClipLoadReport report;
   motion::JointMap map;
-  const motion::AvatarAnimation animation = motion::loadAnimation(avatar, motionPath, options, &report, &map);
+  motion::AvatarAnimation animation = motion::loadAnimation(avatar, motionPath, options, &report, &map);
   spdlog::info("{}: {} frames at {:g} Hz in {}; joint map '{}'", motionPath, report.sourceFrames, report.sourceRate,
                report.units.name, map.name);
-  return animation.toJointMotion(avatar, std::filesystem::path(motionPath).stem().string());
+  return animation;
+}
+
+// The animations the avatar file carries, sampled at --rate: the one --animation names, or
+// every one (none for a file that carries none, or cannot: MakeHuman).
+std::vector<formats::SkinnedJointMotion> ownAnimations() {
+  if (!formats::isAvatarMotionPath(input)) {
+    if (!animationName.empty())
+      throw Error(fmt::format("--animation {}: {} carries no animations (.glb, .gltf, .dae and .fbx files can)",
+                              animationName, input));
+    return {};
+  }
+  if (!animationName.empty()) return {formats::readAvatarMotion(input, rate, animationName)};
+  return formats::readAvatarMotions(input, rate);
+}
+
+// --to .wrl: the humanoid with one motion (the --motion file's, or the avatar file's own
+// animation), as its Joints' interpolators.
+void writeHanimWithMotion(const scene::Avatar& avatar) {
+  formats::HanimHumanoidData h = toHanim(avatar);
+  if (!motionPath.empty()) {
+    h.motion = hanimMotion(avatar, retargeted(avatar), std::filesystem::path(motionPath).stem().string());
+  } else if (const std::vector<formats::SkinnedJointMotion> own = ownAnimations(); !own.empty()) {
+    h.motion = hanimMotion(avatar, motion::AvatarAnimation::fromJointMotion(avatar, own.front(), input),
+                           own.front().animation);
+    if (own.front().animationNames.size() > 1)
+      spdlog::info("{}: a VRML97 humanoid carries one motion: '{}' of the file's {} ({}; --animation chooses)", output,
+                   own.front().animation, own.front().animationNames.size(),
+                   fmt::join(own.front().animationNames, ", "));
+  }
+  writeHanim(output, h);
+  spdlog::info("{}: {} joints, {} segments written to {}", input, avatar.joints.size(), avatar.segments.size(), output);
+  if (h.motion)
+    spdlog::info("{}: motion '{}', {} frames at {:g} Hz, written with it (interpolators routed into the joints)",
+                 output, h.motion->name, h.motion->frames.size(), h.motion->frameRate);
 }
 
 RunFunction setupConvert(CLI::App& app) {
@@ -64,18 +128,22 @@ RunFunction setupConvert(CLI::App& app) {
                  "The avatar to convert: .glb, .gltf, .dae, .fbx or MakeHuman .mhskel (mesh and weights beside it)")
       ->required();
   app.add_option("--to", output,
-                 "Output file: a segmented H-Anim 1.1 VRML97 humanoid (.wrl), or the skinned mesh and skeleton as "
-                 "Collada (.dae, metres) or ASCII FBX (.fbx, centimetres)")
+                 "Output file: a segmented H-Anim 1.1 VRML97 humanoid (.wrl) with one motion as its joints' "
+                 "interpolators, or the skinned mesh and skeleton as Collada (.dae, metres) or ASCII FBX (.fbx, "
+                 "centimetres) with every animation")
       ->required();
   app.add_option("--rate", rate,
-                 "With --to .dae or .fbx: frames per second at which the avatar file's animations are sampled into "
-                 "keys (every animation it carries is written)")
+                 "Frames per second at which the motion is sampled into keys (with --to .dae or .fbx every animation "
+                 "the avatar file carries is written; a .wrl humanoid carries one, the first unless --animation)")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 1000.0));
   CLI::Option* motionOption =
       app.add_option("--motion", motionPath,
-                     "With --to .dae or .fbx: motion the avatar is written with instead of its file's own animations "
-                     "(.bvh, .amc, retargeted as drape run does; or an avatar file's animation), sampled at --rate");
+                     "Motion the avatar is written with instead of its file's own animations (.bvh, .amc, retargeted "
+                     "as drape run does; or an avatar file's animation), sampled at --rate");
+  app.add_option("--animation", animationName,
+                 "Which animation, by name or by index from 0 (drape inspect FILE lists them): of the --motion file "
+                 "when it is an avatar file, else of the avatar file (only that one is written)");
   app.add_option("--joint-map", jointMap, "With --motion: the joint map (JSON) from the motion's joints to the avatar's")
       ->needs(motionOption);
   app.add_option("--motion-scale", motionScale, "With --motion: metres per motion-file unit (default: guessed)")
@@ -87,15 +155,12 @@ RunFunction setupConvert(CLI::App& app) {
     if (ext != ".wrl" && !skinned)
       throw Error(fmt::format("--to {}: drape converts avatars to H-Anim VRML97 (.wrl), Collada (.dae) or FBX (.fbx)", output));
     const scene::Avatar avatar = scene::loadAvatarFile(input);
-    if (!motionPath.empty() && !skinned)
-      throw Error(fmt::format("--motion: {} is an H-Anim VRML97 humanoid, which drape writes without motion; write "
-                              ".dae or .fbx to carry it",
-                              output));
     if (skinned) {
       const std::vector<formats::SkinnedJointMotion> animations =
-          !motionPath.empty()                  ? std::vector<formats::SkinnedJointMotion>{retargeted(avatar)}
-          : formats::isAvatarMotionPath(input) ? formats::readAvatarMotions(input, rate)
-                                               : std::vector<formats::SkinnedJointMotion>{};
+          !motionPath.empty()
+              ? std::vector<formats::SkinnedJointMotion>{retargeted(avatar).toJointMotion(
+                    avatar, std::filesystem::path(motionPath).stem().string())}
+              : ownAnimations();
       formats::writeAssimpSkinnedModel(output, scene::skinnedModelOf(avatar), animations);
       spdlog::info("{}: {} joints, {} skinned vertices written to {}", input, avatar.joints.size(),
                    avatar.skin->mesh.vertexCount(), output);
@@ -106,8 +171,7 @@ RunFunction setupConvert(CLI::App& app) {
                      animations.size() > 1 ? "s" : "", rate, fmt::join(names, "; "));
       return 0;
     }
-    writeHanim(output, toHanim(avatar));
-    spdlog::info("{}: {} joints, {} segments written to {}", input, avatar.joints.size(), avatar.segments.size(), output);
+    writeHanimWithMotion(avatar);
     return 0;
   };
 }

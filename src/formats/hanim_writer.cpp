@@ -1,6 +1,8 @@
 #include "drape/formats/hanim_writer.hpp"
 
+#include <cmath>
 #include <fstream>
+#include <functional>
 #include <set>
 
 #include <fmt/format.h>
@@ -109,6 +111,55 @@ void writeSegment(std::string& out, const HanimSegmentData& s, const std::string
   out += fmt::format("{}        ]\n{}      }}\n{}    }}\n{}  ]\n{}}}\n", indent, indent, indent, indent, indent);
 }
 
+// The motion's nodes and ROUTEs after the Humanoid: a joint whose translation stays within a
+// micrometre of zero in every frame gets no PositionInterpolator (its field keeps 0 0 0).
+// `unique` makes a DEF name no other node has.
+std::string motionText(const HanimMotion& m, const std::vector<std::string>& jointDefs,
+                       const std::function<std::string(const std::string&)>& unique) {
+  const std::size_t frames = m.frames.size();
+  if (frames == 0) throw Error(fmt::format("H-Anim motion '{}': no frames", m.name));
+  if (!(m.frameRate > 0.0) || !std::isfinite(m.frameRate))
+    throw Error(fmt::format("H-Anim motion '{}': frame rate {:g} must be positive", m.name, m.frameRate));
+  for (std::size_t f = 0; f < frames; ++f)
+    if (m.frames[f].size() != jointDefs.size())
+      throw Error(fmt::format("H-Anim motion '{}': frame {} has {} joints, the humanoid {}", m.name, f,
+                              m.frames[f].size(), jointDefs.size()));
+  const double cycle = frames > 1 ? static_cast<double>(frames - 1) / m.frameRate : 1.0 / m.frameRate;
+  std::string keys = "    key [";
+  for (std::size_t f = 0; f < frames; ++f)
+    keys += fmt::format(" {:.9g}", frames > 1 ? static_cast<double>(f) / static_cast<double>(frames - 1) : 0.0);
+  keys += " ]\n";
+  const std::string clock = unique("hanim_clock");
+  std::string out = fmt::format("\n# motion {}: {} frames at {:g} frames/s\nDEF {} TimeSensor {{ cycleInterval {:.9g} loop TRUE }}\n",
+                                quote(m.name), frames, m.frameRate, clock, cycle);
+  std::string routes;
+  for (std::size_t j = 0; j < jointDefs.size(); ++j) {
+    const std::string& def = jointDefs[j];
+    const std::string rotation = unique(def + "_rotation");
+    out += fmt::format("DEF {} OrientationInterpolator {{\n{}    keyValue [\n", rotation, keys);
+    for (std::size_t f = 0; f < frames; ++f) {
+      const Eigen::AngleAxisd r(m.frames[f][j].rotation.normalized());
+      out += fmt::format("      {:.7g} {:.7g} {:.7g} {:.7g}\n", r.axis().x(), r.axis().y(), r.axis().z(), r.angle());
+    }
+    out += "    ]\n}\n";
+    routes += fmt::format("ROUTE {}.fraction_changed TO {}.set_fraction\n", clock, rotation);
+    routes += fmt::format("ROUTE {}.value_changed TO {}.set_rotation\n", rotation, def);
+    bool moves = false;
+    for (std::size_t f = 0; f < frames && !moves; ++f) moves = m.frames[f][j].translation.norm() > 1e-6;
+    if (!moves) continue;
+    const std::string translation = unique(def + "_translation");
+    out += fmt::format("DEF {} PositionInterpolator {{\n{}    keyValue [\n", translation, keys);
+    for (std::size_t f = 0; f < frames; ++f) {
+      const Vec3& t = m.frames[f][j].translation;
+      out += fmt::format("      {:.7g} {:.7g} {:.7g}\n", t.x(), t.y(), t.z());
+    }
+    out += "    ]\n}\n";
+    routes += fmt::format("ROUTE {}.fraction_changed TO {}.set_fraction\n", clock, translation);
+    routes += fmt::format("ROUTE {}.value_changed TO {}.set_translation\n", translation, def);
+  }
+  return out + "\n" + routes;
+}
+
 }  // namespace
 
 std::string vrmlIdentifier(const std::string& name) {
@@ -136,14 +187,16 @@ std::string hanimText(const HanimHumanoidData& h) {
     if (p >= 0 && static_cast<std::size_t>(p) < j) children[static_cast<std::size_t>(p)].push_back(j);
     else roots.push_back(j);
   }
-  // DEF names must be unique: joints are hanim_<name>, segments hanim_<name>_segment,
-  // with a number appended where sanitised names collide.
+  // DEF names must be unique: the humanoid and its joints are hanim_<name>, segments
+  // hanim_<name>_segment, a motion's nodes hanim_clock and hanim_<joint>_rotation and
+  // _translation, with a number appended where sanitised names collide.
   std::set<std::string> taken;
   auto unique = [&](std::string id) {
     std::string candidate = id;
     for (int k = 2; !taken.insert(candidate).second; ++k) candidate = fmt::format("{}_{}", id, k);
     return candidate;
   };
+  const std::string humanoidDef = unique("hanim_" + vrmlIdentifier(h.name));
   std::vector<std::string> jointDefs(n);
   std::vector<std::vector<std::string>> segmentDefs(n);
   for (std::size_t j = 0; j < n; ++j) jointDefs[j] = unique("hanim_" + vrmlIdentifier(h.joints[j].name));
@@ -171,7 +224,7 @@ std::string hanimText(const HanimHumanoidData& h) {
     }
     const HanimJointData& j = h.joints[item.joint];
     jointUses.push_back(jointDef(item.joint));
-    body += fmt::format("{}DEF {} Joint {{\n{}  name {}\n{}  center {:.6g} {:.6g} {:.6g}\n{}  children [\n", indent,
+    body += fmt::format("{}DEF {} Joint {{\n{}  name {}\n{}  center {:.7g} {:.7g} {:.7g}\n{}  children [\n", indent,
                         jointDef(item.joint), indent, quote(j.name), indent, j.center.x(), j.center.y(), j.center.z(), indent);
     for (std::size_t s = 0; s < j.segments.size(); ++s) {
       segmentUses.push_back(segmentDef(item.joint, s));
@@ -180,13 +233,14 @@ std::string hanimText(const HanimHumanoidData& h) {
     stack.push_back({item.joint, true, item.depth});
     for (auto c = children[item.joint].rbegin(); c != children[item.joint].rend(); ++c) stack.push_back({*c, false, item.depth + 2});
   }
-  out += fmt::format("\nDEF hanim_{} Humanoid {{\n  name {}\n  version \"1.1\"\n  info [", vrmlIdentifier(h.name), quote(h.name));
+  out += fmt::format("\nDEF {} Humanoid {{\n  name {}\n  version \"1.1\"\n  info [", humanoidDef, quote(h.name));
   for (std::size_t i = 0; i < h.info.size(); ++i) out += (i ? ", " : " ") + quote(h.info[i]);
   out += " ]\n  humanoidBody [\n" + body + "  ]\n  joints [\n";
   for (const std::string& u : jointUses) out += "    USE " + u + "\n";
   out += "  ]\n  segments [\n";
   for (const std::string& u : segmentUses) out += "    USE " + u + "\n";
   out += "  ]\n}\n";
+  if (h.motion) out += motionText(*h.motion, jointDefs, unique);
   return out;
 }
 

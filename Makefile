@@ -3,6 +3,7 @@
 #   make demo    build, then run the bundled example and print where its results are
 #   make test    install, build with AddressSanitizer + UBSan (build/asan), run every test with CTest;
 #                then build as `make build` does, tests included (build/native), and run them again
+#                (the longest scenarios run in this second half only: docs/ARCHITECTURE.md)
 #   make fuzz    build the libFuzzer targets with clang and run each for FUZZ_SECONDS (default 60)
 #   make bench   run every benchmark on the optimised build and print their JSON
 

@@ -1,3 +1,21 @@
+# drape_precompile(TARGET [HEADERS header...])
+#
+# Precompiles the standard, Eigen and fmt headers that nearly every file of the project
+# includes, and HEADERS besides, so that each file of TARGET parses them once per target
+# instead of once per file. Eigen alone is 130,000 lines after preprocessing, and parsing
+# these headers was about a third of the build's time. DRAPE_PCH=OFF builds without, which
+# shows a file that forgot an include of its own.
+function(drape_precompile target)
+  cmake_parse_arguments(ARG "" "" "HEADERS" ${ARGN})
+  if(NOT DRAPE_PCH)
+    return()
+  endif()
+  target_precompile_headers(${target} PRIVATE
+    <algorithm> <array> <cmath> <cstdint> <filesystem> <fstream> <limits> <optional>
+    <span> <string> <string_view> <vector> <Eigen/Core> <Eigen/Geometry> <fmt/format.h>
+    ${ARG_HEADERS})
+endfunction()
+
 # drape_add_module(NAME [DEPS target...])
 #
 # Builds src/NAME/*.cpp into the static library drape_NAME. Public headers live in
@@ -10,6 +28,7 @@ function(drape_add_module name)
   target_include_directories(drape_${name} PUBLIC "${CMAKE_CURRENT_SOURCE_DIR}/include")
   target_link_libraries(drape_${name} PUBLIC ${ARG_DEPS})
   add_library(drape::${name} ALIAS drape_${name})
+  drape_precompile(drape_${name})
 endfunction()
 
 # drape_add_test(MODULE [TIMEOUT S] [COST C] [DEPS target...] [ENVIRONMENT VAR=VALUE])
@@ -32,6 +51,11 @@ function(drape_add_test module)
   endif()
   target_link_libraries(test_${module} PRIVATE ${libraries} GTest::gtest GTest::gtest_main)
   add_dependencies(test_${module} drape)
+  set(headers <gtest/gtest.h>)
+  if("nlohmann_json::nlohmann_json" IN_LIST ARG_DEPS)
+    list(APPEND headers <nlohmann/json.hpp>)
+  endif()
+  drape_precompile(test_${module} HEADERS ${headers})
   target_include_directories(test_${module} PRIVATE "${PROJECT_SOURCE_DIR}/tests/support/include")
   target_compile_definitions(test_${module} PRIVATE
     DRAPE_DATA_DIR="${DRAPE_DATA_DIR}"

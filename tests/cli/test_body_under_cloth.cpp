@@ -29,6 +29,7 @@
 #include "drape/formats/pc2.hpp"
 #include "drape/mesh/closest_point.hpp"
 #include "drape/scene/avatar_gltf.hpp"
+#include "drape/testing/long_scenario.hpp"
 
 namespace drape {
 namespace {
@@ -148,6 +149,7 @@ const std::set<std::string> kCollidable = {"LowerBack", "Hips", "LeftUpLeg", "Ri
 // The tuck keeps the cloth 2 mm out of the skin at its own points; between them both
 // surfaces are flat triangles of different sizes.
 TEST(BodyUnderCloth, TheSkinIsNowhereOutsideTheWalkingSkirt) {
+  DRAPE_LONG_SCENARIO();
   const std::string mocap = std::string(DRAPE_DATA_DIR) + "/mocap/";
   for (const auto& [motion, name] : {std::pair{kSkirtDir + "/walk.bvh", std::string("bundled")},
                                      std::pair{mocap + "cmu_walk_delfem2.bvh", std::string("delfem2")},
@@ -175,6 +177,7 @@ TEST(BodyUnderCloth, TheSkinIsNowhereOutsideTheWalkingSkirt) {
 // hem). Frame 0 counts too since the suit, whose chest is modelled inside the body, settles
 // out of it before that frame (CharacterWorld::settle).
 TEST(BodyUnderCloth, TheSkinShowsThroughTheWalkingDressOnlyInPlaces) {
+  DRAPE_LONG_SCENARIO();
   const std::string dress = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_dress";
   testing::ScratchDir dir("body-under-dress");
   const std::string out = dir / "out";

@@ -11,6 +11,7 @@
 
 #include "cli_runner.hpp"
 #include "drape/scene/scene.hpp"
+#include "drape/testing/long_scenario.hpp"
 
 namespace drape {
 namespace {
@@ -51,6 +52,7 @@ TEST(MakeScene, WritesWhereTheAvatarsPartsAreCut) {
 }
 
 TEST(MakeScene, DressOnTheWalkingBody) {
+  DRAPE_LONG_SCENARIO();
   ScratchDir dir("make-scene-dress");
   const std::string sceneDir = dir / "dress";
   const CliResult made = runDrape(makeDressScene("obj",

@@ -14,6 +14,7 @@
 #include "drape/formats/obj.hpp"
 #include "drape/formats/pc2.hpp"
 #include "drape/formats/run_manifest.hpp"
+#include "drape/testing/long_scenario.hpp"
 
 namespace drape {
 namespace {
@@ -319,6 +320,7 @@ std::string widestIsaIn(const std::string& flags) {
 // Table 3 and the reference workload beside them, the reduced frequency seen in the counters,
 // and the penetration figures still over every substep.
 TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
+  DRAPE_LONG_SCENARIO();
   testing::ScratchDir dir("bench-paper");
   const auto bench = [&](const std::string& extra) {
     const testing::CliResult r = testing::runDrape("bench paper --json --runs 1 --frames 40 " + extra, dir);

@@ -14,6 +14,7 @@
 #include "cli_runner.hpp"
 #include "drape/formats/pc2.hpp"
 #include "drape/scene/scene.hpp"
+#include "drape/testing/long_scenario.hpp"
 
 namespace drape {
 namespace {
@@ -27,6 +28,7 @@ const std::string kSource = DRAPE_SOURCE_DIR;
 const std::string kDressScene = kSource + "/examples/walking_dress/scene.wrl";
 
 TEST(WalkingDress, WalksStablyWithFewPointsInsideTheBody) {
+  DRAPE_LONG_SCENARIO();
   ScratchDir dir("walking-dress");
   const std::string out = dir / "out";
   const CliResult r = runDrape("run '" + kSource + "/examples/walking_dress/scene.wrl' --motion '" + kSource +
@@ -218,6 +220,7 @@ TEST(WalkingDress, AnUnstableBendingStepIsRefusedBeforeTheFieldsAreBuilt) {
 }
 
 TEST(WalkingDress, RunsTheDazStyleWalkToTheEnd) {
+  DRAPE_LONG_SCENARIO();
   // Before pinched points took their parts' mean velocity, an armpit vertex pressed by Spine,
   // Spine1 and the upper arm at once gathered speed from test to test and the run stopped in
   // frame 69.
@@ -246,6 +249,7 @@ CliResult runDelfem2AsCaptured(const ScratchDir& dir, const std::string& options
 }
 
 TEST(WalkingDress, AnInstabilitySaysWhichPartsPinchedTheCloth) {
+  DRAPE_LONG_SCENARIO();
   // On this walk, as captured, the left arm presses the sleeve against the back (the scene
   // keeps the arms out of the body; --keep-apart none plays the motion as it is), and one
   // vertex lies on four parts' offset surfaces at once, with no place outside them all; the
@@ -272,6 +276,7 @@ TEST(WalkingDress, AnInstabilitySaysWhichPartsPinchedTheCloth) {
 }
 
 TEST(WalkingDress, WhereNoSubstepsKeepTheFrameStableItsEdgesAreHeldToALimit) {
+  DRAPE_LONG_SCENARIO();
   // The pinch above, with the frame not computed again with more substeps: the frame is
   // computed again with strain limiting (--strain-limit auto, the default), which stays on.
   ScratchDir dir("walking-dress-rescued");
@@ -293,6 +298,7 @@ TEST(WalkingDress, WhereNoSubstepsKeepTheFrameStableItsEdgesAreHeldToALimit) {
 }
 
 TEST(WalkingDress, ThePinchIsWeatheredByComputingItsFramesAgain) {
+  DRAPE_LONG_SCENARIO();
   // The same walk as captured, with frames computed again when they go unstable (the
   // default): frame 26, where the pinch above stopped the run, and frame 29 take twice the
   // substeps, and the run goes on.
@@ -350,6 +356,7 @@ TEST(WalkingDress, InspectListsWhereTheMotionPutsTheBodyInsideItself) {
 }
 
 TEST(WalkingDress, WithTheArmsKeptOutOfTheBodyTheWholeDelfem2WalkRuns) {
+  DRAPE_LONG_SCENARIO();
   // As captured, this walk swings the forearms through the small of the back and the run
   // stops in frame 92 with the jacket's back torn (the tests above). The scene keeps the
   // arms out of the body, and the whole walk runs without a frame computed again.

@@ -13,6 +13,7 @@
 #include "drape/scene/scene.hpp"
 #include "drape/sim/character_world.hpp"
 #include "drape/sim/scene_setup.hpp"
+#include "drape/testing/long_scenario.hpp"
 
 namespace drape::sim {
 namespace {
@@ -66,6 +67,7 @@ FaceFigures walk(long frames, bool faceSamples) {
 }
 
 TEST(WalkingDressFaces, TheThighsNoLongerBulgeThroughTheSkirt) {
+  DRAPE_LONG_SCENARIO();
   // The lead-in (30 frames) brings the arms down; the walk's first steps follow.
   constexpr long kFrames = 45;
   const FaceFigures vertices = walk(kFrames, false);

@@ -1,7 +1,7 @@
 # drape: the two commands are `make demo` and `make test`.
 #   make build   install missing Debian packages, build the optimised binary build/release/drape
 #   make demo    build, then run the bundled example and print where its results are
-#   make test    install, build with AddressSanitizer + UBSan (build/asan), run every test with CTest;
+#   make test    install, build with AddressSanitizer + UBSan (build/asan), run the tests with CTest;
 #                then build as `make build` does, tests included (build/native), and run them again
 #                (the longest scenarios run in this second half only: docs/ARCHITECTURE.md)
 #   make fuzz    build the libFuzzer targets with clang and run each for FUZZ_SECONDS (default 60)

@@ -1,11 +1,12 @@
-// `drape inspect SCENE.wrl`: avatars (joint tree with segment triangle counts), garments
-// (vertices, triangles, boundary loops, mask size), materials with units, simulation
-// settings and warnings of a VRML97 scene.
+// `drape inspect SCENE.wrl`: avatars (joint tree with segment triangle counts, the motion
+// of an animated humanoid), garments (vertices, triangles, boundary loops, mask size),
+// materials with units, simulation settings and warnings of a VRML97 scene.
 
 #include <fmt/ostream.h>
 
 #include "command.hpp"
 #include "stitch_gaps.hpp"
+#include "drape/formats/hanim_motion.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/scene/scene.hpp"
 
@@ -68,6 +69,15 @@ void printGarment(std::ostream& out, const scene::Scene& s, const scene::Garment
                1e3 * widestStitch_m(g.mesh, g.stitches));
 }
 
+/// The interpolators that animate the file's humanoids: what `--motion FILE` plays.
+void printHumanoidMotions(const std::string& path, std::ostream& out) {
+  const std::vector<formats::SkinnedJointMotion> motions = formats::readHanimMotions(path, 30.0);
+  for (const formats::SkinnedJointMotion& m : motions)
+    fmt::print(out, "  {} moves: {:.3f} s of interpolators, {} frames at 30 Hz; drape run ... --motion {}{} plays it\n",
+               m.animation, m.end_s - m.start_s, m.frameCount(), path,
+               motions.size() > 1 ? fmt::format(" --animation '{}'", m.animation) : std::string());
+}
+
 void inspectScene(const std::string& path, std::ostream& out) {
   const scene::Scene s = scene::loadScene(path);
   fmt::print(out, "{}: VRML97 scene\n", path);
@@ -80,6 +90,7 @@ void inspectScene(const std::string& path, std::ostream& out) {
     for (std::size_t j = 0; j < a.joints.size(); ++j)
       if (a.joints[j].parent < 0) printJoint(out, a, static_cast<int>(j), 0);
   }
+  if (!s.avatars.empty()) printHumanoidMotions(path, out);
   for (const scene::ExternalAvatar& a : s.externalAvatars)
     fmt::print(out, "  {} (from {}){}{}\n", a.name, fmt::join(a.urls, ", "),
                a.jointMap.empty() ? "" : fmt::format(", joint map {}", fmt::join(a.jointMap, ", ")),

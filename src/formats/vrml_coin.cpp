@@ -46,6 +46,7 @@
 #include <Inventor/misc/SoProtoInstance.h>
 
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <unordered_map>
@@ -385,11 +386,15 @@ class Converter {
     const auto scalar = [](auto v, std::vector<double>& out) { out.push_back(static_cast<double>(v)); };
     const auto vec2 = [](const SbVec2f& v, std::vector<double>& out) { out.insert(out.end(), {v[0], v[1]}); };
     const auto vec3 = [](const auto& v, std::vector<double>& out) { out.insert(out.end(), {v[0], v[1], v[2]}); };
+    // Coin keeps a rotation as a single-precision quaternion; its own axis-angle getter takes
+    // acos of w in float, which loses small angles to about 3e-4 rad. The angle from atan2 of
+    // the quaternion's parts, in double, keeps them to the float parts' 1e-7.
     const auto rotation = [](const SbRotation& r, std::vector<double>& out) {
-      SbVec3f axis;
-      float angle = 0;
-      r.getValue(axis, angle);
-      out.insert(out.end(), {axis[0], axis[1], axis[2], angle});
+      float x = 0, y = 0, z = 0, w = 1;
+      r.getValue(x, y, z, w);
+      const double s = std::sqrt(double{x} * x + double{y} * y + double{z} * z);
+      if (s == 0.0) out.insert(out.end(), {0.0, 0.0, 1.0, 0.0});
+      else out.insert(out.end(), {x / s, y / s, z / s, 2.0 * std::atan2(s, double{w})});
     };
     const auto time = [](const SbTime& t, std::vector<double>& out) { out.push_back(t.getValue()); };
     if (numeric<SoSFFloat, SoMFFloat>(f, field, FieldKind::Float, scalar)) return;

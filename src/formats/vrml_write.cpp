@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "drape/formats/vrml_transform.hpp"
 
 namespace drape::formats::vrml {
 namespace {
@@ -189,9 +190,16 @@ std::vector<double> sampleAnimatedField(const Document& document, std::int32_t n
   const std::size_t j = std::min(i + 1, k.size() - 1);
   const double span = k[j] - k[i];
   const double w = span > 0 ? (t - k[i]) / span : 0.0;
+  const double* a = keyValue->numbers.data() + i * stride;
+  const double* b = keyValue->numbers.data() + j * stride;
+  if (interpolator->type == "OrientationInterpolator" && stride == 4) {
+    // VRML97: along the shortest arc between the two orientations, at constant speed.
+    const Quat qa(rotationOf(a, 4)), qb(rotationOf(b, 4));
+    const Eigen::AngleAxisd r(qa.slerp(w, qb));
+    return {r.axis().x(), r.axis().y(), r.axis().z(), r.angle()};
+  }
   std::vector<double> out(stride);
-  for (std::size_t c = 0; c < stride; ++c)
-    out[c] = (1.0 - w) * keyValue->numbers[i * stride + c] + w * keyValue->numbers[j * stride + c];
+  for (std::size_t c = 0; c < stride; ++c) out[c] = (1.0 - w) * a[c] + w * b[c];
   return out;
 }
 

@@ -10,6 +10,7 @@
 
 #include "drape/core/error.hpp"
 #include "drape/core/files.hpp"
+#include "drape/formats/hanim_motion.hpp"
 #include "drape/motion/interpolate.hpp"
 
 namespace drape::motion {
@@ -372,6 +373,7 @@ std::string formatLabel(const std::string& path) {
   const std::string ext = lowerExtension(path);
   if (ext == ".dae") return "Collada";
   if (ext == ".fbx") return "FBX";
+  if (ext == ".wrl" || ext == ".vrml") return "VRML97 H-Anim";
   return "glTF";
 }
 
@@ -590,7 +592,8 @@ AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& mo
     if (options.jointMapPath.empty() && fitAsOwn(avatar, motion).mismatch.empty()) {
       if (chosenMap) {
         *chosenMap = {};
-        chosenMap->name = fmt::format("its own skin's joints ({})", motion.animation);
+        chosenMap->name = fmt::format("its own {}joints ({})", formats::isVrmlPath(motionPath) ? "" : "skin's ",
+                                      motion.animation);
       }
       return AvatarAnimation::fromJointMotion(avatar, motion, motionPath);
     }
@@ -600,7 +603,7 @@ AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& mo
     return AvatarAnimation::build(avatar, clip, map, options.retarget);
   }
   if (!options.animation.empty())
-    throw Error(fmt::format("--animation: {} is not an avatar file (.glb, .gltf, .dae, .fbx); animations are chosen "
+    throw Error(fmt::format("--animation: {} is not an avatar file (.glb, .gltf, .dae, .fbx, .wrl); animations are chosen "
                             "from an avatar's own file",
                             motionPath));
   const Clip clip = loadClip(motionPath, options.clip, report);

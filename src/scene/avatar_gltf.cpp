@@ -4,12 +4,14 @@
 #include <filesystem>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "drape/core/error.hpp"
 #include "drape/core/files.hpp"
 #include "drape/formats/assimp_avatar.hpp"
 #include "drape/scene/avatar_makehuman.hpp"
 #include "drape/scene/avatar_segment.hpp"
+#include "drape/scene/scene.hpp"
 
 namespace drape::scene {
 
@@ -64,12 +66,25 @@ formats::SkinnedModel skinnedModelOf(const Avatar& avatar) {
   return model;
 }
 
+Avatar loadHumanoidFile(const std::string& path) {
+  Scene scene = loadScene(path);
+  if (scene.avatars.size() == 1) return std::move(scene.avatars.front());
+  if (scene.avatars.empty()) throw Error(fmt::format("{}: has no H-Anim Humanoid to take as an avatar", path));
+  std::vector<std::string> names;
+  for (const Avatar& a : scene.avatars) names.push_back(fmt::format("'{}'", a.name));
+  throw Error(fmt::format("{}: holds {} H-Anim Humanoids ({}); an avatar file holds one", path, names.size(),
+                          fmt::join(names, ", ")));
+}
+
 Avatar loadAvatarFile(const std::string& path) {
   const std::string ext = lowerExtension(path);
   if (ext == ".glb" || ext == ".gltf") return loadGltfAvatar(path);
   if (ext == ".dae" || ext == ".fbx") return loadAssimpAvatar(path);
   if (ext == ".mhskel") return loadMakeHumanAvatar(path);
-  throw Error(fmt::format("{}: drape reads avatars from .glb, .gltf, .dae, .fbx and MakeHuman .mhskel files, not '{}'", path, ext));
+  if (ext == ".wrl" || ext == ".vrml") return loadHumanoidFile(path);
+  throw Error(fmt::format("{}: drape reads avatars from .glb, .gltf, .dae, .fbx, MakeHuman .mhskel and VRML97 H-Anim "
+                          "(.wrl) files, not '{}'",
+                          path, ext));
 }
 
 }  // namespace drape::scene

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "drape/formats/vrml_transform.hpp"
 #include "drape/scene/scene_build.hpp"
 
 namespace drape::scene {
@@ -21,6 +22,7 @@ using formats::vrml::Document;
 using formats::vrml::Field;
 using formats::vrml::FieldKind;
 using formats::vrml::Node;
+using formats::vrml::isTransformLike;
 using Affine = Eigen::Affine3d;
 
 // ---- Field access ------------------------------------------------------------------------
@@ -33,14 +35,6 @@ double number(const Node& n, const char* name, double fallback) {
 Vec3 vec3(const Node& n, const char* name, const Vec3& fallback) {
   const Field* f = n.field(name);
   return f != nullptr && f->numbers.size() >= 3 ? Vec3(f->numbers[0], f->numbers[1], f->numbers[2]) : fallback;
-}
-
-Eigen::AngleAxisd rotation(const Node& n, const char* name) {
-  const Field* f = n.field(name);
-  if (f == nullptr || f->numbers.size() < 4) return Eigen::AngleAxisd(0.0, Vec3::UnitZ());
-  Vec3 axis(f->numbers[0], f->numbers[1], f->numbers[2]);
-  if (axis.norm() < 1e-12) return Eigen::AngleAxisd(0.0, Vec3::UnitZ());
-  return Eigen::AngleAxisd(f->numbers[3], axis.normalized());
 }
 
 std::string string(const Node& n, const char* name) {
@@ -79,25 +73,7 @@ std::string nameOf(const Node& n) {
   return named.empty() ? n.def : named;
 }
 
-/// The VRML97 Transform: T(translation) T(center) R(rotation) R(scaleOrientation) S(scale)
-/// R(-scaleOrientation) T(-center). Joint, Site and Humanoid use the same fields.
-Affine transformOf(const Node& n) {
-  const Vec3 center = vec3(n, "center", Vec3::Zero());
-  const Eigen::AngleAxisd so = rotation(n, "scaleOrientation");
-  Affine t = Affine::Identity();
-  t.translate(vec3(n, "translation", Vec3::Zero()));
-  t.translate(center);
-  t.rotate(rotation(n, "rotation"));
-  t.rotate(so);
-  t.scale(vec3(n, "scale", Vec3::Ones()));
-  t.rotate(so.inverse());
-  t.translate(-center);
-  return t;
-}
-
-bool isTransformLike(const std::string& type) {
-  return type == "Transform" || type == "Joint" || type == "Site" || type == "Humanoid";
-}
+Affine transformOf(const Node& n) { return formats::vrml::TransformFields::of(n).matrix(); }
 
 mesh::TriMesh transformed(const Node& geometry, const Affine& world, const std::string& name) {
   mesh::TriMesh m;

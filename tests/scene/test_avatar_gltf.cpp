@@ -10,6 +10,7 @@
 #include "drape/scene/avatar_gltf.hpp"
 #include "drape/scene/avatar_segment.hpp"
 #include "drape/testing/errors.hpp"
+#include "drape/testing/temp_dir.hpp"
 
 namespace drape::scene {
 namespace {
@@ -96,9 +97,39 @@ TEST(GltfAvatar, SyntaxErrorsNameTheirLineAndColumn) {
   EXPECT_EQ(e.rfind(bad("trailing_comma.gltf") + ":3:32: syntax error while parsing value - unexpected ']'", 0), 0u) << e;
 }
 
+// A VRML97 file of one H-Anim Humanoid is an avatar file; none, or several, is an error
+// that says which.
+TEST(HumanoidFile, OneHumanoidIsAnAvatarNoneOrSeveralAreErrors) {
+  const std::string dir = drape::testing::processTempDir("humanoid-file").string();
+  const auto write = [&](const std::string& name, const std::string& body) {
+    const std::string path = dir + "/" + name;
+    std::ofstream(path) << "#VRML V2.0 utf8\n" << body;
+    return path;
+  };
+  const std::string humanoid = R"(Humanoid { name "%" humanoidBody Joint { name "root" center 0 1 0 children [
+    Joint { name "head" center 0 1.6 0 } ] } }
+)";
+  const auto named = [&](const std::string& name) {
+    std::string h = humanoid;
+    h.replace(h.find('%'), 1, name);
+    return h;
+  };
+  const Avatar one = loadAvatarFile(write("one.wrl", named("solo")));
+  EXPECT_EQ(one.name, "solo");
+  ASSERT_EQ(one.joints.size(), 2u);
+  EXPECT_EQ(one.joints[1].name, "head");
+  EXPECT_EQ(one.joints[1].parent, 0);
+
+  const std::string none = write("none.wrl", "Transform { }\n");
+  EXPECT_EQ(errorOf([&] { (void)loadAvatarFile(none); }), none + ": has no H-Anim Humanoid to take as an avatar");
+  const std::string two = write("two.wrl", named("a") + named("b"));
+  EXPECT_EQ(errorOf([&] { (void)loadAvatarFile(two); }),
+            two + ": holds 2 H-Anim Humanoids ('a', 'b'); an avatar file holds one");
+}
+
 TEST(GltfAvatar, UnknownAvatarExtension) {
   EXPECT_EQ(errorOf([] { (void)loadAvatarFile("x.obj"); }),
-            "x.obj: drape reads avatars from .glb, .gltf, .dae, .fbx and MakeHuman .mhskel files, not '.obj'");
+            "x.obj: drape reads avatars from .glb, .gltf, .dae, .fbx, MakeHuman .mhskel and VRML97 H-Anim (.wrl) files, not '.obj'");
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 #pragma once
-// The animations skinned-avatar files carry, whatever their format: glTF through drape's
-// own reader (gltf_avatar.hpp), Collada and FBX through Assimp (assimp_avatar.hpp), each
-// in a limited child process, each sampled the same way into a SkinnedJointMotion.
+// The animations avatar files carry, whatever their format: glTF through drape's own reader
+// (gltf_avatar.hpp), Collada and FBX through Assimp (assimp_avatar.hpp), VRML97 H-Anim
+// humanoids' interpolators through Coin (hanim_motion.hpp), each in a limited child
+// process, each sampled the same way into a SkinnedJointMotion.
 
 #include <string>
 #include <vector>
@@ -11,7 +12,7 @@
 namespace drape::formats {
 
 /// True for the extensions whose files may carry their avatar's animations (.glb, .gltf,
-/// .dae, .fbx; any case).
+/// .dae, .fbx, .wrl, .vrml; any case).
 [[nodiscard]] bool isAvatarMotionPath(const std::string& path);
 
 /// One animation of the file (a name, an index from 0, or "" for the first) sampled at

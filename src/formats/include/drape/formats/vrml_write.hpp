@@ -38,7 +38,8 @@ void writeAnimation(const std::string& path, const Animation& animation);
 
 /// The values a ROUTE from an interpolator gives field `field` of node `node` at `time`
 /// seconds (the interpolator driven by a TimeSensor's fraction_changed; linear between
-/// keys). Empty when the field is not animated. Numbers as in Field::numbers.
+/// keys, an OrientationInterpolator's along the shortest arc). Empty when the field is not
+/// animated. Numbers as in Field::numbers.
 [[nodiscard]] std::vector<double> sampleAnimatedField(const Document& document, std::int32_t node,
                                                       const std::string& field, double time);
 

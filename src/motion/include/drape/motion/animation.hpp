@@ -144,10 +144,11 @@ struct MotionOptions {
 };
 
 /// Loads FILE.bvh / FILE.amc, picks or reads the joint map, and retargets onto `avatar`;
-/// or takes one of FILE.glb / .gltf / .dae / .fbx's animations (options.animation, by
-/// default the first) as the avatar's own motion
-/// (AvatarAnimation::fromJointMotion; `report` then gives the file's key rate as 0 and its
-/// frames as sampled). Throws drape::Error (exit code 2) naming the file, line and problem.
+/// or takes one of FILE.glb / .gltf / .dae / .fbx's animations, or of FILE.wrl's animated
+/// H-Anim Humanoids (options.animation, by default the first), as the avatar's own motion
+/// when the avatar is that file's (AvatarAnimation::fromJointMotion), retargeted like a
+/// BVH's onto any other; `report` then gives the frames as sampled. Throws drape::Error
+/// (exit code 2) naming the file, line and problem.
 [[nodiscard]] AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& motionPath,
                                             const MotionOptions& options, ClipLoadReport* report = nullptr,
                                             JointMap* chosenMap = nullptr);

@@ -29,8 +29,14 @@ namespace drape::scene {
 /// the avatar has no skinned mesh.
 [[nodiscard]] formats::SkinnedModel skinnedModelOf(const Avatar& avatar);
 
-/// Any avatar file drape reads: .glb/.gltf, .dae/.fbx, or a MakeHuman .mhskel (the mesh
-/// and weights beside it). Throws drape::Error for other extensions.
+/// A VRML97 file of one H-Anim Humanoid (as `drape convert --to .wrl` writes them), read
+/// as a scene (scene::loadScene) and its humanoid taken. Throws drape::Error naming the file
+/// when it holds no Humanoid or several.
+[[nodiscard]] Avatar loadHumanoidFile(const std::string& path);
+
+/// Any avatar file drape reads: .glb/.gltf, .dae/.fbx, a MakeHuman .mhskel (the mesh and
+/// weights beside it), or a VRML97 H-Anim humanoid (.wrl). Throws drape::Error for other
+/// extensions.
 [[nodiscard]] Avatar loadAvatarFile(const std::string& path);
 
 }  // namespace drape::scene

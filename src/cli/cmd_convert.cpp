@@ -1,7 +1,8 @@
 // `drape convert AVATAR --to avatar.wrl|.dae|.fbx`: writes any avatar drape loads (.glb,
-// .gltf, .dae, .fbx, MakeHuman .mhskel) as a segmented H-Anim 1.1 VRML97 humanoid with one
-// motion, or its skinned mesh and skeleton with the animations the file carries, as Collada
-// or (ASCII) FBX through Assimp; or with a motion file's walk retargeted onto it instead.
+// .gltf, .dae, .fbx, MakeHuman .mhskel, an H-Anim .wrl) as a segmented H-Anim 1.1 VRML97
+// humanoid with one motion, or a skinned avatar's mesh and skeleton with the animations the
+// file carries, as Collada or (ASCII) FBX through Assimp; or with a motion file's walk
+// retargeted onto it instead.
 
 #include <filesystem>
 #include <span>
@@ -125,7 +126,8 @@ void writeHanimWithMotion(const scene::Avatar& avatar) {
 
 RunFunction setupConvert(CLI::App& app) {
   app.add_option("avatar", input,
-                 "The avatar to convert: .glb, .gltf, .dae, .fbx or MakeHuman .mhskel (mesh and weights beside it)")
+                 "The avatar to convert: .glb, .gltf, .dae, .fbx, MakeHuman .mhskel (mesh and weights beside it), or "
+                 "an H-Anim VRML97 humanoid (.wrl; segmented, so to .wrl only)")
       ->required();
   app.add_option("--to", output,
                  "Output file: a segmented H-Anim 1.1 VRML97 humanoid (.wrl) with one motion as its joints' "
@@ -155,6 +157,10 @@ RunFunction setupConvert(CLI::App& app) {
     if (ext != ".wrl" && !skinned)
       throw Error(fmt::format("--to {}: drape converts avatars to H-Anim VRML97 (.wrl), Collada (.dae) or FBX (.fbx)", output));
     const scene::Avatar avatar = scene::loadAvatarFile(input);
+    if (skinned && !avatar.skin)
+      throw Error(fmt::format("--to {}: {} is a segmented avatar (rigid parts, no skin and weights), which Collada and "
+                              "FBX skinned models cannot carry; convert it --to .wrl",
+                              output, input));
     if (skinned) {
       const std::vector<formats::SkinnedJointMotion> animations =
           !motionPath.empty()

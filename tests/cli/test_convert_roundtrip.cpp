@@ -268,6 +268,30 @@ TEST(HanimMotionBack, RetargetedOntoItsOwnSkeletonItIsTheSameMotion) {
   EXPECT_LT(largestPoseGap(avatar, own, motion::loadAnimation(avatar, wrl, options)), 2e-5) << "m, without the floor fit";
 }
 
+// The humanoid file is an avatar `drape convert` reads: written again as a humanoid it keeps
+// its motion; a skinned format cannot take its rigid parts, and says so.
+TEST(HanimMotionBack, TheHumanoidConvertsAgainWithItsMotionButNotToASkinnedFormat) {
+  ScratchDir dir("hanim-convert-again");
+  const std::string body = std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel";
+  const std::string wrl = dir / "walker.wrl", again = dir / "again.wrl";
+  CliResult r = runDrape("convert '" + body + "' --motion '" + testing::kSkirtDir + "/walk.bvh' --to '" + wrl + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = runDrape("convert '" + wrl + "' --to '" + again + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("141 frames at 30 Hz, written with it"), std::string::npos) << r.err;
+  const scene::Avatar avatar = scene::loadAvatarFile(body);
+  motion::MotionOptions options;
+  options.jointMapDirectory = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";
+  EXPECT_LT(largestPoseGap(avatar, motion::loadAnimation(avatar, wrl, options), motion::loadAnimation(avatar, again, options)),
+            2e-5);
+  r = runDrape("convert '" + wrl + "' --to '" + (dir / "walker.dae") + "'", dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("is a segmented avatar (rigid parts, no skin and weights), which Collada and FBX skinned "
+                       "models cannot carry; convert it --to .wrl"),
+            std::string::npos)
+      << r.err;
+}
+
 // `drape run` with the humanoid as the scene's avatar (an Avatar node's url, or written into
 // the scene) and as the motion: the walking skirt moves as it does on the MakeHuman body
 // with the BVH walk.

@@ -79,6 +79,24 @@ struct MotionCase {
   std::size_t frames;
 };
 
+/// A case's files: the avatar, the motion it is written with, and the humanoid that
+/// `drape convert` wrote with that motion into the scratch directory.
+struct Converted {
+  std::string avatar, motion, wrl;
+  CliResult result;
+};
+
+Converted convertWithMotion(const MotionCase& c, const ScratchDir& dir) {
+  Converted out;
+  out.avatar = std::string(DRAPE_DATA_DIR) + "/avatars/" + c.avatar;
+  out.motion = *c.motion ? std::string(DRAPE_SOURCE_DIR) + "/" + c.motion : out.avatar;
+  out.wrl = dir / "walker.wrl";
+  out.result = runDrape("convert '" + out.avatar + "' --to '" + out.wrl + "'" +
+                            (*c.motion ? " --motion '" + out.motion + "'" : std::string()),
+                        dir);
+  return out;
+}
+
 class ConvertWithMotion : public ::testing::TestWithParam<MotionCase> {};
 
 // The humanoid written with its motion, read back by drape's VRML97 reader (Coin3D): each
@@ -90,12 +108,7 @@ class ConvertWithMotion : public ::testing::TestWithParam<MotionCase> {};
 TEST_P(ConvertWithMotion, TheJointsInterpolatorsPoseTheBodyAsTheMotionDoes) {
   const MotionCase c = GetParam();
   ScratchDir dir(std::string("convert-motion-") + c.name);
-  const std::string avatarPath = std::string(DRAPE_DATA_DIR) + "/avatars/" + c.avatar;
-  const std::string motionPath = *c.motion ? std::string(DRAPE_SOURCE_DIR) + "/" + c.motion : avatarPath;
-  const std::string wrl = dir / "walker.wrl";
-  const CliResult r = runDrape("convert '" + avatarPath + "' --to '" + wrl + "'" +
-                                   (*c.motion ? " --motion '" + motionPath + "'" : std::string()),
-                               dir);
+  const auto [avatarPath, motionPath, wrl, r] = convertWithMotion(c, dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find(fmt::format("frames at 30 Hz, written with it (interpolators routed into the joints)")),
             std::string::npos)
@@ -177,15 +190,6 @@ TEST(ConvertWithMotion, AnAnimationTheFileDoesNotHaveIsAClearError) {
   EXPECT_EQ(testing::slurp(dir / "z.wrl").find("Interpolator"), std::string::npos);
 }
 
-}  // namespace
-}  // namespace drape
-
-namespace drape {
-namespace {
-
-using testing::CliResult;
-using testing::runDrape;
-using testing::ScratchDir;
 
 /// The largest distance between where two animations put the avatar's segment points, over
 /// every frame (m); infinity when their frame counts differ.
@@ -209,12 +213,7 @@ class HanimMotionBack : public ::testing::TestWithParam<MotionCase> {};
 TEST_P(HanimMotionBack, DrapePlaysTheWrittenMotionAsTheOriginal) {
   const MotionCase c = GetParam();
   ScratchDir dir(std::string("hanim-back-") + c.name);
-  const std::string avatarPath = std::string(DRAPE_DATA_DIR) + "/avatars/" + c.avatar;
-  const std::string motionPath = *c.motion ? std::string(DRAPE_SOURCE_DIR) + "/" + c.motion : avatarPath;
-  const std::string wrl = dir / "walker.wrl";
-  const CliResult r = runDrape("convert '" + avatarPath + "' --to '" + wrl + "'" +
-                                   (*c.motion ? " --motion '" + motionPath + "'" : std::string()),
-                               dir);
+  const auto [avatarPath, motionPath, wrl, r] = convertWithMotion(c, dir);
   ASSERT_EQ(r.code, 0) << r.err;
 
   const scene::Avatar avatar = scene::loadAvatarFile(avatarPath);

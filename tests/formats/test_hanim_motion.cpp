@@ -15,6 +15,7 @@
 #include "drape/formats/vrml_write.hpp"
 #include "drape/testing/errors.hpp"
 #include "drape/testing/temp_dir.hpp"
+#include "hanim_walker.hpp"
 
 namespace drape::formats {
 namespace {
@@ -25,25 +26,8 @@ std::string writeText(const std::string& name, const std::string& text) {
   return path;
 }
 
-// Two joints: the root walks along z and turns about y, its child swings about x; keyed at
-// 25 frames per second.
-HanimHumanoidData walker(std::size_t frames) {
-  HanimHumanoidData h;
-  h.name = "walker";
-  h.joints.push_back({"root", -1, Vec3(0, 1, 0), {}});
-  h.joints.push_back({"knee", 0, Vec3(0, 0.5, 0), {}});
-  h.joints[1].segments.push_back({"shin", {{0, 0.5, 0}, {0.1, 0.1, 0}, {0, 0.1, 0.1}}, {{0, 1, 2}}});
-  HanimMotion m;
-  m.name = "walk";
-  m.frameRate = 25.0;
-  for (std::size_t f = 0; f < frames; ++f) {
-    const double a = 0.05 * static_cast<double>(f);
-    m.frames.push_back({{Quat(Eigen::AngleAxisd(a, Vec3::UnitY())), Vec3(0, 0, 0.04 * static_cast<double>(f))},
-                        {Quat(Eigen::AngleAxisd(-2 * a, Vec3::UnitX())), Vec3::Zero()}});
-  }
-  h.motion = m;
-  return h;
-}
+// The root walks and turns, its child, the knee, swings (hanim_walker.hpp).
+HanimHumanoidData walker(std::size_t frames) { return testing::twoJointWalker(frames, "knee"); }
 
 /// Where the walker's joints are at time t (s) and how far they turned from rest, from the
 /// same keys: the root's fields at t (linear translation, rotation about one axis), its

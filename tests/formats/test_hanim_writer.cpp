@@ -12,29 +12,14 @@
 #include "drape/formats/vrml_write.hpp"
 #include "drape/testing/errors.hpp"
 #include "drape/testing/temp_dir.hpp"
+#include "hanim_walker.hpp"
 
 namespace drape::formats {
 namespace {
 
 // Two joints, the child named "clock" (its DEF takes hanim_clock before the motion's
-// TimeSensor asks for it); the root walks along z and turns about y, the child swings about x.
-HanimHumanoidData walker(std::size_t frames) {
-  HanimHumanoidData h;
-  h.name = "walker";
-  h.joints.push_back({"root", -1, Vec3(0, 1, 0), {}});
-  h.joints.push_back({"clock", 0, Vec3(0, 0.5, 0), {}});
-  h.joints[1].segments.push_back({"shin", {{0, 0.5, 0}, {0.1, 0.1, 0}, {0, 0.1, 0.1}}, {{0, 1, 2}}});
-  HanimMotion m;
-  m.name = "walk";
-  m.frameRate = 25.0;
-  for (std::size_t f = 0; f < frames; ++f) {
-    const double a = 0.05 * static_cast<double>(f);
-    m.frames.push_back({{Quat(Eigen::AngleAxisd(a, Vec3::UnitY())), Vec3(0, 0, 0.04 * static_cast<double>(f))},
-                        {Quat(Eigen::AngleAxisd(-2 * a, Vec3::UnitX())), Vec3::Zero()}});
-  }
-  h.motion = m;
-  return h;
-}
+// TimeSensor asks for it).
+HanimHumanoidData walker(std::size_t frames) { return testing::twoJointWalker(frames, "clock"); }
 
 TEST(HanimWriter, AMotionIsInterpolatorsRoutedIntoTheJoints) {
   const std::size_t frames = 9;

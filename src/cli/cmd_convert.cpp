@@ -95,7 +95,7 @@ motion::AvatarAnimation retargeted(const scene::Avatar& avatar) {
 std::vector<formats::SkinnedJointMotion> ownAnimations() {
   if (!formats::isAvatarMotionPath(input)) {
     if (!animationName.empty())
-      throw Error(fmt::format("--animation {}: {} carries no animations (.glb, .gltf, .dae and .fbx files can)",
+      throw Error(fmt::format("--animation {}: {} carries no animations (.glb, .gltf, .dae, .fbx and H-Anim .wrl files can)",
                               animationName, input));
     return {};
   }
@@ -142,7 +142,7 @@ RunFunction setupConvert(CLI::App& app) {
   CLI::Option* motionOption =
       app.add_option("--motion", motionPath,
                      "Motion the avatar is written with instead of its file's own animations (.bvh, .amc, retargeted "
-                     "as drape run does; or an avatar file's animation), sampled at --rate");
+                     "as drape run does; or an avatar file's animation, .wrl humanoids' included), sampled at --rate");
   app.add_option("--animation", animationName,
                  "Which animation, by name or by index from 0 (drape inspect FILE lists them): of the --motion file "
                  "when it is an avatar file, else of the avatar file (only that one is written)");

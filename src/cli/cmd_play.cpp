@@ -116,8 +116,8 @@ RunFunction setupPlay(CLI::App& app) {
   static PlayOptions o;
   app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes, or a scene to simulate live")
       ->required();
-  CLI::Option* motionOption = app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc; or the avatar's own .glb, .gltf, .dae or .fbx and its animation)");
-  app.add_option("--animation", o.animation, "With an avatar file as --motion (.glb, .gltf, .dae, .fbx): which of its animations plays, by name or by index from 0 (default: the first; drape inspect FILE lists them)")
+  CLI::Option* motionOption = app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc; an avatar file's animation, .glb, .gltf, .dae, .fbx; or an H-Anim humanoid's interpolators, .wrl)");
+  app.add_option("--animation", o.animation, "With an avatar file as --motion (.glb, .gltf, .dae, .fbx, .wrl): which of its animations (of a .wrl, its animated Humanoids) plays, by name or by index from 0 (default: the first; drape inspect FILE lists them)")
       ->needs(motionOption);
   app.add_option("--frames", o.frames, "Close by itself after showing N frames")->check(CLI::PositiveNumber);
   app.add_flag("--once", o.once, "Stop at the last frame instead of starting over");

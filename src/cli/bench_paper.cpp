@@ -20,6 +20,7 @@
 #include "bullet_sheet.hpp"
 #include "command.hpp"
 #include "measure.hpp"
+#include "stage_laps.hpp"
 #include "drape/core/error.hpp"
 #include "drape/core/log.hpp"
 #include "drape/motion/animation.hpp"
@@ -138,7 +139,7 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
     const cloth::StageTimes& t = world.solver(g).stageTimes();
     r.collideSeconds += t.collide_s;
     r.forcesSeconds += t.forces_s;
-    r.stepSeconds += t.forces_s + t.integrate_s + t.collide_s + t.fixtures_s + t.stability_s;
+    r.stepSeconds += stepSeconds(t);
     r.colliderPoseSeconds += world.collider(g)->poseSeconds();
     r.poseSeconds += world.collider(g)->poseSeconds() + t.fixturePoses_s;
     r.counters += world.collider(g)->fieldCounters();

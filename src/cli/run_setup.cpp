@@ -141,8 +141,7 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
       measure_s += r.collider->measureSeconds();
     }
   const double poses_s = colliderPoses_s + total.fixturePoses_s;
-  const double simulated =
-      total.forces_s + total.integrate_s + total.collide_s + total.fixtures_s - poses_s - measure_s;
+  const double simulated = stepSeconds(total) - poses_s - measure_s;
   stats["collision_time_share"] = simulated > 0 ? (total.collide_s - colliderPoses_s - measure_s) / simulated : 0.0;
   stats["penetration_measure_ms_per_frame"] = 1e3 * measure_s / static_cast<double>(std::max(1L, frames));
   stats["animation_ms_per_frame"] = 1e3 * poses_s / static_cast<double>(std::max(1L, frames));
@@ -705,15 +704,7 @@ int simulateRun(const RunSetup& setup) {
   writeResultFiles(setup, runs, segments, jointFrames);
 
   cloth::StageTimes total;
-  for (const GarmentRun& r : runs) {
-    const cloth::StageTimes& t = r.solver->stageTimes();
-    total.forces_s += t.forces_s;
-    total.integrate_s += t.integrate_s;
-    total.collide_s += t.collide_s;
-    total.fixtures_s += t.fixtures_s + t.stability_s;
-    total.fixturePoses_s += t.fixturePoses_s;
-    total.strainLimit_s += t.strainLimit_s;
-  }
+  for (const GarmentRun& r : runs) total += r.solver->stageTimes();
   const auto simulatedFrames = static_cast<double>(std::max<std::size_t>(1, frameMs.size()));
   nlohmann::json stats;
   stats["frames"] = done;

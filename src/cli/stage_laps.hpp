@@ -2,6 +2,7 @@
 // The milliseconds each simulation stage took for one frame, from the solvers' running
 // totals: stats.json's `frame_ms_per_stage` (drape run) and the live player's overlay
 // (drape play SCENE) show a frame's own times, where a frame computed again costs more.
+// And the garments' totals added up, with the step time the collision share divides by.
 
 #include <array>
 #include <cstddef>
@@ -23,6 +24,25 @@ using StageMs = std::array<double, kStageNames.size()>;
 [[nodiscard]] inline StageMs stageTotalsMs(const cloth::StageTimes& t) {
   return {1e3 * t.forces_s, 1e3 * t.integrate_s, 1e3 * t.collide_s, 1e3 * (t.fixtures_s + t.stability_s),
           1e3 * t.strainLimit_s};
+}
+
+/// The garments' stage times added up, stage by stage.
+inline cloth::StageTimes& operator+=(cloth::StageTimes& a, const cloth::StageTimes& b) {
+  a.forces_s += b.forces_s;
+  a.integrate_s += b.integrate_s;
+  a.collide_s += b.collide_s;
+  a.fixtures_s += b.fixtures_s;
+  a.fixturePoses_s += b.fixturePoses_s;
+  a.strainLimit_s += b.strainLimit_s;
+  a.stability_s += b.stability_s;
+  return a;
+}
+
+/// The step's work as the collision share counts it (`drape bench paper` and stats.json's
+/// `collision_time_share`, after the paper's Table 3): forces, integration, collision,
+/// fixtures and the stability check; strain limiting, which only a rescue turns on, aside.
+[[nodiscard]] inline double stepSeconds(const cloth::StageTimes& t) {
+  return t.forces_s + t.integrate_s + t.collide_s + t.fixtures_s + t.stability_s;
 }
 
 inline StageMs& operator+=(StageMs& a, const StageMs& b) {

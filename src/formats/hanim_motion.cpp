@@ -39,12 +39,6 @@ std::vector<std::int32_t> childrenOf(const Node& n, const char* field = "childre
   return out;
 }
 
-/// As the scene reader names H-Anim nodes: the name field, else the DEF name.
-std::string nameOf(const Node& n) {
-  const Field* f = n.field("name");
-  return f != nullptr && !f->strings.empty() && !f->strings[0].empty() ? f->strings[0] : n.def;
-}
-
 /// The TimeSensor's cycle that drives field `name` of `n` through an interpolator, in
 /// seconds; 0 when no interpolator with keys, fed by a TimeSensor, drives it.
 double drivingCycle(const Document& d, const Node& n, const char* name) {
@@ -108,7 +102,7 @@ struct Rig {
       int joint = parentJoint;
       if (n->type == "Joint") {
         joint = static_cast<int>(jointNames.size());
-        const std::string name = nameOf(*n);
+        const std::string name = n->nameOrDef();
         jointNames.push_back(name.empty() ? fmt::format("joint {}", jointNames.size() + 1) : name);
         jointParents.push_back(parentJoint);
         jointFrame.push_back(self);
@@ -247,7 +241,7 @@ std::vector<SkinnedJointMotion> hanimMotions(const vrml::Document& document, dou
         rig.cycle_s = std::max(rig.cycle_s, c);
       }
     if (rig.jointNames.empty() || rig.cycle_s <= 0.0) continue;
-    const std::string name = detail::animationName(nameOf(humanoid), motions.size());
+    const std::string name = detail::animationName(humanoid.nameOrDef(), motions.size());
     detail::appendWithinCap(
         motions, sample(rig, humanoid, static_cast<std::int32_t>(i), humanoidAnimated, name, rate), file);
   }
@@ -267,7 +261,7 @@ SkinnedJointMotion readHanimMotion(const std::string& path, double rate, const s
   if (motions.empty()) {
     std::vector<std::string> humanoids;
     for (const Node& n : document.nodes)
-      if (n.type == "Humanoid") humanoids.push_back(fmt::format("'{}'", nameOf(n)));
+      if (n.type == "Humanoid") humanoids.push_back(fmt::format("'{}'", n.nameOrDef()));
     if (humanoids.empty()) throw Error(fmt::format("{}: has no H-Anim Humanoid to take a motion from", path));
     const bool several = humanoids.size() > 1;
     throw Error(fmt::format("{}: {} {} {} no motion: no interpolator that a TimeSensor drives is routed into {} "

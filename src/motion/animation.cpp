@@ -373,7 +373,7 @@ std::string formatLabel(const std::string& path) {
   const std::string ext = lowerExtension(path);
   if (ext == ".dae") return "Collada";
   if (ext == ".fbx") return "FBX";
-  if (ext == ".wrl" || ext == ".vrml") return "VRML97 H-Anim";
+  if (formats::isVrmlPath(path)) return "VRML97 H-Anim";
   return "glTF";
 }
 

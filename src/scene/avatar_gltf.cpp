@@ -9,6 +9,7 @@
 #include "drape/core/error.hpp"
 #include "drape/core/files.hpp"
 #include "drape/formats/assimp_avatar.hpp"
+#include "drape/formats/hanim_motion.hpp"
 #include "drape/scene/avatar_makehuman.hpp"
 #include "drape/scene/avatar_segment.hpp"
 #include "drape/scene/scene.hpp"
@@ -81,7 +82,7 @@ Avatar loadAvatarFile(const std::string& path) {
   if (ext == ".glb" || ext == ".gltf") return loadGltfAvatar(path);
   if (ext == ".dae" || ext == ".fbx") return loadAssimpAvatar(path);
   if (ext == ".mhskel") return loadMakeHumanAvatar(path);
-  if (ext == ".wrl" || ext == ".vrml") return loadHumanoidFile(path);
+  if (formats::isVrmlPath(path)) return loadHumanoidFile(path);
   throw Error(fmt::format("{}: drape reads avatars from .glb, .gltf, .dae, .fbx, MakeHuman .mhskel and VRML97 H-Anim "
                           "(.wrl) files, not '{}'",
                           path, ext));

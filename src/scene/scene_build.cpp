@@ -68,11 +68,6 @@ SourcePos where(const Node& n, const char* field = nullptr) {
   return {n.file, line, 0};
 }
 
-std::string nameOf(const Node& n) {
-  const std::string named = string(n, "name");
-  return named.empty() ? n.def : named;
-}
-
 Affine transformOf(const Node& n) { return formats::vrml::TransformFields::of(n).matrix(); }
 
 mesh::TriMesh transformed(const Node& geometry, const Affine& world, const std::string& name) {
@@ -241,7 +236,7 @@ class Builder {
     if (humanoidIndex_.contains(index)) return;
     const Node& n = at(index);
     Avatar avatar;
-    avatar.name = nameOf(n);
+    avatar.name = n.nameOrDef();
     if (avatar.name.empty()) avatar.name = fmt::format("humanoid {}", scene_.avatars.size() + 1);
     avatar.source = n.file;
     const Affine rootWorld = world * transformOf(n);
@@ -261,7 +256,7 @@ class Builder {
     if (n.type == "Joint") {
       const Affine local = world * transformOf(n);
       Joint j;
-      j.name = nameOf(n);
+      j.name = n.nameOrDef();
       if (j.name.empty()) j.name = fmt::format("joint {}", avatar.joints.size() + 1);
       j.parent = parent;
       j.restCenter = local * vec3(n, "center", Vec3::Zero());
@@ -273,7 +268,7 @@ class Builder {
     }
     if (n.type == "Segment") {
       Segment s;
-      s.name = nameOf(n);
+      s.name = n.nameOrDef();
       if (s.name.empty()) s.name = fmt::format("segment {}", avatar.segments.size() + 1);
       s.joint = parent;
       s.mesh.name = s.name;
@@ -317,7 +312,7 @@ class Builder {
 
   void externalAvatar(const Node& n, const Affine& world) {
     ExternalAvatar a;
-    a.name = nameOf(n);
+    a.name = n.nameOrDef();
     a.urls = strings(n, "url");
     a.jointMap = strings(n, "jointMap");
     a.cutAtJoints = strings(n, "cutAtJoints");
@@ -342,7 +337,7 @@ class Builder {
       const Node& n = at(index);
       if (n.type != "ClothMaterial")
         throw Error::at(where(n), fmt::format("ClothSet material must be a ClothMaterial, not {}", n.type));
-      m.name = nameOf(n);
+      m.name = n.nameOrDef();
       m.source = where(n);
       const auto get = [&](const char* field, double& value) {
         value = number(n, field, value);
@@ -385,14 +380,14 @@ class Builder {
     if (n->type != "IndexedFaceSet")
       throw Error::at(where(clothSet, field),
                       fmt::format("ClothSet {}: {} must be an IndexedFaceSet or a Shape holding one, not {}",
-                                  nameOf(clothSet), field, n->type));
+                                  clothSet.nameOrDef(), field, n->type));
     return *n;
   }
 
   void garment(const PendingGarment& pending) {
     const Node& n = at(pending.node);
     Garment g;
-    g.name = nameOf(n);
+    g.name = n.nameOrDef();
     if (g.name.empty()) g.name = fmt::format("garment {}", scene_.garments.size() + 1);
     g.source = where(n);
     g.mesh.name = g.name;

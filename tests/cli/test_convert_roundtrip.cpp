@@ -267,14 +267,21 @@ TEST(HanimMotionBack, RetargetedOntoItsOwnSkeletonItIsTheSameMotion) {
   EXPECT_LT(largestPoseGap(avatar, own, motion::loadAnimation(avatar, wrl, options)), 2e-5) << "m, without the floor fit";
 }
 
-// The humanoid file is an avatar `drape convert` reads: written again as a humanoid it keeps
-// its motion; a skinned format cannot take its rigid parts, and says so.
+// The humanoid file is an avatar `drape inspect` lists the motion of and `drape convert`
+// reads: written again as a humanoid it keeps its motion; a skinned format cannot take its
+// rigid parts, and says so.
 TEST(HanimMotionBack, TheHumanoidConvertsAgainWithItsMotionButNotToASkinnedFormat) {
   ScratchDir dir("hanim-convert-again");
   const std::string body = std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel";
   const std::string wrl = dir / "walker.wrl", again = dir / "again.wrl";
   CliResult r = runDrape("convert '" + body + "' --motion '" + testing::kSkirtDir + "/walk.bvh' --to '" + wrl + "'", dir);
   ASSERT_EQ(r.code, 0) << r.err;
+  r = runDrape("inspect '" + wrl + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("makehuman_CMU compliant skeleton moves: 4.667 s of interpolators, 141 frames at 30 Hz; drape "
+                       "run ... --motion " + wrl + " plays it"),
+            std::string::npos)
+      << r.out;
   r = runDrape("convert '" + wrl + "' --to '" + again + "'", dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("141 frames at 30 Hz, written with it"), std::string::npos) << r.err;

@@ -64,6 +64,12 @@ struct Node {
       if (f.name == name) return &f;
     return nullptr;
   }
+  /// What drape calls the node (an H-Anim Joint, a ClothSet, ...): its `name` field, else its
+  /// DEF name; "" when it has neither.
+  [[nodiscard]] std::string nameOrDef() const {
+    const Field* f = field("name");
+    return f != nullptr && !f->strings.empty() && !f->strings[0].empty() ? f->strings[0] : def;
+  }
 };
 
 struct Document {

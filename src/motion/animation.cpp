@@ -69,7 +69,7 @@ Hub findHub(const scene::Avatar& avatar, const std::vector<int>& driving, const 
 }
 
 // Rest-pose correction per avatar joint: the world rotation that turns the avatar's rest
-// bone directions (towards its driven children) onto the motion skeleton's rest bone
+// bone directions (towards its nearest driven descendants) onto the motion skeleton's rest bone
 // directions towards the same children. A T-pose motion then lifts an A-pose avatar's
 // arms at its reference frame, and both skeletons agree wherever the motion goes. Roots
 // keep identity (both stand upright facing +Z); joints with no usable child share their
@@ -80,8 +80,13 @@ std::vector<Quat> restCorrections(const scene::Avatar& avatar, const std::vector
   const std::vector<std::size_t> head = chainHeads(avatar, driving);
   std::vector<Vec3> avatarDir(n, Vec3::Zero()), motionDir(n, Vec3::Zero());
   for (std::size_t c = 0; c < n; ++c) {
-    const int a = avatar.joints[c].parent;
-    if (a < 0 || driving[c] < 0 || driving[static_cast<std::size_t>(a)] < 0) continue;
+    if (driving[c] < 0) continue;
+    // The nearest driven ancestor: an undriven joint between (a second neck joint, a hip
+    // joint that the motion's naming style lacks) is carried rigidly, so the bone to turn
+    // onto the motion's runs from that ancestor to this joint.
+    int a = avatar.joints[c].parent;
+    while (a >= 0 && driving[static_cast<std::size_t>(a)] < 0) a = avatar.joints[static_cast<std::size_t>(a)].parent;
+    if (a < 0) continue;
     if (driving[c] == driving[static_cast<std::size_t>(a)]) continue;  // within one chain: one bone
     // A chain (twist joints) is one bone from its head: the direction is measured there.
     const std::size_t h = head[static_cast<std::size_t>(a)];
@@ -124,16 +129,25 @@ std::vector<Quat> restCorrections(const scene::Avatar& avatar, const std::vector
 }
 
 // Leg-length ratio avatar / motion over LeftUpLeg -> LeftLeg -> LeftFoot (or the right
-// leg); for other names, the ratio of hip heights; else the ratio of overall extents.
+// leg), found by drape's names on the avatar, or on the motion where the avatar names its
+// joints in another style (a CMU capture on a Mixamo character or an H-Anim humanoid);
+// for other names, the ratio of hip heights; else the ratio of overall extents.
 double legLengthRatio(const scene::Avatar& avatar, const std::vector<int>& driving, const std::vector<Vec3>& motionRest,
                       const Skeleton& skeleton) {
+  // The avatar joint named `name` and the motion joint driving it, else the motion joint
+  // named `name` and the avatar joint it drives; {-1, -1} where neither is driven.
+  const auto legJoint = [&](const std::string& name) -> std::pair<int, int> {
+    if (const int a = avatar.findJoint(name); a >= 0 && driving[static_cast<std::size_t>(a)] >= 0)
+      return {a, driving[static_cast<std::size_t>(a)]};
+    const int m = skeleton.find(name);
+    const auto a = std::find(driving.begin(), driving.end(), m);
+    if (m < 0 || a == driving.end()) return {-1, -1};
+    return {static_cast<int>(a - driving.begin()), m};
+  };
   for (const char* side : {"Left", "Right"}) {
-    const int up = avatar.findJoint(fmt::format("{}UpLeg", side));
-    const int knee = avatar.findJoint(fmt::format("{}Leg", side));
-    const int foot = avatar.findJoint(fmt::format("{}Foot", side));
-    if (up < 0 || knee < 0 || foot < 0) continue;
-    const int mu = driving[static_cast<std::size_t>(up)], mk = driving[static_cast<std::size_t>(knee)],
-              mf = driving[static_cast<std::size_t>(foot)];
+    const auto [up, mu] = legJoint(fmt::format("{}UpLeg", side));
+    const auto [knee, mk] = legJoint(fmt::format("{}Leg", side));
+    const auto [foot, mf] = legJoint(fmt::format("{}Foot", side));
     if (mu < 0 || mk < 0 || mf < 0) continue;
     auto centre = [&](int j) { return avatar.joints[static_cast<std::size_t>(j)].restCenter; };
     auto rest = [&](int j) { return motionRest[static_cast<std::size_t>(j)]; };

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -163,6 +164,20 @@ JointMap composeJointMaps(const JointMap& first, const JointMap& second) {
   return composed;
 }
 
+JointMap reverseJointMap(const JointMap& map) {
+  JointMap reversed;
+  reversed.name = map.name + " (reversed)";
+  reversed.source = map.source;
+  std::set<std::string_view> drivers, driven;
+  for (const JointMapEntry& e : map.entries) {
+    if (drivers.count(e.avatarJoint) != 0 || driven.count(e.motionJoint) != 0) continue;
+    drivers.insert(e.avatarJoint);
+    driven.insert(e.motionJoint);
+    reversed.entries.push_back({e.avatarJoint, e.motionJoint, e.avatarAt, e.at});
+  }
+  return reversed;
+}
+
 JointMap chooseJointMap(const std::vector<JointMap>& candidates, const Skeleton& skeleton, const scene::Avatar& avatar) {
   JointMap best = JointMap::identity(skeleton);
   std::size_t bestCount = matchedJointCount(best, skeleton, avatar);
@@ -173,12 +188,17 @@ JointMap chooseJointMap(const std::vector<JointMap>& candidates, const Skeleton&
       bestCount = count;
     }
   };
-  for (const JointMap& m : candidates) consider(m);
+  // The maps as written first, so that a reversed one wins only where it pairs more: the
+  // choices for drape's own names and every style's stay what they were.
+  std::vector<JointMap> maps = candidates;
+  for (const JointMap& m : candidates) maps.push_back(reverseJointMap(m));
+  for (const JointMap& m : maps) consider(m);
   // Then pairs: a naming style's map onto drape's names followed by a rig's map from drape's
-  // names onto its own (the Daz style onto MakeHuman's default rig). A pair wins only where
-  // it pairs strictly more joints than every single map.
-  for (const JointMap& a : candidates)
-    for (const JointMap& b : candidates)
+  // names onto its own (the Daz style onto MakeHuman's default rig), or by a style's map
+  // reversed (the MotionBuilder style onto a Mixamo character). A pair wins only where it
+  // pairs strictly more joints than every single map.
+  for (const JointMap& a : maps)
+    for (const JointMap& b : maps)
       if (&a != &b) consider(composeJointMaps(a, b));
   return best;
 }

@@ -17,6 +17,7 @@
 #include "drape/formats/vrml_read.hpp"
 #include "drape/formats/vrml_write.hpp"
 #include "drape/motion/animation.hpp"
+#include "drape/motion/jointmap.hpp"
 #include "drape/scene/avatar_gltf.hpp"
 #include "drape/scene/scene.hpp"
 
@@ -350,6 +351,62 @@ TEST(HanimMotionRun, TheSkirtWalksTheSameOnTheConvertedHumanoid) {
   for (std::size_t f = 0; f < c.frames.size(); ++f)
     for (std::size_t v = 0; v < c.pointCount; ++v) worst = std::max(worst, (c.frames[f][v] - b.frames[f][v]).norm());
   EXPECT_LT(worst, 1e-4) << "m, the largest gap between the skirt on the scene's own humanoid and on the body";
+}
+
+// A humanoid whose Joints carry H-Anim's standard names (HumanoidRoot, l_hip, l_knee, vl5,
+// skullbase, ...: the converted MakeHuman walker, renamed through the shipped map), as
+// humanoids from other VRML97 tools name them. Its motion drives the MakeHuman body through
+// the shipped 'hanim' map, found by itself, exactly as the walker under drape's names does
+// through a map of the same pairs; and the CMU capture drives it as a scene's avatar
+// through that map reversed.
+TEST(HanimNames, AStandardHumanoidsMotionDrivesTheBodyAndTheCaptureDrivesIt) {
+  ScratchDir dir("hanim-names");
+  const std::string body = std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel";
+  const std::string maps = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";
+  const std::string walker = dir / "walker.wrl", standard = dir / "standard.wrl";
+  CliResult r = runDrape("convert '" + body + "' --motion '" + testing::kSkirtDir + "/walk.bvh' --to '" + walker + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::string text = testing::slurp(walker);
+  const motion::JointMap hanim = motion::readJointMap(maps + "/hanim.json");
+  for (const motion::JointMapEntry& e : hanim.entries) {
+    const std::string from = "name \"" + e.avatarJoint + "\"", to = "name \"" + e.motionJoint + "\"";
+    for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+      text.replace(at, from.size(), to);
+  }
+  std::ofstream(standard) << text;
+
+  const scene::Avatar avatar = scene::loadAvatarFile(body);
+  motion::MotionOptions options;
+  options.jointMapDirectory = maps;
+  motion::JointMap chosen;
+  const motion::AvatarAnimation viaHanim = motion::loadAnimation(avatar, standard, options, nullptr, &chosen);
+  EXPECT_EQ(chosen.name, "hanim");
+  EXPECT_EQ(chosen.entries.size(), 29u);
+  nlohmann::json same = {{"name", "same pairs"}, {"joints", nlohmann::json::object()}};
+  for (const motion::JointMapEntry& e : hanim.entries) same["joints"][e.avatarJoint] = e.avatarJoint;
+  options.jointMapPath = dir / "same.json";
+  std::ofstream(options.jointMapPath) << same.dump(2);
+  const motion::AvatarAnimation viaSamePairs = motion::loadAnimation(avatar, walker, options);
+  ASSERT_EQ(viaHanim.frameCount(), 141u);
+  EXPECT_LT(largestPoseGap(avatar, viaHanim, viaSamePairs), 1e-9) << "m";
+
+  // The standard humanoid as the walking skirt's avatar, with the capture.
+  std::string scene = testing::slurp(testing::kSkirtDir + "/scene.wrl");
+  const std::string url = "url \"../../data/avatars/makehuman_rig_cmu_mb.mhskel\"";
+  ASSERT_NE(scene.find(url), std::string::npos);
+  scene.replace(scene.find(url), url.size(), "url \"standard.wrl\"");
+  const std::string collides = R"(collidesWith [ "LowerBack", "Hips", "LeftUpLeg", "RightUpLeg", "LeftLeg", "RightLeg" ])";
+  ASSERT_NE(scene.find(collides), std::string::npos);
+  scene.replace(scene.find(collides), collides.size(),
+                R"(collidesWith [ "vl5", "HumanoidRoot", "l_hip", "r_hip", "l_knee", "r_knee" ])");
+  std::ofstream(dir / "scene.wrl") << scene;
+  r = runDrape("run '" + (dir / "scene.wrl") + "' --motion '" + testing::kSkirtDir + "/walk.bvh' --frames 12 --out '" +
+                   (dir / "out") + "'",
+               dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("joint map 'motionbuilder + hanim (reversed)' drives 29 of the avatar's 31 joints"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(testing::statsOf(dir / "out")["vertex_substeps_inside_body"], 0);
 }
 
 }  // namespace

@@ -368,6 +368,32 @@ TEST(JointMap, ChainsParseInOrderAndMapsCompose) {
   }
 }
 
+// Reversed, a map drives the avatar joints' names from the motion joints': one to one, the
+// first written entry kept where two motion joints drove one avatar joint or one drove a
+// chain; its places are the same words' places in the file.
+TEST(JointMap, ReversedOneToOneTheFirstWrittenKept) {
+  const JointMap style = parseJointMap(
+      "{\"name\": \"style\", \"joints\": {\n\"lThigh\": \"LeftUpLeg\",\n\"Spine1\": \"Spine1\",\n\"Chest\": \"Spine1\",\n"
+      "\"lShin\": [\"LeftLeg\", \"LeftLegTwist\"]}}",
+      "style.json");
+  const JointMap reversed = reverseJointMap(style);
+  EXPECT_EQ(reversed.name, "style (reversed)");
+  EXPECT_EQ(reversed.source, "style.json");
+  std::vector<std::string> pairs;
+  for (const JointMapEntry& e : reversed.entries) pairs.push_back(e.motionJoint + "->" + e.avatarJoint);
+  EXPECT_EQ(pairs, (std::vector<std::string>{"LeftUpLeg->lThigh", "Spine1->Spine1", "LeftLeg->lShin"}));
+  EXPECT_EQ(reversed.entries[0].at.line, 2);
+  EXPECT_EQ(reversed.entries[0].at.column, 11);  // "LeftUpLeg", the value it was
+  EXPECT_EQ(reversed.entries[0].avatarAt.column, 1);
+  // Twice reversed, a one-to-one map is itself.
+  const JointMap back = reverseJointMap(reverseJointMap(parseJointMap(
+      "{\"name\": \"m\", \"joints\": {\"a\": \"A\", \"b\": \"B\"}}", "m.json")));
+  ASSERT_EQ(back.entries.size(), 2u);
+  EXPECT_EQ(back.entries[1].motionJoint, "b");
+  EXPECT_EQ(back.entries[1].avatarJoint, "B");
+  EXPECT_EQ(back.name, "m (reversed) (reversed)");
+}
+
 TEST(JointMap, MalformedCorpus) {
   // A number beyond double range used to be "bad JSON (...)" with no line or column.
   const std::string overflow = std::string(DRAPE_TEST_DATA_DIR) + "/bad/motion/map_number_overflow.json";

@@ -12,7 +12,9 @@
 //   { "name": "makehuman_default", "joints": { "LeftUpLeg": ["upperleg01.L", "upperleg02.L"] } }
 //
 // A rig's map from drape's names onto its own composes with a naming style's map
-// (chooseJointMap tries the pairs).
+// (chooseJointMap tries the pairs), and every map also serves the other way round
+// (reverseJointMap): a naming style's map drives an avatar of that style from drape's
+// names, so a CMU capture walks a Mixamo character or an H-Anim humanoid.
 
 #include <optional>
 #include <string>
@@ -61,9 +63,16 @@ struct JointMap {
 /// and `second` pairs c with r (a naming style's map, then a rig's map from drape's names).
 [[nodiscard]] JointMap composeJointMaps(const JointMap& first, const JointMap& second);
 
-/// The candidate, ordered pair of candidates composed (composeJointMaps) or the identity map
-/// that pairs the most joints of `skeleton` with `avatar`; a later one only where it pairs
-/// strictly more.
+/// `map` read the other way round, named "NAME (reversed)": each of its avatar joints, as a
+/// motion joint, drives the motion joint it was driven by. One to one, the first written
+/// entry kept: where two motion joints drove one avatar joint (a style's alternative names,
+/// 3ds Max's Spine1 and Chest), or one drove a chain, the later ones are left out.
+[[nodiscard]] JointMap reverseJointMap(const JointMap& map);
+
+/// The candidate, a candidate reversed (reverseJointMap), an ordered pair of those composed
+/// (composeJointMaps) or the identity map that pairs the most joints of `skeleton` with
+/// `avatar`; a later one only where it pairs strictly more, so a reversed map or a pair is
+/// chosen only where no candidate as written does as well.
 [[nodiscard]] JointMap chooseJointMap(const std::vector<JointMap>& candidates, const Skeleton& skeleton,
                                       const scene::Avatar& avatar);
 

@@ -245,6 +245,70 @@ TEST(Retarget, MakeHumanRigsWithTwistBonesOrAFloorRootFollowTheMotionsLimbs) {
   }
 }
 
+// A humanoid of H-Anim 1.1's first level of articulation as the standard lays it out: its
+// 18 Joints near the suggested centres (Annex A, rounded to millimetres), facing +Z with
+// the arms down at the sides, a sacroiliac between the root and the hips and the shoulders
+// on vt10. A CMU walk drives it through the shipped 'hanim' map reversed, found by itself:
+// every Joint but the sacroiliac is paired (MakeHuman names no pelvis joint), and each limb
+// points where the capture's does.
+TEST(Retarget, AStandardHanimHumanoidFollowsTheCapturesLimbs) {
+  scene::Avatar loa1;
+  loa1.name = "LOA1";
+  const auto joint = [&](const char* name, const char* parent, double x, double y, double z) {
+    loa1.joints.push_back({name, *parent ? loa1.findJoint(parent) : -1, Vec3(x, y, z), Quat::Identity()});
+  };
+  joint("HumanoidRoot", "", 0.0, 0.824, 0.028);
+  joint("sacroiliac", "HumanoidRoot", 0.0, 0.915, 0.002);
+  for (const double side : {1.0, -1.0}) {
+    const std::string s = side > 0 ? "l_" : "r_";
+    joint((s + "hip").c_str(), "sacroiliac", side * 0.096, 0.912, 0.0);
+    joint((s + "knee").c_str(), (s + "hip").c_str(), side * 0.104, 0.487, 0.031);
+    joint((s + "ankle").c_str(), (s + "knee").c_str(), side * 0.097, 0.070, -0.027);
+  }
+  joint("vl5", "HumanoidRoot", 0.003, 1.057, -0.078);
+  joint("vt10", "vl5", 0.006, 1.285, -0.082);
+  joint("vc4", "vt10", 0.007, 1.544, -0.025);
+  joint("skullbase", "vc4", 0.004, 1.621, 0.024);
+  for (const double side : {1.0, -1.0}) {
+    const std::string s = side > 0 ? "l_" : "r_";
+    joint((s + "shoulder").c_str(), "vt10", side * 0.191, 1.441, -0.033);
+    joint((s + "elbow").c_str(), (s + "shoulder").c_str(), side * 0.195, 1.139, -0.062);
+    joint((s + "wrist").c_str(), (s + "elbow").c_str(), side * 0.196, 0.869, -0.052);
+  }
+  ASSERT_EQ(loa1.joints.size(), 18u);
+
+  const Clip clip = loadClip(std::string(DRAPE_DATA_DIR) + "/mocap/cmu_12_03_walk.bvh");
+  const JointMap map = chooseJointMap(shippedMaps(), clip.skeleton, loa1);
+  EXPECT_EQ(map.name, "hanim (reversed)");
+  EXPECT_EQ(matchedJointCount(map, clip.skeleton, loa1), 17u);
+  const AvatarAnimation anim = AvatarAnimation::build(loa1, clip, map);
+  const std::vector<std::pair<std::string, std::string>> limbs = {
+      {"LeftUpLeg", "LeftLeg"}, {"LeftLeg", "LeftFoot"},       {"RightUpLeg", "RightLeg"},       {"RightLeg", "RightFoot"},
+      {"LeftArm", "LeftForeArm"}, {"LeftForeArm", "LeftHand"}, {"RightArm", "RightForeArm"}, {"RightForeArm", "RightHand"},
+      {"LowerBack", "Spine"}};
+  // Measured through the pairs as H-Anim defines its Joints, written here apart from the
+  // shipped map: a map that paired left with right, or thigh with shin, would put the limbs
+  // tens of degrees from the capture's (below).
+  JointMap anatomy;
+  for (const auto& [motionJoint, hanimJoint] : std::vector<std::pair<std::string, std::string>>{
+           {"LeftUpLeg", "l_hip"}, {"LeftLeg", "l_knee"}, {"LeftFoot", "l_ankle"}, {"RightUpLeg", "r_hip"},
+           {"RightLeg", "r_knee"}, {"RightFoot", "r_ankle"}, {"LeftArm", "l_shoulder"}, {"LeftForeArm", "l_elbow"},
+           {"LeftHand", "l_wrist"}, {"RightArm", "r_shoulder"}, {"RightForeArm", "r_elbow"}, {"RightHand", "r_wrist"},
+           {"LowerBack", "vl5"}, {"Spine", "vt10"}})
+    anatomy.entries.push_back({motionJoint, hanimJoint, {}, {}});
+  const double angle = largestLimbAngle_deg(loa1, clip, anatomy, anim, limbs);
+  std::printf("cmu_12_03_walk.bvh on an H-Anim LOA1 humanoid: largest limb angle %.2f degrees, root scale %.3f\n", angle,
+              anim.rootScale());
+  EXPECT_LT(angle, 5.0);
+  EXPECT_GT(anim.rootScale(), 0.8);
+  EXPECT_LT(anim.rootScale(), 1.2);
+  JointMap swapped = map;
+  for (JointMapEntry& e : swapped.entries)
+    if (e.avatarJoint.size() > 2 && e.avatarJoint[1] == '_' && (e.avatarJoint[0] == 'l' || e.avatarJoint[0] == 'r'))
+      e.avatarJoint[0] = e.avatarJoint[0] == 'l' ? 'r' : 'l';
+  EXPECT_GT(largestLimbAngle_deg(loa1, clip, anatomy, AvatarAnimation::build(loa1, clip, swapped), limbs), 20.0);
+}
+
 // A map that leaves the avatar's root undriven is refused with how much it pairs and the
 // way out, not left to move a body that stands still.
 TEST(Retarget, AMapThatMissesTheRootSaysHowMuchItPairs) {

@@ -69,8 +69,8 @@ Hub findHub(const scene::Avatar& avatar, const std::vector<int>& driving, const 
 }
 
 // Rest-pose correction per avatar joint: the world rotation that turns the avatar's rest
-// bone directions (towards its nearest driven descendants) onto the motion skeleton's rest bone
-// directions towards the same children. A T-pose motion then lifts an A-pose avatar's
+// bone directions (towards its nearest driven descendants) onto the motion skeleton's rest
+// bone directions towards the same joints. A T-pose motion then lifts an A-pose avatar's
 // arms at its reference frame, and both skeletons agree wherever the motion goes. Roots
 // keep identity (both stand upright facing +Z); joints with no usable child share their
 // parent's correction.

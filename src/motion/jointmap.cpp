@@ -195,8 +195,8 @@ JointMap chooseJointMap(const std::vector<JointMap>& candidates, const Skeleton&
   for (const JointMap& m : maps) consider(m);
   // Then pairs: a naming style's map onto drape's names followed by a rig's map from drape's
   // names onto its own (the Daz style onto MakeHuman's default rig), or by a style's map
-  // reversed (the MotionBuilder style onto a Mixamo character). A pair wins only where it
-  // pairs strictly more joints than every single map.
+  // reversed (the MotionBuilder style onto an H-Anim humanoid, its index finger too). A
+  // pair wins only where it pairs strictly more joints than every single map.
   for (const JointMap& a : maps)
     for (const JointMap& b : maps)
       if (&a != &b) consider(composeJointMaps(a, b));

@@ -38,7 +38,8 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
   RunSetup setup = runSetupFromScene(o.run);
   if (!setup.character)
     throw Error(fmt::format("{}: drape play simulates scenes with an avatar (replay a run directory otherwise)", o.run));
-  if (!o.motion.empty()) addMotion(setup, o.motion, 0.0, "", o.animation);
+  if (const MotionChoice m = sceneMotion(setup, o.run, o.motion, o.animation); !m.path.empty())
+    addMotion(setup, m.path, 0.0, "", m.animation);
   const std::unique_ptr<sim::CharacterWorld> worldPtr = buildWorld(setup);
   sim::CharacterWorld& world = *worldPtr;
   (void)settleWorld(setup, world);
@@ -116,7 +117,7 @@ RunFunction setupPlay(CLI::App& app) {
   static PlayOptions o;
   app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes, or a scene to simulate live")
       ->required();
-  CLI::Option* motionOption = app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc; an avatar file's animation, .glb, .gltf, .dae, .fbx; or an H-Anim humanoid's interpolators, .wrl)");
+  CLI::Option* motionOption = app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc; an avatar file's animation, .glb, .gltf, .dae, .fbx; or an H-Anim humanoid's interpolators, .wrl); none: at rest. Without it, a scene whose own interpolators move its Humanoid plays them");
   app.add_option("--animation", o.animation, "With an avatar file as --motion (.glb, .gltf, .dae, .fbx, .wrl): which of its animations (of a .wrl, its animated Humanoids) plays, by name or by index from 0 (default: the first; drape inspect FILE lists them)")
       ->needs(motionOption);
   app.add_option("--frames", o.frames, "Close by itself after showing N frames")->check(CLI::PositiveNumber);

@@ -42,7 +42,7 @@ RunFunction setupRender(CLI::App& app) {
   static RenderOptions o;
   app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes, or a scene to simulate")
       ->required();
-  CLI::Option* motionOption = app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc; an avatar file's animation, .glb, .gltf, .dae, .fbx; or an H-Anim humanoid's interpolators, .wrl)");
+  CLI::Option* motionOption = app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc; an avatar file's animation, .glb, .gltf, .dae, .fbx; or an H-Anim humanoid's interpolators, .wrl); none: at rest. Without it, a scene whose own interpolators move its Humanoid plays them");
   app.add_option("--animation", o.animation, "With an avatar file as --motion (.glb, .gltf, .dae, .fbx, .wrl): which of its animations (of a .wrl, its animated Humanoids) plays, by name or by index from 0 (default: the first; drape inspect FILE lists them)")
       ->needs(motionOption);
   app.add_option("--frames", o.frames, "With a scene: frames to simulate (default: the lead-in and the whole motion)");
@@ -75,7 +75,8 @@ RunFunction setupRender(CLI::App& app) {
     std::filesystem::path scratch;
     if (std::filesystem::is_regular_file(o.run)) {
       RunSetup setup = runSetupFromScene(o.run);
-      if (!o.motion.empty()) addMotion(setup, o.motion, 0.0, "", o.animation);
+      if (const MotionChoice m = sceneMotion(setup, o.run, o.motion, o.animation); !m.path.empty())
+        addMotion(setup, m.path, 0.0, "", m.animation);
       setup.frames = o.frames > 0 ? o.frames : defaultFrames(setup);
       if (o.runOut.empty()) {
         scratch = std::filesystem::temp_directory_path() / fmt::format("drape-render-{}", ::getpid());

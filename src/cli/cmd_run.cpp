@@ -254,7 +254,8 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     applyOffsets(o, setup);
     applyCollisionOptions(app, o, setup);
   }
-  if (!o.motion.empty() && !avatar)
+  const MotionChoice motion = sceneMotion(setup, o.scene, o.motion, o.animation);
+  if (!motion.path.empty() && !avatar)
     throw Error("--motion: there is no avatar to move (the scene has none; without a scene, give --avatar FILE)");
   for (const std::string& sphere : o.spheres) {
     const auto comma = sphere.rfind(',');
@@ -264,7 +265,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     setup.spheres.push_back({c, r.z()});
   }
 
-  if (app.count("--keep-apart") && !keepApartParts(o.keepApart).empty() && o.motion.empty())
+  if (app.count("--keep-apart") && !keepApartParts(o.keepApart).empty() && motion.path.empty())
     throw Error("--keep-apart corrects a motion: give --motion FILE too");
   if (setup.character) {
     CharacterSetup& ch = *setup.character;
@@ -275,7 +276,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     if (!(o.settle_s >= 0)) throw Error(fmt::format("--settle must be >= 0 s, got {}", o.settle_s));
     ch.settle_s = o.settle_s;
     if (app.count("--keep-apart")) setKeepApart(ch, o.keepApart);
-    if (!o.motion.empty()) addMotion(setup, o.motion, o.motionScale, o.jointMap, o.animation);
+    if (!motion.path.empty()) addMotion(setup, motion.path, o.motionScale, o.jointMap, motion.animation);
   }
 
   if (app.count("--substeps") || o.scene.empty()) {
@@ -319,7 +320,7 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("scene", o->scene, "VRML97 scene with ClothSet garments (and an avatar)");
   app.add_option("--garment", o->garment, "Garment mesh (OBJ), instead of a scene");
   app.add_option("--avatar", o->avatar, "Avatar to wear --garment (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel)");
-  CLI::Option* motionOption = app.add_option("--motion", o->motion, "Motion for the avatar (.bvh, .amc; an avatar file's animation, .glb, .gltf, .dae, .fbx; or an H-Anim humanoid's interpolators, .wrl), retargeted unless the avatar is that file's");
+  CLI::Option* motionOption = app.add_option("--motion", o->motion, "Motion for the avatar (.bvh, .amc; an avatar file's animation, .glb, .gltf, .dae, .fbx; or an H-Anim humanoid's interpolators, .wrl), retargeted unless the avatar is that file's; none: at rest. Without it, a scene whose own interpolators move its Humanoid plays them");
   app.add_option("--joint-map", o->jointMap, "JSON map from the motion's joint names to the avatar's");
   app.add_option("--animation", o->animation, "With an avatar file as --motion (.glb, .gltf, .dae, .fbx, .wrl): which of its animations (of a .wrl, its animated Humanoids) plays, by name or by index from 0 (default: the first; drape inspect FILE lists them)")
       ->needs(motionOption);

@@ -23,6 +23,7 @@
 #include "drape/formats/run_manifest.hpp"
 #include "drape/formats/state_cache.hpp"
 #include "drape/formats/gltf_writer.hpp"
+#include "drape/formats/hanim_motion.hpp"
 #include "drape/formats/vrml_write.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/render/frame.hpp"
@@ -287,6 +288,30 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
   // Frames the motion file holds but drape does not play: say so, the timing shifts.
   if (report.referenceTPoseSkipped) spdlog::info("{}: {}", motionPath, report.referenceTPose());
   if (report.restUnfoldFramesSkipped > 0) spdlog::info("{}: {}", motionPath, report.restUnfoldSkipped());
+}
+
+MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, const std::string& motion,
+                         const std::string& animation) {
+  if (motion == "none") return {};
+  if (!motion.empty()) return {motion, animation};
+  if (scenePath.empty() || !setup.character || !formats::isVrmlPath(scenePath)) return {};
+  // A Humanoid of the scene file itself (an Avatar node's url, or an Inline, is another
+  // file): its interpolators play where ROUTEs feed them. No ROUTE at all, the common case,
+  // costs no second reading of the scene.
+  const scene::Avatar& avatar = *setup.character->avatar;
+  std::error_code ec;
+  if (!std::filesystem::equivalent(avatar.source, scenePath, ec)) return {};
+  std::ifstream in(scenePath, std::ios::binary);
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (text.find("ROUTE") == std::string::npos) return {};
+  for (const formats::SkinnedJointMotion& m : formats::readHanimMotions(scenePath, setup.settings.frameRate_hz))
+    if (m.animation == avatar.name) {
+      spdlog::info("{}: the scene's interpolators move its Humanoid '{}', which plays them ({:.3g} s; --motion none "
+                   "keeps it at rest)",
+                   scenePath, avatar.name, m.end_s - m.start_s);
+      return {scenePath, avatar.name};
+    }
+  return {};
 }
 
 namespace {

@@ -75,6 +75,17 @@ struct RunSetup {
 void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerUnit = 0.0,
                const std::string& jointMap = "", const std::string& animation = "");
 
+/// The motion a scene command plays (`drape run`, `play`, `render`): `motion` as given, none
+/// for "none" (the avatar stays at rest), and with none given the scene's own, where the
+/// scene's avatar is a Humanoid written in the scene file and ROUTEd interpolators drive it:
+/// the scene animates it, as a VRML97 browser would (logged, with how to keep it at rest).
+struct MotionChoice {
+  std::string path;       ///< "": no motion
+  std::string animation;  ///< for addMotion: which of the file's animations
+};
+[[nodiscard]] MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, const std::string& motion,
+                                       const std::string& animation);
+
 /// The character's world of a setup with an avatar: fields built, masks bound, solvers
 /// ready. Used by `drape run`, `drape play SCENE` and `drape bench paper` alike.
 [[nodiscard]] std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup);

@@ -315,7 +315,7 @@ TEST(HanimMotionRun, TheSkirtWalksTheSameOnTheConvertedHumanoid) {
   std::ofstream(dir / "scene.wrl") << scene;
 
   const std::string onHumanoid =
-      testing::runInto(dir, "humanoid", "'" + (dir / "scene.wrl") + "' --motion '" + wrl + "' --frames 12");
+      testing::runInto(dir, "humanoid", fmt::format("'{}' --motion '{}' --frames 12", dir / "scene.wrl", wrl));
   const std::string onBody = testing::runInto(
       dir, "body", "'" + testing::kSkirtDir + "/scene.wrl' --motion '" + testing::kSkirtDir + "/walk.bvh' --frames 12");
   const formats::Pc2Cache a = formats::readPc2(onHumanoid + "/garment.pc2");
@@ -344,13 +344,32 @@ TEST(HanimMotionRun, TheSkirtWalksTheSameOnTheConvertedHumanoid) {
   inScene.replace(inScene.find("avatar USE Body"), 15, "avatar USE " + name);
   std::ofstream(dir / "animated.wrl") << inScene;
   const std::string ownMotion = testing::runInto(
-      dir, "own", "'" + (dir / "animated.wrl") + "' --motion '" + (dir / "animated.wrl") + "' --frames 12");
+      dir, "own", fmt::format("'{0}' --motion '{0}' --frames 12", dir / "animated.wrl"));
   const formats::Pc2Cache c = formats::readPc2(ownMotion + "/garment.pc2");
   ASSERT_EQ(c.frames.size(), 13u);
   worst = 0.0;
   for (std::size_t f = 0; f < c.frames.size(); ++f)
     for (std::size_t v = 0; v < c.pointCount; ++v) worst = std::max(worst, (c.frames[f][v] - b.frames[f][v]).norm());
   EXPECT_LT(worst, 1e-4) << "m, the largest gap between the skirt on the scene's own humanoid and on the body";
+
+  // Without --motion the scene animates its humanoid by itself, as a VRML97 browser would,
+  // and says so; `--motion none` keeps it at rest.
+  CliResult r2 = runDrape("run '" + (dir / "animated.wrl") + "' --frames 12 --out '" + (dir / "by-itself") + "'", dir);
+  ASSERT_EQ(r2.code, 0) << r2.err;
+  EXPECT_NE(r2.err.find("the scene's interpolators move its Humanoid 'makehuman_CMU compliant skeleton', which plays "
+                        "them (4.67 s; --motion none keeps it at rest)"),
+            std::string::npos)
+      << r2.err;
+  const formats::Pc2Cache d = formats::readPc2(dir / "by-itself/garment.pc2");
+  ASSERT_EQ(d.frames.size(), 13u);
+  worst = 0.0;
+  for (std::size_t f = 0; f < d.frames.size(); ++f)
+    for (std::size_t v = 0; v < d.pointCount; ++v) worst = std::max(worst, (d.frames[f][v] - c.frames[f][v]).norm());
+  EXPECT_EQ(worst, 0.0) << "m: the scene by itself plays what --motion scene.wrl plays";
+  r2 = runDrape("run '" + (dir / "animated.wrl") + "' --motion none --frames 2 --out '" + (dir / "at-rest") + "'", dir);
+  ASSERT_EQ(r2.code, 0) << r2.err;
+  EXPECT_EQ(r2.err.find("plays them"), std::string::npos) << r2.err;
+  EXPECT_EQ(r2.err.find("joint map"), std::string::npos) << r2.err;
 }
 
 // A humanoid whose Joints carry H-Anim's standard names (HumanoidRoot, l_hip, l_knee, vl5,

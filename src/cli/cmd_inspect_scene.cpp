@@ -2,6 +2,8 @@
 // of an animated humanoid), garments (vertices, triangles, boundary loops, mask size),
 // materials with units, simulation settings and warnings of a VRML97 scene.
 
+#include <algorithm>
+
 #include <fmt/ostream.h>
 
 #include "command.hpp"
@@ -69,13 +71,21 @@ void printGarment(std::ostream& out, const scene::Scene& s, const scene::Garment
                1e3 * widestStitch_m(g.mesh, g.stitches));
 }
 
-/// The interpolators that animate the file's humanoids: what `--motion FILE` plays.
-void printHumanoidMotions(const std::string& path, std::ostream& out) {
+/// The interpolators that animate the file's humanoids: what `--motion FILE` plays, and what
+/// `drape run FILE` plays by itself on the humanoid the file's garments wear.
+void printHumanoidMotions(const std::string& path, const scene::Scene& s, std::ostream& out) {
   const std::vector<formats::SkinnedJointMotion> motions = formats::readHanimMotions(path, 30.0);
-  for (const formats::SkinnedJointMotion& m : motions)
-    fmt::print(out, "  {} moves: {:.3f} s of interpolators, {} frames at 30 Hz; drape run ... --motion {}{} plays it\n",
-               m.animation, m.end_s - m.start_s, m.frameCount(), path,
-               motions.size() > 1 ? fmt::format(" --animation '{}'", m.animation) : std::string());
+  for (const formats::SkinnedJointMotion& m : motions) {
+    const bool worn = std::any_of(s.garments.begin(), s.garments.end(), [&](const scene::Garment& g) {
+      return g.avatar >= 0 && s.avatars[static_cast<std::size_t>(g.avatar)].name == m.animation;
+    });
+    const std::string plays =
+        worn ? fmt::format("drape run {} plays it by itself (--motion none: at rest)", path)
+             : fmt::format("drape run ... --motion {}{} plays it", path,
+                           motions.size() > 1 ? fmt::format(" --animation '{}'", m.animation) : std::string());
+    fmt::print(out, "  {} moves: {:.3f} s of interpolators, {} frames at 30 Hz; {}\n", m.animation, m.end_s - m.start_s,
+               m.frameCount(), plays);
+  }
 }
 
 void inspectScene(const std::string& path, std::ostream& out) {
@@ -90,7 +100,7 @@ void inspectScene(const std::string& path, std::ostream& out) {
     for (std::size_t j = 0; j < a.joints.size(); ++j)
       if (a.joints[j].parent < 0) printJoint(out, a, static_cast<int>(j), 0);
   }
-  if (!s.avatars.empty()) printHumanoidMotions(path, out);
+  if (!s.avatars.empty()) printHumanoidMotions(path, s, out);
   for (const scene::ExternalAvatar& a : s.externalAvatars)
     fmt::print(out, "  {} (from {}){}{}\n", a.name, fmt::join(a.urls, ", "),
                a.jointMap.empty() ? "" : fmt::format(", joint map {}", fmt::join(a.jointMap, ", ")),

@@ -353,8 +353,14 @@ TEST(HanimMotionRun, TheSkirtWalksTheSameOnTheConvertedHumanoid) {
   EXPECT_LT(worst, 1e-4) << "m, the largest gap between the skirt on the scene's own humanoid and on the body";
 
   // Without --motion the scene animates its humanoid by itself, as a VRML97 browser would,
-  // and says so; `--motion none` keeps it at rest.
-  CliResult r2 = runDrape("run '" + (dir / "animated.wrl") + "' --frames 12 --out '" + (dir / "by-itself") + "'", dir);
+  // and says so, as `drape inspect` does; `--motion none` keeps it at rest.
+  CliResult r2 = runDrape("inspect '" + (dir / "animated.wrl") + "'", dir);
+  ASSERT_EQ(r2.code, 0) << r2.err;
+  EXPECT_NE(r2.out.find("makehuman_CMU compliant skeleton moves: 4.667 s of interpolators, 141 frames at 30 Hz; drape "
+                        "run " + (dir / "animated.wrl") + " plays it by itself (--motion none: at rest)"),
+            std::string::npos)
+      << r2.out;
+  r2 = runDrape("run '" + (dir / "animated.wrl") + "' --frames 12 --out '" + (dir / "by-itself") + "'", dir);
   ASSERT_EQ(r2.code, 0) << r2.err;
   EXPECT_NE(r2.err.find("the scene's interpolators move its Humanoid 'makehuman_CMU compliant skeleton', which plays "
                         "them (4.67 s; --motion none keeps it at rest)"),

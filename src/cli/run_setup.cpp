@@ -292,7 +292,12 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
 
 MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, const std::string& motion,
                          const std::string& animation) {
-  if (motion == "none") return {};
+  if (motion == "none") {
+    if (!animation.empty())
+      throw Error(fmt::format("--animation {}: it chooses one of a motion file's animations, and --motion none plays none",
+                              animation));
+    return {};
+  }
   if (!motion.empty()) return {motion, animation};
   if (scenePath.empty() || !setup.character || !formats::isVrmlPath(scenePath)) return {};
   // A Humanoid of the scene file itself (an Avatar node's url, or an Inline, is another

@@ -376,6 +376,12 @@ TEST(HanimMotionRun, TheSkirtWalksTheSameOnTheConvertedHumanoid) {
   ASSERT_EQ(r2.code, 0) << r2.err;
   EXPECT_EQ(r2.err.find("plays them"), std::string::npos) << r2.err;
   EXPECT_EQ(r2.err.find("joint map"), std::string::npos) << r2.err;
+  r2 = runDrape("run '" + (dir / "animated.wrl") + "' --motion none --animation 0 --frames 2 --out '" + (dir / "x") + "'",
+                dir);
+  EXPECT_EQ(r2.code, 2);
+  EXPECT_NE(r2.err.find("--animation 0: it chooses one of a motion file's animations, and --motion none plays none"),
+            std::string::npos)
+      << r2.err;
 }
 
 // A humanoid whose Joints carry H-Anim's standard names (HumanoidRoot, l_hip, l_knee, vl5,

@@ -98,6 +98,35 @@ Converted convertWithMotion(const MotionCase& c, const ScratchDir& dir) {
   return out;
 }
 
+/// The MakeHuman body with the bundled CMU walk, which most cases here convert.
+const MotionCase kMakeHumanWalk{"MakeHumanWithTheBundledWalk", "makehuman_rig_cmu_mb.mhskel",
+                                "examples/walking_skirt/walk.bvh", 141};
+
+/// `text` with its one `from` replaced by `to`; a test failure where `from` is missing.
+std::string replacedOnce(std::string text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  if (at == std::string::npos) {
+    ADD_FAILURE() << "'" << from << "' is not in the text";
+    return text;
+  }
+  return text.replace(at, from.size(), to);
+}
+
+/// The largest distance between the same point in the same frame of two caches of one
+/// garment (frames and points as many as `a` has).
+double largestGap(const formats::Pc2Cache& a, const formats::Pc2Cache& b) {
+  double worst = 0.0;
+  for (std::size_t f = 0; f < a.frames.size(); ++f)
+    for (std::size_t v = 0; v < a.pointCount; ++v) worst = std::max(worst, (a.frames[f][v] - b.frames[f][v]).norm());
+  return worst;
+}
+
+/// The bundled walking skirt's scene with its avatar from `url` (relative to the scene).
+std::string skirtSceneOn(const std::string& url) {
+  return replacedOnce(testing::slurp(testing::kSkirtDir + "/scene.wrl"),
+                      "url \"../../data/avatars/makehuman_rig_cmu_mb.mhskel\"", "url \"" + url + "\"");
+}
+
 class ConvertWithMotion : public ::testing::TestWithParam<MotionCase> {};
 
 // The humanoid written with its motion, read back by drape's VRML97 reader (Coin3D): each
@@ -169,8 +198,7 @@ TEST_P(ConvertWithMotion, TheJointsInterpolatorsPoseTheBodyAsTheMotionDoes) {
 INSTANTIATE_TEST_SUITE_P(
     Avatars, ConvertWithMotion,
     ::testing::Values(MotionCase{"CesiumMansOwnWalk", "CesiumMan.glb", "", 61},
-                      MotionCase{"MakeHumanWithTheBundledWalk", "makehuman_rig_cmu_mb.mhskel",
-                                 "examples/walking_skirt/walk.bvh", 141}),
+                      kMakeHumanWalk),
     [](const auto& info) { return std::string(info.param.name); });
 
 // Errors name what is wrong: an animation the file does not have, and one asked of a file
@@ -238,17 +266,14 @@ TEST_P(HanimMotionBack, DrapePlaysTheWrittenMotionAsTheOriginal) {
 INSTANTIATE_TEST_SUITE_P(
     Avatars, HanimMotionBack,
     ::testing::Values(MotionCase{"CesiumMansOwnWalk", "CesiumMan.glb", "", 61},
-                      MotionCase{"MakeHumanWithTheBundledWalk", "makehuman_rig_cmu_mb.mhskel",
-                                 "examples/walking_skirt/walk.bvh", 141}),
+                      kMakeHumanWalk),
     [](const auto& info) { return std::string(info.param.name); });
 
 // A joint map forces the humanoid's motion through retargeting, as a BVH's: onto the very
 // skeleton it moves, the retargeted motion is the motion itself, but for the floor fit.
 TEST(HanimMotionBack, RetargetedOntoItsOwnSkeletonItIsTheSameMotion) {
   ScratchDir dir("hanim-retarget");
-  const std::string body = std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel";
-  const std::string wrl = dir / "walker.wrl";
-  const CliResult r = runDrape("convert '" + body + "' --motion '" + testing::kSkirtDir + "/walk.bvh' --to '" + wrl + "'", dir);
+  const auto [body, unusedMotion, wrl, r] = convertWithMotion(kMakeHumanWalk, dir);
   ASSERT_EQ(r.code, 0) << r.err;
   const scene::Avatar avatar = scene::loadAvatarFile(body);
   motion::MotionOptions options;
@@ -273,11 +298,12 @@ TEST(HanimMotionBack, RetargetedOntoItsOwnSkeletonItIsTheSameMotion) {
 // rigid parts, and says so.
 TEST(HanimMotionBack, TheHumanoidConvertsAgainWithItsMotionButNotToASkinnedFormat) {
   ScratchDir dir("hanim-convert-again");
-  const std::string body = std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel";
-  const std::string wrl = dir / "walker.wrl", again = dir / "again.wrl";
-  CliResult r = runDrape("convert '" + body + "' --motion '" + testing::kSkirtDir + "/walk.bvh' --to '" + wrl + "'", dir);
-  ASSERT_EQ(r.code, 0) << r.err;
-  r = runDrape("inspect '" + wrl + "'", dir);
+  const Converted walker = convertWithMotion(kMakeHumanWalk, dir);
+  ASSERT_EQ(walker.result.code, 0) << walker.result.err;
+  const std::string& body = walker.avatar;
+  const std::string& wrl = walker.wrl;
+  const std::string again = dir / "again.wrl";
+  CliResult r = runDrape("inspect '" + wrl + "'", dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("makehuman_CMU compliant skeleton moves: 4.667 s of interpolators, 141 frames at 30 Hz; drape "
                        "run ... --motion " + wrl + " plays it"),
@@ -304,15 +330,10 @@ TEST(HanimMotionBack, TheHumanoidConvertsAgainWithItsMotionButNotToASkinnedForma
 // with the BVH walk.
 TEST(HanimMotionRun, TheSkirtWalksTheSameOnTheConvertedHumanoid) {
   ScratchDir dir("hanim-run");
-  const std::string body = std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel";
-  const std::string wrl = dir / "walker.wrl";
-  CliResult r = runDrape("convert '" + body + "' --motion '" + testing::kSkirtDir + "/walk.bvh' --to '" + wrl + "'", dir);
-  ASSERT_EQ(r.code, 0) << r.err;
-  std::string scene = testing::slurp(testing::kSkirtDir + "/scene.wrl");
-  const std::string url = "url \"../../data/avatars/makehuman_rig_cmu_mb.mhskel\"";
-  ASSERT_NE(scene.find(url), std::string::npos);
-  scene.replace(scene.find(url), url.size(), "url \"walker.wrl\"");
-  std::ofstream(dir / "scene.wrl") << scene;
+  const Converted converted = convertWithMotion(kMakeHumanWalk, dir);
+  ASSERT_EQ(converted.result.code, 0) << converted.result.err;
+  const std::string& wrl = converted.wrl;
+  std::ofstream(dir / "scene.wrl") << skirtSceneOn("walker.wrl");
 
   const std::string onHumanoid =
       testing::runInto(dir, "humanoid", fmt::format("'{}' --motion '{}' --frames 12", dir / "scene.wrl", wrl));
@@ -322,10 +343,7 @@ TEST(HanimMotionRun, TheSkirtWalksTheSameOnTheConvertedHumanoid) {
   const formats::Pc2Cache b = formats::readPc2(onBody + "/garment.pc2");
   ASSERT_EQ(a.frames.size(), 13u);
   ASSERT_EQ(b.frames.size(), 13u);
-  double worst = 0.0;
-  for (std::size_t f = 0; f < a.frames.size(); ++f)
-    for (std::size_t v = 0; v < a.pointCount; ++v) worst = std::max(worst, (a.frames[f][v] - b.frames[f][v]).norm());
-  EXPECT_LT(worst, 1e-4) << "m, the largest gap between the two skirts";
+  EXPECT_LT(largestGap(a, b), 1e-4) << "m, the largest gap between the two skirts";
   EXPECT_EQ(testing::statsOf(onHumanoid)["vertex_substeps_inside_body"], 0);
 
   // The animated humanoid written into the scene itself, in the Avatar node's place: the
@@ -336,21 +354,14 @@ TEST(HanimMotionRun, TheSkirtWalksTheSameOnTheConvertedHumanoid) {
   ASSERT_NE(humanoid, std::string::npos);
   const std::size_t def = walker.rfind("DEF ", humanoid) + 4;
   const std::string name = walker.substr(def, humanoid - def);
-  std::string inScene = testing::slurp(testing::kSkirtDir + "/scene.wrl");
-  const std::string avatarNode = "DEF Body Avatar {\n  " + url + "\n}";
-  ASSERT_NE(inScene.find(avatarNode), std::string::npos);
-  inScene.replace(inScene.find(avatarNode), avatarNode.size(), walker);
-  ASSERT_NE(inScene.find("avatar USE Body"), std::string::npos);
-  inScene.replace(inScene.find("avatar USE Body"), 15, "avatar USE " + name);
-  std::ofstream(dir / "animated.wrl") << inScene;
+  std::ofstream(dir / "animated.wrl") << replacedOnce(
+      replacedOnce(skirtSceneOn("walker.wrl"), "DEF Body Avatar {\n  url \"walker.wrl\"\n}", walker),
+      "avatar USE Body", "avatar USE " + name);
   const std::string ownMotion = testing::runInto(
       dir, "own", fmt::format("'{0}' --motion '{0}' --frames 12", dir / "animated.wrl"));
   const formats::Pc2Cache c = formats::readPc2(ownMotion + "/garment.pc2");
   ASSERT_EQ(c.frames.size(), 13u);
-  worst = 0.0;
-  for (std::size_t f = 0; f < c.frames.size(); ++f)
-    for (std::size_t v = 0; v < c.pointCount; ++v) worst = std::max(worst, (c.frames[f][v] - b.frames[f][v]).norm());
-  EXPECT_LT(worst, 1e-4) << "m, the largest gap between the skirt on the scene's own humanoid and on the body";
+  EXPECT_LT(largestGap(c, b), 1e-4) << "m, the largest gap between the skirt on the scene's own humanoid and on the body";
 
   // Without --motion the scene animates its humanoid by itself, as a VRML97 browser would,
   // and says so, as `drape inspect` does; `--motion none` keeps it at rest.
@@ -368,10 +379,7 @@ TEST(HanimMotionRun, TheSkirtWalksTheSameOnTheConvertedHumanoid) {
       << r2.err;
   const formats::Pc2Cache d = formats::readPc2(dir / "by-itself/garment.pc2");
   ASSERT_EQ(d.frames.size(), 13u);
-  worst = 0.0;
-  for (std::size_t f = 0; f < d.frames.size(); ++f)
-    for (std::size_t v = 0; v < d.pointCount; ++v) worst = std::max(worst, (d.frames[f][v] - c.frames[f][v]).norm());
-  EXPECT_EQ(worst, 0.0) << "m: the scene by itself plays what --motion scene.wrl plays";
+  EXPECT_EQ(largestGap(d, c), 0.0) << "m: the scene by itself plays what --motion scene.wrl plays";
   r2 = runDrape("run '" + (dir / "animated.wrl") + "' --motion none --frames 2 --out '" + (dir / "at-rest") + "'", dir);
   ASSERT_EQ(r2.code, 0) << r2.err;
   EXPECT_EQ(r2.err.find("plays them"), std::string::npos) << r2.err;
@@ -392,11 +400,10 @@ TEST(HanimMotionRun, TheSkirtWalksTheSameOnTheConvertedHumanoid) {
 // through that map reversed.
 TEST(HanimNames, AStandardHumanoidsMotionDrivesTheBodyAndTheCaptureDrivesIt) {
   ScratchDir dir("hanim-names");
-  const std::string body = std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel";
+  const auto [body, unusedMotion, walker, converted] = convertWithMotion(kMakeHumanWalk, dir);
+  ASSERT_EQ(converted.code, 0) << converted.err;
   const std::string maps = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";
-  const std::string walker = dir / "walker.wrl", standard = dir / "standard.wrl";
-  CliResult r = runDrape("convert '" + body + "' --motion '" + testing::kSkirtDir + "/walk.bvh' --to '" + walker + "'", dir);
-  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string standard = dir / "standard.wrl";
   std::string text = testing::slurp(walker);
   const motion::JointMap hanim = motion::readJointMap(maps + "/hanim.json");
   for (const motion::JointMapEntry& e : hanim.entries) {
@@ -422,18 +429,13 @@ TEST(HanimNames, AStandardHumanoidsMotionDrivesTheBodyAndTheCaptureDrivesIt) {
   EXPECT_LT(largestPoseGap(avatar, viaHanim, viaSamePairs), 1e-9) << "m";
 
   // The standard humanoid as the walking skirt's avatar, with the capture.
-  std::string scene = testing::slurp(testing::kSkirtDir + "/scene.wrl");
-  const std::string url = "url \"../../data/avatars/makehuman_rig_cmu_mb.mhskel\"";
-  ASSERT_NE(scene.find(url), std::string::npos);
-  scene.replace(scene.find(url), url.size(), "url \"standard.wrl\"");
-  const std::string collides = R"(collidesWith [ "LowerBack", "Hips", "LeftUpLeg", "RightUpLeg", "LeftLeg", "RightLeg" ])";
-  ASSERT_NE(scene.find(collides), std::string::npos);
-  scene.replace(scene.find(collides), collides.size(),
-                R"(collidesWith [ "vl5", "HumanoidRoot", "l_hip", "r_hip", "l_knee", "r_knee" ])");
-  std::ofstream(dir / "scene.wrl") << scene;
-  r = runDrape("run '" + (dir / "scene.wrl") + "' --motion '" + testing::kSkirtDir + "/walk.bvh' --frames 12 --out '" +
-                   (dir / "out") + "'",
-               dir);
+  std::ofstream(dir / "scene.wrl") << replacedOnce(
+      skirtSceneOn("standard.wrl"),
+      R"(collidesWith [ "LowerBack", "Hips", "LeftUpLeg", "RightUpLeg", "LeftLeg", "RightLeg" ])",
+      R"(collidesWith [ "vl5", "HumanoidRoot", "l_hip", "r_hip", "l_knee", "r_knee" ])");
+  const CliResult r = runDrape(
+      fmt::format("run '{}' --motion '{}/walk.bvh' --frames 12 --out '{}'", dir / "scene.wrl", testing::kSkirtDir, dir / "out"),
+      dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("joint map 'motionbuilder + hanim (reversed)' drives 29 of the avatar's 31 joints"), std::string::npos)
       << r.err;

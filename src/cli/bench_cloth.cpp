@@ -288,7 +288,7 @@ RunFunction setupBenchCloth(CLI::App& app) {
   return [o] { return runBench(*o); };
 }
 
-const bool registered = registerCommand(
+const bool registered_bench_cloth = registerCommand(
     {"cloth", "Cloth step speed and stability on a falling sheet, beside Bullet's soft bodies", "bench", 10,
      &setupBenchCloth});
 

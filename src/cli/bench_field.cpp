@@ -68,7 +68,7 @@ RunFunction setupBenchField(CLI::App& app) {
   };
 }
 
-const bool registered = registerCommand(
+const bool registered_bench_field = registerCommand(
     {"field", "Distance fields on the paper's Table 2 grids: DVDP vs the exact transform", "bench", 100,
      &setupBenchField});
 

@@ -279,7 +279,7 @@ RunFunction setupPaperBench(CLI::App& app) {
   };
 }
 
-const bool registered = registerCommand(
+const bool registered_bench_paper = registerCommand(
     {"paper", "The paper's walking-skirt scenario (Table 3) without rendering", "bench", 30, &setupPaperBench});
 
 }  // namespace

@@ -109,7 +109,7 @@ RunFunction setupBenchRender(CLI::App& app) {
   };
 }
 
-const bool registered =
+const bool registered_bench_render =
     registerCommand({"render", "Headless rendering speed (draw + read-back, PNG encoding)", "bench", 40, &setupBenchRender});
 
 }  // namespace

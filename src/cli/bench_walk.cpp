@@ -122,7 +122,7 @@ RunFunction setupBenchWalk(CLI::App& app) {
   };
 }
 
-const bool registered = registerCommand(
+const bool registered_bench_walk = registerCommand(
     {"walk", "The collision trace's voxel walk: 3D Bresenham vs the paper's lookup table", "bench", 110,
      &setupBenchWalk});
 

@@ -12,7 +12,7 @@ RunFunction setupBench(CLI::App& app) {
   return [] { return 0; };
 }
 
-const bool registered = registerCommand({"bench", "Run a benchmark and print its figures as JSON", "", 90, &setupBench});
+const bool registered_cmd_bench = registerCommand({"bench", "Run a benchmark and print its figures as JSON", "", 90, &setupBench});
 
 }  // namespace
 }  // namespace drape::cli

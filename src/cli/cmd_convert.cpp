@@ -182,7 +182,7 @@ RunFunction setupConvert(CLI::App& app) {
   };
 }
 
-const bool registered =
+const bool registered_cmd_convert =
     registerCommand({"convert", "Convert an avatar to a segmented H-Anim VRML97 humanoid, Collada or FBX", "", 40, &setupConvert});
 
 }  // namespace

@@ -32,7 +32,7 @@ RunFunction setupExport(CLI::App& app) {
   };
 }
 
-const bool registered = registerCommand({"export", "Export a run as animated glTF 2.0 (.glb)", "", 42, &setupExport});
+const bool registered_cmd_export = registerCommand({"export", "Export a run as animated glTF 2.0 (.glb)", "", 42, &setupExport});
 
 }  // namespace
 }  // namespace drape::cli

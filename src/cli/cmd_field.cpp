@@ -196,7 +196,7 @@ RunFunction setupField(CLI::App& app) {
   };
 }
 
-const bool registered =
+const bool registered_cmd_field =
     registerCommand({"field", "Build body-part distance fields, print their figures, write PNG slices", "", 40,
                      &setupField});
 

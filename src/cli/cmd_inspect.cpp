@@ -99,7 +99,7 @@ RunFunction setupInspect(CLI::App& app) {
   };
 }
 
-const bool registered = registerCommand(
+const bool registered_cmd_inspect = registerCommand(
     {"inspect", "Print a readable summary of a scene, avatar, motion or mesh file, or of a run", "", 30, &setupInspect});
 
 }  // namespace

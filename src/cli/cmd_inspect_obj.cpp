@@ -27,7 +27,7 @@ void inspectObj(const std::string& path, std::ostream& out) {
   for (const auto& loop : t.boundaryLoops) fmt::print(out, "    {} vertices\n", loop.size());
 }
 
-const bool registered = registerInspector({".obj"}, "OBJ meshes: counts, bounds, boundary loops", &inspectObj);
+const bool registered_cmd_inspect_obj = registerInspector({".obj"}, "OBJ meshes: counts, bounds, boundary loops", &inspectObj);
 
 }  // namespace
 }  // namespace drape::cli

@@ -141,7 +141,7 @@ void inspectScene(const std::string& path, std::ostream& out) {
   for (const std::string& w : s.warnings) fmt::print(out, "warning: {}\n", w);
 }
 
-const bool registered =
+const bool registered_cmd_inspect_scene =
     registerInspector({".wrl", ".vrml"}, "VRML97 scenes: avatars, garments, materials, simulation", &inspectScene);
 
 }  // namespace

@@ -313,7 +313,7 @@ RunFunction setupMakeScene(CLI::App& app) {
   };
 }
 
-const bool registered = registerCommand(
+const bool registered_cmd_make_scene = registerCommand(
     {"make-scene", "Dress an avatar in a garment modelled for it and write a ready-to-run scene", "", 61, &setupMakeScene});
 
 }  // namespace

@@ -133,7 +133,7 @@ RunFunction setupMakeSkirt(CLI::App& app) {
   };
 }
 
-const bool registered = registerCommand({"make-skirt", "Fit a skirt to an avatar and write a ready-to-run scene", "", 60, &setupMakeSkirt});
+const bool registered_cmd_make_skirt = registerCommand({"make-skirt", "Fit a skirt to an avatar and write a ready-to-run scene", "", 60, &setupMakeSkirt});
 
 }  // namespace
 }  // namespace drape::cli

@@ -161,7 +161,7 @@ RunFunction setupPlay(CLI::App& app) {
   };
 }
 
-const bool registered =
+const bool registered_cmd_play =
     registerCommand({"play", "Replay a run, or simulate a scene live, in a window with time code and overlays", "", 41, &setupPlay});
 
 }  // namespace

@@ -119,7 +119,7 @@ RunFunction setupRender(CLI::App& app) {
   };
 }
 
-const bool registered = registerCommand(
+const bool registered_cmd_render = registerCommand(
     {"render", "Render a run (or simulate a scene and render it) to PNG, video and a contact sheet (headless)", "", 40, &setupRender});
 
 }  // namespace

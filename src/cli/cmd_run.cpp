@@ -438,7 +438,7 @@ RunFunction setupRun(CLI::App& app) {
   return [o, &app] { return runCommand(app, *o); };
 }
 
-const bool registered =
+const bool registered_cmd_run =
     registerCommand({"run", "Simulate garments (on a moving avatar) and write frames, caches, VRML97, glTF and stats", "", 10, &setupRun});
 
 }  // namespace

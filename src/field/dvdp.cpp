@@ -15,6 +15,7 @@
 
 #include "drape/core/error.hpp"
 #include "drape/field/propagation.hpp"
+#include "packed_voxel.hpp"
 
 namespace drape::field {
 namespace {
@@ -25,12 +26,10 @@ constexpr std::int32_t kUnprocessed = 1 << 30;
 constexpr std::int32_t kNoOffer = kUnprocessed + 0xffff;
 constexpr std::int32_t kGuard = -1;
 
-std::uint32_t pack(int x, int y, int z) {
-  return static_cast<std::uint32_t>(x) | (static_cast<std::uint32_t>(y) << 10) | (static_cast<std::uint32_t>(z) << 20);
-}
-int px(std::uint32_t p) { return static_cast<int>(p & 1023u); }
-int py(std::uint32_t p) { return static_cast<int>((p >> 10) & 1023u); }
-int pz(std::uint32_t p) { return static_cast<int>(p >> 20); }
+using packed::pack;
+using packed::px;
+using packed::py;
+using packed::pz;
 
 // Neighbour sets by connectivity: 0 face (6), 1 edge (12), 2 corner (8), 3 all 26.
 struct Neighbours {

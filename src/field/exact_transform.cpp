@@ -9,6 +9,7 @@
 
 #include "drape/core/error.hpp"
 #include "drape/field/propagation.hpp"
+#include "packed_voxel.hpp"
 
 namespace drape::field {
 namespace {
@@ -64,9 +65,9 @@ void checkDims(const GridDims& dims) {
                 std::to_string(dims.nz) + " is empty or has a side above " + std::to_string(kMaxGridSide));
 }
 
-int px(std::uint32_t p) { return static_cast<int>(p & 1023u); }
-int py(std::uint32_t p) { return static_cast<int>((p >> 10) & 1023u); }
-int pz(std::uint32_t p) { return static_cast<int>(p >> 20); }
+using packed::px;
+using packed::py;
+using packed::pz;
 
 // The three passes. `feature` (optional) receives the nearest surface voxel's packed
 // coordinates (x | y << 10 | z << 20).

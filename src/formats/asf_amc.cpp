@@ -42,7 +42,7 @@ std::vector<Line> splitLines(std::string_view text) {
   return lines;
 }
 
-struct Reader {
+struct AsfReader {
   std::string file;
   [[nodiscard]] SourcePos at(const Line& l, std::size_t word) const {
     return {file, l.number, word < l.words.size() ? l.words[word].column : 0};
@@ -58,7 +58,7 @@ struct Reader {
   }
 };
 
-AcclaimDof parseDof(const Reader& r, const Line& l, std::size_t word) {
+AcclaimDof parseDof(const AsfReader& r, const Line& l, std::size_t word) {
   std::string w(l.words[word].text);
   std::transform(w.begin(), w.end(), w.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (w == "rx") return AcclaimDof::RX;
@@ -71,7 +71,7 @@ AcclaimDof parseDof(const Reader& r, const Line& l, std::size_t word) {
   throw Error::at(r.at(l, word), fmt::format("unknown degree of freedom {} (expected rx ry rz tx ty tz l)", quoted(l.words[word].text)));
 }
 
-std::string axisOrder(const Reader& r, const Line& l, std::size_t word) {
+std::string axisOrder(const AsfReader& r, const Line& l, std::size_t word) {
   if (word >= l.words.size()) return "XYZ";
   std::string order(l.words[word].text);
   std::transform(order.begin(), order.end(), order.begin(), [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
@@ -82,7 +82,7 @@ std::string axisOrder(const Reader& r, const Line& l, std::size_t word) {
 }
 
 // ":bonedata" blocks: begin ... end.
-std::size_t readBone(const Reader& r, const std::vector<Line>& lines, std::size_t i, AsfSkeleton& out) {
+std::size_t readBone(const AsfReader& r, const std::vector<Line>& lines, std::size_t i, AsfSkeleton& out) {
   AsfBone bone;
   bone.line = lines[i].number;
   bool named = false;
@@ -119,7 +119,7 @@ std::size_t readBone(const Reader& r, const std::vector<Line>& lines, std::size_
 }
 
 // ":hierarchy": "parent child child..." lines; bones are then reordered parents first.
-std::size_t readHierarchy(const Reader& r, const std::vector<Line>& lines, std::size_t i, AsfSkeleton& out) {
+std::size_t readHierarchy(const AsfReader& r, const std::vector<Line>& lines, std::size_t i, AsfSkeleton& out) {
   std::vector<int> parent(out.bones.size(), -2);  // -2: not yet placed
   std::size_t j = i + 1;
   if (j < lines.size() && lines[j].words[0].text == "begin") ++j;
@@ -169,7 +169,7 @@ int AsfSkeleton::find(std::string_view bone) const {
 }
 
 AsfSkeleton parseAsf(std::string_view text, const std::string& name) {
-  const Reader r{name};
+  const AsfReader r{name};
   const std::vector<Line> lines = splitLines(text);
   AsfSkeleton out;
   out.source = name;
@@ -222,7 +222,7 @@ AsfSkeleton parseAsf(std::string_view text, const std::string& name) {
 AsfSkeleton readAsf(const std::string& path) { return parseAsf(detail::readWholeFile(path), path); }
 
 AmcMotion parseAmc(std::string_view text, const std::string& name, const AsfSkeleton& skeleton) {
-  const Reader r{name};
+  const AsfReader r{name};
   const std::vector<Line> lines = splitLines(text);
   AmcMotion out;
   out.source = name;

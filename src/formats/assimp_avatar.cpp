@@ -29,7 +29,7 @@ namespace drape::formats {
 namespace {
 
 constexpr std::size_t kMaxVertices = 10'000'000;
-constexpr std::size_t kMaxJoints = 1024;
+constexpr std::size_t kMaxAvatarJoints = 1024;
 constexpr std::size_t kMaxFileBytes = std::size_t{1} << 30;
 
 enum class Format { Collada, Fbx };
@@ -336,7 +336,7 @@ std::vector<const aiNode*> skeletonNodes(const SceneReader& r, const std::vector
   std::unordered_set<const aiNode*> member{root};
   for (const aiNode* b : bones)
     for (const aiNode* n = b; n != root && member.insert(n).second; n = n->mParent)
-      if (member.size() > kMaxJoints) r.fail(fmt::format("its skeleton has more than {} joints", kMaxJoints));
+      if (member.size() > kMaxAvatarJoints) r.fail(fmt::format("its skeleton has more than {} joints", kMaxAvatarJoints));
   std::vector<const aiNode*> order;
   std::vector<const aiNode*> stack{root};
   while (!stack.empty()) {
@@ -703,7 +703,7 @@ struct MotionRig {
 void checkWritable(const SkinnedModel& model, const std::string& path) {
   const std::size_t n = model.positions.size();
   if (model.joints.empty()) throw Error(fmt::format("{}: an avatar without joints cannot be written as a skinned model", path));
-  if (model.joints.size() > kMaxJoints) throw Error(fmt::format("{}: more than {} joints", path, kMaxJoints));
+  if (model.joints.size() > kMaxAvatarJoints) throw Error(fmt::format("{}: more than {} joints", path, kMaxAvatarJoints));
   if (model.vertexJoints.size() != n || model.vertexWeights.size() != n)
     throw Error(fmt::format("{}: the skin has weights for {} of {} vertices", path, model.vertexWeights.size(), n));
   for (std::size_t j = 0; j < model.joints.size(); ++j)

@@ -14,7 +14,7 @@ using detail::quoted;
 using detail::WordScanner;
 using Word = WordScanner::Word;
 
-constexpr std::size_t kMaxJoints = 10'000;
+constexpr std::size_t kMaxBvhJoints = 10'000;
 constexpr std::size_t kMaxDepth = 256;
 
 void expectWord(WordScanner& s, std::string_view wanted) {
@@ -57,7 +57,7 @@ void readHierarchy(WordScanner& s, BvhFile& out) {
   if (root.text != "ROOT") throw Error::at(s.pos(root), fmt::format("expected 'ROOT', found {}", quoted(root.text)));
   std::vector<int> open;  // joints whose '}' is pending; -2 marks an End Site block
   auto beginJoint = [&](const Word& keyword) {
-    if (out.joints.size() >= kMaxJoints) throw Error::at(s.pos(keyword), fmt::format("more than {} joints", kMaxJoints));
+    if (out.joints.size() >= kMaxBvhJoints) throw Error::at(s.pos(keyword), fmt::format("more than {} joints", kMaxBvhJoints));
     if (open.size() >= kMaxDepth) throw Error::at(s.pos(keyword), fmt::format("joints nested deeper than {}", kMaxDepth));
     const Word name = s.next();
     if (name.text.empty() || name.text == "{") throw Error::at(s.pos(name), "expected a joint name");

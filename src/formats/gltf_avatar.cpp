@@ -330,7 +330,7 @@ GModel parseDocument(std::string_view bytes, const std::string& name, const std:
 
 // ---- accessors, bounds checked ------------------------------------------------------
 
-struct Reader {
+struct GltfReader {
   const GModel& model;
   std::string name;
 
@@ -407,7 +407,7 @@ Eigen::Matrix4d localMatrix(const GNode& node) {
 }
 
 // Each node's parent (-1 for a root), checked: children exist, no node has two parents.
-std::vector<int> nodeParents(const GModel& model, const Reader& r) {
+std::vector<int> nodeParents(const GModel& model, const GltfReader& r) {
   const std::size_t n = model.nodes.size();
   std::vector<int> parent(n, -1);
   for (std::size_t i = 0; i < n; ++i)
@@ -421,7 +421,7 @@ std::vector<int> nodeParents(const GModel& model, const Reader& r) {
 
 // World matrices of every node from their local matrices.
 std::vector<Eigen::Matrix4d> worldsOf(const std::vector<int>& parent, const std::vector<Eigen::Matrix4d>& local,
-                                      const Reader& r) {
+                                      const GltfReader& r) {
   const std::size_t n = parent.size();
   std::vector<Eigen::Matrix4d> world(n, Eigen::Matrix4d::Identity());
   std::vector<int> state(n, 0);  // 0 todo, 1 visiting, 2 done
@@ -446,7 +446,7 @@ std::vector<Eigen::Matrix4d> worldsOf(const std::vector<int>& parent, const std:
 }
 
 // World matrices of every node in the rest pose (the file's node transforms).
-std::vector<Eigen::Matrix4d> nodeWorlds(const GModel& model, std::vector<int>& parent, const Reader& r) {
+std::vector<Eigen::Matrix4d> nodeWorlds(const GModel& model, std::vector<int>& parent, const GltfReader& r) {
   parent = nodeParents(model, r);
   std::vector<Eigen::Matrix4d> local;
   for (const GNode& node : model.nodes) local.push_back(localMatrix(node));
@@ -463,7 +463,7 @@ struct SkinJoints {
   std::vector<int> parent;        ///< k -> the nearest ancestor that is a joint, or -1
 };
 
-SkinJoints skinJoints(const GModel& model, const std::vector<int>& nodeParent, const Reader& r) {
+SkinJoints skinJoints(const GModel& model, const std::vector<int>& nodeParent, const GltfReader& r) {
   if (model.skins.empty()) r.fail("has no skin (a skinned character is needed)");
   const GSkin& skin = model.skins.front();
   if (skin.joints.empty()) r.fail("its skin has no joints");
@@ -506,7 +506,7 @@ SkinJoints skinJoints(const GModel& model, const std::vector<int>& nodeParent, c
 }
 
 SkinnedModel extract(const GModel& model, const std::string& name) {
-  const Reader r{model, name};
+  const GltfReader r{model, name};
   std::vector<int> nodeParent;
   const std::vector<Eigen::Matrix4d> world = nodeWorlds(model, nodeParent, r);
   const SkinJoints sj = skinJoints(model, nodeParent, r);
@@ -658,7 +658,7 @@ struct Track {
 };
 
 /// The tracks of animation `index` that move nodes (weights channels left out), checked.
-std::vector<Track> readTracks(const GModel& model, std::size_t index, const Reader& r) {
+std::vector<Track> readTracks(const GModel& model, std::size_t index, const GltfReader& r) {
   const GAnimation& anim = model.animations[index];
   std::vector<Track> tracks;
   for (std::size_t ci = 0; ci < anim.channels.size(); ++ci) {
@@ -720,7 +720,7 @@ std::vector<std::string> animationNames(const GModel& model) {
 }
 
 GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, double rate, const std::string& which) {
-  const Reader r{model, name};
+  const GltfReader r{model, name};
   const std::vector<std::string> names = animationNames(model);
   const std::size_t index = detail::chooseAnimation(names, which, name);
   std::vector<int> nodeParent;

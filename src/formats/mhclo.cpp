@@ -11,11 +11,11 @@
 namespace drape::formats {
 namespace {
 
-using Word = detail::LineWord;
+using detail::LineWord;
 
 class LineReader {
  public:
-  LineReader(const std::string& name, int line, const std::vector<Word>& words)
+  LineReader(const std::string& name, int line, const std::vector<LineWord>& words)
       : name_(name), line_(line), words_(words) {}
 
   [[nodiscard]] Error error(std::size_t k, const std::string& what) const {
@@ -40,7 +40,7 @@ class LineReader {
  private:
   const std::string& name_;
   int line_;
-  const std::vector<Word>& words_;
+  const std::vector<LineWord>& words_;
 };
 
 MhcloVertex parseVertex(const LineReader& r, std::size_t count) {
@@ -71,7 +71,7 @@ Mhclo parseMhclo(std::string_view text, const std::string& name) {
     const std::string_view line = text.substr(pos, end - pos);
     pos = end + 1;
     ++lineNo;
-    const std::vector<Word> words = detail::lineWords(line);
+    const std::vector<LineWord> words = detail::lineWords(line);
     if (words.empty() || words[0].text.front() == '#') {
       if (end == text.size()) break;
       continue;

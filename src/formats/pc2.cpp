@@ -25,7 +25,7 @@ struct Pc2Header {
 #pragma pack(pop)
 static_assert(sizeof(Pc2Header) == 32);
 
-constexpr char kSignature[12] = {'P', 'O', 'I', 'N', 'T', 'C', 'A', 'C', 'H', 'E', '2', '\0'};
+constexpr char kPc2Signature[12] = {'P', 'O', 'I', 'N', 'T', 'C', 'A', 'C', 'H', 'E', '2', '\0'};
 
 }  // namespace
 
@@ -34,7 +34,7 @@ Pc2Writer::Pc2Writer(const std::string& path, std::size_t pointCount, double sta
   file_ = std::fopen(path.c_str(), "wb");
   if (!file_) throw Error(fmt::format("{}: cannot be written", path));
   Pc2Header h{};
-  std::memcpy(h.signature, kSignature, sizeof kSignature);
+  std::memcpy(h.signature, kPc2Signature, sizeof kPc2Signature);
   h.version = 1;
   h.numPoints = static_cast<std::int32_t>(pointCount);
   h.startFrame = static_cast<float>(startFrame);
@@ -104,7 +104,7 @@ void checkHeaderNumbers(const Pc2Header& h, const std::string& name) {
 Pc2Cache parsePc2(std::string_view bytes, const std::string& name) {
   Pc2Header h{};
   if (bytes.size() >= sizeof h) std::memcpy(&h, bytes.data(), sizeof h);
-  if (bytes.size() < sizeof h || std::memcmp(h.signature, kSignature, sizeof kSignature) != 0 || h.version != 1 ||
+  if (bytes.size() < sizeof h || std::memcmp(h.signature, kPc2Signature, sizeof kPc2Signature) != 0 || h.version != 1 ||
       h.numPoints < 0 || h.numSamples < 0) {
     throw Error(fmt::format("{}: not a PC2 point cache (expected the POINTCACHE2 header, version 1)", name));
   }

@@ -15,7 +15,7 @@
 namespace drape::formats {
 namespace {
 
-constexpr int kVersion = 1;
+constexpr int kManifestVersion = 1;
 
 // The value under `key`; "missing key" when `j` is not an object or lacks it.
 const nlohmann::json& requiredKey(const nlohmann::json& j, const char* key, const std::string& file) {
@@ -56,7 +56,7 @@ double requiredNumber(const nlohmann::json& j, const char* key, const std::strin
 void writeRunManifest(const std::string& directory, const RunManifest& manifest) {
   nlohmann::json j;
   j["format"] = "drape-run";
-  j["version"] = kVersion;
+  j["version"] = kManifestVersion;
   j["frame_rate"] = manifest.frameRate;
   j["frames"] = manifest.frames;
   j["start_frame"] = manifest.startFrame;
@@ -78,7 +78,7 @@ RunManifest parseRunManifest(std::string_view text, const std::string& name) {
   if (format == j.end() || !format->is_string() || format->get<std::string>() != "drape-run")
     throw Error(fmt::format("{}: not a drape run manifest", name));
   const long long version = requiredWhole(j, "version", name);
-  if (version != kVersion) throw Error(fmt::format("{}: manifest version {} (this drape reads {})", name, version, kVersion));
+  if (version != kManifestVersion) throw Error(fmt::format("{}: manifest version {} (this drape reads {})", name, version, kManifestVersion));
   RunManifest m;
   m.frameRate = requiredNumber(j, "frame_rate", name);
   const long long frames = requiredWhole(j, "frames", name);

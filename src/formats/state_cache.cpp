@@ -11,9 +11,9 @@
 namespace drape::formats {
 namespace {
 
-constexpr char kSignature[8] = {'D', 'R', 'A', 'P', 'E', 'S', 'T', 'S'};
+constexpr char kStateSignature[8] = {'D', 'R', 'A', 'P', 'E', 'S', 'T', 'S'};
 constexpr std::size_t kHeaderBytes = 16;
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kStateVersion = 1;
 
 void putUint32(unsigned char* out, std::uint32_t v) {
   for (int b = 0; b < 4; ++b) out[b] = static_cast<unsigned char>(v >> (8 * b));
@@ -35,8 +35,8 @@ StateCacheWriter::StateCacheWriter(const std::string& path, std::size_t vertexCo
   file_ = std::fopen(path.c_str(), "wb");
   if (!file_) throw Error(fmt::format("{}: cannot be written", path));
   unsigned char header[kHeaderBytes];
-  std::memcpy(header, kSignature, sizeof kSignature);
-  putUint32(header + 8, kVersion);
+  std::memcpy(header, kStateSignature, sizeof kStateSignature);
+  putUint32(header + 8, kStateVersion);
   putUint32(header + 12, static_cast<std::uint32_t>(vertexCount));
   if (std::fwrite(header, 1, sizeof header, file_) != sizeof header) throw Error(fmt::format("{}: write failed", path));
 }
@@ -69,12 +69,12 @@ StateCache parseStateCache(std::string_view bytes, const std::string& name) {
   if (bytes.size() < kHeaderBytes)
     throw Error(fmt::format("{}: not a state cache: {} bytes, shorter than the {}-byte header", name, bytes.size(),
                             kHeaderBytes));
-  if (std::memcmp(bytes.data(), kSignature, sizeof kSignature) != 0)
+  if (std::memcmp(bytes.data(), kStateSignature, sizeof kStateSignature) != 0)
     throw Error(fmt::format("{}: not a state cache: expected 'DRAPESTS' at byte 0", name));
   const std::uint32_t version = getUint32(bytes, 8);
-  if (version != kVersion)
+  if (version != kStateVersion)
     throw Error(fmt::format("{}: state cache version {} at byte 8; this drape reads version {}", name, version,
-                            kVersion));
+                            kStateVersion));
   StateCache cache;
   cache.vertexCount = getUint32(bytes, 12);
   if (cache.vertexCount == 0) throw Error(fmt::format("{}: the vertex count at byte 12 is 0", name));

@@ -104,21 +104,21 @@ void onOtherError(const SoError* error, void*) {
 
 // ---- Reading one file with Coin ----------------------------------------------------------
 
-struct Reader;
-Reader* gReader = nullptr;
+struct VrmlReader;
+VrmlReader* gReader = nullptr;
 
 SoProto* fetchExternProto(SoInput* in, const SbString* urls, int count, void* closure);
 
 /// The state of one readWithCoin call: the files open (for Inline cycles), graphs kept
 /// alive, the first problem met inside a Coin callback (reported once Coin returns).
-struct Reader {
+struct VrmlReader {
   std::vector<std::string> fileStack;
   std::vector<std::string> dirStack;  ///< where relative URLs of the file being read point
   std::vector<SoNode*> keepAlive;
   std::string pendingError;
   std::vector<std::string> warnings;
 
-  ~Reader() {
+  ~VrmlReader() {
     for (SoNode* n : keepAlive) n->unref();
   }
 
@@ -165,7 +165,7 @@ std::pair<std::string, std::string> splitFragment(const std::string& url) {
 }
 
 SoProto* fetchExternProto(SoInput*, const SbString* urls, int count, void*) {
-  Reader* reader = gReader;
+  VrmlReader* reader = gReader;
   if (reader == nullptr || reader->fileStack.empty()) return nullptr;
   const std::string& file = reader->fileStack.back();
   const std::string baseDir = reader->dirStack.back();
@@ -228,7 +228,7 @@ void initCoinOnce() {
   // drape resolves Inline URLs itself, through the same scan as every other file.
   SoVRMLInline::setReadAsSoFile(FALSE);
   SoProto::setFetchExternProtoCallback(fetchExternProto, nullptr);
-  Reader prelude;
+  VrmlReader prelude;
   gReader = &prelude;
   prelude.fileStack.push_back("drape-nodes.wrl");
   prelude.dirStack.push_back("");
@@ -270,7 +270,7 @@ void triangleCallback(void* data, SoCallbackAction*, const SoPrimitiveVertex* a,
 
 class Converter {
  public:
-  Converter(Reader& reader, Document& doc, const std::vector<NodeSite>& sites) : reader_(reader), doc_(doc) {
+  Converter(VrmlReader& reader, Document& doc, const std::vector<NodeSite>& sites) : reader_(reader), doc_(doc) {
     sites_.push_back(&sites);
   }
 
@@ -550,7 +550,7 @@ class Converter {
                             baseDir.empty() ? std::string(".") : baseDir));
   }
 
-  Reader& reader_;
+  VrmlReader& reader_;
   Document& doc_;
   std::vector<const std::vector<NodeSite>*> sites_;
   std::vector<std::string> files_;
@@ -562,7 +562,7 @@ class Converter {
 
 Document readWithCoin(const ScanResult& scanned, const std::string& file, const std::string& baseDir) {
   initCoinOnce();
-  Reader reader;
+  VrmlReader reader;
   gReader = &reader;
   struct Reset {
     ~Reset() { gReader = nullptr; }

@@ -10,15 +10,12 @@
 
 #include "drape/core/error.hpp"
 #include "drape/mesh/closest_point.hpp"
+#include "edge_key.hpp"
 
 namespace drape::mesh {
 namespace {
 
 constexpr int kMaxCellsPerAxis = 256;
-
-std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b) {
-  return (std::uint64_t{std::min(a, b)} << 32) | std::max(a, b);
-}
 
 double cornerAngle(const Vec3& at, const Vec3& b, const Vec3& c) {
   const Vec3 u = b - at, v = c - at;

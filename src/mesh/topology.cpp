@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "edge_key.hpp"
 
 namespace drape::mesh {
 namespace {
@@ -17,11 +18,6 @@ struct HalfEdge {
   std::uint32_t face;
   std::uint32_t corner;    // edge joins corner and corner+1 of the face
 };
-
-std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b) {
-  const auto lo = std::min(a, b), hi = std::max(a, b);
-  return (static_cast<std::uint64_t>(lo) << 32) | hi;
-}
 
 void checkTriangles(const TriMesh& mesh, double minArea) {
   const std::size_t n = mesh.positions.size();

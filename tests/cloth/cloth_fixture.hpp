@@ -2,7 +2,10 @@
 // Shared set-up for the cloth tests: a sheet, a model and a solver in a line or two.
 
 #include <memory>
+#include <utility>
+#include <vector>
 
+#include "drape/cloth/fixture.hpp"
 #include "drape/cloth/forces.hpp"
 #include "drape/cloth/model.hpp"
 #include "drape/cloth/sheets.hpp"
@@ -22,6 +25,11 @@ inline Material knit() {
   m.thickness_m = 5e-4;
   m.density_kg_m3 = 300;
   return m;
+}
+
+/// The given vertices held where the model's rest shape has them.
+inline PinGroup pinAt(const ClothModel& model, std::vector<std::uint32_t> vertices) {
+  return PinGroup::atRest(std::move(vertices), model.restX(), model.restY(), model.restZ());
 }
 
 /// Vertices of a sheet's grid column i (all j) or row j (all i).

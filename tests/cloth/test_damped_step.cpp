@@ -20,7 +20,7 @@
 namespace drape::cloth {
 namespace {
 
-Material knit(double damping_s = 0.0) {
+Material dampedKnit(double damping_s = 0.0) {
   Material m;
   m.youngsModulus_Pa = 5e4;
   m.thickness_m = 5e-4;
@@ -78,7 +78,7 @@ std::vector<std::uint8_t> randomlyFixed(std::size_t n, std::uint32_t seed, doubl
 TEST(MembraneStiffness, IsTheDerivativeOfTheMembraneForcesAtRest) {
   for (std::uint32_t seed = 1; seed <= 5; ++seed) {
     const mesh::TriMesh sheet = irregularSheet(6, seed);
-    const auto model = testing::makeModel(sheet, knit());
+    const auto model = testing::makeModel(sheet, dampedKnit());
     const std::size_t n = 3 * model->vertexCount();
     std::mt19937 rng(seed);
     std::normal_distribution<double> normal;
@@ -117,7 +117,7 @@ TEST(MembraneStiffness, IsTheDerivativeOfTheMembraneForcesAtRest) {
 TEST(MembraneFrequency, MatchesADenseEigensolveOnRandomSheets) {
   for (std::uint32_t seed = 1; seed <= 12; ++seed) {
     const mesh::TriMesh sheet = irregularSheet(4 + static_cast<int>(seed % 3), seed);
-    const auto model = testing::makeModel(sheet, knit());
+    const auto model = testing::makeModel(sheet, dampedKnit());
     const std::vector<std::uint8_t> fixed = randomlyFixed(model->vertexCount(), seed, seed % 2 ? 0.2 : 0.0);
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaledStiffness(*model, fixed),
                                                              Eigen::EigenvaluesOnly);
@@ -131,7 +131,7 @@ TEST(MembraneFrequency, MatchesADenseEigensolveOnRandomSheets) {
 /// at rest.
 double growthOfTheStiffestMode(const mesh::TriMesh& sheet, double damping_s, double dt, int steps,
                                IntegratorKind kind = IntegratorKind::SymplecticEuler) {
-  const auto model = testing::makeModel(sheet, knit(damping_s));
+  const auto model = testing::makeModel(sheet, dampedKnit(damping_s));
   const std::vector<std::uint8_t> none(model->vertexCount(), 0);
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaledStiffness(*model, none));
   Eigen::Index top = 0;
@@ -168,7 +168,7 @@ TEST(DampedStep, TheBoundHoldsForTheStiffestModeAndNoFurther) {
   // With omega^2 dt (dt + 2 beta) = 4 the stiffest mode is neutral; 10 % less damping and
   // it dies away, 10 % more and it grows. (Without margin: dampedStableStep_s keeps 0.9.)
   const mesh::TriMesh sheet = irregularSheet(5, 7);
-  const auto model = testing::makeModel(sheet, knit());
+  const auto model = testing::makeModel(sheet, dampedKnit());
   const double omega = model->membraneFrequency_rad_s();
   const double dt = 0.5 / omega;  // a quarter of the undamped bound 2 / omega
   const double neutral = (4.0 / (omega * omega) - dt * dt) / (2.0 * dt);
@@ -183,15 +183,15 @@ TEST(DampedStep, TheBoundHoldsForTheStiffestModeAndNoFurther) {
 
 TEST(DampedStep, TheSolverRefusesDampingItsSubstepCannotCarryAndSaysWhatWould) {
   const mesh::TriMesh sheet = irregularSheet(5, 3);
-  const double omega = testing::makeModel(sheet, knit())->membraneFrequency_rad_s();
+  const double omega = testing::makeModel(sheet, dampedKnit())->membraneFrequency_rad_s();
   StepSettings settings;
   settings.frameRate_hz = 30;
   settings.substepsPerFrame = static_cast<int>(std::ceil(omega / (30.0 * 0.5)));  // dt <= 0.5 / omega
   const double dt = settings.substep_s();
   const double most = largestStableDamping_s(omega, dt);
-  EXPECT_NO_THROW(ClothSolver(testing::makeModel(sheet, knit(0.99 * most)), settings));
+  EXPECT_NO_THROW(ClothSolver(testing::makeModel(sheet, dampedKnit(0.99 * most)), settings));
   try {
-    ClothSolver solver(testing::makeModel(sheet, knit(1.5 * most)), settings);
+    ClothSolver solver(testing::makeModel(sheet, dampedKnit(1.5 * most)), settings);
     FAIL() << "expected an error";
   } catch (const Error& e) {
     const std::string what = e.what();
@@ -202,7 +202,7 @@ TEST(DampedStep, TheSolverRefusesDampingItsSubstepCannotCarryAndSaysWhatWould) {
   }
   // Pinned vertices do not vibrate: pinning the stiffest corner lowers the frequency and lets
   // more damping through.
-  const auto model = testing::makeModel(sheet, knit());
+  const auto model = testing::makeModel(sheet, dampedKnit());
   std::vector<std::uint8_t> pinned(model->vertexCount(), 0);
   for (std::uint32_t v = 0; v < model->vertexCount(); v += 2) pinned[v] = 1;
   EXPECT_LT(model->membraneFrequency_rad_s(pinned), omega);
@@ -213,7 +213,7 @@ TEST(DampedStep, TheSolverRefusesDampingItsSubstepCannotCarryAndSaysWhatWould) {
 // too). The solver refuses what lies outside, naming the window or the substeps that open one.
 TEST(DampedStep, ForwardEulerHoldsOnlyInsideItsDampingWindow) {
   const mesh::TriMesh sheet = irregularSheet(5, 7);
-  const auto model = testing::makeModel(sheet, knit());
+  const auto model = testing::makeModel(sheet, dampedKnit());
   const double omega = model->membraneFrequency_rad_s();
   const double dt = 0.5 / omega;
   const double upper = 0.5 * dt + 2.0 / (omega * omega * dt);  // neutral, without margin
@@ -233,10 +233,10 @@ TEST(DampedStep, ForwardEulerHoldsOnlyInsideItsDampingWindow) {
   settings.frameRate_hz = 30;
   settings.substepsPerFrame = static_cast<int>(std::ceil(omega / (30.0 * 0.5)));
   const ForwardEulerDampingWindow at = forwardEulerDampingWindow(omega, settings.substep_s());
-  EXPECT_NO_THROW(ClothSolver(testing::makeModel(sheet, knit(0.5 * (at.least_s + at.most_s))), settings));
+  EXPECT_NO_THROW(ClothSolver(testing::makeModel(sheet, dampedKnit(0.5 * (at.least_s + at.most_s))), settings));
   for (const double damping : {0.0, 0.9 * at.least_s, 1.1 * at.most_s}) {
     try {
-      ClothSolver solver(testing::makeModel(sheet, knit(damping)), settings);
+      ClothSolver solver(testing::makeModel(sheet, dampedKnit(damping)), settings);
       FAIL() << "expected an error at " << damping;
     } catch (const Error& e) {
       const std::string what = e.what();
@@ -251,7 +251,7 @@ TEST(DampedStep, ForwardEulerHoldsOnlyInsideItsDampingWindow) {
   settings.substepsPerFrame = static_cast<int>(std::floor(omega / (30.0 * 2.0)));
   const long needed = static_cast<long>(std::floor(omega / (2.0 * kDampedStepMargin * 30.0)));
   try {
-    ClothSolver solver(testing::makeModel(sheet, knit(settings.substep_s())), settings);
+    ClothSolver solver(testing::makeModel(sheet, dampedKnit(settings.substep_s())), settings);
     FAIL() << "expected an error";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find(fmt::format("use more than {} substeps per frame", needed)), std::string::npos)
@@ -260,25 +260,25 @@ TEST(DampedStep, ForwardEulerHoldsOnlyInsideItsDampingWindow) {
   settings.substepsPerFrame = static_cast<int>(needed) + 1;
   const ForwardEulerDampingWindow opened = forwardEulerDampingWindow(omega, settings.substep_s());
   ASSERT_FALSE(opened.empty());
-  EXPECT_NO_THROW(ClothSolver(testing::makeModel(sheet, knit(0.5 * (opened.least_s + opened.most_s))), settings));
+  EXPECT_NO_THROW(ClothSolver(testing::makeModel(sheet, dampedKnit(0.5 * (opened.least_s + opened.most_s))), settings));
 }
 
 TEST(DampedStep, TheFewestStableSubstepsCountTheDamping) {
   const mesh::TriMesh sheet = irregularSheet(5, 11);
   const mesh::Topology topology = mesh::Topology::build(sheet);
   const double rate = 30.0;
-  const int undamped = fewestStableSubsteps(sheet, topology, knit(), rate, 0.0).substepsPerFrame;
-  const auto model = testing::makeModel(sheet, knit());
+  const int undamped = fewestStableSubsteps(sheet, topology, dampedKnit(), rate, 0.0).substepsPerFrame;
+  const auto model = testing::makeModel(sheet, dampedKnit());
   const double omega = model->membraneFrequency_rad_s();
   // Damping three times what the undamped count's substep allows.
   const double beta = 3.0 * std::max(largestStableDamping_s(omega, 1.0 / (rate * undamped)), 1e-6);
-  const int damped = fewestStableSubsteps(sheet, topology, knit(beta), rate, 0.0).substepsPerFrame;
+  const int damped = fewestStableSubsteps(sheet, topology, dampedKnit(beta), rate, 0.0).substepsPerFrame;
   EXPECT_GT(damped, undamped);
   EXPECT_LE(1.0 / (rate * damped), dampedStableStep_s(omega, beta));
   EXPECT_GT(1.0 / (rate * (damped - 1)), dampedStableStep_s(omega, beta));
   // With mass scaling allowed the ladder still ends on a count the damping allows.
-  const SubstepChoice scaled = fewestStableSubsteps(sheet, topology, knit(beta), rate, 0.5);
-  const auto scaledModel = ClothModel::build(sheet, topology, knit(beta),
+  const SubstepChoice scaled = fewestStableSubsteps(sheet, topology, dampedKnit(beta), rate, 0.5);
+  const auto scaledModel = ClothModel::build(sheet, topology, dampedKnit(beta),
                                              {1.0 / (rate * scaled.substepsPerFrame), 0.5});
   EXPECT_LE(1.0 / (rate * scaled.substepsPerFrame),
             dampedStableStep_s(scaledModel->membraneFrequency_rad_s(), beta) * (1 + 1e-12));

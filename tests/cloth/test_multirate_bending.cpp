@@ -15,6 +15,7 @@ namespace {
 
 using testing::column;
 using testing::makeModel;
+using testing::pinAt;
 using testing::run;
 using testing::settingsWithStep;
 
@@ -25,10 +26,6 @@ Material plate(double E, double t, double rho) {
   m.density_kg_m3 = rho;
   m.poissonRatio = 0.3;
   return m;
-}
-
-PinGroup pinAt(const ClothModel& model, std::vector<std::uint32_t> vertices) {
-  return PinGroup::atRest(std::move(vertices), model.restX(), model.restY(), model.restZ());
 }
 
 /// The largest k whose k substeps stay within the bending forces' stable step.

@@ -11,6 +11,7 @@ namespace {
 
 using testing::column;
 using testing::makeModel;
+using testing::pinAt;
 using testing::row;
 using testing::run;
 using testing::settingsWithStep;
@@ -22,10 +23,6 @@ Material fabric(double E, double t, double rho, double nu = 0.3) {
   m.density_kg_m3 = rho;
   m.poissonRatio = nu;
   return m;
-}
-
-PinGroup pinAt(const ClothModel& model, std::vector<std::uint32_t> vertices) {
-  return PinGroup::atRest(std::move(vertices), model.restX(), model.restY(), model.restZ());
 }
 
 // ---------------------------------------------------------------------------------------

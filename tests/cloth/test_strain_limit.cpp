@@ -197,13 +197,13 @@ struct PulledStrip {
 constexpr long kPullFrames = 15;
 constexpr double kPull = 1.4;
 
-long firstUnstableFrame(ClothSolver& solver) { return testing::firstUnstableFrame(solver, kPullFrames); }
+long firstUnstablePullFrame(ClothSolver& solver) { return testing::firstUnstableFrame(solver, kPullFrames); }
 
 /// The fewest substeps per frame that keep the strip stable at rest but not once pulled; 0 if none.
 int stableAtRestNotPulled() {
   for (int n = 1; n <= 200; ++n) {
     const PulledStrip strip(n, 0.0);
-    if (firstUnstableFrame(*strip.solver(1.0)) == 0 && firstUnstableFrame(*strip.solver(kPull)) > 0) return n;
+    if (firstUnstablePullFrame(*strip.solver(1.0)) == 0 && firstUnstablePullFrame(*strip.solver(kPull)) > 0) return n;
   }
   return 0;
 }
@@ -213,7 +213,7 @@ TEST(StrainLimit, AFrameNoSubstepsKeepStableIsComputedAgainWithTheLimitWhichStay
   ASSERT_GT(n, 0) << "no substep count is stable at rest and unstable pulled: the test would mean nothing";
   const PulledStrip without(n, 0.0), with(n, kLimit);
   const auto stops = without.solver(kPull);
-  const long bad = firstUnstableFrame(*stops);
+  const long bad = firstUnstablePullFrame(*stops);
   ASSERT_GT(bad, 0);
   EXPECT_EQ(stops->strainLimitedFrom(), 0);
   EXPECT_EQ(stops->instability().strainLimit, 0.0);

@@ -15,7 +15,7 @@ namespace drape::formats {
 namespace {
 
 std::string mocap(const std::string& f) { return std::string(DRAPE_DATA_DIR) + "/mocap/" + f; }
-std::string bad(const std::string& f) { return std::string(DRAPE_TEST_DATA_DIR) + "/bad/motion/" + f; }
+std::string badMotion(const std::string& f) { return std::string(DRAPE_TEST_DATA_DIR) + "/bad/motion/" + f; }
 
 using drape::testing::errorOf;
 using drape::testing::expectCorpus;
@@ -88,7 +88,7 @@ TEST(AsfAmc, ReadsTheCmuSoccerKick) {
 }
 
 TEST(AsfAmc, MalformedCorpus) {
-  const AsfSkeleton asf = readAsf(bad("small.asf"));
+  const AsfSkeleton asf = readAsf(badMotion("small.asf"));
   expectCorpus(std::string(DRAPE_TEST_DATA_DIR) + "/bad/motion", {
       {"amc_unknown_bone.amc", "8:1: unknown bone 'tibia' (not in the ASF skeleton)"},
       {"amc_wrong_count.amc", "5:1: bone 'femur' has 2 values, expected 3 (its degrees of freedom)"},
@@ -96,7 +96,7 @@ TEST(AsfAmc, MalformedCorpus) {
       // Frame LONG_MAX, then 1: computing LONG_MAX + 1 overflowed a long (undefined behaviour).
       {"amc_frame_number_overflow.amc", "6:1: frame 1 follows frame 9223372036854775807"},
   }, [&](const std::string& path) { (void)readAmc(path, asf); });
-  const std::string asfPath = bad("asf_unknown_parent.asf");
+  const std::string asfPath = badMotion("asf_unknown_parent.asf");
   EXPECT_EQ(errorOf([&] { (void)readAsf(asfPath); }), asfPath + ":26:5: unknown bone 'shin' in the hierarchy");
 }
 
@@ -124,16 +124,16 @@ TEST(MhSkel, ReadsTheDefaultWeights) {
 }
 
 TEST(MhSkel, MalformedCorpus) {
-  const std::string badJson = bad("mhskel_bad_json.mhskel");
+  const std::string badJson = badMotion("mhskel_bad_json.mhskel");
   EXPECT_EQ(errorOf([&] { (void)readMhskel(badJson); }),
             badJson + ":5:3: syntax error while parsing object key - unexpected '}'; expected string literal");
-  const std::string twoRoots = bad("mhskel_two_roots.mhskel");
+  const std::string twoRoots = badMotion("mhskel_two_roots.mhskel");
   EXPECT_EQ(errorOf([&] { (void)readMhskel(twoRoots); }), twoRoots + ": two root bones ('a' and 'b')");
   // A weight beyond double range: nlohmann reports it without a position; drape finds it.
-  const std::string overflow = bad("mhw_weight_overflow.mhw");
+  const std::string overflow = badMotion("mhw_weight_overflow.mhw");
   EXPECT_EQ(errorOf([&] { (void)readMhw(overflow); }), overflow + ":3:29: expected a finite number, found '2e400'");
   // Deep nesting: the message for a bad [vertex, weight] pair dumped it recursively.
-  const std::string deep = bad("mhw_deep_nesting.mhw");
+  const std::string deep = badMotion("mhw_deep_nesting.mhw");
   EXPECT_EQ(errorOf([&] { (void)readMhw(deep); }), deep + ":1:533: nesting deeper than 512 levels");
 }
 

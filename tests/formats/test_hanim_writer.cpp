@@ -19,11 +19,11 @@ namespace {
 
 // Two joints, the child named "clock" (its DEF takes hanim_clock before the motion's
 // TimeSensor asks for it).
-HanimHumanoidData walker(std::size_t frames) { return testing::twoJointWalker(frames, "clock"); }
+HanimHumanoidData clockWalker(std::size_t frames) { return testing::twoJointWalker(frames, "clock"); }
 
 TEST(HanimWriter, AMotionIsInterpolatorsRoutedIntoTheJoints) {
   const std::size_t frames = 9;
-  const HanimHumanoidData h = walker(frames);
+  const HanimHumanoidData h = clockWalker(frames);
   const std::string path = drape::testing::processTempDir("hanim").string() + "/walker.wrl";
   writeHanim(path, h);
   const std::string text = hanimText(h);
@@ -60,13 +60,13 @@ TEST(HanimWriter, AMotionIsInterpolatorsRoutedIntoTheJoints) {
 }
 
 TEST(HanimWriter, AMotionThatDoesNotFitIsRefused) {
-  HanimHumanoidData h = walker(3);
+  HanimHumanoidData h = clockWalker(3);
   h.motion->frames[1].pop_back();
   EXPECT_NE(drape::testing::errorOf([&] { (void)hanimText(h); }).find("H-Anim motion 'walk': frame 1 has 1 joints, the humanoid 2"),
             std::string::npos);
-  h = walker(0);
+  h = clockWalker(0);
   EXPECT_NE(drape::testing::errorOf([&] { (void)hanimText(h); }).find("H-Anim motion 'walk': no frames"), std::string::npos);
-  h = walker(2);
+  h = clockWalker(2);
   h.motion->frameRate = 0.0;
   EXPECT_NE(drape::testing::errorOf([&] { (void)hanimText(h); }).find("frame rate 0 must be positive"), std::string::npos);
 }

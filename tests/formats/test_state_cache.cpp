@@ -15,7 +15,7 @@
 namespace drape::formats {
 namespace {
 
-std::string tempPath(const std::string& name) {
+std::string stateTempPath(const std::string& name) {
   return (testing::processTempDir("state_cache") / name).string();
 }
 
@@ -36,7 +36,7 @@ std::string header(std::uint32_t version, std::uint32_t vertices) {
 }
 
 TEST(StateCache, RoundTripsEveryKnownByteAndTheFrameCount) {
-  const std::string path = tempPath("round.states");
+  const std::string path = stateTempPath("round.states");
   std::vector<std::vector<std::uint8_t>> frames;
   for (int f = 0; f < 7; ++f) {
     std::vector<std::uint8_t> s;
@@ -55,7 +55,7 @@ TEST(StateCache, RoundTripsEveryKnownByteAndTheFrameCount) {
 }
 
 TEST(StateCache, AnEmptyTakeHasNoFrames) {
-  const std::string path = tempPath("empty.states");
+  const std::string path = stateTempPath("empty.states");
   { StateCacheWriter w(path, 3); }
   const StateCache c = readStateCache(path);
   EXPECT_EQ(c.vertexCount, 3u);
@@ -92,14 +92,14 @@ TEST(StateCache, MalformedFilesOnDisk) {
 }
 
 TEST(StateCache, TheWriterRefusesAFrameOfAnotherSizeAndWritesAfterClose) {
-  const std::string path = tempPath("sizes.states");
+  const std::string path = stateTempPath("sizes.states");
   StateCacheWriter w(path, 4);
   const std::vector<std::uint8_t> three(3, 0), four(4, 0);
   EXPECT_THROW(w.writeFrame(three), Error);
   w.writeFrame(four);
   w.close();
   EXPECT_THROW(w.writeFrame(four), Error);
-  EXPECT_THROW(StateCacheWriter(tempPath("none.states"), 0), Error);
+  EXPECT_THROW(StateCacheWriter(stateTempPath("none.states"), 0), Error);
   EXPECT_THROW(StateCacheWriter("/nonexistent/dir/x.states", 4), Error);
 }
 

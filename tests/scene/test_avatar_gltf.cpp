@@ -15,14 +15,14 @@
 namespace drape::scene {
 namespace {
 
-std::string data(const std::string& file) { return std::string(DRAPE_DATA_DIR) + "/avatars/" + file; }
-std::string bad(const std::string& file) { return std::string(DRAPE_TEST_DATA_DIR) + "/bad/motion/" + file; }
+std::string avatarData(const std::string& file) { return std::string(DRAPE_DATA_DIR) + "/avatars/" + file; }
+std::string badMotion(const std::string& file) { return std::string(DRAPE_TEST_DATA_DIR) + "/bad/motion/" + file; }
 
 using drape::testing::errorOf;
 
 TEST(GltfAvatar, ReadsInProcessToo) {
   // The same reader without the child process (what the fuzz target exercises).
-  std::ifstream in(data("CesiumMan.glb"), std::ios::binary);
+  std::ifstream in(avatarData("CesiumMan.glb"), std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const formats::GltfSkinnedModel m = formats::parseGltfSkinnedModel(bytes, "CesiumMan.glb", std::string(DRAPE_DATA_DIR) + "/avatars");
   EXPECT_EQ(m.joints.size(), 19u);
@@ -33,7 +33,7 @@ TEST(GltfAvatar, ReadsInProcessToo) {
 }
 
 TEST(GltfAvatar, CesiumManHas19ClosedSegmentsCoveringEveryTriangle) {
-  const Avatar a = loadGltfAvatar(data("CesiumMan.glb"));
+  const Avatar a = loadGltfAvatar(avatarData("CesiumMan.glb"));
   ASSERT_EQ(a.joints.size(), 19u);
   ASSERT_TRUE(a.skin.has_value());
   EXPECT_EQ(a.skin->mesh.triangles.size(), 4672u);
@@ -57,7 +57,7 @@ TEST(GltfAvatar, CesiumManHas19ClosedSegmentsCoveringEveryTriangle) {
 }
 
 TEST(GltfAvatar, RiggedSimpleIsTwoSegments) {
-  const Avatar a = loadGltfAvatar(data("RiggedSimple.glb"));
+  const Avatar a = loadGltfAvatar(avatarData("RiggedSimple.glb"));
   EXPECT_EQ(a.joints.size(), 2u);
   EXPECT_EQ(a.segments.size(), 2u);
   for (const Segment& s : a.segments) EXPECT_EQ(countBoundaryEdges(s.mesh), 0u) << s.name;
@@ -66,35 +66,35 @@ TEST(GltfAvatar, RiggedSimpleIsTwoSegments) {
 // Regression: a spec-valid skin without inverseBindMatrices crashed Assimp's glTF2 importer;
 // the glTF default (identity) applies.
 TEST(GltfAvatar, SkinWithoutInverseBindMatricesUsesIdentity) {
-  const Avatar a = loadGltfAvatar(bad("skin_without_inverse_bind.gltf"));
+  const Avatar a = loadGltfAvatar(badMotion("skin_without_inverse_bind.gltf"));
   EXPECT_EQ(a.joints.size(), 2u);
   EXPECT_EQ(a.segments.size(), 2u);
 }
 
 // Regression: bytes that are not glTF fell through to other Assimp importers.
 TEST(GltfAvatar, BytesThatAreNotGltfAreAnError) {
-  EXPECT_EQ(errorOf([] { (void)loadGltfAvatar(bad("not_gltf.glb")); }).rfind(bad("not_gltf.glb") + ": ", 0), 0u);
-  const std::string e = errorOf([] { (void)loadGltfAvatar(bad("not_gltf.glb")); });
+  EXPECT_EQ(errorOf([] { (void)loadGltfAvatar(badMotion("not_gltf.glb")); }).rfind(badMotion("not_gltf.glb") + ": ", 0), 0u);
+  const std::string e = errorOf([] { (void)loadGltfAvatar(badMotion("not_gltf.glb")); });
   EXPECT_NE(e, "(no error)");
 }
 
 // Regression: a buffer URI that is a plain path outside the model's folder was read from disk.
 TEST(GltfAvatar, BufferUriOutsideTheFolderIsRefused) {
-  const std::string e = errorOf([] { (void)loadGltfAvatar(bad("buffer_outside_folder.gltf")); });
+  const std::string e = errorOf([] { (void)loadGltfAvatar(badMotion("buffer_outside_folder.gltf")); });
   EXPECT_NE(e.find("outside the model's folder"), std::string::npos) << e;
 }
 
 // Found by fuzz/fuzz_gltf.cpp: a number too large for a double made nlohmann_json throw
 // out_of_range, which escaped as an uncaught exception.
 TEST(GltfAvatar, NumberOverflowIsAnError) {
-  const std::string e = errorOf([] { (void)loadGltfAvatar(bad("number_overflow.gltf")); });
-  EXPECT_EQ(e.rfind(bad("number_overflow.gltf") + ":1:40: expected a finite number, found '0.9E99998807907105", 0), 0u) << e;
+  const std::string e = errorOf([] { (void)loadGltfAvatar(badMotion("number_overflow.gltf")); });
+  EXPECT_EQ(e.rfind(badMotion("number_overflow.gltf") + ":1:40: expected a finite number, found '0.9E99998807907105", 0), 0u) << e;
 }
 
 // A syntax error names its line and column, as every other reader's does.
 TEST(GltfAvatar, SyntaxErrorsNameTheirLineAndColumn) {
-  const std::string e = errorOf([] { (void)loadGltfAvatar(bad("trailing_comma.gltf")); });
-  EXPECT_EQ(e.rfind(bad("trailing_comma.gltf") + ":3:32: syntax error while parsing value - unexpected ']'", 0), 0u) << e;
+  const std::string e = errorOf([] { (void)loadGltfAvatar(badMotion("trailing_comma.gltf")); });
+  EXPECT_EQ(e.rfind(badMotion("trailing_comma.gltf") + ":3:32: syntax error while parsing value - unexpected ']'", 0), 0u) << e;
 }
 
 // A VRML97 file of one H-Anim Humanoid is an avatar file; none, or several, is an error

@@ -18,7 +18,7 @@
 namespace drape::scene {
 namespace {
 
-const std::string kData = std::string(DRAPE_DATA_DIR) + "/vrml/";
+const std::string kVrmlData = std::string(DRAPE_DATA_DIR) + "/vrml/";
 
 Scene fromText(const std::string& text, const std::string& name = "scene.wrl", const std::string& dir = ".") {
   return buildScene(formats::vrml::readText(text, name, dir));
@@ -34,7 +34,7 @@ const std::string kTriangle =
     "IndexedFaceSet { coord Coordinate { point [ 0 0 0, 1 0 0, 0 1 0 ] } coordIndex [ 0 1 2 -1 ] }";
 
 TEST(VrmlScene, Sr1IsAnAvatarOfThirtyJoints) {
-  const Scene s = loadScene(kData + "choreonoid_SR1.wrl");
+  const Scene s = loadScene(kVrmlData + "choreonoid_SR1.wrl");
   ASSERT_EQ(s.avatars.size(), 1u);
   const Avatar& a = s.avatars[0];
   EXPECT_EQ(a.name, "SR1");
@@ -62,7 +62,7 @@ TEST(VrmlScene, Sr1IsAnAvatarOfThirtyJoints) {
 }
 
 TEST(VrmlScene, Gr001SegmentsComeFromInlineFiles) {
-  const Scene s = loadScene(kData + "choreonoid_GR001/GR001.wrl");
+  const Scene s = loadScene(kVrmlData + "choreonoid_GR001/GR001.wrl");
   ASSERT_EQ(s.avatars.size(), 1u);
   EXPECT_EQ(s.avatars[0].joints.size(), 21u);
   ASSERT_EQ(s.avatars[0].segments.size(), 21u);
@@ -74,11 +74,11 @@ TEST(VrmlScene, Gr001SegmentsComeFromInlineFiles) {
 }
 
 TEST(VrmlScene, TorusAndVaseLoad) {
-  const Scene torus = loadScene(kData + "choreonoid_Torus.wrl");
+  const Scene torus = loadScene(kVrmlData + "choreonoid_Torus.wrl");
   ASSERT_EQ(torus.avatars.size(), 1u);
   EXPECT_EQ(torus.avatars[0].joints.size(), 1u);
   EXPECT_EQ(torus.avatars[0].segments.at(0).mesh.triangleCount(), 2048u);  // the Extrusion, tessellated
-  const Scene vase = loadScene(kData + "choreonoid_vase.wrl");
+  const Scene vase = loadScene(kVrmlData + "choreonoid_vase.wrl");
   EXPECT_TRUE(vase.avatars.empty());
   ASSERT_EQ(vase.scenery.size(), 1u);
   EXPECT_EQ(vase.scenery[0].name, "BudVase");

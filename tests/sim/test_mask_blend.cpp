@@ -21,11 +21,10 @@
 #include "drape/scene/scene.hpp"
 #include "drape/sim/character_world.hpp"
 #include "drape/sim/scene_setup.hpp"
+#include "drape/testing/examples.hpp"
 
 namespace drape::sim {
 namespace {
-
-const std::string kWalk = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt/walk.bvh";
 
 /// An avatar walking the bundled walk in a scene's garments; no frame is stepped.
 struct DressedWalk {
@@ -40,7 +39,7 @@ struct DressedWalk {
     motion::MotionOptions mo;
     mo.clip.rate = sc.simulation.frameRate;
     mo.jointMapDirectory = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";
-    animation = std::make_unique<motion::AvatarAnimation>(motion::loadAnimation(*avatar, kWalk, mo));
+    animation = std::make_unique<motion::AvatarAnimation>(motion::loadAnimation(*avatar, testing::kSkirtWalk, mo));
     const WorldSettings settings = toWorldSettings(sc.simulation);
     frames = static_cast<long>((settings.leadIn_s + animation->duration()) * sc.simulation.frameRate);
     world = std::make_unique<CharacterWorld>(*avatar, animation.get(), garmentSpecs(sc, avatar.get()), settings);

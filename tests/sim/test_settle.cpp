@@ -12,11 +12,10 @@
 #include "drape/scene/scene.hpp"
 #include "drape/sim/character_world.hpp"
 #include "drape/sim/scene_setup.hpp"
+#include "drape/testing/examples.hpp"
 
 namespace drape::sim {
 namespace {
-
-const std::string kWalk = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt/walk.bvh";
 
 struct Example {
   scene::Scene scene;
@@ -31,7 +30,7 @@ Example loadExample(const std::string& name) {
   motion::MotionOptions mo;
   mo.clip.rate = e.scene.simulation.frameRate;
   mo.jointMapDirectory = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";
-  e.animation = motion::loadAnimation(*e.avatar, kWalk, mo);
+  e.animation = motion::loadAnimation(*e.avatar, testing::kSkirtWalk, mo);
   return e;
 }
 

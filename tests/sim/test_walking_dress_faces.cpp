@@ -14,12 +14,10 @@
 #include "drape/sim/character_world.hpp"
 #include "drape/sim/scene_setup.hpp"
 #include "drape/testing/long_scenario.hpp"
+#include "drape/testing/examples.hpp"
 
 namespace drape::sim {
 namespace {
-
-const std::string kScene = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_dress/scene.wrl";
-const std::string kWalk = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt/walk.bvh";
 
 struct FaceFigures {
   long frames = 0;
@@ -30,12 +28,12 @@ struct FaceFigures {
 };
 
 FaceFigures walk(long frames, bool faceSamples) {
-  const scene::Scene sc = scene::loadScene(kScene);
+  const scene::Scene sc = scene::loadScene(testing::kDressScene);
   const std::unique_ptr<scene::Avatar> avatar = sceneAvatar(sc);
   motion::MotionOptions mo;
   mo.clip.rate = sc.simulation.frameRate;
   mo.jointMapDirectory = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";
-  const motion::AvatarAnimation animation = motion::loadAnimation(*avatar, kWalk, mo);
+  const motion::AvatarAnimation animation = motion::loadAnimation(*avatar, testing::kSkirtWalk, mo);
   std::vector<GarmentSpec> specs = garmentSpecs(sc, avatar.get());
   FaceFigures r;
   r.faceParts = specs.at(0).faceSamplesWith;  // the scene's, counted either way

@@ -13,11 +13,10 @@
 #include "drape/scene/scene.hpp"
 #include "drape/sim/character_world.hpp"
 #include "drape/sim/scene_setup.hpp"
+#include "drape/testing/examples.hpp"
 
 namespace drape::sim {
 namespace {
-
-const std::string kScene = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt/scene.wrl";
 
 struct ScenarioResult {
   long frames = 0;
@@ -28,7 +27,7 @@ struct ScenarioResult {
 };
 
 ScenarioResult runScenario(const std::string& motionPath, int collisionEvery) {
-  const scene::Scene sc = scene::loadScene(kScene);
+  const scene::Scene sc = scene::loadScene(testing::kSkirtScene);
   const std::unique_ptr<scene::Avatar> avatar = sceneAvatar(sc);
   EXPECT_TRUE(avatar);
   motion::MotionOptions mo;

@@ -24,9 +24,10 @@ endfunction()
 # CLI11, nlohmann_json, fmt, Eigen and GoogleTest templates it instantiates and optimises,
 # again in every file; a batch does that once. Two batches, not one, so that both cores of
 # a two-core machine have work while one target is all there is to build (the drape
-# executable, which every test target waits for). The cli's 22 files took 4.4 minutes to build on two cores, and
-# 1.2 in two batches. A file's names in its anonymous namespace therefore share a scope with
-# its batch's other files: two files may not both define a helper of the same name.
+# executable, which every test target waits for). The cli's 22 files took 4.4 minutes to
+# build on two cores, and 1.2 in two batches. A file's names in its anonymous namespace
+# therefore share a scope with its batch's other files: two files may not both define a
+# helper of the same name.
 # DRAPE_UNITY=OFF (with DRAPE_PCH=OFF) compiles every file alone, which shows a file that
 # forgot an include of its own.
 function(drape_batch target)
@@ -90,7 +91,8 @@ function(drape_add_test module)
     # first): six test helpers that join a data directory and a file name, in the optimised
     # build. GCC 12 to 14 are reported to give these false positives on concatenations; the
     # sanitizer build checks the same code's memory accesses for real.
-    target_compile_options(test_${module} PRIVATE -Wno-array-bounds -Wno-stringop-overflow -Wno-stringop-overread)
+    target_compile_options(test_${module} PRIVATE
+      -Wno-array-bounds -Wno-stringop-overflow -Wno-stringop-overread)
   endif()
   target_include_directories(test_${module} PRIVATE "${PROJECT_SOURCE_DIR}/tests/support/include")
   target_compile_definitions(test_${module} PRIVATE

@@ -9,8 +9,8 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "drape/mesh/edge_key.hpp"
 #include "drape/mesh/closest_point.hpp"
-#include "edge_key.hpp"
 
 namespace drape::mesh {
 namespace {

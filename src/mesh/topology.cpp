@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
-#include "edge_key.hpp"
+#include "drape/mesh/edge_key.hpp"
 
 namespace drape::mesh {
 namespace {

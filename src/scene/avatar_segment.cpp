@@ -9,20 +9,16 @@
 #include <fmt/ranges.h>
 
 #include "drape/core/error.hpp"
+#include "drape/mesh/edge_key.hpp"
 
 namespace drape::scene {
 namespace {
-
-std::uint64_t undirectedKey(std::uint32_t a, std::uint32_t b) {
-  const std::uint32_t lo = std::min(a, b), hi = std::max(a, b);
-  return (static_cast<std::uint64_t>(lo) << 32) | hi;
-}
 
 std::unordered_map<std::uint64_t, int> edgeUseCounts(const mesh::TriMesh& mesh) {
   std::unordered_map<std::uint64_t, int> count;
   count.reserve(mesh.triangles.size() * 3);
   for (const mesh::Triangle& t : mesh.triangles)
-    for (int c = 0; c < 3; ++c) ++count[undirectedKey(t[c], t[(c + 1) % 3])];
+    for (int c = 0; c < 3; ++c) ++count[mesh::edgeKey(t[c], t[(c + 1) % 3])];
   return count;
 }
 
@@ -87,7 +83,7 @@ std::size_t capOpenings(mesh::TriMesh& mesh) {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> boundary;
   for (const mesh::Triangle& t : mesh.triangles)
     for (int c = 0; c < 3; ++c)
-      if (counts.at(undirectedKey(t[c], t[(c + 1) % 3])) == 1) boundary.emplace_back(t[c], t[(c + 1) % 3]);
+      if (counts.at(mesh::edgeKey(t[c], t[(c + 1) % 3])) == 1) boundary.emplace_back(t[c], t[(c + 1) % 3]);
   if (boundary.empty()) return 0;
   // Openings = connected components of the boundary edges.
   std::vector<std::uint32_t> parent(mesh.positions.size());

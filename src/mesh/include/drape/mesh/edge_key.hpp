@@ -1,6 +1,5 @@
 #pragma once
 // An undirected edge as one sortable, hashable word: (lower vertex << 32) | higher vertex.
-// Private to the mesh module.
 
 #include <algorithm>
 #include <cstdint>

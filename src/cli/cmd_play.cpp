@@ -117,9 +117,8 @@ RunFunction setupPlay(CLI::App& app) {
   static PlayOptions o;
   app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes, or a scene to simulate live")
       ->required();
-  CLI::Option* motionOption = app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc; an avatar file's animation, .glb, .gltf, .dae, .fbx; or an H-Anim humanoid's interpolators, .wrl); none: at rest. Without it, a scene whose own interpolators move its Humanoid plays them");
-  app.add_option("--animation", o.animation, "With an avatar file as --motion (.glb, .gltf, .dae, .fbx, .wrl): which of its animations (of a .wrl, its animated Humanoids) plays, by name or by index from 0 (default: the first; drape inspect FILE lists them)")
-      ->needs(motionOption);
+  app.add_option("--motion", o.motion, std::string("With a scene: motion for its avatar ") + kMotionHelp);
+  app.add_option("--animation", o.animation, kAnimationHelp);
   app.add_option("--frames", o.frames, "Close by itself after showing N frames")->check(CLI::PositiveNumber);
   app.add_flag("--once", o.once, "Stop at the last frame instead of starting over");
   app.add_flag("--fast", o.fast, "Show a new frame on every redraw instead of at the run's frame rate");

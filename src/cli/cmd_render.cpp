@@ -42,9 +42,8 @@ RunFunction setupRender(CLI::App& app) {
   static RenderOptions o;
   app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes, or a scene to simulate")
       ->required();
-  CLI::Option* motionOption = app.add_option("--motion", o.motion, "With a scene: motion for its avatar (.bvh, .amc; an avatar file's animation, .glb, .gltf, .dae, .fbx; or an H-Anim humanoid's interpolators, .wrl); none: at rest. Without it, a scene whose own interpolators move its Humanoid plays them");
-  app.add_option("--animation", o.animation, "With an avatar file as --motion (.glb, .gltf, .dae, .fbx, .wrl): which of its animations (of a .wrl, its animated Humanoids) plays, by name or by index from 0 (default: the first; drape inspect FILE lists them)")
-      ->needs(motionOption);
+  app.add_option("--motion", o.motion, std::string("With a scene: motion for its avatar ") + kMotionHelp);
+  app.add_option("--animation", o.animation, kAnimationHelp);
   app.add_option("--frames", o.frames, "With a scene: frames to simulate (default: the lead-in and the whole motion)");
   app.add_option("--run-out", o.runOut, "With a scene: keep the simulated run in this directory (default: a temporary one)");
   app.add_option("--range", o.range,

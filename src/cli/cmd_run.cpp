@@ -320,10 +320,9 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("scene", o->scene, "VRML97 scene with ClothSet garments (and an avatar)");
   app.add_option("--garment", o->garment, "Garment mesh (OBJ), instead of a scene");
   app.add_option("--avatar", o->avatar, "Avatar to wear --garment (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel)");
-  CLI::Option* motionOption = app.add_option("--motion", o->motion, "Motion for the avatar (.bvh, .amc; an avatar file's animation, .glb, .gltf, .dae, .fbx; or an H-Anim humanoid's interpolators, .wrl), retargeted unless the avatar is that file's; none: at rest. Without it, a scene whose own interpolators move its Humanoid plays them");
+  app.add_option("--motion", o->motion, std::string("Motion for the avatar ") + kMotionHelp);
   app.add_option("--joint-map", o->jointMap, "JSON map from the motion's joint names to the avatar's");
-  app.add_option("--animation", o->animation, "With an avatar file as --motion (.glb, .gltf, .dae, .fbx, .wrl): which of its animations (of a .wrl, its animated Humanoids) plays, by name or by index from 0 (default: the first; drape inspect FILE lists them)")
-      ->needs(motionOption);
+  app.add_option("--animation", o->animation, kAnimationHelp);
   app.add_option("--motion-scale", o->motionScale, "Metres per motion-file unit (default: guessed from the skeleton)");
   app.add_option("--voxel", o->voxel_m, "Distance-field voxel size, m (default: the scene's, or 0.005)");
   app.add_option("--field-method", o->fieldMethod, "dvdp (the paper's) or exact")

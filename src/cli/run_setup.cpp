@@ -7,6 +7,7 @@
 #include <array>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <span>
 
 #include <fmt/format.h>
@@ -290,6 +291,23 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
   if (report.restUnfoldFramesSkipped > 0) spdlog::info("{}: {}", motionPath, report.restUnfoldSkipped());
 }
 
+namespace {
+
+/// The animated H-Anim Humanoid `avatar` is, in the VRML97 file it was read from (the scene
+/// itself, or the file an Avatar node names): its ROUTEd interpolators, sampled at `rate`;
+/// empty when nothing moves it. A file without any ROUTE, the common case, is not read again.
+std::optional<formats::SkinnedJointMotion> humanoidMotion(const scene::Avatar& avatar, double rate) {
+  if (!formats::isVrmlPath(avatar.source)) return std::nullopt;
+  std::ifstream in(avatar.source, std::ios::binary);
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (text.find("ROUTE") == std::string::npos) return std::nullopt;
+  for (formats::SkinnedJointMotion& m : formats::readHanimMotions(avatar.source, rate))
+    if (m.animation == avatar.name) return std::move(m);
+  return std::nullopt;
+}
+
+}  // namespace
+
 MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, const std::string& motion,
                          const std::string& animation) {
   if (motion == "none") {
@@ -299,23 +317,37 @@ MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, co
     return {};
   }
   if (!motion.empty()) return {motion, animation};
-  if (scenePath.empty() || !setup.character || !formats::isVrmlPath(scenePath)) return {};
-  // A Humanoid of the scene file itself (an Avatar node's url, or an Inline, is another
-  // file): its interpolators play where ROUTEs feed them. No ROUTE at all, the common case,
-  // costs no second reading of the scene.
+  const std::string nothingToChoose = fmt::format(
+      "--animation {}: the avatar's own file carries no animation to choose from; give the motion with --motion FILE",
+      animation);
+  if (!setup.character) {
+    if (!animation.empty()) throw Error(nothingToChoose);
+    return {};
+  }
+  // With no motion given, the avatar plays what its own file carries, as a viewer of that
+  // file would: a glTF, Collada or FBX file's animation, or the interpolators a VRML97
+  // file ROUTEs into its Humanoid. Logged, with how to keep it at rest.
   const scene::Avatar& avatar = *setup.character->avatar;
-  std::error_code ec;
-  if (!std::filesystem::equivalent(avatar.source, scenePath, ec)) return {};
-  std::ifstream in(scenePath, std::ios::binary);
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (text.find("ROUTE") == std::string::npos) return {};
-  for (const formats::SkinnedJointMotion& m : formats::readHanimMotions(scenePath, setup.settings.frameRate_hz))
-    if (m.animation == avatar.name) {
-      spdlog::info("{}: the scene's interpolators move its Humanoid '{}', which plays them ({:.3g} s; --motion none "
-                   "keeps it at rest)",
-                   scenePath, avatar.name, m.end_s - m.start_s);
-      return {scenePath, avatar.name};
-    }
+  if (!avatar.animations.empty()) {
+    const std::size_t index = formats::detail::chooseAnimation(avatar.animations, animation, avatar.source);
+    spdlog::info("{}: the avatar's own file carries {} animation{}; it plays '{}'{} (--motion none keeps it at rest)",
+                 avatar.source, avatar.animations.size(), avatar.animations.size() == 1 ? "" : "s",
+                 avatar.animations[index],
+                 avatar.animations.size() > 1 && animation.empty() ? ", the first (--animation chooses another)" : "");
+    return {avatar.source, animation};
+  }
+  if (const std::optional<formats::SkinnedJointMotion> m = humanoidMotion(avatar, setup.settings.frameRate_hz)) {
+    std::error_code ec;
+    const bool inTheScene = !scenePath.empty() && std::filesystem::equivalent(avatar.source, scenePath, ec);
+    if (!animation.empty() && animation != avatar.name && animation != "0")
+      throw Error(fmt::format("--animation {}: {} animates one Humanoid, '{}', the avatar", animation, avatar.source,
+                              avatar.name));
+    spdlog::info("{}: the {}'s interpolators move its Humanoid '{}', which plays them ({:.3g} s; --motion none keeps it "
+                 "at rest)",
+                 avatar.source, inTheScene ? "scene" : "avatar file", avatar.name, m->end_s - m->start_s);
+    return {avatar.source, avatar.name};
+  }
+  if (!animation.empty()) throw Error(nothingToChoose);
   return {};
 }
 

@@ -75,10 +75,22 @@ struct RunSetup {
 void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerUnit = 0.0,
                const std::string& jointMap = "", const std::string& animation = "");
 
+/// --motion's help after "Motion for the avatar ", and --animation's, for run, play and render.
+inline constexpr const char* kMotionHelp =
+    "(.bvh, .amc; an avatar file's animation, .glb, .gltf, .dae, .fbx; or an H-Anim humanoid's interpolators, .wrl), "
+    "retargeted unless the avatar is that file's; none: at rest. Without it, the avatar plays its own file's "
+    "animation if the file carries one (a glTF, Collada or FBX animation, or interpolators ROUTEd into a VRML97 "
+    "Humanoid)";
+inline constexpr const char* kAnimationHelp =
+    "Which of an avatar file's animations plays (of --motion's file, or without --motion of the avatar's own; of a "
+    ".wrl, its animated Humanoids), by name or by index from 0 (default: the first; drape inspect FILE lists them)";
+
 /// The motion a scene command plays (`drape run`, `play`, `render`): `motion` as given, none
-/// for "none" (the avatar stays at rest), and with none given the scene's own, where the
-/// scene's avatar is a Humanoid written in the scene file and ROUTEd interpolators drive it:
-/// the scene animates it, as a VRML97 browser would (logged, with how to keep it at rest).
+/// for "none" (the avatar stays at rest), and with none given the avatar's own, where the
+/// file it was read from carries one: a glTF, Collada or FBX animation (`animation` chooses
+/// which), or ROUTEd interpolators that drive its Humanoid in a VRML97 file (the scene
+/// itself or the file an Avatar node names); played as a viewer of that file would play it,
+/// and logged, with how to keep it at rest.
 struct MotionChoice {
   std::string path;       ///< "": no motion
   std::string animation;  ///< for addMotion: which of the file's animations

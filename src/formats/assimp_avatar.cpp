@@ -189,7 +189,9 @@ void configure(Assimp::Importer& importer, bool animations) {
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_TEXTURES, false);
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_CAMERAS, false);
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_LIGHTS, false);
-  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_ANIMATIONS, animations);
+  // Read in both: the skin's scene names the animations the avatar carries (its nodes are
+  // the same whether animation curves are read or not; only the pivots above change them).
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_READ_ANIMATIONS, true);
 }
 
 constexpr unsigned kPostProcess = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
@@ -440,6 +442,13 @@ std::string jointName(const aiNode& node, std::size_t index) {
   return node.mName.length > 0 ? node.mName.C_Str() : fmt::format("joint{}", index);
 }
 
+std::vector<std::string> animationNames(const aiScene& scene) {
+  std::vector<std::string> names;
+  for (unsigned a = 0; a < scene.mNumAnimations; ++a)
+    names.push_back(detail::animationName(scene.mAnimations[a] == nullptr ? "" : scene.mAnimations[a]->mName.C_Str(), a));
+  return names;
+}
+
 SkinnedModel extract(const aiScene& scene, Format format, const std::string& name) {
   const SceneReader r = readerFor(scene, format, name);
   std::vector<std::pair<const aiMesh*, const aiNode*>> meshes;
@@ -447,6 +456,7 @@ SkinnedModel extract(const aiScene& scene, Format format, const std::string& nam
 
   SkinnedModel out;
   out.source = name;
+  out.animations = animationNames(scene);
   std::unordered_map<const aiNode*, std::uint16_t> jointOf;
   for (std::size_t j = 0; j < skeleton.size(); ++j) {
     const aiNode* node = skeleton[j];
@@ -595,13 +605,6 @@ std::vector<NodeTrack> readTracks(const aiScene& scene, const aiAnimation& anim,
     if (!t.positions.empty() || !t.rotations.empty() || !t.scales.empty()) tracks.push_back(std::move(t));
   }
   return tracks;
-}
-
-std::vector<std::string> animationNames(const aiScene& scene) {
-  std::vector<std::string> names;
-  for (unsigned a = 0; a < scene.mNumAnimations; ++a)
-    names.push_back(detail::animationName(scene.mAnimations[a] == nullptr ? "" : scene.mAnimations[a]->mName.C_Str(), a));
-  return names;
 }
 
 // What every animation of a file is sampled against: the skin's joints and rest pose as the

@@ -505,6 +505,12 @@ SkinJoints skinJoints(const GModel& model, const std::vector<int>& nodeParent, c
   return out;
 }
 
+std::vector<std::string> animationNames(const GModel& model) {
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < model.animations.size(); ++i) names.push_back(detail::animationName(model.animations[i].name, i));
+  return names;
+}
+
 SkinnedModel extract(const GModel& model, const std::string& name) {
   const GltfReader r{model, name};
   std::vector<int> nodeParent;
@@ -516,6 +522,7 @@ SkinnedModel extract(const GModel& model, const std::string& name) {
 
   SkinnedModel out;
   out.source = name;
+  out.animations = animationNames(model);
   for (std::size_t k = 0; k < jn; ++k) {
     SkinnedJoint joint;
     joint.name = sj.name[k];
@@ -711,12 +718,6 @@ std::vector<Vec3> skinPositions(const GModel& model, const std::string& name) {
   } catch (const Error&) {
     return {};
   }
-}
-
-std::vector<std::string> animationNames(const GModel& model) {
-  std::vector<std::string> names;
-  for (std::size_t i = 0; i < model.animations.size(); ++i) names.push_back(detail::animationName(model.animations[i].name, i));
-  return names;
 }
 
 GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, double rate, const std::string& which) {

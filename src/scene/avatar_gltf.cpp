@@ -37,6 +37,7 @@ Avatar buildAvatarFromSkinnedModel(const formats::SkinnedModel& model) {
   skin.joints = model.vertexJoints;
   skin.weights = model.vertexWeights;
   avatar.skin = std::move(skin);
+  avatar.animations = model.animations;
   segmentSkinnedAvatar(avatar);
   return avatar;
 }

@@ -346,6 +346,16 @@ TEST(HanimMotionRun, TheSkirtWalksTheSameOnTheConvertedHumanoid) {
   EXPECT_LT(largestGap(a, b), 1e-4) << "m, the largest gap between the two skirts";
   EXPECT_EQ(testing::statsOf(onHumanoid)["vertex_substeps_inside_body"], 0);
 
+  // Without --motion the avatar's own file animates it, as --motion FILE does, and says so.
+  const CliResult own =
+      runDrape(fmt::format("run '{}' --frames 12 --out '{}'", dir / "scene.wrl", dir / "by-its-file"), dir);
+  ASSERT_EQ(own.code, 0) << own.err;
+  EXPECT_NE(own.err.find("walker.wrl: the avatar file's interpolators move its Humanoid 'makehuman_CMU compliant "
+                         "skeleton', which plays them (4.67 s; --motion none keeps it at rest)"),
+            std::string::npos)
+      << own.err;
+  EXPECT_EQ(largestGap(formats::readPc2(dir / "by-its-file/garment.pc2"), a), 0.0);
+
   // The animated humanoid written into the scene itself, in the Avatar node's place: the
   // scene given as its own motion plays it.
   std::string walker = testing::slurp(wrl);

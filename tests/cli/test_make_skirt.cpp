@@ -21,11 +21,11 @@ using testing::statsOf;
 
 const std::string kAvatars = std::string(DRAPE_DATA_DIR) + "/avatars";
 
-/// Runs the scene `dir/scene.wrl` for a few frames (the avatar stands) and checks the skirt
-/// stayed out of the body.
+/// Runs the scene `dir/scene.wrl` for a few frames (the avatar stands, whatever animation
+/// its file carries) and checks the skirt stayed out of the body.
 void runsClean(const ScratchDir& scratch, const std::string& dir) {
   const std::string out = dir + "-run";
-  const CliResult r = runDrape("run '" + dir + "/scene.wrl' --frames 5 --out '" + out + "'", scratch);
+  const CliResult r = runDrape("run '" + dir + "/scene.wrl' --motion none --frames 5 --out '" + out + "'", scratch);
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json stats = statsOf(out);
   EXPECT_EQ(stats["frames"], 5);
@@ -124,6 +124,35 @@ TEST(MakeSkirt, CesiumMansSkirtWalksOnItsOwnAnimation) {
   const nlohmann::json stats = statsOf(run);
   EXPECT_EQ(stats["frames"], 90);
   EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
+
+  // Without --motion the avatar plays its own file's walk, as a glTF viewer would, and says
+  // so: the same run to the byte. --motion none keeps it at rest.
+  const std::string byItself = dir / "by-itself";
+  const CliResult own = runDrape("run '" + out + "/scene.wrl' --out '" + byItself + "'", dir);
+  ASSERT_EQ(own.code, 0) << own.err;
+  EXPECT_NE(own.err.find("CesiumMan.glb: the avatar's own file carries 1 animation; it plays 'animation 0' (--motion "
+                         "none keeps it at rest)"),
+            std::string::npos)
+      << own.err;
+  EXPECT_EQ(statsOf(byItself)["frames"], 90);
+  EXPECT_EQ(testing::slurp(byItself + "/garment.pc2"), testing::slurp(run + "/garment.pc2"));
+  const CliResult still = runDrape("run '" + out + "/scene.wrl' --motion none --frames 2 --out '" + (dir / "still") + "'", dir);
+  ASSERT_EQ(still.code, 0) << still.err;
+  EXPECT_EQ(still.err.find("joint map"), std::string::npos) << still.err;
+  const CliResult jogItself =
+      runDrape("run '" + out + "/scene.wrl' --animation jog --frames 2 --out '" + (dir / "jog-itself") + "'", dir);
+  EXPECT_EQ(jogItself.code, 2);
+  EXPECT_NE(jogItself.err.find("CesiumMan.glb: has no animation 'jog' (it has 1: 0 'animation 0')"), std::string::npos)
+      << jogItself.err;
+  // The bundled skirt's MakeHuman body carries none: --animation alone has nothing to choose.
+  const CliResult none = runDrape("run '" + testing::kSkirtDir + "/scene.wrl' --animation 0 --frames 2 --out '" +
+                                      (dir / "none") + "'",
+                                  dir);
+  EXPECT_EQ(none.code, 2);
+  EXPECT_NE(none.err.find("--animation 0: the avatar's own file carries no animation to choose from; give the motion "
+                          "with --motion FILE"),
+            std::string::npos)
+      << none.err;
 
   // An animation the file does not have; --animation with a BVH.
   const CliResult jog = runDrape("run '" + out + "/scene.wrl' --motion '" + cesium + "' --animation jog --frames 2 --out '" +

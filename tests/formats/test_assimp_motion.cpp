@@ -114,6 +114,24 @@ TEST_P(AssimpMotion, ChoosesAnimationsByNameOrIndexAndListsThemWhenAbsent) {
   EXPECT_EQ(errorOf([&] { (void)readAssimpJointMotion(still, 30.0); }), still + ": has no animation");
 }
 
+TEST_P(AssimpMotion, TheSkinsReaderNamesTheAnimationsTheFileCarries) {
+  // What an avatar loaded from the file could play by itself: the motion reader's names, in
+  // its order; none for a file without animations. The skin is the same either way.
+  const std::string two = written("two-named", {turnAndStride("walk"), turnAndStride("run")});
+  const SkinnedModel model = readAssimpSkinnedModel(two);
+  EXPECT_EQ(model.animations, readAssimpJointMotions(two, 2.0).front().animationNames);
+  ASSERT_EQ(model.animations.size(), 2u);
+  const SkinnedModel still = readAssimpSkinnedModel(written("still-named", {}));
+  EXPECT_TRUE(still.animations.empty());
+  EXPECT_EQ(still.positions, model.positions);
+  EXPECT_EQ(still.triangles, model.triangles);
+  ASSERT_EQ(still.joints.size(), model.joints.size());
+  for (std::size_t j = 0; j < model.joints.size(); ++j) {
+    EXPECT_EQ(still.joints[j].name, model.joints[j].name);
+    EXPECT_TRUE(still.joints[j].restWorld.isApprox(model.joints[j].restWorld, 1e-12)) << model.joints[j].name;
+  }
+}
+
 TEST_P(AssimpMotion, WriterRefusesAnAnimationThatMissesAJoint) {
   SkinnedJointMotion hipOnly = turnAndStride("walk");
   hipOnly.joints = {"hip"};

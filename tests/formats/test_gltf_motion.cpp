@@ -253,6 +253,9 @@ TEST(GltfMotion, CesiumManWalksWithBonesOfConstantLength) {
   const GltfJointMotion m = readGltfJointMotion(path, 30.0);
   const GltfSkinnedModel model = readGltfSkinnedModel(path);
   ASSERT_EQ(m.joints.size(), 19u);
+  // The skin's reader names the animation an avatar loaded from the file plays by itself.
+  EXPECT_EQ(model.animations, (std::vector<std::string>{"animation 0"}));
+  EXPECT_EQ(model.animations, m.animationNames);
   EXPECT_EQ(m.frameCount(), 61u);  // 2 s at 30 Hz
   EXPECT_NEAR(m.end_s - m.start_s, 2.0, 1e-6);
   double largestTurn = 0.0;

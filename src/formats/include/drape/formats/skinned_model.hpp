@@ -28,6 +28,9 @@ struct SkinnedModel {
   std::vector<mesh::Triangle> triangles;
   std::vector<std::array<std::uint16_t, 4>> vertexJoints;  ///< indices into joints
   std::vector<std::array<float, 4>> vertexWeights;         ///< normalised to sum 1
+  /// The file's animations by name ("animation <index>" if one has none), in the file's
+  /// order: what the avatar could play as its own motion (a reader of the motion samples them).
+  std::vector<std::string> animations;
 };
 
 /// One of an avatar file's animations as the motion of its skin's joints, sampled at a

@@ -42,6 +42,10 @@ struct Avatar {
   std::vector<Joint> joints;
   std::vector<Segment> segments;
   std::optional<SkinnedMesh> skin;
+  /// The animations the avatar's own file carries (a glTF, Collada or FBX file's, by name,
+  /// in its order): the motion it plays when no other is given. Empty for the other
+  /// sources (an H-Anim humanoid's interpolators are found where its file has ROUTEs).
+  std::vector<std::string> animations;
 
   /// Index of the joint named `name`, or -1.
   [[nodiscard]] int findJoint(const std::string& name) const {

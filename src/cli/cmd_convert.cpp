@@ -103,13 +103,23 @@ std::vector<formats::SkinnedJointMotion> ownAnimations() {
   return formats::readAvatarMotions(input, rate);
 }
 
+// The one animation a .wrl humanoid is written with: --animation's, else the file's first.
+// A skinned avatar's file named its animations as it was read, so only the first is sampled.
+std::vector<formats::SkinnedJointMotion> firstOwnAnimation(const scene::Avatar& avatar) {
+  if (animationName.empty() && avatar.skin && formats::isAvatarMotionPath(input)) {
+    if (avatar.animations.empty()) return {};
+    return {formats::readAvatarMotion(input, rate)};
+  }
+  return ownAnimations();
+}
+
 // --to .wrl: the humanoid with one motion (the --motion file's, or the avatar file's own
 // animation), as its Joints' interpolators.
 void writeHanimWithMotion(const scene::Avatar& avatar) {
   formats::HanimHumanoidData h = toHanim(avatar);
   if (!motionPath.empty()) {
     h.motion = hanimMotion(avatar, retargeted(avatar), std::filesystem::path(motionPath).stem().string());
-  } else if (const std::vector<formats::SkinnedJointMotion> own = ownAnimations(); !own.empty()) {
+  } else if (const std::vector<formats::SkinnedJointMotion> own = firstOwnAnimation(avatar); !own.empty()) {
     h.motion = hanimMotion(avatar, motion::AvatarAnimation::fromJointMotion(avatar, own.front(), input),
                            own.front().animation);
     if (own.front().animationNames.size() > 1)

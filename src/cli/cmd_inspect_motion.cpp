@@ -91,7 +91,8 @@ void inspectAcclaim(const std::string& path, std::ostream& out) {
   printClip(out, path, "Acclaim AMC", clip, report);
 }
 
-/// An avatar file's own animations: what `drape run --motion FILE` plays.
+/// An avatar file's own animations: what `drape run` plays on this avatar by itself, and
+/// `--motion FILE` on another.
 void inspectAvatarMotion(const std::string& path, std::ostream& out) {
   std::vector<formats::SkinnedJointMotion> motions;
   try {
@@ -105,8 +106,10 @@ void inspectAvatarMotion(const std::string& path, std::ostream& out) {
     return;
   }
   const bool several = motions.size() > 1;
-  fmt::print(out, "  motion     {} animation{}; drape run --motion {}{} plays {} on this avatar\n", motions.size(),
-             several ? "s" : "", path, several ? " --animation NAME|INDEX" : "", several ? "one" : "it");
+  fmt::print(out,
+             "  motion     {} animation{}; drape run plays {} on this avatar by itself (--motion none: at rest), and "
+             "--motion {} on another, retargeted\n",
+             motions.size(), several ? "s" : "", several ? "the first (--animation NAME|INDEX chooses)" : "it", path);
   for (std::size_t i = 0; i < motions.size(); ++i) {
     const formats::SkinnedJointMotion& m = motions[i];
     fmt::print(out, "    {} '{}': {:.3f} s ({:.3f} to {:.3f} s of key times), {} frames at 30 Hz\n", i, m.animation,

@@ -67,9 +67,10 @@ TEST(CliMotion, InspectAmcAndAvatars) {
 TEST(CliMotion, InspectGltfAvatarsNameTheirAnimation) {
   Result r = run("inspect " + data("avatars/CesiumMan.glb"));
   EXPECT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find("motion     1 animation; drape run --motion " + data("avatars/CesiumMan.glb") +
-                       " plays it on this avatar\n    0 'animation 0': 2.000 s (0.000 to 2.000 s of key times), 61 frames at "
-                       "30 Hz\n"),
+  EXPECT_NE(r.out.find("motion     1 animation; drape run plays it on this avatar by itself (--motion none: at rest), "
+                       "and --motion " + data("avatars/CesiumMan.glb") +
+                       " on another, retargeted\n    0 'animation 0': 2.000 s (0.000 to 2.000 s of key times), 61 frames "
+                       "at 30 Hz\n"),
             std::string::npos)
       << r.out;
 }

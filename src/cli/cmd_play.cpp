@@ -39,7 +39,7 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
   if (!setup.character)
     throw Error(fmt::format("{}: drape play simulates scenes with an avatar (replay a run directory otherwise)", o.run));
   if (const MotionChoice m = sceneMotion(setup, o.run, o.motion, o.animation); !m.path.empty())
-    addMotion(setup, m.path, 0.0, "", m.animation);
+    addMotion(setup, m.path, 0.0, "", m.animation, m.sampled.get());
   const std::unique_ptr<sim::CharacterWorld> worldPtr = buildWorld(setup);
   sim::CharacterWorld& world = *worldPtr;
   (void)settleWorld(setup, world);

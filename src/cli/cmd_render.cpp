@@ -75,7 +75,7 @@ RunFunction setupRender(CLI::App& app) {
     if (std::filesystem::is_regular_file(o.run)) {
       RunSetup setup = runSetupFromScene(o.run);
       if (const MotionChoice m = sceneMotion(setup, o.run, o.motion, o.animation); !m.path.empty())
-        addMotion(setup, m.path, 0.0, "", m.animation);
+        addMotion(setup, m.path, 0.0, "", m.animation, m.sampled.get());
       setup.frames = o.frames > 0 ? o.frames : defaultFrames(setup);
       if (o.runOut.empty()) {
         scratch = std::filesystem::temp_directory_path() / fmt::format("drape-render-{}", ::getpid());

@@ -276,7 +276,8 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     if (!(o.settle_s >= 0)) throw Error(fmt::format("--settle must be >= 0 s, got {}", o.settle_s));
     ch.settle_s = o.settle_s;
     if (app.count("--keep-apart")) setKeepApart(ch, o.keepApart);
-    if (!motion.path.empty()) addMotion(setup, motion.path, o.motionScale, o.jointMap, motion.animation);
+    if (!motion.path.empty())
+      addMotion(setup, motion.path, o.motionScale, o.jointMap, motion.animation, motion.sampled.get());
   }
 
   if (app.count("--substeps") || o.scene.empty()) {

@@ -267,7 +267,7 @@ RunSetup runSetupFromScene(const std::string& scenePath, const std::optional<std
 }
 
 void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerUnit, const std::string& jointMap,
-               const std::string& animation) {
+               const std::string& animation, const formats::SkinnedJointMotion* sampled) {
   if (!setup.character)
     throw Error("--motion: there is no avatar to move (the scene has none; without a scene, give --avatar FILE)");
   motion::MotionOptions mo;
@@ -275,6 +275,7 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
   if (metresPerUnit > 0) mo.clip.metresPerUnit = metresPerUnit;
   mo.jointMapPath = jointMap;
   mo.animation = animation;
+  mo.sampled = sampled;
   mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
   motion::ClipLoadReport report;
   motion::JointMap map;
@@ -295,15 +296,15 @@ namespace {
 
 /// The animated H-Anim Humanoid `avatar` is, in the VRML97 file it was read from (the scene
 /// itself, or the file an Avatar node names): its ROUTEd interpolators, sampled at `rate`;
-/// empty when nothing moves it. A file without any ROUTE, the common case, is not read again.
-std::optional<formats::SkinnedJointMotion> humanoidMotion(const scene::Avatar& avatar, double rate) {
-  if (!formats::isVrmlPath(avatar.source)) return std::nullopt;
+/// null when nothing moves it. A file without any ROUTE, the common case, is not read again.
+std::shared_ptr<const formats::SkinnedJointMotion> humanoidMotion(const scene::Avatar& avatar, double rate) {
+  if (!formats::isVrmlPath(avatar.source)) return nullptr;
   std::ifstream in(avatar.source, std::ios::binary);
   const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (text.find("ROUTE") == std::string::npos) return std::nullopt;
+  if (text.find("ROUTE") == std::string::npos) return nullptr;
   for (formats::SkinnedJointMotion& m : formats::readHanimMotions(avatar.source, rate))
-    if (m.animation == avatar.name) return std::move(m);
-  return std::nullopt;
+    if (m.animation == avatar.name) return std::make_shared<const formats::SkinnedJointMotion>(std::move(m));
+  return nullptr;
 }
 
 }  // namespace
@@ -336,7 +337,7 @@ MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, co
                  avatar.animations.size() > 1 && animation.empty() ? ", the first (--animation chooses another)" : "");
     return {avatar.source, animation};
   }
-  if (const std::optional<formats::SkinnedJointMotion> m = humanoidMotion(avatar, setup.settings.frameRate_hz)) {
+  if (std::shared_ptr<const formats::SkinnedJointMotion> m = humanoidMotion(avatar, setup.settings.frameRate_hz)) {
     std::error_code ec;
     const bool inTheScene = !scenePath.empty() && std::filesystem::equivalent(avatar.source, scenePath, ec);
     if (!animation.empty() && animation != avatar.name && animation != "0")
@@ -345,7 +346,7 @@ MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, co
     spdlog::info("{}: the {}'s interpolators move its Humanoid '{}', which plays them ({:.3g} s; --motion none keeps it "
                  "at rest)",
                  avatar.source, inTheScene ? "scene" : "avatar file", avatar.name, m->end_s - m->start_s);
-    return {avatar.source, avatar.name};
+    return {avatar.source, avatar.name, std::move(m)};
   }
   if (!animation.empty()) throw Error(nothingToChoose);
   return {};

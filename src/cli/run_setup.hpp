@@ -71,9 +71,11 @@ struct RunSetup {
 
 /// Loads a motion file onto the setup's avatar (rate = the setup's frame rate). `metresPerUnit`
 /// > 0 overrides the units guess; `jointMap` "" picks one of the shipped maps; `animation`
-/// chooses one of a glTF motion file's animations ("" the first).
+/// chooses one of a glTF motion file's animations ("" the first); `sampled`, when given, is
+/// that animation already sampled at the setup's frame rate (the file is not read again).
 void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerUnit = 0.0,
-               const std::string& jointMap = "", const std::string& animation = "");
+               const std::string& jointMap = "", const std::string& animation = "",
+               const formats::SkinnedJointMotion* sampled = nullptr);
 
 /// --motion's help after "Motion for the avatar ", and --animation's, for run, play and render.
 inline constexpr const char* kMotionHelp =
@@ -94,6 +96,8 @@ inline constexpr const char* kAnimationHelp =
 struct MotionChoice {
   std::string path;       ///< "": no motion
   std::string animation;  ///< for addMotion: which of the file's animations
+  /// The motion as sampled to find it (a VRML97 Humanoid's interpolators), or null.
+  std::shared_ptr<const formats::SkinnedJointMotion> sampled;
 };
 [[nodiscard]] MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, const std::string& motion,
                                        const std::string& animation);

@@ -592,7 +592,8 @@ AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& mo
                               ClipLoadReport* report, JointMap* chosenMap) {
   if (formats::isAvatarMotionPath(motionPath)) {
     const double rate = options.clip.rate > 0 ? options.clip.rate : 30.0;
-    const formats::SkinnedJointMotion motion = formats::readAvatarMotion(motionPath, rate, options.animation);
+    const formats::SkinnedJointMotion motion =
+        options.sampled != nullptr ? *options.sampled : formats::readAvatarMotion(motionPath, rate, options.animation);
     if (report) {
       *report = {};
       report->units.metresPerUnit = 1.0;

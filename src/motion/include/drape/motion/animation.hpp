@@ -141,6 +141,9 @@ struct MotionOptions {
   std::string jointMapDirectory;   ///< the shipped maps (share/drape/jointmaps)
   std::string animation;           ///< --animation: which of an avatar file's animations ("" the first)
   RetargetOptions retarget;
+  /// The avatar file's animation already sampled at clip.rate (by a caller that read the
+  /// file to find it): taken instead of reading the file again. Null: read it.
+  const formats::SkinnedJointMotion* sampled = nullptr;
 };
 
 /// Loads FILE.bvh / FILE.amc, picks or reads the joint map, and retargets onto `avatar`;

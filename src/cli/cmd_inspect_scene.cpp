@@ -11,6 +11,7 @@
 #include "drape/formats/hanim_motion.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/scene/scene.hpp"
+#include "drape/sim/scene_setup.hpp"
 
 namespace drape::cli {
 namespace {
@@ -88,6 +89,26 @@ void printHumanoidMotions(const std::string& path, const scene::Scene& s, std::o
   }
 }
 
+/// The worn avatar of an `Avatar` node, loaded as `drape run` loads it: what its file is,
+/// and the animations it carries, which `drape run FILE` plays by itself.
+void printExternalAvatar(const std::string& path, const scene::Scene& s, std::ostream& out) {
+  std::unique_ptr<scene::Avatar> avatar;
+  try {
+    avatar = sim::sceneAvatar(s);
+  } catch (const Error& e) {
+    fmt::print(out, "    not loaded: {}\n", e.what());
+    return;
+  }
+  if (!avatar) return;
+  fmt::print(out, "    {}: {} joints, {} segments{}\n", avatar->source, avatar->joints.size(), avatar->segments.size(),
+             avatar->skin ? fmt::format(", a skin of {} triangles", avatar->skin->mesh.triangleCount()) : "");
+  const std::size_t n = avatar->animations.size();
+  if (n == 0) return;
+  fmt::print(out, "    its file carries {} animation{} ('{}'); drape run {} plays {} by itself (--motion none: at rest)\n",
+             n, n == 1 ? "" : "s", fmt::join(avatar->animations, "', '"), path,
+             n == 1 ? "it" : "the first (--animation NAME|INDEX chooses)");
+}
+
 void inspectScene(const std::string& path, std::ostream& out) {
   const scene::Scene s = scene::loadScene(path);
   fmt::print(out, "{}: VRML97 scene\n", path);
@@ -105,6 +126,7 @@ void inspectScene(const std::string& path, std::ostream& out) {
     fmt::print(out, "  {} (from {}){}{}\n", a.name, fmt::join(a.urls, ", "),
                a.jointMap.empty() ? "" : fmt::format(", joint map {}", fmt::join(a.jointMap, ", ")),
                a.cutAtJoints.empty() ? "" : fmt::format(", parts cut across joints {}", fmt::join(a.cutAtJoints, ", ")));
+  if (s.avatars.empty() && !s.externalAvatars.empty()) printExternalAvatar(path, s, out);
   fmt::print(out, "garments: {}\n", s.garments.size());
   for (const scene::Garment& g : s.garments) printGarment(out, s, g);
   fmt::print(out, "materials: {}\n", s.materials.size());

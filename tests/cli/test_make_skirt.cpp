@@ -126,7 +126,15 @@ TEST(MakeSkirt, CesiumMansSkirtWalksOnItsOwnAnimation) {
   EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
 
   // Without --motion the avatar plays its own file's walk, as a glTF viewer would, and says
-  // so: the same run to the byte. --motion none keeps it at rest.
+  // so (as `drape inspect` of the scene does): the same run to the byte. --motion none keeps
+  // it at rest.
+  const CliResult inspected = runDrape("inspect '" + out + "/scene.wrl'", dir);
+  ASSERT_EQ(inspected.code, 0) << inspected.err;
+  EXPECT_NE(inspected.out.find("CesiumMan.glb: 19 joints, 19 segments, a skin of 4672 triangles\n    its file carries 1 "
+                               "animation ('animation 0'); drape run " + out + "/scene.wrl plays it by itself (--motion "
+                               "none: at rest)\n"),
+            std::string::npos)
+      << inspected.out;
   const std::string byItself = dir / "by-itself";
   const CliResult own = runDrape("run '" + out + "/scene.wrl' --out '" + byItself + "'", dir);
   ASSERT_EQ(own.code, 0) << own.err;

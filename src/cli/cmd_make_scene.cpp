@@ -241,6 +241,7 @@ int makeScene(MakeSceneOptions& o) {
   if (!o.stitches.empty())
     fmt::print("{} stitches across gaps of up to {:.1f} mm\n", o.stitches.size(), 1e3 * widestStitch_m(garment, o.stitches));
   fmt::print("wrote {}/scene.wrl, {}.obj, {}_mask.obj\n", o.out, o.name, o.name);
+  printHowToRun(o.out, avatar);
   return 0;
 }
 

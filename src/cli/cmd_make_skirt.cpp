@@ -129,6 +129,7 @@ RunFunction setupMakeSkirt(CLI::App& app) {
     fmt::print("skirt: {} vertices, {} triangles, waist at y = {:.3f} m, hem at y = {:.3f} m; {} substeps per frame\n",
                skirt.mesh.vertexCount(), skirt.mesh.triangleCount(), box.max.y(), box.min.y(), substeps);
     fmt::print("wrote {}/scene.wrl, skirt.obj, waistband.obj\n", o.out);
+    printHowToRun(o.out, avatar);
     return 0;
   };
 }

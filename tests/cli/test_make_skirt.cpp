@@ -40,6 +40,10 @@ std::string makeCesiumSkirt(const ScratchDir& dir) {
                                    "--leg-segments joint11,joint12,joint13,joint14 --out '" + out + "'",
                                dir);
   EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("run it: drape run " + out + "/scene.wrl (the avatar plays its own file's animation 'animation "
+                       "0'; --motion FILE plays another)\n"),
+            std::string::npos)
+      << r.out;
   return r.code == 0 ? out : "";
 }
 
@@ -48,6 +52,10 @@ TEST(MakeSkirt, FitsTheMakeHumanBodyWithItsDefaultSegments) {
   const std::string out = dir / "skirt";
   const CliResult r = runDrape("make-skirt '" + kAvatars + "/makehuman_rig_cmu_mb.mhskel' --out '" + out + "'", dir);
   ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("run it: drape run " + out + "/scene.wrl --motion FILE (a BVH or AMC capture, or an animated "
+                       "avatar file; without it the avatar stands at rest)\n"),
+            std::string::npos)
+      << r.out;
   const scene::Scene sc = scene::loadScene(out + "/scene.wrl");
   ASSERT_EQ(sc.garments.size(), 1u);
   EXPECT_EQ(sc.garments[0].mesh.triangleCount(), 480u);

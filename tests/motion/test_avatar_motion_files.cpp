@@ -108,6 +108,23 @@ const std::map<std::string, std::string>& hanimNames() {
   return names;
 }
 
+// VRoid Studio's names for the MakeHuman body's joints (drape's name -> VRoid's): its spine
+// runs Spine, Chest, UpperChest, Neck with the shoulders on UpperChest; like Mixamo's, no
+// hip joints, no second neck joint, no finger base.
+const std::map<std::string, std::string>& vroidNames() {
+  static const std::map<std::string, std::string> names = {
+      {"Hips", "J_Bip_C_Hips"},         {"LowerBack", "J_Bip_C_Spine"},      {"Spine", "J_Bip_C_Chest"},
+      {"Spine1", "J_Bip_C_UpperChest"}, {"Neck", "J_Bip_C_Neck"},            {"Head", "J_Bip_C_Head"},
+      {"LeftUpLeg", "J_Bip_L_UpperLeg"}, {"LeftLeg", "J_Bip_L_LowerLeg"},    {"LeftFoot", "J_Bip_L_Foot"},
+      {"LeftToeBase", "J_Bip_L_ToeBase"}, {"RightUpLeg", "J_Bip_R_UpperLeg"}, {"RightLeg", "J_Bip_R_LowerLeg"},
+      {"RightFoot", "J_Bip_R_Foot"},    {"RightToeBase", "J_Bip_R_ToeBase"}, {"LeftShoulder", "J_Bip_L_Shoulder"},
+      {"LeftArm", "J_Bip_L_UpperArm"},  {"LeftForeArm", "J_Bip_L_LowerArm"}, {"LeftHand", "J_Bip_L_Hand"},
+      {"LeftHandFinger1", "J_Bip_L_Index1"}, {"LThumb", "J_Bip_L_Thumb1"},  {"RightShoulder", "J_Bip_R_Shoulder"},
+      {"RightArm", "J_Bip_R_UpperArm"}, {"RightForeArm", "J_Bip_R_LowerArm"}, {"RightHand", "J_Bip_R_Hand"},
+      {"RightHandFinger1", "J_Bip_R_Index1"}, {"RThumb", "J_Bip_R_Thumb1"}};
+  return names;
+}
+
 // A joint's name in a style: its own there, or, where the style has none, a name of its own
 // that no map knows.
 std::string renamed(const std::map<std::string, std::string>& names, const std::string& prefix, const std::string& name) {
@@ -218,7 +235,8 @@ TEST_P(CaptureOnAStyledAvatar, MovesAsTheBodyDoesThroughTheSamePairs) {
 
 INSTANTIATE_TEST_SUITE_P(Styles, CaptureOnAStyledAvatar,
                          ::testing::Values(Style{"Mixamo", &mixamoNames, "mixamorig:", "mixamo (reversed)"},
-                                           Style{"HAnim", &hanimNames, "", "motionbuilder + hanim (reversed)"}),
+                                           Style{"HAnim", &hanimNames, "", "motionbuilder + hanim (reversed)"},
+                                           Style{"VRoid", &vroidNames, "", "motionbuilder + vroid (reversed)"}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 INSTANTIATE_TEST_SUITE_P(Formats, AvatarMotionFile, ::testing::Values(".dae", ".fbx"),

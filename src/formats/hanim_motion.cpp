@@ -40,7 +40,7 @@ std::vector<std::int32_t> childrenOf(const Node& n, const char* field = "childre
 }
 
 /// The TimeSensor's cycle that drives field `name` of `n` through an interpolator, in
-/// seconds; 0 when no interpolator with keys, fed by a TimeSensor, drives it.
+/// seconds; 0 when no interpolator with keys, fed by an enabled TimeSensor, drives it.
 double drivingCycle(const Document& d, const Node& n, const char* name) {
   const Field* f = n.field(name);
   const Node* interpolator = f != nullptr ? nodeAt(d, f->routeFromNode) : nullptr;
@@ -52,6 +52,10 @@ double drivingCycle(const Document& d, const Node& n, const char* name) {
     return 0.0;
   const Node* sensor = nodeAt(d, fraction->routeFromNode);
   if (sensor == nullptr || sensor->type != "TimeSensor") return 0.0;
+  // A disabled sensor sends no fraction: the field keeps its written value, as in a browser.
+  if (const Field* enabled = sensor->field("enabled"); enabled != nullptr && !enabled->numbers.empty() &&
+                                                      enabled->numbers[0] == 0.0)
+    return 0.0;
   const Field* cycle = sensor->field("cycleInterval");
   const double seconds = cycle != nullptr && !cycle->numbers.empty() ? cycle->numbers[0] : 1.0;  // VRML97's default
   return std::isfinite(seconds) && seconds > 0.0 ? seconds : 0.0;
@@ -264,7 +268,7 @@ SkinnedJointMotion readHanimMotion(const std::string& path, double rate, const s
       if (n.type == "Humanoid") humanoids.push_back(fmt::format("'{}'", n.nameOrDef()));
     if (humanoids.empty()) throw Error(fmt::format("{}: has no H-Anim Humanoid to take a motion from", path));
     const bool several = humanoids.size() > 1;
-    throw Error(fmt::format("{}: {} {} {} no motion: no interpolator that a TimeSensor drives is routed into {} "
+    throw Error(fmt::format("{}: {} {} {} no motion: no interpolator that an enabled TimeSensor drives is routed into {} "
                             "Joints (ROUTE an OrientationInterpolator's value_changed TO a Joint's set_rotation)",
                             path, several ? "Humanoids" : "Humanoid", fmt::join(humanoids, ", "),
                             several ? "have" : "has", several ? "their" : "its"));

@@ -149,6 +149,29 @@ TEST(HanimMotion, ComposesTheHumanoidTheTransformsBetweenJointsAndEachSensorsCyc
   }
 }
 
+// A TimeSensor with `enabled FALSE` sends no fraction: what it would drive keeps its written
+// value, and a humanoid that only disabled sensors would move has no motion.
+TEST(HanimMotion, ADisabledSensorDrivesNothing) {
+  std::string text = kMover;
+  const std::string shortClock = "DEF Short TimeSensor { cycleInterval 0.5 loop TRUE }";
+  ASSERT_NE(text.find(shortClock), std::string::npos);
+  text.replace(text.find(shortClock), shortClock.size(), "DEF Short TimeSensor { cycleInterval 0.5 loop TRUE enabled FALSE }");
+  const SkinnedJointMotion m = readHanimMotion(writeText("half-still.wrl", text), 10.0);
+  ASSERT_EQ(m.frameCount(), 21u);
+  for (std::size_t f = 0; f < 21; ++f) {
+    const double t = static_cast<double>(f) / 10.0;
+    EXPECT_LT((m.frames[2 * f].translation - Vec3(t, 1, 0)).norm(), 1e-6) << t;  // the enabled clock moves it
+    EXPECT_LT(m.frames[2 * f + 1].rotation.angularDistance(Quat::Identity()), 1e-6) << t;  // the arm stays
+  }
+  const std::string clock = "DEF Clock TimeSensor { cycleInterval 2 loop TRUE }";
+  text.replace(text.find(clock), clock.size(), "DEF Clock TimeSensor { cycleInterval 2 loop TRUE enabled FALSE }");
+  const std::string still = writeText("all-still.wrl", text);
+  EXPECT_NE(drape::testing::errorOf([&] { (void)readHanimMotion(still, 10.0); })
+                .find(still + ": Humanoid 'mover' has no motion: no interpolator that an enabled TimeSensor drives is routed "
+                              "into its Joints"),
+            std::string::npos);
+}
+
 // VRML97 interpolates orientations along the shortest arc, not the four numbers linearly:
 // halfway from 1 rad about x to 1 rad about y is the quaternions' slerp.
 TEST(HanimMotion, OrientationsAreInterpolatedAlongTheShortestArc) {
@@ -185,7 +208,7 @@ TEST(HanimMotion, AFileWithoutAMotionSaysWhatIsMissing) {
   still.motion.reset();
   const std::string atRest = writeText("still.wrl", hanimText(still));
   EXPECT_NE(drape::testing::errorOf([&] { (void)readHanimMotion(atRest, 30.0); })
-                .find(atRest + ": Humanoid 'still' has no motion: no interpolator that a TimeSensor drives is routed "
+                .find(atRest + ": Humanoid 'still' has no motion: no interpolator that an enabled TimeSensor drives is routed "
                                "into its Joints"),
             std::string::npos);
   EXPECT_TRUE(readHanimMotions(atRest, 30.0).empty());

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <cstdint>
 #include <filesystem>
 
@@ -68,34 +69,70 @@ Hub findHub(const scene::Avatar& avatar, const std::vector<int>& driving, const 
   return hub;
 }
 
-// Rest-pose correction per avatar joint: the world rotation that turns the avatar's rest
-// bone directions (towards its nearest driven descendants) onto the motion skeleton's rest
-// bone directions towards the same joints. A T-pose motion then lifts an A-pose avatar's
-// arms at its reference frame, and both skeletons agree wherever the motion goes. Roots
-// keep identity (both stand upright facing +Z); joints with no usable child share their
-// parent's correction.
-std::vector<Quat> restCorrections(const scene::Avatar& avatar, const std::vector<int>& driving,
-                                  const std::vector<Vec3>& motionRest, const Skeleton& skeleton) {
+// The driven bones of the avatar at rest, each as (avatar direction, motion direction): from
+// the nearest driven ancestor (an undriven joint between is carried rigidly), a chain of
+// joints one motion joint drives (twist joints) counting as one bone from its head, whose
+// index comes first. What the rest corrections turn onto each other.
+struct RestBone {
+  std::size_t head;
+  Vec3 avatarDir, motionDir;  ///< unit vectors
+};
+
+std::vector<RestBone> restBones(const scene::Avatar& avatar, const std::vector<int>& driving,
+                                const std::vector<Vec3>& motionRest) {
   const std::size_t n = avatar.joints.size();
   const std::vector<std::size_t> head = chainHeads(avatar, driving);
-  std::vector<Vec3> avatarDir(n, Vec3::Zero()), motionDir(n, Vec3::Zero());
+  std::vector<RestBone> bones;
   for (std::size_t c = 0; c < n; ++c) {
     if (driving[c] < 0) continue;
-    // The nearest driven ancestor: an undriven joint between (a second neck joint, a hip
-    // joint that the motion's naming style lacks) is carried rigidly, so the bone to turn
-    // onto the motion's runs from that ancestor to this joint.
     int a = avatar.joints[c].parent;
     while (a >= 0 && driving[static_cast<std::size_t>(a)] < 0) a = avatar.joints[static_cast<std::size_t>(a)].parent;
     if (a < 0) continue;
     if (driving[c] == driving[static_cast<std::size_t>(a)]) continue;  // within one chain: one bone
-    // A chain (twist joints) is one bone from its head: the direction is measured there.
     const std::size_t h = head[static_cast<std::size_t>(a)];
     const Vec3 da = avatar.joints[c].restCenter - avatar.joints[h].restCenter;
     const Vec3 dm = motionRest[static_cast<std::size_t>(driving[c])] -
                     motionRest[static_cast<std::size_t>(driving[static_cast<std::size_t>(a)])];
     if (da.norm() < 1e-9 || dm.norm() < 1e-9) continue;
-    avatarDir[h] += da.normalized();
-    motionDir[h] += dm.normalized();
+    bones.push_back({h, da.normalized(), dm.normalized()});
+  }
+  return bones;
+}
+
+// The quarter turn about the vertical that best faces the avatar's rest pose the way the
+// motion's faces, from the horizontal parts of every driven bone (the hips' and shoulders'
+// spans decide it): identity where both face alike, as glTF characters and CMU captures
+// (+Z) do; a half turn for a VRM 0.x character (-Z); a quarter for one facing along x.
+// Rest poses differ by their axis conventions, in quarter turns; a smaller difference is
+// pose, which the per-joint corrections take.
+Quat restFacingTurn(const std::vector<RestBone>& bones) {
+  double cosine = 0.0, sine = 0.0;  // of the best turn about y, weighted by the bones' horizontal spans
+  for (const RestBone& b : bones) {
+    cosine += b.avatarDir.x() * b.motionDir.x() + b.avatarDir.z() * b.motionDir.z();
+    sine += b.avatarDir.z() * b.motionDir.x() - b.avatarDir.x() * b.motionDir.z();
+  }
+  const double quarters = std::round(std::atan2(sine, cosine) / (std::numbers::pi / 2));
+  if (quarters == 0.0 || !std::isfinite(quarters)) return Quat::Identity();
+  return Quat(Eigen::AngleAxisd(quarters * std::numbers::pi / 2, Vec3::UnitY()));
+}
+
+// Rest-pose correction per avatar joint: the world rotation that turns the avatar's rest
+// bone directions (towards its nearest driven descendants) onto the motion skeleton's rest
+// bone directions towards the same joints. A T-pose motion then lifts an A-pose avatar's
+// arms at its reference frame, and both skeletons agree wherever the motion goes. The
+// avatar is first turned by `facing` (restFacingTurn), and every correction ends with that
+// turn: roots take it alone (both then stand upright facing the same way); joints with no
+// usable child share their parent's correction.
+std::vector<Quat> restCorrections(const scene::Avatar& avatar, const std::vector<int>& driving,
+                                  const Skeleton& skeleton, const std::vector<RestBone>& bones, const Quat& facing) {
+  const std::size_t n = avatar.joints.size();
+  const std::vector<std::size_t> head = chainHeads(avatar, driving);
+  const bool turned = facing.w() != 1.0;  // restFacingTurn gives Identity() exactly for none
+  const auto turn = [&](const Vec3& v) { return turned ? Vec3(facing * v) : v; };
+  std::vector<Vec3> avatarDir(n, Vec3::Zero()), motionDir(n, Vec3::Zero());
+  for (const RestBone& b : bones) {
+    avatarDir[b.head] += turn(b.avatarDir);
+    motionDir[b.head] += b.motionDir;
   }
   // A driven joint with no driven child (a foot whose toes the motion lacks, a head):
   // its motion end site against the avatar's directions to all its children.
@@ -110,7 +147,7 @@ std::vector<Quat> restCorrections(const scene::Avatar& avatar, const std::vector
       if (d.norm() > 1e-9) sum += d.normalized();
     }
     if (sum.norm() < 1e-9) continue;
-    avatarDir[a] = sum;
+    avatarDir[a] = turn(sum);
     motionDir[a] = endSite->normalized();
   }
   std::vector<Quat> correction(n, Quat::Identity());
@@ -125,6 +162,8 @@ std::vector<Quat> restCorrections(const scene::Avatar& avatar, const std::vector
       correction[a] = correction[static_cast<std::size_t>(parent)];
     }
   }
+  if (turned)
+    for (Quat& c : correction) c = (c * facing).normalized();
   return correction;
 }
 
@@ -258,7 +297,11 @@ AvatarAnimation AvatarAnimation::build(const scene::Avatar& avatar, const Clip& 
   }
 
   const std::vector<Vec3> motionRest = clip.skeleton.restPositions();
-  const std::vector<Quat> correction = restCorrections(avatar, anim.driving_, motionRest, clip.skeleton);
+  const std::vector<RestBone> bones = restBones(avatar, anim.driving_, motionRest);
+  const Quat facing = restFacingTurn(bones);
+  const bool turned = facing.w() != 1.0;  // restFacingTurn gives Identity() exactly for none
+  const std::vector<Quat> correction =
+      restCorrections(avatar, anim.driving_, clip.skeleton, bones, facing);
   anim.rootScale_ = options.rootScale > 0.0 ? options.rootScale : legLengthRatio(avatar, anim.driving_, motionRest, clip.skeleton);
   const double floor = avatarFloor(avatar);
   anim.rootHeightOffset_ = floor;  // the motion's y = 0 on the avatar's floor, before grounding
@@ -284,7 +327,7 @@ AvatarAnimation AvatarAnimation::build(const scene::Avatar& avatar, const Clip& 
   const auto placeRoot = [&](std::size_t a, std::size_t f) {
     const RigidTransform& motion = motionWorld[static_cast<std::size_t>(anim.driving_[a])];
     if (f == 0) firstRoot[a] = motion.translation;
-    delta[a] = motion.rotation;
+    delta[a] = turned ? Quat((motion.rotation * facing).normalized()) : motion.rotation;
     position[a] = rootPathFrom(avatar.joints[a].restCenter, motion.translation, firstRoot[a]);
   };
   for (std::size_t f = 0; f < anim.frames_; ++f) {
@@ -303,7 +346,7 @@ AvatarAnimation AvatarAnimation::build(const scene::Avatar& avatar, const Clip& 
       const auto parent = static_cast<std::size_t>(joint.parent);
       if (aboveHub[a]) {
         // Above the hub: upright, at rest height, moving with the hub across the floor.
-        delta[a] = Quat::Identity();
+        delta[a] = facing;
         position[a] = joint.restCenter + hubShift;
       } else if (joint.parent < 0) {
         placeRoot(a, f);

@@ -1,11 +1,13 @@
 // CMU walks retargeted onto the MakeHuman body: feet meet the floor once per gait cycle
-// without sinking through it, and the hips follow the scaled root path.
+// without sinking through it, and the hips follow the scaled root path; a body whose rest
+// pose faces another way is turned to face as the capture does.
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <tuple>
 
 #include "drape/core/error.hpp"
@@ -348,6 +350,60 @@ TEST(Retarget, UnknownJointInAUserMapIsAnErrorWithItsLine) {
     EXPECT_EQ(std::string(e.what()), options.jointMapPath + ":5:5: unknown motion joint 'LeftKnee' (not in the motion's skeleton)");
     EXPECT_EQ(e.code(), ExitCode::BadInput);
   }
+}
+
+// The MakeHuman body turned about the vertical at rest (a VRM 0.x character faces -Z, and
+// CesiumMan +X, where glTF characters and CMU captures face +Z) walks exactly as the body
+// facing +Z does: the retargeting turns it to face as the capture does first. Without that
+// turn its spine's correction, which the shoulders' two directions and the neck's cancel
+// to one vertical direction, left the shoulders facing backwards: 18 cm from where the
+// capture puts them in the half-turned body.
+class RetargetFacing : public ::testing::TestWithParam<int> {};
+
+TEST_P(RetargetFacing, ATurnedBodyWalksAsTheBodyFacingTheCapturesWay) {
+  const double degrees = GetParam();
+  const Quat turn(Eigen::AngleAxisd(degrees * std::numbers::pi / 180.0, Vec3::UnitY()));
+  scene::Avatar turned = makeHuman();
+  for (scene::Joint& j : turned.joints) j.restCenter = turn * j.restCenter;
+  for (scene::Segment& s : turned.segments)
+    for (Vec3& p : s.mesh.positions) p = turn * p;
+  const Clip clip = loadClip(std::string(DRAPE_DATA_DIR) + "/mocap/cmu_12_03_walk.bvh");
+  const JointMap map = chooseJointMap(shippedMaps(), clip.skeleton, makeHuman());
+  const AvatarAnimation facing = AvatarAnimation::build(makeHuman(), clip, map);
+  const AvatarAnimation other = AvatarAnimation::build(turned, clip, map);
+  ASSERT_EQ(other.frameCount(), facing.frameCount());
+  // The root keeps its own place on the floor: the turned body's rest root stands elsewhere.
+  Vec3 shift = turned.joints[0].restCenter - makeHuman().joints[0].restCenter;
+  shift.y() = 0.0;
+  double position = 0.0, angle = 0.0;
+  for (std::size_t f = 0; f < facing.frameCount(); ++f)
+    for (std::size_t j = 0; j < facing.jointCount(); ++j) {
+      position = std::max(position, (other.frame(f)[j].translation - shift - facing.frame(f)[j].translation).norm());
+      // Its joints' frames are the facing body's, turned back from its own rest.
+      angle = std::max(angle, other.frame(f)[j].rotation.angularDistance(facing.frame(f)[j].rotation * turn.conjugate()));
+    }
+  EXPECT_LT(position, 1e-9) << "m";
+  EXPECT_LT(angle, 1e-9) << "rad";
+}
+
+INSTANTIATE_TEST_SUITE_P(QuarterTurns, RetargetFacing, ::testing::Values(90, 180, 270),
+                         [](const ::testing::TestParamInfo<int>& p) { return std::to_string(p.param) + "Degrees"; });
+
+// A rest pose a little turned (a scan standing askew) is pose, not a facing convention: the
+// body is not turned, and its joints keep the corrections of their own bones.
+TEST(Retarget, ABodyALittleTurnedIsNotTurnedAround) {
+  const Quat turn(Eigen::AngleAxisd(20.0 * std::numbers::pi / 180.0, Vec3::UnitY()));
+  scene::Avatar askew = makeHuman();
+  for (scene::Joint& j : askew.joints) j.restCenter = turn * j.restCenter;
+  for (scene::Segment& s : askew.segments)
+    for (Vec3& p : s.mesh.positions) p = turn * p;
+  const Clip clip = loadClip(std::string(DRAPE_DATA_DIR) + "/mocap/cmu_12_03_walk.bvh");
+  const JointMap map = chooseJointMap(shippedMaps(), clip.skeleton, makeHuman());
+  const AvatarAnimation straight = AvatarAnimation::build(makeHuman(), clip, map);
+  const AvatarAnimation a = AvatarAnimation::build(askew, clip, map);
+  // The root follows the capture's own turn, whatever the body's rest facing.
+  for (std::size_t f = 0; f < a.frameCount(); ++f)
+    EXPECT_LT(a.frame(f)[0].rotation.angularDistance(straight.frame(f)[0].rotation), 1e-12) << f;
 }
 
 }  // namespace

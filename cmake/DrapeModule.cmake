@@ -38,6 +38,12 @@ function(drape_batch target)
   list(LENGTH sources count)
   math(EXPR per_batch "(${count} + 1) / 2")
   set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE ${per_batch})
+  # GCC takes the files a batch includes for headers, and warns of a class (a pimpl's Impl)
+  # whose members' types sit in its file's anonymous namespace, which in a header would
+  # differ from file to file. Here each file is its own, and compiled alone it is silent.
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    target_compile_options(${target} PRIVATE -Wno-subobject-linkage)
+  endif()
 endfunction()
 
 # drape_add_module(NAME [UNBATCHED] [DEPS target...])

@@ -317,7 +317,7 @@ MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, co
                               animation));
     return {};
   }
-  if (!motion.empty()) return {motion, animation};
+  if (!motion.empty()) return {motion, animation, nullptr};
   const std::string nothingToChoose = fmt::format(
       "--animation {}: the avatar's own file carries no animation to choose from; give the motion with --motion FILE",
       animation);
@@ -335,7 +335,7 @@ MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, co
                  avatar.source, avatar.animations.size(), avatar.animations.size() == 1 ? "" : "s",
                  avatar.animations[index],
                  avatar.animations.size() > 1 && animation.empty() ? ", the first (--animation chooses another)" : "");
-    return {avatar.source, animation};
+    return {avatar.source, animation, nullptr};
   }
   if (std::shared_ptr<const formats::SkinnedJointMotion> m = humanoidMotion(avatar, setup.settings.frameRate_hz)) {
     std::error_code ec;

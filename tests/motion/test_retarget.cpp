@@ -360,17 +360,27 @@ TEST(Retarget, UnknownJointInAUserMapIsAnErrorWithItsLine) {
 // capture puts them in the half-turned body.
 class RetargetFacing : public ::testing::TestWithParam<int> {};
 
-TEST_P(RetargetFacing, ATurnedBodyWalksAsTheBodyFacingTheCapturesWay) {
-  const double degrees = GetParam();
-  const Quat turn(Eigen::AngleAxisd(degrees * std::numbers::pi / 180.0, Vec3::UnitY()));
+/// The MakeHuman body at rest turned about the vertical through the origin.
+scene::Avatar turnedBody(const Quat& turn) {
   scene::Avatar turned = makeHuman();
   for (scene::Joint& j : turned.joints) j.restCenter = turn * j.restCenter;
   for (scene::Segment& s : turned.segments)
     for (Vec3& p : s.mesh.positions) p = turn * p;
+  return turned;
+}
+
+/// The CMU walk on `avatar` through the map chosen for the MakeHuman body.
+AvatarAnimation walkOn(const scene::Avatar& avatar) {
   const Clip clip = loadClip(std::string(DRAPE_DATA_DIR) + "/mocap/cmu_12_03_walk.bvh");
-  const JointMap map = chooseJointMap(shippedMaps(), clip.skeleton, makeHuman());
-  const AvatarAnimation facing = AvatarAnimation::build(makeHuman(), clip, map);
-  const AvatarAnimation other = AvatarAnimation::build(turned, clip, map);
+  return AvatarAnimation::build(avatar, clip, chooseJointMap(shippedMaps(), clip.skeleton, makeHuman()));
+}
+
+TEST_P(RetargetFacing, ATurnedBodyWalksAsTheBodyFacingTheCapturesWay) {
+  const double degrees = GetParam();
+  const Quat turn(Eigen::AngleAxisd(degrees * std::numbers::pi / 180.0, Vec3::UnitY()));
+  const scene::Avatar turned = turnedBody(turn);
+  const AvatarAnimation facing = walkOn(makeHuman());
+  const AvatarAnimation other = walkOn(turned);
   ASSERT_EQ(other.frameCount(), facing.frameCount());
   // The root keeps its own place on the floor: the turned body's rest root stands elsewhere.
   Vec3 shift = turned.joints[0].restCenter - makeHuman().joints[0].restCenter;
@@ -393,14 +403,8 @@ INSTANTIATE_TEST_SUITE_P(QuarterTurns, RetargetFacing, ::testing::Values(90, 180
 // body is not turned, and its joints keep the corrections of their own bones.
 TEST(Retarget, ABodyALittleTurnedIsNotTurnedAround) {
   const Quat turn(Eigen::AngleAxisd(20.0 * std::numbers::pi / 180.0, Vec3::UnitY()));
-  scene::Avatar askew = makeHuman();
-  for (scene::Joint& j : askew.joints) j.restCenter = turn * j.restCenter;
-  for (scene::Segment& s : askew.segments)
-    for (Vec3& p : s.mesh.positions) p = turn * p;
-  const Clip clip = loadClip(std::string(DRAPE_DATA_DIR) + "/mocap/cmu_12_03_walk.bvh");
-  const JointMap map = chooseJointMap(shippedMaps(), clip.skeleton, makeHuman());
-  const AvatarAnimation straight = AvatarAnimation::build(makeHuman(), clip, map);
-  const AvatarAnimation a = AvatarAnimation::build(askew, clip, map);
+  const AvatarAnimation straight = walkOn(makeHuman());
+  const AvatarAnimation a = walkOn(turnedBody(turn));
   // The root follows the capture's own turn, whatever the body's rest facing.
   for (std::size_t f = 0; f < a.frameCount(); ++f)
     EXPECT_LT(a.frame(f)[0].rotation.angularDistance(straight.frame(f)[0].rotation), 1e-12) << f;

@@ -140,7 +140,9 @@ RunFunction setupPlay(CLI::App& app) {
       options.screenshot = o.screenshot;
       return playScene(o, options);
     }
-    if (!o.motion.empty()) throw Error("--motion: drape play takes a motion only with a scene file, not a run directory");
+    if (!o.motion.empty() || !o.animation.empty())
+      throw Error(fmt::format("{}: drape play takes a motion only with a scene file, not a run directory",
+                              o.motion.empty() ? "--animation" : "--motion"));
     render::RunReplay replay(o.run);
     std::tie(options.width, options.height) = o.picture.parsedSize();
     options.title = fmt::format("drape play {}", o.run);

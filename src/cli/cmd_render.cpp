@@ -86,8 +86,9 @@ RunFunction setupRender(CLI::App& app) {
       setup.outDir = runDir;
       setup.objEvery = setup.frames;
       (void)simulateRun(setup);
-    } else if (!o.motion.empty()) {
-      throw Error("--motion: drape render takes a motion only with a scene file, not a run directory");
+    } else if (!o.motion.empty() || !o.animation.empty()) {
+      throw Error(fmt::format("{}: drape render takes a motion only with a scene file, not a run directory",
+                              o.motion.empty() ? "--animation" : "--motion"));
     } else if (o.frames > 0) {
       throw Error("--frames: drape render simulates frames only from a scene file; for some of a run's frames, "
                   "--range FIRST:LAST");

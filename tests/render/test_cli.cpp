@@ -81,6 +81,15 @@ TEST(RenderCli, ARangeRendersThoseFramesAsTheWholeRunDoes) {
   r = run(drape() + " render " + dir + " --png " + dir + "/bad --frames 3");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.output.find("--range FIRST:LAST"), std::string::npos) << r.output;
+  // A run is drawn as it was simulated: no motion, nor one of an avatar's animations.
+  for (const std::string option : {"--motion walk.bvh", "--animation 0"}) {
+    r = run(drape() + " render " + dir + " --png " + dir + "/bad " + option);
+    EXPECT_EQ(r.status, 2) << option;
+    EXPECT_NE(r.output.find(option.substr(0, option.find(' ')) +
+                            ": drape render takes a motion only with a scene file, not a run directory"),
+              std::string::npos)
+        << r.output;
+  }
 }
 
 TEST(RenderCli, VideoHasEveryFrame) {
@@ -224,6 +233,19 @@ TEST(PlayCli, NoDisplayIsAClearError) {
       run("env -u DISPLAY -u WAYLAND_DISPLAY ASAN_OPTIONS=detect_leaks=0 " + drape() + " play " + dir + " --frames 1");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("needs a display"), std::string::npos) << r.output;
+}
+
+TEST(PlayCli, ARunTakesNoMotion) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_play_motion"), 2);
+  for (const std::string option : {"--motion walk.bvh", "--animation 0"}) {
+    const Result r = run("env -u DISPLAY -u WAYLAND_DISPLAY ASAN_OPTIONS=detect_leaks=0 " + drape() + " play " + dir +
+                         " --frames 1 " + option);
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find(option.substr(0, option.find(' ')) +
+                            ": drape play takes a motion only with a scene file, not a run directory"),
+              std::string::npos)
+        << r.output;
+  }
 }
 
 TEST(RenderCli, SubdividedGarmentsCoverAboutWhatTheSimulatedTrianglesCover) {

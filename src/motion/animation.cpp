@@ -2,9 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <cstdint>
 #include <filesystem>
+#include <numbers>
+#include <optional>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -85,10 +86,14 @@ std::vector<RestBone> restBones(const scene::Avatar& avatar, const std::vector<i
   std::vector<RestBone> bones;
   for (std::size_t c = 0; c < n; ++c) {
     if (driving[c] < 0) continue;
+    // The nearest driven ancestor: an undriven joint between (a second neck joint, a hip
+    // joint that the motion's naming style lacks) is carried rigidly, so the bone to turn
+    // onto the motion's runs from that ancestor to this joint.
     int a = avatar.joints[c].parent;
     while (a >= 0 && driving[static_cast<std::size_t>(a)] < 0) a = avatar.joints[static_cast<std::size_t>(a)].parent;
     if (a < 0) continue;
     if (driving[c] == driving[static_cast<std::size_t>(a)]) continue;  // within one chain: one bone
+    // A chain (twist joints) is one bone from its head: the direction is measured there.
     const std::size_t h = head[static_cast<std::size_t>(a)];
     const Vec3 da = avatar.joints[c].restCenter - avatar.joints[h].restCenter;
     const Vec3 dm = motionRest[static_cast<std::size_t>(driving[c])] -
@@ -104,15 +109,16 @@ std::vector<RestBone> restBones(const scene::Avatar& avatar, const std::vector<i
 // spans decide it): identity where both face alike, as glTF characters and CMU captures
 // (+Z) do; a half turn for a VRM 0.x character (-Z); a quarter for one facing along x.
 // Rest poses differ by their axis conventions, in quarter turns; a smaller difference is
-// pose, which the per-joint corrections take.
-Quat restFacingTurn(const std::vector<RestBone>& bones) {
+// pose, which the per-joint corrections take. None where no turn is needed, so that such an
+// avatar's rotations are not renormalised and its results stay exactly as without this step.
+std::optional<Quat> restFacingTurn(const std::vector<RestBone>& bones) {
   double cosine = 0.0, sine = 0.0;  // of the best turn about y, weighted by the bones' horizontal spans
   for (const RestBone& b : bones) {
     cosine += b.avatarDir.x() * b.motionDir.x() + b.avatarDir.z() * b.motionDir.z();
     sine += b.avatarDir.z() * b.motionDir.x() - b.avatarDir.x() * b.motionDir.z();
   }
   const double quarters = std::round(std::atan2(sine, cosine) / (std::numbers::pi / 2));
-  if (quarters == 0.0 || !std::isfinite(quarters)) return Quat::Identity();
+  if (quarters == 0.0 || !std::isfinite(quarters)) return std::nullopt;
   return Quat(Eigen::AngleAxisd(quarters * std::numbers::pi / 2, Vec3::UnitY()));
 }
 
@@ -124,11 +130,11 @@ Quat restFacingTurn(const std::vector<RestBone>& bones) {
 // turn: roots take it alone (both then stand upright facing the same way); joints with no
 // usable child share their parent's correction.
 std::vector<Quat> restCorrections(const scene::Avatar& avatar, const std::vector<int>& driving,
-                                  const Skeleton& skeleton, const std::vector<RestBone>& bones, const Quat& facing) {
+                                  const Skeleton& skeleton, const std::vector<RestBone>& bones,
+                                  const std::optional<Quat>& facing) {
   const std::size_t n = avatar.joints.size();
   const std::vector<std::size_t> head = chainHeads(avatar, driving);
-  const bool turned = facing.w() != 1.0;  // restFacingTurn gives Identity() exactly for none
-  const auto turn = [&](const Vec3& v) { return turned ? Vec3(facing * v) : v; };
+  const auto turn = [&](const Vec3& v) { return facing ? Vec3(*facing * v) : v; };
   std::vector<Vec3> avatarDir(n, Vec3::Zero()), motionDir(n, Vec3::Zero());
   for (const RestBone& b : bones) {
     avatarDir[b.head] += turn(b.avatarDir);
@@ -162,8 +168,8 @@ std::vector<Quat> restCorrections(const scene::Avatar& avatar, const std::vector
       correction[a] = correction[static_cast<std::size_t>(parent)];
     }
   }
-  if (turned)
-    for (Quat& c : correction) c = (c * facing).normalized();
+  if (facing)
+    for (Quat& c : correction) c = (c * *facing).normalized();
   return correction;
 }
 
@@ -298,8 +304,7 @@ AvatarAnimation AvatarAnimation::build(const scene::Avatar& avatar, const Clip& 
 
   const std::vector<Vec3> motionRest = clip.skeleton.restPositions();
   const std::vector<RestBone> bones = restBones(avatar, anim.driving_, motionRest);
-  const Quat facing = restFacingTurn(bones);
-  const bool turned = facing.w() != 1.0;  // restFacingTurn gives Identity() exactly for none
+  const std::optional<Quat> facing = restFacingTurn(bones);
   const std::vector<Quat> correction =
       restCorrections(avatar, anim.driving_, clip.skeleton, bones, facing);
   anim.rootScale_ = options.rootScale > 0.0 ? options.rootScale : legLengthRatio(avatar, anim.driving_, motionRest, clip.skeleton);
@@ -327,7 +332,7 @@ AvatarAnimation AvatarAnimation::build(const scene::Avatar& avatar, const Clip& 
   const auto placeRoot = [&](std::size_t a, std::size_t f) {
     const RigidTransform& motion = motionWorld[static_cast<std::size_t>(anim.driving_[a])];
     if (f == 0) firstRoot[a] = motion.translation;
-    delta[a] = turned ? Quat((motion.rotation * facing).normalized()) : motion.rotation;
+    delta[a] = facing ? Quat((motion.rotation * *facing).normalized()) : motion.rotation;
     position[a] = rootPathFrom(avatar.joints[a].restCenter, motion.translation, firstRoot[a]);
   };
   for (std::size_t f = 0; f < anim.frames_; ++f) {
@@ -346,7 +351,7 @@ AvatarAnimation AvatarAnimation::build(const scene::Avatar& avatar, const Clip& 
       const auto parent = static_cast<std::size_t>(joint.parent);
       if (aboveHub[a]) {
         // Above the hub: upright, at rest height, moving with the hub across the floor.
-        delta[a] = facing;
+        delta[a] = facing.value_or(Quat::Identity());
         position[a] = joint.restCenter + hubShift;
       } else if (joint.parent < 0) {
         placeRoot(a, f);

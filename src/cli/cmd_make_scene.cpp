@@ -25,6 +25,7 @@
 #include "drape/scene/avatar_gltf.hpp"
 #include "drape/scene/avatar_segment.hpp"
 #include "drape/scene/garment_fit.hpp"
+#include "run_setup.hpp"
 #include "scene_text.hpp"
 #include "stitch_gaps.hpp"
 

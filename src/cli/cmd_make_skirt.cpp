@@ -11,6 +11,7 @@
 #include <fmt/ostream.h>
 
 #include "command.hpp"
+#include "run_setup.hpp"
 #include "scene_text.hpp"
 #include "drape/cloth/model.hpp"
 #include "drape/core/error.hpp"

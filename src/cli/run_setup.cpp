@@ -352,6 +352,22 @@ MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, co
   return {};
 }
 
+void printHowToRun(const std::string& out, const scene::Avatar& avatar) {
+  const std::string scene = (std::filesystem::path(out) / "scene.wrl").string();
+  std::string own;
+  if (!avatar.animations.empty())
+    own = fmt::format("its own file's animation '{}'{}", avatar.animations.front(),
+                      avatar.animations.size() > 1 ? fmt::format(", the first of {}", avatar.animations.size()) : "");
+  else if (humanoidMotion(avatar, 30.0))
+    own = "the interpolators its file routes into it";
+  if (own.empty())
+    fmt::print("run it: drape run {} --motion FILE (a BVH or AMC capture, or an animated avatar file; without it "
+               "the avatar stands at rest)\n",
+               scene);
+  else
+    fmt::print("run it: drape run {} (the avatar plays {}; --motion FILE plays another)\n", scene, own);
+}
+
 namespace {
 
 /// What --keep-apart changed in the motion: one line, and one per pair it moved.

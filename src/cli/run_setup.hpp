@@ -101,6 +101,9 @@ struct MotionChoice {
 };
 [[nodiscard]] MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, const std::string& motion,
                                        const std::string& animation);
+/// The line `drape make-skirt` and `make-scene` end with: how to run the scene they wrote in
+/// `out`, and what moves `avatar` there without --motion (what sceneMotion would play).
+void printHowToRun(const std::string& out, const scene::Avatar& avatar);
 
 /// The character's world of a setup with an avatar: fields built, masks bound, solvers
 /// ready. Used by `drape run`, `drape play SCENE` and `drape bench paper` alike.

@@ -11,7 +11,6 @@
 #include "drape/cloth/material.hpp"
 #include "drape/core/error.hpp"
 #include "drape/mesh/trimesh.hpp"
-#include "drape/scene/avatar.hpp"
 
 namespace drape::cli {
 
@@ -42,20 +41,6 @@ inline std::string prepareSceneDir(const std::string& out, const std::string& av
   if (ec) throw Error(fmt::format("--out {}: cannot create the directory ({})", out, ec.message()));
   if (!avatarUrl.empty()) return avatarUrl;
   return std::filesystem::relative(std::filesystem::absolute(avatar), std::filesystem::absolute(out)).string();
-}
-
-/// The line after "wrote ...": how to run the scene, and what moves the avatar without
-/// --motion (the animation its own file carries, which `drape run` plays by itself).
-inline void printHowToRun(const std::string& out, const scene::Avatar& avatar) {
-  const std::string scene = (std::filesystem::path(out) / "scene.wrl").string();
-  if (avatar.animations.empty())
-    fmt::print("run it: drape run {} --motion FILE (a BVH or AMC capture, or an animated avatar file; without it "
-               "the avatar stands at rest)\n",
-               scene);
-  else
-    fmt::print("run it: drape run {} (the avatar plays its own file's animation '{}'{}; --motion FILE plays another)\n",
-               scene, avatar.animations.front(),
-               avatar.animations.size() > 1 ? fmt::format(", the first of {}", avatar.animations.size()) : "");
 }
 
 }  // namespace drape::cli

@@ -355,6 +355,13 @@ TEST(HanimMotionRun, TheSkirtWalksTheSameOnTheConvertedHumanoid) {
             std::string::npos)
       << own.err;
   EXPECT_EQ(largestGap(formats::readPc2(dir / "by-its-file/garment.pc2"), a), 0.0);
+  // A skirt made for the humanoid says its scene plays by itself.
+  const CliResult made = runDrape(fmt::format("make-skirt '{}' --out '{}'", wrl, dir / "made"), dir);
+  ASSERT_EQ(made.code, 0) << made.err;
+  EXPECT_NE(made.out.find("run it: drape run " + (dir / "made") + "/scene.wrl (the avatar plays the interpolators its "
+                          "file routes into it; --motion FILE plays another)"),
+            std::string::npos)
+      << made.out;
 
   // The animated humanoid written into the scene itself, in the Avatar node's place: the
   // scene given as its own motion plays it.

@@ -7,6 +7,7 @@
 #include <fmt/ostream.h>
 
 #include "command.hpp"
+#include "run_setup.hpp"
 #include "stitch_gaps.hpp"
 #include "drape/formats/hanim_motion.hpp"
 #include "drape/mesh/topology.hpp"
@@ -102,11 +103,11 @@ void printExternalAvatar(const std::string& path, const scene::Scene& s, std::os
   if (!avatar) return;
   fmt::print(out, "    {}: {} joints, {} segments{}\n", avatar->source, avatar->joints.size(), avatar->segments.size(),
              avatar->skin ? fmt::format(", a skin of {} triangles", avatar->skin->mesh.triangleCount()) : "");
-  const std::size_t n = avatar->animations.size();
-  if (n == 0) return;
-  fmt::print(out, "    its file carries {} animation{} ('{}'); drape run {} plays {} by itself (--motion none: at rest)\n",
-             n, n == 1 ? "" : "s", fmt::join(avatar->animations, "', '"), path,
-             n == 1 ? "it" : "the first (--animation NAME|INDEX chooses)");
+  if (!avatar->animations.empty())
+    fmt::print(out, "    its file carries {} animation{} ('{}')\n", avatar->animations.size(),
+               avatar->animations.size() == 1 ? "" : "s", fmt::join(avatar->animations, "', '"));
+  if (const std::string own = ownMotionText(*avatar); !own.empty())
+    fmt::print(out, "    drape run {} plays {} by itself (--motion none: at rest)\n", path, own);
 }
 
 void inspectScene(const std::string& path, std::ostream& out) {

@@ -352,14 +352,19 @@ MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, co
   return {};
 }
 
+std::string ownMotionText(const scene::Avatar& avatar) {
+  if (!avatar.animations.empty())
+    return fmt::format("its own file's animation '{}'{}", avatar.animations.front(),
+                       avatar.animations.size() > 1
+                           ? fmt::format(", the first of {} (--animation NAME|INDEX chooses)", avatar.animations.size())
+                           : "");
+  if (humanoidMotion(avatar, 30.0)) return "the interpolators its file routes into it";
+  return "";
+}
+
 void printHowToRun(const std::string& out, const scene::Avatar& avatar) {
   const std::string scene = (std::filesystem::path(out) / "scene.wrl").string();
-  std::string own;
-  if (!avatar.animations.empty())
-    own = fmt::format("its own file's animation '{}'{}", avatar.animations.front(),
-                      avatar.animations.size() > 1 ? fmt::format(", the first of {}", avatar.animations.size()) : "");
-  else if (humanoidMotion(avatar, 30.0))
-    own = "the interpolators its file routes into it";
+  const std::string own = ownMotionText(avatar);
   if (own.empty())
     fmt::print("run it: drape run {} --motion FILE (a BVH or AMC capture, or an animated avatar file; without it "
                "the avatar stands at rest)\n",

@@ -101,6 +101,9 @@ struct MotionChoice {
 };
 [[nodiscard]] MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, const std::string& motion,
                                        const std::string& animation);
+/// What `avatar` plays without --motion, as the end of "the avatar plays ..." ("its own
+/// file's animation 'walk'"), or "" when it stands at rest.
+[[nodiscard]] std::string ownMotionText(const scene::Avatar& avatar);
 /// The line `drape make-skirt` and `make-scene` end with: how to run the scene they wrote in
 /// `out`, and what moves `avatar` there without --motion (what sceneMotion would play).
 void printHowToRun(const std::string& out, const scene::Avatar& avatar);

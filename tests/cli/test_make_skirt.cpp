@@ -139,8 +139,8 @@ TEST(MakeSkirt, CesiumMansSkirtWalksOnItsOwnAnimation) {
   const CliResult inspected = runDrape("inspect '" + out + "/scene.wrl'", dir);
   ASSERT_EQ(inspected.code, 0) << inspected.err;
   EXPECT_NE(inspected.out.find("CesiumMan.glb: 19 joints, 19 segments, a skin of 4672 triangles\n    its file carries 1 "
-                               "animation ('animation 0'); drape run " + out + "/scene.wrl plays it by itself (--motion "
-                               "none: at rest)\n"),
+                               "animation ('animation 0')\n    drape run " + out + "/scene.wrl plays its own file's "
+                               "animation 'animation 0' by itself (--motion none: at rest)\n"),
             std::string::npos)
       << inspected.out;
   const std::string byItself = dir / "by-itself";

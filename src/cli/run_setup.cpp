@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <filesystem>
 #include <array>
 #include <fstream>
@@ -19,22 +20,15 @@
 #include "drape/core/error.hpp"
 #include "drape/core/log.hpp"
 #include "drape/core/progress.hpp"
-#include "drape/formats/obj.hpp"
-#include "drape/formats/pc2.hpp"
-#include "drape/formats/run_manifest.hpp"
-#include "drape/formats/state_cache.hpp"
-#include "drape/formats/gltf_writer.hpp"
 #include "drape/formats/hanim_motion.hpp"
-#include "drape/formats/vrml_write.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/render/frame.hpp"
-#include "drape/render/outputs.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/body_overlap.hpp"
-#include "drape/sim/body_skin.hpp"
 #include "drape/sim/scene_setup.hpp"
 #include "frames_ahead.hpp"
 #include "measure.hpp"
+#include "run_writer.hpp"
 #include "stage_laps.hpp"
 
 namespace drape::cli {
@@ -87,41 +81,15 @@ namespace fs = std::filesystem;
 /// Triangles smaller than this (m^2) are degenerate for the membrane model.
 constexpr double kMinTriangleArea_m2 = 1e-12;
 
-/// One garment being simulated: its model, solver and output streams.
+/// One garment being simulated: its model and solver (and its collider, on a character).
 struct GarmentRun {
   std::string name;
-  std::string fileStem;  ///< "garment" alone, "garment-<name>" when there are several
   const cloth::ClothModel* model = nullptr;
   std::unique_ptr<cloth::ClothSolver> ownedSolver;  ///< without a character
   cloth::ClothSolver* solver = nullptr;             ///< owned here or by the character world
   const cloth::FieldCollider* collider = nullptr;   ///< on a character
-  std::unique_ptr<formats::Pc2Writer> cache;
-  std::unique_ptr<formats::StateCacheWriter> states;  ///< per vertex and frame: collision state, pinned, bound
-  std::vector<std::vector<Vec3>> frames;            ///< every frame, for result.wrl
   std::vector<cloth::SphereCollider> spheres;       ///< its own static spheres (--sphere)
 };
-
-/// One avatar body part written as a deforming mesh: rest topology and a cache of world
-/// positions per frame (role "segment" in the manifest).
-struct SegmentRun {
-  std::string name;
-  int joint = -1;
-  std::string fileStem;
-  const mesh::TriMesh* mesh = nullptr;  ///< in the joint's frame
-  std::unique_ptr<formats::Pc2Writer> cache;
-};
-
-std::string sanitise(const std::string& name) {
-  std::string out;
-  for (char c : name) out += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
-  return out.empty() ? std::string("part") : out;
-}
-
-void createOutDir(const std::string& dir) {
-  std::error_code ec;
-  fs::create_directories(fs::path(dir) / "frames", ec);
-  if (ec) throw Error(fmt::format("--out {}: cannot create the directory ({})", dir, ec.message()));
-}
 
 std::vector<cloth::PinGroup> pinsOf(const GarmentSetup& g, const cloth::ClothModel& model) {
   if (g.pinned.empty()) return {};
@@ -201,35 +169,6 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
     }
     stats["distance_fields"] = fields;
     stats["distance_field_build_s"] = world->fieldBuild_s();
-  }
-}
-
-/// result.wrl (any VRML97 browser, and drape's reader) and result.glb (glTF viewers, DCC
-/// tools): the garments and, on a character, the animated avatar.
-void writeResultFiles(const RunSetup& setup, const std::vector<GarmentRun>& runs,
-                      const std::vector<SegmentRun>& segments,
-                      const std::vector<std::vector<RigidTransform>>& jointFrames) {
-  const fs::path out(setup.outDir);
-  formats::vrml::Animation animation;
-  animation.frameRate = setup.settings.frameRate_hz;
-  for (std::size_t g = 0; g < runs.size(); ++g)
-    animation.garments.push_back({setup.garments[g].name, runs[g].model->triangles(), runs[g].frames, Vec3(0.8, 0.25, 0.2)});
-  if (setup.character) {
-    const scene::Avatar& avatar = *setup.character->avatar;
-    for (std::size_t j = 0; j < avatar.joints.size(); ++j) {
-      formats::vrml::JointTrack track;
-      track.name = avatar.joints[j].name;
-      for (const SegmentRun& sr : segments)
-        if (sr.joint == static_cast<int>(j)) track.segments.push_back(*sr.mesh);
-      track.frames = jointFrames[j];
-      animation.joints.push_back(std::move(track));
-    }
-  }
-  formats::vrml::writeAnimation((out / "result.wrl").string(), animation);
-  (void)formats::exportRunToGlb(setup.outDir, (out / "result.glb").string());
-  if (setup.preview) {
-    const render::PreviewFiles preview = render::renderPreview(setup.outDir);
-    spdlog::info("preview: {}{}", preview.contactSheet, preview.video.empty() ? " (no ffmpeg: no video)" : ", " + preview.video);
   }
 }
 
@@ -525,7 +464,7 @@ void validateRunSetup(const RunSetup& setup) {
   if (setup.garments.empty()) throw Error("drape run: no garment to simulate");
   if (setup.character && !setup.character->avatar) throw Error("drape run: the character has no avatar", ExitCode::Internal);
   setup.settings.validate("--");
-  if (setup.frames < 1) throw Error(fmt::format("--frames must be >= 1, got {}", setup.frames));
+  if (setup.frames < 1 && !setup.motionStreamed) throw Error(fmt::format("--frames must be >= 1, got {}", setup.frames));
   if (setup.objEvery < 1) throw Error(fmt::format("--every must be >= 1, got {}", setup.objEvery));
   for (const SphereSetup& s : setup.spheres)
     if (!(s.radius_m > 0.0) || !s.centre_m.allFinite())
@@ -566,25 +505,56 @@ void garmentVertexStates(const cloth::ClothSolver& solver, const cloth::FieldCol
   }
 }
 
+namespace {
+
+/// drape run's sink: the run directory's files.
+class WriterSink final : public FrameSink {
+ public:
+  explicit WriterSink(const RunSetup& setup) : setup_(setup) {}
+  void begin(const sim::CharacterWorld* world) override {
+    std::vector<RigidTransform> joints;
+    if (world) {
+      joints.resize(setup_.character->avatar->joints.size());
+      world->poses().evaluate(0.0, joints);
+    }
+    writer_ = std::make_unique<RunWriter>(setup_, world ? &world->fields() : nullptr, world ? leastT0(*world) : 0.0,
+                                          joints);
+  }
+  void write(const FrameTaken& frame) override { writer_->write(frame); }
+  void end(long frames) override { writer_->close(frames); }
+  void stats(const nlohmann::json& stats) override { writer_->writeStats(stats); }
+
+ private:
+  const RunSetup& setup_;
+  std::unique_ptr<RunWriter> writer_;
+};
+
+}  // namespace
+
 int simulateRun(const RunSetup& setup) {
   validateRunSetup(setup);
   createOutDir(setup.outDir);
-  const fs::path out(setup.outDir);
+  WriterSink sink(setup);
+  return simulateInto(setup, sink, nullptr);
+}
+
+int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) {
+  validateRunSetup(setup);
   const cloth::StepSettings& settings = setup.settings;
 
   // Build every garment (topology checks happen here: non-manifold, degenerate). On a
   // character, the world builds the part fields, binds the masks and owns the solvers.
   for (const GarmentSetup& g : setup.garments) (void)mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
   std::unique_ptr<sim::CharacterWorld> world = setup.character ? buildWorld(setup) : nullptr;
-  const std::vector<sim::BodyOverlap> overlaps = world ? findOverlaps(setup, *world) : std::vector<sim::BodyOverlap>{};
+  // A streamed motion is not all there yet: where it puts the body inside itself is found
+  // at the end, for the stats.
+  std::vector<sim::BodyOverlap> overlaps =
+      world && !setup.motionStreamed ? findOverlaps(setup, *world) : std::vector<sim::BodyOverlap>{};
   std::vector<GarmentRun> runs;
-  formats::RunManifest manifest;
-  manifest.frameRate = settings.frameRate_hz;
   for (std::size_t gi = 0; gi < setup.garments.size(); ++gi) {
     const GarmentSetup& g = setup.garments[gi];
     GarmentRun r;
     r.name = g.name;
-    r.fileStem = setup.garments.size() == 1 ? "garment" : "garment-" + sanitise(g.name);
     if (world) {
       r.solver = &world->mutableSolver(gi);
       r.collider = world->collider(gi);
@@ -620,62 +590,17 @@ int simulateRun(const RunSetup& setup) {
                    "the run may diverge (try --substeps {} or more)",
                    g.name, settings.substep_s(), stable,
                    static_cast<long>(std::ceil(1.0 / (settings.frameRate_hz * stable))));
-    formats::writeObj((out / (r.fileStem + ".obj")).string(), g.mesh.positions, g.mesh.triangles,
-                      "drape run: rest topology of " + g.name + " (m)");
-    r.cache = std::make_unique<formats::Pc2Writer>((out / (r.fileStem + ".pc2")).string(), g.mesh.vertexCount(), 0.0,
-                                                   1.0);
-    r.states = std::make_unique<formats::StateCacheWriter>((out / (r.fileStem + ".states")).string(),
-                                                           g.mesh.vertexCount());
-    manifest.meshes.push_back({g.name, "garment", r.fileStem + ".obj", r.fileStem + ".pc2", r.fileStem + ".states"});
     runs.push_back(std::move(r));
   }
-
-  // The avatar's body parts, written as deforming meshes for players and exporters.
-  std::vector<SegmentRun> segments;
-  std::vector<RigidTransform> joints;
-  std::vector<std::vector<RigidTransform>> jointFrames;  // per joint, per frame (result.wrl)
-  std::unique_ptr<sim::BodySkin> skin;                   // the skinned body, when the avatar has one
-  std::unique_ptr<formats::Pc2Writer> skinCache;
-  std::vector<Vec3> skinPositions;
-  if (setup.character) {
-    const scene::Avatar& avatar = *setup.character->avatar;
-    joints.resize(avatar.joints.size());
-    jointFrames.resize(avatar.joints.size());
-    world->poses().evaluate(0.0, joints);
-    std::error_code ec;
-    fs::create_directories(out / "segments", ec);
-    if (avatar.skin) {
-      // The skinned body, which players draw instead of the segments (the collision's own
-      // bodies, still written for the overlays and exporters).
-      skin = std::make_unique<sim::BodySkin>(avatar, world->fields(), leastT0(*world));
-      skin->pose(joints, skinPositions);
-      formats::writeObj((out / "body.obj").string(), skinPositions, avatar.skin->mesh.triangles,
-                        "drape run: the avatar's skinned body (m)");
-      skinCache = std::make_unique<formats::Pc2Writer>((out / "body.pc2").string(), skinPositions.size(), 0.0, 1.0);
-      manifest.meshes.push_back({"body", "skin", "body.obj", "body.pc2", ""});
-    }
-    for (const scene::Segment& seg : avatar.segments) {
-      SegmentRun sr;
-      sr.name = seg.name;
-      sr.joint = seg.joint;
-      sr.mesh = &seg.mesh;
-      sr.fileStem = "segments/" + sanitise(seg.name);
-      std::vector<Vec3> rest;
-      for (const Vec3& p : seg.mesh.positions) rest.push_back(joints[static_cast<std::size_t>(seg.joint)].apply(p));
-      formats::writeObj((out / (sr.fileStem + ".obj")).string(), rest, seg.mesh.triangles,
-                        "drape run: body part " + seg.name + " (m)");
-      sr.cache = std::make_unique<formats::Pc2Writer>((out / (sr.fileStem + ".pc2")).string(), rest.size(), 0.0, 1.0);
-      manifest.meshes.push_back({seg.name, "segment", sr.fileStem + ".obj", sr.fileStem + ".pc2", ""});
-      segments.push_back(std::move(sr));
-    }
-  }
+  sink.begin(world.get());
+  std::vector<RigidTransform> joints(setup.character ? setup.character->avatar->joints.size() : 0);
 
   // Per-frame records for stats.json: each frame's own stage times (frame 0, the initial
   // state, simulates nothing: the settling's times are not the run's), and the output's,
   // which the writing thread fills by frame.
   std::vector<double> frameMs, energy;
   std::vector<StageMs> frameStageMs;
-  std::vector<double> frameOutputMs(static_cast<std::size_t>(std::max(0L, setup.frames)) + 1, 0.0);
+  std::vector<double> frameOutputMs;
   StageLaps stageLaps;
   const auto stageTotals = [&] {
     StageMs sum{};
@@ -687,9 +612,10 @@ int simulateRun(const RunSetup& setup) {
   bool unstableNan = false;
 
   // The frame loop: a thread of its own steps every garment a frame and takes what the
-  // outputs need from the solvers and the poses (which only it touches); this one writes the
-  // caches and poses and tucks the skinned body. On two cores they overlap: the skin's fit
-  // and tuck cost more per frame than the walking skirt's simulation.
+  // outputs need from the solvers and the poses (which only it touches); this one hands
+  // each frame to the sink (drape run's files: caches, poses, the skinned body tucked). On
+  // two cores they overlap: the skin's fit and tuck cost more per frame than the walking
+  // skirt's simulation.
   const auto prepare = [&](FrameTaken& slot) {
     slot.positions.resize(runs.size());
     slot.states.resize(runs.size());
@@ -708,49 +634,24 @@ int simulateRun(const RunSetup& setup) {
     energy.push_back(e);
     if (world) world->poses().evaluate(world->frameTime(frame), taken.joints);
   };
-  std::vector<Vec3> positions;
-  std::vector<sim::GarmentSurface> surfaces;
   const auto write = [&](const FrameTaken& taken) {
     const Clock::time_point start = Clock::now();
-    for (std::size_t g = 0; g < runs.size(); ++g) {
-      GarmentRun& r = runs[g];
-      const std::vector<Vec3>& p = taken.positions[g];
-      r.cache->writeFrame(p);
-      r.frames.push_back(p);
-      r.states->writeFrame(taken.states[g]);
-      if (taken.frame % setup.objEvery == 0 || taken.frame == setup.frames) {
-        const std::string name = runs.size() == 1 ? fmt::format("frame_{:05d}.obj", taken.frame)
-                                                  : fmt::format("{}_{:05d}.obj", r.fileStem, taken.frame);
-        formats::writeObj((out / "frames" / name).string(), p, r.model->triangles(),
-                          fmt::format("drape run: frame {} of {} (m)", taken.frame, r.model->name()));
-      }
-    }
-    if (world) {
-      for (std::size_t j = 0; j < taken.joints.size(); ++j) jointFrames[j].push_back(taken.joints[j]);
-      for (SegmentRun& sr : segments) {
-        positions.clear();
-        const RigidTransform& pose = taken.joints[static_cast<std::size_t>(sr.joint)];
-        for (const Vec3& p : sr.mesh->positions) positions.push_back(pose.apply(p));
-        sr.cache->writeFrame(positions);
-      }
-      if (skinCache) {
-        surfaces.clear();
-        for (std::size_t g = 0; g < runs.size(); ++g) surfaces.push_back({taken.positions[g], runs[g].model->triangles()});
-        skin->pose(taken.joints, surfaces, skinPositions);
-        skinCache->writeFrame(skinPositions);
-      }
-    }
+    sink.write(taken);
     const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
     outputSeconds += seconds;
-    frameOutputMs[static_cast<std::size_t>(taken.frame)] = 1e3 * seconds;
+    const auto f = static_cast<std::size_t>(taken.frame);
+    if (frameOutputMs.size() <= f) frameOutputMs.resize(f + 1, 0.0);
+    frameOutputMs[f] = 1e3 * seconds;
   };
 
   const sim::SettleReport settled = world ? settleWorld(setup, *world) : sim::SettleReport{};
-  Progress progress("drape run", setup.frames);
+  Progress progress("drape run", std::max(0L, setup.frames));
   long done = 0;
+  std::exception_ptr stopped;
   const Clock::time_point loopStart = Clock::now();
   {
-    FramesAhead ahead(kFramesAhead, 0, setup.frames, prepare, [&](long frame, FrameTaken& taken) {
+    FramesAhead ahead(kFramesAhead, 0, gate ? -1 : setup.frames, prepare, [&](long frame, FrameTaken& taken) {
+      if (gate && !gate(frame)) return false;
       if (frame > 0) {
         const Clock::time_point start = Clock::now();
         const std::vector<std::uint8_t> stable =
@@ -771,28 +672,35 @@ int simulateRun(const RunSetup& setup) {
       progress.update(frame);
       return true;
     });
-    while (const FrameTaken* taken = ahead.next()) write(*taken);
+    // What the simulating side throws (a gate that gave up waiting) ends the run as an
+    // instability does: the frames before it are the sink's, then the outputs are finished.
+    for (;;) {
+      const FrameTaken* taken = nullptr;
+      try {
+        taken = ahead.next();
+      } catch (...) {
+        stopped = std::current_exception();
+      }
+      if (taken == nullptr) break;
+      write(*taken);
+    }
   }
   const double loopSeconds = std::chrono::duration<double>(Clock::now() - loopStart).count();
   progress.finish();
-
-  // Close the caches and write stats and manifest (also after an instability).
-  for (GarmentRun& r : runs) {
-    r.cache->close();
-    r.states->close();
+  if (world && setup.motionStreamed) {
+    RunSetup played = setup;
+    played.frames = done;
+    overlaps = findOverlaps(played, *world);
   }
-  for (SegmentRun& sr : segments) sr.cache->close();
-  if (skinCache) skinCache->close();
-  manifest.frames = done + 1;
-  formats::writeRunManifest(setup.outDir, manifest);
-  writeResultFiles(setup, runs, segments, jointFrames);
 
+  // Close the outputs and write the stats (also after an instability).
+  sink.end(done);
   cloth::StageTimes total;
   for (const GarmentRun& r : runs) total += r.solver->stageTimes();
   const auto simulatedFrames = static_cast<double>(std::max<std::size_t>(1, frameMs.size()));
   nlohmann::json stats;
   stats["frames"] = done;
-  stats["frames_requested"] = setup.frames;
+  stats["frames_requested"] = gate ? done : setup.frames;
   stats["settle"] = {{"frames", settled.frames},
                      {"seconds", settled.seconds},
                      {"wall_s", settled.wall_s},
@@ -816,7 +724,7 @@ int simulateRun(const RunSetup& setup) {
   }
   means["output"] = outputSeconds * 1e3 / static_cast<double>(energy.size());
   stats["ms_per_stage"] = std::move(means);
-  frameOutputMs.resize(frameStageMs.size());
+  frameOutputMs.resize(frameStageMs.size(), 0.0);
   byFrame["output"] = frameOutputMs;
   stats["frame_ms_per_stage"] = std::move(byFrame);
   stats["energy"] = energy;
@@ -865,13 +773,13 @@ int simulateRun(const RunSetup& setup) {
   stats["body_overlaps"] = bodyOverlaps;
   if (world && !world->keepApartReport().parts.empty()) stats["keep_apart"] = keepApartJson(world->keepApartReport());
   addCollisionStats(stats, runs, total, done, world.get());
-  const std::string statsPath = (out / "stats.json").string();
-  std::ofstream statsFile(statsPath);
-  statsFile << stats.dump(2) << "\n";
-  if (!statsFile) throw Error(fmt::format("{}: write failed", statsPath));
+  sink.stats(stats);
+
+  if (stopped) std::rethrow_exception(stopped);
 
   if (!unstable.empty())
-    throw Error(fmt::format("{} (results up to frame {} kept in {})", unstable, done, setup.outDir),
+    throw Error(fmt::format("{} (results up to frame {} kept{})", unstable, done,
+                            setup.outDir.empty() ? std::string() : " in " + setup.outDir),
                 ExitCode::Unstable);
   return 0;
 }

@@ -6,10 +6,13 @@
 // DIR/stats.json and DIR/manifest.json.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "drape/cloth/collider.hpp"
 #include "drape/cloth/material.hpp"
@@ -18,6 +21,7 @@
 #include "drape/scene/avatar.hpp"
 #include "drape/sim/body_overlap.hpp"
 #include "drape/sim/character_world.hpp"
+#include "frames_ahead.hpp"
 
 namespace drape::cli {
 
@@ -60,6 +64,11 @@ struct RunSetup {
   /// With reduced-frequency collision tests, pinched points move freely between tests
   /// instead of being held by the parts that pressed them (FieldCollider::setPinchHold).
   bool freePinches = false;
+  /// The character's motion arrives while the run simulates (a cloth-server's pose
+  /// stream): it is played as it is (a pose stream carries the motion already corrected
+  /// where the scene keeps parts apart), and where it puts the body inside itself is found
+  /// at the end.
+  bool motionStreamed = false;
 };
 
 /// Garments, materials, settings and the avatar (as the setup's character, without motion)
@@ -152,6 +161,32 @@ void validateRunSetup(const RunSetup& setup);
 /// written so far (caches, stats with nan_detected, manifest) and throws drape::Error with
 /// ExitCode::Unstable naming garment, vertex and frame.
 int simulateRun(const RunSetup& setup);
+
+/// Where a run's frames go: drape run's files (run_writer.hpp), a cloth-server's stream.
+class FrameSink {
+ public:
+  virtual ~FrameSink() = default;
+  /// The world is built (null without a character) and the garments' solvers made; the
+  /// settling and frame 0 come next.
+  virtual void begin(const sim::CharacterWorld* world) = 0;
+  /// Each frame in order from 0, on the calling thread while the next are simulated.
+  virtual void write(const FrameTaken& frame) = 0;
+  /// After the last frame written, also when the run stopped unstable: `frames` frames
+  /// were simulated after frame 0.
+  virtual void end(long frames) = 0;
+  /// Then the run's stats.json.
+  virtual void stats(const nlohmann::json& stats) = 0;
+};
+
+/// Asked on the simulating thread before each frame from 0: false when there is no frame
+/// to simulate (a pose stream ended), true when its motion is there. It may wait, and what
+/// it throws ends the run as an instability does (outputs finished, then the error).
+using FrameGate = std::function<bool(long frame)>;
+
+/// The simulate-and-hand-over loop behind simulateRun: every frame of the setup (all of
+/// setup.frames without a gate; as long as the gate lets it with one) to `sink`. Returns 0;
+/// throws as simulateRun does.
+int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate);
 
 /// The parts a --face-samples-with option names: as given, or none for "none".
 [[nodiscard]] std::vector<std::string> facePartsOption(const std::vector<std::string>& given);

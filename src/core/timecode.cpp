@@ -11,10 +11,11 @@ namespace drape {
 
 std::string TimeCode::smpte() const {
   const auto fps = std::max<std::int64_t>(1, std::llround(rate));
-  const std::int64_t f = frame < 0 ? 0 : frame;
+  // Before the take's start (a studio's lead-in): the time to go, signed.
+  const std::int64_t f = frame < 0 ? -frame : frame;
   const std::int64_t ff = f % fps;
   const std::int64_t totalSeconds = f / fps;
-  return fmt::format("{:02}:{:02}:{:02}:{:02}", totalSeconds / 3600, (totalSeconds / 60) % 60,
+  return fmt::format("{}{:02}:{:02}:{:02}:{:02}", frame < 0 ? "-" : "", totalSeconds / 3600, (totalSeconds / 60) % 60,
                      totalSeconds % 60, ff);
 }
 

@@ -398,6 +398,29 @@ void AvatarAnimation::evaluateInverse(std::size_t f, double s, std::span<RigidTr
   for (std::size_t j = 0; j < joints_; ++j) out[j] = interpolate(a[j], b[j], s);
 }
 
+AvatarAnimation AvatarAnimation::streamed(std::size_t joints, double rate, TimeCode start, std::vector<int> driving) {
+  if (joints == 0 || !(rate > 0.0) || driving.size() != joints)
+    throw Error(fmt::format("a streamed animation needs joints ({}), a rate ({}) and a driving joint per joint ({})",
+                            joints, rate, driving.size()),
+                ExitCode::Internal);
+  AvatarAnimation anim;
+  anim.joints_ = joints;
+  anim.rate_ = rate;
+  anim.start_ = start;
+  anim.driving_ = std::move(driving);
+  return anim;
+}
+
+void AvatarAnimation::appendFrame(std::span<const RigidTransform> world) {
+  if (world.size() != joints_)
+    throw Error(fmt::format("a frame of {} joints for an animation of {}", world.size(), joints_), ExitCode::Internal);
+  world_.insert(world_.end(), world.begin(), world.end());
+  for (const RigidTransform& t : world) inverse_.push_back(t.inverse());
+  rootPath_.push_back(world.front().translation);
+  ground_.push_back(0.0);
+  ++frames_;
+}
+
 void AvatarAnimation::moveJoints(std::size_t f, std::span<const int> joints, const RigidTransform& motion) {
   for (const int j : joints) {
     const std::size_t i = f * joints_ + static_cast<std::size_t>(j);

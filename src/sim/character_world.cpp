@@ -102,7 +102,7 @@ const RigidTransform& AvatarPoses::jointAt(double t_s, int jointIndex) const {
 
 CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::AvatarAnimation* animation,
                                std::vector<GarmentSpec> garments, const WorldSettings& settings)
-    : avatar_(avatar), settings_(settings) {
+    : avatar_(avatar), animation_(animation), settings_(settings) {
   settings_.step.validate();
   if (animation && animation->jointCount() != avatar.joints.size()) {
     throw Error(fmt::format("{}: the motion drives {} joints, the avatar has {}", avatar.name,
@@ -165,16 +165,18 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
 
 CharacterWorld::~CharacterWorld() = default;
 
-void CharacterWorld::buildFields(const std::vector<GarmentSpec>& garments) {
+std::vector<PartField> buildPartFields(const scene::Avatar& avatar, const std::vector<GarmentSpec>& garments,
+                                       const WorldSettings& settings) {
   // One field per body segment any garment collides with, built once and shared.
   std::vector<std::string> names;
   double shell_m = 0;
   for (const GarmentSpec& g : garments) {
-    shell_m = std::max(shell_m, g.offsets.t3_m);
+    const cloth::OffsetSurfaces offsets = g.offsetsGiven ? g.offsets : cloth::OffsetSurfaces::fromVoxelSize(settings.voxel_m);
+    shell_m = std::max(shell_m, offsets.t3_m);
     for (const std::string& name : g.collidesWith) {
-      if (avatar_.findSegment(name) < 0) {
+      if (avatar.findSegment(name) < 0) {
         throw Error(fmt::format("garment '{}': collidesWith names '{}', which avatar '{}' does not have (it has: {})",
-                                g.name, name, avatar_.name, fmt::join(avatar_.segmentNames(), ", ")));
+                                g.name, name, avatar.name, fmt::join(avatar.segmentNames(), ", ")));
       }
       if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
     }
@@ -185,16 +187,29 @@ void CharacterWorld::buildFields(const std::vector<GarmentSpec>& garments) {
                                 g.name, name, fmt::join(g.collidesWith, ", ")));
   }
   field::FieldSettings fs;
-  fs.voxelSize_m = settings_.voxel_m;
+  fs.voxelSize_m = settings.voxel_m;
   fs.shell_m = shell_m;
-  fs.method = settings_.fieldMethod;
-  const auto start = std::chrono::steady_clock::now();
+  fs.method = settings.fieldMethod;
+  std::vector<PartField> fields;
   for (const std::string& name : names) {
-    const scene::Segment& segment = avatar_.segments[static_cast<std::size_t>(avatar_.findSegment(name))];
+    const scene::Segment& segment = avatar.segments[static_cast<std::size_t>(avatar.findSegment(name))];
     spdlog::debug("distance field for '{}' ({} triangles)", name, segment.mesh.triangleCount());
-    fields_.push_back({name, segment.joint, field::DistanceField::build(segment.mesh, fs)});
-    partMotions_.push_back(std::make_shared<SegmentMotion>(*poses_, segment.joint));
+    fields.push_back({name, segment.joint, field::DistanceField::build(segment.mesh, fs)});
   }
+  return fields;
+}
+
+double leastT0(const std::vector<GarmentSpec>& garments, const WorldSettings& settings) {
+  double t0 = std::numeric_limits<double>::infinity();
+  for (const GarmentSpec& g : garments)
+    t0 = std::min(t0, (g.offsetsGiven ? g.offsets : cloth::OffsetSurfaces::fromVoxelSize(settings.voxel_m)).t0_m);
+  return std::isfinite(t0) ? t0 : 0.0;
+}
+
+void CharacterWorld::buildFields(const std::vector<GarmentSpec>& garments) {
+  const auto start = std::chrono::steady_clock::now();
+  fields_ = buildPartFields(avatar_, garments, settings_);
+  for (const PartField& f : fields_) partMotions_.push_back(std::make_shared<SegmentMotion>(*poses_, f.joint));
   fieldBuild_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 

@@ -17,6 +17,7 @@ TEST(TimeCode, PrintsSmpte) {
   EXPECT_EQ((TimeCode{29, 30}).smpte(), "00:00:00:29");
   EXPECT_EQ((TimeCode{30 * 3661 + 7, 30}).smpte(), "01:01:01:07");
   EXPECT_EQ((TimeCode{25 * 60, 25}).smpte(), "00:01:00:00");
+  EXPECT_EQ((TimeCode{-31, 30}).smpte(), "-00:00:01:01");  // a studio's lead-in, before the take's start
 }
 
 TEST(TimeCode, ParsesWhatItPrints) {

@@ -14,6 +14,7 @@ enum class ExitCode : int {
   Internal = 1,  ///< a bug in drape: please report it
   BadInput = 2,  ///< a file, option or value that drape cannot use
   Unstable = 3,  ///< the simulation diverged (NaN or speed bound exceeded)
+  Unavailable = 4,  ///< a server or peer the command needs does not answer (studio roles)
 };
 
 /// A position in a source file, 1-based; line or column 0 means "not known".

@@ -12,7 +12,8 @@ struct TimeCode {
   double rate = 30.0;      ///< frames per second
 
   [[nodiscard]] double seconds() const { return static_cast<double>(frame) / rate; }
-  /// SMPTE non-drop-frame "HH:MM:SS:FF" (rate rounded to whole frames per second).
+  /// SMPTE non-drop-frame "HH:MM:SS:FF" (rate rounded to whole frames per second); a
+  /// frame before 0 as "-HH:MM:SS:FF" before it.
   [[nodiscard]] std::string smpte() const;
   /// Parses "HH:MM:SS:FF" at the given rate; throws drape::Error on malformed text.
   [[nodiscard]] static TimeCode parseSmpte(const std::string& text, double rate);

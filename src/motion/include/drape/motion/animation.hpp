@@ -81,6 +81,16 @@ class AvatarAnimation {
   /// its motion (`drape convert --motion`).
   [[nodiscard]] formats::SkinnedJointMotion toJointMotion(const scene::Avatar& avatar, const std::string& name) const;
 
+  /// An animation that arrives frame by frame (a studio pose stream, studio/): `joints`
+  /// joints at `rate` frames per second, frame 0 at time code `start`, no frames yet;
+  /// appendFrame adds them. `driving` is what drivingJoint() reports (the sender's).
+  [[nodiscard]] static AvatarAnimation streamed(std::size_t joints, double rate, TimeCode start,
+                                                std::vector<int> driving);
+  /// Adds frame frameCount(): every joint's world transform, exactly as sent; its inverse is
+  /// computed as build() computes it, so a streamed copy of an animation evaluates to the
+  /// same bits. Throws drape::Error (Internal) on a frame of the wrong size.
+  void appendFrame(std::span<const RigidTransform> world);
+
   [[nodiscard]] std::size_t frameCount() const { return frames_; }
   [[nodiscard]] std::size_t jointCount() const { return joints_; }
   [[nodiscard]] double rate() const { return rate_; }          ///< frames per second

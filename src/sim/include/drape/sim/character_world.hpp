@@ -99,6 +99,16 @@ struct PartField {
   field::DistanceField field;
 };
 
+/// The distance fields a world builds for `garments` on `avatar`: one per segment any
+/// garment collides with, in the order the garments first name them (CharacterWorld's
+/// fields(), for a player that draws the body as the world's outputs do). Throws
+/// drape::Error on a segment the avatar does not have.
+[[nodiscard]] std::vector<PartField> buildPartFields(const scene::Avatar& avatar, const std::vector<GarmentSpec>& garments,
+                                                     const WorldSettings& settings);
+/// The garments' least T0, as CharacterWorld gives them their offsets: how far the drawn
+/// skin may stand out of the body parts (BodySkin).
+[[nodiscard]] double leastT0(const std::vector<GarmentSpec>& garments, const WorldSettings& settings);
+
 /// Steps `count` solvers to `frame` in parallel (TBB); per solver, whether it stayed stable.
 /// The solvers must share nothing that changes (each garment has its own poses and colliders).
 std::vector<std::uint8_t> stepInParallel(std::size_t count, long frame,
@@ -162,6 +172,11 @@ class CharacterWorld {
   [[nodiscard]] double fieldBuild_s() const { return fieldBuild_s_; }
   /// What keeping the body apart changed in the motion (empty unless settings asked).
   [[nodiscard]] const KeepApartReport& keepApartReport() const { return keepApart_; }
+  /// The motion the avatar plays: the one the world was made with, or its corrected copy
+  /// where the settings keep parts apart (null: at rest). A pose stream sends this one.
+  [[nodiscard]] const motion::AvatarAnimation* playedMotion() const {
+    return keptApartMotion_ ? keptApartMotion_.get() : animation_;
+  }
 
  private:
   struct GarmentRun {
@@ -187,6 +202,7 @@ class CharacterWorld {
   void liftOutOfTheParts(const GarmentSpec& spec, const std::vector<int>& parts, std::vector<Vec3>& local) const;
 
   const scene::Avatar& avatar_;
+  const motion::AvatarAnimation* animation_ = nullptr;
   WorldSettings settings_;
   std::unique_ptr<AvatarPoses> poses_;
   std::unique_ptr<motion::AvatarAnimation> keptApartMotion_;  ///< the corrected motion, when asked for

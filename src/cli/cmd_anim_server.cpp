@@ -1,0 +1,113 @@
+// `drape anim-server SCENE [--motion FILE]`: the studio's animation server (docs/STUDIO.md).
+// Plays the scene avatar's motion, retargeted as drape run retargets it, into a pose stream
+// on a NATS JetStream server: one take, frame by frame at the scene's frame rate.
+
+#include <chrono>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "command.hpp"
+#include "drape/core/error.hpp"
+#include "drape/core/log.hpp"
+#include "drape/core/progress.hpp"
+#include "drape/studio/publisher.hpp"
+#include "drape/studio/takes.hpp"
+#include "run_setup.hpp"
+#include "studio_options.hpp"
+
+namespace drape::cli {
+namespace {
+
+struct AnimServerOptions {
+  std::string scene, motion, animation, name = "anim", take;
+  bool fast = false;
+  StudioOptions studio;
+};
+
+/// The pose take's first message: the avatar, its joints and how the frames are numbered.
+studio::PoseStart poseStart(const scene::Avatar& avatar, const motion::AvatarAnimation& motion) {
+  studio::PoseStart start;
+  start.character = avatar.name;
+  for (const scene::Joint& j : avatar.joints) start.joints.push_back(j.name);
+  start.driving.assign(motion.drivingJoint().begin(), motion.drivingJoint().end());
+  // The motion's own time code, counted in its frames at the rate it plays.
+  start.start = TimeCode{static_cast<std::int64_t>(std::llround(motion.start().seconds() * motion.rate())), motion.rate()};
+  start.frames = static_cast<std::int64_t>(motion.frameCount());
+  return start;
+}
+
+int runAnimServer(const AnimServerOptions& o) {
+  studio::checkSourceName(o.name, "--name");
+  RunSetup setup = runSetupFromScene(o.scene);
+  if (!setup.character) throw Error(fmt::format("{}: the scene has no avatar to move", o.scene));
+  const MotionChoice choice = sceneMotion(setup, o.scene, o.motion, o.animation);
+  if (choice.path.empty())
+    throw Error(fmt::format("{}: nothing moves the avatar: give --motion FILE (its own file carries no animation)",
+                            o.scene));
+  addMotion(setup, choice.path, 0.0, "", choice.animation, choice.sampled.get());
+  // Where the scene keeps parts apart, the stream carries the motion corrected, as drape
+  // run plays it: the correction needs the parts' distance fields, hence the world.
+  std::unique_ptr<sim::CharacterWorld> world;
+  if (!setup.character->keepApart.empty()) world = buildWorld(setup);
+  const motion::AvatarAnimation& motion = world ? *world->playedMotion() : *setup.character->animation;
+  const scene::Avatar& avatar = *setup.character->avatar;
+
+  studio::Bus bus = studio::Bus::connect(o.studio.server, "drape anim-server " + o.name);
+  studio::Publisher publisher(bus, o.name);
+  const std::string take = o.take.empty() ? studio::newTakeId() : o.take;
+  const studio::PoseStart start = poseStart(avatar, motion);
+  publisher.beginTake(take, start);
+  if (publisher.complete()) {
+    fmt::print("take {} is in {} already, to its end\n", take, studio::subjectOf(o.name));
+    return 0;
+  }
+  spdlog::info("take {}: {} frames of {} at {:g} Hz from {}, on {} ({})", take, motion.frameCount(), avatar.name,
+               motion.rate(), start.start.smpte(), studio::subjectOf(o.name), bus.url(),
+               o.fast ? "as fast as the server takes them" : "in real time");
+
+  const auto began = std::chrono::steady_clock::now();
+  const auto frameTime = std::chrono::duration<double>(1.0 / motion.rate());
+  Progress progress("drape anim-server", static_cast<std::int64_t>(motion.frameCount()));
+  studio::PoseFrame frame;
+  for (std::size_t f = 0; f < motion.frameCount(); ++f) {
+    if (!o.fast) std::this_thread::sleep_until(began + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                         frameTime * static_cast<double>(f)));
+    frame.frame = static_cast<std::int64_t>(f);
+    const std::span<const RigidTransform> joints = motion.frame(f);
+    frame.joints.assign(joints.begin(), joints.end());
+    publisher.send(frame);
+    progress.update(static_cast<std::int64_t>(f + 1));
+  }
+  publisher.send(studio::End{static_cast<std::int64_t>(motion.frameCount()), "", "", 0});
+  progress.finish();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+  fmt::print("sent take {}: {} pose frames of {} to {} on {} in {:.1f} s\n", take, motion.frameCount(), avatar.name,
+             studio::subjectOf(o.name), bus.url(), seconds);
+  return 0;
+}
+
+RunFunction setupAnimServer(CLI::App& app) {
+  static AnimServerOptions o;
+  app.add_option("scene", o.scene, "VRML97 scene whose avatar moves (the cloth-servers and players read it too)")
+      ->required();
+  app.add_option("--motion", o.motion, std::string("Motion for the avatar ") + kMotionHelp);
+  app.add_option("--animation", o.animation, kAnimationHelp);
+  app.add_option("--name", o.name, "This broadcaster's name: it publishes on drape.NAME, into the stream DRAPE_NAME")
+      ->capture_default_str();
+  app.add_option("--take", o.take,
+                 "The take's name (default: the date and time). A take the stream already holds in part is "
+                 "completed, not sent again");
+  app.add_flag("--fast", o.fast, "Send the frames as fast as the server acknowledges them, not at the frame rate");
+  o.studio.add(app, "a server");
+  app.footer("Every role reads the same scene: what it says of the avatar (cutAtJoints, keepApart) they all do alike.\n"
+             "Exit codes: 0 sent, 2 bad input, 4 no NATS server with JetStream answers.");
+  return [] { return runAnimServer(o); };
+}
+
+const bool registered_cmd_anim_server = registerCommand(
+    {"anim-server", "Studio: play an avatar's motion into a pose stream on a NATS JetStream server", "", 60,
+     &setupAnimServer});
+
+}  // namespace
+}  // namespace drape::cli

@@ -1,0 +1,196 @@
+// `drape cloth-server SCENE --poses NAME`: the studio's cloth simulator (docs/STUDIO.md).
+// Follows an anim-server's pose stream take after take, simulates the scene's garments on
+// the avatar as the poses arrive (the loop of drape run, frame by frame), and publishes the
+// garments into a cloth stream. Several cloth-servers may split a scene's garments
+// (--garments); one restarted in the middle of a take computes it again from its start and
+// sends what its stream does not hold yet.
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "command.hpp"
+#include "drape/core/error.hpp"
+#include "drape/core/log.hpp"
+#include "drape/studio/pose_follower.hpp"
+#include "drape/studio/publisher.hpp"
+#include "drape/studio/takes.hpp"
+#include "run_setup.hpp"
+#include "studio_options.hpp"
+
+namespace drape::cli {
+namespace {
+
+struct ClothServerOptions {
+  std::string scene, poses = "anim", name = "cloth", positions = "double";
+  std::vector<std::string> garments;
+  long takes = 0;
+  StudioOptions studio;
+};
+
+/// Keeps the garments `names` lists (all of them for an empty list), in the scene's order.
+void keepGarments(RunSetup& setup, const std::vector<std::string>& names, const std::string& scene) {
+  if (names.empty()) return;
+  std::vector<std::string> have;
+  for (const GarmentSetup& g : setup.garments) have.push_back(g.name);
+  for (const std::string& n : names)
+    if (std::find(have.begin(), have.end(), n) == have.end())
+      throw Error(fmt::format("--garments: {} has no garment '{}' (it has: {})", scene, n, fmt::join(have, ", ")));
+  std::erase_if(setup.garments, [&](const GarmentSetup& g) {
+    return std::find(names.begin(), names.end(), g.name) == names.end();
+  });
+}
+
+/// The cloth take's frames onto the stream, garment by garment.
+class ClothSink final : public FrameSink {
+ public:
+  explicit ClothSink(studio::Publisher& publisher) : publisher_(publisher) {}
+  void begin(const sim::CharacterWorld*) override {}
+  void write(const FrameTaken& taken) override {
+    for (std::size_t g = 0; g < taken.positions.size(); ++g) {
+      frame_.frame = taken.frame;
+      frame_.garment = static_cast<std::uint32_t>(g);
+      frame_.positions = taken.positions[g];
+      frame_.states = taken.states[g];
+      publisher_.send(frame_);
+    }
+    written_ = taken.frame;
+  }
+  void end(long) override {}
+  void stats(const nlohmann::json& stats) override { stats_ = stats.dump(2) + "\n"; }
+  [[nodiscard]] const std::string& statsText() const { return stats_; }
+  [[nodiscard]] long written() const { return written_; }
+
+ private:
+  studio::Publisher& publisher_;
+  studio::ClothFrame frame_;
+  std::string stats_;
+  long written_ = -1;
+};
+
+struct TakeOutcome {
+  long frames = 0;
+  std::string error;
+  ExitCode code = ExitCode::Ok;
+};
+
+/// Simulates the take `poses` follows and publishes it; the take's End says how it ended.
+TakeOutcome simulateTake(const RunSetup& scene, studio::PoseFollower& poses, studio::Publisher& publisher,
+                         const std::string& posesName) {
+  const studio::PoseStart& ps = poses.start();
+  RunSetup setup = scene;
+  // The stream's motion, growing as it comes; the world keeps a pointer to it (the take's
+  // follower outlives the world).
+  setup.character->animation = std::shared_ptr<const motion::AvatarAnimation>(std::shared_ptr<void>(), &poses.animation());
+  setup.character->keepApart.clear();  // the anim-server sends the motion corrected
+  setup.motionStreamed = true;
+  setup.frames = 0;
+  const double rate = setup.settings.frameRate_hz, leadIn = setup.character->leadIn_s;
+
+  studio::ClothStart start;
+  start.poses = posesName;
+  start.poseTake = poses.take();
+  start.character = ps.character;
+  start.start = studio::clothTimeCode(0, ps.start, leadIn);
+  start.leadIn_s = leadIn;
+  for (const GarmentSetup& g : setup.garments)
+    start.garments.push_back({g.name, static_cast<std::uint32_t>(g.mesh.vertexCount())});
+  publisher.beginTake(poses.take(), start);
+  if (publisher.complete()) {
+    spdlog::info("cloth take {} is in {} already, to its end", poses.take(), studio::subjectOf(publisher.source()));
+    return {};
+  }
+
+  ClothSink sink(publisher);
+  const FrameGate gate = [&](long frame) {
+    if (frame == 0) return true;  // motion frame 0 came before the world was built
+    if (poses.waitForFrames(studio::motionFramesNeeded(frame, rate, leadIn, rate))) return true;
+    return frame <= studio::clothFramesOf(poses.frames(), rate, leadIn, rate);
+  };
+  TakeOutcome outcome;
+  try {
+    simulateInto(setup, sink, gate);
+  } catch (const studio::NewTake& e) {
+    outcome.error = e.what();
+    outcome.code = ExitCode::Unavailable;
+  } catch (const Error& e) {
+    outcome.error = e.what();
+    outcome.code = e.code();
+  }
+  outcome.frames = std::max(0L, sink.written());
+  publisher.send(studio::End{outcome.frames, sink.statsText(), outcome.error, static_cast<int>(outcome.code)});
+  return outcome;
+}
+
+int runClothServer(const ClothServerOptions& o) {
+  studio::checkSourceName(o.name, "--name");
+  studio::checkSourceName(o.poses, "--poses");
+  if (o.name == o.poses) throw Error(fmt::format("--name {}: the cloth stream needs a name of its own, not the poses'", o.name));
+  if (o.positions != "double" && o.positions != "float")
+    throw Error(fmt::format("--positions {}: expected double or float", o.positions));
+  RunSetup setup = runSetupFromScene(o.scene);
+  if (!setup.character) throw Error(fmt::format("{}: the scene has no avatar for its garments to move with", o.scene));
+  keepGarments(setup, o.garments, o.scene);
+  {
+    RunSetup check = setup;  // bad garments or settings are said before any waiting
+    check.motionStreamed = true;
+    validateRunSetup(check);
+  }
+  const scene::Avatar& avatar = *setup.character->avatar;
+
+  studio::Bus bus = studio::Bus::connect(o.studio.server, "drape cloth-server " + o.name);
+  studio::StreamReader stream(bus, o.poses, consumerName("cloth-server-" + o.name, false), o.studio.patience(),
+                              o.studio.giveUp());
+  studio::PoseFollower poses(stream);
+  studio::Publisher publisher(bus, o.name, o.positions == "float" ? studio::Precision::Float : studio::Precision::Double);
+  std::vector<std::string> names;
+  for (const GarmentSetup& g : setup.garments) names.push_back(g.name);
+  spdlog::info("cloth-server '{}': {} on {}, following the poses of '{}' on {}", o.name, fmt::join(names, ", "),
+               avatar.name, o.poses, bus.url());
+
+  int exitCode = 0;
+  for (long served = 0; o.takes == 0 || served < o.takes; ++served) {
+    poses.followNextTake(avatar, setup.settings.frameRate_hz);
+    if (!poses.waitForFrames(1)) throw Error(fmt::format("pose take {} ended without a frame", poses.take()));
+    const auto began = std::chrono::steady_clock::now();
+    const TakeOutcome outcome = simulateTake(setup, poses, publisher, o.poses);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+    if (!outcome.error.empty()) {
+      spdlog::error("take {}: {}", poses.take(), outcome.error);
+      exitCode = static_cast<int>(outcome.code);
+      continue;  // a server goes on to the next take
+    }
+    exitCode = 0;
+    fmt::print("take {}: {} cloth frames of {} sent to {} in {:.1f} s ({} pose frames{})\n", poses.take(), outcome.frames,
+               fmt::join(names, ", "), studio::subjectOf(o.name), seconds, poses.frames(),
+               poses.filledFrames() > 0 ? fmt::format(", {} filled in", poses.filledFrames()) : std::string());
+  }
+  return exitCode;
+}
+
+RunFunction setupClothServer(CLI::App& app) {
+  static ClothServerOptions o;
+  app.add_option("scene", o.scene, "VRML97 scene with the garments and the avatar (the anim-server's)")->required();
+  app.add_option("--poses", o.poses, "The anim-server whose pose stream to follow (its --name)")->capture_default_str();
+  app.add_option("--name", o.name, "This broadcaster's name: it publishes on drape.NAME, into the stream DRAPE_NAME")
+      ->capture_default_str();
+  app.add_option("--garments", o.garments, "Simulate only these of the scene's garments (another cloth-server the rest)")
+      ->delimiter(',');
+  app.add_option("--positions", o.positions,
+                 "How positions travel: double (a player records what drape run writes, to the byte) or float (half "
+                 "the bytes)")
+      ->capture_default_str();
+  app.add_option("--takes", o.takes, "Stop after N takes (default: serve take after take)")->check(CLI::PositiveNumber);
+  o.studio.add(app, "pose frames");
+  app.footer(
+      "Exit codes: 0 done, 2 bad input, 3 a garment went unstable (the take's End says where), 4 no NATS server "
+      "answers or a peer went silent past --give-up. A server goes on to the next take after a failed one; with "
+      "--takes the exit code is the last take's.");
+  return [] { return runClothServer(o); };
+}
+
+const bool registered_cmd_cloth_server = registerCommand(
+    {"cloth-server", "Studio: simulate the garments on a pose stream's avatar and publish them", "", 61,
+     &setupClothServer});
+
+}  // namespace
+}  // namespace drape::cli

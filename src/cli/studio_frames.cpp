@@ -1,0 +1,139 @@
+#include "studio_frames.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "drape/core/error.hpp"
+#include "drape/core/log.hpp"
+#include "drape/studio/takes.hpp"
+
+namespace drape::cli {
+namespace {
+
+/// Where two cloth takes disagree about what they simulate, or "".
+std::string disagreement(const studio::ClothStart& a, const studio::ClothStart& b) {
+  if (a.poses != b.poses || a.poseTake != b.poseTake)
+    return fmt::format("take {} of '{}' and take {} of '{}'", a.poseTake, a.poses, b.poseTake, b.poses);
+  if (a.character != b.character) return fmt::format("characters '{}' and '{}'", a.character, b.character);
+  if (a.start.rate != b.start.rate || a.leadIn_s != b.leadIn_s || a.start.frame != b.start.frame)
+    return "different frame rates, lead-ins or time codes";
+  return "";
+}
+
+}  // namespace
+
+StudioFrames::StudioFrames(studio::Bus& bus, RunSetup& setup, const std::vector<std::string>& cloth,
+                           const std::string& take, const StudioOptions& options)
+    : setup_(setup) {
+  if (!setup.character) throw Error("drape player: the scene has no avatar the garments are worn by");
+  if (cloth.empty()) throw Error("--cloth: name at least one cloth-server");
+  const std::string consumer = consumerName("player", true);
+  for (const std::string& source : cloth) {
+    studio::checkSourceName(source, "--cloth");
+    if (std::count(cloth.begin(), cloth.end(), source) > 1) throw Error(fmt::format("--cloth: '{}' twice", source));
+    Cloth c;
+    c.source = source;
+    c.stream = std::make_unique<studio::StreamReader>(bus, source, consumer, options.patience(), options.giveUp());
+    c.follower = std::make_unique<studio::ClothFollower>(*c.stream);
+    c.follower->followNextTake(take);
+    cloth_.push_back(std::move(c));
+  }
+  const studio::ClothStart& first = cloth_.front().follower->start();
+  for (const Cloth& c : cloth_)
+    if (const std::string bad = disagreement(first, c.follower->start()); !bad.empty())
+      throw Error(fmt::format("--cloth: '{}' and '{}' simulate {}: a player collates the cloth of one pose take",
+                              cloth_.front().source, c.source, bad));
+  if (first.start.rate != setup.settings.frameRate_hz)
+    throw Error(fmt::format("cloth take {} runs at {:g} frames per second, the scene at {:g}: give the player the "
+                            "cloth-servers' scene",
+                            take.empty() ? cloth_.front().follower->take() : take, first.start.rate,
+                            setup.settings.frameRate_hz));
+
+  // The garments the streams send, in the scene's order.
+  std::vector<std::string> names;
+  for (const GarmentSetup& g : setup.garments) names.push_back(g.name);
+  std::vector<int> from(setup.garments.size(), -1);  // the stream sending each scene garment
+  for (std::size_t s = 0; s < cloth_.size(); ++s)
+    for (const studio::GarmentInfo& g : cloth_[s].follower->start().garments) {
+      const auto it = std::find(names.begin(), names.end(), g.name);
+      if (it == names.end())
+        throw Error(fmt::format("cloth stream '{}' sends garment '{}', which the scene does not have (it has: {})",
+                                cloth_[s].source, g.name, fmt::join(names, ", ")));
+      const auto i = static_cast<std::size_t>(it - names.begin());
+      if (from[i] >= 0)
+        throw Error(fmt::format("garment '{}' comes from both '{}' and '{}'", g.name, cloth_[static_cast<std::size_t>(from[i])].source,
+                                cloth_[s].source));
+      if (g.vertices != setup.garments[i].mesh.vertexCount())
+        throw Error(fmt::format("cloth stream '{}' sends garment '{}' with {} vertices, the scene's has {}",
+                                cloth_[s].source, g.name, g.vertices, setup.garments[i].mesh.vertexCount()));
+      from[i] = static_cast<int>(s);
+    }
+  std::vector<std::string> missing;
+  std::vector<GarmentSetup> kept;
+  std::vector<std::size_t> keptIndex(setup.garments.size(), 0);
+  for (std::size_t i = 0; i < setup.garments.size(); ++i) {
+    if (from[i] < 0) {
+      missing.push_back(names[i]);
+      continue;
+    }
+    keptIndex[i] = kept.size();
+    kept.push_back(setup.garments[i]);
+  }
+  if (!missing.empty()) spdlog::info("no cloth stream sends {}; the player shows the rest", fmt::join(missing, ", "));
+  for (Cloth& c : cloth_)
+    for (const studio::GarmentInfo& g : c.follower->start().garments)
+      c.garment.push_back(keptIndex[static_cast<std::size_t>(std::find(names.begin(), names.end(), g.name) - names.begin())]);
+  setup.garments = std::move(kept);
+
+  poseStream_ = std::make_unique<studio::StreamReader>(bus, first.poses, consumer, options.patience(), options.giveUp());
+  poses_ = std::make_unique<studio::PoseFollower>(*poseStream_);
+  poses_->followNextTake(*setup.character->avatar, setup.settings.frameRate_hz, first.poseTake);
+  if (!poses_->waitForFrames(1)) throw Error(fmt::format("pose take {} ended without a frame", first.poseTake));
+  avatarPoses_ = std::make_unique<sim::AvatarPoses>(*setup.character->avatar, &poses_->animation(), first.leadIn_s);
+}
+
+StudioFrames::~StudioFrames() = default;
+
+std::vector<RigidTransform> StudioFrames::jointsAtStart() const {
+  std::vector<RigidTransform> joints(setup_.character->avatar->joints.size());
+  avatarPoses_->evaluate(0.0, joints);
+  return joints;
+}
+
+bool StudioFrames::next(long frame, FrameTaken& out) {
+  out.frame = frame;
+  out.positions.resize(setup_.garments.size());
+  out.states.resize(setup_.garments.size());
+  out.joints.resize(setup_.character->avatar->joints.size());
+  out.stageMs = {};
+  bool ended = false;
+  for (Cloth& c : cloth_) {
+    if (!c.follower->waitForFrame(frame)) {
+      ended = true;
+      continue;
+    }
+    for (std::uint32_t g = 0; g < c.garment.size(); ++g) {
+      const studio::ClothFrame& f = c.follower->garment(g);
+      out.positions[c.garment[g]] = f.positions;
+      out.states[c.garment[g]] = f.states;
+      if (f.states.empty()) out.states[c.garment[g]].assign(f.positions.size(), 0);  // a sender that keeps none
+    }
+  }
+  if (ended) return false;
+  const studio::ClothStart& s = start();
+  (void)poses_->waitForFrames(studio::motionFramesNeeded(frame, s.start.rate, s.leadIn_s, s.start.rate));
+  // The time as the cloth-servers' world computes a frame's (CharacterWorld::frameTime).
+  avatarPoses_->evaluate(static_cast<double>(frame) / setup_.settings.frameRate_hz, out.joints);
+  return true;
+}
+
+std::vector<std::pair<std::string, std::string>> StudioFrames::stats() const {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const Cloth& c : cloth_)
+    if (c.follower->end() && !c.follower->end()->stats.empty()) out.emplace_back(c.source, c.follower->end()->stats);
+  return out;
+}
+
+}  // namespace drape::cli

@@ -1,0 +1,59 @@
+#pragma once
+// What `drape player` collates (docs/STUDIO.md): the cloth takes of one or more
+// cloth-servers and the pose take they simulated, frame by frame as drape run's outputs
+// see them: every garment's positions and vertex states, and the avatar's joints at the
+// frame's time, from the same poses the cloth-servers played (the lead-in included).
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "drape/sim/character_world.hpp"
+#include "drape/studio/bus.hpp"
+#include "drape/studio/cloth_follower.hpp"
+#include "drape/studio/pose_follower.hpp"
+#include "frames_ahead.hpp"
+#include "run_setup.hpp"
+#include "studio_options.hpp"
+
+namespace drape::cli {
+
+class StudioFrames {
+ public:
+  /// Follows the next take of each cloth stream of `cloth` (the take `take`, if given) and
+  /// the pose take they simulated. Keeps of `setup` (the scene's) the garments the streams
+  /// send, in the scene's order; throws drape::Error (BadInput) when a stream sends a
+  /// garment the scene does not have or has otherwise, or two streams send the same one, or
+  /// they follow different poses.
+  StudioFrames(studio::Bus& bus, RunSetup& setup, const std::vector<std::string>& cloth, const std::string& take,
+               const StudioOptions& options);
+  ~StudioFrames();
+
+  /// Frame `frame` (the next after the last, from 0) into `out` (sized here); false when
+  /// the takes ended before it. Throws what a cloth-server's take ended with (a garment
+  /// that went unstable) after the frames before it.
+  bool next(long frame, FrameTaken& out);
+
+  /// The joints at frame 0 (the rest pose, where the lead-in starts).
+  [[nodiscard]] std::vector<RigidTransform> jointsAtStart() const;
+  [[nodiscard]] const studio::ClothStart& start() const { return cloth_.front().follower->start(); }
+  [[nodiscard]] const std::string& take() const { return cloth_.front().follower->take(); }
+  /// The cloth-servers' stats, by stream (after next() returned false).
+  [[nodiscard]] std::vector<std::pair<std::string, std::string>> stats() const;
+
+ private:
+  struct Cloth {
+    std::string source;
+    std::unique_ptr<studio::StreamReader> stream;
+    std::unique_ptr<studio::ClothFollower> follower;
+    std::vector<std::size_t> garment;  ///< per garment of the stream, its index in the setup
+  };
+  const RunSetup& setup_;
+  std::vector<Cloth> cloth_;
+  std::unique_ptr<studio::StreamReader> poseStream_;
+  std::unique_ptr<studio::PoseFollower> poses_;
+  std::unique_ptr<sim::AvatarPoses> avatarPoses_;
+};
+
+}  // namespace drape::cli

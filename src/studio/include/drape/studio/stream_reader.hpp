@@ -1,0 +1,42 @@
+#pragma once
+// One broadcaster's stream read message by message, decoded: what the followers of pose and
+// cloth takes share. A message that is not a studio frame, or that another broadcaster
+// sent, is logged and skipped (a server survives bad frames); a stream that stays silent
+// is waited for, with a line every `patience`, and given up on after `giveUp` (if > 0)
+// with an Unavailable error that says what was awaited.
+
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "drape/studio/bus.hpp"
+#include "drape/studio/messages.hpp"
+
+namespace drape::studio {
+
+class StreamReader {
+ public:
+  /// Reads `source`'s stream (created if the server has none yet) as the durable consumer
+  /// `consumer`, from its message `sequence` (0: its first).
+  StreamReader(Bus& bus, std::string source, const std::string& consumer, std::chrono::milliseconds patience,
+               std::chrono::milliseconds giveUp, std::uint64_t sequence = 0);
+
+  /// The next message of the stream that is a studio frame of this source; `waitingFor`
+  /// names it in the lines said while waiting.
+  [[nodiscard]] Message next(const std::string& waitingFor);
+
+  [[nodiscard]] const std::string& source() const { return source_; }
+  [[nodiscard]] const std::string& url() const { return bus_.url(); }
+  /// Messages skipped as not studio frames of this source.
+  [[nodiscard]] std::int64_t skipped() const { return skipped_; }
+
+ private:
+  Bus& bus_;
+  std::string source_;
+  Reader reader_;
+  std::chrono::milliseconds patience_, giveUp_;
+  std::int64_t skipped_ = 0;
+};
+
+}  // namespace drape::studio

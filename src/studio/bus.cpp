@@ -47,11 +47,7 @@ void checkSourceName(const std::string& name, const std::string& option) {
 
 std::string subjectOf(const std::string& source) { return "drape." + source; }
 
-std::string streamOf(const std::string& source) {
-  std::string out = "DRAPE_";
-  for (char c : source) out += c == '-' ? '_' : static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  return out;
-}
+std::string streamOf(const std::string& source) { return "DRAPE_" + source; }
 
 struct Bus::Impl {
   std::string url;
@@ -158,6 +154,10 @@ std::uint64_t Bus::publish(const std::string& source, std::span<const std::uint8
   jsPubAck* ack = nullptr;
   jsErrCode jerr = static_cast<jsErrCode>(0);
   const natsStatus s = js_Publish(&ack, impl_->js, subject.c_str(), data.data(), static_cast<int>(data.size()), &po, &jerr);
+  if (noJetStream(s))
+    throw Error(fmt::format("{}: no stream takes {} (was {} deleted, or does the server run without JetStream?)",
+                            impl_->url, subject, streamOf(source)),
+                ExitCode::Unavailable);
   if (s != NATS_OK) impl_->fail(fmt::format("cannot publish on {}", subject), s, jerr);
   const std::uint64_t sequence = ack->Duplicate ? 0 : ack->Sequence;
   jsPubAck_Destroy(ack);
@@ -258,7 +258,9 @@ std::optional<Received> Reader::next(std::chrono::milliseconds timeout) {
     jsFetchRequest_Init(&request);
     request.Batch = kFetchBatch;
     request.NoWait = true;
-    request.Expires = std::max<std::int64_t>(1, timeout.count()) * kNanosPerMilli;
+    // The server answers a request that may not wait at once; the client still waits up to
+    // its expiry for that answer, so keep it short.
+    request.Expires = std::min<std::int64_t>(50, std::max<std::int64_t>(1, timeout.count())) * kNanosPerMilli;
     jsErrCode jerr = static_cast<jsErrCode>(0);
     natsStatus s = natsSubscription_FetchRequest(&list, r.subscription, &request);
     if (s == NATS_OK && list.Count > 0) {

@@ -23,14 +23,17 @@ StreamReader::StreamReader(Bus& bus, std::string source, const std::string& cons
 Message StreamReader::next(const std::string& waitingFor) {
   std::chrono::milliseconds waited{0};
   for (;;) {
-    std::optional<Received> r = reader_.next(patience_);
+    const std::chrono::milliseconds slice =
+        giveUp_.count() > 0 ? std::min(patience_, std::max(giveUp_ - waited, std::chrono::milliseconds(1))) : patience_;
+    const auto began = std::chrono::steady_clock::now();
+    std::optional<Received> r = reader_.next(slice);
     if (!r) {
-      waited += patience_;
+      waited += std::max(slice, std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - began));
       if (giveUp_.count() > 0 && waited >= giveUp_)
-        throw Error(fmt::format("{}: no {} came from '{}' for {:g} s; giving up", bus_.url(), waitingFor, source_,
-                                static_cast<double>(waited.count()) / 1000.0),
+        throw Error(fmt::format("{}: waited {:.1f} s for {} from '{}'; giving up", bus_.url(),
+                                static_cast<double>(waited.count()) / 1000.0, waitingFor, source_),
                     ExitCode::Unavailable);
-      spdlog::info("waiting for {} from '{}' on {} (nothing for {:g} s)", waitingFor, source_, bus_.url(),
+      spdlog::info("waiting for {} from '{}' on {} (nothing for {:.0f} s)", waitingFor, source_, bus_.url(),
                    static_cast<double>(waited.count()) / 1000.0);
       continue;
     }

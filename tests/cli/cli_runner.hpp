@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -54,6 +55,73 @@ inline CliResult runDrape(const std::string& args, const ScratchDir& scratch) {
   r.err = slurp(errFile);
   return r;
 }
+
+/// The walking skirt twice over, as two garments 'Skirt' and 'Skirt2' of one scene (they do
+/// not touch each other: each comes out as the skirt alone), written into `scratch`.
+inline std::string twoSkirtScene(const ScratchDir& scratch) {
+  std::string scene = slurp(kSkirtDir + "/scene.wrl");
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const std::size_t at = scene.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) scene.replace(at, from.size(), to);
+  };
+  replace("url \"../../data/", "url \"" + std::string(DRAPE_DATA_DIR) + "/");
+  replace("constraintMask IndexedFaceSet {", "constraintMask DEF SkirtMask IndexedFaceSet {");
+  scene += R"(
+DEF Skirt2 ClothSet {
+  cloth Shape { geometry USE SkirtMesh }
+  constraintMask USE SkirtMask
+  material USE Knit
+  avatar USE Body
+  collidesWith [ "LowerBack", "Hips", "LeftUpLeg", "RightUpLeg", "LeftLeg", "RightLeg" ]
+  maskTolerance 0.0005
+  bindThreshold 0.040
+}
+)";
+  const std::string path = scratch / "two.wrl";
+  std::ofstream(path) << scene;
+  return path;
+}
+
+/// A drape command running in the background (a studio role), its standard output and
+/// error in files of the scratch directory; killed, if still running, when it goes.
+class DrapeProcess {
+ public:
+  DrapeProcess(const std::string& args, const ScratchDir& scratch, const std::string& name)
+      : out_(scratch / (name + ".out")), err_(scratch / (name + ".err")) {
+    const std::string cmd = std::string("ASAN_OPTIONS=detect_leaks=0 exec '") + DRAPE_EXE + "' " + args + " >'" + out_ +
+                            "' 2>'" + err_ + "'";
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+  }
+  ~DrapeProcess() {
+    if (pid_ > 0) kill();
+  }
+  DrapeProcess(const DrapeProcess&) = delete;
+  DrapeProcess& operator=(const DrapeProcess&) = delete;
+
+  /// Waits for it to end: its exit code and output (code -1 when a signal ended it).
+  CliResult wait() {
+    int status = 0;
+    if (pid_ > 0) ::waitpid(pid_, &status, 0);
+    pid_ = -1;
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out_), slurp(err_)};
+  }
+  /// Ends it at once (SIGKILL: no chance to tidy up, as a crash or a pulled plug).
+  CliResult kill() {
+    if (pid_ > 0) ::kill(pid_, SIGKILL);
+    return wait();
+  }
+  /// What it has written to standard error so far.
+  [[nodiscard]] std::string errSoFar() const { return slurp(err_); }
+
+ private:
+  std::string out_, err_;
+  pid_t pid_ = -1;
+};
 
 /// `drape run ARGS --out SCRATCH/NAME`, which must exit 0 (the test fails with its error
 /// otherwise); returns the output directory.

@@ -242,27 +242,7 @@ TEST(RunScene, WalkingSkirtWritesEverything) {
 // alone, so nothing passes between garments stepping at the same time.
 TEST(RunScene, TwoGarmentsInParallelComeOutAsEachAlone) {
   ScratchDir dir("run-two-garments");
-  std::string scene = slurp(kSkirtDir + "/scene.wrl");
-  const auto replace = [&](const std::string& from, const std::string& to) {
-    const std::size_t at = scene.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    scene.replace(at, from.size(), to);
-  };
-  replace("url \"../../data/", "url \"" + std::string(DRAPE_DATA_DIR) + "/");
-  replace("constraintMask IndexedFaceSet {", "constraintMask DEF SkirtMask IndexedFaceSet {");
-  scene += R"(
-DEF Skirt2 ClothSet {
-  cloth Shape { geometry USE SkirtMesh }
-  constraintMask USE SkirtMask
-  material USE Knit
-  avatar USE Body
-  collidesWith [ "LowerBack", "Hips", "LeftUpLeg", "RightUpLeg", "LeftLeg", "RightLeg" ]
-  maskTolerance 0.0005
-  bindThreshold 0.040
-}
-)";
-  const std::string twoScene = dir / "two.wrl";
-  std::ofstream(twoScene) << scene;
+  const std::string twoScene = twoSkirtScene(dir);
   const std::string motion = " --motion '" + kSkirtDir + "/walk.bvh' --frames 20 --out '";
   const CliResult one = runDrape("run '" + kSkirtDir + "/scene.wrl'" + motion + (dir / "one") + "'", dir);
   ASSERT_EQ(one.code, 0) << one.err;

@@ -1,0 +1,179 @@
+// The studio's three roles as separate processes on a real nats-server: what the player
+// records is what drape run writes, to the byte, also when a cloth-server is killed in the
+// middle of the take and started again, when junk arrives on the pose stream, when two
+// cloth-servers split the garments, and when the take goes unstable; errors say what to do.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <thread>
+
+#include "cli_runner.hpp"
+#include "drape/studio/bus.hpp"
+#include "drape/testing/nats_server.hpp"
+
+namespace drape::testing {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+const std::string kScene = kSkirtDir + "/scene.wrl";
+const std::string kWalk = kSkirtDir + "/walk.bvh";
+
+/// stats.json without what the clocks say.
+nlohmann::json untimed(nlohmann::json stats) {
+  for (const char* key : {"ms_per_frame", "loop_wall_ms_per_frame", "ms_per_stage", "frame_ms_per_stage",
+                          "collision_time_share", "penetration_measure_ms_per_frame", "animation_ms_per_frame",
+                          "distance_field_build_s", "distance_fields", "settle"})
+    stats.erase(key);
+  return stats;
+}
+
+/// Every file of run directory `got` is the one of `want`, byte for byte (stats.json but
+/// its timings).
+void expectSameRun(const std::string& got, const std::string& want) {
+  std::size_t files = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(want)) {
+    if (!entry.is_regular_file()) continue;
+    const fs::path relative = fs::relative(entry.path(), want);
+    const fs::path mine = fs::path(got) / relative;
+    ASSERT_TRUE(fs::exists(mine)) << relative << " was not recorded";
+    ++files;
+    if (relative == "stats.json") {
+      EXPECT_EQ(untimed(statsOf(got)), untimed(statsOf(want)));
+      continue;
+    }
+    ASSERT_EQ(slurp(mine.string()) == slurp(entry.path().string()), true) << relative << " differs";
+  }
+  EXPECT_GT(files, 40u);
+}
+
+std::string roles(const NatsServer& server) { return " --server " + server.url() + " --give-up 120"; }
+
+TEST(Studio, ThePlayerRecordsWhatDrapeRunWritesThroughAKilledClothServerAndJunk) {
+  ScratchDir dir("studio-roles");
+  NatsServer server;
+  const std::string reference = runInto(dir, "reference", "'" + kScene + "' --motion '" + kWalk + "'");
+
+  // The player first: it waits for the cloth. Then a cloth-server, then the anim-server at
+  // the frame rate, so that the take is under way when the cloth-server is killed.
+  DrapeProcess player("player '" + kScene + "' --record '" + (dir / "recorded") + "'" + roles(server), dir, "player");
+  auto cloth = std::make_unique<DrapeProcess>("cloth-server '" + kScene + "' --takes 1" + roles(server), dir, "cloth1");
+  DrapeProcess anim("anim-server '" + kScene + "' --motion '" + kWalk + "' --take walk-1" + roles(server), dir, "anim");
+
+  studio::Bus bus = studio::Bus::connect(server.url(), "test");
+  bus.ensureStream("anim");
+  // Junk on the pose stream while the take runs: a server survives bad frames.
+  for (int i = 0; i < 50 && bus.range("anim").messages < 10; ++i) std::this_thread::sleep_for(100ms);
+  (void)bus.publish("anim", std::vector<std::uint8_t>{'n', 'o', 't', ' ', 'a', ' ', 'f', 'r', 'a', 'm', 'e', '!'}, "junk");
+  bus.ensureStream("cloth");
+  for (int i = 0; i < 600 && bus.range("cloth").messages < 60; ++i) std::this_thread::sleep_for(50ms);
+  const CliResult killed = cloth->kill();
+  const std::uint64_t held = bus.range("cloth").messages;
+  EXPECT_GE(held, 60u);
+  EXPECT_LT(held, 170u) << "the cloth-server was to be killed in the middle of the take";
+  EXPECT_NE(killed.err.find("not a drape studio frame"), std::string::npos) << killed.err;
+
+  // Started again, it computes the take from its start and sends only what is missing.
+  cloth = std::make_unique<DrapeProcess>("cloth-server '" + kScene + "' --takes 1" + roles(server), dir, "cloth2");
+  const CliResult sent = anim.wait();
+  ASSERT_EQ(sent.code, 0) << sent.err;
+  EXPECT_NE(sent.out.find("sent take walk-1: 141 pose frames"), std::string::npos) << sent.out;
+  const CliResult again = cloth->wait();
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_NE(again.err.find("drape.cloth: the stream already holds"), std::string::npos) << again.err;
+  EXPECT_NE(again.out.find("take walk-1: 170 cloth frames of Skirt sent to drape.cloth"), std::string::npos) << again.out;
+  const CliResult recorded = player.wait();
+  ASSERT_EQ(recorded.code, 0) << recorded.err;
+  EXPECT_NE(recorded.out.find("recorded take walk-1: 171 frames"), std::string::npos) << recorded.out;
+  EXPECT_EQ(bus.range("cloth").messages, 173u) << "the take's start, 171 frames and its end, each once";
+  expectSameRun(dir / "recorded", reference);
+}
+
+TEST(Studio, TwoClothServersSplitTheGarmentsAndThePlayerCollatesThem) {
+  ScratchDir dir("studio-split");
+  NatsServer server;
+  const std::string scene = twoSkirtScene(dir);
+  const std::string reference = runInto(dir, "reference", "'" + scene + "' --motion '" + kWalk + "'");
+  DrapeProcess first("cloth-server '" + scene + "' --name front --garments Skirt --takes 1" + roles(server), dir, "front");
+  DrapeProcess second("cloth-server '" + scene + "' --name back --garments Skirt2 --takes 1" + roles(server), dir, "back");
+  const CliResult sent = runDrape("anim-server '" + scene + "' --motion '" + kWalk + "' --fast" + roles(server), dir);
+  ASSERT_EQ(sent.code, 0) << sent.err;
+  for (DrapeProcess* p : {&first, &second}) {
+    const CliResult r = p->wait();
+    ASSERT_EQ(r.code, 0) << r.err;
+  }
+  // The player joins after both are done: the streams hold the take.
+  const CliResult recorded = runDrape(
+      "player '" + scene + "' --cloth back,front --record '" + (dir / "recorded") + "'" + roles(server), dir);
+  ASSERT_EQ(recorded.code, 0) << recorded.err;
+  for (const char* file : {"garment-Skirt.pc2", "garment-Skirt2.pc2", "garment-Skirt.states", "body.pc2",
+                           "manifest.json", "result.wrl"})
+    EXPECT_TRUE(slurp(dir / ("recorded/" + std::string(file))) == slurp(reference + "/" + file)) << file;
+  const nlohmann::json stats = statsOf(dir / "recorded");
+  ASSERT_TRUE(stats.contains("cloth_servers")) << stats.dump();
+  EXPECT_EQ(stats["cloth_servers"]["front"]["garments"][0]["name"], "Skirt");
+  EXPECT_EQ(stats["cloth_servers"]["back"]["garments"][0]["name"], "Skirt2");
+}
+
+TEST(Studio, AnUnstableTakeIsRecordedUpToItsLastGoodFrame) {
+  ScratchDir dir("studio-unstable");
+  NatsServer server;
+  // Four substeps a frame: far beyond the skirt's stable step; frame 2 goes unstable.
+  std::string text = slurp(kScene);
+  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+           {"stepsPerFrame 33", "stepsPerFrame 4"},
+           {"bendEvery 8", "bendEvery 1"},
+           {"url \"../../data/", "url \"" + std::string(DRAPE_DATA_DIR) + "/"}})
+    text.replace(text.find(from), from.size(), to);
+  const std::string scene = dir / "unstable.wrl";
+  std::ofstream(scene) << text;
+  DrapeProcess cloth("cloth-server '" + scene + "' --takes 1" + roles(server), dir, "cloth");
+  ASSERT_EQ(runDrape("anim-server '" + scene + "' --motion '" + kWalk + "' --fast" + roles(server), dir).code, 0);
+  const CliResult served = cloth.wait();
+  EXPECT_EQ(served.code, 3) << served.err;
+  const CliResult recorded = runDrape("player '" + scene + "' --record '" + (dir / "recorded") + "'" + roles(server), dir);
+  EXPECT_EQ(recorded.code, 3) << recorded.err;
+  EXPECT_NE(recorded.err.find("garment 'Skirt': vertex"), std::string::npos) << recorded.err;
+  EXPECT_NE(recorded.err.find("the 2 frames before it recorded in"), std::string::npos) << recorded.err;
+  EXPECT_EQ(formats::readPc2(dir / "recorded/garment.pc2").frames.size(), 2u);
+  EXPECT_TRUE(statsOf(dir / "recorded")["unstable"].get<bool>());
+}
+
+TEST(Studio, ErrorsSayWhatToDo) {
+  ScratchDir dir("studio-errors");
+  std::string nowhere;
+  {
+    const NatsServer gone;
+    nowhere = gone.url();
+  }
+  CliResult r = runDrape("player '" + kScene + "' --record '" + (dir / "rec") + "' --server " + nowhere, dir);
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_NE(r.err.find(nowhere + ": no NATS server answers (start one with nats-server -js"), std::string::npos) << r.err;
+
+  r = runDrape("player '" + kScene + "'", dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("give --record DIR or --window"), std::string::npos) << r.err;
+  r = runDrape("anim-server '" + kScene + "' --server " + nowhere, dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("nothing moves the avatar: give --motion FILE"), std::string::npos) << r.err;
+  r = runDrape("cloth-server '" + kScene + "' --garments Skirt,Cape --server " + nowhere, dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("has no garment 'Cape' (it has: Skirt)"), std::string::npos) << r.err;
+  r = runDrape("cloth-server '" + kScene + "' --name anim --server " + nowhere, dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("needs a name of its own"), std::string::npos) << r.err;
+  r = runDrape("cloth-server '" + kScene + "' --name 'my.cloth' --server " + nowhere, dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("1 to 64 letters, digits"), std::string::npos) << r.err;
+
+  // A cloth-server waits for poses that never come, and gives up when told.
+  const NatsServer server;
+  r = runDrape("cloth-server '" + kScene + "' --server " + server.url() + " --give-up 1", dir);
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_NE(r.err.find("for a take's poses from 'anim'; giving up"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace drape::testing

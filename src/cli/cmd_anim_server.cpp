@@ -54,7 +54,7 @@ int runAnimServer(const AnimServerOptions& o) {
   const scene::Avatar& avatar = *setup.character->avatar;
 
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape anim-server " + o.name);
-  studio::Publisher publisher(bus, o.name);
+  studio::Publisher publisher(bus, o.name, studio::Precision::Double, o.studio.giveUp());
   const std::string take = o.take.empty() ? studio::newTakeId() : o.take;
   const studio::PoseStart start = poseStart(avatar, motion);
   publisher.beginTake(take, start);

@@ -141,7 +141,8 @@ int runClothServer(const ClothServerOptions& o) {
   studio::StreamReader stream(bus, o.poses, consumerName("cloth-server-" + o.name, false), o.studio.patience(),
                               o.studio.giveUp());
   studio::PoseFollower poses(stream);
-  studio::Publisher publisher(bus, o.name, o.positions == "float" ? studio::Precision::Float : studio::Precision::Double);
+  studio::Publisher publisher(bus, o.name, o.positions == "float" ? studio::Precision::Float : studio::Precision::Double,
+                              o.studio.giveUp());
   std::vector<std::string> names;
   for (const GarmentSetup& g : setup.garments) names.push_back(g.name);
   spdlog::info("cloth-server '{}': {} on {}, following the poses of '{}' on {}", o.name, fmt::join(names, ", "),

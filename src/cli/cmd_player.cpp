@@ -3,7 +3,9 @@
 // frame, and records them as a run directory (what drape run --out writes, to the byte) or
 // shows them live in a window.
 
+#include <chrono>
 #include <iostream>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -23,7 +25,7 @@ namespace {
 struct PlayerRoleOptions {
   std::string scene, record, take, screenshot;
   std::vector<std::string> cloth{"cloth"};
-  bool window = false, preview = false;
+  bool window = false, preview = false, everyFrame = false;
   long every = 1, frames = 0;
   StudioOptions studio;
   PictureOptions picture;
@@ -100,9 +102,18 @@ int show(const PlayerRoleOptions& o) {
   if (avatar.skin) skin = std::make_unique<sim::BodySkin>(avatar, fields, sim::leastT0(setup.garments, worldSettings(setup)));
 
   FrameTaken taken;
-  long next = 0;
+  long next = 0, skipped = 0;
   std::vector<sim::GarmentSurface> garments;
+  std::optional<std::chrono::steady_clock::time_point> first;
   render::CallbackSource source(meshes, setup.settings.frameRate_hz, [&](render::Frame& out) {
+    // Live, a window that draws slower than the frame rate keeps to the take's time by
+    // leaving frames out (their poses and cloth still read, in order); --every-frame shows
+    // each, falling behind.
+    const auto now = std::chrono::steady_clock::now();
+    if (!first) first = now;
+    const auto due = static_cast<long>(std::chrono::duration<double>(now - *first).count() * setup.settings.frameRate_hz);
+    for (; !o.everyFrame && next < due; ++next, ++skipped)
+      if (!frames.next(next, taken)) return false;
     if (!frames.next(next, taken)) return false;
     // The take's time code: cloth frame 0 is the lead-in's start, before the poses' first.
     out.time = TimeCode{frames.start().start.frame + next, frames.start().start.rate};
@@ -136,7 +147,8 @@ int show(const PlayerRoleOptions& o) {
   options.screenshot = o.screenshot;
   render::SubdividedSource shown(source, o.picture.subdivide);
   const render::PlayerStats stats = render::Player(options).run(shown);
-  std::cout << fmt::format("showed {} frames of take {} in {:.1f} s\n", stats.framesDrawn, frames.take(), stats.seconds);
+  std::cout << fmt::format("showed {} frames of take {} in {:.1f} s{}\n", stats.framesDrawn, frames.take(), stats.seconds,
+                           skipped > 0 ? fmt::format(" ({} left out to keep to the take's time)", skipped) : "");
   return 0;
 }
 
@@ -154,6 +166,9 @@ RunFunction setupPlayer(CLI::App& app) {
   app.add_flag("--preview", o.preview, "With --record: also a contact sheet and, with ffmpeg, an MP4");
   app.add_option("--every", o.every, "With --record: an OBJ frame every K frames")->capture_default_str()->check(CLI::PositiveNumber);
   app.add_option("--screenshot", o.screenshot, "With --window: save the last picture as a PNG when it closes");
+  app.add_flag("--every-frame", o.everyFrame,
+               "With --window: show every frame, however long drawing takes (default: leave frames out to keep to "
+               "the take's time)");
   o.studio.add(app, "frames");
   o.picture.add(app);
   app.footer("drape render DIR and drape play DIR show a recording afterwards.\n"

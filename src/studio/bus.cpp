@@ -6,11 +6,13 @@
 #include <algorithm>
 #include <cctype>
 #include <deque>
+#include <thread>
 
 #include <fmt/format.h>
 #include <nats/nats.h>
 
 #include "drape/core/error.hpp"
+#include "drape/core/log.hpp"
 
 namespace drape::studio {
 namespace {
@@ -130,6 +132,11 @@ void Bus::ensureStream(const std::string& source) {
   config.Storage = js_FileStorage;
   config.Duplicates = std::int64_t{120} * 1'000'000'000;
   s = js_AddStream(&info, impl_->js, &config, nullptr, &jerr);
+  if (s != NATS_OK && jerr == JSStreamSubjectOverlapErr)
+    throw Error(fmt::format("{}: subject {} belongs to another stream of this server than {}: give this broadcaster "
+                            "another --name, or delete that stream",
+                            impl_->url, subject, stream),
+                ExitCode::Unavailable);
   if (s != NATS_OK) impl_->fail(fmt::format("cannot create stream {} for {}", stream, subject), s, jerr);
   jsStreamInfo_Destroy(info);
 }
@@ -193,6 +200,7 @@ struct Reader::Impl {
   std::string consumer;
   natsSubscription* subscription = nullptr;
   std::deque<Received> ready;
+  bool outage = false;  ///< the last read failed: said once, until a read works again
 
   ~Impl() {
     if (subscription == nullptr) return;
@@ -267,14 +275,25 @@ std::optional<Received> Reader::next(std::chrono::milliseconds timeout) {
       r.take(list);
     } else {
       if (s == NATS_OK) natsMsgList_Destroy(&list);
-      if (s != NATS_OK && s != NATS_TIMEOUT && s != NATS_NOT_FOUND)
-        r.bus->fail(fmt::format("cannot read as {}", r.consumer), s, jerr);
       natsMsgList one{};
-      s = natsSubscription_Fetch(&one, r.subscription, 1, std::max<std::int64_t>(1, timeout.count()), &jerr);
+      if (s == NATS_OK || s == NATS_TIMEOUT || s == NATS_NOT_FOUND)
+        s = natsSubscription_Fetch(&one, r.subscription, 1, std::max<std::int64_t>(1, timeout.count()), &jerr);
       if (s == NATS_TIMEOUT || s == NATS_NOT_FOUND) return std::nullopt;
-      if (s != NATS_OK) r.bus->fail(fmt::format("cannot read as {}", r.consumer), s, jerr);
+      if (s == NATS_CONNECTION_CLOSED || s == NATS_INVALID_SUBSCRIPTION)
+        r.bus->fail(fmt::format("cannot read as {}", r.consumer), s, jerr);
+      if (s != NATS_OK) {
+        // The server went away (restarting, or a network between): the connection comes
+        // back by itself and the consumer, stored with the stream, with it. Until then this
+        // is a read that found nothing; the caller says what it waits for.
+        if (!r.outage) spdlog::warn("{}: reading as {}: {}; trying again", r.bus->url, r.consumer, statusText(s, jerr));
+        r.outage = true;
+        std::this_thread::sleep_for(std::min(timeout, std::chrono::milliseconds(250)));
+        return std::nullopt;
+      }
       r.take(one);
     }
+    if (r.outage) spdlog::info("{}: reading as {} again", r.bus->url, r.consumer);
+    r.outage = false;
   }
   if (r.ready.empty()) return std::nullopt;
   Received out = std::move(r.ready.front());

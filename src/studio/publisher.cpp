@@ -1,5 +1,7 @@
 #include "drape/studio/publisher.hpp"
 
+#include <thread>
+
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
@@ -8,8 +10,8 @@
 
 namespace drape::studio {
 
-Publisher::Publisher(Bus& bus, std::string source, Precision precision)
-    : bus_(bus), source_(std::move(source)), precision_(precision) {
+Publisher::Publisher(Bus& bus, std::string source, Precision precision, std::chrono::milliseconds giveUp)
+    : bus_(bus), source_(std::move(source)), precision_(precision), giveUp_(giveUp) {
   bus_.ensureStream(source_);
 }
 
@@ -66,7 +68,22 @@ void Publisher::send(const Payload& payload) {
   const std::uint64_t index = index_++;
   if (index < held_) return;
   const std::vector<std::uint8_t> bytes = encode(Message{source_, take_, payload}, precision_);
-  (void)bus_.publish(source_, bytes, idOf(payload));
+  const std::string id = idOf(payload);
+  const auto began = std::chrono::steady_clock::now();
+  for (bool said = false;; said = true) {
+    try {
+      (void)bus_.publish(source_, bytes, id);
+      if (said) spdlog::info("{}: the server takes messages again", subjectOf(source_));
+      return;
+    } catch (const Error& e) {
+      // Sent again under the same id: the stream keeps it once if the first did arrive.
+      if (e.code() != ExitCode::Unavailable ||
+          (giveUp_.count() > 0 && std::chrono::steady_clock::now() - began > giveUp_))
+        throw;
+      if (!said) spdlog::warn("{}; sending it again until the server takes it", e.what());
+      std::this_thread::sleep_for(std::chrono::milliseconds(250));
+    }
+  }
 }
 
 }  // namespace drape::studio

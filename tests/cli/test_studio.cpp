@@ -91,6 +91,33 @@ TEST(Studio, ThePlayerRecordsWhatDrapeRunWritesThroughAKilledClothServerAndJunk)
   expectSameRun(dir / "recorded", reference);
 }
 
+TEST(Studio, TheRolesRideOutARestartOfTheServer) {
+  ScratchDir dir("studio-server-restart");
+  NatsServer server;
+  DrapeProcess cloth("cloth-server '" + kScene + "' --takes 1" + roles(server), dir, "cloth");
+  DrapeProcess anim("anim-server '" + kScene + "' --motion '" + kWalk + "' --take restart" + roles(server), dir, "anim");
+  {
+    studio::Bus bus = studio::Bus::connect(server.url(), "test");
+    bus.ensureStream("cloth");
+    for (int i = 0; i < 600 && bus.range("cloth").messages < 50; ++i) std::this_thread::sleep_for(50ms);
+  }
+  // In the middle of the take the server goes for a second and a half and comes back on
+  // its store: the roles wait, reconnect and go on where they were.
+  server.stop();
+  std::this_thread::sleep_for(1500ms);
+  server.start();
+  const CliResult sent = anim.wait();
+  ASSERT_EQ(sent.code, 0) << sent.err;
+  const CliResult served = cloth.wait();
+  ASSERT_EQ(served.code, 0) << served.err;
+  EXPECT_NE(served.err.find("trying again"), std::string::npos) << served.err;
+  const CliResult recorded = runDrape("player '" + kScene + "' --record '" + (dir / "recorded") + "'" + roles(server), dir);
+  ASSERT_EQ(recorded.code, 0) << recorded.err;
+  const std::string reference = runInto(dir, "reference", "'" + kScene + "' --motion '" + kWalk + "'");
+  for (const char* file : {"garment.pc2", "garment.states", "body.pc2"})
+    EXPECT_TRUE(slurp(dir / ("recorded/" + std::string(file))) == slurp(reference + "/" + file)) << file;
+}
+
 TEST(Studio, TwoClothServersSplitTheGarmentsAndThePlayerCollatesThem) {
   ScratchDir dir("studio-split");
   NatsServer server;
@@ -139,6 +166,26 @@ TEST(Studio, AnUnstableTakeIsRecordedUpToItsLastGoodFrame) {
   EXPECT_NE(recorded.err.find("the 2 frames before it recorded in"), std::string::npos) << recorded.err;
   EXPECT_EQ(formats::readPc2(dir / "recorded/garment.pc2").frames.size(), 2u);
   EXPECT_TRUE(statsOf(dir / "recorded")["unstable"].get<bool>());
+}
+
+TEST(Studio, ThePlayerShowsATakeLiveInAWindow) {
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps installs xvfb)";
+  ScratchDir dir("studio-window");
+  NatsServer server;
+  DrapeProcess cloth("cloth-server '" + kScene + "' --takes 1" + roles(server), dir, "cloth");
+  DrapeProcess anim("anim-server '" + kScene + "' --motion '" + kWalk + "'" + roles(server), dir, "anim");
+  const std::string shot = dir / "live.png";
+  const std::string cmd = std::string("ASAN_OPTIONS=detect_leaks=0 xvfb-run -a '") + DRAPE_EXE + "' player '" + kScene +
+                          "' --window --frames 8 --size 320x240 --screenshot '" + shot + "'" + roles(server) + " >'" +
+                          (dir / "player.txt") + "' 2>&1";
+  const int status = std::system(cmd.c_str());
+  const std::string out = slurp(dir / "player.txt");
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << out;
+  EXPECT_NE(out.find("showed 8 frames of take"), std::string::npos) << out;
+  EXPECT_GT(fs::file_size(shot), 1000u);
+  EXPECT_EQ(anim.wait().code, 0);
+  EXPECT_EQ(cloth.wait().code, 0);
 }
 
 TEST(Studio, ErrorsSayWhatToDo) {

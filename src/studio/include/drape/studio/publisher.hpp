@@ -7,6 +7,7 @@
 // stream does not hold yet. Every message also carries an id, so that the stream drops one
 // sent twice within its duplicate window.
 
+#include <chrono>
 #include <cstdint>
 #include <string>
 
@@ -17,7 +18,11 @@ namespace drape::studio {
 
 class Publisher {
  public:
-  Publisher(Bus& bus, std::string source, Precision precision = Precision::Double);
+  /// A message the server does not take (it is restarting, or out of reach) is sent again,
+  /// under the same id, until it is taken, for at most `giveUp` (0: for ever); then the
+  /// error is thrown.
+  Publisher(Bus& bus, std::string source, Precision precision = Precision::Double,
+            std::chrono::milliseconds giveUp = std::chrono::milliseconds(0));
 
   /// Starts take `take` with its PoseStart or ClothStart. Returns the messages of it the
   /// stream already held (0 for a new take: the stream was emptied for it).
@@ -40,6 +45,7 @@ class Publisher {
   Bus& bus_;
   std::string source_;
   Precision precision_;
+  std::chrono::milliseconds giveUp_;
   std::string take_;
   std::uint64_t held_ = 0;   ///< messages of this take the stream held when it began
   std::uint64_t index_ = 0;  ///< messages of this take sent so far, held ones included

@@ -31,14 +31,6 @@ struct PlayerRoleOptions {
   PictureOptions picture;
 };
 
-sim::WorldSettings worldSettings(const RunSetup& setup) {
-  sim::WorldSettings ws;
-  ws.step = setup.settings;
-  ws.voxel_m = setup.character->voxel_m;
-  ws.fieldMethod = setup.character->fieldMethod;
-  return ws;
-}
-
 /// The part fields the skinned body is fitted to, as the cloth-servers' worlds build them
 /// (none for an avatar without a skin: the segments need none).
 std::vector<sim::PartField> skinFields(const RunSetup& setup) {

@@ -349,7 +349,7 @@ nlohmann::json keepApartJson(const sim::KeepApartReport& report) {
 
 }  // namespace
 
-std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup) {
+sim::WorldSettings worldSettings(const RunSetup& setup) {
   if (!setup.character) throw Error("drape: the scene has no avatar to simulate on");
   sim::WorldSettings ws;
   ws.step = setup.settings;
@@ -357,10 +357,17 @@ std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup) {
   ws.fieldMethod = setup.character->fieldMethod;
   ws.leadIn_s = setup.character->leadIn_s;
   if (setup.character->animation) ws.keepApart.parts = setup.character->keepApart;
-  spdlog::info("building distance fields ({:.4g} m voxels) and binding constraint masks", ws.voxel_m);
+  return ws;
+}
+
+std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup) {
+  const sim::WorldSettings ws = worldSettings(setup);
+  const bool built = setup.character->fields != nullptr;
+  spdlog::info("{} and binding constraint masks",
+               built ? "distance fields built before" : fmt::format("building distance fields ({:.4g} m voxels)", ws.voxel_m));
   auto world = std::make_unique<sim::CharacterWorld>(*setup.character->avatar, setup.character->animation.get(),
-                                                     setup.garments, ws);
-  spdlog::info("{} distance fields in {:.2f} s", world->fields().size(), world->fieldBuild_s());
+                                                     setup.garments, ws, setup.character->fields);
+  if (!built) spdlog::info("{} distance fields in {:.2f} s", world->fields().size(), world->fieldBuild_s());
   logKeptApart(world->keepApartReport());
   return world;
 }

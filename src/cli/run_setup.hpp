@@ -40,6 +40,9 @@ struct CharacterSetup {
   double settle_s = 1.0;
   /// Parts whose motion is corrected to keep them out of the collidable parts (--keep-apart).
   std::vector<std::string> keepApart{};
+  /// The part fields, when built before for these garments (a cloth-server's, once for all
+  /// its takes); null: the world builds them.
+  std::shared_ptr<const std::vector<sim::PartField>> fields{};
 };
 
 struct SphereSetup {
@@ -116,6 +119,9 @@ struct MotionChoice {
 /// The line `drape make-skirt` and `make-scene` end with: how to run the scene they wrote in
 /// `out`, and what moves `avatar` there without --motion (what sceneMotion would play).
 void printHowToRun(const std::string& out, const scene::Avatar& avatar);
+
+/// The world settings of a setup with an avatar (its step, voxel size, field method, lead-in).
+[[nodiscard]] sim::WorldSettings worldSettings(const RunSetup& setup);
 
 /// The character's world of a setup with an avatar: fields built, masks bound, solvers
 /// ready. Used by `drape run`, `drape play SCENE` and `drape bench paper` alike.

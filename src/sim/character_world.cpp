@@ -101,7 +101,8 @@ const RigidTransform& AvatarPoses::jointAt(double t_s, int jointIndex) const {
 }
 
 CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::AvatarAnimation* animation,
-                               std::vector<GarmentSpec> garments, const WorldSettings& settings)
+                               std::vector<GarmentSpec> garments, const WorldSettings& settings,
+                               std::shared_ptr<const std::vector<PartField>> fields)
     : avatar_(avatar), animation_(animation), settings_(settings) {
   settings_.step.validate();
   if (animation && animation->jointCount() != avatar.joints.size()) {
@@ -120,7 +121,7 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
                                               settings_.step.massScaling()));
     cloth::checkBendingStep(*models.back(), settings_.step);
   }
-  buildFields(garments);
+  buildFields(garments, std::move(fields));
   if (animation && !settings_.keepApart.parts.empty()) keepBodyApart(*animation, garments);
 
   for (std::size_t g = 0; g < garments.size(); ++g) {
@@ -128,15 +129,15 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
     const std::shared_ptr<const cloth::ClothModel>& model = models[g];
     std::vector<int> parts;
     for (const std::string& name : spec.collidesWith) {
-      const auto it = std::find_if(fields_.begin(), fields_.end(), [&](const PartField& p) { return p.segment == name; });
-      parts.push_back(static_cast<int>(it - fields_.begin()));
+      const auto it = std::find_if(fields_->begin(), fields_->end(), [&](const PartField& p) { return p.segment == name; });
+      parts.push_back(static_cast<int>(it - fields_->begin()));
     }
     // The garment's own poses of the parts: garments step in parallel, and a pose cache
     // serves one thread.
     GarmentRun run;
     run.poses = std::make_unique<AvatarPoses>(avatar, keptApartMotion_ ? keptApartMotion_.get() : animation,
                                               settings.leadIn_s);
-    for (const PartField& f : fields_) run.motions.push_back(std::make_shared<SegmentMotion>(*run.poses, f.joint));
+    for (const PartField& f : *fields_) run.motions.push_back(std::make_shared<SegmentMotion>(*run.poses, f.joint));
     std::vector<cloth::PinGroup> pins = bindMask(spec, parts, run.motions);
     if (!spec.pinned.empty()) {
       const auto& m = *model;
@@ -144,9 +145,9 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
     }
     std::vector<cloth::CollisionPart> collisionParts;
     for (int p : parts) {
-      const bool faces = std::find(spec.faceSamplesWith.begin(), spec.faceSamplesWith.end(), fields_[p].segment) !=
+      const bool faces = std::find(spec.faceSamplesWith.begin(), spec.faceSamplesWith.end(), (*fields_)[p].segment) !=
                          spec.faceSamplesWith.end();
-      collisionParts.push_back({fields_[p].segment, &fields_[p].field, run.motions[static_cast<std::size_t>(p)], faces});
+      collisionParts.push_back({(*fields_)[p].segment, &(*fields_)[p].field, run.motions[static_cast<std::size_t>(p)], faces});
     }
     run.collider = std::make_unique<cloth::FieldCollider>(spec.name, std::move(collisionParts), spec.offsets,
                                                           spec.material.staticFriction, spec.material.dynamicFriction,
@@ -165,11 +166,14 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
 
 CharacterWorld::~CharacterWorld() = default;
 
-std::vector<PartField> buildPartFields(const scene::Avatar& avatar, const std::vector<GarmentSpec>& garments,
-                                       const WorldSettings& settings) {
-  // One field per body segment any garment collides with, built once and shared.
+namespace {
+
+/// The segments any garment collides with, in the order the garments first name them, and
+/// the largest T3 (the fields' shell). Throws on a segment the avatar does not have.
+std::vector<std::string> collidableSegments(const scene::Avatar& avatar, const std::vector<GarmentSpec>& garments,
+                                            const WorldSettings& settings, double& shell_m) {
   std::vector<std::string> names;
-  double shell_m = 0;
+  shell_m = 0;
   for (const GarmentSpec& g : garments) {
     const cloth::OffsetSurfaces offsets = g.offsetsGiven ? g.offsets : cloth::OffsetSurfaces::fromVoxelSize(settings.voxel_m);
     shell_m = std::max(shell_m, offsets.t3_m);
@@ -186,6 +190,16 @@ std::vector<PartField> buildPartFields(const scene::Avatar& avatar, const std::v
                                 "with: {})",
                                 g.name, name, fmt::join(g.collidesWith, ", ")));
   }
+  return names;
+}
+
+}  // namespace
+
+std::vector<PartField> buildPartFields(const scene::Avatar& avatar, const std::vector<GarmentSpec>& garments,
+                                       const WorldSettings& settings) {
+  // One field per body segment any garment collides with, built once and shared.
+  double shell_m = 0;
+  const std::vector<std::string> names = collidableSegments(avatar, garments, settings, shell_m);
   field::FieldSettings fs;
   fs.voxelSize_m = settings.voxel_m;
   fs.shell_m = shell_m;
@@ -206,10 +220,22 @@ double leastT0(const std::vector<GarmentSpec>& garments, const WorldSettings& se
   return std::isfinite(t0) ? t0 : 0.0;
 }
 
-void CharacterWorld::buildFields(const std::vector<GarmentSpec>& garments) {
+void CharacterWorld::buildFields(const std::vector<GarmentSpec>& garments,
+                                 std::shared_ptr<const std::vector<PartField>> given) {
   const auto start = std::chrono::steady_clock::now();
-  fields_ = buildPartFields(avatar_, garments, settings_);
-  for (const PartField& f : fields_) partMotions_.push_back(std::make_shared<SegmentMotion>(*poses_, f.joint));
+  if (given) {
+    // Built before for the same avatar and garments (a cloth-server's, once for all its
+    // takes): the same parts, in the same order, or the garments' colliders would be wrong.
+    double shell_m = 0;
+    const std::vector<std::string> names = collidableSegments(avatar_, garments, settings_, shell_m);
+    bool same = names.size() == given->size();
+    for (std::size_t k = 0; same && k < names.size(); ++k) same = names[k] == (*given)[k].segment;
+    if (!same) throw Error("the part fields given to the world are not the ones its garments collide with", ExitCode::Internal);
+    fields_ = std::move(given);
+  } else {
+    fields_ = std::make_shared<const std::vector<PartField>>(buildPartFields(avatar_, garments, settings_));
+  }
+  for (const PartField& f : *fields_) partMotions_.push_back(std::make_shared<SegmentMotion>(*poses_, f.joint));
   fieldBuild_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -218,7 +244,7 @@ void CharacterWorld::keepBodyApart(const motion::AvatarAnimation& animation, con
   if (keep.margin_m <= 0)
     for (const GarmentSpec& g : garments) keep.margin_m = std::max(keep.margin_m, 2.0 * g.offsets.t2_m);
   keptApartMotion_ = std::make_unique<motion::AvatarAnimation>(animation);
-  keepApart_ = sim::keepBodyApart(avatar_, *keptApartMotion_, fields_, keep);
+  keepApart_ = sim::keepBodyApart(avatar_, *keptApartMotion_, *fields_, keep);
   poses_->useAnimation(keptApartMotion_.get());
 }
 
@@ -345,7 +371,7 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 p = spec.mesh.positions[spec.bound[i]];
     for (std::size_t k = 0; k < np; ++k) {
-      const PartField& pf = fields_[static_cast<std::size_t>(parts[k])];
+      const PartField& pf = (*fields_)[static_cast<std::size_t>(parts[k])];
       const Vec3 l = partMotions_[static_cast<std::size_t>(parts[k])]->poseAt(0.0).inverse().apply(p);
       local[i * np + k] = l;
       if (!pf.field.containsPoint(l)) continue;
@@ -366,7 +392,7 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
                                          p.x(), p.y(), p.z())
                            : fmt::format("vertex {} at ({:.3f}, {:.3f}, {:.3f}) m is {:.3f} m from '{}'", v, p.x(),
                                          p.y(), p.z(), distance[i * np + static_cast<std::size_t>(k)],
-                                         fields_[static_cast<std::size_t>(parts[static_cast<std::size_t>(k)])].segment);
+                                         (*fields_)[static_cast<std::size_t>(parts[static_cast<std::size_t>(k)])].segment);
     }
   }
   if (unbound > 0) {
@@ -381,8 +407,8 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
   std::vector<std::uint8_t> adjacent(np * np, 0);  // parts whose joints are parent and child
   for (std::size_t a = 0; a < np; ++a)
     for (std::size_t b = 0; b < np; ++b) {
-      const int ja = fields_[static_cast<std::size_t>(parts[a])].joint;
-      const int jb = fields_[static_cast<std::size_t>(parts[b])].joint;
+      const int ja = (*fields_)[static_cast<std::size_t>(parts[a])].joint;
+      const int jb = (*fields_)[static_cast<std::size_t>(parts[b])].joint;
       adjacent[a * np + b] = ja >= 0 && jb >= 0 && ja != jb &&
                              (avatar_.joints[static_cast<std::size_t>(ja)].parent == jb ||
                               avatar_.joints[static_cast<std::size_t>(jb)].parent == ja);
@@ -409,7 +435,7 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
   for (std::size_t k = 0; k < groups.size(); ++k) {
     if (groups[k].vertices.empty()) continue;
     spdlog::debug("garment '{}': {} mask vertices follow '{}'", spec.name, groups[k].vertices.size(),
-                  fields_[static_cast<std::size_t>(parts[k])].segment);
+                  (*fields_)[static_cast<std::size_t>(parts[k])].segment);
     groups[k].motion = motions[static_cast<std::size_t>(parts[k])];
     out.push_back(std::move(groups[k]));
   }
@@ -447,7 +473,7 @@ void CharacterWorld::liftOutOfTheParts(const GarmentSpec& spec, const std::vecto
 
   // How far q lies inside part k (0 if not); l: q in the part's frame.
   const auto below = [&](const Vec3& q, std::size_t k, Vec3& l) {
-    const field::DistanceField& f = fields_[static_cast<std::size_t>(parts[k])].field;
+    const field::DistanceField& f = (*fields_)[static_cast<std::size_t>(parts[k])].field;
     l = toLocal[k].apply(q);
     const field::PointLocation at = f.locate(l);
     return at.inVolume && at.distance_m < target - kTolerance_m ? target - at.distance_m : 0.0;
@@ -459,7 +485,7 @@ void CharacterWorld::liftOutOfTheParts(const GarmentSpec& spec, const std::vecto
       Vec3 l;
       const double depth = below(p[i], k, l);
       if (depth <= 0) continue;
-      const field::DistanceField& f = fields_[static_cast<std::size_t>(parts[k])].field;
+      const field::DistanceField& f = (*fields_)[static_cast<std::size_t>(parts[k])].field;
       p[i] += pose[k].rotation * (f.newtonDirection(l) * depth);
     }
   };
@@ -517,7 +543,7 @@ void CharacterWorld::liftOutOfTheParts(const GarmentSpec& spec, const std::vecto
                "modelled, the deepest {:.1f} mm inside '{}'; the mask is moved out onto the body before it is bound "
                "(by {:.1f} mm at most, its edges {:.0f} % longer or shorter at most{})",
                spec.name, modelledBelow, n, 1e3 * deepest,
-               fields_[static_cast<std::size_t>(parts[deepestPart])].segment, 1e3 * furthest, 100 * strain,
+               (*fields_)[static_cast<std::size_t>(parts[deepestPart])].segment, 1e3 * furthest, 100 * strain,
                still ? fmt::format("; {} still inside", still) : std::string());
 }
 

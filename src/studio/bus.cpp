@@ -147,6 +147,12 @@ void Bus::purge(const std::string& source) {
   if (s != NATS_OK) impl_->fail(fmt::format("cannot empty stream {}", streamOf(source)), s, jerr);
 }
 
+void Bus::remove(const std::string& source) {
+  jsErrCode jerr = static_cast<jsErrCode>(0);
+  const natsStatus s = js_DeleteStream(impl_->js, streamOf(source).c_str(), nullptr, &jerr);
+  if (s != NATS_OK && s != NATS_NOT_FOUND) impl_->fail(fmt::format("cannot delete stream {}", streamOf(source)), s, jerr);
+}
+
 std::uint64_t Bus::publish(const std::string& source, std::span<const std::uint8_t> data, const std::string& messageId) {
   const std::size_t most = maxPayload();
   if (most > 0 && data.size() > most)
@@ -190,7 +196,7 @@ std::optional<Received> Bus::get(const std::string& source, std::uint64_t sequen
   if (s == NATS_NOT_FOUND) return std::nullopt;
   if (s != NATS_OK) impl_->fail(fmt::format("cannot read message {} of stream {}", sequence, streamOf(source)), s, jerr);
   const auto* bytes = reinterpret_cast<const std::uint8_t*>(natsMsg_GetData(msg));
-  Received r{{bytes, bytes + natsMsg_GetDataLength(msg)}, sequence};
+  Received r{{bytes, bytes + natsMsg_GetDataLength(msg)}, sequence, natsMsg_GetTime(msg)};
   natsMsg_Destroy(msg);
   return r;
 }
@@ -216,12 +222,14 @@ struct Reader::Impl {
       natsMsg* msg = list.Msgs[i];
       jsMsgMetaData* meta = nullptr;
       std::uint64_t sequence = 0;
+      std::int64_t time = 0;
       if (natsMsg_GetMetaData(&meta, msg) == NATS_OK) {
         sequence = meta->Sequence.Stream;
+        time = meta->Timestamp;
         jsMsgMetaData_Destroy(meta);
       }
       const auto* bytes = reinterpret_cast<const std::uint8_t*>(natsMsg_GetData(msg));
-      ready.push_back({{bytes, bytes + natsMsg_GetDataLength(msg)}, sequence});
+      ready.push_back({{bytes, bytes + natsMsg_GetDataLength(msg)}, sequence, time});
     }
     natsMsgList_Destroy(&list);
   }

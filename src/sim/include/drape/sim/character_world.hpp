@@ -132,9 +132,12 @@ class CharacterWorld {
  public:
   /// Builds the part fields, binds every garment's mask and establishes the initial
   /// collision states. `animation` may be null (the avatar stands in its rest pose).
+  /// `fields`, when given, are the part fields buildPartFields built for the same avatar,
+  /// garments and settings (a cloth-server builds them once for all its takes).
   /// Throws drape::Error on unknown segment names or unbindable mask vertices.
   CharacterWorld(const scene::Avatar& avatar, const motion::AvatarAnimation* animation,
-                 std::vector<GarmentSpec> garments, const WorldSettings& settings);
+                 std::vector<GarmentSpec> garments, const WorldSettings& settings,
+                 std::shared_ptr<const std::vector<PartField>> fields = nullptr);
   ~CharacterWorld();
   CharacterWorld(const CharacterWorld&) = delete;
   CharacterWorld& operator=(const CharacterWorld&) = delete;
@@ -162,7 +165,7 @@ class CharacterWorld {
   [[nodiscard]] cloth::ClothSolver& mutableSolver(std::size_t g) { return *garments_[g].solver; }
   [[nodiscard]] const cloth::FieldCollider* collider(std::size_t g) const { return garments_[g].collider.get(); }
   [[nodiscard]] cloth::FieldCollider* collider(std::size_t g) { return garments_[g].collider.get(); }
-  [[nodiscard]] const std::vector<PartField>& fields() const { return fields_; }
+  [[nodiscard]] const std::vector<PartField>& fields() const { return *fields_; }
   [[nodiscard]] const AvatarPoses& poses() const { return *poses_; }
   /// The garment whose step failed and why, after stepFrame returned false.
   [[nodiscard]] std::string instability() const { return instability_; }
@@ -186,7 +189,7 @@ class CharacterWorld {
     std::unique_ptr<cloth::FieldCollider> collider;
     std::unique_ptr<cloth::ClothSolver> solver;
   };
-  void buildFields(const std::vector<GarmentSpec>& garments);
+  void buildFields(const std::vector<GarmentSpec>& garments, std::shared_ptr<const std::vector<PartField>> given);
   /// After stepping `frame`: logs each garment's recovery, and false (instability_ set, with
   /// `when` before it) at the first that went unstable.
   bool checkStable(const std::vector<std::uint8_t>& stables, long frame, const std::string& when);
@@ -207,7 +210,7 @@ class CharacterWorld {
   std::unique_ptr<AvatarPoses> poses_;
   std::unique_ptr<motion::AvatarAnimation> keptApartMotion_;  ///< the corrected motion, when asked for
   KeepApartReport keepApart_;
-  std::vector<PartField> fields_;
+  std::shared_ptr<const std::vector<PartField>> fields_;
   std::vector<std::shared_ptr<const cloth::FixtureMotion>> partMotions_;  ///< per field
   std::vector<GarmentRun> garments_;
   std::string instability_;

@@ -21,6 +21,7 @@ namespace drape::studio {
 struct Received {
   std::vector<std::uint8_t> data;
   std::uint64_t sequence = 0;
+  std::int64_t time_ns = 0;  ///< when the stream stored it: ns since 1970, the server's clock
 };
 
 /// First and last sequence of a broadcaster's stream (both 0 when it holds nothing).
@@ -62,6 +63,8 @@ class Bus {
   void ensureStream(const std::string& source);
   /// Empties `source`'s stream (a new take replaces the last one).
   void purge(const std::string& source);
+  /// Deletes `source`'s stream, if the server has it.
+  void remove(const std::string& source);
   /// Publishes `data` on `source`'s subject and waits for the stream's acknowledgement;
   /// `messageId` lets the stream drop a message published twice. Returns its sequence (0
   /// when the stream dropped it as a duplicate). Throws drape::Error (Unavailable) when no

@@ -15,6 +15,7 @@
 #include "drape/core/files.hpp"
 #include "drape/sim/body_overlap.hpp"
 #include "inspect_run.hpp"
+#include "inspect_studio.hpp"
 #include "run_setup.hpp"
 
 namespace drape::cli {
@@ -49,7 +50,10 @@ RunFunction setupInspect(CLI::App& app) {
   static std::string path, motion;
   static std::vector<std::string> keepApart;
   static RunQuery query;
-  app.add_option("file", path, "The file to summarise, or a run directory (what `drape run --out` wrote)")->required();
+  app.add_option("file", path,
+                 "The file to summarise, a run directory (what `drape run --out` wrote), or a studio's NATS server "
+                 "(nats://HOST:PORT)")
+      ->required();
   app.add_option("--motion", motion,
                  "With a scene: also load this motion onto its avatar and list where it puts the collidable parts "
                  "inside each other (cloth between them has no place), without simulating");
@@ -73,10 +77,16 @@ RunFunction setupInspect(CLI::App& app) {
     std::string text = "Understands:";
     text += fmt::format("\n  {:<18} {}", "DIR", "a run directory (manifest.json): its meshes, figures and, with "
                                                 "--deepest or --vertex, where its garments lie against the body");
+    text += fmt::format("\n  {:<18} {}", "nats://HOST:PORT",
+                        "a studio's NATS server: each drape stream, its take, what it carries, how far it has come");
     for (const InspectorEntry& e : registeredInspectors()) text += fmt::format("\n  {:<18} {}", fmt::join(e.extensions, " "), e.what);
     return text;
   });
   return [] {
+    if (isServerUrl(path)) {
+      inspectStudio(path, std::cout);
+      return 0;
+    }
     if (!std::filesystem::exists(path)) throw Error(fmt::format("{}: no such file", path));
     if (std::filesystem::is_directory(path)) {
       if (!motion.empty() || !keepApart.empty()) throw Error("--motion and --keep-apart go with a scene, not a run");

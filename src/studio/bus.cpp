@@ -189,6 +189,23 @@ StreamRange Bus::range(const std::string& source) {
   return r;
 }
 
+std::vector<std::string> Bus::broadcasters() {
+  jsStreamNamesList* list = nullptr;
+  jsErrCode jerr = static_cast<jsErrCode>(0);
+  const natsStatus s = js_StreamNames(&list, impl_->js, nullptr, &jerr);
+  if (s == NATS_NOT_FOUND) return {};
+  if (s != NATS_OK) impl_->fail("cannot list the streams", s, jerr);
+  std::vector<std::string> out;
+  const std::string prefix = streamOf("");
+  for (int i = 0; i < list->Count; ++i) {
+    const std::string name = list->List[i];
+    if (name.rfind(prefix, 0) == 0 && name.size() > prefix.size()) out.push_back(name.substr(prefix.size()));
+  }
+  jsStreamNamesList_Destroy(list);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 std::optional<Received> Bus::get(const std::string& source, std::uint64_t sequence) {
   natsMsg* msg = nullptr;
   jsErrCode jerr = static_cast<jsErrCode>(0);

@@ -71,6 +71,8 @@ class Bus {
   /// stream takes it, or (BadInput) when it is over the server's max_payload.
   std::uint64_t publish(const std::string& source, std::span<const std::uint8_t> data, const std::string& messageId);
   [[nodiscard]] StreamRange range(const std::string& source);
+  /// The broadcasters whose streams the server holds (streams named DRAPE_NAME), sorted.
+  [[nodiscard]] std::vector<std::string> broadcasters();
   /// The message at `sequence` of `source`'s stream, or nothing where it holds none.
   [[nodiscard]] std::optional<Received> get(const std::string& source, std::uint64_t sequence);
 

@@ -196,7 +196,8 @@ RunFunction setupClothServer(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--takes", o.takes,
                  "Stop after simulating N takes (default: serve take after take; a take its stream holds whole "
-                 "already is not simulated again and does not count)")->check(CLI::PositiveNumber);
+                 "already is not simulated again and does not count)")
+      ->check(CLI::PositiveNumber);
   o.studio.add(app, "pose frames");
   app.footer(
       "Exit codes: 0 done, 2 bad input, 3 a garment went unstable (the take's End says where), 4 no NATS server "

@@ -106,7 +106,7 @@ RunFunction setupAnimServer(CLI::App& app) {
 }
 
 const bool registered_cmd_anim_server = registerCommand(
-    {"anim-server", "Studio: play an avatar's motion into a pose stream on a NATS JetStream server", "", 60,
+    {"anim-server", "Studio: play an avatar's motion into a pose stream on a NATS JetStream server", "", 70,
      &setupAnimServer});
 
 }  // namespace

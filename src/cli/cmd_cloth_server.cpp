@@ -207,7 +207,7 @@ RunFunction setupClothServer(CLI::App& app) {
 }
 
 const bool registered_cmd_cloth_server = registerCommand(
-    {"cloth-server", "Studio: simulate the garments on a pose stream's avatar and publish them", "", 61,
+    {"cloth-server", "Studio: simulate the garments on a pose stream's avatar and publish them", "", 71,
      &setupClothServer});
 
 }  // namespace

@@ -173,7 +173,7 @@ RunFunction setupPlayer(CLI::App& app) {
 }
 
 const bool registered_cmd_player = registerCommand(
-    {"player", "Studio: collate a take's cloth and poses by time code; record it or show it live", "", 62,
+    {"player", "Studio: collate a take's cloth and poses by time code; record it or show it live", "", 72,
      &setupPlayer});
 
 }  // namespace

@@ -185,6 +185,11 @@ void ClothSolver::restartFrame(long frame) {
   for (Collider* c : colliders_) c->restartFrame(state_, t0);
 }
 
+void ClothSolver::setWind(const Vec3& wind_m_s) {
+  if (!wind_m_s.allFinite()) throw Error("the wind must be finite", ExitCode::Internal);
+  settings_.wind_m_s = wind_m_s;
+}
+
 bool ClothSolver::runFrame(long frame, int refinement) {
   const int n = settings_.substepsPerFrame * refinement;
   // The same expression as StepSettings::substep_s: unrefined frames keep their bits.

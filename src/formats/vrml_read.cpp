@@ -36,7 +36,10 @@ const ScanOptions& scanOptions() {
   static const ScanOptions options = [] {
     ScanOptions o;
     o.knownProtos = scan(kPreludeText, "drape-nodes.wrl").declared;
-    o.trackedTypes = {"ClothSet", "ClothMaterial", "Simulation", "Avatar"};
+    o.trackedTypes = {"ClothSet", "ClothMaterial", "Simulation", "Avatar",
+                      // EGML's (docs/EVENTS.md): its errors name the line of the event too.
+                      "EventGraph", "Sequence", "Parallel", "Loop", "Parameters", "Condition", "StateMachine",
+                      "State", "Wait", "Play", "Wind"};
     return o;
   }();
   return options;

@@ -161,7 +161,9 @@ TEST(VrmlRead, PreludeIsTheShippedFile) {
   std::vector<std::string> names;
   for (const ProtoInterface& p : r.declared) names.push_back(p.name);
   EXPECT_EQ(names, (std::vector<std::string>{"ClothSet", "ClothMaterial", "Simulation", "Avatar", "Humanoid", "Joint",
-                                             "Segment", "Site", "Displacer"}));
+                                             "Segment", "Site", "Displacer", "EventGraph", "Sequence", "Parallel",
+                                             "Loop", "Parameters", "Condition", "StateMachine", "State", "Wait",
+                                             "Play", "Wind"}));
 }
 
 TEST(VrmlRead, ExternProtoToThePreludeLoads) {

@@ -133,6 +133,9 @@ class ClothSolver {
 
   [[nodiscard]] const ClothModel& model() const { return *model_; }
   [[nodiscard]] const StepSettings& settings() const { return settings_; }
+  /// The wind from the next substep on (a scripted event graph changes it from frame to
+  /// frame, docs/EVENTS.md); throws drape::Error when it is not finite.
+  void setWind(const Vec3& wind_m_s);
   [[nodiscard]] const ClothState& state() const { return state_; }
   /// Mutable state for set-up (initial velocities, tests). Not during a step.
   [[nodiscard]] ClothState& mutableState() { return state_; }

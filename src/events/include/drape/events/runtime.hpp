@@ -1,0 +1,160 @@
+#pragma once
+// Running EGML event graphs (docs/EVENTS.md): a scheduler that advances every running event
+// by one animation tick at a time and composes what the Plays say into the character's pose.
+//
+// Each event, once started, runs as a thread of its own (a Running) with the parameters its
+// path through the graph has gathered: the speed (multiplied down the graph), the character,
+// the named parameters. Control events start, advance and stop their children; leaves act
+// on the character (Play) or the environment (Wind). A graph started while others run (one
+// injected into a live anim-server) starts at once, and its Plays blend from whatever the
+// character is doing. Events sent from outside reach the running state machines at the next
+// tick.
+//
+// The pose: every Play started on the character is a layer over the ones before it, in the
+// order they started, weighted from 0 to 1 over its blend time; a Play that ends leaves its
+// last pose as a layer until a later one covers it, so the character holds where a motion
+// stopped. A joint's world transforms are blended as the micro-interpolation does (SLERP of
+// the rotation, linear translation); a Play anchored (the default) has its motion's path
+// turned and moved, about the vertical, to go on from where the character stands.
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "drape/core/math.hpp"
+#include "drape/events/graph.hpp"
+#include "drape/motion/animation.hpp"
+#include "drape/scene/avatar.hpp"
+
+namespace drape::events {
+
+/// The motions graphs play, each loaded once onto the avatar (retargeted as drape run
+/// --motion retargets, at the run's frame rate).
+class Motions {
+ public:
+  /// Loads what `graph` plays that is not loaded yet. `options` gives the rate and the
+  /// shipped joint maps; each Play's animation and joint map come from the Play.
+  void load(const Graph& graph, const scene::Avatar& avatar, const motion::MotionOptions& options);
+  /// The motion a Play plays (loaded before).
+  [[nodiscard]] const motion::AvatarAnimation& of(const Event& play) const;
+
+ private:
+  std::map<std::tuple<std::string, std::string, std::string>, std::unique_ptr<motion::AvatarAnimation>> loaded_;
+};
+
+/// What one tick gives.
+struct Tick {
+  std::vector<RigidTransform> joints;  ///< the character's joints in the world
+  std::optional<Vec3> wind;            ///< the wind a Wind event set (none: the scene's holds)
+};
+
+class Running;
+
+class Scheduler {
+ public:
+  /// One character, `avatar`, which Plays name by any of `names` (or not at all). The ticks
+  /// are 1 / rate apart; `parameters` are set for every graph (a Parameters event below
+  /// overrides them).
+  Scheduler(const scene::Avatar& avatar, std::vector<std::string> names, double rate,
+            std::vector<std::pair<std::string, std::string>> parameters = {});
+  ~Scheduler();
+  Scheduler(const Scheduler&) = delete;
+  Scheduler& operator=(const Scheduler&) = delete;
+
+  /// Starts `graph` at the coming tick; `motions` (which must hold its motions, and outlive
+  /// it) gives what its Plays play. Throws drape::Error when a Play names another character.
+  void start(const Graph& graph, const Motions& motions);
+  /// An event for the running state machines, acted on at the next tick.
+  void send(const std::string& event);
+  /// The next tick: the first at time 0, each next 1 / rate later. Returns whether any graph
+  /// still runs after it.
+  bool tick(Tick& out);
+
+  [[nodiscard]] long ticks() const { return ticks_; }
+  [[nodiscard]] double rate() const { return rate_; }
+  [[nodiscard]] bool running() const { return !graphs_.empty(); }
+
+  // For the running events.
+  struct Context {
+    std::string character;
+    std::map<std::string, std::string> parameters;
+    const Motions* motions = nullptr;
+  };
+  [[nodiscard]] std::unique_ptr<Running> launch(const Event& e, const Context& context);
+  /// A new pose layer on top (weight 0 to 1); with `root`, its poses are anchored: turned
+  /// and moved about the vertical so that `root` lands where the layers below it stand.
+  /// Returns its id.
+  std::uint64_t addLayer(std::vector<RigidTransform> pose, double weight, std::optional<RigidTransform> root);
+  /// Updates layer `id`'s pose and weight, if it is not covered yet.
+  void setLayer(std::uint64_t id, std::span<const RigidTransform> pose, double weight);
+  std::uint64_t pushWind(const Vec3& velocity);
+  void popWind(std::uint64_t id);
+  void setBaseWind(const Vec3& velocity) { baseWind_ = velocity; }
+
+ private:
+  struct Layer {
+    std::uint64_t id = 0;
+    std::vector<RigidTransform> pose;     ///< as the motion has it
+    double weight = 0.0;
+    std::optional<RigidTransform> root;   ///< to be anchored: the motion's root at its start
+    std::optional<RigidTransform> anchor; ///< found when first composed
+  };
+  void compose();
+  void checkCharacters(const Event& e, const std::string& inherited) const;
+
+  const scene::Avatar& avatar_;
+  std::vector<std::string> names_;
+  double rate_;
+  std::map<std::string, std::string> parameters_;
+  std::vector<std::unique_ptr<Running>> graphs_;
+  std::vector<std::unique_ptr<Running>> starting_;  ///< started since the last tick
+  std::vector<std::string> pending_;                ///< events sent since the last tick
+  std::vector<Layer> layers_;
+  std::vector<RigidTransform> composite_;
+  std::vector<std::pair<std::uint64_t, Vec3>> winds_;
+  std::optional<Vec3> baseWind_;
+  std::uint64_t nextId_ = 1;
+  long ticks_ = 0;
+};
+
+/// A running event: advanced by its parent, stopped by it before its end when cut.
+class Running {
+ public:
+  virtual ~Running() = default;
+  /// Runs on for `dt` seconds of its own time. Returns the part of dt left over when it
+  /// ended within it (>= 0), or -1 while it runs on.
+  virtual double advance(double dt) = 0;
+  /// Ends it now (its parent's time is up, or its state was left).
+  virtual void stop() {}
+  /// An event sent from outside, for the state machines in it.
+  virtual void send(const std::string&) {}
+};
+
+/// A graph rendered frame by frame, as drape run plays it.
+struct Rendered {
+  motion::AvatarAnimation animation;
+  std::vector<std::optional<Vec3>> wind;  ///< per frame
+  long frames = 0;
+  bool ended = false;  ///< the graph ended (else it was cut at the most frames asked for)
+};
+
+/// An event sent at a time of the script: `drape run --send NAME@SECONDS`.
+struct TimedEvent {
+  std::string name;
+  double at_s = 0.0;
+};
+
+/// Runs `graph` from its start until it ends, or for `maxFrames` frames (> 0) at most, with
+/// `events` sent at their times. Throws drape::Error for a graph that never ends when
+/// maxFrames is 0.
+[[nodiscard]] Rendered render(const Graph& graph, const Motions& motions, const scene::Avatar& avatar,
+                              const std::vector<std::string>& names, double rate, long maxFrames,
+                              const std::vector<TimedEvent>& events,
+                              const std::vector<std::pair<std::string, std::string>>& parameters);
+
+}  // namespace drape::events

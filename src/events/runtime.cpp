@@ -1,0 +1,486 @@
+#include "drape/events/runtime.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "drape/core/error.hpp"
+#include "drape/core/log.hpp"
+#include "drape/motion/interpolate.hpp"
+
+namespace drape::events {
+namespace {
+
+constexpr double kRunning = -1.0;
+/// Times this close are one: durations summed tick by tick come out a rounding short.
+constexpr double kTimeEpsilon = 1e-9;
+/// Events that end without taking time, in one advance, before a loop of them is an error.
+constexpr int kMostZeroTimeRounds = 10000;
+
+/// The yaw of a rotation: its forward axis (+z) turned about the vertical.
+double yawOf(const Quat& q) {
+  const Vec3 forward = q * Vec3::UnitZ();
+  return std::atan2(forward.x(), forward.z());
+}
+
+/// The transform about the vertical that carries `from`'s place on the floor and heading onto `to`'s.
+RigidTransform anchorOnto(const RigidTransform& to, const RigidTransform& from) {
+  const Quat turn(Eigen::AngleAxisd(yawOf(to.rotation) - yawOf(from.rotation), Vec3::UnitY()));
+  const Vec3 fromFloor(from.translation.x(), 0.0, from.translation.z());
+  const Vec3 toFloor(to.translation.x(), 0.0, to.translation.z());
+  return {turn, toFloor - turn * fromFloor};
+}
+
+// --- control events ------------------------------------------------------------------
+
+/// What Sequence, Parallel and Loop share: their own speed and cut.
+class Control : public Running {
+ public:
+  Control(Scheduler& s, const Event& e, Scheduler::Context context) : s_(s), e_(e), context_(std::move(context)) {
+    if (!e.character.empty()) context_.character = e.character;
+  }
+  double advance(double dt) final {
+    // Its duration counts in its parent's time; its children run at its speed.
+    double take = dt;
+    bool cut = false;
+    if (e_.duration_s >= 0.0 && elapsed_ + dt >= e_.duration_s - kTimeEpsilon) {
+      take = std::max(0.0, e_.duration_s - elapsed_);
+      cut = true;
+    }
+    elapsed_ += take;
+    // What is left over is never below 0: a rounding below would read as "runs on".
+    const double left = run(take * e_.speed);
+    if (left >= 0.0) return std::max(0.0, left / e_.speed + (dt - take));
+    if (!cut) return kRunning;
+    stop();
+    return std::max(0.0, dt - take);
+  }
+
+ protected:
+  /// Runs the children for dt of this event's own time: the left-over, or kRunning.
+  virtual double run(double dt) = 0;
+  Scheduler& s_;
+  const Event& e_;
+  Scheduler::Context context_;
+  double elapsed_ = 0.0;
+};
+
+class Sequence : public Control {
+ public:
+  Sequence(Scheduler& s, const Event& e, const Scheduler::Context& c, int rounds) : Control(s, e, c), rounds_(rounds) {
+    (void)startNext();
+  }
+  void stop() override {
+    if (current_) current_->stop();
+    current_.reset();
+  }
+  void send(const std::string& event) override {
+    if (current_) current_->send(event);
+  }
+
+ private:
+  /// Starts the next child (the first again after the last, while rounds are left); false
+  /// when none is left.
+  bool startNext() {
+    if (e_.children.empty()) return false;
+    if (index_ == e_.children.size()) {
+      index_ = 0;
+      if (rounds_ > 0 && ++round_ >= rounds_) return false;
+    }
+    current_ = s_.launch(e_.children[index_++], context_);
+    return true;
+  }
+  double run(double dt) override {
+    int idle = 0;  // children in a row that ended without taking time
+    while (current_) {
+      const double left = current_->advance(dt);
+      if (left < 0.0) return kRunning;
+      idle = left >= dt ? idle + 1 : 0;
+      if (idle > kMostZeroTimeRounds)
+        throw Error::at(e_.where, fmt::format("{}: repeats events that take no time, for ever", kindName(e_.kind)));
+      current_.reset();
+      dt = left;
+      if (!startNext()) return dt;
+    }
+    return dt;
+  }
+
+  int rounds_;  ///< 1 for a Sequence; a Loop's count (0: for ever)
+  std::size_t index_ = 0;
+  int round_ = 0;
+  std::unique_ptr<Running> current_;
+};
+
+class Parallel : public Control {
+ public:
+  Parallel(Scheduler& s, const Event& e, const Scheduler::Context& c) : Control(s, e, c) {
+    for (const Event& child : e.children) children_.push_back(s_.launch(child, context_));
+  }
+  void stop() override {
+    for (auto& c : children_)
+      if (c) c->stop();
+    children_.clear();
+  }
+  void send(const std::string& event) override {
+    for (auto& c : children_)
+      if (c) c->send(event);
+  }
+
+ private:
+  double run(double dt) override {
+    double left = dt;
+    bool any = false;
+    for (auto& c : children_) {
+      if (!c) continue;
+      const double l = c->advance(dt);
+      if (l < 0.0) {
+        any = true;
+        continue;
+      }
+      left = std::min(left, l);
+      c.reset();
+    }
+    if (any) return kRunning;
+    children_.clear();
+    return left;
+  }
+  std::vector<std::unique_ptr<Running>> children_;
+};
+
+/// A Parameters event: its children side by side, with its parameters set.
+Scheduler::Context withParameters(Scheduler::Context c, const Event& e) {
+  for (const auto& [name, value] : e.parameters) c.parameters[name] = value;
+  return c;
+}
+
+class StateMachine : public Running {
+ public:
+  StateMachine(Scheduler& s, const Event& e, Scheduler::Context c) : s_(s), e_(e), context_(std::move(c)) {
+    enter(e.initial);
+  }
+  double advance(double dt) override {
+    for (int round = 0;; ++round) {
+      if (round > kMostZeroTimeRounds)
+        throw Error::at(e_.where, "StateMachine: goes from state to state without taking time, for ever");
+      const double left = running_->advance(dt);
+      if (left < 0.0) return kRunning;
+      const long next = e_.children[current_].next;
+      if (next < 0) return left;
+      enter(static_cast<std::size_t>(next));
+      dt = left;
+    }
+  }
+  void stop() override {
+    if (running_) running_->stop();
+  }
+  /// At once: the state it names starts now (the scheduler sends events at a tick).
+  void send(const std::string& event) override {
+    const Event& state = e_.children[current_];
+    const auto it = std::find(state.on.begin(), state.on.end(), event);
+    if (it == state.on.end()) {
+      if (running_) running_->send(event);  // for machines inside the state
+      return;
+    }
+    const std::size_t to = state.to[static_cast<std::size_t>(it - state.on.begin())];
+    spdlog::debug("{}: '{}' moves it from state '{}' to '{}'", e_.where.str(), event, state.name, e_.children[to].name);
+    if (running_) running_->stop();
+    enter(to);
+  }
+
+ private:
+  void enter(std::size_t state) {
+    current_ = state;
+    running_ = s_.launch(e_.children[state], context_);
+  }
+  Scheduler& s_;
+  const Event& e_;
+  Scheduler::Context context_;
+  std::size_t current_ = 0;
+  std::unique_ptr<Running> running_;
+};
+
+class Condition : public Running {
+ public:
+  Condition(Scheduler& s, const Event& e, const Scheduler::Context& c) {
+    const auto it = c.parameters.find(e.parameter);
+    const bool holds =
+        it != c.parameters.end() && std::find(e.equals.begin(), e.equals.end(), it->second) != e.equals.end();
+    spdlog::debug("{}: {} is '{}': {}", e.where.str(), e.parameter, it == c.parameters.end() ? "(not set)" : it->second,
+                  holds ? "then" : "otherwise");
+    branch_ = s.launch(e.children[holds ? 0 : 1], c);
+  }
+  double advance(double dt) override { return branch_->advance(dt); }
+  void stop() override { branch_->stop(); }
+  void send(const std::string& event) override { branch_->send(event); }
+
+ private:
+  std::unique_ptr<Running> branch_;
+};
+
+// --- leaves ------------------------------------------------------------------------
+
+class Wait : public Running {
+ public:
+  explicit Wait(const Event& e) : duration_(e.duration_s) {}
+  double advance(double dt) override {
+    elapsed_ += dt;
+    return elapsed_ >= duration_ - kTimeEpsilon ? std::max(0.0, elapsed_ - duration_) : kRunning;
+  }
+
+ private:
+  double duration_;
+  double elapsed_ = 0.0;
+};
+
+class Wind : public Running {
+ public:
+  Wind(Scheduler& s, const Event& e) : s_(s), duration_(e.duration_s) {
+    if (duration_ < 0.0) {
+      s_.setBaseWind(e.velocity);  // from now on, whatever ends
+    } else {
+      id_ = s_.pushWind(e.velocity);
+    }
+  }
+  ~Wind() override { stop(); }
+  double advance(double dt) override {
+    if (duration_ < 0.0) return dt;
+    elapsed_ += dt;
+    if (elapsed_ < duration_ - kTimeEpsilon) return kRunning;
+    stop();
+    return std::max(0.0, elapsed_ - duration_);
+  }
+  void stop() override {
+    if (id_ != 0) s_.popWind(id_);
+    id_ = 0;
+  }
+
+ private:
+  Scheduler& s_;
+  double duration_;
+  double elapsed_ = 0.0;
+  std::uint64_t id_ = 0;
+};
+
+class Play : public Running {
+ public:
+  Play(Scheduler& s, const Event& e, const Scheduler::Context& c)
+      : s_(s), e_(e), motion_(c.motions->of(e)), pose_(motion_.jointCount()) {
+    end_s_ = e.to_s < 0.0 ? motion_.duration() : std::min(e.to_s, motion_.duration());
+    if (e.from_s > end_s_)
+      throw Error::at(e.where, fmt::format("Play: from {:g} s is past the end of {} ({:g} s)", e.from_s, e.motion, end_s_));
+    sample(e.from_s);
+    // Anchored, its path goes on from where the character stands when the layer is first
+    // composed: the motion's root at `from` is carried there.
+    std::optional<RigidTransform> root;
+    if (e.anchor) root = pose_.front();
+    id_ = s_.addLayer(pose_, weight(), root);
+  }
+  double advance(double dt) override {
+    if (id_ == 0) return dt;
+    elapsed_ += dt;
+    const double at = e_.from_s + elapsed_ * e_.speed;
+    const bool over = at >= end_s_ - kTimeEpsilon;
+    sample(over ? end_s_ : at);
+    s_.setLayer(id_, pose_, weight());
+    if (!over) return kRunning;
+    id_ = 0;  // its last pose stays, as a layer, until a later one covers it
+    return std::max(0.0, at - end_s_) / e_.speed;
+  }
+  void stop() override { id_ = 0; }
+
+ private:
+  [[nodiscard]] double weight() const {
+    return e_.blend_s > 0.0 ? std::min(1.0, (elapsed_ + kTimeEpsilon) / e_.blend_s) : 1.0;
+  }
+  /// The motion at its time t (s). A time on a frame (give or take the rounding of summed
+  /// ticks) is that frame, to the bit.
+  void sample(double t) {
+    double frames = t * motion_.rate();
+    if (std::abs(frames - std::round(frames)) < 1e-6) frames = std::round(frames);
+    const auto f = static_cast<std::size_t>(std::floor(frames));
+    motion_.evaluate(f, frames - static_cast<double>(f), pose_);
+  }
+  Scheduler& s_;
+  const Event& e_;
+  const motion::AvatarAnimation& motion_;
+  std::vector<RigidTransform> pose_;
+  double end_s_ = 0.0, elapsed_ = 0.0;
+  std::uint64_t id_ = 0;
+};
+
+}  // namespace
+
+void Motions::load(const Graph& graph, const scene::Avatar& avatar, const motion::MotionOptions& options) {
+  for (const auto& key : graph.motions()) {
+    if (loaded_.contains(key)) continue;
+    motion::MotionOptions o = options;
+    o.jointMapPath = std::get<2>(key);
+    o.animation = std::get<1>(key);
+    o.sampled = nullptr;
+    motion::ClipLoadReport report;
+    loaded_[key] = std::make_unique<motion::AvatarAnimation>(motion::loadAnimation(avatar, std::get<0>(key), o, &report));
+    spdlog::info("{}: {} frames at {:g} Hz, played by the event graph{}", std::get<0>(key), report.sourceFrames,
+                 report.sourceRate, std::get<1>(key).empty() ? "" : fmt::format(" ('{}')", std::get<1>(key)));
+  }
+}
+
+const motion::AvatarAnimation& Motions::of(const Event& play) const {
+  const auto it = loaded_.find(std::make_tuple(play.motion, play.animation, play.jointMap));
+  if (it == loaded_.end()) throw Error(play.where.str() + ": Play: its motion was not loaded", ExitCode::Internal);
+  return *it->second;
+}
+
+Scheduler::Scheduler(const scene::Avatar& avatar, std::vector<std::string> names, double rate,
+                     std::vector<std::pair<std::string, std::string>> parameters)
+    : avatar_(avatar), names_(std::move(names)), rate_(rate) {
+  if (!(rate > 0.0)) throw Error(fmt::format("the event graph's rate {} must be > 0", rate), ExitCode::Internal);
+  for (auto& [name, value] : parameters) parameters_[name] = value;
+  if (std::find(names_.begin(), names_.end(), avatar.name) == names_.end()) names_.push_back(avatar.name);
+  for (const scene::Joint& j : avatar.joints) composite_.push_back(j.restWorld());
+}
+
+Scheduler::~Scheduler() {
+  // Events first: their destructors hand back what they hold (a wind).
+  starting_.clear();
+  graphs_.clear();
+}
+
+void Scheduler::checkCharacters(const Event& e, const std::string& inherited) const {
+  const std::string character = e.character.empty() ? inherited : e.character;
+  if (e.kind == Kind::Play && !character.empty() &&
+      std::find(names_.begin(), names_.end(), character) == names_.end())
+    throw Error::at(e.where, fmt::format("Play: character '{}' is not in the scene (its character answers to: {})",
+                                         character, fmt::join(names_, ", ")));
+  for (const Event& c : e.children) checkCharacters(c, character);
+}
+
+void Scheduler::start(const Graph& graph, const Motions& motions) {
+  checkCharacters(graph.root, "");
+  Context c;
+  c.parameters = parameters_;
+  c.motions = &motions;
+  c.character = graph.root.character;
+  starting_.push_back(launch(graph.root, c));
+}
+
+void Scheduler::send(const std::string& event) { pending_.push_back(event); }
+
+std::unique_ptr<Running> Scheduler::launch(const Event& e, const Context& context) {
+  switch (e.kind) {
+    case Kind::Sequence: return std::make_unique<Sequence>(*this, e, context, 1);
+    case Kind::Loop: return std::make_unique<Sequence>(*this, e, context, e.count);
+    case Kind::Parallel: return std::make_unique<Parallel>(*this, e, context);
+    case Kind::Parameters: return std::make_unique<Parallel>(*this, e, withParameters(context, e));
+    case Kind::Condition: return std::make_unique<Condition>(*this, e, context);
+    case Kind::StateMachine: return std::make_unique<StateMachine>(*this, e, context);
+    case Kind::Wait: return std::make_unique<Wait>(e);
+    case Kind::Play: return std::make_unique<Play>(*this, e, context);
+    case Kind::Wind: return std::make_unique<Wind>(*this, e);
+  }
+  throw Error(e.where.str() + ": an event of no known kind", ExitCode::Internal);
+}
+
+std::uint64_t Scheduler::addLayer(std::vector<RigidTransform> pose, double weight, std::optional<RigidTransform> root) {
+  layers_.push_back({nextId_, std::move(pose), weight, root, std::nullopt});
+  return nextId_++;
+}
+
+void Scheduler::setLayer(std::uint64_t id, std::span<const RigidTransform> pose, double weight) {
+  for (Layer& l : layers_)
+    if (l.id == id) {
+      std::copy(pose.begin(), pose.end(), l.pose.begin());
+      l.weight = weight;
+    }
+}
+
+std::uint64_t Scheduler::pushWind(const Vec3& velocity) {
+  winds_.emplace_back(nextId_, velocity);
+  return nextId_++;
+}
+
+void Scheduler::popWind(std::uint64_t id) {
+  std::erase_if(winds_, [id](const auto& w) { return w.first == id; });
+}
+
+void Scheduler::compose() {
+  // From the rest pose, each layer over what is below it; an anchored layer is carried, the
+  // first time, onto where what is below it stands.
+  for (std::size_t j = 0; j < composite_.size(); ++j) composite_[j] = avatar_.joints[j].restWorld();
+  for (Layer& l : layers_) {
+    if (l.root && !l.anchor) l.anchor = anchorOnto(composite_.front(), *l.root);
+    for (std::size_t j = 0; j < composite_.size(); ++j) {
+      const RigidTransform joint = l.anchor ? *l.anchor * l.pose[j] : l.pose[j];
+      composite_[j] = l.weight >= 1.0 ? joint : motion::interpolate(composite_[j], joint, l.weight);
+    }
+  }
+  // Layers a later one covers whole are gone: nothing of them shows any more.
+  for (std::size_t k = layers_.size(); k-- > 1;)
+    if (layers_[k].weight >= 1.0) {
+      layers_.erase(layers_.begin(), layers_.begin() + static_cast<long>(k));
+      break;
+    }
+}
+
+bool Scheduler::tick(Tick& out) {
+  if (ticks_ > 0) {
+    const double dt = 1.0 / rate_;
+    for (auto& g : graphs_)
+      if (g->advance(dt) >= 0.0) g.reset();
+    std::erase(graphs_, nullptr);
+  }
+  // Events act at the tick: a state entered now starts at this tick's time, and what ends
+  // at once because of it (a state with nothing in it) ends now too.
+  if (!pending_.empty()) {
+    for (const std::string& event : pending_)
+      for (auto& g : graphs_) g->send(event);
+    pending_.clear();
+    for (auto& g : graphs_)
+      if (g->advance(0.0) >= 0.0) g.reset();
+    std::erase(graphs_, nullptr);
+  }
+  // Graphs started since the last tick start here, at their time 0.
+  for (auto& g : starting_)
+    if (g->advance(0.0) < 0.0) graphs_.push_back(std::move(g));
+  starting_.clear();
+  compose();
+  out.joints = composite_;
+  out.wind = !winds_.empty() ? std::optional<Vec3>(winds_.back().second) : baseWind_;
+  ++ticks_;
+  return !graphs_.empty();
+}
+
+Rendered render(const Graph& graph, const Motions& motions, const scene::Avatar& avatar,
+                const std::vector<std::string>& names, double rate, long maxFrames,
+                const std::vector<TimedEvent>& events, const std::vector<std::pair<std::string, std::string>>& parameters) {
+  Scheduler scheduler(avatar, names, rate, parameters);
+  scheduler.start(graph, motions);
+  std::vector<int> driving(avatar.joints.size(), -1);
+  Rendered r{motion::AvatarAnimation::streamed(avatar.joints.size(), rate, TimeCode{0, rate}, driving), {}, 0, false};
+  std::vector<TimedEvent> toSend = events;
+  std::sort(toSend.begin(), toSend.end(), [](const TimedEvent& a, const TimedEvent& b) { return a.at_s < b.at_s; });
+  std::size_t sent = 0;
+  // An endless graph needs a limit; one about an hour long is a mistake more likely than a take.
+  const long most = maxFrames > 0 ? maxFrames : static_cast<long>(3600.0 * rate);
+  Tick tick;
+  for (long f = 0; f < most; ++f) {
+    // An event at time t acts at the first tick at or after it.
+    while (sent < toSend.size() && toSend[sent].at_s <= static_cast<double>(f) / rate) scheduler.send(toSend[sent++].name);
+    const bool more = scheduler.tick(tick);
+    r.animation.appendFrame(tick.joints);
+    r.wind.push_back(tick.wind);
+    ++r.frames;
+    if (!more) {
+      r.ended = true;
+      return r;
+    }
+  }
+  if (maxFrames <= 0)
+    throw Error(fmt::format("{}: the event graph runs on past an hour (a Loop for ever, or a state machine that never "
+                            "ends): give the frames to render",
+                            graph.file.empty() ? "the graph" : graph.file));
+  return r;
+}
+
+}  // namespace drape::events

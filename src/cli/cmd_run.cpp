@@ -37,6 +37,8 @@ struct RunOptions {
   bool preview = false, countEverySubstep = false, exactSliding = false, freePinches = false, noStitches = false;
   double stitchGaps_m = 0.0;  ///< --stitch-gaps
   std::vector<std::string> faceSamplesWith, keepApart, cutAtJoints;
+  std::string events;                       ///< --events: an EGML event graph instead of --motion
+  std::vector<std::string> sets, sends;     ///< --set NAME=VALUE, --send EVENT@SECONDS
   std::string garment, units = "m", pinVertices, pinMask, out, substeps = "33", integrator = "symplectic-euler";
   std::string strainLimit = "auto";
   std::string wind, gravity;
@@ -254,7 +256,11 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     applyOffsets(o, setup);
     applyCollisionOptions(app, o, setup);
   }
-  const MotionChoice motion = sceneMotion(setup, o.scene, o.motion, o.animation);
+  if (!o.events.empty() && (!o.motion.empty() || !o.animation.empty()))
+    throw Error("--events plays an event graph's motions: give it or --motion, not both");
+  if (o.events.empty() && (!o.sets.empty() || !o.sends.empty()))
+    throw Error(fmt::format("{}: it is for an event graph: give --events FILE.egml", o.sets.empty() ? "--send" : "--set"));
+  const MotionChoice motion = o.events.empty() ? sceneMotion(setup, o.scene, o.motion, o.animation) : MotionChoice{};
   if (!motion.path.empty() && !avatar)
     throw Error("--motion: there is no avatar to move (the scene has none; without a scene, give --avatar FILE)");
   for (const std::string& sphere : o.spheres) {
@@ -265,8 +271,9 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     setup.spheres.push_back({c, r.z()});
   }
 
-  if (app.count("--keep-apart") && !keepApartParts(o.keepApart).empty() && motion.path.empty())
-    throw Error("--keep-apart corrects a motion: give --motion FILE too");
+  if (app.count("--keep-apart") && !keepApartParts(o.keepApart).empty() && motion.path.empty() && o.events.empty())
+    throw Error("--keep-apart corrects a motion: give --motion FILE (or --events FILE) too");
+  if (!o.events.empty() && !avatar) throw Error("--events: there is no avatar for the event graph to move");
   if (setup.character) {
     CharacterSetup& ch = *setup.character;
     if (o.voxel_m > 0) ch.voxel_m = o.voxel_m;
@@ -278,6 +285,13 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     if (app.count("--keep-apart")) setKeepApart(ch, o.keepApart);
     if (!motion.path.empty())
       addMotion(setup, motion.path, o.motionScale, o.jointMap, motion.animation, motion.sampled.get());
+    if (!o.events.empty()) {
+      // With --frames, as many motion frames as those frames read (the lead-in before them).
+      const long motionFrames =
+          app.count("--frames") ? std::max(2L, o.frames - static_cast<long>(std::floor(ch.leadIn_s * setup.settings.frameRate_hz)) + 2)
+                                : 0;
+      addEvents(setup, o.events, o.sets, o.sends, motionFrames);
+    }
   }
 
   if (app.count("--substeps") || o.scene.empty()) {
@@ -322,6 +336,13 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--garment", o->garment, "Garment mesh (OBJ), instead of a scene");
   app.add_option("--avatar", o->avatar, "Avatar to wear --garment (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel)");
   app.add_option("--motion", o->motion, std::string("Motion for the avatar ") + kMotionHelp);
+  app.add_option("--events", o->events,
+                 "Instead of --motion: an EGML event graph (.egml) that plays motions on the avatar, in sequence, "
+                 "blended, looped, by state, and sets the wind (docs/EVENTS.md)");
+  app.add_option("--set", o->sets, "With --events: a parameter of the graph, NAME=VALUE (its Conditions test them); repeatable");
+  app.add_option("--send", o->sends,
+                 "With --events: an event for the graph's state machines at a time of the script, EVENT@SECONDS; "
+                 "repeatable");
   app.add_option("--joint-map", o->jointMap, "JSON map from the motion's joint names to the avatar's");
   app.add_option("--animation", o->animation, kAnimationHelp);
   app.add_option("--motion-scale", o->motionScale, "Metres per motion-file unit (default: guessed from the skeleton)");

@@ -20,6 +20,7 @@
 #include "drape/core/error.hpp"
 #include "drape/core/log.hpp"
 #include "drape/core/progress.hpp"
+#include "drape/events/runtime.hpp"
 #include "drape/formats/hanim_motion.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/render/frame.hpp"
@@ -199,6 +200,10 @@ RunSetup runSetupFromScene(const std::string& scenePath, const std::optional<std
   if (avatar) {
     setup.character = CharacterSetup{avatar, nullptr, sc.simulation.voxelSize};
     setup.character->keepApart = sc.simulation.keepApart;
+    for (const scene::ExternalAvatar& a : sc.externalAvatars)
+      if (!a.name.empty()) setup.character->names.push_back(a.name);
+    for (const scene::Avatar& a : sc.avatars)
+      if (!a.name.empty()) setup.character->names.push_back(a.name);
     if (const std::string bad = unknownKeepApartPart(*setup.character); !bad.empty())
       throw Error::at(sc.simulation.source, "Simulation keepApart: " + bad);
   }
@@ -229,6 +234,65 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
   // Frames the motion file holds but drape does not play: say so, the timing shifts.
   if (report.referenceTPoseSkipped) spdlog::info("{}: {}", motionPath, report.referenceTPose());
   if (report.restUnfoldFramesSkipped > 0) spdlog::info("{}: {}", motionPath, report.restUnfoldSkipped());
+}
+
+std::vector<std::pair<std::string, std::string>> parameterOptions(const std::vector<std::string>& sets) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const std::string& set : sets) {
+    const auto eq = set.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw Error(fmt::format("--set {}: expected NAME=VALUE (a parameter of the event graph)", set));
+    out.emplace_back(set.substr(0, eq), set.substr(eq + 1));
+  }
+  return out;
+}
+
+namespace {
+
+/// --send NAME@SECONDS options as timed events; throws naming --send.
+std::vector<events::TimedEvent> timedEvents(const std::vector<std::string>& sends) {
+  std::vector<events::TimedEvent> out;
+  for (const std::string& send : sends) {
+    const auto at = send.rfind('@');
+    double seconds = -1.0;
+    if (at != std::string::npos && at > 0) {
+      try {
+        std::size_t used = 0;
+        seconds = std::stod(send.substr(at + 1), &used);
+        if (used != send.size() - at - 1) seconds = -1.0;
+      } catch (const std::exception&) {
+        seconds = -1.0;
+      }
+    }
+    if (!(seconds >= 0.0) || !std::isfinite(seconds))
+      throw Error(fmt::format("--send {}: expected EVENT@SECONDS (an event for the graph's state machines, at a time "
+                              "of the script)",
+                              send));
+    out.push_back({send.substr(0, at), seconds});
+  }
+  return out;
+}
+
+}  // namespace
+
+void addEvents(RunSetup& setup, const std::string& graphPath, const std::vector<std::string>& sets,
+               const std::vector<std::string>& sends, long motionFrames) {
+  if (!setup.character) throw Error("--events: there is no avatar for the event graph to move");
+  const events::Graph graph = events::readGraph(graphPath);
+  const scene::Avatar& avatar = *setup.character->avatar;
+  motion::MotionOptions mo;
+  mo.clip.rate = setup.settings.frameRate_hz;
+  mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
+  auto motions = std::make_shared<events::Motions>();
+  motions->load(graph, avatar, mo);
+  events::Rendered r = events::render(graph, *motions, avatar, setup.character->names, setup.settings.frameRate_hz,
+                                      motionFrames, timedEvents(sends), parameterOptions(sets));
+  spdlog::info("{}: the event graph runs {} frames ({:.2f} s){}", graphPath, r.frames,
+               static_cast<double>(r.frames - 1) / setup.settings.frameRate_hz,
+               r.ended ? "" : ", cut there (it runs on)");
+  setup.character->animation = std::make_shared<const motion::AvatarAnimation>(std::move(r.animation));
+  const bool windy = std::any_of(r.wind.begin(), r.wind.end(), [](const auto& w) { return w.has_value(); });
+  setup.motionWind = windy ? std::make_shared<const MotionWind>(std::move(r.wind)) : nullptr;
 }
 
 namespace {
@@ -545,6 +609,21 @@ int simulateRun(const RunSetup& setup) {
   return simulateInto(setup, sink, nullptr);
 }
 
+namespace {
+
+/// The wind over frame `frame`: what the event graph set at the motion frame at its end
+/// (the scene's during the lead-in and where the graph set none).
+Vec3 windOf(const RunSetup& setup, long frame) {
+  const double rate = setup.settings.frameRate_hz;
+  const double t = static_cast<double>(frame) / rate - (setup.character ? setup.character->leadIn_s : 0.0);
+  if (t < 0.0) return setup.settings.wind_m_s;
+  const MotionWind& wind = *setup.motionWind;
+  const auto f = std::min(wind.size() - 1, static_cast<std::size_t>(std::floor(t * rate + 1e-6)));
+  return wind[f].value_or(setup.settings.wind_m_s);
+}
+
+}  // namespace
+
 int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) {
   validateRunSetup(setup);
   const cloth::StepSettings& settings = setup.settings;
@@ -660,6 +739,10 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
     FramesAhead ahead(kFramesAhead, 0, gate ? -1 : setup.frames, prepare, [&](long frame, FrameTaken& taken) {
       if (gate && !gate(frame)) return false;
       if (frame > 0) {
+        if (setup.motionWind && !setup.motionWind->empty()) {
+          const Vec3 wind = windOf(setup, frame);
+          for (GarmentRun& r : runs) r.solver->setWind(wind);
+        }
         const Clock::time_point start = Clock::now();
         const std::vector<std::uint8_t> stable =
             sim::stepInParallel(runs.size(), frame, [&](std::size_t g) -> cloth::ClothSolver& { return *runs[g].solver; });

@@ -43,7 +43,13 @@ struct CharacterSetup {
   /// The part fields, when built before for these garments (a cloth-server's, once for all
   /// its takes); null: the world builds them.
   std::shared_ptr<const std::vector<sim::PartField>> fields{};
+  /// What the scene calls the character (its Avatar or Humanoid node), besides the avatar's
+  /// own name: an event graph's Plays name it so.
+  std::vector<std::string> names{};
 };
+
+/// Per motion frame, the wind an event graph set (none: the scene's).
+using MotionWind = std::vector<std::optional<Vec3>>;
 
 struct SphereSetup {
   Vec3 centre_m = Vec3::Zero();
@@ -72,6 +78,9 @@ struct RunSetup {
   /// where the scene keeps parts apart), and where it puts the body inside itself is found
   /// at the end.
   bool motionStreamed = false;
+  /// The wind of each motion frame where an event graph sets it (docs/EVENTS.md); null or
+  /// empty: the settings' wind throughout. A cloth-server's grows as its poses come.
+  std::shared_ptr<const MotionWind> motionWind{};
 };
 
 /// Garments, materials, settings and the avatar (as the setup's character, without motion)
@@ -88,6 +97,15 @@ struct RunSetup {
 void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerUnit = 0.0,
                const std::string& jointMap = "", const std::string& animation = "",
                const formats::SkinnedJointMotion* sampled = nullptr);
+
+/// Plays an EGML event graph (docs/EVENTS.md) on the setup's avatar: its motion and the wind
+/// it sets. `sets` are NAME=VALUE parameters, `sends` NAME@SECONDS events; `motionFrames` > 0
+/// renders that many motion frames at most (an endless graph needs it).
+void addEvents(RunSetup& setup, const std::string& graphPath, const std::vector<std::string>& sets,
+               const std::vector<std::string>& sends, long motionFrames);
+
+/// --set NAME=VALUE options as parameters; throws naming --set.
+[[nodiscard]] std::vector<std::pair<std::string, std::string>> parameterOptions(const std::vector<std::string>& sets);
 
 /// --motion's help after "Motion for the avatar ", and --animation's, for run, play and render.
 inline constexpr const char* kMotionHelp =

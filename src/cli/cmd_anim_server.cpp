@@ -2,15 +2,20 @@
 // Plays the scene avatar's motion, retargeted as drape run retargets it, into a pose stream
 // on a NATS JetStream server: one take, frame by frame at the scene's frame rate.
 
+#include <atomic>
 #include <chrono>
+#include <csignal>
+#include <list>
 #include <thread>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "command.hpp"
 #include "drape/core/error.hpp"
 #include "drape/core/log.hpp"
 #include "drape/core/progress.hpp"
+#include "drape/events/runtime.hpp"
 #include "drape/studio/publisher.hpp"
 #include "drape/studio/takes.hpp"
 #include "run_setup.hpp"
@@ -20,10 +25,117 @@ namespace drape::cli {
 namespace {
 
 struct AnimServerOptions {
-  std::string scene, motion, animation, name = "anim", take;
-  bool fast = false;
+  std::string scene, motion, animation, name = "anim", take, events;
+  std::vector<std::string> sets;
+  long frames = 0;
+  bool fast = false, hold = false;
   StudioOptions studio;
 };
+
+/// Set by SIGINT and SIGTERM: a live take ends at the next frame, with its End sent.
+std::atomic<bool> stopAsked{false};
+
+extern "C" void askToStop(int) { stopAsked = true; }
+
+/// What an Inject asks of a live take: a graph started at once, an event sent; the answer.
+studio::InjectReply injected(const studio::Inject& in, long frame, events::Scheduler& scheduler,
+                             events::Motions& motions, std::list<events::Graph>& graphs, const scene::Avatar& avatar,
+                             const motion::MotionOptions& options) {
+  std::vector<std::string> done;
+  try {
+    if (!in.graph.empty()) {
+      events::Graph g = events::parseGraph(in.graph, fmt::format("graph injected at frame {}", frame), in.baseDir);
+      motions.load(g, avatar, options);
+      graphs.push_back(std::move(g));
+      scheduler.start(graphs.back(), motions);
+      done.push_back(fmt::format("started graph{} at frame {}",
+                                 graphs.back().name.empty() ? "" : " '" + graphs.back().name + "'", frame));
+    }
+    if (!in.event.empty()) {
+      scheduler.send(in.event);
+      done.push_back(fmt::format("sent event '{}' at frame {}", in.event, frame));
+    }
+  } catch (const Error& e) {
+    return {false, e.what()};
+  }
+  if (done.empty()) return {false, "the request asks for nothing (give a graph or an event)"};
+  spdlog::info("{}", fmt::join(done, "; "));
+  return {true, fmt::format("{}", fmt::join(done, "; "))};
+}
+
+/// `--events`: plays an event graph live, frame by frame, taking graphs and events injected
+/// while it runs (drape inject).
+int runEventGraph(const AnimServerOptions& o, RunSetup& setup) {
+  const scene::Avatar& avatar = *setup.character->avatar;
+  if (!setup.character->keepApart.empty())
+    spdlog::warn("{}: the scene keeps {} apart, a correction of a whole motion: a live event graph plays without it",
+                 o.scene, fmt::join(setup.character->keepApart, ", "));
+  const double rate = setup.settings.frameRate_hz;
+  motion::MotionOptions mo;
+  mo.clip.rate = rate;
+  mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
+  std::list<events::Graph> graphs;
+  graphs.push_back(events::readGraph(o.events));
+  events::Motions motions;
+  motions.load(graphs.back(), avatar, mo);
+  events::Scheduler scheduler(avatar, setup.character->names, rate, parameterOptions(o.sets));
+  scheduler.start(graphs.back(), motions);
+
+  studio::Bus bus = studio::Bus::connect(o.studio.server, "drape anim-server " + o.name);
+  studio::Publisher publisher(bus, o.name, studio::Precision::Double, o.studio.giveUp());
+  studio::Listener requests = bus.listen(studio::requestSubjectOf(o.name));
+  const std::string take = o.take.empty() ? studio::newTakeId() : o.take;
+  studio::PoseStart start;
+  start.character = avatar.name;
+  for (const scene::Joint& j : avatar.joints) start.joints.push_back(j.name);
+  start.driving.assign(avatar.joints.size(), -1);
+  start.start = TimeCode{0, rate};
+  start.frames = o.frames;  // 0: live, as long as it runs
+  publisher.beginTake(take, start);
+  std::signal(SIGINT, askToStop);
+  std::signal(SIGTERM, askToStop);
+  spdlog::info("take {}: the event graph {} on {} at {:g} Hz, on {} ({}); drape inject --to {} starts graphs and sends "
+               "events while it runs",
+               take, o.events, avatar.name, rate, studio::subjectOf(o.name), o.fast ? "as fast as the server takes it" : "in real time",
+               o.name);
+
+  const auto began = std::chrono::steady_clock::now();
+  const auto frameTime = std::chrono::duration<double>(1.0 / rate);
+  events::Tick tick;
+  studio::PoseFrame frame;
+  long f = 0;
+  for (; o.frames == 0 || f < o.frames; ++f) {
+    if (!o.fast)
+      std::this_thread::sleep_until(began + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                frameTime * static_cast<double>(f)));
+    while (const std::optional<studio::Request> r = requests.next(std::chrono::milliseconds(0))) {
+      studio::InjectReply reply{false, "not a drape inject request"};
+      try {
+        const studio::Message m = studio::decode(r->data);
+        if (const auto* in = std::get_if<studio::Inject>(&m.payload))
+          reply = injected(*in, f, scheduler, motions, graphs, avatar, mo);
+      } catch (const Error& e) {
+        reply.message = e.what();
+      }
+      if (!reply.accepted) spdlog::warn("an injection refused: {}", reply.message);
+      requests.answer(*r, studio::encode(studio::Message{o.name, take, reply}));
+    }
+    const bool more = scheduler.tick(tick);
+    frame.frame = f;
+    frame.joints = tick.joints;
+    frame.wind = tick.wind;
+    publisher.send(frame);
+    if ((!more && !o.hold) || stopAsked) {
+      ++f;
+      break;
+    }
+  }
+  publisher.send(studio::End{f, "", stopAsked ? "stopped (a signal)" : "", 0});
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+  fmt::print("sent take {}: {} pose frames of {}'s event graph to {} on {} in {:.1f} s\n", take, f, avatar.name,
+             studio::subjectOf(o.name), bus.url(), seconds);
+  return 0;
+}
 
 /// The pose take's first message: the avatar, its joints and how the frames are numbered.
 studio::PoseStart poseStart(const scene::Avatar& avatar, const motion::AvatarAnimation& motion) {
@@ -41,6 +153,14 @@ int runAnimServer(const AnimServerOptions& o) {
   studio::checkSourceName(o.name, "--name");
   RunSetup setup = runSetupFromScene(o.scene);
   if (!setup.character) throw Error(fmt::format("{}: the scene has no avatar to move", o.scene));
+  if (!o.events.empty()) {
+    if (!o.motion.empty() || !o.animation.empty())
+      throw Error("--events plays an event graph's motions: give it or --motion, not both");
+    return runEventGraph(o, setup);
+  }
+  if (!o.sets.empty() || o.hold || o.frames > 0)
+    throw Error(fmt::format("{}: it is for an event graph: give --events FILE.egml",
+                            !o.sets.empty() ? "--set" : o.hold ? "--hold" : "--frames"));
   const MotionChoice choice = sceneMotion(setup, o.scene, o.motion, o.animation);
   if (choice.path.empty())
     throw Error(fmt::format("{}: nothing moves the avatar: give --motion FILE (its own file carries no animation)",
@@ -99,6 +219,14 @@ RunFunction setupAnimServer(CLI::App& app) {
                  "The take's name (default: the date and time). A take the stream already holds in part is "
                  "completed, not sent again");
   app.add_flag("--fast", o.fast, "Send the frames as fast as the server acknowledges them, not at the frame rate");
+  app.add_option("--events", o.events,
+                 "Instead of a motion: play an EGML event graph live (docs/EVENTS.md), taking graphs and events "
+                 "injected while it runs (drape inject --to NAME)");
+  app.add_option("--set", o.sets, "With --events: a parameter of the graph, NAME=VALUE; repeatable");
+  app.add_flag("--hold", o.hold,
+               "With --events: go on when the graphs end, the character holding its pose, until stopped (Ctrl-C, "
+               "SIGTERM) or --frames");
+  app.add_option("--frames", o.frames, "With --events: end the take after N frames")->check(CLI::PositiveNumber);
   o.studio.add(app, "a server");
   app.footer("Every role reads the same scene: what it says of the avatar (cutAtJoints, keepApart) they all do alike.\n"
              "Exit codes: 0 sent, 2 bad input, 4 no NATS server with JetStream answers.");

@@ -84,6 +84,8 @@ TakeOutcome simulateTake(const RunSetup& scene, studio::PoseFollower& poses, stu
   setup.character->animation = std::shared_ptr<const motion::AvatarAnimation>(std::shared_ptr<void>(), &poses.animation());
   setup.character->keepApart.clear();  // the anim-server sends the motion corrected
   setup.motionStreamed = true;
+  // The wind an event graph of the anim-server sets, frame by frame, as the poses come.
+  setup.motionWind = std::shared_ptr<const MotionWind>(std::shared_ptr<void>(), &poses.wind());
   setup.frames = 0;
   const double rate = setup.settings.frameRate_hz, leadIn = setup.character->leadIn_s;
 

@@ -51,6 +51,8 @@ std::string subjectOf(const std::string& source) { return "drape." + source; }
 
 std::string streamOf(const std::string& source) { return "DRAPE_" + source; }
 
+std::string requestSubjectOf(const std::string& source) { return subjectOf(source) + ".inject"; }
+
 struct Bus::Impl {
   std::string url;
   natsOptions* options = nullptr;
@@ -323,6 +325,79 @@ std::optional<Received> Reader::next(std::chrono::milliseconds timeout) {
   if (r.ready.empty()) return std::nullopt;
   Received out = std::move(r.ready.front());
   r.ready.pop_front();
+  return out;
+}
+
+}  // namespace drape::studio
+
+namespace drape::studio {
+
+struct Listener::Impl {
+  Bus::Impl* bus = nullptr;
+  std::string subject;
+  natsSubscription* subscription = nullptr;
+  ~Impl() {
+    if (subscription == nullptr) return;
+    (void)natsSubscription_Unsubscribe(subscription);
+    natsSubscription_Destroy(subscription);
+  }
+};
+
+Listener::Listener(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Listener::Listener(Listener&&) noexcept = default;
+Listener& Listener::operator=(Listener&&) noexcept = default;
+Listener::~Listener() = default;
+
+Listener Bus::listen(const std::string& subject) {
+  auto impl = std::make_unique<Listener::Impl>();
+  impl->bus = impl_.get();
+  impl->subject = subject;
+  natsStatus s = natsConnection_SubscribeSync(&impl->subscription, impl_->connection, subject.c_str());
+  // The subscription is the server's once the connection has sent it: a request right after
+  // this returns finds it.
+  if (s == NATS_OK) s = natsConnection_Flush(impl_->connection);
+  if (s != NATS_OK) impl_->fail(fmt::format("cannot listen on {}", subject), s);
+  return Listener(std::move(impl));
+}
+
+std::optional<Request> Listener::next(std::chrono::milliseconds timeout) {
+  natsMsg* msg = nullptr;
+  const natsStatus s = natsSubscription_NextMsg(&msg, impl_->subscription, std::max<std::int64_t>(0, timeout.count()));
+  if (s == NATS_TIMEOUT) return std::nullopt;
+  if (s != NATS_OK) {
+    // The connection is down (it comes back by itself): nothing to answer now.
+    std::this_thread::sleep_for(std::min(timeout, std::chrono::milliseconds(250)));
+    return std::nullopt;
+  }
+  const auto* bytes = reinterpret_cast<const std::uint8_t*>(natsMsg_GetData(msg));
+  Request r{{bytes, bytes + natsMsg_GetDataLength(msg)}, natsMsg_GetReply(msg) ? natsMsg_GetReply(msg) : ""};
+  natsMsg_Destroy(msg);
+  return r;
+}
+
+void Listener::answer(const Request& request, std::span<const std::uint8_t> data) {
+  if (request.replyTo.empty()) return;  // a message sent without waiting for an answer
+  const natsStatus s = natsConnection_Publish(impl_->bus->connection, request.replyTo.c_str(), data.data(),
+                                              static_cast<int>(data.size()));
+  if (s != NATS_OK) spdlog::warn("{}: could not answer a request on {}: {}", impl_->bus->url, impl_->subject, statusText(s, static_cast<jsErrCode>(0)));
+}
+
+std::vector<std::uint8_t> Bus::request(const std::string& subject, std::span<const std::uint8_t> data,
+                                       std::chrono::milliseconds timeout) {
+  natsMsg* reply = nullptr;
+  const natsStatus s = natsConnection_Request(&reply, impl_->connection, subject.c_str(), data.data(),
+                                              static_cast<int>(data.size()), timeout.count());
+  if (s == NATS_NO_RESPONDERS)
+    throw Error(fmt::format("{}: nobody listens on {} (is the anim-server running, with --events?)", impl_->url, subject),
+                ExitCode::Unavailable);
+  if (s == NATS_TIMEOUT)
+    throw Error(fmt::format("{}: no answer on {} within {:g} s", impl_->url, subject,
+                            static_cast<double>(timeout.count()) / 1000.0),
+                ExitCode::Unavailable);
+  if (s != NATS_OK) impl_->fail(fmt::format("cannot send a request on {}", subject), s);
+  const auto* bytes = reinterpret_cast<const std::uint8_t*>(natsMsg_GetData(reply));
+  std::vector<std::uint8_t> out(bytes, bytes + natsMsg_GetDataLength(reply));
+  natsMsg_Destroy(reply);
   return out;
 }
 

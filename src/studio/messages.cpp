@@ -49,7 +49,9 @@ struct Put {
     for (const RigidTransform& t : p.joints)
       joints.emplace_back(t.rotation.w(), t.rotation.x(), t.rotation.y(), t.rotation.z(), t.translation.x(),
                           t.translation.y(), t.translation.z());
-    return w::CreatePoseFrameDirect(b, p.frame, &joints).Union();
+    std::vector<double> wind;
+    if (p.wind) wind = {p.wind->x(), p.wind->y(), p.wind->z()};
+    return w::CreatePoseFrameDirect(b, p.frame, &joints, p.wind ? &wind : nullptr).Union();
   }
   fb::Offset<void> operator()(const ClothStart& c) const {
     std::vector<fb::Offset<w::GarmentInfo>> garments;
@@ -77,6 +79,12 @@ struct Put {
   fb::Offset<void> operator()(const End& e) const {
     return w::CreateEndDirect(b, e.frames, e.stats.c_str(), e.error.c_str(), e.exitCode).Union();
   }
+  fb::Offset<void> operator()(const Inject& i) const {
+    return w::CreateInjectDirect(b, i.graph.c_str(), i.baseDir.c_str(), i.event.c_str()).Union();
+  }
+  fb::Offset<void> operator()(const InjectReply& r) const {
+    return w::CreateInjectReplyDirect(b, r.accepted, r.message.c_str()).Union();
+  }
 };
 
 w::Payload payloadType(const Payload& p) {
@@ -85,7 +93,9 @@ w::Payload payloadType(const Payload& p) {
     case 1: return w::Payload_PoseFrame;
     case 2: return w::Payload_ClothStart;
     case 3: return w::Payload_ClothFrame;
-    default: return w::Payload_End;
+    case 4: return w::Payload_End;
+    case 5: return w::Payload_Inject;
+    default: return w::Payload_InjectReply;
   }
 }
 
@@ -129,6 +139,12 @@ PoseFrame read(const w::PoseFrame& in) {
     if (std::abs(q.squaredNorm() - 1.0) > 1e-6)
       refuse(fmt::format("PoseFrame {} has a joint rotation of norm {:.6g}, not a unit quaternion", out.frame, q.norm()));
     out.joints.push_back({q, Vec3(t->tx(), t->ty(), t->tz())});
+  }
+  if (const auto* wind = in.wind(); wind != nullptr && wind->size() > 0) {
+    if (wind->size() != 3) refuse(fmt::format("PoseFrame {} has a wind of {} numbers, not 3", out.frame, wind->size()));
+    const Vec3 v(wind->Get(0), wind->Get(1), wind->Get(2));
+    if (!v.allFinite()) refuse(fmt::format("PoseFrame {} has a wind that is not finite", out.frame));
+    out.wind = v;
   }
   return out;
 }
@@ -178,6 +194,10 @@ ClothFrame read(const w::ClothFrame& in) {
   return out;
 }
 
+Inject read(const w::Inject& in) { return {str(in.graph()), str(in.base_dir()), str(in.event())}; }
+
+InjectReply read(const w::InjectReply& in) { return {in.accepted(), str(in.message())}; }
+
 End read(const w::End& in) {
   End out;
   out.frames = in.frames();
@@ -223,6 +243,8 @@ Message decode(std::span<const std::uint8_t> bytes) {
     case w::Payload_ClothStart: out.payload = read(known(in->payload_as_ClothStart())); break;
     case w::Payload_ClothFrame: out.payload = read(known(in->payload_as_ClothFrame())); break;
     case w::Payload_End: out.payload = read(known(in->payload_as_End())); break;
+    case w::Payload_Inject: out.payload = read(known(in->payload_as_Inject())); break;
+    case w::Payload_InjectReply: out.payload = read(known(in->payload_as_InjectReply())); break;
     default: refuse(fmt::format("its payload is of unknown type {}", static_cast<int>(in->payload_type())));
   }
   return out;
@@ -235,6 +257,10 @@ std::string describe(const Payload& payload) {
     std::string operator()(const ClothStart& c) const { return "ClothStart of " + c.character; }
     std::string operator()(const ClothFrame& c) const { return fmt::format("ClothFrame {} of garment {}", c.frame, c.garment); }
     std::string operator()(const End& e) const { return fmt::format("End after {} frames", e.frames); }
+    std::string operator()(const Inject& i) const {
+      return i.graph.empty() ? "Inject of event '" + i.event + "'" : "Inject of a graph";
+    }
+    std::string operator()(const InjectReply& r) const { return r.accepted ? "InjectReply: done" : "InjectReply: refused"; }
   };
   return std::visit(Describe{}, payload);
 }

@@ -38,6 +38,7 @@ void PoseFollower::followNextTake(const scene::Avatar& avatar, double rate, cons
     take_ = m->take;
     start_ = *start;
     animation_.emplace(motion::AvatarAnimation::streamed(avatar.joints.size(), rate, start->start, start->driving));
+    wind_.clear();
     ended_ = false;
     filled_ = skipped_ = 0;
     spdlog::info("following pose take {} from '{}': {} at {:g} Hz from {}{}", take_, stream_.source(), start->character, rate,
@@ -71,10 +72,12 @@ void PoseFollower::add(const PoseFrame& frame) {
         fill[j] = have == 0 ? frame.joints[j]
                             : motion::interpolate(animation_->frame(static_cast<std::size_t>(have - 1))[j], frame.joints[j], s);
       animation_->appendFrame(fill);
+      wind_.push_back(frame.wind);
       ++filled_;
     }
   }
   animation_->appendFrame(frame.joints);
+  wind_.push_back(frame.wind);
 }
 
 bool PoseFollower::waitForFrames(std::int64_t count) {

@@ -23,6 +23,9 @@ std::string Publisher::idOf(const Payload& payload) const {
     std::string operator()(const PoseFrame& p) const { return messageId(take, "pose", p.frame); }
     std::string operator()(const ClothFrame& c) const { return messageId(take, "cloth", c.frame, c.garment); }
     std::string operator()(const End&) const { return messageId(take, "end", 0); }
+    // Requests and answers are not a take's messages; a broadcaster never sends them.
+    std::string operator()(const Inject&) const { return messageId(take, "inject", 0); }
+    std::string operator()(const InjectReply&) const { return messageId(take, "reply", 0); }
   };
   return std::visit(Id{take_}, payload);
 }

@@ -6,10 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <thread>
 
 #include "cli_runner.hpp"
 #include "drape/studio/bus.hpp"
+#include "drape/studio/messages.hpp"
 #include "drape/testing/nats_server.hpp"
 
 namespace drape::testing {
@@ -194,6 +196,72 @@ TEST(Studio, ThePlayerShowsATakeLiveInAWindow) {
   EXPECT_GT(fs::file_size(shot), 1000u);
   EXPECT_EQ(anim.wait().code, 0);
   EXPECT_EQ(cloth.wait().code, 0);
+}
+
+TEST(Studio, AnEventGraphThroughTheStudioIsDrapeRunsToTheByte) {
+  // The bundled day (walk, kick, walk on, a gust) played live by the anim-server: the
+  // cloth-server blows the gust its pose frames carry, and the recording is drape run
+  // --events of the same graph.
+  ScratchDir dir("studio-events");
+  NatsServer server;
+  const std::string day = std::string(DRAPE_SOURCE_DIR) + "/examples/event_graph/day.egml";
+  const std::string reference = runInto(dir, "reference", "'" + kScene + "' --events '" + day + "'");
+  DrapeProcess cloth("cloth-server '" + kScene + "' --takes 1" + roles(server), dir, "cloth");
+  const CliResult sent = runDrape("anim-server '" + kScene + "' --events '" + day + "' --fast" + roles(server), dir);
+  ASSERT_EQ(sent.code, 0) << sent.err;
+  EXPECT_NE(sent.out.find("223 pose frames"), std::string::npos) << sent.out;
+  ASSERT_EQ(cloth.wait().code, 0);
+  const CliResult recorded = runDrape("player '" + kScene + "' --record '" + (dir / "recorded") + "'" + roles(server), dir);
+  ASSERT_EQ(recorded.code, 0) << recorded.err;
+  for (const char* file : {"garment.pc2", "garment.states", "body.pc2", "segments/Hips.pc2"})
+    EXPECT_TRUE(slurp(dir / ("recorded/" + std::string(file))) == slurp(reference + "/" + file)) << file;
+}
+
+TEST(Studio, ALiveEventGraphTakesEventsAndGraphsInjected) {
+  ScratchDir dir("studio-inject");
+  NatsServer server;
+  const std::string idle = dir / "idle.egml";
+  std::ofstream(idle) << "#VRML V2.0 utf8\n"
+                         "StateMachine { states [\n"
+                         "  State { name \"Stand\" children [ Loop { children [ Wait { duration 1 } ] } ] on [ \"walk\" ] "
+                         "to [ \"Walk\" ] }\n"
+                         "  State { name \"Walk\" children [ Play { motion \"" + kWalk + "\" to 1.5 blend 0 } ] next \"Stand\" }\n"
+                         "] }\n";
+  DrapeProcess anim("anim-server '" + kScene + "' --events '" + idle + "' --hold --frames 150" + roles(server), dir,
+                    "anim");
+  // The anim-server listens once its take has begun.
+  studio::Bus bus = studio::Bus::connect(server.url(), "test");
+  bus.ensureStream("anim");
+  for (int i = 0; i < 600 && bus.range("anim").messages < 20; ++i) std::this_thread::sleep_for(50ms);
+  CliResult r = runDrape("inject --event walk" + roles(server), dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("sent event 'walk' at frame "), std::string::npos) << r.out;
+  const long at = std::stol(r.out.substr(r.out.find("at frame ") + 9));
+  const std::string broken = dir / "broken.egml";
+  std::ofstream(broken) << "#VRML V2.0 utf8\nPlay { from -1 motion \"" + kWalk + "\" }\n";
+  r = runDrape("inject --graph '" + broken + "'" + roles(server), dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(broken + ":2: Play: from -1 must be >= 0 s"), std::string::npos) << r.err;
+  r = runDrape("inject --to nobody --event walk" + roles(server), dir);
+  EXPECT_EQ(r.code, 4);
+  EXPECT_NE(r.err.find("nobody listens on drape.nobody.inject"), std::string::npos) << r.err;
+  const CliResult sent = anim.wait();
+  ASSERT_EQ(sent.code, 0) << sent.err;
+  EXPECT_NE(sent.out.find("150 pose frames"), std::string::npos) << sent.out;
+
+  // The poses: at rest up to the event, walking from it on.
+  studio::Bus reader = studio::Bus::connect(server.url(), "test");
+  const studio::StreamRange range = reader.range("anim");
+  std::vector<Vec3> hips;
+  for (std::uint64_t seq = range.first; seq <= range.last; ++seq) {
+    const studio::Message m = studio::decode(reader.get("anim", seq)->data);
+    if (const auto* p = std::get_if<studio::PoseFrame>(&m.payload)) hips.push_back(p->joints[0].translation);
+  }
+  ASSERT_EQ(hips.size(), 150u);
+  ASSERT_GT(at, 5);
+  ASSERT_LT(at + 30, 150);
+  for (long f = 1; f < at; ++f) EXPECT_EQ(hips[static_cast<std::size_t>(f)], hips[0]) << "frame " << f << ": before the event";
+  EXPECT_GT((hips[static_cast<std::size_t>(at + 30)] - hips[0]).norm(), 0.3) << "the walk did not move the hips";
 }
 
 TEST(Studio, ErrorsSayWhatToDo) {

@@ -34,6 +34,8 @@ std::vector<Message> sampleMessages(std::mt19937& rng) {
   pf.frame = 17;
   for (int j = 0; j < 4; ++j) pf.joints.push_back(randomTransform(rng));
   out.push_back({"anim", "T1", pf});
+  pf.wind = Vec3(4.0, 0.0, -0.5);  // an event graph's gust
+  out.push_back({"anim", "T1", pf});
   ClothStart cs;
   cs.poses = "anim";
   cs.poseTake = "T1";
@@ -51,6 +53,9 @@ std::vector<Message> sampleMessages(std::mt19937& rng) {
   out.push_back({"cloth", "T1", cf});
   out.push_back({"cloth", "T1", End{170, "{\"frames\": 170}\n", "", 0}});
   out.push_back({"cloth", "T1", End{26, "", "garment 'Skirt' went unstable at vertex 12 in frame 26", 3}});
+  out.push_back({"inject", "", Inject{"#VRML V2.0 utf8\nPlay { motion \"kick.bvh\" }\n", "/studio/takes", ""}});
+  out.push_back({"inject", "", Inject{"", "", "kick"}});
+  out.push_back({"anim", "", InjectReply{true, "started the graph at frame 120"}});
   return out;
 }
 
@@ -69,6 +74,7 @@ void expectSame(const Message& a, const Message& b) {
   } else if (const auto* x = std::get_if<PoseFrame>(&a.payload)) {
     const auto& y = std::get<PoseFrame>(b.payload);
     EXPECT_EQ(x->frame, y.frame);
+    EXPECT_EQ(x->wind, y.wind);
     ASSERT_EQ(x->joints.size(), y.joints.size());
     for (std::size_t j = 0; j < x->joints.size(); ++j) {
       EXPECT_EQ(x->joints[j].rotation.coeffs(), y.joints[j].rotation.coeffs());
@@ -92,6 +98,15 @@ void expectSame(const Message& a, const Message& b) {
     EXPECT_EQ(x->garment, y.garment);
     EXPECT_EQ(x->positions, y.positions);
     EXPECT_EQ(x->states, y.states);
+  } else if (const auto* x = std::get_if<Inject>(&a.payload)) {
+    const auto& y = std::get<Inject>(b.payload);
+    EXPECT_EQ(x->graph, y.graph);
+    EXPECT_EQ(x->baseDir, y.baseDir);
+    EXPECT_EQ(x->event, y.event);
+  } else if (const auto* x = std::get_if<InjectReply>(&a.payload)) {
+    const auto& y = std::get<InjectReply>(b.payload);
+    EXPECT_EQ(x->accepted, y.accepted);
+    EXPECT_EQ(x->message, y.message);
   } else {
     const auto& x2 = std::get<End>(a.payload);
     const auto& y = std::get<End>(b.payload);

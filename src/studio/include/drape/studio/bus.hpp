@@ -38,8 +38,18 @@ void checkSourceName(const std::string& name, const std::string& option);
 /// `drape.NAME` and `DRAPE_NAME`.
 [[nodiscard]] std::string subjectOf(const std::string& source);
 [[nodiscard]] std::string streamOf(const std::string& source);
+/// `drape.NAME.inject`: requests to a broadcaster (an anim-server's event graphs), not kept
+/// in any stream.
+[[nodiscard]] std::string requestSubjectOf(const std::string& source);
+
+/// A request that came to a Listener, to be answered.
+struct Request {
+  std::vector<std::uint8_t> data;
+  std::string replyTo;
+};
 
 class Reader;
+class Listener;
 
 /// One connection to a NATS server with JetStream. Moves, does not copy; closes on
 /// destruction. The connection reconnects by itself when the server goes away and comes
@@ -80,10 +90,36 @@ class Bus {
   /// `consumer` (which replaces a consumer of that name: a reader starts where it is told).
   [[nodiscard]] Reader read(const std::string& source, const std::string& consumer, std::uint64_t sequence);
 
+  /// The requests that come on `subject` from now on (core NATS: while nobody listens, a
+  /// request finds no responder and its sender is told so).
+  [[nodiscard]] Listener listen(const std::string& subject);
+  /// Sends a request on `subject` and waits for its answer. Throws drape::Error (Unavailable)
+  /// when nobody listens there or no answer came within `timeout`.
+  [[nodiscard]] std::vector<std::uint8_t> request(const std::string& subject, std::span<const std::uint8_t> data,
+                                                  std::chrono::milliseconds timeout);
+
   struct Impl;
 
  private:
   explicit Bus(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+class Listener {
+ public:
+  Listener(Listener&&) noexcept;
+  Listener& operator=(Listener&&) noexcept;
+  ~Listener();
+  /// The next request, or nothing when none came within `timeout` (0: only one already there).
+  [[nodiscard]] std::optional<Request> next(std::chrono::milliseconds timeout);
+  /// Answers `request`.
+  void answer(const Request& request, std::span<const std::uint8_t> data);
+
+  struct Impl;
+
+ private:
+  friend class Bus;
+  explicit Listener(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
 

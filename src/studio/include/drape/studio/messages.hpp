@@ -10,6 +10,7 @@
 // that says what is wrong, never a read out of bounds.
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <variant>
@@ -34,6 +35,7 @@ struct PoseStart {
 struct PoseFrame {
   std::int64_t frame = 0;                ///< motion frame, from 0
   std::vector<RigidTransform> joints;    ///< world transforms, in PoseStart's joint order
+  std::optional<Vec3> wind;              ///< the wind an event graph set (none: the scene's)
 };
 
 struct GarmentInfo {
@@ -64,7 +66,21 @@ struct End {
   int exitCode = 0;         ///< drape's exit code for that error
 };
 
-using Payload = std::variant<PoseStart, PoseFrame, ClothStart, ClothFrame, End>;
+/// To an anim-server playing an event graph (drape inject): a graph to start at once (EGML
+/// text, its relative motion paths found in `baseDir` on the anim-server's machine), an
+/// event for its state machines, or both.
+struct Inject {
+  std::string graph;
+  std::string baseDir;
+  std::string event;
+};
+
+struct InjectReply {
+  bool accepted = false;
+  std::string message;
+};
+
+using Payload = std::variant<PoseStart, PoseFrame, ClothStart, ClothFrame, End, Inject, InjectReply>;
 
 struct Message {
   std::string source;  ///< the broadcaster

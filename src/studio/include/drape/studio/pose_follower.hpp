@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <vector>
 #include <stdexcept>
 #include <string>
 
@@ -47,6 +48,9 @@ class PoseFollower {
   /// The motion so far (the same object for the whole take: a world may keep a pointer).
   [[nodiscard]] const motion::AvatarAnimation& animation() const { return *animation_; }
   [[nodiscard]] bool ended() const { return ended_; }
+  /// Per frame so far, the wind the sender's event graph set (none: the scene's); the same
+  /// object for the whole take.
+  [[nodiscard]] const std::vector<std::optional<Vec3>>& wind() const { return wind_; }
   /// The frames the take ended with (after ended()).
   [[nodiscard]] std::int64_t frames() const { return static_cast<std::int64_t>(animation_->frameCount()); }
   /// Frames that never came and were filled in, and messages skipped as not frames of the take.
@@ -61,6 +65,7 @@ class PoseFollower {
   std::string take_;
   PoseStart start_;
   std::optional<motion::AvatarAnimation> animation_;
+  std::vector<std::optional<Vec3>> wind_;
   bool ended_ = false;
   std::int64_t filled_ = 0, skipped_ = 0;
 };

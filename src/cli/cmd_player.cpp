@@ -23,7 +23,7 @@ namespace drape::cli {
 namespace {
 
 struct PlayerRoleOptions {
-  std::string scene, record, take, screenshot;
+  std::string scene, record, take, screenshot, from;
   std::vector<std::string> cloth{"cloth"};
   bool window = false, preview = false, everyFrame = false;
   long every = 1, frames = 0;
@@ -94,7 +94,8 @@ int show(const PlayerRoleOptions& o) {
   if (avatar.skin) skin = std::make_unique<sim::BodySkin>(avatar, fields, sim::leastT0(setup.garments, worldSettings(setup)));
 
   FrameTaken taken;
-  long next = 0, skipped = 0;
+  const long firstShown = o.from.empty() ? 0 : frames.seek(o.from);
+  long next = firstShown, skipped = 0;
   std::vector<sim::GarmentSurface> garments;
   std::optional<std::chrono::steady_clock::time_point> first;
   render::CallbackSource source(meshes, setup.settings.frameRate_hz, [&](render::Frame& out) {
@@ -103,7 +104,8 @@ int show(const PlayerRoleOptions& o) {
     // each, falling behind.
     const auto now = std::chrono::steady_clock::now();
     if (!first) first = now;
-    const auto due = static_cast<long>(std::chrono::duration<double>(now - *first).count() * setup.settings.frameRate_hz);
+    const auto due =
+        firstShown + static_cast<long>(std::chrono::duration<double>(now - *first).count() * setup.settings.frameRate_hz);
     for (; !o.everyFrame && next < due; ++next, ++skipped)
       if (!frames.next(next, taken)) return false;
     if (!frames.next(next, taken)) return false;
@@ -139,7 +141,10 @@ int show(const PlayerRoleOptions& o) {
   options.screenshot = o.screenshot;
   render::SubdividedSource shown(source, o.picture.subdivide);
   const render::PlayerStats stats = render::Player(options).run(shown);
-  std::cout << fmt::format("showed {} frames of take {} in {:.1f} s{}\n", stats.framesDrawn, frames.take(), stats.seconds,
+  const TimeCode from{frames.start().start.frame + firstShown, frames.start().start.rate};
+  std::cout << fmt::format("showed {} frame{} of take {} from {} in {:.1f} s{}\n", stats.framesDrawn,
+                           stats.framesDrawn == 1 ? "" : "s", frames.take(),
+                           from.smpte(), stats.seconds,
                            skipped > 0 ? fmt::format(" ({} left out to keep to the take's time)", skipped) : "");
   return 0;
 }
@@ -154,9 +159,12 @@ RunFunction setupPlayer(CLI::App& app) {
   auto* win = app.add_flag("--window", o.window, "Show the take live in a window (needs a display)");
   rec->excludes(win);
   app.add_option("--take", o.take, "The take to play (default: the one the cloth streams hold, or the next)");
-  app.add_option("--frames", o.frames, "Stop after frame N")->check(CLI::PositiveNumber);
+  app.add_option("--frames", o.frames, "Stop after frame N (with --window: after N frames shown)")->check(CLI::PositiveNumber);
   app.add_flag("--preview", o.preview, "With --record: also a contact sheet and, with ffmpeg, an MP4");
   app.add_option("--every", o.every, "With --record: an OBJ frame every K frames")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--from", o.from,
+                 "With --window: start at time code HH:MM:SS:FF of the take, or 'now' (the newest frame: join a live "
+                 "take where it is), without reading the cloth before it");
   app.add_option("--screenshot", o.screenshot, "With --window: save the last picture as a PNG when it closes");
   app.add_flag("--every-frame", o.everyFrame,
                "With --window: show every frame, however long drawing takes (default: leave frames out to keep to "
@@ -168,6 +176,8 @@ RunFunction setupPlayer(CLI::App& app) {
              "4 no NATS server answers or a peer went silent past --give-up.");
   return [] {
     if (o.record.empty() && !o.window) throw Error("drape player: give --record DIR or --window");
+    if (!o.from.empty() && !o.window)
+      throw Error("--from applies to --window: a recording is the whole take, which the streams keep from its start");
     return o.window ? show(o) : record(o);
   };
 }

@@ -1,6 +1,7 @@
 #include "studio_frames.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -127,6 +128,33 @@ bool StudioFrames::next(long frame, FrameTaken& out) {
   // The time as the cloth-servers' world computes a frame's (CharacterWorld::frameTime).
   avatarPoses_->evaluate(static_cast<double>(frame) / setup_.settings.frameRate_hz, out.joints);
   return true;
+}
+
+long StudioFrames::seek(const std::string& from) {
+  const studio::ClothStart& s = start();
+  const TimeCode first = s.start;
+  std::int64_t newest = std::numeric_limits<std::int64_t>::max();
+  std::optional<std::int64_t> ended;
+  for (Cloth& c : cloth_) {
+    const studio::ClothFollower::Held held = c.follower->held();
+    newest = std::min(newest, held.newest);
+    if (held.ended) ended = std::min(ended.value_or(*held.ended), *held.ended);
+  }
+  std::int64_t frame = 0;
+  if (from == "now") {
+    frame = std::max<std::int64_t>(newest, 0);
+  } else {
+    const TimeCode at = TimeCode::parseSmpte(from, first.rate);
+    frame = at.frame - first.frame;
+    if (frame < 0)
+      throw Error(fmt::format("--from {}: take {} starts at {}", from, take(), first.smpte()));
+    if (ended && frame > *ended)
+      throw Error(fmt::format("--from {}: take {} ends at {} (frame {})", from, take(),
+                              TimeCode{first.frame + *ended, first.rate}.smpte(), *ended));
+  }
+  for (Cloth& c : cloth_) c.follower->seek(frame);
+  spdlog::info("starting at {} (frame {} of take {})", TimeCode{first.frame + frame, first.rate}.smpte(), frame, take());
+  return static_cast<long>(frame);
 }
 
 std::vector<std::pair<std::string, std::string>> StudioFrames::stats() const {

@@ -35,6 +35,12 @@ class StudioFrames {
   /// that went unstable) after the frames before it.
   bool next(long frame, FrameTaken& out);
 
+  /// Where `from` says a player starts: "now" (the newest frame every stream holds
+  /// whole: a live take joined where it is) or a time code HH:MM:SS:FF of the take. Jumps
+  /// there without reading the cloth before it and returns the frame, for next(). Throws
+  /// drape::Error (BadInput) for a time code before the take or past its end.
+  long seek(const std::string& from);
+
   /// The joints at frame 0 (the rest pose, where the lead-in starts).
   [[nodiscard]] std::vector<RigidTransform> jointsAtStart() const;
   [[nodiscard]] const studio::ClothStart& start() const { return cloth_.front().follower->start(); }

@@ -22,12 +22,15 @@ std::string TimeCode::smpte() const {
 TimeCode TimeCode::parseSmpte(const std::string& text, double rate) {
   int h = 0, m = 0, s = 0, f = 0;
   char tail = 0;
-  if (std::sscanf(text.c_str(), "%d:%d:%d:%d%c", &h, &m, &s, &f, &tail) != 4 || h < 0 || m < 0 ||
+  const bool before = !text.empty() && text.front() == '-';  // as smpte() prints a frame before 0
+  const char* digits = text.c_str() + (before ? 1 : 0);
+  if (std::sscanf(digits, "%d:%d:%d:%d%c", &h, &m, &s, &f, &tail) != 4 || digits[0] == '-' || digits[0] == '+' || h < 0 || m < 0 ||
       m > 59 || s < 0 || s > 59 || f < 0 || f >= std::llround(rate)) {
     throw Error(fmt::format("time code '{}': expected HH:MM:SS:FF at {} frames/s", text, rate));
   }
   const auto fps = std::llround(rate);
-  return TimeCode{((static_cast<std::int64_t>(h) * 60 + m) * 60 + s) * fps + f, rate};
+  const std::int64_t frame = ((static_cast<std::int64_t>(h) * 60 + m) * 60 + s) * fps + f;
+  return TimeCode{before ? -frame : frame, rate};
 }
 
 }  // namespace drape

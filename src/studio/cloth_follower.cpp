@@ -12,12 +12,16 @@ namespace drape::studio {
 
 const ClothStart& ClothFollower::followNextTake(const std::string& take) {
   for (;;) {
-    Message m = pending_ ? std::move(*pending_) : stream_.next("a take's cloth");
+    const bool wasPending = pending_.has_value();
+    Message m = wasPending ? std::move(*pending_) : stream_.next("a take's cloth");
+    const std::uint64_t sequence = wasPending ? pendingSequence_ : stream_.sequence();
+    if (!wasPending) ++read_;
     pending_.reset();
     const auto* start = std::get_if<ClothStart>(&m.payload);
     if (start == nullptr || (!take.empty() && m.take != take)) continue;  // an earlier take's frames
     take_ = m.take;
     start_ = *start;
+    startSequence_ = sequence;
     frames_.clear();
     current_ = -1;
     end_.reset();
@@ -30,9 +34,11 @@ const ClothStart& ClothFollower::followNextTake(const std::string& take) {
 
 void ClothFollower::readOne(const std::string& waitingFor) {
   Message m = stream_.next(waitingFor);
+  ++read_;
   if (std::holds_alternative<ClothStart>(m.payload)) {
     if (m.take == take_) return;  // the same take announced again (a restarted server)
     pending_ = std::move(m);
+    pendingSequence_ = stream_.sequence();
     throw NewTake(fmt::format("the cloth stream '{}' started take {} before take {} ended", stream_.source(),
                               pending_->take, take_));
   }
@@ -82,6 +88,66 @@ bool ClothFollower::waitForFrame(std::int64_t frame) {
   }
   current_ = frame;
   return true;
+}
+
+std::optional<std::int64_t> ClothFollower::frameFrom(std::uint64_t sequence, std::uint64_t last) {
+  // Between two frames there may be a restarted server's ClothStart again, or a message
+  // that is not a frame: a few steps over them; a run of more ends the take as far as a
+  // search cares.
+  constexpr std::uint64_t kLookAhead = 8;
+  for (std::uint64_t s = sequence; s <= last && s < sequence + kLookAhead; ++s) {
+    const std::optional<Message> m = stream_.at(s);
+    if (!m) continue;
+    if (m->take != take_) {
+      if (std::holds_alternative<ClothStart>(m->payload)) return std::nullopt;  // the next take
+      continue;
+    }
+    if (std::holds_alternative<End>(m->payload)) return std::nullopt;
+    if (const auto* f = std::get_if<ClothFrame>(&m->payload)) return f->frame;
+  }
+  return std::nullopt;
+}
+
+ClothFollower::Held ClothFollower::held() {
+  Held out;
+  if (end_) out.ended = end_->frames;
+  const StreamRange range = stream_.range();
+  // From the stream's end back to the newest frame of the take: past its End (and its
+  // stats) or, live, at once.
+  for (std::uint64_t s = range.last; s > startSequence_ && s >= range.first && s > 0; --s) {
+    const std::optional<Message> m = stream_.at(s);
+    if (!m || m->take != take_) continue;
+    if (const auto* end = std::get_if<End>(&m->payload)) {
+      out.ended = end->frames;
+      continue;
+    }
+    if (const auto* f = std::get_if<ClothFrame>(&m->payload)) {
+      // Garments go out in order: a frame is whole once its last garment is there.
+      out.newest = f->garment + 1 == start_.garments.size() ? f->frame : f->frame - 1;
+      break;
+    }
+  }
+  return out;
+}
+
+void ClothFollower::seek(std::int64_t frame) {
+  const StreamRange range = stream_.range();
+  // lo: a message before the frame (the take's start at first); hi: one at or after it.
+  std::uint64_t lo = startSequence_, hi = range.last + 1;
+  while (hi - lo > 1) {
+    const std::uint64_t mid = lo + (hi - lo) / 2;
+    const std::optional<std::int64_t> f = frameFrom(mid, range.last);
+    if (f && *f < frame)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  frames_.clear();
+  pending_.reset();
+  end_.reset();  // read again, if the jump was back from it
+  current_ = frame - 1;
+  stream_.restartAt(lo + 1);
+  spdlog::debug("cloth take {}: frame {} begins at message {} of '{}'", take_, frame, lo + 1, stream_.source());
 }
 
 const ClothFrame& ClothFollower::garment(std::uint32_t garment) const {

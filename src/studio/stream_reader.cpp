@@ -1,5 +1,7 @@
 #include "drape/studio/stream_reader.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
@@ -17,8 +19,25 @@ Reader openReader(Bus& bus, const std::string& source, const std::string& consum
 
 StreamReader::StreamReader(Bus& bus, std::string source, const std::string& consumer,
                            std::chrono::milliseconds patience, std::chrono::milliseconds giveUp, std::uint64_t sequence)
-    : bus_(bus), source_(std::move(source)), reader_(openReader(bus, source_, consumer, sequence)), patience_(patience),
-      giveUp_(giveUp) {}
+    : bus_(bus), source_(std::move(source)), consumer_(consumer), reader_(openReader(bus, source_, consumer, sequence)),
+      patience_(patience), giveUp_(giveUp) {}
+
+void StreamReader::restartAt(std::uint64_t sequence) {
+  reader_.reset();
+  reader_.emplace(openReader(bus_, source_, consumer_, std::max<std::uint64_t>(sequence, 1)));
+  sequence_ = sequence > 0 ? sequence - 1 : 0;
+}
+
+std::optional<Message> StreamReader::at(std::uint64_t sequence) {
+  std::optional<Received> r = bus_.get(source_, sequence);
+  if (!r) return std::nullopt;
+  try {
+    Message m = decode(r->data);
+    if (m.source == source_) return m;
+  } catch (const Error&) {  // not a studio frame: as if the stream held none there
+  }
+  return std::nullopt;
+}
 
 Message StreamReader::next(const std::string& waitingFor) {
   std::chrono::milliseconds waited{0};
@@ -26,7 +45,7 @@ Message StreamReader::next(const std::string& waitingFor) {
     const std::chrono::milliseconds slice =
         giveUp_.count() > 0 ? std::min(patience_, std::max(giveUp_ - waited, std::chrono::milliseconds(1))) : patience_;
     const auto began = std::chrono::steady_clock::now();
-    std::optional<Received> r = reader_.next(slice);
+    std::optional<Received> r = reader_->next(slice);
     if (!r) {
       waited += std::max(slice, std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - began));
       if (giveUp_.count() > 0 && waited >= giveUp_)
@@ -37,6 +56,7 @@ Message StreamReader::next(const std::string& waitingFor) {
                    static_cast<double>(waited.count()) / 1000.0);
       continue;
     }
+    sequence_ = r->sequence;
     try {
       Message m = decode(r->data);
       if (m.source == source_) return m;

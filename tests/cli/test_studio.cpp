@@ -1,7 +1,8 @@
 // The studio's three roles as separate processes on a real nats-server: what the player
 // records is what drape run writes, to the byte, also when a cloth-server is killed in the
 // middle of the take and started again, when junk arrives on the pose stream, when two
-// cloth-servers split the garments, and when the take goes unstable; errors say what to do.
+// cloth-servers split the garments, and when the take goes unstable; a window shows a take
+// live or from a time code; errors say what to do.
 
 #include <gtest/gtest.h>
 
@@ -9,7 +10,10 @@
 #include <fstream>
 #include <thread>
 
+#include <fmt/format.h>
+
 #include "cli_runner.hpp"
+#include "drape/core/timecode.hpp"
 #include "drape/studio/bus.hpp"
 #include "drape/studio/messages.hpp"
 #include "drape/testing/nats_server.hpp"
@@ -178,7 +182,23 @@ TEST(Studio, AnUnstableTakeIsRecordedUpToItsLastGoodFrame) {
   EXPECT_TRUE(statsOf(dir / "recorded")["unstable"].get<bool>());
 }
 
-TEST(Studio, ThePlayerShowsATakeLiveInAWindow) {
+/// `drape player ARGS --window` under a virtual display: exit status and what it said.
+std::pair<int, std::string> showInWindow(const std::string& args, const NatsServer& server, const ScratchDir& dir,
+                                         const std::string& name) {
+  const std::string cmd = std::string("ASAN_OPTIONS=detect_leaks=0 xvfb-run -a '") + DRAPE_EXE + "' player '" + kScene +
+                          "' --window --size 320x240 " + args + roles(server) + " >'" + (dir / (name + ".txt")) + "' 2>&1";
+  const int status = std::system(cmd.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir / (name + ".txt"))};
+}
+
+/// The time code a player said it showed the take from.
+TimeCode shownFrom(const std::string& said) {
+  const std::size_t at = said.find(" from ", said.find("showed "));
+  if (at == std::string::npos) return {};
+  return TimeCode::parseSmpte(said.substr(at + 6, said.find(' ', at + 6) - at - 6), 30.0);
+}
+
+TEST(Studio, ThePlayerShowsATakeLiveInAWindowAndFromATimeCode) {
   if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
     GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps installs xvfb)";
   ScratchDir dir("studio-window");
@@ -186,16 +206,48 @@ TEST(Studio, ThePlayerShowsATakeLiveInAWindow) {
   DrapeProcess cloth("cloth-server '" + kScene + "' --takes 1" + roles(server), dir, "cloth");
   DrapeProcess anim("anim-server '" + kScene + "' --motion '" + kWalk + "'" + roles(server), dir, "anim");
   const std::string shot = dir / "live.png";
-  const std::string cmd = std::string("ASAN_OPTIONS=detect_leaks=0 xvfb-run -a '") + DRAPE_EXE + "' player '" + kScene +
-                          "' --window --frames 8 --size 320x240 --screenshot '" + shot + "'" + roles(server) + " >'" +
-                          (dir / "player.txt") + "' 2>&1";
-  const int status = std::system(cmd.c_str());
-  const std::string out = slurp(dir / "player.txt");
-  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << out;
+  const auto [status, out] = showInWindow("--frames 8 --screenshot '" + shot + "'", server, dir, "player");
+  ASSERT_EQ(status, 0) << out;
   EXPECT_NE(out.find("showed 8 frames of take"), std::string::npos) << out;
   EXPECT_GT(fs::file_size(shot), 1000u);
   EXPECT_EQ(anim.wait().code, 0);
   EXPECT_EQ(cloth.wait().code, 0);
+
+  // The whole take is in the stream now: a player starts where it is told.
+  const TimeCode start = shownFrom(out);
+  studio::Bus bus = studio::Bus::connect(server.url(), "test");
+  const studio::StreamRange range = bus.range("cloth");
+  std::int64_t last = -1;
+  for (std::uint64_t s = range.last; s >= range.first && last < 0; --s)
+    if (const auto m = bus.get("cloth", s))
+      if (const studio::Message msg = studio::decode(m->data); std::holds_alternative<studio::End>(msg.payload))
+        last = std::get<studio::End>(msg.payload).frames;
+  ASSERT_GT(last, 40);
+  const TimeCode at{start.frame + 37, start.rate};
+  const auto [atStatus, atOut] = showInWindow("--frames 3 --from " + at.smpte(), server, dir, "at");
+  ASSERT_EQ(atStatus, 0) << atOut;
+  EXPECT_NE(atOut.find("showed 3 frames of take"), std::string::npos) << atOut;
+  EXPECT_EQ(shownFrom(atOut).frame, at.frame) << atOut;
+  EXPECT_NE(atOut.find("(frame 37 of take"), std::string::npos) << atOut;
+
+  // "now" on a take that has ended: its last frame, and the window closes after it.
+  const auto [nowStatus, nowOut] = showInWindow("--frames 5 --from now", server, dir, "now");
+  ASSERT_EQ(nowStatus, 0) << nowOut;
+  EXPECT_NE(nowOut.find("showed 1 frame of take"), std::string::npos) << nowOut;
+  EXPECT_EQ(shownFrom(nowOut).frame, start.frame + last) << nowOut;
+
+  const TimeCode before{start.frame - 1, start.rate}, after{start.frame + last + 1, start.rate};
+  const auto [beforeStatus, beforeOut] = showInWindow("--from " + before.smpte(), server, dir, "before");
+  EXPECT_EQ(beforeStatus, 2) << beforeOut;
+  EXPECT_NE(beforeOut.find("starts at " + start.smpte()), std::string::npos) << beforeOut;
+  const auto [afterStatus, afterOut] = showInWindow("--from " + after.smpte(), server, dir, "after");
+  EXPECT_EQ(afterStatus, 2) << afterOut;
+  EXPECT_NE(afterOut.find(fmt::format("ends at {} (frame {})", TimeCode{start.frame + last, 30.0}.smpte(), last)),
+            std::string::npos)
+      << afterOut;
+  const auto [badStatus, badOut] = showInWindow("--from 00:00:01", server, dir, "bad");
+  EXPECT_EQ(badStatus, 2) << badOut;
+  EXPECT_NE(badOut.find("expected HH:MM:SS:FF"), std::string::npos) << badOut;
 }
 
 TEST(Studio, AnEventGraphThroughTheStudioIsDrapeRunsToTheByte) {
@@ -278,6 +330,9 @@ TEST(Studio, ErrorsSayWhatToDo) {
   r = runDrape("player '" + kScene + "'", dir);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("give --record DIR or --window"), std::string::npos) << r.err;
+  r = runDrape("player '" + kScene + "' --record '" + (dir / "rec") + "' --from now --server " + nowhere, dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--from applies to --window"), std::string::npos) << r.err;
   r = runDrape("anim-server '" + kScene + "' --server " + nowhere, dir);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("nothing moves the avatar: give --motion FILE"), std::string::npos) << r.err;

@@ -21,12 +21,15 @@ TEST(TimeCode, PrintsSmpte) {
 }
 
 TEST(TimeCode, ParsesWhatItPrints) {
-  for (std::int64_t f : {0, 1, 29, 30, 1799, 108000 + 17}) {
+  for (std::int64_t f : {0, 1, 29, 30, 1799, 108000 + 17, -1, -31, -108000 - 17}) {
     const TimeCode tc{f, 30};
     EXPECT_EQ(TimeCode::parseSmpte(tc.smpte(), 30).frame, f);
   }
   EXPECT_THROW((void)TimeCode::parseSmpte("00:00:00:30", 30), Error);
   EXPECT_THROW((void)TimeCode::parseSmpte("1:2:3", 30), Error);
+  EXPECT_THROW((void)TimeCode::parseSmpte("--00:00:01:00", 30), Error);
+  EXPECT_THROW((void)TimeCode::parseSmpte("-+0:00:01:00", 30), Error);
+  EXPECT_THROW((void)TimeCode::parseSmpte("00:00:01:00 ", 30), Error);
 }
 
 TEST(SourcePos, FormatsWhatIsKnown) {

@@ -1,8 +1,8 @@
 // Following takes on a real nats-server: the pose follower grows the sender's animation
 // bit for bit through duplicates, gaps, garbage and strangers; the cloth follower gathers a
-// frame's garments whatever their order; a publisher restarted in the middle of a take
-// sends only what the stream lacks; and the motion a cloth frame waits for is all the
-// frame's substeps read.
+// frame's garments whatever their order, and seeks to any frame without reading the ones
+// before; a publisher restarted in the middle of a take sends only what the stream lacks;
+// and the motion a cloth frame waits for is all the frame's substeps read.
 
 #include <gtest/gtest.h>
 
@@ -198,6 +198,95 @@ TEST(ClothFollower, GathersEachFrameWholeAndReportsTheTakesError) {
     EXPECT_NE(std::string(e.what()).find("went unstable in frame 2"), std::string::npos) << e.what();
   }
   EXPECT_EQ(cloth.skippedMessages(), 1);
+}
+
+TEST(ClothFollower, SeeksToAnyFrameAsReadingFromTheStartWould) {
+  // A take of 150 frames of two garments, with what a stream can hold between them: the
+  // take announced again by a restarted server, a message that is no studio frame, one
+  // from a stranger. Seeking to a random frame gathers that frame as reading everything
+  // before it does, and reads only a handful of messages to get there.
+  testing::NatsServer server;
+  Bus bus = Bus::connect(server.url(), "test");
+  bus.ensureStream("cloth");
+  ClothStart start;
+  start.poses = "anim";
+  start.poseTake = "T";
+  start.character = "tester";
+  start.start = TimeCode{-30, 30.0};
+  start.garments = {{"Skirt", 3}, {"Top", 2}};
+  send(bus, "cloth", "T", start, "start");
+  constexpr std::int64_t kFrames = 150;
+  std::mt19937 rng(11);
+  for (std::int64_t f = 0; f < kFrames; ++f) {
+    send(bus, "cloth", "T", clothFrame(f, 0, 3), fmt::format("{}.0", f));
+    if (rng() % 9 == 0) (void)bus.publish("cloth", std::vector<std::uint8_t>{1, 2, 3}, fmt::format("junk{}", f));
+    if (rng() % 13 == 0) send(bus, "cloth", "T", start, fmt::format("restart{}", f));
+    if (rng() % 11 == 0) (void)bus.publish("cloth", encode(Message{"other", "T", clothFrame(f + 7, 1, 2)}), fmt::format("x{}", f));
+    send(bus, "cloth", "T", clothFrame(f, 1, 2), fmt::format("{}.1", f));
+  }
+  send(bus, "cloth", "T", End{kFrames - 1, "{}", "", 0}, "end");
+
+  StreamReader all(bus, "cloth", "all", 200ms, 10s);
+  ClothFollower reference(all);
+  (void)reference.followNextTake();
+  std::vector<std::vector<ClothFrame>> expected;
+  for (std::int64_t f = 0; f < kFrames; ++f) {
+    ASSERT_TRUE(reference.waitForFrame(f));
+    expected.push_back({reference.garment(0), reference.garment(1)});
+  }
+  const ClothFollower::Held held = reference.held();
+  EXPECT_EQ(held.newest, kFrames - 1);
+  ASSERT_TRUE(held.ended.has_value());
+  EXPECT_EQ(*held.ended, kFrames - 1);
+
+  StreamReader stream(bus, "cloth", "seeker", 200ms, 10s);
+  ClothFollower cloth(stream);
+  (void)cloth.followNextTake();
+  std::uniform_int_distribution<std::int64_t> any(0, kFrames - 1);
+  for (int trial = 0; trial < 40; ++trial) {
+    const std::int64_t target = trial == 0 ? 0 : trial == 1 ? kFrames - 1 : any(rng);
+    const std::int64_t before = cloth.messagesRead();
+    cloth.seek(target);  // forwards and back, and back again past the End read
+    for (std::int64_t f = target; f < std::min(target + 3, kFrames); ++f) {
+      ASSERT_TRUE(cloth.waitForFrame(f)) << "seeking to " << target;
+      for (std::uint32_t g = 0; g < 2; ++g) {
+        EXPECT_EQ(cloth.garment(g).frame, f);
+        EXPECT_EQ(cloth.garment(g).positions, expected[static_cast<std::size_t>(f)][g].positions) << f << " " << g;
+        EXPECT_EQ(cloth.garment(g).states, expected[static_cast<std::size_t>(f)][g].states);
+      }
+    }
+    // Three frames of two garments and what lay between them: never the frames before.
+    EXPECT_LE(cloth.messagesRead() - before, 16) << "seeking to " << target;
+    if (target == kFrames - 1) EXPECT_FALSE(cloth.waitForFrame(kFrames));
+  }
+}
+
+TEST(ClothFollower, HoldsTheNewestWholeFrameOfALiveTake) {
+  testing::NatsServer server;
+  Bus bus = Bus::connect(server.url(), "test");
+  bus.ensureStream("cloth");
+  ClothStart start;
+  start.poses = "anim";
+  start.poseTake = "T";
+  start.garments = {{"Skirt", 3}, {"Top", 2}};
+  send(bus, "cloth", "T", start, "start");
+  StreamReader stream(bus, "cloth", "player", 200ms, 10s);
+  ClothFollower cloth(stream);
+  (void)cloth.followNextTake();
+  EXPECT_EQ(cloth.held().newest, -1);
+  send(bus, "cloth", "T", clothFrame(0, 0, 3), "0.0");
+  EXPECT_EQ(cloth.held().newest, -1);  // frame 0 lacks its second garment
+  send(bus, "cloth", "T", clothFrame(0, 1, 2), "0.1");
+  send(bus, "cloth", "T", clothFrame(1, 0, 3), "1.0");
+  EXPECT_EQ(cloth.held().newest, 0);
+  send(bus, "cloth", "T", clothFrame(1, 1, 2), "1.1");
+  const ClothFollower::Held held = cloth.held();
+  EXPECT_EQ(held.newest, 1);
+  EXPECT_FALSE(held.ended.has_value());
+  cloth.seek(held.newest);
+  ASSERT_TRUE(cloth.waitForFrame(1));
+  EXPECT_EQ(cloth.garment(1).positions[1], Vec3(1.0, 1.0, 1.0));
+  EXPECT_EQ(cloth.messagesRead(), 3);  // its start, then frame 1's two garments
 }
 
 TEST(Publisher, ARestartedServerSendsOnlyWhatTheStreamLacks) {

@@ -15,7 +15,8 @@ struct TimeCode {
   /// SMPTE non-drop-frame "HH:MM:SS:FF" (rate rounded to whole frames per second); a
   /// frame before 0 as "-HH:MM:SS:FF" before it.
   [[nodiscard]] std::string smpte() const;
-  /// Parses "HH:MM:SS:FF" at the given rate; throws drape::Error on malformed text.
+  /// Parses "HH:MM:SS:FF" (or "-HH:MM:SS:FF", as smpte() prints a frame before 0) at the
+  /// given rate; throws drape::Error on malformed text.
   [[nodiscard]] static TimeCode parseSmpte(const std::string& text, double rate);
 };
 

@@ -27,6 +27,21 @@ class ClothFollower {
   /// when the stream starts another take first, and drape::Error with the take's own
   /// error when its server stopped it (a garment went unstable).
   bool waitForFrame(std::int64_t frame);
+  /// What the stream holds of the take followed now: its newest whole frame (-1: none
+  /// yet) and, when its End came, the frames it had.
+  struct Held {
+    std::int64_t newest = -1;
+    std::optional<std::int64_t> ended;
+  };
+  [[nodiscard]] Held held();
+  /// Jumps ahead (or back) to frame `frame` of the take without reading what lies before
+  /// it: finds where the frame begins in the stream by a binary search over its sequence
+  /// (the cloth-servers send a take's frames in order) and reads on from there. A jump
+  /// forgets the frames gathered; the next waitForFrame asks for `frame` or later.
+  void seek(std::int64_t frame);
+  /// Messages of the stream read so far (the ones a seek jumps over are not read).
+  [[nodiscard]] std::int64_t messagesRead() const { return read_; }
+
   /// Garment `garment` of the frame waitForFrame last had.
   [[nodiscard]] const ClothFrame& garment(std::uint32_t garment) const;
 
@@ -40,9 +55,16 @@ class ClothFollower {
  private:
   /// Reads one message of the take into the frames gathered.
   void readOne(const std::string& waitingFor);
+  /// The frame number of the first cloth frame of the take at or after `sequence`, looking
+  /// at no more than a few messages; nothing when there is none (the take's End, another
+  /// take, the stream's end).
+  [[nodiscard]] std::optional<std::int64_t> frameFrom(std::uint64_t sequence, std::uint64_t last);
 
   StreamReader& stream_;
   std::optional<Message> pending_;
+  std::uint64_t pendingSequence_ = 0;
+  std::uint64_t startSequence_ = 0;  ///< where the take's ClothStart is in the stream
+  std::int64_t read_ = 0;
   std::string take_;
   ClothStart start_;
   std::map<std::int64_t, std::vector<std::optional<ClothFrame>>> frames_;

@@ -25,6 +25,16 @@ class StreamReader {
   /// The next message of the stream that is a studio frame of this source; `waitingFor`
   /// names it in the lines said while waiting.
   [[nodiscard]] Message next(const std::string& waitingFor);
+  /// The stream's sequence of the message next() returned last (0 before the first).
+  [[nodiscard]] std::uint64_t sequence() const { return sequence_; }
+
+  /// Reads on from the stream's message `sequence` (a jump, forwards or back).
+  void restartAt(std::uint64_t sequence);
+  /// The message at `sequence`, read without moving the reader; nothing where the stream
+  /// holds none or it is not a studio frame of this source.
+  [[nodiscard]] std::optional<Message> at(std::uint64_t sequence);
+  /// What the stream holds now.
+  [[nodiscard]] StreamRange range() { return bus_.range(source_); }
 
   [[nodiscard]] const std::string& source() const { return source_; }
   [[nodiscard]] const std::string& url() const { return bus_.url(); }
@@ -33,8 +43,10 @@ class StreamReader {
 
  private:
   Bus& bus_;
-  std::string source_;
-  Reader reader_;
+  std::string source_, consumer_;
+  // Optional so that a jump closes the old consumer before making its namesake.
+  std::optional<Reader> reader_;
+  std::uint64_t sequence_ = 0;
   std::chrono::milliseconds patience_, giveUp_;
   std::int64_t skipped_ = 0;
 };

@@ -1,6 +1,7 @@
 // `drape inspect FILE.egml`: an EGML event graph (docs/EVENTS.md) as a tree: each event with
 // its line, what it does and, where the graph says so by itself, how long it lasts.
 
+#include <cmath>
 #include <optional>
 
 #include <fmt/ostream.h>
@@ -8,6 +9,7 @@
 
 #include "command.hpp"
 #include "drape/events/graph.hpp"
+#include "drape/events/runtime.hpp"
 
 namespace drape::cli {
 namespace {
@@ -21,6 +23,10 @@ std::optional<double> lasts(const events::Event& e) {
   switch (e.kind) {
     case Kind::Wait: return e.duration_s;
     case Kind::Wind: return e.duration_s < 0.0 ? 0.0 : e.duration_s;
+    case Kind::Path: {
+      const double d = events::PathCourse(e).duration();
+      return d >= 0.0 ? std::optional<double>(d) : std::nullopt;  // steering: as far as the motion walks
+    }
     case Kind::Play:
       if (e.to_s < 0.0) return std::nullopt;
       return (e.to_s - e.from_s) / e.speed;
@@ -42,7 +48,7 @@ std::optional<double> lasts(const events::Event& e) {
       }
       break;
   }
-  if (e.kind != Kind::Parameters && d) d = *d / e.speed;
+  if (e.kind != Kind::Parameters && e.kind != Kind::Path && d) d = *d / e.speed;
   if ((e.kind == Kind::Sequence || e.kind == Kind::Parallel || e.kind == Kind::Loop) && e.duration_s >= 0.0)
     d = d ? std::min(*d, e.duration_s) : e.duration_s;
   return d;
@@ -73,6 +79,14 @@ std::string what(const events::Event& e) {
                          e.from_s, e.to_s < 0.0 ? "its end" : fmt::format("{:g} s", e.to_s),
                          e.speed != 1.0 ? fmt::format(" at {:g} times its speed", e.speed) : "",
                          fmt::format(", blending in over {:g} s", e.blend_s), e.anchor ? "" : ", not anchored");
+    case Kind::Path: {
+      const events::PathCourse course(e);
+      return fmt::format("{} points, {:.3g} m, {}{}", e.points.size(), course.length(),
+                         e.pathSpeed_mps > 0.0 ? fmt::format("carried at {:g} m/s", e.pathSpeed_mps)
+                                               : std::string("steering the character's own travel"),
+                         e.turn ? fmt::format(", turning {:.0f} degrees", course.turn(course.length()) * 180.0 / M_PI)
+                                : ", not turning");
+    }
     case Kind::Wind:
       return fmt::format("{:g} {:g} {:g} m/s{}", e.velocity.x(), e.velocity.y(), e.velocity.z(),
                          e.duration_s < 0.0 ? " from then on" : fmt::format(" for {:g} s", e.duration_s));

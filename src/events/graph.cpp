@@ -23,7 +23,8 @@ const std::map<std::string, Kind, std::less<>>& kinds() {
   static const std::map<std::string, Kind, std::less<>> table{
       {"Sequence", Kind::Sequence},     {"Parallel", Kind::Parallel},         {"Loop", Kind::Loop},
       {"Parameters", Kind::Parameters}, {"Condition", Kind::Condition},       {"StateMachine", Kind::StateMachine},
-      {"Wait", Kind::Wait},             {"Play", Kind::Play},                 {"Wind", Kind::Wind}};
+      {"Wait", Kind::Wait},             {"Play", Kind::Play},                 {"Wind", Kind::Wind},
+      {"Path", Kind::Path}};
   return table;
 }
 
@@ -166,6 +167,9 @@ class Builder {
       case Kind::Play:
         play(n, e);
         break;
+      case Kind::Path:
+        path(n, e);
+        break;
       case Kind::Wind: {
         const vrml::Field* v = n.field("velocity");
         if (v != nullptr && v->numbers.size() == 3) e.velocity = Vec3(v->numbers[0], v->numbers[1], v->numbers[2]);
@@ -220,6 +224,34 @@ class Builder {
       state.next = next.empty() ? -1 : static_cast<long>(find(s, next, "next"));
       e.children.push_back(std::move(state));
     }
+  }
+
+  void path(const vrml::Node& n, Event& e) {
+    e.character = text(n, "character");
+    const vrml::Field* p = n.field("points");
+    if (p != nullptr)
+      for (std::size_t k = 0; k + 2 < p->numbers.size(); k += 3)
+        e.points.emplace_back(p->numbers[k], p->numbers[k + 1], p->numbers[k + 2]);
+    if (e.points.size() < 2) throw fail(n, fmt::format("{} points: a path goes through 2 or more", e.points.size()), "points");
+    for (std::size_t k = 0; k < e.points.size(); ++k) {
+      if (!e.points[k].allFinite()) throw fail(n, fmt::format("point {} is not finite", k), "points");
+      if (k > 0) {
+        const Vec3 d = e.points[k] - e.points[k - 1];
+        if (std::hypot(d.x(), d.z()) < 1e-6)
+          throw fail(n, fmt::format("points {} and {} are one place on the floor: a path goes somewhere", k - 1, k),
+                     "points");
+      }
+    }
+    e.pathSpeed_mps = number(n, "speed", 0.0);
+    e.ease_s = number(n, "ease", 0.5);
+    e.corner_m = number(n, "corner", 0.5);
+    e.turn = number(n, "turn", 1.0) != 0.0;
+    if (!(e.pathSpeed_mps >= 0.0) || !std::isfinite(e.pathSpeed_mps))
+      throw fail(n, fmt::format("speed {} must be >= 0 m/s (0: as the character's motion travels)", e.pathSpeed_mps),
+                 "speed");
+    if (!(e.ease_s >= 0.0) || !std::isfinite(e.ease_s)) throw fail(n, fmt::format("ease {} must be >= 0 s", e.ease_s), "ease");
+    if (!(e.corner_m >= 0.0) || !std::isfinite(e.corner_m))
+      throw fail(n, fmt::format("corner {} must be >= 0 m", e.corner_m), "corner");
   }
 
   void play(const vrml::Node& n, Event& e) {
@@ -291,6 +323,7 @@ const char* kindName(Kind kind) {
     case Kind::Wait: return "Wait";
     case Kind::Play: return "Play";
     case Kind::Wind: return "Wind";
+    case Kind::Path: return "Path";
   }
   return "?";
 }

@@ -19,6 +19,15 @@ constexpr double kTimeEpsilon = 1e-9;
 /// Events that end without taking time, in one advance, before a loop of them is an error.
 constexpr int kMostZeroTimeRounds = 10000;
 
+/// An angle in (-pi, pi].
+double wrapped(double a) {
+  a = std::remainder(a, 2.0 * M_PI);
+  return a <= -M_PI ? a + 2.0 * M_PI : a;
+}
+
+/// The heading of a direction on the floor, as yawOf measures it.
+double headingOf(const Vec3& d) { return std::atan2(d.x(), d.z()); }
+
 /// The yaw of a rotation: its forward axis (+z) turned about the vertical.
 double yawOf(const Quat& q) {
   const Vec3 forward = q * Vec3::UnitZ();
@@ -312,6 +321,137 @@ class Play : public Running {
 
 }  // namespace
 
+PathCourse::PathCourse(const Event& e)
+    : points_(e.points), speed_(e.pathSpeed_mps), ease_(e.ease_s), corner_(e.turn ? e.corner_m : 0.0) {
+  lengths_.push_back(0.0);
+  for (std::size_t k = 1; k < points_.size(); ++k) {
+    const Vec3 d = points_[k] - points_[k - 1];
+    lengths_.push_back(lengths_.back() + std::hypot(d.x(), d.z()));
+  }
+  turns_.assign(points_.size(), 0.0);
+  if (!e.turn) return;
+  for (std::size_t k = 1; k + 1 < points_.size(); ++k)
+    turns_[k] = wrapped(headingOf(points_[k + 1] - points_[k]) - headingOf(points_[k] - points_[k - 1]));
+}
+
+Vec3 PathCourse::at(double s) const {
+  s = std::clamp(s, 0.0, length());
+  const auto k = static_cast<std::size_t>(std::upper_bound(lengths_.begin(), lengths_.end(), s) - lengths_.begin());
+  if (k >= points_.size()) return points_.back();
+  const double span = lengths_[k] - lengths_[k - 1];
+  return points_[k - 1] + (points_[k] - points_[k - 1]) * ((s - lengths_[k - 1]) / span);
+}
+
+double PathCourse::turn(double s) const {
+  double a = 0.0;
+  for (std::size_t k = 1; k + 1 < points_.size(); ++k) {
+    if (turns_[k] == 0.0) continue;
+    const double w = std::min({corner_, lengths_[k] - lengths_[k - 1], lengths_[k + 1] - lengths_[k]});
+    const double from = lengths_[k] - 0.5 * w;
+    const double part = w > 0.0 ? std::clamp((s - from) / w, 0.0, 1.0) : (s >= lengths_[k] ? 1.0 : 0.0);
+    a += turns_[k] * part;
+  }
+  return a;
+}
+
+double PathCourse::duration() const {
+  if (!(speed_ > 0.0)) return -1.0;
+  if (length() >= speed_ * ease_) return length() / speed_ + ease_;
+  return 2.0 * ease_;
+}
+
+double PathCourse::travelled(double t) const {
+  const double total = duration(), L = length();
+  if (t >= total) return L;
+  if (t <= 0.0) return 0.0;
+  if (ease_ <= 0.0) return speed_ * t;
+  // The speed reached: the path's own, or on a short path what half of it allows.
+  const double top = L >= speed_ * ease_ ? speed_ : L / ease_;
+  if (t < ease_) return 0.5 * top * t * t / ease_;
+  if (t > total - ease_) {
+    const double r = total - t;
+    return L - 0.5 * top * r * r / ease_;
+  }
+  return 0.5 * top * ease_ + top * (t - ease_);
+}
+
+/// A Path as it runs: its course, how far along it the character is, and what the Path
+/// event that runs it has seen of time. The scheduler holds the one it follows and moves
+/// the character at each composition; the event may end before that last step is made.
+struct PathState {
+  PathState(const Event& e) : course(e), carried(e.pathSpeed_mps > 0.0), where(e.where) {}
+
+  /// The carrier after this tick, from the one before and the root as the layers put it
+  /// at the last tick and now.
+  RigidTransform carry(const RigidTransform& carrier, const RigidTransform& before, const RigidTransform& now) {
+    if (!started) {
+      start = carrier.rotation;
+      started = true;
+    }
+    const Vec3 step = now.translation - before.translation;
+    double next = s;
+    if (carried) {
+      next = course.travelled(elapsed);
+    } else {
+      // Steering: the path goes as far as the character walks forwards, its sway aside.
+      Vec3 forward = now.rotation * Vec3::UnitZ();
+      forward.y() = 0.0;
+      if (forward.norm() > 1e-9) next = std::min(course.length(), s + std::max(0.0, Vec3(step.x(), 0.0, step.z()).dot(forward.normalized())));
+    }
+    const Quat rotation = (Quat(Eigen::AngleAxisd(course.turn(next), Vec3::UnitY())) * start).normalized();
+    Vec3 root = carrier.apply(before.translation) + rotation * step;
+    if (carried) root += course.at(next) - course.at(s);
+    s = next;
+    return {rotation, root - rotation * now.translation};
+  }
+  /// Whether it has done all it does: the course travelled, or its event stopped.
+  [[nodiscard]] bool done() const { return stopped || s >= course.length() - 1e-12; }
+
+  PathCourse course;
+  bool carried;
+  SourcePos where;
+  double s = 0.0;        ///< metres along the course
+  double elapsed = 0.0;  ///< seconds of the event's time
+  bool stopped = false;
+  bool ended = false;  ///< its event ran to its end (a carried one's last step still to make)
+  bool started = false;
+  Quat start = Quat::Identity();  ///< the carrier's rotation when the path started
+};
+
+namespace {
+
+class Path : public Running {
+ public:
+  Path(Scheduler& s, const Event& e) : s_(s), state_(std::make_shared<PathState>(e)) { s_.follow(state_); }
+  ~Path() override { stop(); }
+  double advance(double dt) override {
+    if (s_.following() != state_.get()) return dt;  // a later Path took over
+    if (state_->carried) {
+      const double total = state_->course.duration();
+      const double left = state_->elapsed + dt - total;
+      state_->elapsed = std::min(total, state_->elapsed + dt);
+      // Ends at its duration; the scheduler makes the last step at this tick's composition.
+      if (left < -kTimeEpsilon) return kRunning;
+      state_->ended = true;
+      return std::max(0.0, left);
+    }
+    state_->elapsed += dt;
+    if (!state_->done()) return kRunning;
+    state_->ended = true;
+    return 0.0;
+  }
+  /// Cut before its end: the character stays where this tick moves it to.
+  void stop() override {
+    if (s_.following() == state_.get() && !state_->ended) state_->stopped = true;
+  }
+
+ private:
+  Scheduler& s_;
+  std::shared_ptr<PathState> state_;
+};
+
+}  // namespace
+
 void Motions::load(const Graph& graph, const scene::Avatar& avatar, const motion::MotionOptions& options) {
   for (const auto& key : graph.motions()) {
     if (loaded_.contains(key)) continue;
@@ -349,10 +489,10 @@ Scheduler::~Scheduler() {
 
 void Scheduler::checkCharacters(const Event& e, const std::string& inherited) const {
   const std::string character = e.character.empty() ? inherited : e.character;
-  if (e.kind == Kind::Play && !character.empty() &&
+  if ((e.kind == Kind::Play || e.kind == Kind::Path) && !character.empty() &&
       std::find(names_.begin(), names_.end(), character) == names_.end())
-    throw Error::at(e.where, fmt::format("Play: character '{}' is not in the scene (its character answers to: {})",
-                                         character, fmt::join(names_, ", ")));
+    throw Error::at(e.where, fmt::format("{}: character '{}' is not in the scene (its character answers to: {})",
+                                         kindName(e.kind), character, fmt::join(names_, ", ")));
   for (const Event& c : e.children) checkCharacters(c, character);
 }
 
@@ -378,6 +518,7 @@ std::unique_ptr<Running> Scheduler::launch(const Event& e, const Context& contex
     case Kind::Wait: return std::make_unique<Wait>(e);
     case Kind::Play: return std::make_unique<Play>(*this, e, context);
     case Kind::Wind: return std::make_unique<Wind>(*this, e);
+    case Kind::Path: return std::make_unique<Path>(*this, e);
   }
   throw Error(e.where.str() + ": an event of no known kind", ExitCode::Internal);
 }
@@ -393,6 +534,11 @@ void Scheduler::setLayer(std::uint64_t id, std::span<const RigidTransform> pose,
       std::copy(pose.begin(), pose.end(), l.pose.begin());
       l.weight = weight;
     }
+}
+
+void Scheduler::follow(std::shared_ptr<PathState> path) {
+  if (path_ && !path_->done()) leaving_ = std::move(path_);
+  path_ = std::move(path);
 }
 
 std::uint64_t Scheduler::pushWind(const Vec3& velocity) {
@@ -415,6 +561,18 @@ void Scheduler::compose() {
       composite_[j] = l.weight >= 1.0 ? joint : motion::interpolate(composite_[j], joint, l.weight);
     }
   }
+  // The Path followed moves the character from where the last tick left it.
+  const RigidTransform root = composite_.front();
+  if (leaving_ && lastRoot_) carrier_ = leaving_->carry(carrier_, *lastRoot_, *lastRoot_);  // its course, up to now
+  leaving_.reset();
+  if (path_) {
+    if (lastRoot_) {  // a Path cut at this tick still makes the step up to the cut
+      carrier_ = path_->carry(carrier_, *lastRoot_, root);
+      carried_ = true;
+    }
+    if (path_->done()) path_.reset();
+  }
+  lastRoot_ = root;
   // Layers a later one covers whole are gone: nothing of them shows any more.
   for (std::size_t k = layers_.size(); k-- > 1;)
     if (layers_[k].weight >= 1.0) {
@@ -446,6 +604,8 @@ bool Scheduler::tick(Tick& out) {
   starting_.clear();
   compose();
   out.joints = composite_;
+  if (carried_)
+    for (RigidTransform& j : out.joints) j = carrier_ * j;
   out.wind = !winds_.empty() ? std::optional<Vec3>(winds_.back().second) : baseWind_;
   ++ticks_;
   return !graphs_.empty();
@@ -477,8 +637,8 @@ Rendered render(const Graph& graph, const Motions& motions, const scene::Avatar&
     }
   }
   if (maxFrames <= 0)
-    throw Error(fmt::format("{}: the event graph runs on past an hour (a Loop for ever, or a state machine that never "
-                            "ends): give the frames to render",
+    throw Error(fmt::format("{}: the event graph runs on past an hour (a Loop for ever, a state machine that never "
+                            "ends, or a steering Path longer than the walk it steers): give the frames to render",
                             graph.file.empty() ? "the graph" : graph.file));
   return r;
 }

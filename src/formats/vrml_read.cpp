@@ -39,7 +39,7 @@ const ScanOptions& scanOptions() {
     o.trackedTypes = {"ClothSet", "ClothMaterial", "Simulation", "Avatar",
                       // EGML's (docs/EVENTS.md): its errors name the line of the event too.
                       "EventGraph", "Sequence", "Parallel", "Loop", "Parameters", "Condition", "StateMachine",
-                      "State", "Wait", "Play", "Wind"};
+                      "State", "Wait", "Play", "Wind", "Path"};
     return o;
   }();
   return options;

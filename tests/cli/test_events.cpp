@@ -1,6 +1,7 @@
 // drape run --events: an EGML event graph drives the avatar (docs/EVENTS.md). A graph of one
 // Play is the motion it plays, to the byte; the bundled day's gust moves the skirt from the
-// frame it starts and not before; parameters and events reach the graph; errors say what to do.
+// frame it starts and not before; the bundled stroll's Path turns the walk round its bend;
+// parameters and events reach the graph; errors say what to do.
 
 #include <gtest/gtest.h>
 
@@ -82,6 +83,47 @@ EventGraph { children [
   EXPECT_FALSE(slurp(plain + "/segments/Hips.pc2") == slurp(going + "/segments/Hips.pc2")) << "--send go moved nothing";
 }
 
+/// The mean of a point cache's frame: where the body is.
+Vec3 centroid(const formats::Pc2Cache& cache, std::size_t frame) {
+  Vec3 sum = Vec3::Zero();
+  for (const Vec3& p : cache.frames.at(frame)) sum += p;
+  return sum / static_cast<double>(cache.frames.at(frame).size());
+}
+
+TEST(EventGraphRun, TheBundledStrollTurnsTheWalkRoundItsBend) {
+  // The bundled stroll, and the same walk with its steering Path taken out: the steered
+  // walk ends up about 43 degrees to the left of the straight one (its 3 m of path: 0.25 m
+  // ahead, 1.5 m of bend, the rest at 60 degrees; then half a metre more of walk at 60), the
+  // skirt on the body throughout.
+  ScratchDir dir("events-stroll");
+  const std::string stroll = std::string(DRAPE_SOURCE_DIR) + "/examples/event_graph/stroll.egml";
+  std::string text = slurp(stroll);
+  for (std::size_t at; (at = text.find("../walking_skirt/")) != std::string::npos;)
+    text.replace(at, 17, kSkirtDir + "/");
+  std::ofstream(dir / "stroll.egml") << text;
+  const std::string steer = "Path { points [ 0 0 0, 0 0 1, 1.732 0 2 ] corner 1.5 }";
+  ASSERT_NE(text.find(steer), std::string::npos);
+  text.replace(text.find(steer), steer.size(), "");
+  std::ofstream(dir / "straight.egml") << text;
+  const std::string steered = runInto(dir, "steered", "'" + kScene + "' --events '" + (dir / "stroll.egml") + "'");
+  const std::string straight = runInto(dir, "straight", "'" + kScene + "' --events '" + (dir / "straight.egml") + "'");
+  const formats::Pc2Cache a = formats::readPc2(steered + "/body.pc2"), b = formats::readPc2(straight + "/body.pc2");
+  ASSERT_EQ(a.frames.size(), b.frames.size());
+  const std::size_t start = 30, walked = 30 + 126;  // after the lead-in; 4.2 s of walk later
+  const Vec3 da = centroid(a, walked) - centroid(a, start), db = centroid(b, walked) - centroid(b, start);
+  const double turned = std::atan2(db.z() * da.x() - db.x() * da.z(), db.x() * da.x() + db.z() * da.z()) * 180.0 / M_PI;
+  EXPECT_GT(turned, 33.0) << da.transpose() << " against " << db.transpose();
+  EXPECT_LT(turned, 53.0) << da.transpose() << " against " << db.transpose();
+  // Then both are carried the same 0.8 m, standing.
+  const Vec3 ca = centroid(a, a.frames.size() - 1) - centroid(a, walked), cb = centroid(b, b.frames.size() - 1) - centroid(b, walked);
+  EXPECT_NEAR((ca - cb).norm(), 0.0, 0.05) << ca.transpose() << " against " << cb.transpose();
+  EXPECT_NEAR(Vec3(ca.x(), 0, ca.z()).norm(), 0.806, 0.05);
+  for (const std::string& run : {steered, straight}) {
+    EXPECT_EQ(statsOf(run)["vertex_substeps_inside_body"], 0) << run;
+    EXPECT_EQ(statsOf(run)["vertex_substeps_below_T0"], 0) << run;
+  }
+}
+
 TEST(EventGraphRun, ErrorsSayWhatToDo) {
   ScratchDir dir("events-errors");
   const std::string endless = writeScript(dir, "endless.egml", "Loop { children [ Wait { duration 1 } ] }\n");
@@ -110,6 +152,14 @@ TEST(EventGraphRun, ErrorsSayWhatToDo) {
   EXPECT_NE(r.out.find("EGML event graph 'walk, kick, walk', 2 events at its top, 2 motions, 7.4 s"), std::string::npos)
       << r.out;
   EXPECT_NE(r.out.find("Wind  (line 23): 4 0 0 m/s for 1.5 s"), std::string::npos) << r.out;
+  r = runDrape("inspect '" + std::string(DRAPE_SOURCE_DIR) + "/examples/event_graph/stroll.egml'", dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("Path  (line 19): 3 points, 3 m, steering the character's own travel, turning 60 degrees"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("Path  (line 23): 2 points, 0.806 m, carried at 0.5 m/s, not turning, 2.21245 s"),
+            std::string::npos)
+      << r.out;
 }
 
 }  // namespace

@@ -83,6 +83,27 @@ EventGraph {
   EXPECT_EQ(g.characters(), (std::vector<std::string>{"Body"}));
 }
 
+TEST(EgmlGraph, ReadsAPath) {
+  const Graph g = readGraph(script("path", R"(
+Parallel { children [
+  Path { points [ 0 0 0, 2 0 0, 2 0.5 3 ] speed 1.2 ease 0.25 corner 0.4 }
+  Path { points [ 0 0 0, 0 0 1 ] turn FALSE }
+] }
+)"));
+  const Event& carried = g.root.children[0].children[0];
+  EXPECT_EQ(carried.kind, Kind::Path);
+  EXPECT_EQ(carried.where.line, 4);
+  EXPECT_EQ(carried.points, (std::vector<Vec3>{Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(2, 0.5, 3)}));
+  EXPECT_FLOAT_EQ(static_cast<float>(carried.pathSpeed_mps), 1.2f);
+  EXPECT_EQ(carried.ease_s, 0.25);
+  EXPECT_FLOAT_EQ(static_cast<float>(carried.corner_m), 0.4f);
+  EXPECT_TRUE(carried.turn);
+  const Event& steering = g.root.children[0].children[1];
+  EXPECT_EQ(steering.pathSpeed_mps, 0.0);  // steers the character's own travel
+  EXPECT_EQ(steering.ease_s, 0.5);
+  EXPECT_FALSE(steering.turn);
+}
+
 TEST(EgmlGraph, WhatItCannotUseIsSaidWithItsLine) {
   const auto refused = [](const std::string& name, const std::string& text) {
     const std::string path = script(name, text);
@@ -111,6 +132,14 @@ TEST(EgmlGraph, WhatItCannotUseIsSaidWithItsLine) {
   EXPECT_NE(e9.find("Play: to 1 must be after from 2"), std::string::npos) << e9;
   auto [p10, e10] = refused("speed", "Parallel { speed 0 }\n");
   EXPECT_NE(e10.find("Parallel: speed 0 must be > 0"), std::string::npos) << e10;
+  auto [p11, e11] = refused("path1", "Path { points [ 1 0 1 ] }\n");
+  EXPECT_EQ(e11, p11 + ":2: Path: 1 points: a path goes through 2 or more") << e11;
+  auto [p12, e12] = refused("path2", "Path {\n  points [ 0 0 0, 1 0 0, 1 2 0 ] }\n");
+  EXPECT_EQ(e12, p12 + ":3: Path: points 1 and 2 are one place on the floor: a path goes somewhere") << e12;
+  auto [p13, e13] = refused("path3", "Path { points [ 0 0 0, 1 0 0 ] speed -1 }\n");
+  EXPECT_NE(e13.find("Path: speed -1 must be >= 0 m/s (0: as the character's motion travels)"), std::string::npos) << e13;
+  auto [p14, e14] = refused("path4", "Path { points [ 0 0 0, 1 0 0 ] ease -0.5 }\n");
+  EXPECT_NE(e14.find("Path: ease -0.5 must be >= 0 s"), std::string::npos) << e14;
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // The scheduler: when random graphs of control events end, against their durations worked
 // out by hand; Plays against the motions they play, to the bit; anchoring, blending,
-// conditions, state machines, wind and graphs started while others run.
+// conditions, state machines, wind, paths against their speed profile and turns worked out
+// by hand, and graphs started while others run.
 
 #include <gtest/gtest.h>
 
@@ -281,6 +282,136 @@ TEST(Scheduler, AGraphStartedWhileAnotherRunsTakesTheCharacterOver) {
   long more = 0;
   while (s.tick(tick)) ++more;
   EXPECT_EQ(more, static_cast<long>(w.alone.frameCount()) - 1 - 52);
+}
+
+Event pathEvent(std::vector<Vec3> points, double speed, double ease = 0.5, double corner = 0.0, bool turn = true) {
+  Event e;
+  e.kind = Kind::Path;
+  e.points = std::move(points);
+  e.pathSpeed_mps = speed;
+  e.ease_s = ease;
+  e.corner_m = corner;
+  e.turn = turn;
+  return e;
+}
+
+/// Where a path carried at `v` with ease `te` is after t seconds, from the constant
+/// acceleration v / te over the ease: v t^2 / (2 te), then v te / 2 + v (t - te), then the
+/// same backwards from its end.
+double trapezoid(double t, double length, double v, double te) {
+  const double total = length / v + te;
+  if (t <= te) return v * t * t / (2 * te);
+  if (t >= total) return length;
+  if (t >= total - te) return length - v * (total - t) * (total - t) / (2 * te);
+  return v * te / 2 + v * (t - te);
+}
+
+double yawOfRoot(const RigidTransform& r) {
+  const Vec3 f = r.rotation * Vec3::UnitZ();
+  return std::atan2(f.x(), f.z());
+}
+
+scene::Avatar twoJoints() {
+  scene::Avatar a = oneJoint();
+  a.joints.push_back({"Head", 0, Vec3(0, 1.6, 0.2)});
+  return a;
+}
+
+TEST(Scheduler, APathCarriesTheCharacterAtItsSpeedEasingInAndOut) {
+  // 2 m along x, then 2 m along z (a turn of 90 degrees to the right), at 1 m/s with half a
+  // second of ease; then a second's wait, where the character stays where it was carried.
+  const scene::Avatar avatar = twoJoints();
+  const Motions none;
+  const Graph g = graphOf(
+      control(Kind::Sequence, {pathEvent({Vec3(5, 0, 5), Vec3(7, 0, 5), Vec3(7, 0, 7)}, 1.0, 0.5), wait(1.0)}));
+  const Rendered r = render(g, none, avatar, {}, kRate, 0, {}, {});
+  ASSERT_EQ(r.frames, 166);  // 4.5 s of path, 1 s of waiting
+  for (long f = 0; f < r.frames; ++f) {
+    const double s = trapezoid(static_cast<double>(f) / kRate, 4.0, 1.0, 0.5);
+    const Vec3 want = s < 2 ? Vec3(s, 1, 0) : Vec3(2, 1, s - 2);
+    const double turn = s >= 2 ? -M_PI / 2 : 0.0;
+    const std::span<const RigidTransform> joints = r.animation.frame(static_cast<std::size_t>(f));
+    ASSERT_TRUE(joints[0].translation.isApprox(want, 1e-9)) << "frame " << f << ": " << joints[0].translation.transpose();
+    ASSERT_NEAR(yawOfRoot(joints[0]), turn, 1e-9) << "frame " << f;
+    // The body turns as one about the vertical through the root.
+    const Vec3 head = want + Quat(Eigen::AngleAxisd(turn, Vec3::UnitY())) * Vec3(0, 0.6, 0.2);
+    ASSERT_TRUE(joints[1].translation.isApprox(head, 1e-9)) << "frame " << f;
+  }
+  // Too short to reach its speed (0.2 m at 1 m/s with 0.5 s of ease): up and down in a second.
+  const Rendered shortPath = render(graphOf(pathEvent({Vec3(0, 0, 0), Vec3(0, 0, 0.2)}, 1.0, 0.5)), none, avatar, {},
+                                    kRate, 0, {}, {});
+  EXPECT_EQ(shortPath.frames, 31);
+  EXPECT_NEAR(shortPath.animation.frame(15)[0].translation.z(), 0.1, 1e-9);
+  EXPECT_NEAR(shortPath.animation.frame(30)[0].translation.z(), 0.2, 1e-9);
+}
+
+TEST(Scheduler, APathTurnsOverItsCornerAndNotAtAllWhenToldNot) {
+  const scene::Avatar avatar = oneJoint();
+  const Motions none;
+  // At 1 m/s without ease, a left turn of 90 degrees at 2 m, spread over a metre.
+  const std::vector<Vec3> points{Vec3(0, 0, 0), Vec3(0, 0, 2), Vec3(2, 0, 2)};
+  const Rendered r = render(graphOf(pathEvent(points, 1.0, 0.0, 1.0)), none, avatar, {}, kRate, 0, {}, {});
+  ASSERT_EQ(r.frames, 121);
+  for (long f = 0; f < r.frames; ++f) {
+    const double s = static_cast<double>(f) / kRate;
+    const double want = M_PI / 2 * std::clamp(s - 1.5, 0.0, 1.0);
+    ASSERT_NEAR(yawOfRoot(r.animation.frame(static_cast<std::size_t>(f))[0]), want, 1e-9) << "frame " << f;
+  }
+  const Rendered straight = render(graphOf(pathEvent(points, 1.0, 0.0, 1.0, false)), none, avatar, {}, kRate, 0, {}, {});
+  for (long f = 0; f < straight.frames; ++f)
+    ASSERT_NEAR(yawOfRoot(straight.animation.frame(static_cast<std::size_t>(f))[0]), 0.0, 1e-12) << "frame " << f;
+  EXPECT_TRUE(straight.animation.frame(120)[0].translation.isApprox(Vec3(2, 1, 2), 1e-9));
+}
+
+TEST(Scheduler, APathCutShortLeavesTheCharacterWhereItWasAndALaterOneTakesOver) {
+  const scene::Avatar avatar = oneJoint();
+  const Motions none;
+  const Event cut = control(Kind::Parallel, {pathEvent({Vec3(0, 0, 0), Vec3(5, 0, 0)}, 1.0, 0.0)}, 1.0, 1.0);
+  const Rendered r = render(graphOf(control(Kind::Sequence, {cut, wait(1.0)})), none, avatar, {}, kRate, 0, {}, {});
+  ASSERT_EQ(r.frames, 61);
+  for (long f = 30; f < r.frames; ++f)
+    ASSERT_TRUE(r.animation.frame(static_cast<std::size_t>(f))[0].translation.isApprox(Vec3(1, 1, 0), 1e-9)) << f;
+  // A second path starts after half a second, along z: the first stops where it was.
+  const Event second = control(Kind::Sequence, {wait(0.5), pathEvent({Vec3(0, 0, 0), Vec3(0, 0, 1)}, 1.0, 0.0)});
+  const Rendered both = render(graphOf(control(Kind::Parallel, {pathEvent({Vec3(0, 0, 0), Vec3(5, 0, 0)}, 1.0, 0.0), second})),
+                               none, avatar, {}, kRate, 0, {}, {});
+  EXPECT_EQ(both.frames, 46);
+  EXPECT_TRUE(both.animation.frame(45)[0].translation.isApprox(Vec3(0.5, 1, 1), 1e-9))
+      << both.animation.frame(45)[0].translation.transpose();
+}
+
+TEST(Scheduler, APathSteersAWalkAlongItsTurns) {
+  // The walk, steered along 1.5 m ahead and then 1.5 m to the right of where it heads; the
+  // wind that follows the path marks the tick it ends.
+  Walk w;
+  const Graph plain = graphOf(w.play());
+  const Event path = pathEvent({Vec3(0, 0, 0), Vec3(0, 0, 1.5), Vec3(-1.5, 0, 1.5)}, 0.0, 0.5, 0.5);
+  const Graph steered = graphOf(
+      control(Kind::Parallel, {w.play(), control(Kind::Sequence, {path, windEvent(Vec3(1, 0, 0), -1)})}));
+  const Rendered a = w.render(plain), b = w.render(steered);
+  ASSERT_EQ(a.frames, b.frames);
+  const auto root = [](const Rendered& r, long f) { return r.animation.frame(static_cast<std::size_t>(f))[0]; };
+  long ended = -1;
+  for (long f = 0; f < b.frames && ended < 0; ++f)
+    if (b.wind[static_cast<std::size_t>(f)]) ended = f;
+  ASSERT_GT(ended, 30) << "the path never ended";
+  const Vec3 travel = root(a, ended).translation - root(a, 0).translation;
+  // It ends when the walk has gone the path's 3 m forwards (its sway aside).
+  EXPECT_NEAR(Vec3(travel.x(), 0, travel.z()).norm(), 3.0, 0.15);
+  for (long f = 1; f < b.frames; ++f) {
+    // Each step is the walk's own, turned: as long, as high.
+    const Vec3 da = root(a, f).translation - root(a, f - 1).translation;
+    const Vec3 db = root(b, f).translation - root(b, f - 1).translation;
+    ASSERT_NEAR(da.norm(), db.norm(), 1e-9) << "frame " << f;
+    ASSERT_NEAR(root(a, f).translation.y(), root(b, f).translation.y(), 1e-9) << "frame " << f;
+  }
+  // It went 1.5 m the way it headed and 1.5 m to its right, and heads right from then on.
+  const double heading = std::atan2(travel.x(), travel.z());
+  const Vec3 want = Quat(Eigen::AngleAxisd(heading, Vec3::UnitY())) * Vec3(-1.5, 0, 1.5);
+  const Vec3 went = root(b, ended).translation - root(b, 0).translation;
+  EXPECT_LT((Vec3(went.x(), 0, went.z()) - want).norm(), 0.25) << went.transpose() << " against " << want.transpose();
+  for (long f = ended; f < b.frames; f += 10)
+    ASSERT_NEAR(std::remainder(yawOfRoot(root(b, f)) - yawOfRoot(root(a, f)) + M_PI / 2, 2 * M_PI), 0.0, 1e-9) << f;
 }
 
 TEST(Scheduler, WhatCannotRunIsSaid) {

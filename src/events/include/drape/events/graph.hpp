@@ -34,6 +34,7 @@ enum class Kind {
   Wait,          ///< nothing, for a while
   Play,          ///< a motion played on a character
   Wind,          ///< the wind
+  Path,          ///< the character's root moved along a path
 };
 
 [[nodiscard]] const char* kindName(Kind kind);
@@ -74,6 +75,15 @@ struct Event {
 
   // Wind: its velocity (m/s), for `duration` (< 0: from now on).
   Vec3 velocity = Vec3::Zero();
+
+  // Path: the points the root goes through (m, the scene's axes; only their differences
+  // count: the path starts where the character stands), the speed along it (m/s; 0: as
+  // fast as the character's own motion travels, which the path steers), the ease in and out
+  // of that speed (s), the length over which a corner turns the character (m), and whether
+  // it turns at all.
+  std::vector<Vec3> points;
+  double pathSpeed_mps = 0.0, ease_s = 0.5, corner_m = 0.5;
+  bool turn = true;
 };
 
 struct Graph {

@@ -15,7 +15,9 @@
 // last pose as a layer until a later one covers it, so the character holds where a motion
 // stopped. A joint's world transforms are blended as the micro-interpolation does (SLERP of
 // the rotation, linear translation); a Play anchored (the default) has its motion's path
-// turned and moved, about the vertical, to go on from where the character stands.
+// turned and moved, about the vertical, to go on from where the character stands. A Path
+// moves the whole composed pose about the vertical on top of that: carried at a speed, or
+// steering the character's own travel along its turns.
 
 #include <map>
 #include <memory>
@@ -47,6 +49,32 @@ class Motions {
   std::map<std::tuple<std::string, std::string, std::string>, std::unique_ptr<motion::AvatarAnimation>> loaded_;
 };
 
+/// A Path event's course, as its fields define it: the polyline by arc length, the turn
+/// the character makes along it, and, carried at a speed, where it is when.
+class PathCourse {
+ public:
+  explicit PathCourse(const Event& path);
+  /// Its length on the floor (m): the horizontal lengths of its segments.
+  [[nodiscard]] double length() const { return lengths_.back(); }
+  /// The point `s` metres along it (clamped to its ends); the height moves with the rest.
+  [[nodiscard]] Vec3 at(double s) const;
+  /// How far the character has turned about the vertical (radians, anticlockwise seen from
+  /// above; 0 at the start) `s` metres along: each corner's turn, spread over `corner`
+  /// metres centred on it (less where a segment beside it is shorter).
+  [[nodiscard]] double turn(double s) const;
+  /// Carried at its speed: how long it takes (s), and how far along it is after `t` seconds:
+  /// speeding up at a constant rate over the ease, then steady, then slowing down as it came
+  /// (on a path too short to reach its speed, it turns back half way).
+  [[nodiscard]] double duration() const;
+  [[nodiscard]] double travelled(double t) const;
+
+ private:
+  std::vector<Vec3> points_;
+  std::vector<double> lengths_;  ///< arc length at each point
+  std::vector<double> turns_;    ///< the turn at each inner point (radians)
+  double speed_, ease_, corner_;
+};
+
 /// What one tick gives.
 struct Tick {
   std::vector<RigidTransform> joints;  ///< the character's joints in the world
@@ -54,6 +82,7 @@ struct Tick {
 };
 
 class Running;
+struct PathState;
 
 class Scheduler {
  public:
@@ -92,6 +121,10 @@ class Scheduler {
   std::uint64_t addLayer(std::vector<RigidTransform> pose, double weight, std::optional<RigidTransform> root);
   /// Updates layer `id`'s pose and weight, if it is not covered yet.
   void setLayer(std::uint64_t id, std::span<const RigidTransform> pose, double weight);
+  /// The Path that moves the character from this tick's composition on; a Path started
+  /// after another takes over from it.
+  void follow(std::shared_ptr<PathState> path);
+  [[nodiscard]] const PathState* following() const { return path_.get(); }
   std::uint64_t pushWind(const Vec3& velocity);
   void popWind(std::uint64_t id);
   void setBaseWind(const Vec3& velocity) { baseWind_ = velocity; }
@@ -115,7 +148,15 @@ class Scheduler {
   std::vector<std::unique_ptr<Running>> starting_;  ///< started since the last tick
   std::vector<std::string> pending_;                ///< events sent since the last tick
   std::vector<Layer> layers_;
-  std::vector<RigidTransform> composite_;
+  std::vector<RigidTransform> composite_;  ///< the layers' pose, before the carrier
+  // Where the Paths have moved the character: the carrier, applied on top of the layers
+  // (anchoring reads the layers' pose, so a motion anchored after a Path goes on from
+  // where the path left it), and the root as the layers had it at the last tick.
+  RigidTransform carrier_ = RigidTransform::identity();
+  std::optional<RigidTransform> lastRoot_;
+  std::shared_ptr<PathState> path_;
+  std::shared_ptr<PathState> leaving_;  ///< taken over at this tick: its last step still to make
+  bool carried_ = false;  ///< a Path has moved it (else the layers' pose is the pose, to the bit)
   std::vector<std::pair<std::uint64_t, Vec3>> winds_;
   std::optional<Vec3> baseWind_;
   std::uint64_t nextId_ = 1;

@@ -163,7 +163,7 @@ TEST(VrmlRead, PreludeIsTheShippedFile) {
   EXPECT_EQ(names, (std::vector<std::string>{"ClothSet", "ClothMaterial", "Simulation", "Avatar", "Humanoid", "Joint",
                                              "Segment", "Site", "Displacer", "EventGraph", "Sequence", "Parallel",
                                              "Loop", "Parameters", "Condition", "StateMachine", "State", "Wait",
-                                             "Play", "Wind"}));
+                                             "Play", "Wind", "Path"}));
 }
 
 TEST(VrmlRead, ExternProtoToThePreludeLoads) {

@@ -160,17 +160,23 @@ ClothFrame clothFrame(std::int64_t frame, std::uint32_t garment, std::size_t ver
   return c;
 }
 
+/// A cloth take T of the poses "anim"'s take T on 'tester', from `start`.
+ClothStart clothStartOf(TimeCode start, std::vector<GarmentInfo> garments) {
+  ClothStart s;
+  s.poses = "anim";
+  s.poseTake = "T";
+  s.character = "tester";
+  s.start = start;
+  s.garments = std::move(garments);
+  return s;
+}
+
 TEST(ClothFollower, GathersEachFrameWholeAndReportsTheTakesError) {
   testing::NatsServer server;
   Bus bus = Bus::connect(server.url(), "test");
   bus.ensureStream("cloth");
-  ClothStart start;
-  start.poses = "anim";
-  start.poseTake = "T";
-  start.character = "tester";
-  start.start = TimeCode{60, 30.0};
+  ClothStart start = clothStartOf(TimeCode{60, 30.0}, {{"Skirt", 4}, {"Top", 2}});
   start.leadIn_s = 1.0;
-  start.garments = {{"Skirt", 4}, {"Top", 2}};
   send(bus, "cloth", "T", start, "start");
   // Garments out of order, one frame sent twice, one that fits no garment.
   send(bus, "cloth", "T", clothFrame(0, 1, 2), "0.1");
@@ -208,12 +214,7 @@ TEST(ClothFollower, SeeksToAnyFrameAsReadingFromTheStartWould) {
   testing::NatsServer server;
   Bus bus = Bus::connect(server.url(), "test");
   bus.ensureStream("cloth");
-  ClothStart start;
-  start.poses = "anim";
-  start.poseTake = "T";
-  start.character = "tester";
-  start.start = TimeCode{-30, 30.0};
-  start.garments = {{"Skirt", 3}, {"Top", 2}};
+  const ClothStart start = clothStartOf(TimeCode{-30, 30.0}, {{"Skirt", 3}, {"Top", 2}});
   send(bus, "cloth", "T", start, "start");
   constexpr std::int64_t kFrames = 150;
   std::mt19937 rng(11);
@@ -265,10 +266,7 @@ TEST(ClothFollower, HoldsTheNewestWholeFrameOfALiveTake) {
   testing::NatsServer server;
   Bus bus = Bus::connect(server.url(), "test");
   bus.ensureStream("cloth");
-  ClothStart start;
-  start.poses = "anim";
-  start.poseTake = "T";
-  start.garments = {{"Skirt", 3}, {"Top", 2}};
+  const ClothStart start = clothStartOf(TimeCode{0, 30.0}, {{"Skirt", 3}, {"Top", 2}});
   send(bus, "cloth", "T", start, "start");
   StreamReader stream(bus, "cloth", "player", 200ms, 10s);
   ClothFollower cloth(stream);

@@ -338,7 +338,7 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--motion", o->motion, std::string("Motion for the avatar ") + kMotionHelp);
   app.add_option("--events", o->events,
                  "Instead of --motion: an EGML event graph (.egml) that plays motions on the avatar, in sequence, "
-                 "blended, looped, by state, and sets the wind (docs/EVENTS.md)");
+                 "blended, looped, by state, moves it along paths and sets the wind (docs/EVENTS.md)");
   app.add_option("--set", o->sets, "With --events: a parameter of the graph, NAME=VALUE (its Conditions test them); repeatable");
   app.add_option("--send", o->sends,
                  "With --events: an event for the graph's state machines at a time of the script, EVENT@SECONDS; "

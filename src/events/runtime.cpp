@@ -379,7 +379,7 @@ double PathCourse::travelled(double t) const {
 /// event that runs it has seen of time. The scheduler holds the one it follows and moves
 /// the character at each composition; the event may end before that last step is made.
 struct PathState {
-  PathState(const Event& e) : course(e), carried(e.pathSpeed_mps > 0.0), where(e.where) {}
+  explicit PathState(const Event& e) : course(e), carried(e.pathSpeed_mps > 0.0), where(e.where) {}
 
   /// The carrier after this tick, from the one before and the root as the layers put it
   /// at the last tick and now.

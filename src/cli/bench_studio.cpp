@@ -18,8 +18,6 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <thread>
 #include <iostream>
 
@@ -29,6 +27,7 @@
 #include "bench_machine.hpp"
 #include "command.hpp"
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
 #include "drape/core/log.hpp"
 #include "drape/studio/bus.hpp"
 #include "drape/studio/local_server.hpp"
@@ -60,10 +59,7 @@ class DiscardSink final : public FrameSink {
   nlohmann::json stats_;
 };
 
-std::string slurpText(const fs::path& path) {
-  std::ifstream in(path);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+std::string slurpText(const fs::path& path) { return readFileText(path).value_or(""); }
 
 /// This drape with `args`, its output in `log`; returns its process.
 pid_t spawnDrape(const std::vector<std::string>& args, const fs::path& log) {

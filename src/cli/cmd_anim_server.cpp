@@ -71,9 +71,7 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup) {
     spdlog::warn("{}: the scene keeps {} apart, a correction of a whole motion: a live event graph plays without it",
                  o.scene, fmt::join(setup.character->keepApart, ", "));
   const double rate = setup.settings.frameRate_hz;
-  motion::MotionOptions mo;
-  mo.clip.rate = rate;
-  mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
+  const motion::MotionOptions mo = motionOptions(setup);
   std::list<events::Graph> graphs;
   graphs.push_back(events::readGraph(o.events));
   events::Motions motions;
@@ -90,7 +88,8 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup) {
   for (const scene::Joint& j : avatar.joints) start.joints.push_back(j.name);
   start.driving.assign(avatar.joints.size(), -1);
   start.start = TimeCode{0, rate};
-  start.frames = o.frames;  // 0: live, as long as it runs
+  // Known ahead only when it holds to --frames; else 0: live, as long as its graphs run.
+  start.frames = o.hold ? o.frames : 0;
   publisher.beginTake(take, start);
   std::signal(SIGINT, askToStop);
   std::signal(SIGTERM, askToStop);

@@ -3,14 +3,13 @@
 // what the character does, or an event for the state machines of the graphs running.
 
 #include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <iterator>
 
 #include <fmt/format.h>
 
 #include "command.hpp"
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
 #include "drape/events/graph.hpp"
 #include "drape/studio/bus.hpp"
 #include "drape/studio/messages.hpp"
@@ -33,8 +32,7 @@ int runInject(const InjectOptions& o) {
   if (!o.graph.empty()) {
     // Read here first, so that a script with a mistake is told here, with its lines.
     (void)events::readGraph(o.graph);
-    std::ifstream file(o.graph, std::ios::binary);
-    in.graph.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+    in.graph = readFileText(o.graph).value_or("");
     in.baseDir = std::filesystem::absolute(o.graph).parent_path().string();
   }
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape inject");

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -14,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
 #include "drape/core/progress.hpp"
 #include "drape/core/timecode.hpp"
 #include "drape/formats/json_text.hpp"
@@ -29,10 +28,9 @@ using render::MeshRole;
 /// DIR/stats.json, or null when the run has none (runs cut short by a failed write).
 nlohmann::json readStats(const std::filesystem::path& directory) {
   const std::filesystem::path path = directory / "stats.json";
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return nullptr;
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  nlohmann::json stats = formats::parseJsonText(text, path.string());
+  const std::optional<std::string> text = readFileText(path);
+  if (!text) return nullptr;
+  nlohmann::json stats = formats::parseJsonText(*text, path.string());
   if (!stats.is_object()) throw Error(fmt::format("{}: expected a JSON object", path.string()));
   return stats;
 }

@@ -6,7 +6,6 @@
 #include <exception>
 #include <filesystem>
 #include <array>
-#include <fstream>
 #include <limits>
 #include <optional>
 #include <span>
@@ -18,6 +17,7 @@
 #include "drape/cloth/model.hpp"
 #include "drape/cloth/solver.hpp"
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
 #include "drape/core/log.hpp"
 #include "drape/core/progress.hpp"
 #include "drape/events/runtime.hpp"
@@ -210,17 +210,22 @@ RunSetup runSetupFromScene(const std::string& scenePath, const std::optional<std
   return setup;
 }
 
+motion::MotionOptions motionOptions(const RunSetup& setup) {
+  motion::MotionOptions mo;
+  mo.clip.rate = setup.settings.frameRate_hz;
+  mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
+  return mo;
+}
+
 void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerUnit, const std::string& jointMap,
                const std::string& animation, const formats::SkinnedJointMotion* sampled) {
   if (!setup.character)
     throw Error("--motion: there is no avatar to move (the scene has none; without a scene, give --avatar FILE)");
-  motion::MotionOptions mo;
-  mo.clip.rate = setup.settings.frameRate_hz;
+  motion::MotionOptions mo = motionOptions(setup);
   if (metresPerUnit > 0) mo.clip.metresPerUnit = metresPerUnit;
   mo.jointMapPath = jointMap;
   mo.animation = animation;
   mo.sampled = sampled;
-  mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
   motion::ClipLoadReport report;
   motion::JointMap map;
   setup.character->animation = std::make_shared<const motion::AvatarAnimation>(
@@ -280,12 +285,9 @@ void addEvents(RunSetup& setup, const std::string& graphPath, const std::vector<
   if (!setup.character) throw Error("--events: there is no avatar for the event graph to move");
   const events::Graph graph = events::readGraph(graphPath);
   const scene::Avatar& avatar = *setup.character->avatar;
-  motion::MotionOptions mo;
-  mo.clip.rate = setup.settings.frameRate_hz;
-  mo.jointMapDirectory = std::string(DRAPE_SHARE_DIR) + "/jointmaps";
-  auto motions = std::make_shared<events::Motions>();
-  motions->load(graph, avatar, mo);
-  events::Rendered r = events::render(graph, *motions, avatar, setup.character->names, setup.settings.frameRate_hz,
+  events::Motions motions;
+  motions.load(graph, avatar, motionOptions(setup));
+  events::Rendered r = events::render(graph, motions, avatar, setup.character->names, setup.settings.frameRate_hz,
                                       motionFrames, timedEvents(sends), parameterOptions(sets));
   spdlog::info("{}: the event graph runs {} frames ({:.2f} s){}", graphPath, r.frames,
                static_cast<double>(r.frames - 1) / setup.settings.frameRate_hz,
@@ -302,9 +304,7 @@ namespace {
 /// null when nothing moves it. A file without any ROUTE, the common case, is not read again.
 std::shared_ptr<const formats::SkinnedJointMotion> humanoidMotion(const scene::Avatar& avatar, double rate) {
   if (!formats::isVrmlPath(avatar.source)) return nullptr;
-  std::ifstream in(avatar.source, std::ios::binary);
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (text.find("ROUTE") == std::string::npos) return nullptr;
+  if (readFileText(avatar.source).value_or("").find("ROUTE") == std::string::npos) return nullptr;
   for (formats::SkinnedJointMotion& m : formats::readHanimMotions(avatar.source, rate))
     if (m.animation == avatar.name) return std::make_shared<const formats::SkinnedJointMotion>(std::move(m));
   return nullptr;

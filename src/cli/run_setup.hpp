@@ -98,6 +98,10 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
                const std::string& jointMap = "", const std::string& animation = "",
                const formats::SkinnedJointMotion* sampled = nullptr);
 
+/// How motion files load onto the setup's avatar: at its frame rate, with the shipped joint
+/// maps (what --motion and an event graph's Plays share).
+[[nodiscard]] motion::MotionOptions motionOptions(const RunSetup& setup);
+
 /// Plays an EGML event graph (docs/EVENTS.md) on the setup's avatar: its motion and the wind
 /// it sets. `sets` are NAME=VALUE parameters, `sends` NAME@SECONDS events; `motionFrames` > 0
 /// renders that many motion frames at most (an endless graph needs it).

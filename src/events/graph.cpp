@@ -3,7 +3,6 @@
 #include "drape/events/graph.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -12,6 +11,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "drape/core/files.hpp"
 #include "drape/formats/vrml_read.hpp"
 
 namespace drape::events {
@@ -352,10 +352,6 @@ Graph parseGraph(std::string_view text, const std::string& name, const std::stri
   return Builder(doc, baseDir).build();
 }
 
-bool isEgmlPath(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext == ".egml";
-}
+bool isEgmlPath(const std::string& path) { return lowerExtension(path) == ".egml"; }
 
 }  // namespace drape::events

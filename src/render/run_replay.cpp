@@ -2,14 +2,13 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
 #include "drape/formats/json_text.hpp"
 #include "drape/formats/obj.hpp"
 #include "drape/formats/pc2.hpp"
@@ -31,10 +30,9 @@ static_assert((vertex_state::kCollisionMask | vertex_state::kPinned | vertex_sta
 /// business; a malformed file, or columns that do not hold a value per frame, is reported.
 std::vector<std::vector<StageTime>> readStageTimes(const std::filesystem::path& directory, std::int64_t frames) {
   const std::filesystem::path path = directory / "stats.json";
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return {};
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const nlohmann::json j = formats::parseJsonText(text, path.string());
+  const std::optional<std::string> text = readFileText(path);
+  if (!text) return {};
+  const nlohmann::json j = formats::parseJsonText(*text, path.string());
   if (!j.is_object()) return {};
   if (j.contains("frame_ms_per_stage") && j["frame_ms_per_stage"].is_object()) {
     std::vector<std::vector<StageTime>> stages(static_cast<std::size_t>(frames));

@@ -36,9 +36,15 @@ int runInject(const InjectOptions& o) {
     in.baseDir = std::filesystem::absolute(o.graph).parent_path().string();
   }
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape inject");
-  const std::vector<std::uint8_t> answer =
-      bus.request(studio::requestSubjectOf(o.to), studio::encode(studio::Message{"inject", "", in}),
-                  std::chrono::milliseconds(static_cast<long long>(1000.0 * o.timeout_s)));
+  std::vector<std::uint8_t> answer;
+  try {
+    answer = bus.request(studio::requestSubjectOf(o.to), studio::encode(studio::Message{"inject", "", in}),
+                         std::chrono::milliseconds(static_cast<long long>(1000.0 * o.timeout_s)));
+  } catch (const Error& e) {
+    if (e.code() != ExitCode::Unavailable) throw;
+    throw Error(fmt::format("{} (is 'drape anim-server --name {} --events FILE.egml' running on it?)", e.what(), o.to),
+                ExitCode::Unavailable);
+  }
   const studio::Message m = studio::decode(answer);
   const auto* reply = std::get_if<studio::InjectReply>(&m.payload);
   if (reply == nullptr) throw Error(fmt::format("'{}' answered with a {}, not a reply", o.to, studio::describe(m.payload)));

@@ -328,10 +328,6 @@ std::optional<Received> Reader::next(std::chrono::milliseconds timeout) {
   return out;
 }
 
-}  // namespace drape::studio
-
-namespace drape::studio {
-
 struct Listener::Impl {
   Bus::Impl* bus = nullptr;
   std::string subject;
@@ -388,8 +384,7 @@ std::vector<std::uint8_t> Bus::request(const std::string& subject, std::span<con
   const natsStatus s = natsConnection_Request(&reply, impl_->connection, subject.c_str(), data.data(),
                                               static_cast<int>(data.size()), timeout.count());
   if (s == NATS_NO_RESPONDERS)
-    throw Error(fmt::format("{}: nobody listens on {} (is the anim-server running, with --events?)", impl_->url, subject),
-                ExitCode::Unavailable);
+    throw Error(fmt::format("{}: nobody listens on {}", impl_->url, subject), ExitCode::Unavailable);
   if (s == NATS_TIMEOUT)
     throw Error(fmt::format("{}: no answer on {} within {:g} s", impl_->url, subject,
                             static_cast<double>(timeout.count()) / 1000.0),

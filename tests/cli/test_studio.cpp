@@ -296,7 +296,10 @@ TEST(Studio, ALiveEventGraphTakesEventsAndGraphsInjected) {
   EXPECT_NE(r.err.find(broken + ":2: Play: from -1 must be >= 0 s"), std::string::npos) << r.err;
   r = runDrape("inject --to nobody --event walk" + roles(server), dir);
   EXPECT_EQ(r.code, 4);
-  EXPECT_NE(r.err.find("nobody listens on drape.nobody.inject"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("nobody listens on drape.nobody.inject (is 'drape anim-server --name nobody --events FILE.egml' "
+                       "running on it?)"),
+            std::string::npos)
+      << r.err;
   const CliResult sent = anim.wait();
   ASSERT_EQ(sent.code, 0) << sent.err;
   EXPECT_NE(sent.out.find("150 pose frames"), std::string::npos) << sent.out;

@@ -379,7 +379,7 @@ double PathCourse::travelled(double t) const {
 /// event that runs it has seen of time. The scheduler holds the one it follows and moves
 /// the character at each composition; the event may end before that last step is made.
 struct PathState {
-  explicit PathState(const Event& e) : course(e), carried(e.pathSpeed_mps > 0.0), where(e.where) {}
+  explicit PathState(const Event& e) : course(e), carried(e.pathSpeed_mps > 0.0) {}
 
   /// The carrier after this tick, from the one before and the root as the layers put it
   /// at the last tick and now.
@@ -409,9 +409,8 @@ struct PathState {
 
   PathCourse course;
   bool carried;
-  SourcePos where;
   double s = 0.0;        ///< metres along the course
-  double elapsed = 0.0;  ///< seconds of the event's time
+  double elapsed = 0.0;  ///< seconds of the event's time (carried: its place on the speed profile)
   bool stopped = false;
   bool ended = false;  ///< its event ran to its end (a carried one's last step still to make)
   bool started = false;
@@ -435,7 +434,6 @@ class Path : public Running {
       state_->ended = true;
       return std::max(0.0, left);
     }
-    state_->elapsed += dt;
     if (!state_->done()) return kRunning;
     state_->ended = true;
     return 0.0;

@@ -6,6 +6,8 @@
 #include <chrono>
 #include <csignal>
 #include <list>
+#include <optional>
+#include <vector>
 #include <thread>
 
 #include <fmt/format.h>
@@ -13,9 +15,12 @@
 
 #include "command.hpp"
 #include "drape/core/error.hpp"
+#include "drape/core/line_stream.hpp"
 #include "drape/core/log.hpp"
 #include "drape/core/progress.hpp"
 #include "drape/events/runtime.hpp"
+#include "drape/formats/bvh.hpp"
+#include "drape/motion/live_motion.hpp"
 #include "drape/studio/publisher.hpp"
 #include "drape/studio/takes.hpp"
 #include "run_setup.hpp"
@@ -25,7 +30,7 @@ namespace drape::cli {
 namespace {
 
 struct AnimServerOptions {
-  std::string scene, motion, animation, name = "anim", take, events;
+  std::string scene, motion, animation, name = "anim", take, events, live;
   std::vector<std::string> sets;
   long frames = 0;
   bool fast = false, hold = false;
@@ -136,6 +141,160 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup) {
   return 0;
 }
 
+/// Waits between lines of a live source, and how often it says what it waits for.
+constexpr std::chrono::milliseconds kLiveTick{200};
+
+/// Opens `--live SOURCE`; a TCP source that is not up yet is tried again each second, saying
+/// so every `patience`, until `giveUp` (0: for ever) or a signal.
+LineStream openLiveSource(const std::string& source, std::chrono::milliseconds patience, std::chrono::milliseconds giveUp) {
+  const auto began = std::chrono::steady_clock::now();
+  auto said = began;
+  for (;;) {
+    try {
+      return LineStream::open(source);
+    } catch (const Error& e) {
+      if (e.code() != ExitCode::Unavailable) throw;
+      const auto now = std::chrono::steady_clock::now();
+      if (stopAsked || (giveUp.count() > 0 && now - began >= giveUp))
+        throw Error(fmt::format("{}; gave up after {:.0f} s", e.what(), std::chrono::duration<double>(now - began).count()),
+                    ExitCode::Unavailable);
+      if (now - said >= patience) {
+        spdlog::info("{}; trying again each second", e.what());
+        said = now;
+      }
+      std::this_thread::sleep_for(std::chrono::seconds(1));
+    }
+  }
+}
+
+/// Waits for a line of a live source, saying what it waits for every `patience`; nothing
+/// when the source has ended, a signal came, or it stayed silent for `giveUp` (0: for ever),
+/// which `silent` then says.
+std::optional<std::string> nextLiveLine(LineStream& source, std::chrono::milliseconds patience,
+                                        std::chrono::milliseconds giveUp, const char* awaiting, bool& silent) {
+  const auto began = std::chrono::steady_clock::now();
+  auto said = began;
+  std::string line;
+  for (;;) {
+    const LineStream::Status status = source.next(line, kLiveTick);
+    if (status == LineStream::Status::Line) return line;
+    if (status == LineStream::Status::Ended || stopAsked) return std::nullopt;
+    const auto now = std::chrono::steady_clock::now();
+    if (giveUp.count() > 0 && now - began >= giveUp) {
+      silent = true;
+      return std::nullopt;
+    }
+    if (now - said >= patience) {
+      spdlog::info("waiting for {} from {} ({:.0f} s silent, after line {})", awaiting, source.name(),
+                   std::chrono::duration<double>(now - began).count(), source.lineNumber());
+      said = now;
+    }
+  }
+}
+
+/// The BVH header of a live source: its lines up to "Frame Time:". Throws where the source
+/// ends or goes silent first, or the header runs past any BVH's size.
+std::string readLiveHeader(LineStream& source, const StudioOptions& studio) {
+  constexpr std::size_t kMaxHeader = std::size_t{16} << 20;
+  std::string header;
+  bool silent = false;
+  while (const std::optional<std::string> line = nextLiveLine(source, studio.patience(), studio.giveUp(), "a BVH header", silent)) {
+    header += *line;
+    header += '\n';
+    if (formats::endsBvhHeader(*line)) return header;
+    if (header.size() > kMaxHeader)
+      throw Error(fmt::format("{}:{}: no 'Frame Time:' in the first {} MiB: not a BVH header", source.name(),
+                              source.lineNumber(), kMaxHeader >> 20));
+  }
+  if (silent) throw Error(fmt::format("{}: no BVH header came within --give-up", source.name()), ExitCode::Unavailable);
+  if (stopAsked) throw Error(fmt::format("{}: stopped (a signal) before the BVH header came", source.name()));
+  if (!source.endReason().empty())
+    throw Error(fmt::format("{}: {} before its BVH header ended", source.name(), source.endReason()), ExitCode::Unavailable);
+  // What there is, parsed, says what is missing where.
+  (void)formats::parseBvhHeader(header, source.name());
+  throw Error(fmt::format("{}:{}: the source ended before its BVH header did", source.name(), source.lineNumber()));
+}
+
+/// `--live SOURCE`: a BVH written while it is captured, from standard input, a TCP server or
+/// a named pipe, retargeted and sent frame by frame as it comes (motion/live_motion.hpp).
+int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
+  const scene::Avatar& avatar = *setup.character->avatar;
+  if (!setup.character->keepApart.empty())
+    spdlog::warn("{}: the scene keeps {} apart, a correction of a whole motion: a live motion plays without it", o.scene,
+                 fmt::join(setup.character->keepApart, ", "));
+  std::signal(SIGINT, askToStop);
+  std::signal(SIGTERM, askToStop);
+  // The server first: a studio with no NATS server is said before the capture is waited for.
+  studio::Bus bus = studio::Bus::connect(o.studio.server, "drape anim-server " + o.name);
+  LineStream source = openLiveSource(o.live, o.studio.patience(), o.studio.giveUp());
+  spdlog::info("reading a live BVH from {}", source.name());
+  const formats::BvhFile header = formats::parseBvhHeader(readLiveHeader(source, o.studio), source.name());
+  motion::LiveMotion live(avatar, header, motionOptions(setup));
+
+  studio::Publisher publisher(bus, o.name, studio::Precision::Double, o.studio.giveUp());
+  const std::string take = o.take.empty() ? studio::newTakeId() : o.take;
+  studio::PoseStart start;
+  start.character = avatar.name;
+  for (const scene::Joint& j : avatar.joints) start.joints.push_back(j.name);
+  start.driving.assign(live.drivingJoint().begin(), live.drivingJoint().end());
+  start.start = TimeCode{0, live.rate()};
+  start.frames = 0;  // live: as long as the source sends
+  publisher.beginTake(take, start);
+  spdlog::info("take {}: live motion from {} ({} joints at {:g} Hz in {}, joint map '{}') on {}, sent at {:g} Hz as it "
+               "comes, on {} ({})",
+               take, source.name(), header.joints.size(), live.sourceRate(), live.report().units.name,
+               live.jointMap().name, avatar.name, live.rate(), studio::subjectOf(o.name), bus.url());
+
+  const auto began = std::chrono::steady_clock::now();
+  std::vector<double> values(header.channelCount), previous;
+  studio::PoseFrame frame;
+  frame.joints.resize(live.jointCount());
+  std::int64_t sent = 0;
+  std::size_t badLines = 0;
+  const auto sendReady = [&] {
+    while (live.next(frame.joints)) {
+      frame.frame = sent++;
+      publisher.send(frame);
+      if (sent == 1) spdlog::info("the first pose frame is out; frames follow as the capture sends them");
+    }
+  };
+  bool silent = false;
+  while (const std::optional<std::string> line =
+             nextLiveLine(source, o.studio.patience(), o.studio.giveUp(), "motion frames", silent)) {
+    if (line->find_first_not_of(" \t\r") == std::string::npos) continue;
+    try {
+      formats::parseBvhFrameLine(*line, source.name(), source.lineNumber(), values);
+      previous = values;
+    } catch (const Error& e) {
+      // A live take survives a bad line: the frame before it stands in, so the motion keeps its time.
+      if (++badLines <= 10 || badLines % 100 == 0)
+        spdlog::warn("{} ({})", e.what(),
+                     previous.empty() ? "skipped: no frame before it" : "the frame before it stands in");
+      if (previous.empty()) continue;
+      values = previous;
+    }
+    live.push(values);
+    sendReady();
+  }
+  std::string ended;
+  if (silent) {
+    ended = fmt::format("{} went silent for {:g} s (--give-up)", source.name(), o.studio.giveUp_s);
+  } else if (stopAsked) {
+    ended = "stopped (a signal)";
+  } else {
+    live.finish();
+    sendReady();
+    if (!source.endReason().empty()) ended = fmt::format("{}: {}", source.name(), source.endReason());
+  }
+  publisher.send(studio::End{sent, "", ended, silent ? static_cast<int>(ExitCode::Unavailable) : 0});
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+  fmt::print("sent take {}: {} pose frames of {} from {} ({} source frames{}) to {} on {} in {:.1f} s{}\n", take, sent,
+             avatar.name, source.name(), live.sourceFrames(),
+             badLines > 0 ? fmt::format(", {} bad lines", badLines) : std::string(), studio::subjectOf(o.name),
+             bus.url(), seconds, ended.empty() ? "" : " (" + ended + ")");
+  return silent ? static_cast<int>(ExitCode::Unavailable) : 0;
+}
+
 /// The pose take's first message: the avatar, its joints and how the frames are numbered.
 studio::PoseStart poseStart(const scene::Avatar& avatar, const motion::AvatarAnimation& motion) {
   studio::PoseStart start;
@@ -152,6 +311,15 @@ int runAnimServer(const AnimServerOptions& o) {
   studio::checkSourceName(o.name, "--name");
   RunSetup setup = runSetupFromScene(o.scene);
   if (!setup.character) throw Error(fmt::format("{}: the scene has no avatar to move", o.scene));
+  if (!o.live.empty()) {
+    if (!o.motion.empty() || !o.animation.empty() || !o.events.empty())
+      throw Error(fmt::format("--live plays the motion its source sends: give it or {}, not both",
+                              !o.events.empty() ? "--events" : !o.motion.empty() ? "--motion" : "--animation"));
+    if (!o.sets.empty() || o.hold || o.frames > 0 || o.fast)
+      throw Error(fmt::format("{}: a live take goes at the pace its source sends, for as long",
+                              !o.sets.empty() ? "--set" : o.hold ? "--hold" : o.frames > 0 ? "--frames" : "--fast"));
+    return runLiveMotion(o, setup);
+  }
   if (!o.events.empty()) {
     if (!o.motion.empty() || !o.animation.empty())
       throw Error("--events plays an event graph's motions: give it or --motion, not both");
@@ -221,14 +389,20 @@ RunFunction setupAnimServer(CLI::App& app) {
   app.add_option("--events", o.events,
                  "Instead of a motion: play an EGML event graph live (docs/EVENTS.md), taking graphs and events "
                  "injected while it runs (drape inject --to NAME)");
+  app.add_option("--live", o.live,
+                 "Instead of a motion: a BVH written while it is captured, from SOURCE: - (standard input), "
+                 "tcp://HOST:PORT (connected to) or a named pipe; its frames are sent as they come, retargeted as "
+                 "--motion retargets a file (docs/MOTION.md), until the source closes or Ctrl-C")
+      ->type_name("SOURCE");
   app.add_option("--set", o.sets, "With --events: a parameter of the graph, NAME=VALUE; repeatable");
   app.add_flag("--hold", o.hold,
                "With --events: go on when the graphs end, the character holding its pose, until stopped (Ctrl-C, "
                "SIGTERM) or --frames");
   app.add_option("--frames", o.frames, "With --events: end the take after N frames")->check(CLI::PositiveNumber);
-  o.studio.add(app, "a server");
+  o.studio.add(app, "a server (with --live, without a line from the source)");
   app.footer("Every role reads the same scene: what it says of the avatar (cutAtJoints, keepApart) they all do alike.\n"
-             "Exit codes: 0 sent, 2 bad input, 4 no NATS server with JetStream answers.");
+             "Exit codes: 0 sent, 2 bad input, 4 no NATS server with JetStream answers (or a --live source that does not "
+             "answer, or stays silent past --give-up).");
   return [] { return runAnimServer(o); };
 }
 

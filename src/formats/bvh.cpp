@@ -1,6 +1,7 @@
 #include "drape/formats/bvh.hpp"
 
 #include <algorithm>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -182,6 +183,42 @@ BvhFile parseBvh(std::string_view text, const std::string& name) {
   readMotionHeader(s, out);
   readFrames(s, text, out);
   return out;
+}
+
+BvhFile parseBvhHeader(std::string_view text, const std::string& name) {
+  BvhFile out;
+  out.source = name;
+  WordScanner s(text, name);
+  readHierarchy(s, out);
+  readMotionHeader(s, out);
+  if (!s.atEnd()) {
+    const Word w = s.next();
+    throw Error::at(s.pos(w), fmt::format("expected the header to end after 'Frame Time:', found {}", quoted(w.text)));
+  }
+  return out;
+}
+
+bool endsBvhHeader(std::string_view line) {
+  const std::vector<detail::LineWord> words = detail::lineWords(line, 3);
+  if (words.empty() || words[0].text != "Frame") return false;
+  return words.size() > 1 && words[1].text.substr(0, 5) == "Time:";
+}
+
+void parseBvhFrameLine(std::string_view line, const std::string& name, int lineNumber, std::span<double> out) {
+  const std::vector<detail::LineWord> words = detail::lineWords(line, out.size() + 1);
+  for (std::size_t i = 0; i < words.size() && i < out.size(); ++i) {
+    const std::optional<double> v = detail::finiteNumber(words[i].text);
+    if (!v)
+      throw Error::at({name, lineNumber, words[i].column},
+                      fmt::format("expected a number, found {}", quoted(words[i].text)));
+    out[i] = *v;
+  }
+  if (words.size() != out.size()) {
+    const int column = words.size() > out.size() ? words[out.size()].column : static_cast<int>(line.size()) + 1;
+    throw Error::at({name, lineNumber, column},
+                    fmt::format("expected {} values (one per channel), found {}", out.size(),
+                                words.size() > out.size() ? "more" : std::to_string(words.size())));
+  }
 }
 
 BvhFile readBvh(const std::string& path) { return parseBvh(detail::readWholeFile(path), path); }

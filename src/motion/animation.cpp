@@ -237,28 +237,29 @@ double avatarFloor(const scene::Avatar& avatar) {
   return std::isinf(floor) ? 0.0 : floor;
 }
 
-// The capture floor is seldom level over a take (the CMU walk in data/ rises about 7 cm
-// in 3 s), so a fixed root height leaves the feet floating or sinking as the clip goes on.
-// Grounding measures the avatar's own lowest point per frame, takes its minimum over each
-// window of about one gait cycle (1 s) and smooths that over the same window: the result
-// is the floor the motion walks on, subtracted from every joint's height.
-std::vector<double> measureGround(const scene::Avatar& avatar, const std::vector<RigidTransform>& world,
-                                     std::size_t frames, double rate, double floor) {
-  const std::size_t n = avatar.joints.size();
-  // Up to 256 points per segment are plenty to find its lowest point.
+// Up to 256 points per segment are plenty to find its lowest point.
+std::vector<std::pair<int, Vec3>> groundSamples(const scene::Avatar& avatar) {
   std::vector<std::pair<int, Vec3>> samples;
   for (const scene::Segment& s : avatar.segments) {
     const std::size_t stride = std::max<std::size_t>(1, s.mesh.positions.size() / 256);
     for (std::size_t v = 0; v < s.mesh.positions.size(); v += stride) samples.emplace_back(s.joint, s.mesh.positions[v]);
   }
+  return samples;
+}
+
+// The capture floor is seldom level over a take (the CMU walk in data/ rises about 7 cm
+// in 3 s), so a fixed root height leaves the feet floating or sinking as the clip goes on.
+// Grounding measures the avatar's own lowest point per frame, takes its minimum over each
+// window of about one gait cycle (1 s) and smooths that over the same window: the result
+// is the floor the motion walks on, subtracted from every joint's height.
+std::vector<double> measureGround(const Retargeter& retargeter, const std::vector<RigidTransform>& world,
+                                  std::size_t frames, double rate) {
+  const std::size_t n = retargeter.jointCount();
   std::vector<double> lowest(frames, 0.0), window(frames, 0.0), correction(frames, 0.0);
-  if (samples.empty()) return correction;
-  for (std::size_t f = 0; f < frames; ++f) {
-    double low = std::numeric_limits<double>::infinity();
-    for (const auto& [joint, p] : samples) low = std::min(low, world[f * n + static_cast<std::size_t>(joint)].apply(p).y());
-    lowest[f] = low - floor;
-  }
-  const auto half = static_cast<std::size_t>(std::max(1.0, std::round(rate * 0.5)));
+  if (!retargeter.hasGroundSamples()) return correction;
+  for (std::size_t f = 0; f < frames; ++f)
+    lowest[f] = retargeter.lowestAboveFloor({world.data() + f * n, n});
+  const std::size_t half = groundHalfWindow(rate);
   auto range = [&](std::size_t f) {
     return std::make_pair(f > half ? f - half : 0, std::min(frames - 1, f + half));
   };
@@ -277,94 +278,118 @@ std::vector<double> measureGround(const scene::Avatar& avatar, const std::vector
 
 }  // namespace
 
+std::size_t groundHalfWindow(double rate) { return static_cast<std::size_t>(std::max(1.0, std::round(rate * 0.5))); }
+
+Retargeter::Retargeter(const scene::Avatar& avatar, const Skeleton& skeleton, const JointMap& map,
+                       const RetargetOptions& options, const std::string& source)
+    : avatar_(&avatar), skeleton_(skeleton), options_(options) {
+  const std::size_t n = avatar.joints.size();
+  if (n == 0) throw Error(fmt::format("{}: the avatar has no joints to animate", avatar.source));
+  driving_ = drivingJoints(avatar, skeleton, map);
+  // An avatar root the motion does not drive (a game rig's Root on the floor under the
+  // pelvis) carries the hub: the avatar joint the motion's root drives.
+  const Hub hub = findHub(avatar, driving_, skeleton);
+  hub_ = hub.joint;
+  aboveHub_ = hub.above;
+  for (std::size_t a = 0; a < n; ++a) {
+    if (avatar.joints[a].parent >= 0 || driving_[a] >= 0 || aboveHub_[a]) continue;
+    const auto paired = std::count_if(driving_.begin(), driving_.end(), [](int j) { return j >= 0; });
+    throw Error(fmt::format("{}: no joint of the motion {} drives the avatar's root joint '{}' (joint map '{}' pairs "
+                            "{} of the motion's {} joints with the avatar's); give a joint map naming the motion's "
+                            "joints (--joint-map FILE, docs/MOTION.md)",
+                            avatar.source.empty() ? avatar.name : avatar.source, source, avatar.joints[a].name,
+                            map.name, paired, skeleton.size()));
+  }
+  const std::vector<Vec3> motionRest = skeleton.restPositions();
+  const std::vector<RestBone> bones = restBones(avatar, driving_, motionRest);
+  facing_ = restFacingTurn(bones);
+  correction_ = restCorrections(avatar, driving_, skeleton, bones, facing_);
+  rootScale_ = options.rootScale > 0.0 ? options.rootScale : legLengthRatio(avatar, driving_, motionRest, skeleton);
+  floor_ = avatarFloor(avatar);
+  samples_ = groundSamples(avatar);
+  motionWorld_.resize(skeleton.size());
+  delta_.resize(n);
+  position_.resize(n);
+  firstRoot_.assign(n, Vec3::Zero());
+}
+
+void Retargeter::retarget(std::span<const Quat> local, const Vec3& root, std::span<RigidTransform> out) {
+  const scene::Avatar& avatar = *avatar_;
+  const std::size_t n = avatar.joints.size();
+  const bool first = !started_;
+  started_ = true;
+  // The scaled motion root path from an avatar joint's rest position (the root's, or the hub's).
+  const auto rootPathFrom = [&](const Vec3& rest, const Vec3& motionRoot, const Vec3& start) {
+    Vec3 p = rootScale_ * motionRoot;
+    if (options_.anchorRootAtRest) {
+      p.x() = rest.x() + rootScale_ * (motionRoot.x() - start.x());
+      p.z() = rest.z() + rootScale_ * (motionRoot.z() - start.z());
+    }
+    p.y() = floor_ + rootScale_ * motionRoot.y();
+    return p;
+  };
+  // A root (or the hub) turns with its motion joint and moves along the scaled root path.
+  const auto placeRoot = [&](std::size_t a) {
+    const RigidTransform& motion = motionWorld_[static_cast<std::size_t>(driving_[a])];
+    if (first) firstRoot_[a] = motion.translation;
+    delta_[a] = facing_ ? Quat((motion.rotation * *facing_).normalized()) : motion.rotation;
+    position_[a] = rootPathFrom(avatar.joints[a].restCenter, motion.translation, firstRoot_[a]);
+  };
+  forwardKinematics(skeleton_, local, root, motionWorld_);
+  // The hub first: the joints above it, earlier in the order, move with it.
+  Vec3 hubShift = Vec3::Zero();
+  if (hub_ >= 0) {
+    const auto h = static_cast<std::size_t>(hub_);
+    placeRoot(h);
+    hubShift = position_[h] - avatar.joints[h].restCenter;
+    hubShift.y() = 0.0;
+  }
+  for (std::size_t a = 0; a < n; ++a) {
+    const scene::Joint& joint = avatar.joints[a];
+    const int m = driving_[a];
+    const auto parent = static_cast<std::size_t>(joint.parent);
+    if (aboveHub_[a]) {
+      // Above the hub: upright, at rest height, moving with the hub across the floor.
+      delta_[a] = facing_.value_or(Quat::Identity());
+      position_[a] = joint.restCenter + hubShift;
+    } else if (joint.parent < 0) {
+      placeRoot(a);
+    } else if (static_cast<int>(a) != hub_) {
+      delta_[a] = m >= 0 ? Quat((motionWorld_[static_cast<std::size_t>(m)].rotation * correction_[a]).normalized())
+                         : delta_[parent];
+      position_[a] = position_[parent] + delta_[parent] * (joint.restCenter - avatar.joints[parent].restCenter);
+    }
+    out[a] = {(delta_[a] * joint.restOrientation).normalized(), position_[a]};
+  }
+}
+
+double Retargeter::lowestAboveFloor(std::span<const RigidTransform> world) const {
+  double low = std::numeric_limits<double>::infinity();
+  for (const auto& [joint, p] : samples_) low = std::min(low, world[static_cast<std::size_t>(joint)].apply(p).y());
+  return low - floor_;
+}
+
 AvatarAnimation AvatarAnimation::build(const scene::Avatar& avatar, const Clip& clip, const JointMap& map,
                                        const RetargetOptions& options) {
   const std::size_t n = avatar.joints.size();
   if (n == 0) throw Error(fmt::format("{}: the avatar has no joints to animate", avatar.source));
   if (clip.frameCount() == 0) throw Error(fmt::format("{}: the motion has no frames", clip.source));
+  Retargeter retargeter(avatar, clip.skeleton, map, options, clip.source);
   AvatarAnimation anim;
   anim.frames_ = clip.frameCount();
   anim.joints_ = n;
   anim.rate_ = clip.rate;
   anim.start_ = clip.start;
-  anim.driving_ = drivingJoints(avatar, clip.skeleton, map);
-  // An avatar root the motion does not drive (a game rig's Root on the floor under the
-  // pelvis) carries the hub: the avatar joint the motion's root drives.
-  const Hub hub = findHub(avatar, anim.driving_, clip.skeleton);
-  const std::vector<std::uint8_t>& aboveHub = hub.above;
-  for (std::size_t a = 0; a < n; ++a) {
-    if (avatar.joints[a].parent >= 0 || anim.driving_[a] >= 0 || aboveHub[a]) continue;
-    const auto paired = std::count_if(anim.driving_.begin(), anim.driving_.end(), [](int j) { return j >= 0; });
-    throw Error(fmt::format("{}: no joint of the motion {} drives the avatar's root joint '{}' (joint map '{}' pairs "
-                            "{} of the motion's {} joints with the avatar's); give a joint map naming the motion's "
-                            "joints (--joint-map FILE, docs/MOTION.md)",
-                            avatar.source.empty() ? avatar.name : avatar.source, clip.source, avatar.joints[a].name,
-                            map.name, paired, clip.skeleton.size()));
-  }
-
-  const std::vector<Vec3> motionRest = clip.skeleton.restPositions();
-  const std::vector<RestBone> bones = restBones(avatar, anim.driving_, motionRest);
-  const std::optional<Quat> facing = restFacingTurn(bones);
-  const std::vector<Quat> correction =
-      restCorrections(avatar, anim.driving_, clip.skeleton, bones, facing);
-  anim.rootScale_ = options.rootScale > 0.0 ? options.rootScale : legLengthRatio(avatar, anim.driving_, motionRest, clip.skeleton);
-  const double floor = avatarFloor(avatar);
-  anim.rootHeightOffset_ = floor;  // the motion's y = 0 on the avatar's floor, before grounding
-
-  std::vector<RigidTransform> motionWorld(clip.skeleton.size());
-  std::vector<Quat> delta(n);  // world rotation from the avatar's rest pose
-  std::vector<Vec3> position(n);
-  std::vector<Vec3> firstRoot(n, Vec3::Zero());
+  anim.driving_.assign(retargeter.drivingJoint().begin(), retargeter.drivingJoint().end());
+  anim.rootScale_ = retargeter.rootScale();
+  anim.rootHeightOffset_ = retargeter.floor();  // the motion's y = 0 on the avatar's floor, before grounding
   anim.world_.resize(anim.frames_ * n);
   anim.inverse_.resize(anim.frames_ * n);
   anim.rootPath_.resize(anim.frames_);
-  // The scaled motion root path from an avatar joint's rest position (the root's, or the hub's).
-  const auto rootPathFrom = [&](const Vec3& rest, const Vec3& motionRoot, const Vec3& first) {
-    Vec3 p = anim.rootScale_ * motionRoot;
-    if (options.anchorRootAtRest) {
-      p.x() = rest.x() + anim.rootScale_ * (motionRoot.x() - first.x());
-      p.z() = rest.z() + anim.rootScale_ * (motionRoot.z() - first.z());
-    }
-    p.y() = anim.rootHeightOffset_ + anim.rootScale_ * motionRoot.y();
-    return p;
-  };
-  // A root (or the hub) turns with its motion joint and moves along the scaled root path.
-  const auto placeRoot = [&](std::size_t a, std::size_t f) {
-    const RigidTransform& motion = motionWorld[static_cast<std::size_t>(anim.driving_[a])];
-    if (f == 0) firstRoot[a] = motion.translation;
-    delta[a] = facing ? Quat((motion.rotation * *facing).normalized()) : motion.rotation;
-    position[a] = rootPathFrom(avatar.joints[a].restCenter, motion.translation, firstRoot[a]);
-  };
-  for (std::size_t f = 0; f < anim.frames_; ++f) {
-    forwardKinematics(clip.skeleton, clip.frameRotations(f), clip.rootTranslations[f], motionWorld);
-    // The hub first: the joints above it, earlier in the order, move with it.
-    Vec3 hubShift = Vec3::Zero();
-    if (hub.joint >= 0) {
-      const auto h = static_cast<std::size_t>(hub.joint);
-      placeRoot(h, f);
-      hubShift = position[h] - avatar.joints[h].restCenter;
-      hubShift.y() = 0.0;
-    }
-    for (std::size_t a = 0; a < n; ++a) {
-      const scene::Joint& joint = avatar.joints[a];
-      const int m = anim.driving_[a];
-      const auto parent = static_cast<std::size_t>(joint.parent);
-      if (aboveHub[a]) {
-        // Above the hub: upright, at rest height, moving with the hub across the floor.
-        delta[a] = facing.value_or(Quat::Identity());
-        position[a] = joint.restCenter + hubShift;
-      } else if (joint.parent < 0) {
-        placeRoot(a, f);
-      } else if (static_cast<int>(a) != hub.joint) {
-        delta[a] = m >= 0 ? Quat((motionWorld[static_cast<std::size_t>(m)].rotation * correction[a]).normalized())
-                          : delta[parent];
-        position[a] = position[parent] + delta[parent] * (joint.restCenter - avatar.joints[parent].restCenter);
-      }
-      anim.world_[f * n + a] = {(delta[a] * joint.restOrientation).normalized(), position[a]};
-    }
-  }
+  for (std::size_t f = 0; f < anim.frames_; ++f)
+    retargeter.retarget(clip.frameRotations(f), clip.rootTranslations[f], {anim.world_.data() + f * n, n});
   anim.ground_.assign(anim.frames_, 0.0);
-  if (options.groundFeet) anim.ground_ = measureGround(avatar, anim.world_, anim.frames_, anim.rate_, floor);
+  if (options.groundFeet) anim.ground_ = measureGround(retargeter, anim.world_, anim.frames_, anim.rate_);
   for (std::size_t f = 0; f < anim.frames_; ++f) {
     for (std::size_t a = 0; a < n; ++a) {
       RigidTransform& t = anim.world_[f * n + a];
@@ -648,16 +673,16 @@ Clip clipOfJointMotion(const formats::SkinnedJointMotion& m, const std::string& 
   return clip;
 }
 
+}  // namespace
+
 /// The user's joint map (checked strictly), or the shipped map that pairs the most joints.
-JointMap mapFor(const Clip& clip, const scene::Avatar& avatar, const MotionOptions& options) {
+JointMap jointMapFor(const Clip& clip, const scene::Avatar& avatar, const MotionOptions& options) {
   if (options.jointMapPath.empty())
     return chooseJointMap(readJointMapDirectory(options.jointMapDirectory), clip.skeleton, avatar);
   JointMap map = readJointMap(options.jointMapPath);
   checkJointMap(map, clip.skeleton, avatar);
   return map;
 }
-
-}  // namespace
 
 AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& motionPath, const MotionOptions& options,
                               ClipLoadReport* report, JointMap* chosenMap) {
@@ -684,7 +709,7 @@ AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& mo
       return AvatarAnimation::fromJointMotion(avatar, motion, motionPath);
     }
     const Clip clip = clipOfJointMotion(motion, motionPath);
-    const JointMap map = mapFor(clip, avatar, options);
+    const JointMap map = jointMapFor(clip, avatar, options);
     if (chosenMap) *chosenMap = map;
     return AvatarAnimation::build(avatar, clip, map, options.retarget);
   }
@@ -693,7 +718,7 @@ AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& mo
                             "from an avatar's own file",
                             motionPath));
   const Clip clip = loadClip(motionPath, options.clip, report);
-  const JointMap map = mapFor(clip, avatar, options);
+  const JointMap map = jointMapFor(clip, avatar, options);
   if (chosenMap) *chosenMap = map;
   return AvatarAnimation::build(avatar, clip, map, options.retarget);
 }

@@ -206,6 +206,25 @@ Clip resample(const Clip& clip, double rate) {
   return out;
 }
 
+void bvhFramePose(const formats::BvhFile& bvh, const double* values, std::span<Quat> rotations, Vec3& root) {
+  for (std::size_t j = 0; j < bvh.joints.size(); ++j) {
+    const formats::BvhJoint& joint = bvh.joints[j];
+    Quat q = Quat::Identity();
+    Vec3 position = Vec3::Zero();
+    for (std::size_t c = 0; c < joint.channels.size(); ++c) {
+      const double v = values[joint.firstChannel + c];
+      const int axis = positionAxis(joint.channels[c]);
+      if (axis >= 0) {
+        position[axis] = v;
+      } else {
+        q = q * axisRotation(joint.channels[c], v);  // file order composes left to right
+      }
+    }
+    rotations[j] = q.normalized();
+    if (joint.parent < 0 && j == 0) root = position;
+  }
+}
+
 Clip clipFromBvh(const formats::BvhFile& bvh, const ClipLoadOptions& options, ClipLoadReport* report) {
   Clip clip;
   clip.source = bvh.source;
@@ -215,25 +234,8 @@ Clip clipFromBvh(const formats::BvhFile& bvh, const ClipLoadOptions& options, Cl
   const std::size_t n = bvh.joints.size();
   clip.rotations.resize(bvh.frameCount * n);
   clip.rootTranslations.resize(bvh.frameCount);
-  for (std::size_t f = 0; f < bvh.frameCount; ++f) {
-    const double* values = bvh.frame(f);
-    for (std::size_t j = 0; j < n; ++j) {
-      const formats::BvhJoint& joint = bvh.joints[j];
-      Quat q = Quat::Identity();
-      Vec3 position = Vec3::Zero();
-      for (std::size_t c = 0; c < joint.channels.size(); ++c) {
-        const double v = values[joint.firstChannel + c];
-        const int axis = positionAxis(joint.channels[c]);
-        if (axis >= 0) {
-          position[axis] = v;
-        } else {
-          q = q * axisRotation(joint.channels[c], v);  // file order composes left to right
-        }
-      }
-      clip.rotations[f * n + j] = q.normalized();
-      if (joint.parent < 0 && j == 0) clip.rootTranslations[f] = position;
-    }
-  }
+  for (std::size_t f = 0; f < bvh.frameCount; ++f)
+    bvhFramePose(bvh, bvh.frame(f), {clip.rotations.data() + f * n, n}, clip.rootTranslations[f]);
   UnitsGuess guess;
   const double scale = chooseScale(clip.skeleton.restExtent(), options, guess);
   finishClip(clip, scale, options, report, guess);

@@ -6,7 +6,15 @@
 
 #include <gtest/gtest.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
 #include <filesystem>
+#include <functional>
+#include <sstream>
 #include <fstream>
 #include <thread>
 
@@ -317,6 +325,144 @@ TEST(Studio, ALiveEventGraphTakesEventsAndGraphsInjected) {
   ASSERT_LT(at + 30, 150);
   for (long f = 1; f < at; ++f) EXPECT_EQ(hips[static_cast<std::size_t>(f)], hips[0]) << "frame " << f << ": before the event";
   EXPECT_GT((hips[static_cast<std::size_t>(at + 30)] - hips[0]).norm(), 0.3) << "the walk did not move the hips";
+}
+
+/// A capture program's broadcast: a TCP server on a free loopback port that sends `text` to
+/// the first client, `perBatch` lines at a time with `pause` between, after `before` has
+/// returned true for the line about to go (a test's way to hold the source at a point).
+class CaptureBroadcast {
+ public:
+  CaptureBroadcast() {
+    listener_ = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ::bind(listener_, reinterpret_cast<sockaddr*>(&address), sizeof address);
+    socklen_t length = sizeof address;
+    ::getsockname(listener_, reinterpret_cast<sockaddr*>(&address), &length);
+    ::listen(listener_, 1);
+    url_ = "tcp://127.0.0.1:" + std::to_string(ntohs(address.sin_port));
+  }
+  ~CaptureBroadcast() {
+    if (thread_.joinable()) thread_.join();
+    ::close(listener_);
+  }
+  [[nodiscard]] const std::string& url() const { return url_; }
+
+  void send(std::vector<std::string> lines, std::size_t perBatch, std::chrono::milliseconds pause,
+            std::function<void(std::size_t)> before = {}) {
+    thread_ = std::thread([this, lines = std::move(lines), perBatch, pause, before = std::move(before)] {
+      const int peer = ::accept(listener_, nullptr, nullptr);
+      if (peer < 0) return;
+      for (std::size_t i = 0; i < lines.size(); i += perBatch) {
+        if (before) before(i);
+        std::string batch;
+        for (std::size_t k = i; k < std::min(lines.size(), i + perBatch); ++k) batch += lines[k] + "\n";
+        for (std::size_t done = 0; done < batch.size();) {
+          const ssize_t n = ::send(peer, batch.data() + done, batch.size() - done, MSG_NOSIGNAL);
+          if (n <= 0) break;
+          done += static_cast<std::size_t>(n);
+        }
+        std::this_thread::sleep_for(pause);
+      }
+      ::close(peer);
+    });
+  }
+
+ private:
+  int listener_ = -1;
+  std::string url_;
+  std::thread thread_;
+};
+
+std::vector<std::string> linesOf(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+TEST(Studio, ALiveCaptureOverTcpIsSimulatedAsItComes) {
+  // The walk's BVH broadcast as a capture program sends it, 40 lines at a time, one of its
+  // frame lines garbled: the anim-server sends poses while the capture goes on (the source
+  // is held at its middle until the pose stream shows it), a cloth-server simulates them, a
+  // player records the take.
+  ScratchDir dir("studio-live");
+  NatsServer server;
+  std::vector<std::string> lines = linesOf(slurp(kWalk));
+  ASSERT_EQ(lines.size(), 187u + 566u) << "the walk's header and frames";
+  lines[187 + 300] = "0 0 oops";  // file line 488
+  studio::Bus bus = studio::Bus::connect(server.url(), "test");
+  bus.ensureStream("anim");
+  std::atomic<std::uint64_t> posesAtMiddle{0};
+  CaptureBroadcast capture;
+  capture.send(lines, 40, 5ms, [&](std::size_t line) {
+    if (line < 187 + 280 || posesAtMiddle > 0) return;
+    // 280 of the 566 frames sent: at 120 Hz resampled to 30, 69 pose frames are due.
+    for (int i = 0; i < 400 && bus.range("anim").messages < 60; ++i) std::this_thread::sleep_for(50ms);
+    posesAtMiddle = bus.range("anim").messages;
+  });
+  DrapeProcess cloth("cloth-server '" + kScene + "' --takes 1" + roles(server), dir, "cloth");
+  const CliResult sent = runDrape("anim-server '" + kScene + "' --live " + capture.url() + " --take live" + roles(server), dir);
+  ASSERT_EQ(sent.code, 0) << sent.err;
+  EXPECT_GE(posesAtMiddle.load(), 60u) << "the poses were to go out while the capture was still sending";
+  EXPECT_NE(sent.out.find("sent take live: 141 pose frames of makehuman_CMU compliant skeleton from " + capture.url() +
+                          " (566 source frames, 1 bad lines)"),
+            std::string::npos)
+      << sent.out;
+  EXPECT_NE(sent.err.find(capture.url() + ":488:5: expected a number, found 'oops' (the frame before it stands in)"),
+            std::string::npos)
+      << sent.err;
+  EXPECT_NE(sent.err.find("joint map 'motionbuilder'"), std::string::npos) << sent.err;
+  const CliResult served = cloth.wait();
+  ASSERT_EQ(served.code, 0) << served.err;
+  EXPECT_NE(served.out.find("take live: 170 cloth frames of Skirt"), std::string::npos) << served.out;
+  const CliResult recorded = runDrape("player '" + kScene + "' --record '" + (dir / "recorded") + "'" + roles(server), dir);
+  ASSERT_EQ(recorded.code, 0) << recorded.err;
+  const nlohmann::json stats = statsOf(dir / "recorded");
+  EXPECT_EQ(stats["frames"], 170);
+  EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
+}
+
+TEST(Studio, ALiveSourceThatIsNotThereOrFallsSilentEndsTheTakeSaying) {
+  ScratchDir dir("studio-live-errors");
+  NatsServer server;
+  std::string closedPort;
+  {
+    const CaptureBroadcast gone;
+    closedPort = gone.url();
+  }
+  CliResult r = runDrape("anim-server '" + kScene + "' --live " + closedPort + " --server " + server.url() + " --give-up 1", dir);
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_NE(r.err.find(closedPort + ": cannot connect (Connection refused); gave up after"), std::string::npos) << r.err;
+
+  // The header, three frames, then silence: the take ends after --give-up, its End saying why.
+  std::vector<std::string> lines = linesOf(slurp(kWalk));
+  lines.resize(187 + 12);
+  CaptureBroadcast silent;
+  silent.send(lines, lines.size(), 3000ms);
+  r = runDrape("anim-server '" + kScene + "' --live " + silent.url() + " --take quiet --server " + server.url() +
+                   " --give-up 1",
+               dir);
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_NE(r.out.find("went silent for 1 s (--give-up)"), std::string::npos) << r.out;
+  studio::Bus bus = studio::Bus::connect(server.url(), "test");
+  const studio::StreamRange range = bus.range("anim");
+  const studio::Message last = studio::decode(bus.get("anim", range.last)->data);
+  const auto* end = std::get_if<studio::End>(&last.payload);
+  ASSERT_NE(end, nullptr);
+  EXPECT_EQ(end->exitCode, 4);
+  EXPECT_NE(end->error.find("went silent"), std::string::npos) << end->error;
+
+  // Not a BVH: the header's error where it is.
+  CaptureBroadcast junk;
+  junk.send({"HIERARCHY", "ROOT Hips", "{", "OFFSET 0 0"}, 4, 10ms);
+  r = runDrape("anim-server '" + kScene + "' --live " + junk.url() + " --server " + server.url() + " --give-up 5", dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find(junk.url() + ":5:1: expected a number, found end of file"), std::string::npos) << r.err;
+  r = runDrape("anim-server '" + kScene + "' --live - --motion '" + kWalk + "' --server " + server.url(), dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--live plays the motion its source sends: give it or --motion, not both"), std::string::npos) << r.err;
 }
 
 TEST(Studio, ErrorsSayWhatToDo) {

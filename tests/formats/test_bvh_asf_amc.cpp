@@ -3,9 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <functional>
 
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
 #include "drape/formats/asf_amc.hpp"
 #include "drape/formats/bvh.hpp"
 #include "drape/formats/mhskel.hpp"
@@ -70,6 +72,58 @@ TEST(Bvh, DeepNestingIsAnErrorNotAStackOverflow) {
   std::string text = "HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n";
   for (int i = 1; i < 400; ++i) text += "JOINT j" + std::to_string(i) + "\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n";
   EXPECT_NE(errorOf([&] { (void)parseBvh(text, "deep.bvh"); }).find("joints nested deeper than 256"), std::string::npos);
+}
+
+// A BVH that arrives as it is written: the header alone, then a frame per line, read as the
+// whole file is read.
+TEST(BvhStream, ReadsTheHeaderAndEachFrameLineAsTheWholeFileIsRead) {
+  const std::string text = drape::readFileText(mocap("cmu_walk_delfem2.bvh")).value();
+  const BvhFile whole = parseBvh(text, "walk.bvh");
+  std::size_t at = 0;
+  int line = 0;
+  std::string header;
+  for (;;) {
+    const std::size_t end = text.find('\n', at);
+    const std::string_view l(text.data() + at, end - at);
+    header.append(l).push_back('\n');
+    ++line;
+    at = end + 1;
+    if (endsBvhHeader(l)) break;
+  }
+  EXPECT_EQ(line, whole.firstFrameLine - 1);
+  const BvhFile head = parseBvhHeader(header, "walk.bvh");
+  EXPECT_EQ(head.joints.size(), whole.joints.size());
+  EXPECT_EQ(head.channelCount, whole.channelCount);
+  EXPECT_EQ(head.frameTime, whole.frameTime);
+  EXPECT_TRUE(head.values.empty());
+  std::vector<double> values(head.channelCount);
+  for (std::size_t f = 0; f < whole.frameCount; ++f) {
+    const std::size_t end = text.find('\n', at);
+    parseBvhFrameLine(std::string_view(text.data() + at, (end == std::string::npos ? text.size() : end) - at),
+                      "walk.bvh", ++line, values);
+    ASSERT_TRUE(std::equal(values.begin(), values.end(), whole.frame(f))) << "frame " << f;
+    at = end + 1;
+  }
+}
+
+TEST(BvhStream, SaysWhereAFrameLineOrHeaderIsWrong) {
+  std::vector<double> three(3);
+  EXPECT_EQ(errorOf([&] { parseBvhFrameLine("1 2 x", "stdin", 40, three); }), "stdin:40:5: expected a number, found 'x'");
+  EXPECT_EQ(errorOf([&] { parseBvhFrameLine("1 2", "stdin", 41, three); }),
+            "stdin:41:4: expected 3 values (one per channel), found 2");
+  EXPECT_EQ(errorOf([&] { parseBvhFrameLine("1 2 3 4", "stdin", 42, three); }),
+            "stdin:42:7: expected 3 values (one per channel), found more");
+  EXPECT_EQ(errorOf([&] { parseBvhFrameLine("1 nan 3", "stdin", 43, three); }), "stdin:43:3: expected a number, found 'nan'");
+  const std::string header = "HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 3 Xposition Yposition Zposition\n}\n"
+                             "MOTION\nFrames: 0\nFrame Time: 0.01\n";
+  EXPECT_EQ(parseBvhHeader(header, "stdin").channelCount, 3u);
+  EXPECT_EQ(errorOf([&] { (void)parseBvhHeader(header + "1 2 3\n", "stdin"); }),
+            "stdin:10:1: expected the header to end after 'Frame Time:', found '1'");
+  EXPECT_EQ(errorOf([&] { (void)parseBvhHeader("HIERARCHY\nROOT Hips\n{\n", "stdin"); }),
+            "stdin:4:1: expected 'OFFSET', found end of file");
+  EXPECT_TRUE(endsBvhHeader("Frame Time: 0.0083333"));
+  EXPECT_TRUE(endsBvhHeader("\tFrame Time:0.01\r"));
+  EXPECT_FALSE(endsBvhHeader("Frames: 12"));
 }
 
 TEST(AsfAmc, ReadsTheCmuSoccerKick) {

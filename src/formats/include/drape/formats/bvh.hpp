@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -49,6 +50,16 @@ struct BvhFile {
 
 /// Reads and parses a BVH file (throws drape::Error "path: no such file" etc.).
 [[nodiscard]] BvhFile readBvh(const std::string& path);
+
+/// A BVH that arrives as it is written (a live capture's stream, a pipe): the header first,
+/// the text up to and including its "Frame Time:" line, read as parseBvh reads it, with no
+/// frames (frameCount as declared, which such a stream need not keep; values empty).
+[[nodiscard]] BvhFile parseBvhHeader(std::string_view text, const std::string& name);
+/// True for the line that ends a BVH header ("Frame Time: T"): what a stream reader waits for.
+[[nodiscard]] bool endsBvhHeader(std::string_view line);
+/// One frame of such a stream, the line `lineNumber` of `name`: exactly out.size() finite
+/// values (the channels). Throws drape::Error "name:line:column: expected ...".
+void parseBvhFrameLine(std::string_view line, const std::string& name, int lineNumber, std::span<double> out);
 
 /// "Xposition" etc.
 [[nodiscard]] const char* bvhChannelName(BvhChannel channel);

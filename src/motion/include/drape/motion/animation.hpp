@@ -33,7 +33,10 @@
 // capture floors are seldom level, the body is grounded: each frame is lowered by the
 // smoothed per-gait-cycle minimum of the avatar's lowest point (groundCorrection()).
 
+#include <cstdint>
+#include <optional>
 #include <span>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -58,6 +61,52 @@ struct RetargetOptions {
   /// floor (see groundCorrection()).
   bool groundFeet = true;
 };
+
+/// Retargeting one pose at a time: what AvatarAnimation::build does for each frame of a
+/// clip (the rest corrections, the scaled root path, the hub), for a motion that arrives
+/// frame by frame (a live capture, live_motion.hpp). Grounding, a correction over a window of
+/// frames, is the caller's: build() centres its window, a live motion trails it.
+class Retargeter {
+ public:
+  /// `avatar` must outlive the retargeter. Throws drape::Error naming `source` when no
+  /// motion joint drives the avatar's root.
+  Retargeter(const scene::Avatar& avatar, const Skeleton& skeleton, const JointMap& map, const RetargetOptions& options,
+             const std::string& source);
+
+  /// The avatar joints' world transforms for one pose of the motion (its local rotations and
+  /// root translation, m), before grounding. The first call fixes where the root path starts.
+  /// `out` has jointCount() entries. Allocates nothing.
+  void retarget(std::span<const Quat> local, const Vec3& root, std::span<RigidTransform> out);
+
+  /// m, the avatar's lowest point above its floor in the pose `world` (sampled, up to 256
+  /// points per segment); the quantity grounding follows.
+  [[nodiscard]] double lowestAboveFloor(std::span<const RigidTransform> world) const;
+  [[nodiscard]] bool hasGroundSamples() const { return !samples_.empty(); }
+
+  [[nodiscard]] std::size_t jointCount() const { return driving_.size(); }
+  [[nodiscard]] std::span<const int> drivingJoint() const { return driving_; }
+  [[nodiscard]] double rootScale() const { return rootScale_; }
+  [[nodiscard]] double floor() const { return floor_; }  ///< m, the avatar's lowest rest point
+
+ private:
+  const scene::Avatar* avatar_;
+  Skeleton skeleton_;
+  RetargetOptions options_;
+  std::vector<int> driving_;
+  int hub_ = -1;
+  std::vector<std::uint8_t> aboveHub_;
+  std::optional<Quat> facing_;
+  std::vector<Quat> correction_;
+  double rootScale_ = 1.0, floor_ = 0.0;
+  std::vector<std::pair<int, Vec3>> samples_;
+  bool started_ = false;
+  std::vector<RigidTransform> motionWorld_;
+  std::vector<Quat> delta_;
+  std::vector<Vec3> position_, firstRoot_;
+};
+
+/// Frames on either side of a frame in grounding's windows at `rate` (half a second).
+[[nodiscard]] std::size_t groundHalfWindow(double rate);
 
 class AvatarAnimation {
  public:
@@ -155,6 +204,10 @@ struct MotionOptions {
   /// file to find it): taken instead of reading the file again. Null: read it.
   const formats::SkinnedJointMotion* sampled = nullptr;
 };
+
+/// The joint map for `clip` on `avatar`: options.jointMapPath's (checked strictly), or the
+/// shipped map of options.jointMapDirectory that pairs the most joints.
+[[nodiscard]] JointMap jointMapFor(const Clip& clip, const scene::Avatar& avatar, const MotionOptions& options);
 
 /// Loads FILE.bvh / FILE.amc, picks or reads the joint map, and retargets onto `avatar`;
 /// or takes one of FILE.glb / .gltf / .dae / .fbx's animations, or of FILE.wrl's animated

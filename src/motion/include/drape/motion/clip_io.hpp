@@ -4,6 +4,7 @@
 // the motion rate.
 
 #include <optional>
+#include <span>
 #include <string>
 
 #include "drape/formats/bvh.hpp"
@@ -58,6 +59,11 @@ struct ClipLoadReport {
 /// root translation. Position channels of other joints are ignored.
 [[nodiscard]] Clip clipFromBvh(const formats::BvhFile& bvh, const ClipLoadOptions& options = {},
                                ClipLoadReport* report = nullptr);
+
+/// One BVH frame's values (file units, degrees) as clipFromBvh converts them: each joint's
+/// local rotation into `rotations` (bvh.joints.size() of them) and the root's position
+/// channels into `root`, still in file units (a clip scales them to metres). Allocates nothing.
+void bvhFramePose(const formats::BvhFile& bvh, const double* values, std::span<Quat> rotations, Vec3& root);
 
 /// ASF skeleton + AMC motion to a clip (see asf_amc.hpp for the conventions).
 [[nodiscard]] Clip clipFromAsfAmc(const formats::AsfSkeleton& asf, const formats::AmcMotion& amc,

@@ -1,19 +1,59 @@
 // libFuzzer target: BVH text through the reader and the clip conversion (units guess,
-// T-pose test, resampling). Any drape::Error is a correct answer; a crash is a bug.
+// T-pose test, resampling), and as a live source sends it (anim-server --live): the header
+// up to its "Frame Time:" line, then a frame a line. Any drape::Error is a correct answer; a
+// crash is a bug.
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "drape/core/error.hpp"
 #include "drape/formats/bvh.hpp"
 #include "drape/motion/clip_io.hpp"
 
+namespace {
+
+void readAsStream(std::string_view text) {
+  std::string header;
+  std::size_t at = 0;
+  int line = 0;
+  const auto nextLine = [&](std::string_view& out) {
+    if (at >= text.size()) return false;
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    out = text.substr(at, end - at);
+    at = end + 1;
+    ++line;
+    return true;
+  };
+  std::string_view l;
+  while (nextLine(l)) {
+    header.append(l).push_back('\n');
+    if (drape::formats::endsBvhHeader(l)) break;
+  }
+  const drape::formats::BvhFile head = drape::formats::parseBvhHeader(header, "stream");
+  std::vector<double> values(head.channelCount);
+  while (nextLine(l)) {
+    try {
+      drape::formats::parseBvhFrameLine(l, "stream", line, values);
+    } catch (const drape::Error&) {
+    }
+  }
+}
+
+}  // namespace
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string_view text(reinterpret_cast<const char*>(data), size);
   try {
-    const drape::formats::BvhFile bvh =
-        drape::formats::parseBvh(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.bvh");
+    const drape::formats::BvhFile bvh = drape::formats::parseBvh(text, "fuzz.bvh");
     (void)drape::motion::clipFromBvh(bvh);
+  } catch (const drape::Error&) {
+  }
+  try {
+    readAsStream(text);
   } catch (const drape::Error&) {
   }
   return 0;

@@ -9,9 +9,16 @@
 //          without a bus
 //   live   the anim-server sends in real time: per cloth frame past the lead-in, how long after
 //          the last pose frame it needed the stream held it (the cloth-server's latency)
+//   capture  the anim-server takes the motion live (--live) from a capture broadcast the
+//          benchmark serves on a TCP port, a frame line at a time at the capture's own rate:
+//          per pose frame and per cloth frame, how long after the capture sent the last
+//          source frame it needed the stream held it (capture to pose, capture to cloth)
 
+#include <arpa/inet.h>
 #include <fcntl.h>
+#include <netinet/in.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -29,6 +36,8 @@
 #include "drape/core/error.hpp"
 #include "drape/core/files.hpp"
 #include "drape/core/log.hpp"
+#include "drape/formats/bvh.hpp"
+#include "drape/motion/live_motion.hpp"
 #include "drape/studio/bus.hpp"
 #include "drape/studio/local_server.hpp"
 #include "drape/studio/messages.hpp"
@@ -121,9 +130,112 @@ TakeTimes readTake(studio::Bus& bus, const std::string& source) {
   return t;
 }
 
+/// A capture program's broadcast of a BVH: a TCP server on a free loopback port that sends
+/// the header to the first client at once, then each frame line at its time (frame i at
+/// i * Frame Time after the first), noting when each was sent (ns on the clock the stream's
+/// times are on). It leaves Nagle's algorithm on, as a capture program may.
+class CaptureBroadcast {
+ public:
+  explicit CaptureBroadcast(const std::string& bvhPath) {
+    const std::string text = readFileText(bvhPath).value_or("");
+    std::size_t at = 0;
+    bool inHeader = true;
+    while (at < text.size()) {
+      const std::size_t end = std::min(text.find('\n', at), text.size());
+      const std::string line = text.substr(at, end - at);
+      at = end + 1;
+      if (inHeader) {
+        header_ += line + "\n";
+        if (formats::endsBvhHeader(line)) inHeader = false;
+      } else if (line.find_first_not_of(" \t\r") != std::string::npos) {
+        frames_.push_back(line + "\n");
+      }
+    }
+    frameTime_s_ = formats::parseBvhHeader(header_, bvhPath).frameTime;
+    listener_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t length = sizeof address;
+    if (listener_ < 0 || ::bind(listener_, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 ||
+        ::getsockname(listener_, reinterpret_cast<sockaddr*>(&address), &length) != 0 || ::listen(listener_, 1) != 0)
+      throw Error("drape bench studio: cannot listen on a loopback port for the capture broadcast", ExitCode::Internal);
+    url_ = "tcp://127.0.0.1:" + std::to_string(ntohs(address.sin_port));
+    written_ns_.assign(frames_.size(), 0);
+    thread_ = std::thread([this] { serve(); });
+  }
+  ~CaptureBroadcast() {
+    ::shutdown(listener_, SHUT_RDWR);
+    if (thread_.joinable()) thread_.join();
+    ::close(listener_);
+  }
+  CaptureBroadcast(const CaptureBroadcast&) = delete;
+  CaptureBroadcast& operator=(const CaptureBroadcast&) = delete;
+
+  [[nodiscard]] const std::string& url() const { return url_; }
+  [[nodiscard]] const std::string& header() const { return header_; }
+  [[nodiscard]] const std::vector<std::string>& frames() const { return frames_; }
+  /// When each frame line was written: waits for the broadcast to have sent them all.
+  [[nodiscard]] const std::vector<std::int64_t>& writtenNs() {
+    if (thread_.joinable()) thread_.join();
+    return written_ns_;
+  }
+
+ private:
+  static void sendAll(int fd, const std::string& text) {
+    for (std::size_t done = 0; done < text.size();) {
+      const ssize_t n = ::send(fd, text.data() + done, text.size() - done, MSG_NOSIGNAL);
+      if (n <= 0) return;
+      done += static_cast<std::size_t>(n);
+    }
+  }
+  void serve() {
+    const int peer = ::accept(listener_, nullptr, nullptr);
+    if (peer < 0) return;
+    sendAll(peer, header_);
+    const auto began = std::chrono::steady_clock::now();
+    for (std::size_t i = 0; i < frames_.size(); ++i) {
+      std::this_thread::sleep_until(began + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                std::chrono::duration<double>(frameTime_s_ * static_cast<double>(i))));
+      // Noted as the line goes, before the send returns: the anim-server may have it by then.
+      written_ns_[i] = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                           std::chrono::system_clock::now().time_since_epoch())
+                           .count();
+      sendAll(peer, frames_[i]);
+    }
+    ::close(peer);
+  }
+
+  std::string header_, url_;
+  std::vector<std::string> frames_;
+  double frameTime_s_ = 1.0 / 30.0;
+  int listener_ = -1;
+  std::vector<std::int64_t> written_ns_;
+  std::thread thread_;
+};
+
+/// For each pose frame a live take of `capture` makes on `setup`'s avatar, the source frames
+/// that had come when it was ready (motion::LiveMotion, run here over the same lines).
+std::vector<std::size_t> readyAfter(const RunSetup& setup, const CaptureBroadcast& capture) {
+  const formats::BvhFile header = formats::parseBvhHeader(capture.header(), "capture");
+  motion::LiveMotion live(*setup.character->avatar, header, motionOptions(setup));
+  std::vector<double> values(header.channelCount);
+  std::vector<RigidTransform> joints(live.jointCount());
+  std::vector<std::size_t> ready;
+  int line = 0;
+  for (const std::string& text : capture.frames()) {
+    formats::parseBvhFrameLine(std::string_view(text).substr(0, text.size() - 1), "capture", ++line, values);
+    live.push(values);
+    while (live.next(joints)) ready.push_back(static_cast<std::size_t>(line));
+  }
+  live.finish();
+  while (live.next(joints)) ready.push_back(capture.frames().size());
+  return ready;
+}
+
 /// One take through an anim-server and a cloth-server of this drape; the streams' times.
 std::pair<TakeTimes, TakeTimes> runTake(const StudioBenchOptions& o, const std::string& url, const fs::path& dir,
-                                        const std::string& tag, bool fast) {
+                                        const std::string& tag, bool fast, const std::string& live = "") {
   // Streams of their own for each take, beside whatever else the server holds.
   const std::string anim = fmt::format("bench-{}-anim-{}", tag, ::getpid());
   const std::string cloth = fmt::format("bench-{}-cloth-{}", tag, ::getpid());
@@ -135,8 +247,9 @@ std::pair<TakeTimes, TakeTimes> runTake(const StudioBenchOptions& o, const std::
   const fs::path clothLog = dir / (tag + "-cloth.log");
   for (int i = 0; i < 1200 && slurpText(clothLog).find("following the poses of") == std::string::npos; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  std::vector<std::string> animArgs{"anim-server", o.scene, "--motion", o.motion, "--name", anim, "--take", tag,
+  std::vector<std::string> animArgs{"anim-server", o.scene, "--name", anim, "--take", tag,
                                     "--server", url, "--give-up", "120"};
+  animArgs.insert(animArgs.begin() + 2, {live.empty() ? "--motion" : "--live", live.empty() ? o.motion : live});
   if (fast) animArgs.push_back("--fast");
   const pid_t sender = spawnDrape(animArgs, dir / (tag + "-anim.log"));
   const int sent = waitFor(sender), served = waitFor(server);
@@ -165,6 +278,8 @@ RunFunction setupStudioBench(CLI::App& app) {
   app.add_option("--positions", o.positions, "How the cloth-server sends positions: double or float")
       ->capture_default_str();
   return [] {
+    if (lowerExtension(o.motion) != ".bvh")
+      throw Error(fmt::format("drape bench studio: --motion {}: the capture take broadcasts a BVH", o.motion));
     // The reference: the same setup through drape run's loop in one process, no outputs.
     RunSetup setup = runSetupFromScene(o.scene);
     addMotion(setup, o.motion);
@@ -184,6 +299,8 @@ RunFunction setupStudioBench(CLI::App& app) {
     }
     const auto [fastPoses, fastCloth] = runTake(o, url, dir, "fast", true);
     const auto [livePoses, liveCloth] = runTake(o, url, dir, "live", false);
+    CaptureBroadcast capture(o.motion);
+    const auto [capturePoses, captureCloth] = runTake(o, url, dir, "capture", false, capture.url());
     own.reset();
     std::error_code ignored;
     fs::remove_all(dir, ignored);
@@ -198,6 +315,20 @@ RunFunction setupStudioBench(CLI::App& app) {
       if (need > livePoses.frame_ns.size()) continue;  // the take's end: it needed the End
       latency_ms.push_back(1e-6 * static_cast<double>(liveCloth.frame_ns[k] - livePoses.frame_ns[need - 1]));
     }
+    // Capture to pose and to cloth: a pose frame waits for the source frames LiveMotion
+    // needed for it; a cloth frame for the pose frames its substeps read.
+    const std::vector<std::size_t> ready = readyAfter(setup, capture);
+    const std::vector<std::int64_t>& written = capture.writtenNs();
+    std::vector<double> toPose_ms, toCloth_ms;
+    for (std::size_t k = 0; k < capturePoses.frame_ns.size() && k < ready.size(); ++k)
+      toPose_ms.push_back(1e-6 * static_cast<double>(capturePoses.frame_ns[k] - written[ready[k] - 1]));
+    for (std::size_t k = 1; k < captureCloth.frame_ns.size(); ++k) {
+      if (static_cast<double>(k) / rate <= leadIn) continue;
+      const auto need = static_cast<std::size_t>(studio::motionFramesNeeded(static_cast<std::int64_t>(k), rate, leadIn, rate));
+      if (need > ready.size() || need > capturePoses.frame_ns.size()) continue;
+      toCloth_ms.push_back(1e-6 * static_cast<double>(captureCloth.frame_ns[k] - written[ready[need - 1] - 1]));
+    }
+    const auto largest = [](const std::vector<double>& v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); };
     const nlohmann::json clothStats = nlohmann::json::parse(fastCloth.stats, nullptr, false);
 
     nlohmann::json j;
@@ -223,6 +354,18 @@ RunFunction setupStudioBench(CLI::App& app) {
                  {"latency_ms_p95", percentile(latency_ms, 0.95)},
                  {"latency_ms_max", latency_ms.empty() ? 0.0 : *std::max_element(latency_ms.begin(), latency_ms.end())},
                  {"frame_period_ms", 1e3 / rate}};
+    j["capture"] = {{"what", "anim-server --live from a TCP capture broadcast of the motion at its own rate: per pose "
+                             "frame and per cloth frame past the lead-in, its time in the stream less the time the "
+                             "capture sent the last source frame it needed"},
+                    {"source_frames", capture.frames().size()},
+                    {"pose_frames", capturePoses.frame_ns.size()},
+                    {"capture_to_pose_ms_median", median(toPose_ms)},
+                    {"capture_to_pose_ms_p95", percentile(toPose_ms, 0.95)},
+                    {"capture_to_pose_ms_max", largest(toPose_ms)},
+                    {"capture_to_cloth_ms_median", median(toCloth_ms)},
+                    {"capture_to_cloth_ms_p95", percentile(toCloth_ms, 0.95)},
+                    {"capture_to_cloth_ms_max", largest(toCloth_ms)},
+                    {"cloth_frames_measured", toCloth_ms.size()}};
     j["server"] = o.server.empty() ? "a nats-server of the benchmark's own on 127.0.0.1" : o.server;
     j["machine"] = benchMachine();
     std::cout << j.dump(2) << std::endl;
@@ -231,7 +374,7 @@ RunFunction setupStudioBench(CLI::App& app) {
 }
 
 const bool registered_bench_studio = registerCommand(
-    {"studio", "The studio's roles on a NATS JetStream server beside drape run's loop", "bench", 45, &setupStudioBench});
+    {"studio", "The studio's roles on a NATS JetStream server beside drape run's loop, from a motion file and a live capture", "bench", 45, &setupStudioBench});
 
 }  // namespace
 }  // namespace drape::cli

@@ -2,6 +2,8 @@
 
 #include <fcntl.h>
 #include <netdb.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
@@ -60,7 +62,11 @@ int connectTcp(const std::string& source) {
 
 LineStream LineStream::open(const std::string& source) {
   if (source == "-") return LineStream(STDIN_FILENO, false, "stdin");
-  if (source.starts_with(kTcp)) return LineStream(connectTcp(source), true, source);
+  if (source.starts_with(kTcp)) {
+    LineStream s(connectTcp(source), true, source);
+    s.tcp_ = true;
+    return s;
+  }
   std::error_code ec;
   if (!std::filesystem::exists(source, ec)) throw Error(fmt::format("{}: no such file", source));
   if (std::filesystem::is_directory(source, ec)) throw Error(fmt::format("{}: is a directory, not a stream", source));
@@ -79,6 +85,7 @@ LineStream& LineStream::operator=(LineStream&& other) noexcept {
   fd_ = std::exchange(other.fd_, -1);
   owned_ = std::exchange(other.owned_, false);
   closed_ = other.closed_;
+  tcp_ = other.tcp_;
   name_ = std::move(other.name_);
   buffer_ = std::move(other.buffer_);
   scanned_ = other.scanned_;
@@ -132,6 +139,13 @@ LineStream::Status LineStream::next(std::string& line, std::chrono::milliseconds
     const ssize_t got = ::read(fd_, chunk, sizeof chunk);
     if (got > 0) {
       buffer_.append(chunk, static_cast<std::size_t>(got));
+      // Acknowledge at once, every time (Linux resets it): a sender that batches small
+      // writes (Nagle's algorithm, on unless a program turns it off) waits for the previous
+      // write's acknowledgement, which a delayed one holds back up to 40 ms, over a frame.
+      if (tcp_) {
+        const int on = 1;
+        ::setsockopt(fd_, IPPROTO_TCP, TCP_QUICKACK, &on, sizeof on);
+      }
     } else if (got == 0) {
       // A named pipe whose writer has not come yet reads as closed too; it has not ended
       // until someone wrote to it, so wait for a writer.

@@ -47,6 +47,7 @@ class LineStream {
   int fd_ = -1;
   bool owned_ = false;
   bool closed_ = false;
+  bool tcp_ = false;
   std::string name_;
   std::string buffer_;
   std::size_t scanned_ = 0;  ///< bytes of buffer_ known to hold no newline

@@ -239,7 +239,11 @@ int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
   start.driving.assign(live.drivingJoint().begin(), live.drivingJoint().end());
   start.start = TimeCode{0, live.rate()};
   start.frames = 0;  // live: as long as the source sends
-  publisher.beginTake(take, start);
+  // A capture does not come again: a take of this name in the stream cannot be completed.
+  if (publisher.beginTake(take, start) > 0)
+    throw Error(fmt::format("--take {}: {} holds that take already, and a live capture cannot be sent again to "
+                            "complete it; give the take another name",
+                            take, studio::subjectOf(o.name)));
   spdlog::info("take {}: live motion from {} ({} joints at {:g} Hz in {}, joint map '{}') on {}, sent at {:g} Hz as it "
                "comes, on {} ({})",
                take, source.name(), header.joints.size(), live.sourceRate(), live.report().units.name,

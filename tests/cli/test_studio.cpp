@@ -460,6 +460,12 @@ TEST(Studio, ALiveSourceThatIsNotThereOrFallsSilentEndsTheTakeSaying) {
   r = runDrape("anim-server '" + kScene + "' --live " + junk.url() + " --server " + server.url() + " --give-up 5", dir);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find(junk.url() + ":5:1: expected a number, found end of file"), std::string::npos) << r.err;
+  // The take 'quiet' is in the stream: a live capture cannot complete it.
+  CaptureBroadcast again;
+  again.send(lines, lines.size(), 10ms);
+  r = runDrape("anim-server '" + kScene + "' --live " + again.url() + " --take quiet --server " + server.url(), dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--take quiet: drape.anim holds that take already"), std::string::npos) << r.err;
   r = runDrape("anim-server '" + kScene + "' --live - --motion '" + kWalk + "' --server " + server.url(), dir);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("--live plays the motion its source sends: give it or --motion, not both"), std::string::npos) << r.err;

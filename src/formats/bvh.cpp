@@ -175,22 +175,29 @@ const char* bvhChannelName(BvhChannel channel) {
   return "?";
 }
 
-BvhFile parseBvh(std::string_view text, const std::string& name) {
+namespace {
+
+// The hierarchy and the MOTION header, which a file and a stream both begin with.
+BvhFile readHeader(WordScanner& s, const std::string& name) {
   BvhFile out;
   out.source = name;
-  WordScanner s(text, name);
   readHierarchy(s, out);
   readMotionHeader(s, out);
+  return out;
+}
+
+}  // namespace
+
+BvhFile parseBvh(std::string_view text, const std::string& name) {
+  WordScanner s(text, name);
+  BvhFile out = readHeader(s, name);
   readFrames(s, text, out);
   return out;
 }
 
 BvhFile parseBvhHeader(std::string_view text, const std::string& name) {
-  BvhFile out;
-  out.source = name;
   WordScanner s(text, name);
-  readHierarchy(s, out);
-  readMotionHeader(s, out);
+  BvhFile out = readHeader(s, name);
   if (!s.atEnd()) {
     const Word w = s.next();
     throw Error::at(s.pos(w), fmt::format("expected the header to end after 'Frame Time:', found {}", quoted(w.text)));

@@ -13,19 +13,10 @@
 #include "drape/formats/bvh.hpp"
 #include "drape/motion/animation.hpp"
 #include "drape/motion/live_motion.hpp"
-#include "drape/scene/avatar_makehuman.hpp"
+#include "makehuman.hpp"
 
 namespace drape::motion {
 namespace {
-
-const scene::Avatar& makeHuman() {
-  static const scene::Avatar avatar = [] {
-    scene::MakeHumanAvatarOptions options;
-    options.directory = std::string(DRAPE_DATA_DIR) + "/avatars";
-    return scene::buildMakeHumanAvatar(options);
-  }();
-  return avatar;
-}
 
 std::string mocap(const std::string& file) { return std::string(DRAPE_DATA_DIR) + "/mocap/" + file; }
 

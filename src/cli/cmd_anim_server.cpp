@@ -15,6 +15,7 @@
 
 #include "command.hpp"
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
 #include "drape/core/line_stream.hpp"
 #include "drape/core/log.hpp"
 #include "drape/core/progress.hpp"
@@ -30,7 +31,7 @@ namespace drape::cli {
 namespace {
 
 struct AnimServerOptions {
-  std::string scene, motion, animation, name = "anim", take, events, live;
+  std::string scene, motion, animation, name = "anim", take, events, live, liveHeader;
   std::vector<std::string> sets;
   long frames = 0;
   bool fast = false, hold = false;
@@ -215,6 +216,22 @@ std::string readLiveHeader(LineStream& source, const StudioOptions& studio) {
   throw Error(fmt::format("{}:{}: the source ended before its BVH header did", source.name(), source.lineNumber()));
 }
 
+/// `--live-header FILE`: a BVH file's header, its lines up to "Frame Time:" (its frames are
+/// not read), for a source that sends frame lines only.
+formats::BvhFile headerOfFile(const std::string& path) {
+  const std::optional<std::string> text = readFileText(path);
+  if (!text) throw Error(fmt::format("--live-header {}: no such file", path));
+  std::size_t at = 0;
+  while (at < text->size()) {
+    const std::size_t end = std::min(text->find('\n', at), text->size());
+    const bool last = formats::endsBvhHeader(std::string_view(*text).substr(at, end - at));
+    at = end + 1;
+    if (last) return formats::parseBvhHeader(std::string_view(*text).substr(0, std::min(at, text->size())), path);
+  }
+  (void)formats::parseBvhHeader(*text, path);  // says what is missing where
+  throw Error(fmt::format("{}: no 'Frame Time:' line, so no BVH header", path));
+}
+
 /// `--live SOURCE`: a BVH written while it is captured, from standard input, a TCP server or
 /// a named pipe, retargeted and sent frame by frame as it comes (motion/live_motion.hpp).
 int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
@@ -226,9 +243,13 @@ int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
   std::signal(SIGTERM, askToStop);
   // The server first: a studio with no NATS server is said before the capture is waited for.
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape anim-server " + o.name);
+  const std::optional<formats::BvhFile> fileHeader =
+      o.liveHeader.empty() ? std::nullopt : std::optional(headerOfFile(o.liveHeader));
   LineStream source = openLiveSource(o.live, o.studio.patience(), o.studio.giveUp());
-  spdlog::info("reading a live BVH from {}", source.name());
-  const formats::BvhFile header = formats::parseBvhHeader(readLiveHeader(source, o.studio), source.name());
+  spdlog::info("reading a live BVH from {}{}", source.name(),
+               fileHeader ? fmt::format(" (frame lines only: the skeleton is {}'s)", o.liveHeader) : "");
+  const formats::BvhFile header =
+      fileHeader ? *fileHeader : formats::parseBvhHeader(readLiveHeader(source, o.studio), source.name());
   motion::LiveMotion live(avatar, header, motionOptions(setup));
 
   studio::Publisher publisher(bus, o.name, studio::Precision::Double, o.studio.giveUp());
@@ -319,11 +340,15 @@ int runAnimServer(const AnimServerOptions& o) {
     if (!o.motion.empty() || !o.animation.empty() || !o.events.empty())
       throw Error(fmt::format("--live plays the motion its source sends: give it or {}, not both",
                               !o.events.empty() ? "--events" : !o.motion.empty() ? "--motion" : "--animation"));
+    if (!o.liveHeader.empty() && lowerExtension(o.liveHeader) != ".bvh")
+      throw Error(fmt::format("--live-header {}: expected a .bvh file (its skeleton: the header up to Frame Time)",
+                              o.liveHeader));
     if (!o.sets.empty() || o.hold || o.frames > 0 || o.fast)
       throw Error(fmt::format("{}: a live take goes at the pace its source sends, for as long",
                               !o.sets.empty() ? "--set" : o.hold ? "--hold" : o.frames > 0 ? "--frames" : "--fast"));
     return runLiveMotion(o, setup);
   }
+  if (!o.liveHeader.empty()) throw Error("--live-header is the skeleton of a --live source: give --live SOURCE");
   if (!o.events.empty()) {
     if (!o.motion.empty() || !o.animation.empty())
       throw Error("--events plays an event graph's motions: give it or --motion, not both");
@@ -398,6 +423,10 @@ RunFunction setupAnimServer(CLI::App& app) {
                  "tcp://HOST:PORT (connected to) or a named pipe; its frames are sent as they come, retargeted as "
                  "--motion retargets a file (docs/MOTION.md), until the source closes or Ctrl-C")
       ->type_name("SOURCE");
+  app.add_option("--live-header", o.liveHeader,
+                 "With --live: the skeleton from this BVH file's header (its frames are not played), for a source "
+                 "that sends frame lines only, one frame of channel values a line")
+      ->type_name("FILE.bvh");
   app.add_option("--set", o.sets, "With --events: a parameter of the graph, NAME=VALUE; repeatable");
   app.add_flag("--hold", o.hold,
                "With --events: go on when the graphs end, the character holding its pose, until stopped (Ctrl-C, "

@@ -471,6 +471,48 @@ TEST(Studio, ALiveSourceThatIsNotThereOrFallsSilentEndsTheTakeSaying) {
   EXPECT_NE(r.err.find("--live plays the motion its source sends: give it or --motion, not both"), std::string::npos) << r.err;
 }
 
+/// Every pose frame's joints of the take in stream `source`.
+std::vector<std::vector<RigidTransform>> poseFramesOf(const NatsServer& server, const std::string& source) {
+  studio::Bus bus = studio::Bus::connect(server.url(), "test");
+  const studio::StreamRange range = bus.range(source);
+  std::vector<std::vector<RigidTransform>> frames;
+  for (std::uint64_t seq = range.first; seq != 0 && seq <= range.last; ++seq) {
+    const studio::Message m = studio::decode(bus.get(source, seq)->data);
+    if (const auto* p = std::get_if<studio::PoseFrame>(&m.payload)) frames.push_back(p->joints);
+  }
+  return frames;
+}
+
+TEST(Studio, ALiveSourceOfFrameLinesTakesItsSkeletonFromABvhFile) {
+  // A stream of frame lines with no header, the skeleton given by --live-header: the same
+  // pose frames, to the bit, as the stream that sends its header first.
+  ScratchDir dir("studio-live-header");
+  NatsServer server;
+  const std::vector<std::string> lines = linesOf(slurp(kWalk));
+  CaptureBroadcast whole, framesOnly;
+  whole.send(lines, 100, 1ms);
+  framesOnly.send(std::vector<std::string>(lines.begin() + 187, lines.end()), 100, 1ms);
+  CliResult r = runDrape("anim-server '" + kScene + "' --live " + whole.url() + " --name whole" + roles(server), dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = runDrape("anim-server '" + kScene + "' --live " + framesOnly.url() + " --live-header '" + kWalk + "' --name lines" +
+                   roles(server),
+               dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("141 pose frames"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("frame lines only: the skeleton is " + kWalk + "'s"), std::string::npos) << r.err;
+  const auto a = poseFramesOf(server, "whole"), b = poseFramesOf(server, "lines");
+  ASSERT_EQ(a.size(), 141u);
+  ASSERT_EQ(b.size(), a.size());
+  for (std::size_t f = 0; f < a.size(); ++f)
+    for (std::size_t j = 0; j < a[f].size(); ++j) {
+      ASSERT_EQ(a[f][j].translation, b[f][j].translation) << "frame " << f << " joint " << j;
+      ASSERT_EQ(a[f][j].rotation.coeffs(), b[f][j].rotation.coeffs()) << "frame " << f << " joint " << j;
+    }
+  r = runDrape("anim-server '" + kScene + "' --live-header '" + kWalk + "' --motion '" + kWalk + "'" + roles(server), dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--live-header is the skeleton of a --live source"), std::string::npos) << r.err;
+}
+
 TEST(Studio, ErrorsSayWhatToDo) {
   ScratchDir dir("studio-errors");
   std::string nowhere;

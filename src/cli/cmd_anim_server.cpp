@@ -301,22 +301,24 @@ int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
     live.push(values);
     sendReady();
   }
+  // However the source ended, the frames it sent are the take's: the last ones resampled out.
+  live.finish();
+  sendReady();
   std::string ended;
   if (silent) {
     ended = fmt::format("{} went silent for {:g} s (--give-up)", source.name(), o.studio.giveUp_s);
   } else if (stopAsked) {
     ended = "stopped (a signal)";
-  } else {
-    live.finish();
-    sendReady();
-    if (!source.endReason().empty()) ended = fmt::format("{}: {}", source.name(), source.endReason());
+  } else if (!source.endReason().empty()) {
+    ended = fmt::format("{}: {}", source.name(), source.endReason());
   }
   publisher.send(studio::End{sent, "", ended, silent ? static_cast<int>(ExitCode::Unavailable) : 0});
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
   fmt::print("sent take {}: {} pose frames of {} from {} ({} source frames{}) to {} on {} in {:.1f} s{}\n", take, sent,
              avatar.name, source.name(), live.sourceFrames(),
-             badLines > 0 ? fmt::format(", {} bad lines", badLines) : std::string(), studio::subjectOf(o.name),
-             bus.url(), seconds, ended.empty() ? "" : " (" + ended + ")");
+             badLines > 0 ? fmt::format(", {} bad line{}", badLines, badLines == 1 ? "" : "s") : std::string(),
+             studio::subjectOf(o.name),
+             bus.url(), seconds, ended.empty() ? "" : "; " + ended);
   return silent ? static_cast<int>(ExitCode::Unavailable) : 0;
 }
 

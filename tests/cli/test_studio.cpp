@@ -407,7 +407,7 @@ TEST(Studio, ALiveCaptureOverTcpIsSimulatedAsItComes) {
   ASSERT_EQ(sent.code, 0) << sent.err;
   EXPECT_GE(posesAtMiddle.load(), 60u) << "the poses were to go out while the capture was still sending";
   EXPECT_NE(sent.out.find("sent take live: 141 pose frames of makehuman_CMU compliant skeleton from " + capture.url() +
-                          " (566 source frames, 1 bad lines)"),
+                          " (566 source frames, 1 bad line)"),
             std::string::npos)
       << sent.out;
   EXPECT_NE(sent.err.find(capture.url() + ":488:5: expected a number, found 'oops' (the frame before it stands in)"),

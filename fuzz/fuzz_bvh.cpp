@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
-#include <string>
 #include <string_view>
 #include <vector>
 
@@ -17,9 +16,9 @@
 namespace {
 
 void readAsStream(std::string_view text) {
-  std::string header;
-  std::size_t at = 0;
-  int line = 0;
+  std::size_t at = drape::formats::bvhHeaderLength(text).value_or(text.size());
+  const drape::formats::BvhFile head = drape::formats::parseBvhHeader(text.substr(0, at), "stream");
+  int line = static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
   const auto nextLine = [&](std::string_view& out) {
     if (at >= text.size()) return false;
     const std::size_t end = std::min(text.find('\n', at), text.size());
@@ -29,11 +28,6 @@ void readAsStream(std::string_view text) {
     return true;
   };
   std::string_view l;
-  while (nextLine(l)) {
-    header.append(l).push_back('\n');
-    if (drape::formats::endsBvhHeader(l)) break;
-  }
-  const drape::formats::BvhFile head = drape::formats::parseBvhHeader(header, "stream");
   std::vector<double> values(head.channelCount);
   while (nextLine(l)) {
     try {

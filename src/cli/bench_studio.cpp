@@ -27,6 +27,7 @@
 #include <filesystem>
 #include <thread>
 #include <iostream>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -138,20 +139,12 @@ class CaptureBroadcast {
  public:
   explicit CaptureBroadcast(const std::string& bvhPath) {
     const std::string text = readFileText(bvhPath).value_or("");
-    std::size_t at = 0;
-    bool inHeader = true;
-    while (at < text.size()) {
-      const std::size_t end = std::min(text.find('\n', at), text.size());
-      const std::string line = text.substr(at, end - at);
-      at = end + 1;
-      if (inHeader) {
-        header_ += line + "\n";
-        if (formats::endsBvhHeader(line)) inHeader = false;
-      } else if (line.find_first_not_of(" \t\r") != std::string::npos) {
-        frames_.push_back(line + "\n");
-      }
-    }
+    const std::size_t headerBytes = formats::bvhHeaderLength(text).value_or(text.size());
+    header_ = text.substr(0, headerBytes);
     frameTime_s_ = formats::parseBvhHeader(header_, bvhPath).frameTime;
+    std::istringstream rest(text.substr(headerBytes));
+    for (std::string line; std::getline(rest, line);)
+      if (line.find_first_not_of(" \t\r") != std::string::npos) frames_.push_back(line + "\n");
     listener_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
     sockaddr_in address{};
     address.sin_family = AF_INET;

@@ -7,6 +7,7 @@
 #include <csignal>
 #include <list>
 #include <optional>
+#include <span>
 #include <vector>
 #include <thread>
 
@@ -42,6 +43,20 @@ struct AnimServerOptions {
 std::atomic<bool> stopAsked{false};
 
 extern "C" void askToStop(int) { stopAsked = true; }
+
+/// A pose take's first message: the avatar and its joints (every frame lists them in this
+/// order), the motion joints driving them, and how the frames are numbered (`frames` 0:
+/// not known ahead, a live take).
+studio::PoseStart poseStart(const scene::Avatar& avatar, std::span<const int> driving, TimeCode start,
+                            std::int64_t frames) {
+  studio::PoseStart p;
+  p.character = avatar.name;
+  for (const scene::Joint& j : avatar.joints) p.joints.push_back(j.name);
+  p.driving.assign(driving.begin(), driving.end());
+  p.start = start;
+  p.frames = frames;
+  return p;
+}
 
 /// What an Inject asks of a live take: a graph started at once, an event sent; the answer.
 studio::InjectReply injected(const studio::Inject& in, long frame, events::Scheduler& scheduler,
@@ -89,14 +104,9 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup) {
   studio::Publisher publisher(bus, o.name, studio::Precision::Double, o.studio.giveUp());
   studio::Listener requests = bus.listen(studio::requestSubjectOf(o.name));
   const std::string take = o.take.empty() ? studio::newTakeId() : o.take;
-  studio::PoseStart start;
-  start.character = avatar.name;
-  for (const scene::Joint& j : avatar.joints) start.joints.push_back(j.name);
-  start.driving.assign(avatar.joints.size(), -1);
-  start.start = TimeCode{0, rate};
-  // Known ahead only when it holds to --frames; else 0: live, as long as its graphs run.
-  start.frames = o.hold ? o.frames : 0;
-  publisher.beginTake(take, start);
+  // Its length known ahead only when it holds to --frames; else 0: live, as long as its graphs run.
+  publisher.beginTake(take, poseStart(avatar, std::vector<int>(avatar.joints.size(), -1), TimeCode{0, rate},
+                                      o.hold ? o.frames : 0));
   std::signal(SIGINT, askToStop);
   std::signal(SIGTERM, askToStop);
   spdlog::info("take {}: the event graph {} on {} at {:g} Hz, on {} ({}); drape inject --to {} starts graphs and sends "
@@ -221,13 +231,8 @@ std::string readLiveHeader(LineStream& source, const StudioOptions& studio) {
 formats::BvhFile headerOfFile(const std::string& path) {
   const std::optional<std::string> text = readFileText(path);
   if (!text) throw Error(fmt::format("--live-header {}: no such file", path));
-  std::size_t at = 0;
-  while (at < text->size()) {
-    const std::size_t end = std::min(text->find('\n', at), text->size());
-    const bool last = formats::endsBvhHeader(std::string_view(*text).substr(at, end - at));
-    at = end + 1;
-    if (last) return formats::parseBvhHeader(std::string_view(*text).substr(0, std::min(at, text->size())), path);
-  }
+  if (const std::optional<std::size_t> length = formats::bvhHeaderLength(*text))
+    return formats::parseBvhHeader(std::string_view(*text).substr(0, *length), path);
   (void)formats::parseBvhHeader(*text, path);  // says what is missing where
   throw Error(fmt::format("{}: no 'Frame Time:' line, so no BVH header", path));
 }
@@ -254,14 +259,9 @@ int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
 
   studio::Publisher publisher(bus, o.name, studio::Precision::Double, o.studio.giveUp());
   const std::string take = o.take.empty() ? studio::newTakeId() : o.take;
-  studio::PoseStart start;
-  start.character = avatar.name;
-  for (const scene::Joint& j : avatar.joints) start.joints.push_back(j.name);
-  start.driving.assign(live.drivingJoint().begin(), live.drivingJoint().end());
-  start.start = TimeCode{0, live.rate()};
-  start.frames = 0;  // live: as long as the source sends
-  // A capture does not come again: a take of this name in the stream cannot be completed.
-  if (publisher.beginTake(take, start) > 0)
+  // Live: as long as the source sends. A capture does not come again, so a take of this name
+  // in the stream cannot be completed.
+  if (publisher.beginTake(take, poseStart(avatar, live.drivingJoint(), TimeCode{0, live.rate()}, 0)) > 0)
     throw Error(fmt::format("--take {}: {} holds that take already, and a live capture cannot be sent again to "
                             "complete it; give the take another name",
                             take, studio::subjectOf(o.name)));
@@ -322,16 +322,12 @@ int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
   return silent ? static_cast<int>(ExitCode::Unavailable) : 0;
 }
 
-/// The pose take's first message: the avatar, its joints and how the frames are numbered.
+/// A recorded motion's take: its frames numbered from the motion's own time code, counted in
+/// its frames at the rate it plays.
 studio::PoseStart poseStart(const scene::Avatar& avatar, const motion::AvatarAnimation& motion) {
-  studio::PoseStart start;
-  start.character = avatar.name;
-  for (const scene::Joint& j : avatar.joints) start.joints.push_back(j.name);
-  start.driving.assign(motion.drivingJoint().begin(), motion.drivingJoint().end());
-  // The motion's own time code, counted in its frames at the rate it plays.
-  start.start = TimeCode{static_cast<std::int64_t>(std::llround(motion.start().seconds() * motion.rate())), motion.rate()};
-  start.frames = static_cast<std::int64_t>(motion.frameCount());
-  return start;
+  return poseStart(avatar, motion.drivingJoint(),
+                   TimeCode{static_cast<std::int64_t>(std::llround(motion.start().seconds() * motion.rate())), motion.rate()},
+                   static_cast<std::int64_t>(motion.frameCount()));
 }
 
 int runAnimServer(const AnimServerOptions& o) {

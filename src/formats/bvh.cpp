@@ -211,6 +211,16 @@ bool endsBvhHeader(std::string_view line) {
   return words.size() > 1 && words[1].text.substr(0, 5) == "Time:";
 }
 
+std::optional<std::size_t> bvhHeaderLength(std::string_view text) {
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    const bool last = endsBvhHeader(text.substr(at, end - at));
+    at = std::min(end + 1, text.size());
+    if (last) return at;
+  }
+  return std::nullopt;
+}
+
 void parseBvhFrameLine(std::string_view line, const std::string& name, int lineNumber, std::span<double> out) {
   const std::vector<detail::LineWord> words = detail::lineWords(line, out.size() + 1);
   for (std::size_t i = 0; i < words.size() && i < out.size(); ++i) {

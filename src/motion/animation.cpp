@@ -372,9 +372,8 @@ double Retargeter::lowestAboveFloor(std::span<const RigidTransform> world) const
 AvatarAnimation AvatarAnimation::build(const scene::Avatar& avatar, const Clip& clip, const JointMap& map,
                                        const RetargetOptions& options) {
   const std::size_t n = avatar.joints.size();
-  if (n == 0) throw Error(fmt::format("{}: the avatar has no joints to animate", avatar.source));
   if (clip.frameCount() == 0) throw Error(fmt::format("{}: the motion has no frames", clip.source));
-  Retargeter retargeter(avatar, clip.skeleton, map, options, clip.source);
+  Retargeter retargeter(avatar, clip.skeleton, map, options, clip.source);  // throws for an avatar without joints
   AvatarAnimation anim;
   anim.frames_ = clip.frameCount();
   anim.joints_ = n;

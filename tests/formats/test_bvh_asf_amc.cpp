@@ -91,6 +91,9 @@ TEST(BvhStream, ReadsTheHeaderAndEachFrameLineAsTheWholeFileIsRead) {
     if (endsBvhHeader(l)) break;
   }
   EXPECT_EQ(line, whole.firstFrameLine - 1);
+  EXPECT_EQ(bvhHeaderLength(text), header.size());
+  EXPECT_EQ(bvhHeaderLength("HIERARCHY\nROOT Hips\n"), std::nullopt);
+  EXPECT_EQ(bvhHeaderLength("MOTION\nFrame Time: 0.01"), 23u) << "a last line without its newline";
   const BvhFile head = parseBvhHeader(header, "walk.bvh");
   EXPECT_EQ(head.joints.size(), whole.joints.size());
   EXPECT_EQ(head.channelCount, whole.channelCount);

@@ -86,6 +86,7 @@ TEST(LiveMotion, DropsAReferenceTPoseAsTheFileLoaderDoes) {
   const formats::BvhFile bvh = formats::readBvh(mocap("cmu_12_03_walk.bvh"));
   ClipLoadReport report;
   (void)loadClip(mocap("cmu_12_03_walk.bvh"), liveComparable(30.0, false).clip, &report);
+  ASSERT_TRUE(report.referenceTPoseSkipped) << "the CMU walk opens with a reference T-pose";
   const LiveRun live = runLive(bvh, liveComparable(30.0, false));
   EXPECT_EQ(live.tposeSkipped, report.referenceTPoseSkipped);
 }

@@ -57,6 +57,9 @@ struct BvhFile {
 [[nodiscard]] BvhFile parseBvhHeader(std::string_view text, const std::string& name);
 /// True for the line that ends a BVH header ("Frame Time: T"): what a stream reader waits for.
 [[nodiscard]] bool endsBvhHeader(std::string_view line);
+/// Bytes of `text` up to and including its header's last line (and that line's newline):
+/// where a BVH's frames begin. Nothing when no line ends a header.
+[[nodiscard]] std::optional<std::size_t> bvhHeaderLength(std::string_view text);
 /// One frame of such a stream, the line `lineNumber` of `name`: exactly out.size() finite
 /// values (the channels). Throws drape::Error "name:line:column: expected ...".
 void parseBvhFrameLine(std::string_view line, const std::string& name, int lineNumber, std::span<double> out);

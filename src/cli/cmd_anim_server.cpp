@@ -26,6 +26,7 @@
 #include "drape/studio/publisher.hpp"
 #include "drape/studio/takes.hpp"
 #include "run_setup.hpp"
+#include "stop_signal.hpp"
 #include "studio_options.hpp"
 
 namespace drape::cli {
@@ -39,10 +40,8 @@ struct AnimServerOptions {
   StudioOptions studio;
 };
 
-/// Set by SIGINT and SIGTERM: a live take ends at the next frame, with its End sent.
-std::atomic<bool> stopAsked{false};
-
-extern "C" void askToStop(int) { stopAsked = true; }
+/// Set by SIGINT and SIGTERM (stopOnSignals()): a live take ends at the next frame, with its End sent.
+const std::atomic<bool>& stopAsked = detail::stopAsked;
 
 /// A pose take's first message: the avatar and its joints (every frame lists them in this
 /// order), the motion joints driving them, and how the frames are numbered (`frames` 0:
@@ -107,8 +106,7 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup) {
   // Its length known ahead only when it holds to --frames; else 0: live, as long as its graphs run.
   publisher.beginTake(take, poseStart(avatar, std::vector<int>(avatar.joints.size(), -1), TimeCode{0, rate},
                                       o.hold ? o.frames : 0));
-  std::signal(SIGINT, askToStop);
-  std::signal(SIGTERM, askToStop);
+  (void)stopOnSignals();
   spdlog::info("take {}: the event graph {} on {} at {:g} Hz, on {} ({}); drape inject --to {} starts graphs and sends "
                "events while it runs",
                take, o.events, avatar.name, rate, studio::subjectOf(o.name), o.fast ? "as fast as the server takes it" : "in real time",
@@ -244,8 +242,7 @@ int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
   if (!setup.character->keepApart.empty())
     spdlog::warn("{}: the scene keeps {} apart, a correction of a whole motion: a live motion plays without it", o.scene,
                  fmt::join(setup.character->keepApart, ", "));
-  std::signal(SIGINT, askToStop);
-  std::signal(SIGTERM, askToStop);
+  (void)stopOnSignals();
   // The server first: a studio with no NATS server is said before the capture is waited for.
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape anim-server " + o.name);
   const std::optional<formats::BvhFile> fileHeader =

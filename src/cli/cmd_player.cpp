@@ -3,11 +3,15 @@
 // frame, and records them as a run directory (what drape run --out writes, to the byte) or
 // shows them live in a window.
 
+#include <cctype>
 #include <chrono>
+#include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <optional>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "command.hpp"
 #include "drape/core/error.hpp"
@@ -17,16 +21,20 @@
 #include "drape/studio/pose_follower.hpp"
 #include "render_options.hpp"
 #include "run_writer.hpp"
+#include "stop_signal.hpp"
 #include "studio_frames.hpp"
+#include "take_feed.hpp"
 
 namespace drape::cli {
 namespace {
+
+namespace fs = std::filesystem;
 
 struct PlayerRoleOptions {
   std::string scene, record, take, screenshot, from;
   std::vector<std::string> cloth{"cloth"};
   bool window = false, preview = false, everyFrame = false;
-  long every = 1, frames = 0;
+  long every = 1, frames = 0, takes = 1;
   StudioOptions studio;
   PictureOptions picture;
 };
@@ -47,43 +55,135 @@ nlohmann::json statsOf(const std::vector<std::pair<std::string, std::string>>& s
   return out;
 }
 
-int record(const PlayerRoleOptions& o) {
-  RunSetup setup = runSetupFromScene(o.scene);
-  studio::Bus bus = studio::Bus::connect(o.studio.server, "drape player");
-  StudioFrames frames(bus, setup, o.cloth, o.take, o.studio);
-  setup.outDir = o.record;
-  setup.preview = o.preview;
-  setup.objEvery = o.every;
-  const std::vector<sim::PartField> fields = skinFields(setup);
-  RunWriter writer(setup, &fields, sim::leastT0(setup.garments, worldSettings(setup)), frames.jointsAtStart());
+/// Where a take is recorded when a player records several: its name, made a file name.
+std::string takeDirName(const std::string& take) {
+  std::string name = take;
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
+  return name.empty() || name == "." || name == ".." ? "take" : name;
+}
+
+/// The part fields of the skinned body, built again only when a take sends other garments.
+class SkinFields {
+ public:
+  const std::vector<sim::PartField>& of(const RunSetup& setup) {
+    std::vector<std::string> names;
+    for (const GarmentSetup& g : setup.garments) names.push_back(g.name);
+    if (!fields_ || names != names_) {
+      fields_ = skinFields(setup);
+      names_ = std::move(names);
+    }
+    return *fields_;
+  }
+
+ private:
+  std::optional<std::vector<sim::PartField>> fields_;
+  std::vector<std::string> names_;
+};
+
+/// How one take's recording ended.
+struct Recording {
+  long frames = 0;
+  std::string failure;  ///< the take's error (a garment went unstable), or ""
+  ExitCode code = ExitCode::Ok;
+  std::string cutShort;  ///< the stream started another take first: what it said, or ""
+  bool stopped = false;  ///< a signal stopped the player
+};
+
+/// Records the take `frames` follows into `setup.outDir`: the frames it has (all of them,
+/// or --frames), then the stats, as drape run writes them.
+Recording recordTake(const PlayerRoleOptions& o, RunSetup& setup, StudioFrames& frames, SkinFields& fields,
+                     const std::atomic<bool>& stop) {
+  RunWriter writer(setup, &fields.of(setup), sim::leastT0(setup.garments, worldSettings(setup)), frames.jointsAtStart());
   FrameTaken taken;
   long last = -1;
-  std::string failure;
-  ExitCode failed = ExitCode::Ok;
+  Recording out;
   try {
-    while ((o.frames == 0 || last < o.frames) && frames.next(last + 1, taken)) {
+    while ((o.frames == 0 || last < o.frames) && !stop && frames.next(last + 1, taken)) {
       writer.write(taken);
       ++last;
     }
+    out.stopped = stop;
+  } catch (const studio::Stopped&) {
+    out.stopped = true;
   } catch (const Error& e) {  // the take's own end: the frames before it are kept, as drape run keeps them
-    failure = e.what();
-    failed = e.code();
+    out.failure = e.what();
+    out.code = e.code();
+  } catch (const studio::NewTake& e) {
+    out.cutShort = e.what();
   }
   writer.close(std::max(0L, last));
   if (const auto stats = frames.stats(); !stats.empty()) writer.writeStats(statsOf(stats));
-  if (!failure.empty())
-    throw Error(fmt::format("{} (the {} frames before it recorded in {})", failure, last + 1, o.record), failed);
-  fmt::print("recorded take {}: {} frames of {} in {}/\n", frames.take(), last + 1, frames.start().character, o.record);
-  return 0;
+  out.frames = last + 1;
+  return out;
 }
+
+int record(const PlayerRoleOptions& o) {
+  RunSetup setup = runSetupFromScene(o.scene);
+  studio::Bus bus = studio::Bus::connect(o.studio.server, "drape player");
+  StudioFrames frames(bus, setup, o.cloth, o.studio);
+  setup.preview = o.preview;
+  setup.objEvery = o.every;
+  SkinFields fields;
+  // A signal ends the recording where it is, its files closed: how a recorder of take after take stops.
+  const std::atomic<bool>& stop = stopOnSignals();
+  frames.stopOn(&stop);
+  int exitCode = 0;
+  for (long recorded = 0; o.takes == 0 || recorded < o.takes; ++recorded) {
+    try {
+      frames.followNextTake(o.take);
+    } catch (const studio::Stopped&) {
+      fmt::print("stopped (a signal) waiting for a take; {} recorded\n", recorded);
+      return exitCode;
+    }
+    const std::string dir = o.takes == 1 ? o.record : (fs::path(o.record) / takeDirName(frames.take())).string();
+    setup.outDir = dir;
+    const Recording r = recordTake(o, setup, frames, fields, stop);
+    if (!r.failure.empty()) {
+      const std::string said = fmt::format("{} (the {} frames before it recorded in {})", r.failure, r.frames, dir);
+      if (o.takes == 1) throw Error(said, r.code);
+      spdlog::error("take {}: {}", frames.take(), said);  // a recorder goes on to the next take
+      exitCode = static_cast<int>(r.code);
+      continue;
+    }
+    exitCode = 0;
+    fmt::print("recorded take {}: {} frames of {} in {}/{}\n", frames.take(), r.frames, frames.start().character, dir,
+               r.stopped              ? " (stopped by a signal)"
+               : !r.cutShort.empty() ? " (cut short: " + r.cutShort + ")"
+                                     : "");
+    std::fflush(stdout);
+    if (r.stopped) break;
+  }
+  return exitCode;
+}
+
+/// What a window showed of one take, said when it moves on to the next and when it closes.
+struct Shown {
+  std::string take;
+  TimeCode from;
+  long frames = 0, left = 0;
+  std::chrono::steady_clock::time_point began;
+
+  void say() const {
+    if (frames == 0) return;
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+    std::cout << fmt::format("showed {} frame{} of take {} from {} in {:.1f} s{}\n", frames, frames == 1 ? "" : "s", take,
+                             from.smpte(), seconds,
+                             left > 0 ? fmt::format(" ({} left out to keep to the take's time)", left) : "");
+    std::cout.flush();
+  }
+};
 
 int show(const PlayerRoleOptions& o) {
   RunSetup setup = runSetupFromScene(o.scene);
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape player");
-  StudioFrames frames(bus, setup, o.cloth, o.take, o.studio);
+  StudioFrames frames(bus, setup, o.cloth, o.studio);
+  frames.followNextTake(o.take);
+  // The window's meshes are the first take's garments; the feed reads on with a setup of its own.
+  const std::vector<GarmentSetup> garmentsShown = setup.garments;
   const scene::Avatar& avatar = *setup.character->avatar;
   std::vector<render::MeshInfo> meshes;
-  for (const GarmentSetup& g : setup.garments)
+  for (const GarmentSetup& g : garmentsShown)
     meshes.push_back({g.name, render::MeshRole::Garment, g.mesh.vertexCount(), g.mesh.triangles});
   for (const scene::Segment& seg : avatar.segments)
     meshes.push_back({seg.name, render::MeshRole::Segment, seg.mesh.vertexCount(), seg.mesh.triangles});
@@ -91,61 +191,77 @@ int show(const PlayerRoleOptions& o) {
     meshes.push_back({"body", render::MeshRole::Skin, avatar.skin->mesh.vertexCount(), avatar.skin->mesh.triangles});
   const std::vector<sim::PartField> fields = skinFields(setup);
   std::unique_ptr<sim::BodySkin> skin;
-  if (avatar.skin) skin = std::make_unique<sim::BodySkin>(avatar, fields, sim::leastT0(setup.garments, worldSettings(setup)));
+  if (avatar.skin) skin = std::make_unique<sim::BodySkin>(avatar, fields, sim::leastT0(garmentsShown, worldSettings(setup)));
+  const std::string firstTake = frames.take();
+  const double rate = setup.settings.frameRate_hz;
 
-  FrameTaken taken;
   const long firstShown = o.from.empty() ? 0 : frames.seek(o.from);
-  long next = firstShown, skipped = 0;
+  TakeFeed feed(frames, firstShown, o.takes);
+  Shown shown;
+  std::optional<std::size_t> showing;  // which take of the feed
   std::vector<sim::GarmentSurface> garments;
   std::optional<std::chrono::steady_clock::time_point> first;
-  render::CallbackSource source(meshes, setup.settings.frameRate_hz, [&](render::Frame& out) {
-    // Live, a window that draws slower than the frame rate keeps to the take's time by
-    // leaving frames out (their poses and cloth still read, in order); --every-frame shows
-    // each, falling behind.
-    const auto now = std::chrono::steady_clock::now();
-    if (!first) first = now;
-    const auto due =
-        firstShown + static_cast<long>(std::chrono::duration<double>(now - *first).count() * setup.settings.frameRate_hz);
-    for (; !o.everyFrame && next < due; ++next, ++skipped)
-      if (!frames.next(next, taken)) return false;
-    if (!frames.next(next, taken)) return false;
-    // The take's time code: cloth frame 0 is the lead-in's start, before the poses' first.
-    out.time = TimeCode{frames.start().start.frame + next, frames.start().start.rate};
-    ++next;
-    out.positions.resize(meshes.size());
-    out.states.resize(meshes.size());
-    garments.clear();
-    for (std::size_t g = 0; g < setup.garments.size(); ++g) {
-      out.positions[g] = taken.positions[g];
-      out.states[g] = taken.states[g];
-      garments.push_back({taken.positions[g], setup.garments[g].mesh.triangles});
-    }
-    for (std::size_t s = 0; s < avatar.segments.size(); ++s) {
-      const scene::Segment& seg = avatar.segments[s];
-      std::vector<Vec3>& p = out.positions[setup.garments.size() + s];
-      p.clear();
-      const RigidTransform& pose = taken.joints[static_cast<std::size_t>(seg.joint)];
-      for (const Vec3& v : seg.mesh.positions) p.push_back(pose.apply(v));
-    }
-    if (skin) skin->pose(taken.joints, garments, out.positions.back());
-    return true;
-  });
+  long firstOfTake = firstShown;
+  render::CallbackSource source(
+      meshes, rate,
+      [&](render::Frame& out) {
+        // Live, a window that draws slower than the frame rate keeps to the take's time by
+        // leaving frames out (their poses and cloth still read, in order); --every-frame shows
+        // each, falling behind.
+        const auto now = std::chrono::steady_clock::now();
+        std::optional<TakeFeed::Latest> due;
+        if (!o.everyFrame && showing)
+          due = TakeFeed::Latest{
+              *showing, firstOfTake + static_cast<long>(std::chrono::duration<double>(now - *first).count() * rate)};
+        long left = 0;
+        std::optional<TakeFeed::Item> item = feed.next(due, &left);
+        if (!item) return false;
+        if (showing != item->take) {  // a take begins: its time from its first frame shown
+          shown.say();
+          if (showing) spdlog::info("the next take: {}", item->takeName);
+          showing = item->take;
+          first = now;
+          firstOfTake = item->taken.frame;
+          shown = Shown{item->takeName, item->time, 0, 0, now};
+        }
+        ++shown.frames;
+        shown.left += left;
+        // The take's time code: cloth frame 0 is the lead-in's start, before the poses' first.
+        out.time = item->time;
+        const FrameTaken& taken = item->taken;
+        out.positions.resize(meshes.size());
+        out.states.resize(meshes.size());
+        garments.clear();
+        for (std::size_t g = 0; g < garmentsShown.size(); ++g) {
+          out.positions[g] = taken.positions[g];
+          out.states[g] = taken.states[g];
+          garments.push_back({taken.positions[g], garmentsShown[g].mesh.triangles});
+        }
+        for (std::size_t s = 0; s < avatar.segments.size(); ++s) {
+          const scene::Segment& seg = avatar.segments[s];
+          std::vector<Vec3>& p = out.positions[garmentsShown.size() + s];
+          p.clear();
+          const RigidTransform& pose = taken.joints[static_cast<std::size_t>(seg.joint)];
+          for (const Vec3& v : seg.mesh.positions) p.push_back(pose.apply(v));
+        }
+        if (skin) skin->pose(taken.joints, garments, out.positions.back());
+        return true;
+      },
+      [&](std::int64_t) { return feed.ready(); });
   render::PlayerOptions options;
   std::tie(options.width, options.height) = o.picture.parsedSize();
-  options.title = fmt::format("drape player: take {}", frames.take());
+  options.title = o.takes == 1 ? fmt::format("drape player: take {}", firstTake)
+                               : fmt::format("drape player: take after take of {}", fmt::join(o.cloth, ", "));
   if (o.frames > 0) options.maxFrames = o.frames;
   options.loop = false;
   options.view = o.picture.view();
   options.follow = o.picture.follow;
   options.overlay = o.picture.overlay();
   options.screenshot = o.screenshot;
-  render::SubdividedSource shown(source, o.picture.subdivide);
-  const render::PlayerStats stats = render::Player(options).run(shown);
-  const TimeCode from{frames.start().start.frame + firstShown, frames.start().start.rate};
-  std::cout << fmt::format("showed {} frame{} of take {} from {} in {:.1f} s{}\n", stats.framesDrawn,
-                           stats.framesDrawn == 1 ? "" : "s", frames.take(),
-                           from.smpte(), stats.seconds,
-                           skipped > 0 ? fmt::format(" ({} left out to keep to the take's time)", skipped) : "");
+  options.close = &stopOnSignals();  // Ctrl-C closes the window as its user would: the screenshot, what it showed
+  render::SubdividedSource subdivided(source, o.picture.subdivide);
+  (void)render::Player(options).run(subdivided);
+  shown.say();
   return 0;
 }
 
@@ -160,6 +276,11 @@ RunFunction setupPlayer(CLI::App& app) {
   rec->excludes(win);
   app.add_option("--take", o.take, "The take to play (default: the one the cloth streams hold, or the next)");
   app.add_option("--frames", o.frames, "Stop after frame N (with --window: after N frames shown)")->check(CLI::PositiveNumber);
+  app.add_option("--takes", o.takes,
+                 "Play N takes one after another, 0 for take after take until stopped (with --record: each in "
+                 "DIR/TAKE, its name, unless N is 1)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_flag("--preview", o.preview, "With --record: also a contact sheet and, with ffmpeg, an MP4");
   app.add_option("--every", o.every, "With --record: an OBJ frame every K frames")->capture_default_str()->check(CLI::PositiveNumber);
   app.add_option("--from", o.from,
@@ -176,6 +297,8 @@ RunFunction setupPlayer(CLI::App& app) {
              "4 no NATS server answers or a peer went silent past --give-up.");
   return [] {
     if (o.record.empty() && !o.window) throw Error("drape player: give --record DIR or --window");
+    if (!o.take.empty() && o.takes != 1)
+      throw Error("--take names one take: it does not go with --takes " + std::to_string(o.takes));
     if (!o.from.empty() && !o.window)
       throw Error("--from applies to --window: a recording is the whole take, which the streams keep from its start");
     return o.window ? show(o) : record(o);

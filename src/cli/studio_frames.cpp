@@ -26,36 +26,42 @@ std::string disagreement(const studio::ClothStart& a, const studio::ClothStart& 
 }  // namespace
 
 StudioFrames::StudioFrames(studio::Bus& bus, RunSetup& setup, const std::vector<std::string>& cloth,
-                           const std::string& take, const StudioOptions& options)
-    : setup_(setup) {
+                           const StudioOptions& options)
+    : setup_(setup), sceneGarments_(setup.garments), options_(options), bus_(bus),
+      consumer_(consumerName("player", true)) {
   if (!setup.character) throw Error("drape player: the scene has no avatar the garments are worn by");
   if (cloth.empty()) throw Error("--cloth: name at least one cloth-server");
-  const std::string consumer = consumerName("player", true);
   for (const std::string& source : cloth) {
     studio::checkSourceName(source, "--cloth");
     if (std::count(cloth.begin(), cloth.end(), source) > 1) throw Error(fmt::format("--cloth: '{}' twice", source));
     Cloth c;
     c.source = source;
-    c.stream = std::make_unique<studio::StreamReader>(bus, source, consumer, options.patience(), options.giveUp());
+    c.stream = std::make_unique<studio::StreamReader>(bus, source, consumer_, options.patience(), options.giveUp());
     c.follower = std::make_unique<studio::ClothFollower>(*c.stream);
-    c.follower->followNextTake(take);
     cloth_.push_back(std::move(c));
+  }
+}
+
+void StudioFrames::followNextTake(const std::string& take) {
+  for (Cloth& c : cloth_) {
+    const std::string before = c.follower->take();
+    c.follower->followNextTake(take, before);
+    c.garment.clear();
   }
   const studio::ClothStart& first = cloth_.front().follower->start();
   for (const Cloth& c : cloth_)
     if (const std::string bad = disagreement(first, c.follower->start()); !bad.empty())
       throw Error(fmt::format("--cloth: '{}' and '{}' simulate {}: a player collates the cloth of one pose take",
                               cloth_.front().source, c.source, bad));
-  if (first.start.rate != setup.settings.frameRate_hz)
+  if (first.start.rate != setup_.settings.frameRate_hz)
     throw Error(fmt::format("cloth take {} runs at {:g} frames per second, the scene at {:g}: give the player the "
                             "cloth-servers' scene",
-                            take.empty() ? cloth_.front().follower->take() : take, first.start.rate,
-                            setup.settings.frameRate_hz));
+                            cloth_.front().follower->take(), first.start.rate, setup_.settings.frameRate_hz));
 
   // The garments the streams send, in the scene's order.
   std::vector<std::string> names;
-  for (const GarmentSetup& g : setup.garments) names.push_back(g.name);
-  std::vector<int> from(setup.garments.size(), -1);  // the stream sending each scene garment
+  for (const GarmentSetup& g : sceneGarments_) names.push_back(g.name);
+  std::vector<int> from(sceneGarments_.size(), -1);  // the stream sending each scene garment
   for (std::size_t s = 0; s < cloth_.size(); ++s)
     for (const studio::GarmentInfo& g : cloth_[s].follower->start().garments) {
       const auto it = std::find(names.begin(), names.end(), g.name);
@@ -66,36 +72,49 @@ StudioFrames::StudioFrames(studio::Bus& bus, RunSetup& setup, const std::vector<
       if (from[i] >= 0)
         throw Error(fmt::format("garment '{}' comes from both '{}' and '{}'", g.name, cloth_[static_cast<std::size_t>(from[i])].source,
                                 cloth_[s].source));
-      if (g.vertices != setup.garments[i].mesh.vertexCount())
+      if (g.vertices != sceneGarments_[i].mesh.vertexCount())
         throw Error(fmt::format("cloth stream '{}' sends garment '{}' with {} vertices, the scene's has {}",
-                                cloth_[s].source, g.name, g.vertices, setup.garments[i].mesh.vertexCount()));
+                                cloth_[s].source, g.name, g.vertices, sceneGarments_[i].mesh.vertexCount()));
       from[i] = static_cast<int>(s);
     }
   std::vector<std::string> missing;
   std::vector<GarmentSetup> kept;
-  std::vector<std::size_t> keptIndex(setup.garments.size(), 0);
-  for (std::size_t i = 0; i < setup.garments.size(); ++i) {
+  std::vector<std::size_t> keptIndex(sceneGarments_.size(), 0);
+  for (std::size_t i = 0; i < sceneGarments_.size(); ++i) {
     if (from[i] < 0) {
       missing.push_back(names[i]);
       continue;
     }
     keptIndex[i] = kept.size();
-    kept.push_back(setup.garments[i]);
+    kept.push_back(sceneGarments_[i]);
   }
   if (!missing.empty()) spdlog::info("no cloth stream sends {}; the player shows the rest", fmt::join(missing, ", "));
   for (Cloth& c : cloth_)
     for (const studio::GarmentInfo& g : c.follower->start().garments)
       c.garment.push_back(keptIndex[static_cast<std::size_t>(std::find(names.begin(), names.end(), g.name) - names.begin())]);
-  setup.garments = std::move(kept);
+  setup_.garments = std::move(kept);
 
-  poseStream_ = std::make_unique<studio::StreamReader>(bus, first.poses, consumer, options.patience(), options.giveUp());
-  poses_ = std::make_unique<studio::PoseFollower>(*poseStream_);
-  poses_->followNextTake(*setup.character->avatar, setup.settings.frameRate_hz, first.poseTake);
+  // The poses from where the stream is: a take's poses come before its cloth.
+  if (!poseStream_ || poseStream_->source() != first.poses) {
+    poses_.reset();
+    poseStream_ = std::make_unique<studio::StreamReader>(bus_, first.poses, consumer_, options_.patience(),
+                                                         options_.giveUp());
+    poseStream_->stopOn(stop_);
+    poses_ = std::make_unique<studio::PoseFollower>(*poseStream_);
+  }
+  avatarPoses_.reset();
+  poses_->followNextTake(*setup_.character->avatar, setup_.settings.frameRate_hz, first.poseTake);
   if (!poses_->waitForFrames(1)) throw Error(fmt::format("pose take {} ended without a frame", first.poseTake));
-  avatarPoses_ = std::make_unique<sim::AvatarPoses>(*setup.character->avatar, &poses_->animation(), first.leadIn_s);
+  avatarPoses_ = std::make_unique<sim::AvatarPoses>(*setup_.character->avatar, &poses_->animation(), first.leadIn_s);
 }
 
 StudioFrames::~StudioFrames() = default;
+
+void StudioFrames::stopOn(const std::atomic<bool>* flag) {
+  stop_ = flag;
+  for (Cloth& c : cloth_) c.stream->stopOn(flag);
+  if (poseStream_) poseStream_->stopOn(flag);
+}
 
 std::vector<RigidTransform> StudioFrames::jointsAtStart() const {
   std::vector<RigidTransform> joints(setup_.character->avatar->joints.size());

@@ -4,6 +4,7 @@
 // see them: every garment's positions and vertex states, and the avatar's joints at the
 // frame's time, from the same poses the cloth-servers played (the lead-in included).
 
+#include <atomic>
 #include <memory>
 #include <optional>
 #include <string>
@@ -21,18 +22,24 @@ namespace drape::cli {
 
 class StudioFrames {
  public:
-  /// Follows the next take of each cloth stream of `cloth` (the take `take`, if given) and
-  /// the pose take they simulated. Keeps of `setup` (the scene's) the garments the streams
-  /// send, in the scene's order; throws drape::Error (BadInput) when a stream sends a
-  /// garment the scene does not have or has otherwise, or two streams send the same one, or
-  /// they follow different poses.
-  StudioFrames(studio::Bus& bus, RunSetup& setup, const std::vector<std::string>& cloth, const std::string& take,
-               const StudioOptions& options);
+  /// Reads the cloth streams of `cloth` (each from its first message) for the scene of
+  /// `setup`, following no take yet. Throws drape::Error (BadInput) for a bad or repeated
+  /// stream name or a scene without an avatar.
+  StudioFrames(studio::Bus& bus, RunSetup& setup, const std::vector<std::string>& cloth, const StudioOptions& options);
   ~StudioFrames();
 
-  /// Frame `frame` (the next after the last, from 0) into `out` (sized here); false when
-  /// the takes ended before it. Throws what a cloth-server's take ended with (a garment
-  /// that went unstable) after the frames before it.
+  /// Follows the next take of each cloth stream (the take `take`, if given; never the one
+  /// followed before, which a stream may still hold) and the pose take they simulated,
+  /// reading on from where the streams are. Keeps of the scene's garments in `setup` the
+  /// ones the streams send, in the scene's order; throws drape::Error (BadInput) when a
+  /// stream sends a garment the scene does not have or has otherwise, or two streams send
+  /// the same one, or they follow different poses.
+  void followNextTake(const std::string& take = "");
+
+  /// Frame `frame` (the next after the last, from 0) of the take followed into `out`
+  /// (sized here); false when the takes ended before it. Throws what a cloth-server's take
+  /// ended with (a garment that went unstable) after the frames before it, and
+  /// studio::NewTake when a stream started another take before this one ended.
   bool next(long frame, FrameTaken& out);
 
   /// Where `from` says a player starts: "now" (the newest frame every stream holds
@@ -40,6 +47,9 @@ class StudioFrames {
   /// there without reading the cloth before it and returns the frame, for next(). Throws
   /// drape::Error (BadInput) for a time code before the take or past its end.
   long seek(const std::string& from);
+
+  /// A flag that ends every wait of the streams (studio::Stopped) once set.
+  void stopOn(const std::atomic<bool>* flag);
 
   /// The joints at frame 0 (the rest pose, where the lead-in starts).
   [[nodiscard]] std::vector<RigidTransform> jointsAtStart() const;
@@ -55,11 +65,16 @@ class StudioFrames {
     std::unique_ptr<studio::ClothFollower> follower;
     std::vector<std::size_t> garment;  ///< per garment of the stream, its index in the setup
   };
-  const RunSetup& setup_;
+  RunSetup& setup_;
+  const std::vector<GarmentSetup> sceneGarments_;
+  const StudioOptions options_;
+  studio::Bus& bus_;
+  std::string consumer_;
   std::vector<Cloth> cloth_;
   std::unique_ptr<studio::StreamReader> poseStream_;
   std::unique_ptr<studio::PoseFollower> poses_;
   std::unique_ptr<sim::AvatarPoses> avatarPoses_;
+  const std::atomic<bool>* stop_ = nullptr;
 };
 
 }  // namespace drape::cli

@@ -211,10 +211,11 @@ PlayerStats Player::run(FrameSource& source) {
 
       // Input: keys, orbit by dragging, zoom by the wheel.
       if (keys.pressed(window, GLFW_KEY_ESCAPE) || keys.pressed(window, GLFW_KEY_Q)) break;
+      if (options_.close != nullptr && options_.close->load()) glfwSetWindowShouldClose(window, GLFW_TRUE);  // drawn once more: the screenshot
       if (keys.pressed(window, GLFW_KEY_SPACE)) paused = !paused;
       if (keys.pressed(window, GLFW_KEY_R)) view = initialView;
       if (keys.pressed(window, GLFW_KEY_F)) following = !following;
-      if (paused && keys.pressed(window, GLFW_KEY_RIGHT)) advance(index + 1);
+      if (paused && keys.pressed(window, GLFW_KEY_RIGHT) && source.ready(index + 1)) advance(index + 1);
       if (paused && keys.pressed(window, GLFW_KEY_LEFT) && source.frameCount()) advance(index - 1);
       double cursorX = 0, cursorY = 0;
       glfwGetCursorPos(window, &cursorX, &cursorY);
@@ -229,7 +230,8 @@ PlayerStats Player::run(FrameSource& source) {
       input.scroll = 0.0;
 
       // Time: one new frame per frame period (or per redraw when not real-time).
-      if (!paused && !finished && (!options_.realTime || now >= nextFrameAt)) {
+      // A live source's frame that has not come yet is asked for again at the next redraw.
+      if (!paused && !finished && (!options_.realTime || now >= nextFrameAt) && source.ready(index + 1)) {
         nextFrameAt = std::max(nextFrameAt + 1.0 / source.frameRate(), now);
         if (!advance(index + 1)) finished = true;
       }

@@ -10,7 +10,7 @@
 
 namespace drape::studio {
 
-const ClothStart& ClothFollower::followNextTake(const std::string& take) {
+const ClothStart& ClothFollower::followNextTake(const std::string& take, const std::string& after) {
   for (;;) {
     const bool wasPending = pending_.has_value();
     Message m = wasPending ? std::move(*pending_) : stream_.next("a take's cloth");
@@ -19,6 +19,7 @@ const ClothStart& ClothFollower::followNextTake(const std::string& take) {
     pending_.reset();
     const auto* start = std::get_if<ClothStart>(&m.payload);
     if (start == nullptr || (!take.empty() && m.take != take)) continue;  // an earlier take's frames
+    if (!after.empty() && m.take == after) continue;
     take_ = m.take;
     start_ = *start;
     startSequence_ = sequence;

@@ -40,20 +40,28 @@ std::optional<Message> StreamReader::at(std::uint64_t sequence) {
 }
 
 Message StreamReader::next(const std::string& waitingFor) {
-  std::chrono::milliseconds waited{0};
+  using std::chrono::milliseconds;
+  // Waits in slices: up to the next line said (every `patience`), the give-up, and with a
+  // stop flag a tenth of a second, so that a stop is seen at once.
+  milliseconds waited{0}, saidAt{0};
   for (;;) {
-    const std::chrono::milliseconds slice =
-        giveUp_.count() > 0 ? std::min(patience_, std::max(giveUp_ - waited, std::chrono::milliseconds(1))) : patience_;
+    if (stop_ != nullptr && stop_->load()) throw Stopped(fmt::format("stopped while waiting for {} from '{}'", waitingFor, source_));
+    milliseconds slice = std::max(patience_ - (waited - saidAt), milliseconds(1));
+    if (giveUp_.count() > 0) slice = std::min(slice, std::max(giveUp_ - waited, milliseconds(1)));
+    if (stop_ != nullptr) slice = std::min(slice, milliseconds(100));
     const auto began = std::chrono::steady_clock::now();
     std::optional<Received> r = reader_->next(slice);
     if (!r) {
-      waited += std::max(slice, std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - began));
+      waited += std::max(slice, std::chrono::duration_cast<milliseconds>(std::chrono::steady_clock::now() - began));
       if (giveUp_.count() > 0 && waited >= giveUp_)
         throw Error(fmt::format("{}: waited {:.1f} s for {} from '{}'; giving up", bus_.url(),
                                 static_cast<double>(waited.count()) / 1000.0, waitingFor, source_),
                     ExitCode::Unavailable);
-      spdlog::info("waiting for {} from '{}' on {} (nothing for {:.0f} s)", waitingFor, source_, bus_.url(),
-                   static_cast<double>(waited.count()) / 1000.0);
+      if (waited - saidAt >= patience_) {
+        saidAt = waited;
+        spdlog::info("waiting for {} from '{}' on {} (nothing for {:.0f} s)", waitingFor, source_, bus_.url(),
+                     static_cast<double>(waited.count()) / 1000.0);
+      }
       continue;
     }
     sequence_ = r->sequence;

@@ -87,10 +87,12 @@ DEF Skirt2 ClothSet {
 /// error in files of the scratch directory; killed, if still running, when it goes.
 class DrapeProcess {
  public:
-  DrapeProcess(const std::string& args, const ScratchDir& scratch, const std::string& name)
+  /// `prefix`: a command drape runs under (xvfb-run -a: a virtual display).
+  DrapeProcess(const std::string& args, const ScratchDir& scratch, const std::string& name,
+               const std::string& prefix = "")
       : out_(scratch / (name + ".out")), err_(scratch / (name + ".err")) {
-    const std::string cmd = std::string("ASAN_OPTIONS=detect_leaks=0 exec '") + DRAPE_EXE + "' " + args + " >'" + out_ +
-                            "' 2>'" + err_ + "'";
+    const std::string cmd = "ASAN_OPTIONS=detect_leaks=0 exec " + prefix + " '" + DRAPE_EXE + "' " + args + " >'" +
+                            out_ + "' 2>'" + err_ + "'";
     pid_ = ::fork();
     if (pid_ == 0) {
       ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
@@ -117,6 +119,12 @@ class DrapeProcess {
   }
   /// What it has written to standard error so far.
   [[nodiscard]] std::string errSoFar() const { return slurp(err_); }
+  /// What it has written to standard output so far.
+  [[nodiscard]] std::string outSoFar() const { return slurp(out_); }
+  /// Sends it `signal` (SIGINT: Ctrl-C), as a user or a service manager stops it.
+  void signal(int signal) const {
+    if (pid_ > 0) ::kill(pid_, signal);
+  }
 
  private:
   std::string out_, err_;

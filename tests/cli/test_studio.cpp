@@ -258,6 +258,82 @@ TEST(Studio, ThePlayerShowsATakeLiveInAWindowAndFromATimeCode) {
   EXPECT_NE(badOut.find("expected HH:MM:SS:FF"), std::string::npos) << badOut;
 }
 
+/// Waits (up to two minutes) for `process` to say `what` on standard output or error.
+bool said(const DrapeProcess& process, const std::string& what) {
+  for (int i = 0; i < 2400; ++i) {
+    if (process.outSoFar().find(what) != std::string::npos || process.errSoFar().find(what) != std::string::npos)
+      return true;
+    std::this_thread::sleep_for(50ms);
+  }
+  return false;
+}
+
+TEST(Studio, ARecorderRecordsTakeAfterTakeEachUnderItsNameUntilStopped) {
+  ScratchDir dir("studio-takes");
+  NatsServer server;
+  const std::string reference = runInto(dir, "reference", "'" + kScene + "' --motion '" + kWalk + "'");
+  DrapeProcess player("player '" + kScene + "' --record '" + (dir / "takes") + "' --takes 0" + roles(server), dir,
+                      "player");
+  DrapeProcess cloth("cloth-server '" + kScene + "'" + roles(server), dir, "cloth");
+  const std::string motion = "anim-server '" + kScene + "' --motion '" + kWalk + "'";
+  // Each take once the recorder has the last: a stream holds one take, the newest.
+  ASSERT_EQ(runDrape(motion + " --fast --take monday-1" + roles(server), dir).code, 0);
+  ASSERT_TRUE(said(player, "recorded take monday-1: 171 frames")) << player.errSoFar();
+  ASSERT_EQ(runDrape(motion + " --fast --take 'scene 12/take 3'" + roles(server), dir).code, 0);
+  ASSERT_TRUE(said(player, "recorded take scene 12/take 3: 171 frames")) << player.errSoFar();
+
+  // A take cut short: its anim-server stops in the middle (killed) and another take comes.
+  {
+    DrapeProcess cut(motion + " --take cut" + roles(server), dir, "cut");
+    studio::Bus bus = studio::Bus::connect(server.url(), "test");
+    const auto clothOfCut = [&] {
+      const studio::StreamRange range = bus.range("cloth");
+      const auto first = range.messages > 0 ? bus.get("cloth", range.first) : std::nullopt;
+      return first && studio::decode(first->data).take == "cut" ? range.messages : 0;
+    };
+    for (int i = 0; i < 2400 && clothOfCut() < 40; ++i) std::this_thread::sleep_for(50ms);
+    ASSERT_GE(clothOfCut(), 40u);
+    (void)cut.kill();
+  }
+  ASSERT_EQ(runDrape(motion + " --fast --take after-the-cut" + roles(server), dir).code, 0);
+  ASSERT_TRUE(said(player, "recorded take after-the-cut: 171 frames")) << player.errSoFar();
+
+  // Ctrl-C: the recorder stops where it waits.
+  player.signal(SIGINT);
+  const CliResult stopped = player.wait();
+  EXPECT_EQ(stopped.code, 0) << stopped.err;
+  EXPECT_NE(stopped.out.find("stopped (a signal) waiting for a take; 4 recorded"), std::string::npos) << stopped.out;
+  EXPECT_NE((stopped.out + stopped.err).find("started take after-the-cut before take cut ended"), std::string::npos)
+      << stopped.out << stopped.err;
+  expectSameRun(dir / "takes/monday-1", reference);
+  expectSameRun(dir / "takes/after-the-cut", reference);
+  for (const char* file : {"garment.pc2", "garment.states", "body.pc2"})
+    EXPECT_TRUE(slurp(dir / ("takes/scene_12_take_3/" + std::string(file))) == slurp(reference + "/" + file)) << file;
+  const std::size_t cutFrames = formats::readPc2(dir / "takes/cut/garment.pc2").frames.size();
+  EXPECT_GE(cutFrames, 1u);
+  EXPECT_LT(cutFrames, 171u);
+}
+
+TEST(Studio, AWindowMovesOnToTheNextTake) {
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps installs xvfb)";
+  ScratchDir dir("studio-window-takes");
+  NatsServer server;
+  DrapeProcess cloth("cloth-server '" + kScene + "'" + roles(server), dir, "cloth");
+  // Every frame of the first take and 29 of the second, then it closes.
+  DrapeProcess window("player '" + kScene + "' --window --size 320x240 --takes 2 --every-frame --frames 200" +
+                          roles(server),
+                      dir, "window", "xvfb-run -a");
+  const std::string motion = "anim-server '" + kScene + "' --motion '" + kWalk + "' --fast";
+  ASSERT_EQ(runDrape(motion + " --take first" + roles(server), dir).code, 0);
+  ASSERT_TRUE(said(window, "take first: its 171 frames read; waiting for the next take")) << window.errSoFar();
+  ASSERT_EQ(runDrape(motion + " --take second" + roles(server), dir).code, 0);
+  const CliResult shown = window.wait();
+  ASSERT_EQ(shown.code, 0) << shown.err;
+  EXPECT_NE(shown.out.find("showed 171 frames of take first from -00:00:01:00"), std::string::npos) << shown.out;
+  EXPECT_NE(shown.out.find("showed 29 frames of take second from -00:00:01:00"), std::string::npos) << shown.out;
+}
+
 TEST(Studio, AnEventGraphThroughTheStudioIsDrapeRunsToTheByte) {
   // The bundled day (walk, kick, walk on, a gust) played live by the anim-server: the
   // cloth-server blows the gust its pose frames carry, and the recording is drape run
@@ -530,6 +606,9 @@ TEST(Studio, ErrorsSayWhatToDo) {
   r = runDrape("player '" + kScene + "' --record '" + (dir / "rec") + "' --from now --server " + nowhere, dir);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("--from applies to --window"), std::string::npos) << r.err;
+  r = runDrape("player '" + kScene + "' --record '" + (dir / "rec") + "' --take walk --takes 2 --server " + nowhere, dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--take names one take: it does not go with --takes 2"), std::string::npos) << r.err;
   r = runDrape("anim-server '" + kScene + "' --server " + nowhere, dir);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("nothing moves the avatar: give --motion FILE"), std::string::npos) << r.err;

@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <random>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -206,6 +208,40 @@ TEST(ClothFollower, GathersEachFrameWholeAndReportsTheTakesError) {
   EXPECT_EQ(cloth.skippedMessages(), 1);
 }
 
+TEST(ClothFollower, TheNextTakePassesOverTheOneFollowedAndAStopEndsAWait) {
+  testing::NatsServer server;
+  Bus bus = Bus::connect(server.url(), "test");
+  bus.ensureStream("cloth");
+  const ClothStart start = clothStartOf(TimeCode{0, 30.0}, {{"Skirt", 4}});
+  // Take A, then A announced again (a restarted cloth-server), then take B.
+  send(bus, "cloth", "A", start, "A.start");
+  send(bus, "cloth", "A", clothFrame(0, 0, 4), "A.0");
+  send(bus, "cloth", "A", End{1, "{}", "", 0}, "A.end");
+  send(bus, "cloth", "A", start, "A.start.again");
+  send(bus, "cloth", "B", start, "B.start");
+  send(bus, "cloth", "B", clothFrame(0, 0, 4), "B.0");
+
+  // Waiting in slices of a tenth of a second: a stop is seen long before the 30 s give-up.
+  std::atomic<bool> stop{false};
+  StreamReader stream(bus, "cloth", "player", 5s, 30s);
+  stream.stopOn(&stop);
+  ClothFollower cloth(stream);
+  (void)cloth.followNextTake();
+  EXPECT_EQ(cloth.take(), "A");
+  ASSERT_TRUE(cloth.waitForFrame(0));
+  EXPECT_FALSE(cloth.waitForFrame(1));
+  (void)cloth.followNextTake("", "A");
+  EXPECT_EQ(cloth.take(), "B");
+  ASSERT_TRUE(cloth.waitForFrame(0));
+
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(300ms);
+    stop = true;
+  });
+  EXPECT_THROW((void)cloth.waitForFrame(1), Stopped);  // not the give-up's Error
+  stopper.join();
+}
+
 TEST(ClothFollower, SeeksToAnyFrameAsReadingFromTheStartWould) {
   // A take of 150 frames of two garments, with what a stream can hold between them: the
   // take announced again by a restarted server, a message that is no studio frame, one
@@ -258,7 +294,9 @@ TEST(ClothFollower, SeeksToAnyFrameAsReadingFromTheStartWould) {
     }
     // Three frames of two garments and what lay between them: never the frames before.
     EXPECT_LE(cloth.messagesRead() - before, 16) << "seeking to " << target;
-    if (target == kFrames - 1) EXPECT_FALSE(cloth.waitForFrame(kFrames));
+    if (target == kFrames - 1) {
+      EXPECT_FALSE(cloth.waitForFrame(kFrames));
+    }
   }
 }
 

@@ -59,6 +59,7 @@ class SubdividedSource final : public FrameSource {
   [[nodiscard]] double frameRate() const override { return inner_.frameRate(); }
   [[nodiscard]] std::optional<std::int64_t> frameCount() const override { return inner_.frameCount(); }
   bool read(std::int64_t index, Frame& out) override;
+  [[nodiscard]] bool ready(std::int64_t index) override { return inner_.ready(index); }
 
  private:
   FrameSource& inner_;

@@ -77,6 +77,10 @@ class FrameSource {
   [[nodiscard]] virtual std::optional<std::int64_t> frameCount() const = 0;
   /// Fills `out` with frame `index`; returns false when there is no such frame (the end).
   virtual bool read(std::int64_t index, Frame& out) = 0;
+  /// Whether read(index) would answer at once. A live source whose next frame has not come
+  /// says false, and a player draws the frame it has (turning, zooming, closing) and asks
+  /// again.
+  [[nodiscard]] virtual bool ready(std::int64_t /*index*/) { return true; }
 };
 
 /// A live source: `advance` fills the next frame (positions, states, stages, time) and
@@ -85,8 +89,10 @@ class FrameSource {
 class CallbackSource final : public FrameSource {
  public:
   using Advance = std::function<bool(Frame& out)>;
-  CallbackSource(std::vector<MeshInfo> meshes, double frameRate, Advance advance)
-      : meshes_(std::move(meshes)), frameRate_(frameRate), advance_(std::move(advance)) {}
+  /// Whether the next advance would answer at once (none: always).
+  using Ready = std::function<bool(std::int64_t index)>;
+  CallbackSource(std::vector<MeshInfo> meshes, double frameRate, Advance advance, Ready ready = {})
+      : meshes_(std::move(meshes)), frameRate_(frameRate), advance_(std::move(advance)), ready_(std::move(ready)) {}
   [[nodiscard]] const std::vector<MeshInfo>& meshes() const override { return meshes_; }
   [[nodiscard]] double frameRate() const override { return frameRate_; }
   [[nodiscard]] std::optional<std::int64_t> frameCount() const override { return std::nullopt; }
@@ -94,11 +100,13 @@ class CallbackSource final : public FrameSource {
     out.index = index;
     return advance_(out);
   }
+  [[nodiscard]] bool ready(std::int64_t index) override { return !ready_ || ready_(index); }
 
  private:
   std::vector<MeshInfo> meshes_;
   double frameRate_;
   Advance advance_;
+  Ready ready_;
 };
 
 /// Bounds of every position of a frame (m).

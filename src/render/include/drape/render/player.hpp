@@ -9,6 +9,7 @@
 // Mouse: drag to orbit, wheel to zoom. Keys: space pause, left/right step (paused),
 // F follow the characters or frame all seen so far, R reset the view, Esc or Q quit.
 
+#include <atomic>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -33,6 +34,8 @@ struct PlayerOptions {
   std::vector<Aabb> followFraming;
   OverlaySettings overlay;
   std::string screenshot;  ///< "": none; else the last picture the window showed, as PNG
+  /// Set (by a signal handler, another thread): the window closes as if its user closed it.
+  const std::atomic<bool>* close = nullptr;
 };
 
 struct PlayerStats {

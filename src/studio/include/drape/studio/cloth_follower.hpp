@@ -19,8 +19,10 @@ class ClothFollower {
  public:
   explicit ClothFollower(StreamReader& stream) : stream_(stream) {}
 
-  /// Waits for the next take's ClothStart on the stream (the take `take` only, when given).
-  const ClothStart& followNextTake(const std::string& take = "");
+  /// Waits for the next take's ClothStart on the stream (the take `take` only, when given),
+  /// passing over those of the take `after` (the one followed before, which the stream
+  /// holds until another replaces it, and which a restarted server may announce again).
+  const ClothStart& followNextTake(const std::string& take = "", const std::string& after = "");
 
   /// Waits until every garment of cloth frame `frame` is there; false when the take ended
   /// before it. Frames before `frame` are forgotten. Throws NewTake (pose_follower.hpp)

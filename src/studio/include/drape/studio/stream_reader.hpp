@@ -5,15 +5,22 @@
 // is waited for, with a line every `patience`, and given up on after `giveUp` (if > 0)
 // with an Unavailable error that says what was awaited.
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "drape/studio/bus.hpp"
 #include "drape/studio/messages.hpp"
 
 namespace drape::studio {
+
+/// Thrown by a reader waiting for a message when the flag it was given is set.
+struct Stopped : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 class StreamReader {
  public:
@@ -23,8 +30,11 @@ class StreamReader {
                std::chrono::milliseconds giveUp, std::uint64_t sequence = 0);
 
   /// The next message of the stream that is a studio frame of this source; `waitingFor`
-  /// names it in the lines said while waiting.
+  /// names it in the lines said while waiting. Throws Stopped when the flag of stopOn() is
+  /// set while it waits.
   [[nodiscard]] Message next(const std::string& waitingFor);
+  /// A flag (a signal's, another thread's) that ends a wait within a tenth of a second.
+  void stopOn(const std::atomic<bool>* flag) { stop_ = flag; }
   /// The stream's sequence of the message next() returned last (0 before the first).
   [[nodiscard]] std::uint64_t sequence() const { return sequence_; }
 
@@ -49,6 +59,7 @@ class StreamReader {
   std::uint64_t sequence_ = 0;
   std::chrono::milliseconds patience_, giveUp_;
   std::int64_t skipped_ = 0;
+  const std::atomic<bool>* stop_ = nullptr;
 };
 
 }  // namespace drape::studio

@@ -294,7 +294,8 @@ RunFunction setupPlayer(CLI::App& app) {
   o.picture.add(app);
   app.footer("drape render DIR and drape play DIR show a recording afterwards.\n"
              "Exit codes: 0 done, 2 bad input, 3 a garment went unstable in the take (the frames before are kept), "
-             "4 no NATS server answers or a peer went silent past --give-up.");
+             "4 no NATS server answers or a peer went silent past --give-up. With --takes the exit code is the last "
+             "take's; Ctrl-C stops a recorder with the take it was recording closed, and closes a window.");
   return [] {
     if (o.record.empty() && !o.window) throw Error("drape player: give --record DIR or --window");
     if (!o.take.empty() && o.takes != 1)

@@ -16,15 +16,13 @@
 
 #include "command.hpp"
 #include "drape/core/error.hpp"
-#include "drape/core/files.hpp"
-#include "drape/core/line_stream.hpp"
 #include "drape/core/log.hpp"
 #include "drape/core/progress.hpp"
 #include "drape/events/runtime.hpp"
-#include "drape/formats/bvh.hpp"
 #include "drape/motion/live_motion.hpp"
 #include "drape/studio/publisher.hpp"
 #include "drape/studio/takes.hpp"
+#include "live_capture.hpp"
 #include "run_setup.hpp"
 #include "stop_signal.hpp"
 #include "studio_options.hpp"
@@ -150,91 +148,6 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup) {
   return 0;
 }
 
-/// Waits between lines of a live source, and how often it says what it waits for.
-constexpr std::chrono::milliseconds kLiveTick{200};
-
-/// Opens `--live SOURCE`; a TCP source that is not up yet is tried again each second, saying
-/// so every `patience`, until `giveUp` (0: for ever) or a signal.
-LineStream openLiveSource(const std::string& source, std::chrono::milliseconds patience, std::chrono::milliseconds giveUp) {
-  const auto began = std::chrono::steady_clock::now();
-  auto said = began;
-  for (;;) {
-    try {
-      return LineStream::open(source);
-    } catch (const Error& e) {
-      if (e.code() != ExitCode::Unavailable) throw;
-      const auto now = std::chrono::steady_clock::now();
-      if (stopAsked || (giveUp.count() > 0 && now - began >= giveUp))
-        throw Error(fmt::format("{}; gave up after {:.0f} s", e.what(), std::chrono::duration<double>(now - began).count()),
-                    ExitCode::Unavailable);
-      if (now - said >= patience) {
-        spdlog::info("{}; trying again each second", e.what());
-        said = now;
-      }
-      std::this_thread::sleep_for(std::chrono::seconds(1));
-    }
-  }
-}
-
-/// Waits for a line of a live source, saying what it waits for every `patience`; nothing
-/// when the source has ended, a signal came, or it stayed silent for `giveUp` (0: for ever),
-/// which `silent` then says.
-std::optional<std::string> nextLiveLine(LineStream& source, std::chrono::milliseconds patience,
-                                        std::chrono::milliseconds giveUp, const char* awaiting, bool& silent) {
-  const auto began = std::chrono::steady_clock::now();
-  auto said = began;
-  std::string line;
-  for (;;) {
-    const LineStream::Status status = source.next(line, kLiveTick);
-    if (status == LineStream::Status::Line) return line;
-    if (status == LineStream::Status::Ended || stopAsked) return std::nullopt;
-    const auto now = std::chrono::steady_clock::now();
-    if (giveUp.count() > 0 && now - began >= giveUp) {
-      silent = true;
-      return std::nullopt;
-    }
-    if (now - said >= patience) {
-      spdlog::info("waiting for {} from {} ({:.0f} s silent, after line {})", awaiting, source.name(),
-                   std::chrono::duration<double>(now - began).count(), source.lineNumber());
-      said = now;
-    }
-  }
-}
-
-/// The BVH header of a live source: its lines up to "Frame Time:". Throws where the source
-/// ends or goes silent first, or the header runs past any BVH's size.
-std::string readLiveHeader(LineStream& source, const StudioOptions& studio) {
-  constexpr std::size_t kMaxHeader = std::size_t{16} << 20;
-  std::string header;
-  bool silent = false;
-  while (const std::optional<std::string> line = nextLiveLine(source, studio.patience(), studio.giveUp(), "a BVH header", silent)) {
-    header += *line;
-    header += '\n';
-    if (formats::endsBvhHeader(*line)) return header;
-    if (header.size() > kMaxHeader)
-      throw Error(fmt::format("{}:{}: no 'Frame Time:' in the first {} MiB: not a BVH header", source.name(),
-                              source.lineNumber(), kMaxHeader >> 20));
-  }
-  if (silent) throw Error(fmt::format("{}: no BVH header came within --give-up", source.name()), ExitCode::Unavailable);
-  if (stopAsked) throw Error(fmt::format("{}: stopped (a signal) before the BVH header came", source.name()));
-  if (!source.endReason().empty())
-    throw Error(fmt::format("{}: {} before its BVH header ended", source.name(), source.endReason()), ExitCode::Unavailable);
-  // What there is, parsed, says what is missing where.
-  (void)formats::parseBvhHeader(header, source.name());
-  throw Error(fmt::format("{}:{}: the source ended before its BVH header did", source.name(), source.lineNumber()));
-}
-
-/// `--live-header FILE`: a BVH file's header, its lines up to "Frame Time:" (its frames are
-/// not read), for a source that sends frame lines only.
-formats::BvhFile headerOfFile(const std::string& path) {
-  const std::optional<std::string> text = readFileText(path);
-  if (!text) throw Error(fmt::format("--live-header {}: no such file", path));
-  if (const std::optional<std::size_t> length = formats::bvhHeaderLength(*text))
-    return formats::parseBvhHeader(std::string_view(*text).substr(0, *length), path);
-  (void)formats::parseBvhHeader(*text, path);  // says what is missing where
-  throw Error(fmt::format("{}: no 'Frame Time:' line, so no BVH header", path));
-}
-
 /// `--live SOURCE`: a BVH written while it is captured, from standard input, a TCP server or
 /// a named pipe, retargeted and sent frame by frame as it comes (motion/live_motion.hpp).
 int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
@@ -245,14 +158,9 @@ int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
   (void)stopOnSignals();
   // The server first: a studio with no NATS server is said before the capture is waited for.
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape anim-server " + o.name);
-  const std::optional<formats::BvhFile> fileHeader =
-      o.liveHeader.empty() ? std::nullopt : std::optional(headerOfFile(o.liveHeader));
-  LineStream source = openLiveSource(o.live, o.studio.patience(), o.studio.giveUp());
-  spdlog::info("reading a live BVH from {}{}", source.name(),
-               fileHeader ? fmt::format(" (frame lines only: the skeleton is {}'s)", o.liveHeader) : "");
-  const formats::BvhFile header =
-      fileHeader ? *fileHeader : formats::parseBvhHeader(readLiveHeader(source, o.studio), source.name());
-  motion::LiveMotion live(avatar, header, motionOptions(setup));
+  LiveCapture capture(avatar, {o.live, o.liveHeader, o.studio.patience(), o.studio.giveUp()}, motionOptions(setup),
+                      stopAsked);
+  const motion::LiveMotion& live = capture.motion();
 
   studio::Publisher publisher(bus, o.name, studio::Precision::Double, o.studio.giveUp());
   const std::string take = o.take.empty() ? studio::newTakeId() : o.take;
@@ -264,59 +172,29 @@ int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
                             take, studio::subjectOf(o.name)));
   spdlog::info("take {}: live motion from {} ({} joints at {:g} Hz in {}, joint map '{}') on {}, sent at {:g} Hz as it "
                "comes, on {} ({})",
-               take, source.name(), header.joints.size(), live.sourceRate(), live.report().units.name,
+               take, capture.name(), capture.header().joints.size(), live.sourceRate(), live.report().units.name,
                live.jointMap().name, avatar.name, live.rate(), studio::subjectOf(o.name), bus.url());
 
   const auto began = std::chrono::steady_clock::now();
-  std::vector<double> values(header.channelCount), previous;
   studio::PoseFrame frame;
   frame.joints.resize(live.jointCount());
   std::int64_t sent = 0;
-  std::size_t badLines = 0;
-  const auto sendReady = [&] {
-    while (live.next(frame.joints)) {
-      frame.frame = sent++;
-      publisher.send(frame);
-      if (sent == 1) spdlog::info("the first pose frame is out; frames follow as the capture sends them");
-    }
-  };
-  bool silent = false;
-  while (const std::optional<std::string> line =
-             nextLiveLine(source, o.studio.patience(), o.studio.giveUp(), "motion frames", silent)) {
-    if (line->find_first_not_of(" \t\r") == std::string::npos) continue;
-    try {
-      formats::parseBvhFrameLine(*line, source.name(), source.lineNumber(), values);
-      previous = values;
-    } catch (const Error& e) {
-      // A live take survives a bad line: the frame before it stands in, so the motion keeps its time.
-      if (++badLines <= 10 || badLines % 100 == 0)
-        spdlog::warn("{} ({})", e.what(),
-                     previous.empty() ? "skipped: no frame before it" : "the frame before it stands in");
-      if (previous.empty()) continue;
-      values = previous;
-    }
-    live.push(values);
-    sendReady();
+  while (capture.next(frame.joints)) {
+    frame.frame = sent++;
+    publisher.send(frame);
+    if (sent == 1) spdlog::info("the first pose frame is out; frames follow as the capture sends them");
   }
-  // However the source ended, the frames it sent are the take's: the last ones resampled out.
-  live.finish();
-  sendReady();
-  std::string ended;
-  if (silent) {
-    ended = fmt::format("{} went silent for {:g} s (--give-up)", source.name(), o.studio.giveUp_s);
-  } else if (stopAsked) {
-    ended = "stopped (a signal)";
-  } else if (!source.endReason().empty()) {
-    ended = fmt::format("{}: {}", source.name(), source.endReason());
-  }
-  publisher.send(studio::End{sent, "", ended, silent ? static_cast<int>(ExitCode::Unavailable) : 0});
+  const std::string ended = capture.ended();
+  const int code = capture.silent() ? static_cast<int>(ExitCode::Unavailable) : 0;
+  publisher.send(studio::End{sent, "", ended, code});
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
   fmt::print("sent take {}: {} pose frames of {} from {} ({} source frames{}) to {} on {} in {:.1f} s{}\n", take, sent,
-             avatar.name, source.name(), live.sourceFrames(),
-             badLines > 0 ? fmt::format(", {} bad line{}", badLines, badLines == 1 ? "" : "s") : std::string(),
-             studio::subjectOf(o.name),
-             bus.url(), seconds, ended.empty() ? "" : "; " + ended);
-  return silent ? static_cast<int>(ExitCode::Unavailable) : 0;
+             avatar.name, capture.name(), live.sourceFrames(),
+             capture.badLines() > 0
+                 ? fmt::format(", {} bad line{}", capture.badLines(), capture.badLines() == 1 ? "" : "s")
+                 : std::string(),
+             studio::subjectOf(o.name), bus.url(), seconds, ended.empty() ? "" : "; " + ended);
+  return code;
 }
 
 /// A recorded motion's take: its frames numbered from the motion's own time code, counted in
@@ -335,9 +213,6 @@ int runAnimServer(const AnimServerOptions& o) {
     if (!o.motion.empty() || !o.animation.empty() || !o.events.empty())
       throw Error(fmt::format("--live plays the motion its source sends: give it or {}, not both",
                               !o.events.empty() ? "--events" : !o.motion.empty() ? "--motion" : "--animation"));
-    if (!o.liveHeader.empty() && lowerExtension(o.liveHeader) != ".bvh")
-      throw Error(fmt::format("--live-header {}: expected a .bvh file (its skeleton: the header up to Frame Time)",
-                              o.liveHeader));
     if (!o.sets.empty() || o.hold || o.frames > 0 || o.fast)
       throw Error(fmt::format("{}: a live take goes at the pace its source sends, for as long",
                               !o.sets.empty() ? "--set" : o.hold ? "--hold" : o.frames > 0 ? "--frames" : "--fast"));
@@ -413,15 +288,9 @@ RunFunction setupAnimServer(CLI::App& app) {
   app.add_option("--events", o.events,
                  "Instead of a motion: play an EGML event graph live (docs/EVENTS.md), taking graphs and events "
                  "injected while it runs (drape inject --to NAME)");
-  app.add_option("--live", o.live,
-                 "Instead of a motion: a BVH written while it is captured, from SOURCE: - (standard input), "
-                 "tcp://HOST:PORT (connected to) or a named pipe; its frames are sent as they come, retargeted as "
-                 "--motion retargets a file (docs/MOTION.md), until the source closes or Ctrl-C")
+  app.add_option("--live", o.live, std::string("Instead of a motion: ") + kLiveHelp + "; its frames are sent as they come")
       ->type_name("SOURCE");
-  app.add_option("--live-header", o.liveHeader,
-                 "With --live: the skeleton from this BVH file's header (its frames are not played), for a source "
-                 "that sends frame lines only, one frame of channel values a line")
-      ->type_name("FILE.bvh");
+  app.add_option("--live-header", o.liveHeader, kLiveHeaderHelp)->type_name("FILE.bvh");
   app.add_option("--set", o.sets, "With --events: a parameter of the graph, NAME=VALUE; repeatable");
   app.add_flag("--hold", o.hold,
                "With --events: go on when the graphs end, the character holding its pose, until stopped (Ctrl-C, "

@@ -4,7 +4,10 @@
 // --motion (BVH, ASF/AMC) and its body parts collide through distance fields.
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
+#include <chrono>
+#include <functional>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -25,7 +28,10 @@
 #include "drape/scene/avatar_segment.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/scene_setup.hpp"
+#include "live_capture.hpp"
+#include "live_run.hpp"
 #include "run_setup.hpp"
+#include "stop_signal.hpp"
 #include "stitch_gaps.hpp"
 
 namespace drape::cli {
@@ -38,6 +44,8 @@ struct RunOptions {
   double stitchGaps_m = 0.0;  ///< --stitch-gaps
   std::vector<std::string> faceSamplesWith, keepApart, cutAtJoints;
   std::string events;                       ///< --events: an EGML event graph instead of --motion
+  std::string live, liveHeader;             ///< --live SOURCE, --live-header FILE.bvh: a capture as it comes
+  double giveUp_s = 0.0;                    ///< --give-up: a live source silent this long ends the run
   std::vector<std::string> sets, sends;     ///< --set NAME=VALUE, --send EVENT@SECONDS
   std::string garment, units = "m", pinVertices, pinMask, out, substeps = "33", integrator = "symplectic-euler";
   std::string strainLimit = "auto";
@@ -231,6 +239,27 @@ std::shared_ptr<const scene::Avatar> loadAvatarCut(const std::string& path, cons
   return std::make_shared<const scene::Avatar>(std::move(avatar));
 }
 
+/// `--live SOURCE`: the run on a capture as it comes, until the source ends (it closes, Ctrl-C,
+/// or silence past --give-up: exit code 4) or --frames; what came is written as any run is.
+int runLive(const RunOptions& o, RunSetup& setup, const std::function<void()>& saidResults) {
+  const std::atomic<bool>& stop = stopOnSignals();
+  const std::chrono::milliseconds giveUp(static_cast<long long>(1000.0 * o.giveUp_s));
+  motion::MotionOptions motion = motionOptions(setup);
+  if (o.motionScale > 0) motion.clip.metresPerUnit = o.motionScale;
+  motion.jointMapPath = o.jointMap;
+  LiveCapture capture(*setup.character->avatar, {o.live, o.liveHeader, std::chrono::seconds(5), giveUp}, motion, stop);
+  LiveRun live(setup, capture, o.frames);
+  const int code = simulateRun(setup, live.gate());
+  saidResults();
+  const std::string ended = capture.ended();
+  fmt::print("live: {} motion frames from {} ({} source frames{}){}\n", live.motionFrames(), capture.name(),
+             capture.motion().sourceFrames(),
+             capture.badLines() > 0 ? fmt::format(", {} bad line{}", capture.badLines(), capture.badLines() == 1 ? "" : "s")
+                                    : std::string(),
+             ended.empty() ? "" : "; " + ended);
+  return capture.silent() ? static_cast<int>(ExitCode::Unavailable) : code;
+}
+
 int runCommand(const CLI::App& app, RunOptions& o) {
   if (o.scene.empty() == o.garment.empty())
     throw Error("drape run: give either a scene file (drape run SCENE.wrl) or --garment FILE.obj");
@@ -258,9 +287,18 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   }
   if (!o.events.empty() && (!o.motion.empty() || !o.animation.empty()))
     throw Error("--events plays an event graph's motions: give it or --motion, not both");
+  if (!o.live.empty() && (!o.motion.empty() || !o.animation.empty() || !o.events.empty()))
+    throw Error(fmt::format("--live plays the motion its source sends: give it or {}, not both",
+                            !o.events.empty() ? "--events" : !o.motion.empty() ? "--motion" : "--animation"));
+  if (o.live.empty() && (!o.liveHeader.empty() || o.giveUp_s > 0))
+    throw Error(fmt::format("{} is for a live source: give --live SOURCE", o.liveHeader.empty() ? "--give-up" : "--live-header"));
+  if (!o.live.empty() && !avatar) throw Error("--live: there is no avatar for the capture to move");
+  if (!o.live.empty() && app.count("--keep-apart"))
+    throw Error("--keep-apart corrects a whole motion, which a live source never is");
   if (o.events.empty() && (!o.sets.empty() || !o.sends.empty()))
     throw Error(fmt::format("{}: it is for an event graph: give --events FILE.egml", o.sets.empty() ? "--send" : "--set"));
-  const MotionChoice motion = o.events.empty() ? sceneMotion(setup, o.scene, o.motion, o.animation) : MotionChoice{};
+  const MotionChoice motion =
+      o.events.empty() && o.live.empty() ? sceneMotion(setup, o.scene, o.motion, o.animation) : MotionChoice{};
   if (!motion.path.empty() && !avatar)
     throw Error("--motion: there is no avatar to move (the scene has none; without a scene, give --avatar FILE)");
   for (const std::string& sphere : o.spheres) {
@@ -304,19 +342,23 @@ int runCommand(const CLI::App& app, RunOptions& o) {
                    setup.settings.maxAddedMass > 0.0 ? ", with mass scaling within --max-added-mass" : "");
     }
   }
-  // Frames: as asked, or the lead-in plus the whole motion.
+  // Frames: as asked, or the lead-in plus the whole motion (a live one: as long as it comes).
   setup.frames = o.frames;
-  if (!app.count("--frames")) setup.frames = defaultFrames(setup);
+  if (!app.count("--frames") && o.live.empty()) setup.frames = defaultFrames(setup);
   setup.objEvery = o.every;
   setup.outDir = o.out;
   setup.preview = o.preview;
   setup.countEverySubstep = o.countEverySubstep;
   setup.exactSliding = o.exactSliding;
   setup.freePinches = o.freePinches;
-  const int code = simulateRun(setup);
   const bool skin = setup.character && setup.character->avatar->skin;
-  fmt::print("results in {}/: garment caches (.pc2, .states), {}frames/, result.wrl, result.glb, stats.json{}\n", o.out,
-             skin ? "the skinned body (body.pc2), " : "", o.preview ? ", preview.png" : "");
+  const auto saidResults = [&] {
+    fmt::print("results in {}/: garment caches (.pc2, .states), {}frames/, result.wrl, result.glb, stats.json{}\n", o.out,
+               skin ? "the skinned body (body.pc2), " : "", o.preview ? ", preview.png" : "");
+  };
+  if (!o.live.empty()) return runLive(o, setup, saidResults);
+  const int code = simulateRun(setup);
+  saidResults();
   return code;
 }
 
@@ -343,6 +385,11 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--send", o->sends,
                  "With --events: an event for the graph's state machines at a time of the script, EVENT@SECONDS; "
                  "repeatable");
+  app.add_option("--live", o->live, std::string("Instead of a motion: ") + kLiveHelp + "; simulated as it comes")
+      ->type_name("SOURCE");
+  app.add_option("--live-header", o->liveHeader, kLiveHeaderHelp)->type_name("FILE.bvh");
+  app.add_option("--give-up", o->giveUp_s, "With --live: end the run after S seconds without a line (exit code 4)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--joint-map", o->jointMap, "JSON map from the motion's joint names to the avatar's");
   app.add_option("--animation", o->animation, kAnimationHelp);
   app.add_option("--motion-scale", o->motionScale, "Metres per motion-file unit (default: guessed from the skeleton)");

@@ -602,11 +602,11 @@ class WriterSink final : public FrameSink {
 
 }  // namespace
 
-int simulateRun(const RunSetup& setup) {
+int simulateRun(const RunSetup& setup, const FrameGate& gate) {
   validateRunSetup(setup);
   createOutDir(setup.outDir);
   WriterSink sink(setup);
-  return simulateInto(setup, sink, nullptr);
+  return simulateInto(setup, sink, gate);
 }
 
 namespace {

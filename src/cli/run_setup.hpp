@@ -185,10 +185,11 @@ void validateRunSetup(const RunSetup& setup);
 /// maxAddedMass of each (cloth::fewestStableSubsteps), at least 1.
 [[nodiscard]] int stableSubsteps(const RunSetup& setup);
 
-/// Simulates and writes every output. Returns 0; on instability it finishes the files
-/// written so far (caches, stats with nan_detected, manifest) and throws drape::Error with
-/// ExitCode::Unstable naming garment, vertex and frame.
-int simulateRun(const RunSetup& setup);
+/// Simulates and writes every output (each frame once `gate`, if given, lets it: a live
+/// motion's). Returns 0; on instability it finishes the files written so far (caches, stats
+/// with nan_detected, manifest) and throws drape::Error with ExitCode::Unstable naming
+/// garment, vertex and frame.
+int simulateRun(const RunSetup& setup, const std::function<bool(long frame)>& gate = nullptr);
 
 /// Where a run's frames go: drape run's files (run_writer.hpp), a cloth-server's stream.
 class FrameSink {

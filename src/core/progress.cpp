@@ -22,7 +22,12 @@ void Progress::update(std::int64_t done) {
   if (elapsed < 1.0 || (shown_ && now - lastDraw_ < std::chrono::milliseconds(100))) return;
   lastDraw_ = now;
   shown_ = true;
-  const double fraction = total_ > 0 ? static_cast<double>(done) / static_cast<double>(total_) : 0.0;
+  if (total_ <= 0) {  // a live run: how far it has come, with no end known
+    std::fprintf(stderr, "\r%s: %lld, %.1fs elapsed   ", label_.c_str(), static_cast<long long>(done), elapsed);
+    std::fflush(stderr);
+    return;
+  }
+  const double fraction = static_cast<double>(done) / static_cast<double>(total_);
   const double eta = fraction > 0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
   std::fprintf(stderr, "\r%s: %lld/%lld (%3.0f%%) %.1fs elapsed, ~%.1fs left   ", label_.c_str(),
                static_cast<long long>(done), static_cast<long long>(total_), 100.0 * fraction,

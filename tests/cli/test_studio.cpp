@@ -498,6 +498,48 @@ TEST(Studio, ALiveCaptureOverTcpIsSimulatedAsItComes) {
   const nlohmann::json stats = statsOf(dir / "recorded");
   EXPECT_EQ(stats["frames"], 170);
   EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
+
+  // The same broadcast into drape run --live, in one process: the studio's take, to the byte.
+  CaptureBroadcast again;
+  again.send(lines, 40, 1ms);
+  const CliResult alone = runDrape("run '" + kScene + "' --live " + again.url() + " --out '" + (dir / "alone") + "'", dir);
+  ASSERT_EQ(alone.code, 0) << alone.err;
+  EXPECT_NE(alone.out.find("live: 141 motion frames from " + again.url() + " (566 source frames, 1 bad line)"),
+            std::string::npos)
+      << alone.out;
+  expectSameRun(dir / "alone", dir / "recorded");
+}
+
+TEST(Studio, ALiveRunEndsWithItsSourceAndSaysWhy) {
+  ScratchDir dir("live-run");
+  // Piped in: the whole walk, then the pipe closes; --frames ends a run before its source does.
+  const CliResult piped =
+      runDrape("run '" + kScene + "' --live - --frames 40 --out '" + (dir / "piped") + "' < '" + kWalk + "'", dir);
+  ASSERT_EQ(piped.code, 0) << piped.err;
+  EXPECT_EQ(statsOf(dir / "piped")["frames"], 40);
+  // The header and a second of frames, then silence: --give-up ends the run, which keeps what came.
+  std::vector<std::string> lines = linesOf(slurp(kWalk));
+  lines.resize(187 + 120);
+  CaptureBroadcast silent;
+  silent.send(lines, lines.size(), 4000ms);
+  const CliResult quiet = runDrape(
+      "run '" + kScene + "' --live " + silent.url() + " --give-up 1 --out '" + (dir / "quiet") + "'", dir);
+  EXPECT_EQ(quiet.code, 4) << quiet.err;
+  EXPECT_NE(quiet.out.find("went silent for 1 s (--give-up)"), std::string::npos) << quiet.out;
+  // 120 frames at 120 Hz: 30 at 30 Hz, after the lead-in's 30.
+  EXPECT_EQ(statsOf(dir / "quiet")["frames"], 59);
+  EXPECT_EQ(statsOf(dir / "quiet")["vertex_substeps_inside_body"], 0);
+
+  CliResult r = runDrape("run '" + kScene + "' --live - --motion '" + kWalk + "' --out '" + (dir / "x") + "'", dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--live plays the motion its source sends: give it or --motion, not both"), std::string::npos)
+      << r.err;
+  r = runDrape("run '" + kScene + "' --give-up 3 --out '" + (dir / "x") + "'", dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--give-up is for a live source: give --live SOURCE"), std::string::npos) << r.err;
+  r = runDrape("run '" + kScene + "' --live - --out '" + (dir / "x") + "' < /dev/null", dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("stdin:1:1"), std::string::npos) << r.err;
 }
 
 TEST(Studio, ALiveSourceThatIsNotThereOrFallsSilentEndsTheTakeSaying) {

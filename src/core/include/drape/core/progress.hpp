@@ -11,6 +11,7 @@ namespace drape {
 
 class Progress {
  public:
+  /// `total` 0: no end known (a live run): it counts what is done.
   Progress(std::string label, std::int64_t total);
   ~Progress();
   Progress(const Progress&) = delete;

@@ -1,0 +1,57 @@
+#include "live_run.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "drape/core/error.hpp"
+#include "drape/core/log.hpp"
+#include "drape/studio/takes.hpp"
+
+namespace drape::cli {
+
+LiveRun::LiveRun(RunSetup& setup, LiveCapture& capture, long maxFrames)
+    : capture_(capture),
+      joints_(capture.motion().jointCount()),
+      frameRate_(setup.settings.frameRate_hz),
+      leadIn_s_(setup.character->leadIn_s),
+      maxFrames_(maxFrames) {
+  const motion::LiveMotion& live = capture.motion();
+  const std::span<const int> driving = live.drivingJoint();
+  animation_ = std::make_shared<motion::AvatarAnimation>(motion::AvatarAnimation::streamed(
+      live.jointCount(), live.rate(), TimeCode{0, live.rate()}, std::vector<int>(driving.begin(), driving.end())));
+  CharacterSetup& character = *setup.character;
+  if (!character.keepApart.empty()) {
+    spdlog::warn("the scene keeps {} apart, a correction of a whole motion: a live motion plays without it",
+                 fmt::join(character.keepApart, ", "));
+    character.keepApart.clear();
+  }
+  character.animation = animation_;
+  setup.motionStreamed = true;
+  setup.frames = maxFrames;
+  if (!waitForFrames(1))
+    throw Error(fmt::format("{} ended before its first frame{}", capture.name(),
+                            capture.ended().empty() ? "" : " (" + capture.ended() + ")"),
+                ExitCode::Unavailable);
+  spdlog::info("live motion from {} ({} joints at {:g} Hz in {}, joint map '{}') on {} at {:g} Hz, simulated as it comes",
+               capture.name(), capture.header().joints.size(), live.sourceRate(), live.report().units.name,
+               live.jointMap().name, setup.character->avatar->name, live.rate());
+}
+
+bool LiveRun::waitForFrames(std::int64_t count) {
+  while (!ended_ && motionFrames() < count) {
+    if (capture_.next(joints_)) animation_->appendFrame(joints_);
+    else ended_ = true;
+  }
+  return motionFrames() >= count;
+}
+
+bool LiveRun::admit(long frame) {
+  if (maxFrames_ > 0 && frame > maxFrames_) return false;
+  if (frame == 0) return true;  // its motion frame came before the world was built
+  const double motionRate = animation_->rate();
+  if (waitForFrames(studio::motionFramesNeeded(frame, frameRate_, leadIn_s_, motionRate))) return true;
+  // The capture ended: the frames up to its last motion frame's time are still simulated.
+  return frame <= studio::clothFramesOf(motionFrames(), frameRate_, leadIn_s_, motionRate);
+}
+
+}  // namespace drape::cli

@@ -2,6 +2,7 @@
 // `drape play SCENE.wrl [--motion FILE]`: simulates the scene live in the window, the
 // garments coloured by collision state when that overlay is on.
 
+#include <chrono>
 #include <filesystem>
 #include <iostream>
 
@@ -17,7 +18,10 @@
 #include "drape/sim/character_world.hpp"
 #include "frames_ahead.hpp"
 #include "render_options.hpp"
+#include "live_capture.hpp"
+#include "live_run.hpp"
 #include "run_setup.hpp"
+#include "stop_signal.hpp"
 
 namespace drape::cli {
 namespace {
@@ -25,6 +29,8 @@ namespace {
 struct PlayOptions {
   std::string run;
   std::string motion, animation;
+  std::string live, liveHeader;  ///< --live SOURCE: a capture simulated as it comes
+  double giveUp_s = 0.0;
   long frames = 0;
   bool once = false;
   bool fast = false;
@@ -38,8 +44,19 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
   RunSetup setup = runSetupFromScene(o.run);
   if (!setup.character)
     throw Error(fmt::format("{}: drape play simulates scenes with an avatar (replay a run directory otherwise)", o.run));
-  if (const MotionChoice m = sceneMotion(setup, o.run, o.motion, o.animation); !m.path.empty())
+  // A live capture: read as the simulation asks for its frames, on the simulating thread.
+  std::unique_ptr<LiveCapture> capture;
+  std::unique_ptr<LiveRun> live;
+  if (!o.live.empty()) {
+    const std::chrono::milliseconds giveUp(static_cast<long long>(1000.0 * o.giveUp_s));
+    capture = std::make_unique<LiveCapture>(*setup.character->avatar,
+                                            LiveCapture::Options{o.live, o.liveHeader, std::chrono::seconds(5), giveUp},
+                                            motionOptions(setup), stopOnSignals());
+    live = std::make_unique<LiveRun>(setup, *capture, 0);
+    options.close = &stopOnSignals();  // Ctrl-C closes the window
+  } else if (const MotionChoice m = sceneMotion(setup, o.run, o.motion, o.animation); !m.path.empty()) {
     addMotion(setup, m.path, 0.0, "", m.animation, m.sampled.get());
+  }
   const std::unique_ptr<sim::CharacterWorld> worldPtr = buildWorld(setup);
   sim::CharacterWorld& world = *worldPtr;
   (void)settleWorld(setup, world);
@@ -67,6 +84,7 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
   };
   StageLaps stageLaps;
   FramesAhead ahead(kFramesAhead, 0, -1, prepare, [&](long frame, FrameTaken& taken) {
+    if (live && !live->admit(frame)) return false;  // the capture ended
     if (frame > 0 && !world.stepFrame(frame)) {
       spdlog::error("{}", world.instability());
       return false;
@@ -82,6 +100,13 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
     world.poses().evaluate(world.frameTime(frame), taken.joints);
     return true;
   });
+  // However the window closes, a capture the simulating thread waits on stops, so that it ends.
+  const struct StopCaptureOnLeave {
+    bool live;
+    ~StopCaptureOnLeave() {
+      if (live) askToStop();
+    }
+  } stopCaptureOnLeave{capture != nullptr};
   std::vector<sim::GarmentSurface> garments;
   render::CallbackSource source(meshes, step.frameRate_hz, [&](render::Frame& out) {
     const FrameTaken* taken = ahead.next();
@@ -105,11 +130,12 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
     }
     if (skin) skin->pose(taken->joints, garments, out.positions.back());
     return true;
-  });
+  }, [&](std::int64_t) { return ahead.ready(); });  // live, a frame may be a while coming: the window stays live
   options.loop = false;
   render::SubdividedSource shown(source, o.picture.subdivide);
   const render::PlayerStats stats = render::Player(options).run(shown);
-  std::cout << fmt::format("simulated and showed {} frames in {:.1f} s\n", stats.framesDrawn, stats.seconds);
+  std::cout << fmt::format("simulated and showed {} frames in {:.1f} s{}\n", stats.framesDrawn, stats.seconds,
+                           capture ? " of the live motion from " + capture->name() : std::string());
   return 0;
 }
 
@@ -119,6 +145,11 @@ RunFunction setupPlay(CLI::App& app) {
       ->required();
   app.add_option("--motion", o.motion, std::string("With a scene: motion for its avatar ") + kMotionHelp);
   app.add_option("--animation", o.animation, kAnimationHelp);
+  app.add_option("--live", o.live, std::string("With a scene, instead of a motion: ") + kLiveHelp + "; simulated and shown as it comes")
+      ->type_name("SOURCE");
+  app.add_option("--live-header", o.liveHeader, kLiveHeaderHelp)->type_name("FILE.bvh");
+  app.add_option("--give-up", o.giveUp_s, "With --live: stop simulating after S seconds without a line")
+      ->check(CLI::PositiveNumber);
   app.add_option("--frames", o.frames, "Close by itself after showing N frames")->check(CLI::PositiveNumber);
   app.add_flag("--once", o.once, "Stop at the last frame instead of starting over");
   app.add_flag("--fast", o.fast, "Show a new frame on every redraw instead of at the run's frame rate");
@@ -140,9 +171,9 @@ RunFunction setupPlay(CLI::App& app) {
       options.screenshot = o.screenshot;
       return playScene(o, options);
     }
-    if (!o.motion.empty() || !o.animation.empty())
+    if (!o.motion.empty() || !o.animation.empty() || !o.live.empty())
       throw Error(fmt::format("{}: drape play takes a motion only with a scene file, not a run directory",
-                              o.motion.empty() ? "--animation" : "--motion"));
+                              !o.live.empty() ? "--live" : o.motion.empty() ? "--animation" : "--motion"));
     render::RunReplay replay(o.run);
     std::tie(options.width, options.height) = o.picture.parsedSize();
     options.title = fmt::format("drape play {}", o.run);

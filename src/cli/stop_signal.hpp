@@ -20,4 +20,8 @@ inline const std::atomic<bool>& stopOnSignals() {
   return detail::stopAsked;
 }
 
+/// Sets the flag as a signal would: what waits on it (a live source) stops (a window that
+/// closed, say).
+inline void askToStop() { detail::stopAsked = true; }
+
 }  // namespace drape::cli

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <filesystem>
 #include <functional>
 #include <sstream>
@@ -540,6 +541,34 @@ TEST(Studio, ALiveRunEndsWithItsSourceAndSaysWhy) {
   r = runDrape("run '" + kScene + "' --live - --out '" + (dir / "x") + "' < /dev/null", dir);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("stdin:1:1"), std::string::npos) << r.err;
+}
+
+TEST(Studio, ALiveCaptureIsShownInAWindowThatStaysLiveWhileItsSourceIsSilent) {
+  // drape play SCENE --live: the header and a second of frames, then a long silence; the
+  // window shows the frames that came, goes on drawing while the simulation waits for more,
+  // and closes on Ctrl-C (which must reach the simulating thread's wait, or it would hang).
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps installs xvfb)";
+  ScratchDir dir("live-window");
+  std::vector<std::string> lines = linesOf(slurp(kWalk));
+  lines.resize(187 + 120);
+  CaptureBroadcast capture;
+  capture.send(lines, lines.size(), 12000ms);
+  const std::string shot = dir / "live.png";
+  DrapeProcess play("play '" + kScene + "' --live " + capture.url() + " --size 320x240 --screenshot '" + shot + "'", dir,
+                    "play", "xvfb-run -a");
+  ASSERT_TRUE(said(play, "waiting for motion frames from " + capture.url())) << play.errSoFar();
+  // Ctrl-C to drape itself, not to xvfb-run: the one process whose command line starts with it.
+  std::string pattern = "^";
+  for (const char c : std::string(DRAPE_EXE) + " play")
+    pattern += std::isalnum(static_cast<unsigned char>(c)) || c == ' ' || c == '/' ? std::string(1, c) : std::string("\\") + c;
+  ASSERT_EQ(std::system(("pkill -INT -f '" + pattern + "'").c_str()), 0);
+  const CliResult shown = play.wait();
+  // 120 frames at 120 Hz: 30 at 30 Hz after the lead-in's 30, each shown but the last, whose
+  // substeps wait for a motion frame after the 30th while the source is silent.
+  EXPECT_NE(shown.out.find("simulated and showed 59 frames in "), std::string::npos) << shown.out << shown.err;
+  EXPECT_NE(shown.out.find("of the live motion from " + capture.url()), std::string::npos) << shown.out;
+  EXPECT_GT(fs::file_size(shot), 1000u);
 }
 
 TEST(Studio, ALiveSourceThatIsNotThereOrFallsSilentEndsTheTakeSaying) {

@@ -48,6 +48,9 @@ class RunAhead {
   RunAhead(const RunAhead&) = delete;
   RunAhead& operator=(const RunAhead&) = delete;
 
+  /// Whether next() would return at once: an item, the end or what `take` threw is there.
+  [[nodiscard]] bool ready() const { return ended_ || !full_.empty(); }
+
   /// The next item, or nullptr after the last; rethrows what `take` threw. The item is the
   /// consumer's until the next call.
   [[nodiscard]] const Slot* next() {

@@ -145,7 +145,8 @@ RunFunction setupPlay(CLI::App& app) {
       ->required();
   app.add_option("--motion", o.motion, std::string("With a scene: motion for its avatar ") + kMotionHelp);
   app.add_option("--animation", o.animation, kAnimationHelp);
-  app.add_option("--live", o.live, std::string("With a scene, instead of a motion: ") + kLiveHelp + "; simulated and shown as it comes")
+  app.add_option("--live", o.live,
+                 std::string("With a scene, instead of a motion: ") + kLiveHelp + "; shown as it is simulated")
       ->type_name("SOURCE");
   app.add_option("--live-header", o.liveHeader, kLiveHeaderHelp)->type_name("FILE.bvh");
   app.add_option("--give-up", o.giveUp_s, "With --live: stop simulating after S seconds without a line")

@@ -385,7 +385,7 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--send", o->sends,
                  "With --events: an event for the graph's state machines at a time of the script, EVENT@SECONDS; "
                  "repeatable");
-  app.add_option("--live", o->live, std::string("Instead of a motion: ") + kLiveHelp + "; simulated as it comes")
+  app.add_option("--live", o->live, std::string("Instead of a motion: ") + kLiveHelp)
       ->type_name("SOURCE");
   app.add_option("--live-header", o->liveHeader, kLiveHeaderHelp)->type_name("FILE.bvh");
   app.add_option("--give-up", o->giveUp_s, "With --live: end the run after S seconds without a line (exit code 4)")

@@ -32,6 +32,7 @@ namespace {
 
 struct AnimServerOptions {
   std::string scene, motion, animation, name = "anim", take, events, live, liveHeader;
+  std::string timecode;  ///< --timecode: motion frame 0's time code, HH:MM:SS:FF or now
   std::vector<std::string> sets;
   long frames = 0;
   bool fast = false, hold = false;
@@ -40,6 +41,11 @@ struct AnimServerOptions {
 
 /// Set by SIGINT and SIGTERM (stopOnSignals()): a live take ends at the next frame, with its End sent.
 const std::atomic<bool>& stopAsked = detail::stopAsked;
+
+/// The time code of the take's motion frame 0: --timecode's (now: the time of day), else `own`.
+TimeCode takeStart(const AnimServerOptions& o, TimeCode own) {
+  return o.timecode.empty() ? own : TimeCode::parseOption(o.timecode, own.rate);
+}
 
 /// A pose take's first message: the avatar and its joints (every frame lists them in this
 /// order), the motion joints driving them, and how the frames are numbered (`frames` 0:
@@ -102,8 +108,8 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup) {
   studio::Listener requests = bus.listen(studio::requestSubjectOf(o.name));
   const std::string take = o.take.empty() ? studio::newTakeId() : o.take;
   // Its length known ahead only when it holds to --frames; else 0: live, as long as its graphs run.
-  publisher.beginTake(take, poseStart(avatar, std::vector<int>(avatar.joints.size(), -1), TimeCode{0, rate},
-                                      o.hold ? o.frames : 0));
+  publisher.beginTake(take, poseStart(avatar, std::vector<int>(avatar.joints.size(), -1),
+                                      takeStart(o, TimeCode{0, rate}), o.hold ? o.frames : 0));
   (void)stopOnSignals();
   spdlog::info("take {}: the event graph {} on {} at {:g} Hz, on {} ({}); drape inject --to {} starts graphs and sends "
                "events while it runs",
@@ -166,7 +172,7 @@ int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
   const std::string take = o.take.empty() ? studio::newTakeId() : o.take;
   // Live: as long as the source sends. A capture does not come again, so a take of this name
   // in the stream cannot be completed.
-  if (publisher.beginTake(take, poseStart(avatar, live.drivingJoint(), TimeCode{0, live.rate()}, 0)) > 0)
+  if (publisher.beginTake(take, poseStart(avatar, live.drivingJoint(), takeStart(o, TimeCode{0, live.rate()}), 0)) > 0)
     throw Error(fmt::format("--take {}: {} holds that take already, and a live capture cannot be sent again to "
                             "complete it; give the take another name",
                             take, studio::subjectOf(o.name)));
@@ -209,6 +215,8 @@ int runAnimServer(const AnimServerOptions& o) {
   studio::checkSourceName(o.name, "--name");
   RunSetup setup = runSetupFromScene(o.scene);
   if (!setup.character) throw Error(fmt::format("{}: the scene has no avatar to move", o.scene));
+  if (!o.timecode.empty() && o.timecode != "now")
+    (void)TimeCode::parseSmpte(o.timecode, setup.settings.frameRate_hz);  // said before anything waits
   if (!o.live.empty()) {
     if (!o.motion.empty() || !o.animation.empty() || !o.events.empty())
       throw Error(fmt::format("--live plays the motion its source sends: give it or {}, not both",
@@ -242,7 +250,8 @@ int runAnimServer(const AnimServerOptions& o) {
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape anim-server " + o.name);
   studio::Publisher publisher(bus, o.name, studio::Precision::Double, o.studio.giveUp());
   const std::string take = o.take.empty() ? studio::newTakeId() : o.take;
-  const studio::PoseStart start = poseStart(avatar, motion);
+  studio::PoseStart start = poseStart(avatar, motion);
+  start.start = takeStart(o, start.start);
   publisher.beginTake(take, start);
   if (publisher.complete()) {
     fmt::print("take {} is in {} already, to its end\n", take, studio::subjectOf(o.name));
@@ -284,6 +293,10 @@ RunFunction setupAnimServer(CLI::App& app) {
   app.add_option("--take", o.take,
                  "The take's name (default: the date and time). A take the stream already holds in part is "
                  "completed, not sent again");
+  app.add_option("--timecode", o.timecode,
+                 "The time code of the take's first motion frame: HH:MM:SS:FF, or now (this machine's time of day, "
+                 "local); default the motion's own, 00:00:00:00 for most files and for live and scripted takes")
+      ->type_name("TIMECODE|now");
   app.add_flag("--fast", o.fast, "Send the frames as fast as the server acknowledges them, not at the frame rate");
   app.add_option("--events", o.events,
                  "Instead of a motion: play an EGML event graph live (docs/EVENTS.md), taking graphs and events "

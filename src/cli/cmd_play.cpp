@@ -111,7 +111,7 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
   render::CallbackSource source(meshes, step.frameRate_hz, [&](render::Frame& out) {
     const FrameTaken* taken = ahead.next();
     if (!taken) return false;
-    out.time = TimeCode{taken->frame, step.frameRate_hz};
+    out.time = frameTimeCode(setup, taken->frame);
     out.stages = stagesTaken(taken->stageMs);
     out.positions.resize(meshes.size());
     out.states.resize(meshes.size());

@@ -138,6 +138,7 @@ int record(const PlayerRoleOptions& o) {
     }
     const std::string dir = o.takes == 1 ? o.record : (fs::path(o.record) / takeDirName(frames.take())).string();
     setup.outDir = dir;
+    setup.timeCodeOfFrame0 = frames.start().start.frame;  // the take's time code, kept in the recording
     const Recording r = recordTake(o, setup, frames, fields, stop);
     if (!r.failure.empty()) {
       const std::string said = fmt::format("{} (the {} frames before it recorded in {})", r.failure, r.frames, dir);

@@ -28,6 +28,7 @@
 #include "drape/scene/avatar_segment.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/scene_setup.hpp"
+#include "drape/studio/takes.hpp"
 #include "live_capture.hpp"
 #include "live_run.hpp"
 #include "run_setup.hpp"
@@ -46,6 +47,7 @@ struct RunOptions {
   std::string events;                       ///< --events: an EGML event graph instead of --motion
   std::string live, liveHeader;             ///< --live SOURCE, --live-header FILE.bvh: a capture as it comes
   double giveUp_s = 0.0;                    ///< --give-up: a live source silent this long ends the run
+  std::string timecode;                     ///< --timecode: motion frame 0's time code, HH:MM:SS:FF or now
   std::vector<std::string> sets, sends;     ///< --set NAME=VALUE, --send EVENT@SECONDS
   std::string garment, units = "m", pinVertices, pinMask, out, substeps = "33", integrator = "symplectic-euler";
   std::string strainLimit = "auto";
@@ -239,6 +241,15 @@ std::shared_ptr<const scene::Avatar> loadAvatarCut(const std::string& path, cons
   return std::make_shared<const scene::Avatar>(std::move(avatar));
 }
 
+/// --timecode: the run's frames numbered from motion frame 0 at that time code (now: the
+/// time of day), the lead-in's before it, as the studio numbers a take's.
+void stampTimeCode(const RunOptions& o, RunSetup& setup) {
+  if (o.timecode.empty()) return;
+  const TimeCode motionStart = TimeCode::parseOption(o.timecode, setup.settings.frameRate_hz);
+  setup.timeCodeOfFrame0 =
+      setup.character ? studio::clothTimeCode(0, motionStart, setup.character->leadIn_s).frame : motionStart.frame;
+}
+
 /// `--live SOURCE`: the run on a capture as it comes, until the source ends (it closes, Ctrl-C,
 /// or silence past --give-up: exit code 4) or --frames; what came is written as any run is.
 int runLive(const RunOptions& o, RunSetup& setup, const std::function<void()>& saidResults) {
@@ -249,6 +260,7 @@ int runLive(const RunOptions& o, RunSetup& setup, const std::function<void()>& s
   motion.jointMapPath = o.jointMap;
   LiveCapture capture(*setup.character->avatar, {o.live, o.liveHeader, std::chrono::seconds(5), giveUp}, motion, stop);
   LiveRun live(setup, capture, o.frames);
+  stampTimeCode(o, setup);  // now: when the first frame came
   const int code = simulateRun(setup, live.gate());
   saidResults();
   const std::string ended = capture.ended();
@@ -356,7 +368,9 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     fmt::print("results in {}/: garment caches (.pc2, .states), {}frames/, result.wrl, result.glb, stats.json{}\n", o.out,
                skin ? "the skinned body (body.pc2), " : "", o.preview ? ", preview.png" : "");
   };
+  if (!o.timecode.empty() && o.timecode != "now") (void)TimeCode::parseSmpte(o.timecode, setup.settings.frameRate_hz);
   if (!o.live.empty()) return runLive(o, setup, saidResults);
+  stampTimeCode(o, setup);
   const int code = simulateRun(setup);
   saidResults();
   return code;
@@ -390,6 +404,10 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--live-header", o->liveHeader, kLiveHeaderHelp)->type_name("FILE.bvh");
   app.add_option("--give-up", o->giveUp_s, "With --live: end the run after S seconds without a line (exit code 4)")
       ->check(CLI::PositiveNumber);
+  app.add_option("--timecode", o->timecode,
+                 "The time code of the motion's first frame (the lead-in's frames before it): HH:MM:SS:FF, or now "
+                 "(this machine's time of day, local; with --live, when the first frame came); default the motion's own")
+      ->type_name("TIMECODE|now");
   app.add_option("--joint-map", o->jointMap, "JSON map from the motion's joint names to the avatar's");
   app.add_option("--animation", o->animation, kAnimationHelp);
   app.add_option("--motion-scale", o->motionScale, "Metres per motion-file unit (default: guessed from the skeleton)");

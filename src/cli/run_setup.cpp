@@ -20,6 +20,7 @@
 #include "drape/core/files.hpp"
 #include "drape/core/log.hpp"
 #include "drape/core/progress.hpp"
+#include "drape/studio/takes.hpp"
 #include "drape/events/runtime.hpp"
 #include "drape/formats/hanim_motion.hpp"
 #include "drape/mesh/topology.hpp"
@@ -208,6 +209,14 @@ RunSetup runSetupFromScene(const std::string& scenePath, const std::optional<std
       throw Error::at(sc.simulation.source, "Simulation keepApart: " + bad);
   }
   return setup;
+}
+
+TimeCode frameTimeCode(const RunSetup& setup, long frame) {
+  const double rate = setup.settings.frameRate_hz;
+  if (setup.timeCodeOfFrame0) return TimeCode{*setup.timeCodeOfFrame0 + frame, rate};
+  if (!setup.character) return TimeCode{frame, rate};
+  const TimeCode motionStart = setup.character->animation ? setup.character->animation->start() : TimeCode{0, rate};
+  return studio::clothTimeCode(frame, TimeCode{motionStart.frame, rate}, setup.character->leadIn_s);
 }
 
 motion::MotionOptions motionOptions(const RunSetup& setup) {

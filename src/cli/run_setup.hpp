@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drape/cloth/collider.hpp"
+#include "drape/core/timecode.hpp"
 #include "drape/cloth/material.hpp"
 #include "drape/mesh/trimesh.hpp"
 #include "drape/motion/animation.hpp"
@@ -81,7 +82,15 @@ struct RunSetup {
   /// The wind of each motion frame where an event graph sets it (docs/EVENTS.md); null or
   /// empty: the settings' wind throughout. A cloth-server's grows as its poses come.
   std::shared_ptr<const MotionWind> motionWind{};
+  /// The time code of frame 0 (a frame number at the frame rate; a studio player's, its
+  /// cloth take's). None: frameTimeCode's.
+  std::optional<std::int64_t> timeCodeOfFrame0;
 };
+
+/// The time code of frame `frame` of the run, as the studio numbers a cloth take's: the
+/// setup's timeCodeOfFrame0 and on; else, on a character, motion frame 0 at its motion's
+/// time code (0 where it has none) and the lead-in's frames before it; else the frame.
+[[nodiscard]] TimeCode frameTimeCode(const RunSetup& setup, long frame);
 
 /// Garments, materials, settings and the avatar (as the setup's character, without motion)
 /// from a VRML97 scene. Throws drape::Error on a bad scene or one with no ClothSet.

@@ -76,6 +76,7 @@ struct RunWriter::Impl {
       : setup(s), out(s.outDir) {
     createOutDir(setup.outDir);
     manifest.frameRate = setup.settings.frameRate_hz;
+    manifest.startFrame = static_cast<long>(frameTimeCode(setup, 0).frame);
     for (const GarmentSetup& g : setup.garments) {
       GarmentFiles f;
       f.name = g.name;

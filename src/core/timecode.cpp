@@ -1,6 +1,8 @@
 #include "drape/core/timecode.hpp"
 
+#include <chrono>
 #include <cmath>
+#include <ctime>
 #include <cstdio>
 
 #include <fmt/format.h>
@@ -31,6 +33,22 @@ TimeCode TimeCode::parseSmpte(const std::string& text, double rate) {
   const auto fps = std::llround(rate);
   const std::int64_t frame = ((static_cast<std::int64_t>(h) * 60 + m) * 60 + s) * fps + f;
   return TimeCode{before ? -frame : frame, rate};
+}
+
+TimeCode TimeCode::timeOfDay(double rate) {
+  const auto now = std::chrono::system_clock::now();
+  const std::time_t seconds = std::chrono::system_clock::to_time_t(now);
+  std::tm local{};
+  localtime_r(&seconds, &local);
+  const double sinceMidnight =
+      (local.tm_hour * 60.0 + local.tm_min) * 60.0 + local.tm_sec +
+      std::chrono::duration<double>(now - std::chrono::system_clock::from_time_t(seconds)).count();
+  const auto fps = std::max<std::int64_t>(1, std::llround(rate));
+  return TimeCode{static_cast<std::int64_t>(std::floor(sinceMidnight * static_cast<double>(fps))), rate};
+}
+
+TimeCode TimeCode::parseOption(const std::string& text, double rate) {
+  return text == "now" ? timeOfDay(rate) : parseSmpte(text, rate);
 }
 
 }  // namespace drape

@@ -115,11 +115,16 @@ void LiveMotion::emitUpTo(double lastIndex, bool ending) {
 void LiveMotion::emit(const SourcePose& a, const SourcePose& b, double s) {
   ++emitted_;
   const std::size_t n = a.local.size();
-  std::vector<Quat> local(n);
-  for (std::size_t j = 0; j < n; ++j) local[j] = resampling_ ? slerp(a.local[j], b.local[j], s) : a.local[j];
+  local_.resize(n);
+  for (std::size_t j = 0; j < n; ++j) local_[j] = resampling_ ? slerp(a.local[j], b.local[j], s) : a.local[j];
   const Vec3 root = resampling_ ? Vec3((1.0 - s) * a.root + s * b.root) : a.root;
-  std::vector<RigidTransform> world(retargeter_.jointCount());
-  retargeter_.retarget(local, root, world);
+  std::vector<RigidTransform> world;
+  if (!spare_.empty()) {
+    world = std::move(spare_.back());
+    spare_.pop_back();
+  }
+  world.resize(retargeter_.jointCount());
+  retargeter_.retarget(local_, root, world);
   if (options_.retarget.groundFeet) ground(world);
   ready_.push_back(std::move(world));
 }
@@ -142,6 +147,7 @@ void LiveMotion::ground(std::vector<RigidTransform>& world) {
 bool LiveMotion::next(std::span<RigidTransform> out) {
   if (ready_.empty()) return false;
   std::copy(ready_.front().begin(), ready_.front().end(), out.begin());
+  spare_.push_back(std::move(ready_.front()));
   ready_.pop_front();
   return true;
 }

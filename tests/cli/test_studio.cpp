@@ -12,6 +12,8 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <condition_variable>
+#include <mutex>
 #include <cctype>
 #include <filesystem>
 #include <functional>
@@ -69,13 +71,17 @@ std::string roles(const NatsServer& server) { return " --server " + server.url()
 TEST(Studio, ThePlayerRecordsWhatDrapeRunWritesThroughAKilledClothServerAndJunk) {
   ScratchDir dir("studio-roles");
   NatsServer server;
-  const std::string reference = runInto(dir, "reference", "'" + kScene + "' --motion '" + kWalk + "'");
+  // The take at ten in the morning: the recording keeps its time code, as drape run numbers it.
+  const std::string reference =
+      runInto(dir, "reference", "'" + kScene + "' --motion '" + kWalk + "' --timecode 10:00:00:00");
 
   // The player first: it waits for the cloth. Then a cloth-server, then the anim-server at
   // the frame rate, so that the take is under way when the cloth-server is killed.
   DrapeProcess player("player '" + kScene + "' --record '" + (dir / "recorded") + "'" + roles(server), dir, "player");
   auto cloth = std::make_unique<DrapeProcess>("cloth-server '" + kScene + "' --takes 1" + roles(server), dir, "cloth1");
-  DrapeProcess anim("anim-server '" + kScene + "' --motion '" + kWalk + "' --take walk-1" + roles(server), dir, "anim");
+  DrapeProcess anim("anim-server '" + kScene + "' --motion '" + kWalk + "' --take walk-1 --timecode 10:00:00:00" +
+                        roles(server),
+                    dir, "anim");
 
   studio::Bus bus = studio::Bus::connect(server.url(), "test");
   bus.ensureStream("anim");
@@ -104,6 +110,9 @@ TEST(Studio, ThePlayerRecordsWhatDrapeRunWritesThroughAKilledClothServerAndJunk)
   EXPECT_NE(recorded.out.find("recorded take walk-1: 171 frames"), std::string::npos) << recorded.out;
   EXPECT_EQ(bus.range("cloth").messages, 173u) << "the take's start, 171 frames and its end, each once";
   expectSameRun(dir / "recorded", reference);
+  EXPECT_EQ(formats::readRunManifest(dir / "recorded").startFrame, 10 * 3600 * 30 - 30) << "the lead-in before 10:00";
+  const CliResult inspected = runDrape("inspect '" + (dir / "recorded") + "'", dir);
+  EXPECT_NE(inspected.out.find("171 frames at 30 fps (09:59:59:00 to 10:00:04:20)"), std::string::npos) << inspected.out;
 }
 
 TEST(Studio, TheRolesRideOutARestartOfTheServer) {
@@ -191,6 +200,10 @@ TEST(Studio, AnUnstableTakeIsRecordedUpToItsLastGoodFrame) {
   EXPECT_TRUE(statsOf(dir / "recorded")["unstable"].get<bool>());
 }
 
+/// Whether windows can be tested: a virtual display, under xvfb-run.
+bool haveXvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
+constexpr const char* kNoXvfb = "xvfb-run is not installed (scripts/install-deps installs xvfb)";
+
 /// `drape player ARGS --window` under a virtual display: exit status and what it said.
 std::pair<int, std::string> showInWindow(const std::string& args, const NatsServer& server, const ScratchDir& dir,
                                          const std::string& name) {
@@ -208,8 +221,7 @@ TimeCode shownFrom(const std::string& said) {
 }
 
 TEST(Studio, ThePlayerShowsATakeLiveInAWindowAndFromATimeCode) {
-  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
-    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps installs xvfb)";
+  if (!haveXvfb()) GTEST_SKIP() << kNoXvfb;
   ScratchDir dir("studio-window");
   NatsServer server;
   DrapeProcess cloth("cloth-server '" + kScene + "' --takes 1" + roles(server), dir, "cloth");
@@ -316,8 +328,7 @@ TEST(Studio, ARecorderRecordsTakeAfterTakeEachUnderItsNameUntilStopped) {
 }
 
 TEST(Studio, AWindowMovesOnToTheNextTake) {
-  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
-    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps installs xvfb)";
+  if (!haveXvfb()) GTEST_SKIP() << kNoXvfb;
   ScratchDir dir("studio-window-takes");
   NatsServer server;
   DrapeProcess cloth("cloth-server '" + kScene + "'" + roles(server), dir, "cloth");
@@ -421,6 +432,12 @@ class CaptureBroadcast {
     url_ = "tcp://127.0.0.1:" + std::to_string(ntohs(address.sin_port));
   }
   ~CaptureBroadcast() {
+    {
+      const std::lock_guard lock(mutex_);
+      done_ = true;
+    }
+    woken_.notify_all();  // a pause ends at once: a long silence costs the test nothing
+    ::shutdown(listener_, SHUT_RDWR);  // and so does an accept nobody came to
     if (thread_.joinable()) thread_.join();
     ::close(listener_);
   }
@@ -440,7 +457,8 @@ class CaptureBroadcast {
           if (n <= 0) break;
           done += static_cast<std::size_t>(n);
         }
-        std::this_thread::sleep_for(pause);
+        std::unique_lock lock(mutex_);
+        if (woken_.wait_for(lock, pause, [this] { return done_; })) break;
       }
       ::close(peer);
     });
@@ -449,6 +467,9 @@ class CaptureBroadcast {
  private:
   int listener_ = -1;
   std::string url_;
+  std::mutex mutex_;
+  std::condition_variable woken_;
+  bool done_ = false;
   std::thread thread_;
 };
 
@@ -522,7 +543,7 @@ TEST(Studio, ALiveRunEndsWithItsSourceAndSaysWhy) {
   std::vector<std::string> lines = linesOf(slurp(kWalk));
   lines.resize(187 + 120);
   CaptureBroadcast silent;
-  silent.send(lines, lines.size(), 4000ms);
+  silent.send(lines, lines.size(), 60000ms);
   const CliResult quiet = runDrape(
       "run '" + kScene + "' --live " + silent.url() + " --give-up 1 --out '" + (dir / "quiet") + "'", dir);
   EXPECT_EQ(quiet.code, 4) << quiet.err;
@@ -547,13 +568,12 @@ TEST(Studio, ALiveCaptureIsShownInAWindowThatStaysLiveWhileItsSourceIsSilent) {
   // drape play SCENE --live: the header and a second of frames, then a long silence; the
   // window shows the frames that came, goes on drawing while the simulation waits for more,
   // and closes on Ctrl-C (which must reach the simulating thread's wait, or it would hang).
-  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
-    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps installs xvfb)";
+  if (!haveXvfb()) GTEST_SKIP() << kNoXvfb;
   ScratchDir dir("live-window");
   std::vector<std::string> lines = linesOf(slurp(kWalk));
   lines.resize(187 + 120);
   CaptureBroadcast capture;
-  capture.send(lines, lines.size(), 12000ms);
+  capture.send(lines, lines.size(), 60000ms);
   const std::string shot = dir / "live.png";
   DrapeProcess play("play '" + kScene + "' --live " + capture.url() + " --size 320x240 --screenshot '" + shot + "'", dir,
                     "play", "xvfb-run -a");
@@ -587,7 +607,7 @@ TEST(Studio, ALiveSourceThatIsNotThereOrFallsSilentEndsTheTakeSaying) {
   std::vector<std::string> lines = linesOf(slurp(kWalk));
   lines.resize(187 + 12);
   CaptureBroadcast silent;
-  silent.send(lines, lines.size(), 3000ms);
+  silent.send(lines, lines.size(), 60000ms);
   r = runDrape("anim-server '" + kScene + "' --live " + silent.url() + " --take quiet --server " + server.url() +
                    " --give-up 1",
                dir);

@@ -2,6 +2,10 @@
 
 #include <csignal>
 #include <cstdlib>
+#include <ctime>
+#include <string>
+#include <utility>
+#include <vector>
 #include <thread>
 
 #include "drape/core/error.hpp"
@@ -30,6 +34,30 @@ TEST(TimeCode, ParsesWhatItPrints) {
   EXPECT_THROW((void)TimeCode::parseSmpte("--00:00:01:00", 30), Error);
   EXPECT_THROW((void)TimeCode::parseSmpte("-+0:00:01:00", 30), Error);
   EXPECT_THROW((void)TimeCode::parseSmpte("00:00:01:00 ", 30), Error);
+}
+
+TEST(TimeCode, ReadsTheTimeOfDayInTheLocalZone) {
+  const char* saved = std::getenv("TZ");
+  const std::string before = saved != nullptr ? saved : "";
+  // POSIX zones: XYZ-5 is five hours ahead of UTC, ABC+3:30 three and a half behind.
+  const std::vector<std::pair<const char*, long>> zones = {{"UTC0", 0}, {"XYZ-5", 5 * 3600}, {"ABC+3:30", -(3 * 3600 + 1800)}};
+  for (const auto& [zone, ahead_s] : zones) {
+    ::setenv("TZ", zone, 1);
+    ::tzset();
+    const std::time_t from = std::time(nullptr);
+    const TimeCode now = TimeCode::timeOfDay(25.0);
+    const std::time_t to = std::time(nullptr);
+    const auto secondOfDay = [ahead = ahead_s](std::time_t t) { return ((t + ahead) % 86400 + 86400) % 86400; };
+    if (secondOfDay(to) < secondOfDay(from)) continue;  // midnight came in between
+    EXPECT_EQ(now.rate, 25.0);
+    EXPECT_GE(now.frame, secondOfDay(from) * 25) << zone;
+    EXPECT_LT(now.frame, (secondOfDay(to) + 1) * 25) << zone;
+  }
+  if (saved != nullptr) ::setenv("TZ", before.c_str(), 1);
+  else ::unsetenv("TZ");
+  ::tzset();
+  EXPECT_EQ(TimeCode::parseOption("10:00:00:00", 30).frame, 10 * 3600 * 30);
+  EXPECT_THROW((void)TimeCode::parseOption("later", 30), Error);
 }
 
 TEST(SourcePos, FormatsWhatIsKnown) {

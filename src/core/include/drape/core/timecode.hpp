@@ -18,6 +18,11 @@ struct TimeCode {
   /// Parses "HH:MM:SS:FF" (or "-HH:MM:SS:FF", as smpte() prints a frame before 0) at the
   /// given rate; throws drape::Error on malformed text.
   [[nodiscard]] static TimeCode parseSmpte(const std::string& text, double rate);
+  /// The time of day on this machine's clock (local time, from midnight) as a time code at
+  /// `rate`: what a studio's time-of-day time code reads now.
+  [[nodiscard]] static TimeCode timeOfDay(double rate);
+  /// A command line's time code: "now" (timeOfDay) or HH:MM:SS:FF, as parseSmpte.
+  [[nodiscard]] static TimeCode parseOption(const std::string& text, double rate);
 };
 
 }  // namespace drape

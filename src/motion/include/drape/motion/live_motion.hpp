@@ -82,6 +82,10 @@ class LiveMotion {
   SourcePose previous_, current_, converted_;
   std::deque<double> lowest_, window_;  ///< the trailing windows of grounding
   std::deque<std::vector<RigidTransform>> ready_;
+  // Scratch kept from frame to frame, so that a frame in steady state allocates nothing: the
+  // resampled local rotations, and the frames next() handed out, for emit() to fill again.
+  std::vector<Quat> local_;
+  std::vector<std::vector<RigidTransform>> spare_;
 };
 
 }  // namespace drape::motion

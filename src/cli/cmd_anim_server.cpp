@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <deque>
 #include <csignal>
 #include <list>
 #include <optional>
@@ -23,6 +24,7 @@
 #include "drape/studio/publisher.hpp"
 #include "drape/studio/takes.hpp"
 #include "live_capture.hpp"
+#include "live_run.hpp"
 #include "run_setup.hpp"
 #include "stop_signal.hpp"
 #include "studio_options.hpp"
@@ -91,10 +93,10 @@ studio::InjectReply injected(const studio::Inject& in, long frame, events::Sched
 /// while it runs (drape inject).
 int runEventGraph(const AnimServerOptions& o, RunSetup& setup) {
   const scene::Avatar& avatar = *setup.character->avatar;
-  if (!setup.character->keepApart.empty())
-    spdlog::warn("{}: the scene keeps {} apart, a correction of a whole motion: a live event graph plays without it",
-                 o.scene, fmt::join(setup.character->keepApart, ", "));
   const double rate = setup.settings.frameRate_hz;
+  // Kept apart as drape run keeps a graph's motion apart: each frame goes out the
+  // correction's delay after its tick, so an injection shows that much later too.
+  const std::shared_ptr<sim::LiveKeepApart> keep = liveKeepApart(setup, rate);
   const motion::MotionOptions mo = motionOptions(setup);
   std::list<events::Graph> graphs;
   graphs.push_back(events::readGraph(o.events));
@@ -120,6 +122,25 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup) {
   const auto frameTime = std::chrono::duration<double>(1.0 / rate);
   events::Tick tick;
   studio::PoseFrame frame;
+  frame.joints.resize(avatar.joints.size());
+  std::deque<std::optional<Vec3>> winds;  // the ticks' winds, until their frames go out
+  std::int64_t sent = 0;
+  // A tick's frame out: at once, or kept apart once the correction has it.
+  const auto sendReady = [&] {
+    if (!keep) {
+      frame.frame = sent++;
+      frame.joints = tick.joints;
+      frame.wind = tick.wind;
+      publisher.send(frame);
+      return;
+    }
+    while (keep->next(frame.joints)) {
+      frame.frame = sent++;
+      frame.wind = winds.front();
+      winds.pop_front();
+      publisher.send(frame);
+    }
+  };
   long f = 0;
   for (; o.frames == 0 || f < o.frames; ++f) {
     if (!o.fast)
@@ -138,18 +159,24 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup) {
       requests.answer(*r, studio::encode(studio::Message{o.name, take, reply}));
     }
     const bool more = scheduler.tick(tick);
-    frame.frame = f;
-    frame.joints = tick.joints;
-    frame.wind = tick.wind;
-    publisher.send(frame);
+    if (keep) {
+      keep->push(tick.joints);
+      winds.push_back(tick.wind);
+    }
+    sendReady();
     if ((!more && !o.hold) || stopAsked) {
       ++f;
       break;
     }
   }
-  publisher.send(studio::End{f, "", stopAsked ? "stopped (a signal)" : "", 0});
+  if (keep) {
+    keep->finish();
+    sendReady();
+  }
+  publisher.send(studio::End{sent, "", stopAsked ? "stopped (a signal)" : "", 0});
+  if (keep) logKeptApart(keep->report());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
-  fmt::print("sent take {}: {} pose frames of {}'s event graph to {} on {} in {:.1f} s\n", take, f, avatar.name,
+  fmt::print("sent take {}: {} pose frames of {}'s event graph to {} on {} in {:.1f} s\n", take, sent, avatar.name,
              studio::subjectOf(o.name), bus.url(), seconds);
   return 0;
 }
@@ -158,15 +185,16 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup) {
 /// a named pipe, retargeted and sent frame by frame as it comes (motion/live_motion.hpp).
 int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
   const scene::Avatar& avatar = *setup.character->avatar;
-  if (!setup.character->keepApart.empty())
-    spdlog::warn("{}: the scene keeps {} apart, a correction of a whole motion: a live motion plays without it", o.scene,
-                 fmt::join(setup.character->keepApart, ", "));
   (void)stopOnSignals();
-  // The server first: a studio with no NATS server is said before the capture is waited for.
+  // The server first: a studio with no NATS server is said before the capture is waited for;
+  // then the keep-apart's fields, so that the capture's first frames do not wait for them.
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape anim-server " + o.name);
+  prepareLiveRun(setup);
   LiveCapture capture(avatar, {o.live, o.liveHeader, o.studio.patience(), o.studio.giveUp()}, motionOptions(setup),
                       stopAsked);
   const motion::LiveMotion& live = capture.motion();
+  // The stream carries the motion kept apart, as it carries a recorded motion's.
+  capture.keepApart(liveKeepApart(setup, live.rate()));
 
   studio::Publisher publisher(bus, o.name, studio::Precision::Double, o.studio.giveUp());
   const std::string take = o.take.empty() ? studio::newTakeId() : o.take;
@@ -193,6 +221,7 @@ int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
   const std::string ended = capture.ended();
   const int code = capture.silent() ? static_cast<int>(ExitCode::Unavailable) : 0;
   publisher.send(studio::End{sent, "", ended, code});
+  if (capture.keptApart()) logKeptApart(capture.keptApart()->report());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
   fmt::print("sent take {}: {} pose frames of {} from {} ({} source frames{}) to {} on {} in {:.1f} s{}\n", take, sent,
              avatar.name, capture.name(), live.sourceFrames(),

@@ -49,6 +49,7 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
   std::unique_ptr<LiveRun> live;
   if (!o.live.empty()) {
     const std::chrono::milliseconds giveUp(static_cast<long long>(1000.0 * o.giveUp_s));
+    prepareLiveRun(setup);
     capture = std::make_unique<LiveCapture>(*setup.character->avatar,
                                             LiveCapture::Options{o.live, o.liveHeader, std::chrono::seconds(5), giveUp},
                                             motionOptions(setup), stopOnSignals());

@@ -242,10 +242,11 @@ std::shared_ptr<const scene::Avatar> loadAvatarCut(const std::string& path, cons
 }
 
 /// --timecode: the run's frames numbered from motion frame 0 at that time code (now: the
-/// time of day), the lead-in's before it, as the studio numbers a take's.
-void stampTimeCode(const RunOptions& o, RunSetup& setup) {
+/// time of day, `earlier_s` before now), the lead-in's before it, as the studio numbers a take's.
+void stampTimeCode(const RunOptions& o, RunSetup& setup, double earlier_s = 0.0) {
   if (o.timecode.empty()) return;
-  const TimeCode motionStart = TimeCode::parseOption(o.timecode, setup.settings.frameRate_hz);
+  TimeCode motionStart = TimeCode::parseOption(o.timecode, setup.settings.frameRate_hz);
+  if (o.timecode == "now") motionStart.frame -= std::llround(earlier_s * motionStart.rate);
   setup.timeCodeOfFrame0 =
       setup.character ? studio::clothTimeCode(0, motionStart, setup.character->leadIn_s).frame : motionStart.frame;
 }
@@ -258,10 +259,12 @@ int runLive(const RunOptions& o, RunSetup& setup, const std::function<void()>& s
   motion::MotionOptions motion = motionOptions(setup);
   if (o.motionScale > 0) motion.clip.metresPerUnit = o.motionScale;
   motion.jointMapPath = o.jointMap;
+  prepareLiveRun(setup);
   LiveCapture capture(*setup.character->avatar, {o.live, o.liveHeader, std::chrono::seconds(5), giveUp}, motion, stop);
   LiveRun live(setup, capture, o.frames);
-  stampTimeCode(o, setup);  // now: when the first frame came
+  stampTimeCode(o, setup, live.lag_s());  // now: when the first frame came
   const int code = simulateRun(setup, live.gate());
+  if (capture.keptApart()) logKeptApart(capture.keptApart()->report());
   saidResults();
   const std::string ended = capture.ended();
   fmt::print("live: {} motion frames from {} ({} source frames{}){}\n", live.motionFrames(), capture.name(),
@@ -305,8 +308,6 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   if (o.live.empty() && (!o.liveHeader.empty() || o.giveUp_s > 0))
     throw Error(fmt::format("{} is for a live source: give --live SOURCE", o.liveHeader.empty() ? "--give-up" : "--live-header"));
   if (!o.live.empty() && !avatar) throw Error("--live: there is no avatar for the capture to move");
-  if (!o.live.empty() && app.count("--keep-apart"))
-    throw Error("--keep-apart corrects a whole motion, which a live source never is");
   if (o.events.empty() && (!o.sets.empty() || !o.sends.empty()))
     throw Error(fmt::format("{}: it is for an event graph: give --events FILE.egml", o.sets.empty() ? "--send" : "--set"));
   const MotionChoice motion =
@@ -321,8 +322,9 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     setup.spheres.push_back({c, r.z()});
   }
 
-  if (app.count("--keep-apart") && !keepApartParts(o.keepApart).empty() && motion.path.empty() && o.events.empty())
-    throw Error("--keep-apart corrects a motion: give --motion FILE (or --events FILE) too");
+  if (app.count("--keep-apart") && !keepApartParts(o.keepApart).empty() && motion.path.empty() && o.events.empty() &&
+      o.live.empty())
+    throw Error("--keep-apart corrects a motion: give --motion FILE (or --events FILE, or --live SOURCE) too");
   if (!o.events.empty() && !avatar) throw Error("--events: there is no avatar for the event graph to move");
   if (setup.character) {
     CharacterSetup& ch = *setup.character;
@@ -424,8 +426,9 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--keep-apart", o->keepApart,
                  "Body parts whose motion is corrected, before simulating, to keep them out of the collidable parts "
                  "they go into (a forearm swung through the back): each is swung about the joint above it and "
-                 "keeps twice the garments' T2 from the other part's surface, e.g. LeftForeArm,RightForeArm; overrides the "
-                 "scene's keepApart, 'none' for none")
+                 "keeps twice the garments' T2 from the other part's surface, e.g. LeftForeArm,RightForeArm (with "
+                 "--live, each frame once the 15 after it have come, at 30 Hz); overrides the scene's keepApart, 'none' "
+                 "for none")
       ->delimiter(',');
   app.add_option("--lead-in", o->leadIn_s, "Seconds to blend from the rest pose into the motion")->capture_default_str();
   app.add_option("--settle", o->settle_s,

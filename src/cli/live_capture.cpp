@@ -127,7 +127,26 @@ LiveCapture::LiveCapture(const scene::Avatar& avatar, const Options& options, co
       live_(avatar, header_, motion),
       values_(header_.channelCount) {}
 
+void LiveCapture::keepApart(std::shared_ptr<sim::LiveKeepApart> keep) {
+  keep_ = std::move(keep);
+  retargeted_.resize(live_.jointCount());
+}
+
 bool LiveCapture::next(std::span<RigidTransform> joints) {
+  if (!keep_) return nextRetargeted(joints);
+  while (!keep_->next(joints)) {
+    if (keepFinished_) return false;
+    if (nextRetargeted(retargeted_)) {
+      keep_->push(retargeted_);
+    } else {
+      keep_->finish();
+      keepFinished_ = true;
+    }
+  }
+  return true;
+}
+
+bool LiveCapture::nextRetargeted(std::span<RigidTransform> joints) {
   for (;;) {
     if (live_.next(joints)) return true;
     if (finished_) return false;

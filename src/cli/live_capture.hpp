@@ -7,9 +7,13 @@
 //   LiveCapture capture(avatar, {"tcp://127.0.0.1:7001"}, motionOptions(setup), stopOnSignals());
 //   while (capture.next(joints)) use(joints);   // every frame at capture.motion().rate()
 //   if (capture.silent()) ...                    // it went silent past the give-up
+//
+// Where the scene keeps parts apart, keepApart() puts the correction between the retargeting
+// and next(): each frame then comes out the correction's delay later (sim/keep_apart.hpp).
 
 #include <atomic>
 #include <chrono>
+#include <memory>
 #include <cstddef>
 #include <optional>
 #include <span>
@@ -21,6 +25,7 @@
 #include "drape/formats/bvh.hpp"
 #include "drape/motion/live_motion.hpp"
 #include "drape/scene/avatar.hpp"
+#include "drape/sim/keep_apart.hpp"
 
 namespace drape::cli {
 
@@ -57,6 +62,11 @@ class LiveCapture {
   /// stands in, so the motion keeps its time.
   bool next(std::span<RigidTransform> joints);
 
+  /// From now on next() gives the frames as `keep` corrects them (null: as they come).
+  void keepApart(std::shared_ptr<sim::LiveKeepApart> keep);
+  /// The correction keepApart() gave, or null.
+  [[nodiscard]] const sim::LiveKeepApart* keptApart() const { return keep_.get(); }
+
   [[nodiscard]] const motion::LiveMotion& motion() const { return live_; }
   [[nodiscard]] const formats::BvhFile& header() const { return header_; }
   [[nodiscard]] const std::string& name() const { return source_.name(); }
@@ -70,6 +80,8 @@ class LiveCapture {
  private:
   LiveCapture(const scene::Avatar& avatar, const Options& options, const motion::MotionOptions& motion,
               const std::atomic<bool>& stop, std::optional<formats::BvhFile> fileHeader);
+  /// next() without the keep-apart: the retargeted frames as they come.
+  bool nextRetargeted(std::span<RigidTransform> joints);
 
   Options options_;
   const std::atomic<bool>& stop_;
@@ -79,6 +91,9 @@ class LiveCapture {
   std::vector<double> values_, previous_;
   std::size_t badLines_ = 0;
   bool finished_ = false, silent_ = false;
+  std::shared_ptr<sim::LiveKeepApart> keep_;
+  std::vector<RigidTransform> retargeted_;  ///< a frame on its way into keep_
+  bool keepFinished_ = false;
 };
 
 }  // namespace drape::cli

@@ -9,6 +9,11 @@
 
 namespace drape::cli {
 
+void prepareLiveRun(RunSetup& setup) {
+  if (setup.character && !setup.character->keepApart.empty())
+    buildPartFieldsOnce(setup, fmt::format("to keep {} apart", fmt::join(setup.character->keepApart, ", ")));
+}
+
 LiveRun::LiveRun(RunSetup& setup, LiveCapture& capture, long maxFrames)
     : capture_(capture),
       joints_(capture.motion().jointCount()),
@@ -20,9 +25,12 @@ LiveRun::LiveRun(RunSetup& setup, LiveCapture& capture, long maxFrames)
   animation_ = std::make_shared<motion::AvatarAnimation>(motion::AvatarAnimation::streamed(
       live.jointCount(), live.rate(), TimeCode{0, live.rate()}, std::vector<int>(driving.begin(), driving.end())));
   CharacterSetup& character = *setup.character;
-  if (!character.keepApart.empty()) {
-    spdlog::warn("the scene keeps {} apart, a correction of a whole motion: a live motion plays without it",
-                 fmt::join(character.keepApart, ", "));
+  // The capture keeps the parts apart on its way in, so the world is given the motion
+  // corrected and keeps nothing apart itself.
+  if (std::shared_ptr<sim::LiveKeepApart> keep = liveKeepApart(setup, live.rate())) {
+    capture.keepApart(keep);
+    lag_s_ = static_cast<double>(keep->delay()) / live.rate();
+    character.liveKeptApart = std::move(keep);
     character.keepApart.clear();
   }
   character.animation = animation_;

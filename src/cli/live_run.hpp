@@ -15,12 +15,17 @@
 
 namespace drape::cli {
 
+/// What a LiveRun on `setup` needs built before its capture is opened, so that the capture's
+/// first frames do not wait for it: the part fields of its keep-apart.
+void prepareLiveRun(RunSetup& setup);
+
 class LiveRun {
  public:
   /// Plays `capture` on `setup`'s character (which must have an avatar): the setup's motion
-  /// becomes the capture's, streamed, without a keep-apart (it corrects a whole motion; the
-  /// scene's is said and left out), and the capture's first frame is read, which the world
-  /// is built on. `maxFrames` > 0 ends the run after that frame whatever the capture sends.
+  /// becomes the capture's, streamed, kept apart on its way in where the character keeps
+  /// parts apart (liveKeepApart: the part fields are built here, and each frame comes the
+  /// correction's delay later), and the capture's first frame is read, which the world is
+  /// built on. `maxFrames` > 0 ends the run after that frame whatever the capture sends.
   /// Throws drape::Error (Unavailable) when the capture ends before its first frame.
   LiveRun(RunSetup& setup, LiveCapture& capture, long maxFrames);
 
@@ -30,6 +35,9 @@ class LiveRun {
   [[nodiscard]] FrameGate gate() {
     return [this](long frame) { return admit(frame); };
   }
+
+  /// How long after it was captured a frame comes (s): the keep-apart's delay, or 0.
+  [[nodiscard]] double lag_s() const { return lag_s_; }
 
   /// Motion frames so far.
   [[nodiscard]] std::int64_t motionFrames() const { return static_cast<std::int64_t>(animation_->frameCount()); }
@@ -41,7 +49,7 @@ class LiveRun {
   LiveCapture& capture_;
   std::shared_ptr<motion::AvatarAnimation> animation_;
   std::vector<RigidTransform> joints_;
-  double frameRate_, leadIn_s_;
+  double frameRate_, leadIn_s_, lag_s_ = 0.0;
   long maxFrames_;
   bool ended_ = false;
 };

@@ -387,21 +387,6 @@ void printHowToRun(const std::string& out, const scene::Avatar& avatar) {
 
 namespace {
 
-/// What --keep-apart changed in the motion: one line, and one per pair it moved.
-void logKeptApart(const sim::KeepApartReport& report) {
-  if (report.parts.empty()) return;
-  spdlog::info("--keep-apart {}: the motion corrected in {} frames, turned by up to {:.1f} degrees, in {:.2f} s; {}",
-               fmt::join(report.parts, ","), report.framesChanged, report.largestAngle_deg, report.seconds,
-               report.pairs.empty() ? "no part lacked its clearance" : fmt::format("{} pairs", report.pairs.size()));
-  for (const sim::KeptApart& k : report.pairs) spdlog::info("  {}", sim::describe(k));
-  const auto short_ = std::count_if(report.pairs.begin(), report.pairs.end(),
-                                    [](const sim::KeptApart& k) { return k.framesRemaining > 0; });
-  if (short_ > 0)
-    spdlog::warn("--keep-apart: {} of these pairs still lack clearance in some frames: no joint is turned more than "
-                 "{:g} degrees from the captured motion, and a part in line with its joint cannot be turned away",
-                 short_, report.maxTurn_deg);
-}
-
 /// stats.json's keep_apart: what the correction of the motion changed.
 nlohmann::json keepApartJson(const sim::KeepApartReport& report) {
   nlohmann::json pairs = nlohmann::json::array();
@@ -421,6 +406,46 @@ nlohmann::json keepApartJson(const sim::KeepApartReport& report) {
 }
 
 }  // namespace
+
+void logKeptApart(const sim::KeepApartReport& report) {
+  if (report.parts.empty()) return;
+  spdlog::info("--keep-apart {}: the motion corrected in {} frames, turned by up to {:.1f} degrees, in {:.2f} s; {}",
+               fmt::join(report.parts, ","), report.framesChanged, report.largestAngle_deg, report.seconds,
+               report.pairs.empty() ? "no part lacked its clearance" : fmt::format("{} pairs", report.pairs.size()));
+  for (const sim::KeptApart& k : report.pairs) spdlog::info("  {}", sim::describe(k));
+  const auto short_ = std::count_if(report.pairs.begin(), report.pairs.end(),
+                                    [](const sim::KeptApart& k) { return k.framesRemaining > 0; });
+  if (short_ > 0)
+    spdlog::warn("--keep-apart: {} of these pairs still lack clearance in some frames: no joint is turned more than "
+                 "{:g} degrees from the captured motion, and a part in line with its joint cannot be turned away",
+                 short_, report.maxTurn_deg);
+}
+
+void buildPartFieldsOnce(RunSetup& setup, const std::string& why) {
+  if (!setup.character || setup.character->fields) return;
+  CharacterSetup& character = *setup.character;
+  const sim::WorldSettings ws = worldSettings(setup);
+  spdlog::info("building distance fields ({:.4g} m voxels) {}", ws.voxel_m, why);
+  const auto began = std::chrono::steady_clock::now();
+  character.fields =
+      std::make_shared<const std::vector<sim::PartField>>(sim::buildPartFields(*character.avatar, setup.garments, ws));
+  spdlog::info("{} distance fields in {:.2f} s", character.fields->size(),
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count());
+}
+
+std::shared_ptr<sim::LiveKeepApart> liveKeepApart(RunSetup& setup, double rate) {
+  if (!setup.character || setup.character->keepApart.empty()) return nullptr;
+  CharacterSetup& character = *setup.character;
+  buildPartFieldsOnce(setup, fmt::format("to keep {} apart", fmt::join(character.keepApart, ", ")));
+  sim::WorldSettings ws = worldSettings(setup);
+  ws.keepApart.parts = character.keepApart;
+  auto keep = std::make_shared<sim::LiveKeepApart>(*character.avatar, *character.fields,
+                                                   sim::keepApartSettings(setup.garments, ws), rate);
+  spdlog::info("keeping {} apart on the live motion: each frame corrected {} frames ({:.2f} s) after it comes, the "
+               "smoothing's reach ahead",
+               fmt::join(character.keepApart, ", "), keep->delay(), static_cast<double>(keep->delay()) / rate);
+  return keep;
+}
 
 sim::WorldSettings worldSettings(const RunSetup& setup) {
   if (!setup.character) throw Error("drape: the scene has no avatar to simulate on");
@@ -871,6 +896,8 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
                             {"frames", o.frames}});
   stats["body_overlaps"] = bodyOverlaps;
   if (world && !world->keepApartReport().parts.empty()) stats["keep_apart"] = keepApartJson(world->keepApartReport());
+  else if (setup.character && setup.character->liveKeptApart)
+    stats["keep_apart"] = keepApartJson(setup.character->liveKeptApart->report());
   addCollisionStats(stats, runs, total, done, world.get());
   sink.stats(stats);
 

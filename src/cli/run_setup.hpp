@@ -44,6 +44,9 @@ struct CharacterSetup {
   /// The part fields, when built before for these garments (a cloth-server's, once for all
   /// its takes); null: the world builds them.
   std::shared_ptr<const std::vector<sim::PartField>> fields{};
+  /// A live motion's keep-apart (the capture corrects it on its way in; liveKeepApart): its
+  /// report goes where a recorded motion's does. Null otherwise.
+  std::shared_ptr<const sim::LiveKeepApart> liveKeptApart{};
   /// What the scene calls the character (its Avatar or Humanoid node), besides the avatar's
   /// own name: an event graph's Plays name it so.
   std::vector<std::string> names{};
@@ -164,6 +167,17 @@ sim::SettleReport settleWorld(const RunSetup& setup, sim::CharacterWorld& world)
 /// The least T0 of the world's garments: how far the drawn skin may stand out of the body
 /// parts (sim::BodySkin).
 [[nodiscard]] double leastT0(const sim::CharacterWorld& world);
+
+/// Builds the character's part fields (sim::buildPartFields) into it, saying `why`, unless
+/// they were built before: a world built after takes them.
+void buildPartFieldsOnce(RunSetup& setup, const std::string& why);
+/// A live motion's keep-apart (sim::LiveKeepApart), as a world corrects a recorded motion:
+/// the character's keepApart parts, the margin its garments need. The part fields it reads are
+/// built here (buildPartFieldsOnce) unless they were before: build them before the capture
+/// is opened, so that its first frames do not wait for them. Null when the character keeps no parts apart. `rate` is the motion's.
+[[nodiscard]] std::shared_ptr<sim::LiveKeepApart> liveKeepApart(RunSetup& setup, double rate);
+/// Logs what a keep-apart changed in the motion: one line, and one per pair it moved.
+void logKeptApart(const sim::KeepApartReport& report);
 
 /// The parts --keep-apart names: the list, or none for 'none' (which overrides a scene's).
 [[nodiscard]] std::vector<std::string> keepApartParts(const std::vector<std::string>& option);

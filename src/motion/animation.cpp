@@ -445,11 +445,13 @@ void AvatarAnimation::appendFrame(std::span<const RigidTransform> world) {
   ++frames_;
 }
 
-void AvatarAnimation::moveJoints(std::size_t f, std::span<const int> joints, const RigidTransform& motion) {
-  for (const int j : joints) {
-    const std::size_t i = f * joints_ + static_cast<std::size_t>(j);
-    world_[i] = motion * world_[i];
-    inverse_[i] = world_[i].inverse();
+void AvatarAnimation::setFrame(std::size_t f, std::span<const RigidTransform> world) {
+  if (world.size() != joints_ || f >= frames_)
+    throw Error(fmt::format("frame {} of {} joints for an animation of {} frames of {}", f, world.size(), frames_, joints_),
+                ExitCode::Internal);
+  for (std::size_t j = 0; j < joints_; ++j) {
+    world_[f * joints_ + j] = world[j];
+    inverse_[f * joints_ + j] = world[j].inverse();
   }
 }
 

@@ -220,6 +220,15 @@ double leastT0(const std::vector<GarmentSpec>& garments, const WorldSettings& se
   return std::isfinite(t0) ? t0 : 0.0;
 }
 
+KeepApartSettings keepApartSettings(const std::vector<GarmentSpec>& garments, const WorldSettings& settings) {
+  KeepApartSettings keep = settings.keepApart;
+  if (keep.margin_m <= 0)
+    for (const GarmentSpec& g : garments)
+      keep.margin_m = std::max(
+          keep.margin_m, 2.0 * (g.offsetsGiven ? g.offsets : cloth::OffsetSurfaces::fromVoxelSize(settings.voxel_m)).t2_m);
+  return keep;
+}
+
 void CharacterWorld::buildFields(const std::vector<GarmentSpec>& garments,
                                  std::shared_ptr<const std::vector<PartField>> given) {
   const auto start = std::chrono::steady_clock::now();
@@ -240,9 +249,7 @@ void CharacterWorld::buildFields(const std::vector<GarmentSpec>& garments,
 }
 
 void CharacterWorld::keepBodyApart(const motion::AvatarAnimation& animation, const std::vector<GarmentSpec>& garments) {
-  KeepApartSettings keep = settings_.keepApart;
-  if (keep.margin_m <= 0)
-    for (const GarmentSpec& g : garments) keep.margin_m = std::max(keep.margin_m, 2.0 * g.offsets.t2_m);
+  const KeepApartSettings keep = keepApartSettings(garments, settings_);
   keptApartMotion_ = std::make_unique<motion::AvatarAnimation>(animation);
   keepApart_ = sim::keepBodyApart(avatar_, *keptApartMotion_, *fields_, keep);
   poses_->useAnimation(keptApartMotion_.get());

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <span>
 
 #include <fmt/format.h>
 
@@ -15,7 +16,6 @@
 namespace drape::sim {
 namespace {
 
-constexpr int kSolves = 2;            // one smoothed, then one that is not
 constexpr int kTurnsPerFrame = 32;    // per frame and solve: enough for a limb against two parts
 constexpr double kMaxTurn_rad = 0.1;  // per turn, so that the first-order lift stays close
 constexpr double kMinLever_m = 0.01;  // a deepest vertex closer than this to the line of the lift cannot be swung
@@ -82,10 +82,16 @@ class Solver {
     for (std::size_t s = 0; s < pivots_.size(); ++s)
       for (std::size_t j = 0; j < avatar.joints.size(); ++j)
         if (isAncestorOrSelf(avatar, pivots_[s], static_cast<int>(j))) subtrees_[s].push_back(static_cast<int>(j));
+    order_.resize(pivots_.size());
+    for (std::size_t s = 0; s < order_.size(); ++s) order_[s] = s;
+    std::sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) { return pivots_[a] < pivots_[b]; });
+    givenUp_.resize(pairs_.size());
   }
 
   [[nodiscard]] const std::vector<Pair>& pairs() const { return pairs_; }
   [[nodiscard]] std::size_t pivotCount() const { return pivots_.size(); }
+  [[nodiscard]] const scene::Avatar& avatar() const { return avatar_; }
+  [[nodiscard]] const std::vector<PartField>& fields() const { return fields_; }
 
   /// Where a pair is closest: the point (world) and the way the moved part must go there.
   struct Closest {
@@ -93,14 +99,10 @@ class Solver {
     Vec3 away = Vec3::Zero();
   };
 
-  /// The most pair p lacks of its clearance in frame f of `animation` (<= 0: none): the
-  /// moved part's vertices read in the other's field and, when the moved part collides
-  /// too, the other's vertices in its field (a thin limb can take an edge of the other
-  /// part inside it with none of its own vertices inside that part).
-  [[nodiscard]] double lack(const motion::AvatarAnimation& animation, std::size_t f, const Pair& p,
-                            Closest* where = nullptr) const {
-    return lack(animation.frame(f), p, where);
-  }
+  /// The most pair p lacks of its clearance in `pose` (every joint's world transform; <= 0:
+  /// none): the moved part's vertices read in the other's field and, when the moved part
+  /// collides too, the other's vertices in its field (a thin limb can take an edge of the
+  /// other part inside it with none of its own vertices inside that part).
   [[nodiscard]] double lack(std::span<const RigidTransform> pose, const Pair& p, Closest* where = nullptr) const {
     const scene::Segment& seg = avatar_.segments[static_cast<std::size_t>(p.segment)];
     const PartField& into = fields_[p.into];
@@ -122,21 +124,21 @@ class Solver {
     return p.target_m - std::min(c.distance_m, back.distance_m);
   }
 
-  /// Swings the pivots of frame f until every pair keeps its clearance, or no turn can help
+  /// Swings the pivots of `pose` until every pair keeps its clearance, or no turn can help
   /// a pair (its deepest point in line with the pivot, or the pivot's correction at
-  /// settings.maxTurn_deg), composing each turn into `turns` (per pivot, in its parent's
-  /// frame).
-  void solveFrame(motion::AvatarAnimation& animation, std::size_t f, std::vector<std::vector<Quat>>& turns) const {
+  /// settings.maxTurn_deg), composing each turn into `turns` (the frame's, one per pivot, in
+  /// its parent's frame).
+  void solveFrame(std::span<RigidTransform> pose, std::span<Quat> turns) const {
     const double maxTurn = settings_.maxTurn_deg * std::numbers::pi / 180.0;
-    std::vector<std::uint8_t> givenUp(pairs_.size(), 0);
+    std::fill(givenUp_.begin(), givenUp_.end(), std::uint8_t{0});
     for (int t = 0; t < kTurnsPerFrame; ++t) {
       double worst = kTolerance_m;
       std::size_t chosenIndex = pairs_.size();
       Closest at;
       for (std::size_t pi = 0; pi < pairs_.size(); ++pi) {
-        if (givenUp[pi]) continue;
+        if (givenUp_[pi]) continue;
         Closest c;
-        const double l = lack(animation, f, pairs_[pi], &c);
+        const double l = lack(pose, pairs_[pi], &c);
         if (l > worst) {
           worst = l;
           chosenIndex = pi;
@@ -144,41 +146,35 @@ class Solver {
         }
       }
       if (chosenIndex == pairs_.size()) return;
-      const Pair* chosen = &pairs_[chosenIndex];
-      const Vec3 pivot = animation.frame(f)[static_cast<std::size_t>(chosen->pivot)].translation;
+      const Pair& chosen = pairs_[chosenIndex];
+      const Vec3 pivot = pose[static_cast<std::size_t>(chosen.pivot)].translation;
       const Vec3 axis = (at.point - pivot).cross(at.away);
       const double lever = axis.norm();
-      const double room = maxTurn - angleOf(turns[chosen->pivotSlot][f]);
+      const double room = maxTurn - angleOf(turns[chosen.pivotSlot]);
       if (lever < kMinLever_m || room <= 1e-6) {
-        givenUp[chosenIndex] = 1;
+        givenUp_[chosenIndex] = 1;
         continue;
       }
       const double angle = std::min({worst / lever, kMaxTurn_rad, room});
       const Quat turn(Eigen::AngleAxisd(angle, axis / lever));
-      animation.moveJoints(f, subtrees_[chosen->pivotSlot], {turn, pivot - turn * pivot});
-      const Quat parent = parentRotation(animation, f, chosen->pivot);
-      Quat& q = turns[chosen->pivotSlot][f];
+      moveJoints(pose, subtrees_[chosen.pivotSlot], {turn, pivot - turn * pivot});
+      const Quat parent = parentRotation(pose, chosen.pivot);
+      Quat& q = turns[chosen.pivotSlot];
       q = ((parent.conjugate() * turn * parent) * q).normalized();
     }
   }
 
-  /// `original` with the turns applied, parents' before their children's.
-  [[nodiscard]] motion::AvatarAnimation apply(const motion::AvatarAnimation& original,
-                                              const std::vector<std::vector<Quat>>& turns) const {
-    motion::AvatarAnimation out = original;
-    std::vector<std::size_t> order(pivots_.size());
-    for (std::size_t s = 0; s < order.size(); ++s) order[s] = s;
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return pivots_[a] < pivots_[b]; });
-    for (std::size_t f = 0; f < out.frameCount(); ++f)
-      for (const std::size_t s : order) {
-        const Quat& q = turns[s][f];
-        if (q.vec().squaredNorm() == 0) continue;
-        const Quat parent = parentRotation(out, f, pivots_[s]);
-        const Quat turn = (parent * q * parent.conjugate()).normalized();
-        const Vec3 pivot = out.frame(f)[static_cast<std::size_t>(pivots_[s])].translation;
-        out.moveJoints(f, subtrees_[s], {turn, pivot - turn * pivot});
-      }
-    return out;
+  /// Applies a frame's turns (one per pivot, in its parent's frame) to `pose`, parents'
+  /// before their children's.
+  void applyFrame(std::span<RigidTransform> pose, std::span<const Quat> turns) const {
+    for (const std::size_t s : order_) {
+      const Quat& q = turns[s];
+      if (q.vec().squaredNorm() == 0) continue;
+      const Quat parent = parentRotation(pose, pivots_[s]);
+      const Quat turn = (parent * q * parent.conjugate()).normalized();
+      const Vec3 pivot = pose[static_cast<std::size_t>(pivots_[s])].translation;
+      moveJoints(pose, subtrees_[s], {turn, pivot - turn * pivot});
+    }
   }
 
   static constexpr double kTolerance_m = 1e-4;
@@ -232,9 +228,15 @@ class Solver {
     return pivots_.size() - 1;
   }
 
-  [[nodiscard]] Quat parentRotation(const motion::AvatarAnimation& animation, std::size_t f, int pivot) const {
+  /// Moves `joints` of `pose` by `motion`, applied after their world transforms (as
+  /// AvatarAnimation::moveJoints moves a frame's).
+  static void moveJoints(std::span<RigidTransform> pose, std::span<const int> joints, const RigidTransform& motion) {
+    for (const int j : joints) pose[static_cast<std::size_t>(j)] = motion * pose[static_cast<std::size_t>(j)];
+  }
+
+  [[nodiscard]] Quat parentRotation(std::span<const RigidTransform> pose, int pivot) const {
     const int parent = avatar_.joints[static_cast<std::size_t>(pivot)].parent;
-    return parent < 0 ? Quat::Identity() : animation.frame(f)[static_cast<std::size_t>(parent)].rotation;
+    return parent < 0 ? Quat::Identity() : pose[static_cast<std::size_t>(parent)].rotation;
   }
 
   const scene::Avatar& avatar_;
@@ -243,118 +245,309 @@ class Solver {
   std::vector<Pair> pairs_;
   std::vector<int> pivots_;
   std::vector<std::vector<int>> subtrees_;  // per pivot: it and every joint below it
+  std::vector<std::size_t> order_;          // the pivots, parents before children
+  mutable std::vector<std::uint8_t> givenUp_;  // solveFrame's, per pair: scratch kept from frame to frame
 };
 
-/// Each frame takes the largest turn within `reach` frames of it: smoothed afterwards, a
-/// turn then stays about as large as each frame needed (a plain average would take the
-/// peaks off, and the last solve would put them back as kinks).
-void widen(std::vector<std::vector<Quat>>& turns, int reach) {
-  for (std::vector<Quat>& series : turns) {
-    const std::vector<Quat> in = series;
-    const int n = static_cast<int>(in.size());
-    for (int f = 0; f < n; ++f)
-      for (int k = std::max(0, f - reach); k <= std::min(n - 1, f + reach); ++k)
-        if (angleOf(in[static_cast<std::size_t>(k)]) > angleOf(series[static_cast<std::size_t>(f)]))
-          series[static_cast<std::size_t>(f)] = in[static_cast<std::size_t>(k)];
+// The smoothing of the first solve's turns, a frame at a time: a frame's widened turns read
+// the first solve's within `reach` frames of it, its blended turns the widened ones within
+// the Gaussian's reach. Frames before the first and after the last (n - 1) are the first's and
+// the last's (the motion holds them beyond its ends). `at(k)` gives frame k's turns, one per
+// pivot, for both: the whole motion's series, or a live motion's window of frames.
+
+/// Each pivot's largest turn within `reach` frames of f: smoothed afterwards, a turn then
+/// stays about as large as each frame needed (a plain average would take the peaks off, and
+/// the last solve would put them back as kinks).
+template <class At>
+void widened(const At& at, std::size_t f, std::size_t n, std::size_t reach, std::span<Quat> out) {
+  const std::size_t first = f > reach ? f - reach : 0, last = std::min(n - 1, f + reach);
+  const std::span<const Quat> own = at(f);
+  for (std::size_t s = 0; s < out.size(); ++s) {
+    Quat widest = own[s];
+    for (std::size_t k = first; k <= last; ++k)
+      if (angleOf(at(k)[s]) > angleOf(widest)) widest = at(k)[s];
+    out[s] = widest;
   }
 }
 
-/// Gaussian smoothing over frames of each pivot's turns (the motion holds its first and
-/// last frames beyond its ends).
-void smooth(std::vector<std::vector<Quat>>& turns, double sigma_frames) {
-  if (sigma_frames <= 0) return;
-  const int reach = static_cast<int>(std::ceil(3 * sigma_frames));
-  widen(turns, static_cast<int>(std::ceil(2 * sigma_frames)));
-  std::vector<double> w(static_cast<std::size_t>(2 * reach + 1));
-  for (int k = -reach; k <= reach; ++k)
-    w[static_cast<std::size_t>(k + reach)] = std::exp(-0.5 * k * k / (sigma_frames * sigma_frames));
-  for (std::vector<Quat>& series : turns) {
-    const std::vector<Quat> in = series;
-    const int n = static_cast<int>(in.size());
-    for (int f = 0; f < n; ++f) {
-      Eigen::Vector4d sum = Eigen::Vector4d::Zero();
-      double total = 0;
-      for (int k = -reach; k <= reach; ++k) {
-        const Quat& q = in[static_cast<std::size_t>(std::clamp(f + k, 0, n - 1))];
-        const double wk = w[static_cast<std::size_t>(k + reach)];
-        sum += wk * (q.w() < 0 ? -q.coeffs() : q.coeffs());  // one hemisphere: the turns are small
-        total += wk;
-      }
-      Quat q;
-      q.coeffs() = sum / total;
-      series[static_cast<std::size_t>(f)] = q.normalized();
+/// The Gaussian blend at frame f of the widened turns: `weights` over frames f - reach to
+/// f + reach (2 reach + 1 of them).
+template <class At>
+void blended(const At& at, std::size_t f, std::size_t n, std::span<const double> weights, std::span<Quat> out) {
+  const long reach = static_cast<long>(weights.size() / 2), last = static_cast<long>(n) - 1;
+  for (std::size_t s = 0; s < out.size(); ++s) {
+    Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+    double total = 0;
+    for (long k = -reach; k <= reach; ++k) {
+      const Quat& q = at(static_cast<std::size_t>(std::clamp(static_cast<long>(f) + k, 0L, last)))[s];
+      const double wk = weights[static_cast<std::size_t>(k + reach)];
+      sum += wk * (q.w() < 0 ? -q.coeffs() : q.coeffs());  // one hemisphere: the turns are small
+      total += wk;
     }
+    Quat q;
+    q.coeffs() = sum / total;
+    out[s] = q.normalized();
   }
 }
 
-/// Per pair: the most it lacks, in which frame, and in how many frames more than `over`.
+/// The frames a smoothing over `sigma_frames` reaches on either side: the widening's, and the
+/// Gaussian's, whose weights are returned. None when it is off (sigma_frames <= 0).
+struct Reach {
+  std::size_t widen = 0, blend = 0;
+  std::vector<double> weights;
+
+  explicit Reach(double sigma_frames) {
+    if (sigma_frames <= 0) return;
+    widen = static_cast<std::size_t>(std::ceil(2 * sigma_frames));
+    blend = static_cast<std::size_t>(std::ceil(3 * sigma_frames));
+    const int r = static_cast<int>(blend);
+    for (int k = -r; k <= r; ++k) weights.push_back(std::exp(-0.5 * k * k / (sigma_frames * sigma_frames)));
+  }
+  [[nodiscard]] bool smooths() const { return !weights.empty(); }
+  [[nodiscard]] std::size_t frames() const { return widen + blend; }  ///< how far ahead a frame's correction reads
+};
+
+/// Per pair: the most it lacks, in which frame, and in how many frames more than a bound.
 struct Lack {
   double most_m = 0;
   long frame = 0, frames = 0;
 };
 
-std::vector<Lack> measure(const Solver& solver, const motion::AvatarAnimation& animation, double over) {
-  std::vector<Lack> out(solver.pairs().size());
-  for (std::size_t f = 0; f < animation.frameCount(); ++f)
-    for (std::size_t i = 0; i < out.size(); ++i) {
-      const double l = solver.lack(animation, f, solver.pairs()[i]);
-      if (l > over) ++out[i].frames;
-      if (l > out[i].most_m) out[i] = {l, static_cast<long>(f), out[i].frames};
+/// What a correction found and left, counted frame by frame: each pair's lack before it (over
+/// the solver's tolerance) and after it (over a tenth of a voxel), and the turns it made.
+class Tally {
+ public:
+  Tally(const Solver& solver, double voxel_m)
+      : solver_(solver), after_over_m_(0.1 * voxel_m), before_(solver.pairs().size()), after_(solver.pairs().size()) {}
+
+  void before(std::span<const RigidTransform> pose, long frame) { count(before_, pose, frame, Solver::kTolerance_m); }
+  void after(std::span<const RigidTransform> pose, std::span<const Quat> turns, long frame) {
+    count(after_, pose, frame, after_over_m_);
+    bool changed = false;
+    for (const Quat& q : turns) {
+      const double a = angleOf(q);
+      changed = changed || a > 1e-6;
+      largestAngle_deg_ = std::max(largestAngle_deg_, a * 180.0 / std::numbers::pi);
     }
-  return out;
+    framesChanged_ += changed ? 1 : 0;
+  }
+
+  [[nodiscard]] KeepApartReport report(const scene::Avatar& avatar, const std::vector<PartField>& fields,
+                                       const KeepApartSettings& settings) const {
+    KeepApartReport report;
+    report.parts = settings.parts;
+    report.maxTurn_deg = settings.maxTurn_deg;
+    for (std::size_t i = 0; i < before_.size(); ++i) {
+      if (before_[i].frames == 0) continue;
+      const Pair& p = solver_.pairs()[i];
+      KeptApart k;
+      k.part = avatar.segments[static_cast<std::size_t>(p.segment)].name;
+      k.from = fields[p.into].segment;
+      k.pivot = avatar.joints[static_cast<std::size_t>(p.pivot)].name;
+      k.target_m = p.target_m;
+      k.deepest_m = before_[i].most_m;
+      k.deepestFrame = before_[i].frame;
+      k.frames = before_[i].frames;
+      k.remaining_m = std::max(0.0, after_[i].most_m);
+      k.framesRemaining = after_[i].frames;
+      report.pairs.push_back(k);
+    }
+    std::sort(report.pairs.begin(), report.pairs.end(),
+              [](const KeptApart& a, const KeptApart& b) { return a.deepest_m > b.deepest_m; });
+    report.largestAngle_deg = largestAngle_deg_;
+    report.framesChanged = framesChanged_;
+    return report;
+  }
+
+ private:
+  void count(std::vector<Lack>& lacks, std::span<const RigidTransform> pose, long frame, double over) const {
+    for (std::size_t i = 0; i < lacks.size(); ++i) {
+      const double l = solver_.lack(pose, solver_.pairs()[i]);
+      if (l > over) ++lacks[i].frames;
+      if (l > lacks[i].most_m) lacks[i] = {l, frame, lacks[i].frames};
+    }
+  }
+
+  const Solver& solver_;
+  double after_over_m_;
+  std::vector<Lack> before_, after_;
+  double largestAngle_deg_ = 0;
+  long framesChanged_ = 0;
+};
+
+double voxelOf(const std::vector<PartField>& fields) {
+  return fields.empty() ? 0.005 : fields.front().field.voxelSize();
+}
+
+double seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
 }  // namespace
 
 KeepApartReport keepBodyApart(const scene::Avatar& avatar, motion::AvatarAnimation& animation,
                               const std::vector<PartField>& fields, const KeepApartSettings& settings) {
-  KeepApartReport report;
-  report.parts = settings.parts;
-  report.maxTurn_deg = settings.maxTurn_deg;
-  if (settings.parts.empty()) return report;
+  if (settings.parts.empty()) {
+    KeepApartReport report;
+    report.maxTurn_deg = settings.maxTurn_deg;
+    return report;
+  }
   const auto start = std::chrono::steady_clock::now();
   const Solver solver(avatar, fields, settings);
-  const double voxel = fields.empty() ? 0.005 : fields.front().field.voxelSize();
-  const std::vector<Lack> before = measure(solver, animation, Solver::kTolerance_m);
+  Tally tally(solver, voxelOf(fields));
+  const std::size_t n = animation.frameCount(), pivots = solver.pivotCount();
+  // Turns laid out [frame][pivot]: the first solve's, then the smoothed ones the last solve
+  // starts from and adds to.
+  std::vector<Quat> turns(n * pivots, Quat::Identity());
+  const auto turnsOf = [&](std::vector<Quat>& series, std::size_t f) { return std::span<Quat>(series).subspan(f * pivots, pivots); };
+  std::vector<RigidTransform> pose(animation.jointCount());
+  const auto copyFrame = [&](std::size_t f) {
+    const std::span<const RigidTransform> from = animation.frame(f);
+    std::copy(from.begin(), from.end(), pose.begin());
+  };
 
-  const motion::AvatarAnimation original = animation;
-  std::vector<std::vector<Quat>> turns(solver.pivotCount(), std::vector<Quat>(animation.frameCount(), Quat::Identity()));
-  for (int solve = 0; solve < kSolves; ++solve) {
-    // Each solve turns the joints of its copy as it records the turns: the last copy is the
-    // corrected motion.
-    animation = solver.apply(original, turns);
-    for (std::size_t f = 0; f < animation.frameCount(); ++f) solver.solveFrame(animation, f, turns);
-    if (solve + 1 < kSolves) smooth(turns, settings.smoothing_s * animation.rate());
+  for (std::size_t f = 0; f < n; ++f) {
+    tally.before(animation.frame(f), static_cast<long>(f));
+    copyFrame(f);
+    solver.solveFrame(pose, turnsOf(turns, f));
+  }
+  const Reach reach(settings.smoothing_s * animation.rate());
+  if (reach.smooths()) {
+    const auto firstAt = [&](std::size_t k) { return std::span<const Quat>(turnsOf(turns, k)); };
+    std::vector<Quat> wide(turns.size());
+    for (std::size_t f = 0; f < n; ++f) widened(firstAt, f, n, reach.widen, turnsOf(wide, f));
+    const auto wideAt = [&](std::size_t k) { return std::span<const Quat>(turnsOf(wide, k)); };
+    for (std::size_t f = 0; f < n; ++f) blended(wideAt, f, n, reach.weights, turnsOf(turns, f));
+  }
+  for (std::size_t f = 0; f < n; ++f) {
+    copyFrame(f);
+    solver.applyFrame(pose, turnsOf(turns, f));
+    solver.solveFrame(pose, turnsOf(turns, f));
+    tally.after(pose, turnsOf(turns, f), static_cast<long>(f));
+    animation.setFrame(f, pose);
+  }
+  KeepApartReport report = tally.report(avatar, fields, settings);
+  report.seconds = seconds(start);
+  return report;
+}
+
+// A live motion's frames are kept in rings of ring_ slots, frame f in slot f % ring_: its pose
+// until it is out, its first solve's turns until the frames around it are widened, its
+// widened turns until the frames around it are blended.
+struct LiveKeepApart::State {
+  State(const scene::Avatar& avatar, const std::vector<PartField>& fields, const KeepApartSettings& keep, double rate)
+      : settings(keep),
+        solver(avatar, fields, settings),
+        tally(solver, voxelOf(fields)),
+        reach(settings.smoothing_s * rate),
+        joints(avatar.joints.size()),
+        pivots(solver.pivotCount()),
+        ring(2 * reach.frames() + 2),
+        poses(ring * joints),
+        first(ring * pivots),
+        wide(ring * pivots),
+        pose(joints),
+        turns(pivots) {}
+
+  [[nodiscard]] std::span<RigidTransform> poseOf(std::size_t f) {
+    return std::span<RigidTransform>(poses).subspan((f % ring) * joints, joints);
+  }
+  [[nodiscard]] std::span<Quat> of(std::vector<Quat>& series, std::size_t f) const {
+    return std::span<Quat>(series).subspan((f % ring) * pivots, pivots);
   }
 
-  const std::vector<Lack> after = measure(solver, animation, 0.1 * voxel);
-  for (std::size_t i = 0; i < before.size(); ++i) {
-    if (before[i].frames == 0) continue;
-    const Pair& p = solver.pairs()[i];
-    KeptApart k;
-    k.part = avatar.segments[static_cast<std::size_t>(p.segment)].name;
-    k.from = fields[p.into].segment;
-    k.pivot = avatar.joints[static_cast<std::size_t>(p.pivot)].name;
-    k.target_m = p.target_m;
-    k.deepest_m = before[i].most_m;
-    k.deepestFrame = before[i].frame;
-    k.frames = before[i].frames;
-    k.remaining_m = std::max(0.0, after[i].most_m);
-    k.framesRemaining = after[i].frames;
-    report.pairs.push_back(k);
-  }
-  std::sort(report.pairs.begin(), report.pairs.end(),
-            [](const KeptApart& a, const KeptApart& b) { return a.deepest_m > b.deepest_m; });
-  for (std::size_t f = 0; f < animation.frameCount(); ++f) {
-    bool changed = false;
-    for (const std::vector<Quat>& series : turns) {
-      const double a = angleOf(series[f]);
-      changed = changed || a > 1e-6;
-      report.largestAngle_deg = std::max(report.largestAngle_deg, a * 180.0 / std::numbers::pi);
+  /// Widens every frame whose widening has all it reads.
+  void widen() {
+    if (!reach.smooths()) {
+      widenedCount = pushed;
+      return;
     }
-    report.framesChanged += changed ? 1 : 0;
+    const auto firstAt = [this](std::size_t k) { return std::span<const Quat>(of(first, k)); };
+    for (; widenedCount < pushed && (finished || widenedCount + reach.widen < pushed); ++widenedCount)
+      widened(firstAt, widenedCount, pushed, reach.widen, of(wide, widenedCount));
   }
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  [[nodiscard]] bool ready() const {
+    return emitted < widenedCount && (finished || !reach.smooths() || emitted + reach.blend < widenedCount);
+  }
+
+  KeepApartSettings settings;
+  Solver solver;
+  Tally tally;
+  Reach reach;
+  std::size_t joints, pivots, ring;
+  std::vector<RigidTransform> poses;
+  std::vector<Quat> first, wide;
+  std::vector<RigidTransform> pose;  // scratch: the frame being corrected
+  std::vector<Quat> turns;           // scratch: its turns
+  std::size_t pushed = 0, widenedCount = 0, emitted = 0;
+  bool finished = false;
+  double seconds = 0;
+};
+
+LiveKeepApart::LiveKeepApart(const scene::Avatar& avatar, const std::vector<PartField>& fields,
+                             const KeepApartSettings& settings, double rate)
+    : state_(std::make_unique<State>(avatar, fields, settings, rate)) {}
+
+LiveKeepApart::~LiveKeepApart() = default;
+
+std::size_t LiveKeepApart::delay() const { return state_->reach.frames(); }
+
+void LiveKeepApart::push(std::span<const RigidTransform> pose) {
+  State& s = *state_;
+  if (pose.size() != s.joints)
+    throw Error(fmt::format("keep apart: a frame of {} joints for an avatar of {}", pose.size(), s.joints),
+                ExitCode::Internal);
+  if (s.finished) throw Error("keep apart: a frame after the motion's end", ExitCode::Internal);
+  if (s.pushed - s.emitted > delay())
+    throw Error(fmt::format("keep apart: {} frames waiting to be taken, {} at most", s.pushed - s.emitted, delay() + 1),
+                ExitCode::Internal);
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t f = s.pushed;
+  std::copy(pose.begin(), pose.end(), s.poseOf(f).begin());
+  s.tally.before(pose, static_cast<long>(f));
+  std::copy(pose.begin(), pose.end(), s.pose.begin());
+  const std::span<Quat> turns = s.of(s.first, f);
+  std::fill(turns.begin(), turns.end(), Quat::Identity());
+  s.solver.solveFrame(s.pose, turns);
+  ++s.pushed;
+  s.widen();
+  s.seconds += seconds(start);
+}
+
+void LiveKeepApart::finish() {
+  state_->finished = true;
+  state_->widen();
+}
+
+bool LiveKeepApart::next(std::span<RigidTransform> out) {
+  State& s = *state_;
+  if (!s.ready()) return false;
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t f = s.emitted;
+  if (s.reach.smooths()) {
+    const auto wideAt = [&s](std::size_t k) { return std::span<const Quat>(s.of(s.wide, k)); };
+    blended(wideAt, f, s.widenedCount, s.reach.weights, s.turns);
+  } else {
+    const std::span<const Quat> first = s.of(s.first, f);
+    std::copy(first.begin(), first.end(), s.turns.begin());
+  }
+  const std::span<const RigidTransform> original = s.poseOf(f);
+  std::copy(original.begin(), original.end(), s.pose.begin());
+  s.solver.applyFrame(s.pose, s.turns);
+  s.solver.solveFrame(s.pose, s.turns);
+  s.tally.after(s.pose, s.turns, static_cast<long>(f));
+  std::copy(s.pose.begin(), s.pose.end(), out.begin());
+  ++s.emitted;
+  s.seconds += seconds(start);
+  return true;
+}
+
+std::size_t LiveKeepApart::framesOut() const { return state_->emitted; }
+
+KeepApartReport LiveKeepApart::report() const {
+  KeepApartReport report = state_->tally.report(state_->solver.avatar(), state_->solver.fields(), state_->settings);
+  report.seconds = state_->seconds;
   return report;
 }
 

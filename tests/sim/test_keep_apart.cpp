@@ -216,6 +216,94 @@ TEST(KeepApart, APartThatGoesIntoNothingLeavesTheMotionAsItIs) {
       ASSERT_EQ(corrected.frame(f)[j].rotation.coeffs(), w.animation.frame(f)[j].rotation.coeffs());
 }
 
+/// The walk kept apart a frame at a time: each frame pushed, every ready frame taken as it
+/// comes (the lag the stream sees recorded), the last ones after finish().
+struct LiveCorrected {
+  std::vector<std::vector<RigidTransform>> frames;
+  std::vector<std::size_t> readyAfterPush;  // per pushed frame: frames out after it
+  KeepApartReport report;
+  std::size_t delay = 0;
+};
+
+LiveCorrected keptApartLive(const Walk& w, const KeepApartSettings& keep) {
+  LiveKeepApart live(w.avatar, w.fields, keep, w.animation.rate());
+  LiveCorrected out;
+  out.delay = live.delay();
+  std::vector<RigidTransform> pose(w.avatar.joints.size());
+  const auto take = [&] {
+    while (live.next(pose)) out.frames.push_back(pose);
+  };
+  for (std::size_t f = 0; f < w.animation.frameCount(); ++f) {
+    live.push(w.animation.frame(f));
+    take();
+    out.readyAfterPush.push_back(out.frames.size());
+  }
+  live.finish();
+  take();
+  out.report = live.report();
+  return out;
+}
+
+TEST(KeepApart, AMotionKeptApartAFrameAtATimeIsTheWholeMotionsCorrectionToTheBit) {
+  // Smoothed (0.1 s: frames wait 2 + 3 sigmas, 15 at 30 Hz), smoothed more than the walk's
+  // first frames reach back (the clamping at both ends), and not at all (no wait).
+  const Walk& w = delfem2Walk();
+  const std::size_t n = w.animation.frameCount();
+  for (const double smoothing : {0.1, 0.5, 0.0}) {
+    SCOPED_TRACE(::testing::Message() << "smoothing " << smoothing << " s");
+    KeepApartSettings keep;
+    keep.parts = {"LeftForeArm", "RightForeArm"};
+    keep.margin_m = kMargin;
+    keep.smoothing_s = smoothing;
+    motion::AvatarAnimation whole = w.animation;
+    const KeepApartReport report = keepBodyApart(w.avatar, whole, w.fields, keep);
+    ASSERT_GT(report.framesChanged, 0);
+    const LiveCorrected live = keptApartLive(w, keep);
+    const double sigma = smoothing * w.animation.rate();  // frames, as the settings give it
+    const std::size_t delay =
+        static_cast<std::size_t>(std::ceil(2 * sigma)) + static_cast<std::size_t>(std::ceil(3 * sigma));
+    EXPECT_EQ(live.delay, delay);
+    ASSERT_EQ(live.frames.size(), n);
+    for (std::size_t f = 0; f < n; ++f) {
+      // Frame f is out once frame f + delay has come, and not before.
+      EXPECT_EQ(live.readyAfterPush[f], f >= delay ? f - delay + 1 : 0) << "after frame " << f;
+      for (std::size_t j = 0; j < w.avatar.joints.size(); ++j) {
+        const RigidTransform& a = whole.frame(f)[j];
+        const RigidTransform& b = live.frames[f][j];
+        ASSERT_EQ(a.rotation.coeffs(), b.rotation.coeffs()) << "frame " << f << ", joint " << j;
+        ASSERT_EQ(a.translation, b.translation) << "frame " << f << ", joint " << j;
+      }
+    }
+    EXPECT_EQ(live.report.framesChanged, report.framesChanged);
+    EXPECT_EQ(live.report.largestAngle_deg, report.largestAngle_deg);
+    ASSERT_EQ(live.report.pairs.size(), report.pairs.size());
+    for (std::size_t i = 0; i < report.pairs.size(); ++i) EXPECT_EQ(describe(live.report.pairs[i]), describe(report.pairs[i]));
+  }
+}
+
+TEST(KeepApart, ALiveCorrectionRefusesFramesItCannotHold) {
+  const Walk& w = delfem2Walk();
+  KeepApartSettings keep;
+  keep.parts = {"LeftForeArm"};
+  keep.margin_m = kMargin;
+  LiveKeepApart live(w.avatar, w.fields, keep, w.animation.rate());
+  const std::vector<RigidTransform> wrong(w.avatar.joints.size() - 1);
+  EXPECT_THROW(live.push(wrong), Error);
+  // Frames pushed and none taken: the window holds delay() + 1 of them, and no more.
+  for (std::size_t f = 0; f <= live.delay(); ++f) live.push(w.animation.frame(f));
+  EXPECT_THROW(live.push(w.animation.frame(live.delay() + 1)), Error);
+  std::vector<RigidTransform> pose(w.avatar.joints.size());
+  ASSERT_TRUE(live.next(pose));
+  ASSERT_FALSE(live.next(pose));
+  live.push(w.animation.frame(live.delay() + 1));
+  live.finish();
+  EXPECT_THROW(live.push(w.animation.frame(0)), Error);
+  std::size_t out = 1;
+  while (live.next(pose)) ++out;
+  EXPECT_EQ(out, live.delay() + 2);
+  EXPECT_EQ(live.framesOut(), out);
+}
+
 TEST(KeepApart, RefusesAnUnknownPartAndTheRoot) {
   const Walk& w = delfem2Walk();
   motion::AvatarAnimation corrected = w.animation;

@@ -160,10 +160,11 @@ class AvatarAnimation {
   /// paper does. Allocates nothing.
   void evaluateInverse(std::size_t f, double s, std::span<RigidTransform> out) const;
 
-  /// Moves `joints` of frame f by `motion`, applied after their world transforms (their
-  /// inverses follow): a correction of the retargeted pose, such as a limb swung about its
-  /// joint out of the body (sim/keep_apart.hpp). The root's path is not changed.
-  void moveJoints(std::size_t f, std::span<const int> joints, const RigidTransform& motion);
+  /// Replaces frame f's joint world transforms by `world` (their inverses follow): a
+  /// correction of the retargeted pose, such as limbs swung about their joints out of the
+  /// body (sim/keep_apart.hpp). The root's path is not changed. Throws drape::Error
+  /// (Internal) on a frame of the wrong size.
+  void setFrame(std::size_t f, std::span<const RigidTransform> world);
 
   /// m, world position of the root joint per frame (the path the character travels).
   [[nodiscard]] std::span<const Vec3> rootPath() const { return rootPath_; }

@@ -108,6 +108,9 @@ struct PartField {
 /// The garments' least T0, as CharacterWorld gives them their offsets: how far the drawn
 /// skin may stand out of the body parts (BodySkin).
 [[nodiscard]] double leastT0(const std::vector<GarmentSpec>& garments, const WorldSettings& settings);
+/// settings.keepApart with its margin as a world keeps parts apart for `garments`: the one
+/// given, or twice the garments' largest T2 (room for cloth on both parts' collision surfaces).
+[[nodiscard]] KeepApartSettings keepApartSettings(const std::vector<GarmentSpec>& garments, const WorldSettings& settings);
 
 /// Steps `count` solvers to `frame` in parallel (TBB); per solver, whether it stayed stable.
 /// The solvers must share nothing that changes (each garment has its own poses and colliders).

@@ -25,6 +25,9 @@
 // vertex in line with the joint and the gradient) is left where it is; what is left short
 // is reported.
 
+#include <cstddef>
+#include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -79,6 +82,48 @@ struct KeepApartReport {
 /// has no joint above it that can swing it (the root).
 [[nodiscard]] KeepApartReport keepBodyApart(const scene::Avatar& avatar, motion::AvatarAnimation& animation,
                                             const std::vector<PartField>& fields, const KeepApartSettings& settings);
+
+/// The same correction of a motion that arrives a frame at a time (a live capture, or an
+/// event graph played live): frame for frame what keepBodyApart makes of the whole motion,
+/// to the bit, each frame out once delay() frames after it have come (the smoothing reads
+/// that far ahead: 15 frames, half a second, at 30 Hz and the default 0.1 s), and the last
+/// ones once the motion has ended. A frame allocates nothing.
+///
+///   sim::LiveKeepApart keep(avatar, fields, settings, live.rate());
+///   keep.push(pose);                   // each frame's joints as it comes
+///   while (keep.next(out)) use(out);   // every frame now corrected
+///   keep.finish();                     // the motion ended: its last frames follow from next()
+class LiveKeepApart {
+ public:
+  /// `avatar` and `fields` must outlive it; `rate` is the motion's, in frames per second.
+  /// Throws drape::Error as keepBodyApart does.
+  LiveKeepApart(const scene::Avatar& avatar, const std::vector<PartField>& fields, const KeepApartSettings& settings,
+                double rate);
+  ~LiveKeepApart();
+  LiveKeepApart(const LiveKeepApart&) = delete;
+  LiveKeepApart& operator=(const LiveKeepApart&) = delete;
+
+  /// Takes the motion's next frame: every avatar joint's world transform. Throws drape::Error
+  /// (Internal) on another count, after finish(), or when more than delay() frames came
+  /// before it that next() has not taken.
+  void push(std::span<const RigidTransform> pose);
+  /// The motion has ended: its last frames become ready.
+  void finish();
+  /// The next corrected frame into `out` (every joint's world transform); false when none is
+  /// ready.
+  bool next(std::span<RigidTransform> out);
+
+  /// Frames a frame waits for before it is corrected (0 without smoothing).
+  [[nodiscard]] std::size_t delay() const;
+  [[nodiscard]] std::size_t framesOut() const;
+  /// What keepBodyApart reports, over the frames out so far (frames numbered from the first
+  /// pushed).
+  [[nodiscard]] KeepApartReport report() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 /// "LeftForeArm out of LowerBack about LeftArm: 39.0 mm short of its 12 mm clearance at
 /// most, in 37 frames (most in frame 80); 0.0 mm after".

@@ -90,15 +90,16 @@ constexpr long kFramesPerSlice = 34;  ///< the scenario's frames between two sli
 /// alone, and the reference is stepped between blocks of frames.
 PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
   RunSetup setup = runSetupFromScene(o.scene);
-  if (!setup.character) throw Error(fmt::format("{}: the scene has no avatar", o.scene));
+  CharacterSetup* character = oneCharacter(setup, "drape bench paper");
+  if (!character) throw Error(fmt::format("{}: the scene has no avatar", o.scene));
   if (o.collisionEvery > 0)
     for (GarmentSetup& g : setup.garments) g.collisionEvery = o.collisionEvery;
   if (o.bendEvery > 0) setup.settings.bendEvery = o.bendEvery;
   if (o.faceSamplesWith)
     for (GarmentSetup& g : setup.garments) g.faceSamplesWith = *o.faceSamplesWith;
-  if (o.keepApart) setKeepApart(*setup.character, *o.keepApart);
-  addMotion(setup, o.motion);
-  const std::unique_ptr<sim::CharacterWorld> worldPtr = buildWorld(setup);
+  if (o.keepApart) setKeepApart(*character, *o.keepApart);
+  addMotion(setup, *character, o.motion);
+  const std::unique_ptr<sim::CharacterWorld> worldPtr = buildWorld(setup, *character);
   sim::CharacterWorld& world = *worldPtr;
   for (std::size_t g = 0; g < world.garmentCount(); ++g) {
     world.collider(g)->setMeasurePenetration(measure);
@@ -107,7 +108,7 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
     world.collider(g)->setRestingBalls(!o.noRestingBalls);
     world.collider(g)->setCountEverySubstep(measure);
   }
-  (void)settleWorld(setup, world);  // before the frames timed: the solvers' clocks start after it
+  (void)settleWorld(*character, world);  // before the frames timed: the solvers' clocks start after it
 
   PaperRun r;
   r.substeps = setup.settings.substepsPerFrame;

@@ -62,7 +62,7 @@ struct StudioBenchOptions {
 /// drape run's loop without outputs: the frames are taken and dropped.
 class DiscardSink final : public FrameSink {
  public:
-  void begin(const sim::CharacterWorld*) override {}
+  void begin(const std::vector<const sim::CharacterWorld*>&) override {}
   void write(const FrameTaken&) override {}
   void end(long) override {}
   void stats(const nlohmann::json& s) override { stats_ = s; }
@@ -211,7 +211,7 @@ class CaptureBroadcast {
 /// that had come when it was ready (motion::LiveMotion, run here over the same lines).
 std::vector<std::size_t> readyAfter(const RunSetup& setup, const CaptureBroadcast& capture) {
   const formats::BvhFile header = formats::parseBvhHeader(capture.header(), "capture");
-  motion::LiveMotion live(*setup.character->avatar, header, motionOptions(setup));
+  motion::LiveMotion live(*setup.characters.front().avatar, header, motionOptions(setup));
   std::vector<double> values(header.channelCount);
   std::vector<RigidTransform> joints(live.jointCount());
   std::vector<std::size_t> ready;
@@ -275,7 +275,9 @@ RunFunction setupStudioBench(CLI::App& app) {
       throw Error(fmt::format("drape bench studio: --motion {}: the capture take broadcasts a BVH", o.motion));
     // The reference: the same setup through drape run's loop in one process, no outputs.
     RunSetup setup = runSetupFromScene(o.scene);
-    addMotion(setup, o.motion);
+    CharacterSetup* character = oneCharacter(setup, "drape bench studio");
+    if (!character) throw Error(fmt::format("{}: the scene has no avatar", o.scene));
+    addMotion(setup, *character, o.motion);
     setup.frames = defaultFrames(setup);
     DiscardSink reference;
     simulateInto(setup, reference, nullptr);
@@ -299,7 +301,7 @@ RunFunction setupStudioBench(CLI::App& app) {
     fs::remove_all(dir, ignored);
 
     const auto frames = static_cast<long>(fastCloth.frame_ns.size()) - 1;  // after frame 0
-    const double rate = setup.settings.frameRate_hz, leadIn = setup.character->leadIn_s;
+    const double rate = setup.settings.frameRate_hz, leadIn = character->leadIn_s;
     const double fastSeconds = 1e-9 * static_cast<double>(fastCloth.end_ns - fastCloth.frame_ns.front());
     std::vector<double> latency_ms;
     for (std::size_t k = 1; k < liveCloth.frame_ns.size(); ++k) {

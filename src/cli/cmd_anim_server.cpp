@@ -91,18 +91,18 @@ studio::InjectReply injected(const studio::Inject& in, long frame, events::Sched
 
 /// `--events`: plays an event graph live, frame by frame, taking graphs and events injected
 /// while it runs (drape inject).
-int runEventGraph(const AnimServerOptions& o, RunSetup& setup) {
-  const scene::Avatar& avatar = *setup.character->avatar;
+int runEventGraph(const AnimServerOptions& o, RunSetup& setup, CharacterSetup& character) {
+  const scene::Avatar& avatar = *character.avatar;
   const double rate = setup.settings.frameRate_hz;
   // Kept apart as drape run keeps a graph's motion apart: each frame goes out the
   // correction's delay after its tick, so an injection shows that much later too.
-  const std::shared_ptr<sim::LiveKeepApart> keep = liveKeepApart(setup, rate);
+  const std::shared_ptr<sim::LiveKeepApart> keep = liveKeepApart(setup, character, rate);
   const motion::MotionOptions mo = motionOptions(setup);
   std::list<events::Graph> graphs;
   graphs.push_back(events::readGraph(o.events));
   events::Motions motions;
   motions.load(graphs.back(), avatar, mo);
-  events::Scheduler scheduler(avatar, setup.character->names, rate, parameterOptions(o.sets));
+  events::Scheduler scheduler(avatar, character.names, rate, parameterOptions(o.sets));
   scheduler.start(graphs.back(), motions);
 
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape anim-server " + o.name);
@@ -183,8 +183,8 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup) {
 
 /// `--live SOURCE`: a BVH written while it is captured, from standard input, a TCP server or
 /// a named pipe, retargeted and sent frame by frame as it comes (motion/live_motion.hpp).
-int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
-  const scene::Avatar& avatar = *setup.character->avatar;
+int runLiveMotion(const AnimServerOptions& o, RunSetup& setup, CharacterSetup& character) {
+  const scene::Avatar& avatar = *character.avatar;
   (void)stopOnSignals();
   // The server first: a studio with no NATS server is said before the capture is waited for;
   // then the keep-apart's fields, so that the capture's first frames do not wait for them.
@@ -194,7 +194,7 @@ int runLiveMotion(const AnimServerOptions& o, RunSetup& setup) {
                       stopAsked);
   const motion::LiveMotion& live = capture.motion();
   // The stream carries the motion kept apart, as it carries a recorded motion's.
-  capture.keepApart(liveKeepApart(setup, live.rate()));
+  capture.keepApart(liveKeepApart(setup, character, live.rate()));
 
   studio::Publisher publisher(bus, o.name, studio::Precision::Double, o.studio.giveUp());
   const std::string take = o.take.empty() ? studio::newTakeId() : o.take;
@@ -243,7 +243,8 @@ studio::PoseStart poseStart(const scene::Avatar& avatar, const motion::AvatarAni
 int runAnimServer(const AnimServerOptions& o) {
   studio::checkSourceName(o.name, "--name");
   RunSetup setup = runSetupFromScene(o.scene);
-  if (!setup.character) throw Error(fmt::format("{}: the scene has no avatar to move", o.scene));
+  CharacterSetup* character = oneCharacter(setup, "the studio");
+  if (!character) throw Error(fmt::format("{}: the scene has no avatar to move", o.scene));
   if (!o.timecode.empty() && o.timecode != "now")
     (void)TimeCode::parseSmpte(o.timecode, setup.settings.frameRate_hz);  // said before anything waits
   if (!o.live.empty()) {
@@ -253,28 +254,28 @@ int runAnimServer(const AnimServerOptions& o) {
     if (!o.sets.empty() || o.hold || o.frames > 0 || o.fast)
       throw Error(fmt::format("{}: a live take goes at the pace its source sends, for as long",
                               !o.sets.empty() ? "--set" : o.hold ? "--hold" : o.frames > 0 ? "--frames" : "--fast"));
-    return runLiveMotion(o, setup);
+    return runLiveMotion(o, setup, *character);
   }
   if (!o.liveHeader.empty()) throw Error("--live-header is the skeleton of a --live source: give --live SOURCE");
   if (!o.events.empty()) {
     if (!o.motion.empty() || !o.animation.empty())
       throw Error("--events plays an event graph's motions: give it or --motion, not both");
-    return runEventGraph(o, setup);
+    return runEventGraph(o, setup, *character);
   }
   if (!o.sets.empty() || o.hold || o.frames > 0)
     throw Error(fmt::format("{}: it is for an event graph: give --events FILE.egml",
                             !o.sets.empty() ? "--set" : o.hold ? "--hold" : "--frames"));
-  const MotionChoice choice = sceneMotion(setup, o.scene, o.motion, o.animation);
+  const MotionChoice choice = sceneMotion(setup, character, o.scene, o.motion, o.animation);
   if (choice.path.empty())
     throw Error(fmt::format("{}: nothing moves the avatar: give --motion FILE (its own file carries no animation)",
                             o.scene));
-  addMotion(setup, choice.path, 0.0, "", choice.animation, choice.sampled.get());
+  addMotion(setup, *character, choice.path, 0.0, "", choice.animation, choice.sampled.get());
   // Where the scene keeps parts apart, the stream carries the motion corrected, as drape
   // run plays it: the correction needs the parts' distance fields, hence the world.
   std::unique_ptr<sim::CharacterWorld> world;
-  if (!setup.character->keepApart.empty()) world = buildWorld(setup);
-  const motion::AvatarAnimation& motion = world ? *world->playedMotion() : *setup.character->animation;
-  const scene::Avatar& avatar = *setup.character->avatar;
+  if (!character->keepApart.empty()) world = buildWorld(setup, *character);
+  const motion::AvatarAnimation& motion = world ? *world->playedMotion() : *character->animation;
+  const scene::Avatar& avatar = *character->avatar;
 
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape anim-server " + o.name);
   studio::Publisher publisher(bus, o.name, studio::Precision::Double, o.studio.giveUp());

@@ -35,8 +35,8 @@ void keepGarments(RunSetup& setup, const std::vector<std::string>& names, const 
   for (const std::string& n : names)
     if (std::find(have.begin(), have.end(), n) == have.end())
       throw Error(fmt::format("--garments: {} has no garment '{}' (it has: {})", scene, n, fmt::join(have, ", ")));
-  std::erase_if(setup.garments, [&](const GarmentSetup& g) {
-    return std::find(names.begin(), names.end(), g.name) == names.end();
+  keepGarmentsWhere(setup, [&](std::size_t g) {
+    return std::find(names.begin(), names.end(), setup.garments[g].name) != names.end();
   });
 }
 
@@ -44,7 +44,7 @@ void keepGarments(RunSetup& setup, const std::vector<std::string>& names, const 
 class ClothSink final : public FrameSink {
  public:
   explicit ClothSink(studio::Publisher& publisher) : publisher_(publisher) {}
-  void begin(const sim::CharacterWorld*) override {}
+  void begin(const std::vector<const sim::CharacterWorld*>&) override {}
   void write(const FrameTaken& taken) override {
     for (std::size_t g = 0; g < taken.positions.size(); ++g) {
       frame_.frame = taken.frame;
@@ -79,15 +79,16 @@ TakeOutcome simulateTake(const RunSetup& scene, studio::PoseFollower& poses, stu
                          const std::string& posesName) {
   const studio::PoseStart& ps = poses.start();
   RunSetup setup = scene;
+  CharacterSetup& character = setup.characters.front();
   // The stream's motion, growing as it comes; the world keeps a pointer to it (the take's
   // follower outlives the world).
-  setup.character->animation = std::shared_ptr<const motion::AvatarAnimation>(std::shared_ptr<void>(), &poses.animation());
-  setup.character->keepApart.clear();  // the anim-server sends the motion corrected
+  character.animation = std::shared_ptr<const motion::AvatarAnimation>(std::shared_ptr<void>(), &poses.animation());
+  character.keepApart.clear();  // the anim-server sends the motion corrected
   setup.motionStreamed = true;
   // The wind an event graph of the anim-server sets, frame by frame, as the poses come.
   setup.motionWind = std::shared_ptr<const MotionWind>(std::shared_ptr<void>(), &poses.wind());
   setup.frames = 0;
-  const double rate = setup.settings.frameRate_hz, leadIn = setup.character->leadIn_s;
+  const double rate = setup.settings.frameRate_hz, leadIn = character.leadIn_s;
 
   studio::ClothStart start;
   start.poses = posesName;
@@ -134,21 +135,23 @@ int runClothServer(const ClothServerOptions& o) {
   if (o.positions != "double" && o.positions != "float")
     throw Error(fmt::format("--positions {}: expected double or float", o.positions));
   RunSetup setup = runSetupFromScene(o.scene);
-  if (!setup.character) throw Error(fmt::format("{}: the scene has no avatar for its garments to move with", o.scene));
+  if (!oneCharacter(setup, "the studio"))
+    throw Error(fmt::format("{}: the scene has no avatar for its garments to move with", o.scene));
   keepGarments(setup, o.garments, o.scene);
+  CharacterSetup& character = setup.characters.front();
   {
     RunSetup check = setup;  // bad garments or settings are said before any waiting
     check.motionStreamed = true;
     validateRunSetup(check);
   }
-  const scene::Avatar& avatar = *setup.character->avatar;
+  const scene::Avatar& avatar = *character.avatar;
   // The part fields once, for every take: a take's world is then ready in moments, well
   // within the lead-in.
-  spdlog::info("building distance fields ({:.4g} m voxels) for every take", setup.character->voxel_m);
+  spdlog::info("building distance fields ({:.4g} m voxels) for every take", character.voxel_m);
   const auto fieldsBegan = std::chrono::steady_clock::now();
-  setup.character->fields = std::make_shared<const std::vector<sim::PartField>>(
-      sim::buildPartFields(avatar, setup.garments, worldSettings(setup)));
-  spdlog::info("{} distance fields in {:.2f} s", setup.character->fields->size(),
+  character.fields = std::make_shared<const std::vector<sim::PartField>>(
+      sim::buildPartFields(avatar, setup.garments, worldSettings(setup, character)));
+  spdlog::info("{} distance fields in {:.2f} s", character.fields->size(),
                std::chrono::duration<double>(std::chrono::steady_clock::now() - fieldsBegan).count());
 
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape cloth-server " + o.name);

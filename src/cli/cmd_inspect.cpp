@@ -31,17 +31,18 @@ std::vector<InspectorEntry>& inspectors() {
 void inspectBodyOverlaps(const std::string& scenePath, const std::string& motionPath,
                          const std::vector<std::string>& keepApart, std::ostream& out) {
   RunSetup setup = runSetupFromScene(scenePath);
-  if (!setup.character) throw Error(fmt::format("--motion: {} has no avatar to move", scenePath));
-  addMotion(setup, motionPath);
-  if (!keepApart.empty()) setKeepApart(*setup.character, keepApart);
+  CharacterSetup* character = oneCharacter(setup, "drape inspect --motion");
+  if (!character) throw Error(fmt::format("--motion: {} has no avatar to move", scenePath));
+  addMotion(setup, *character, motionPath);
+  if (!keepApart.empty()) setKeepApart(*character, keepApart);
   setup.frames = defaultFrames(setup);
-  const std::unique_ptr<sim::CharacterWorld> world = buildWorld(setup);
-  const std::vector<sim::BodyOverlap> found = bodyOverlaps(setup, *world);
+  const std::unique_ptr<sim::CharacterWorld> world = buildWorld(setup, *character);
+  const std::vector<sim::BodyOverlap> found = bodyOverlaps(setup, *character, *world);
   fmt::print(out, "body overlaps over {} frames with {} (collidable parts inside each other beyond their overlap at "
                   "rest, deeper than a voxel): {}\n",
              setup.frames, motionPath, found.empty() ? "none" : std::to_string(found.size()));
   for (const sim::BodyOverlap& o : found) fmt::print(out, "  {}\n", sim::describe(o));
-  if (!found.empty() && setup.character->keepApart.empty())
+  if (!found.empty() && character->keepApart.empty())
     fmt::print(out, "cloth caught between such parts has no place; `drape run --keep-apart PARTS` (or the scene's "
                     "Simulation keepApart) turns the parts named out of the others before simulating\n");
 }

@@ -90,24 +90,39 @@ void printHumanoidMotions(const std::string& path, const scene::Scene& s, std::o
   }
 }
 
-/// The worn avatar of an `Avatar` node, loaded as `drape run` loads it: what its file is,
-/// and the animations it carries, which `drape run FILE` plays by itself.
-void printExternalAvatar(const std::string& path, const scene::Scene& s, std::ostream& out) {
-  std::unique_ptr<scene::Avatar> avatar;
+/// A worn avatar of an `Avatar` node, loaded as `drape run` loads it: what its file is, and
+/// the animations it carries, which `drape run FILE` plays by itself.
+void printAvatarFile(const std::string& path, const scene::Avatar& avatar, std::ostream& out) {
+  fmt::print(out, "    {}: {} joints, {} segments{}\n", avatar.source, avatar.joints.size(), avatar.segments.size(),
+             avatar.skin ? fmt::format(", a skin of {} triangles", avatar.skin->mesh.triangleCount()) : "");
+  if (!avatar.animations.empty())
+    fmt::print(out, "    its file carries {} animation{} ('{}')\n", avatar.animations.size(),
+               avatar.animations.size() == 1 ? "" : "s", fmt::join(avatar.animations, "', '"));
+  if (const std::string own = ownMotionText(avatar); !own.empty())
+    fmt::print(out, "    drape run {} plays {} by itself (--motion none: at rest)\n", path, own);
+}
+
+/// The scene's characters as `drape run` loads them: with several, who wears what; the files
+/// of the Avatar nodes worn.
+void printCharacters(const std::string& path, const scene::Scene& s, std::ostream& out) {
+  std::vector<sim::SceneCharacter> characters;
   try {
-    avatar = sim::sceneAvatar(s);
+    characters = sim::sceneCharacters(s);
   } catch (const Error& e) {
     fmt::print(out, "    not loaded: {}\n", e.what());
     return;
   }
-  if (!avatar) return;
-  fmt::print(out, "    {}: {} joints, {} segments{}\n", avatar->source, avatar->joints.size(), avatar->segments.size(),
-             avatar->skin ? fmt::format(", a skin of {} triangles", avatar->skin->mesh.triangleCount()) : "");
-  if (!avatar->animations.empty())
-    fmt::print(out, "    its file carries {} animation{} ('{}')\n", avatar->animations.size(),
-               avatar->animations.size() == 1 ? "" : "s", fmt::join(avatar->animations, "', '"));
-  if (const std::string own = ownMotionText(*avatar); !own.empty())
-    fmt::print(out, "    drape run {} plays {} by itself (--motion none: at rest)\n", path, own);
+  const bool several = characters.size() > 1;
+  if (several) fmt::print(out, "characters: {}\n", characters.size());
+  for (const sim::SceneCharacter& c : characters) {
+    if (several) {
+      std::vector<std::string> worn;
+      for (const std::size_t g : c.garments) worn.push_back(s.garments[g].name);
+      fmt::print(out, "  {} wears {}{}\n", c.name, fmt::join(worn, ", "),
+                 fmt::format(" (drape run --motion {}=FILE moves it)", c.name));
+    }
+    if (c.external) printAvatarFile(path, *c.avatar, out);
+  }
 }
 
 void inspectScene(const std::string& path, std::ostream& out) {
@@ -127,7 +142,7 @@ void inspectScene(const std::string& path, std::ostream& out) {
     fmt::print(out, "  {} (from {}){}{}\n", a.name, fmt::join(a.urls, ", "),
                a.jointMap.empty() ? "" : fmt::format(", joint map {}", fmt::join(a.jointMap, ", ")),
                a.cutAtJoints.empty() ? "" : fmt::format(", parts cut across joints {}", fmt::join(a.cutAtJoints, ", ")));
-  if (s.avatars.empty() && !s.externalAvatars.empty()) printExternalAvatar(path, s, out);
+  if (!s.externalAvatars.empty() || s.avatars.size() > 1) printCharacters(path, s, out);
   fmt::print(out, "garments: {}\n", s.garments.size());
   for (const scene::Garment& g : s.garments) printGarment(out, s, g);
   fmt::print(out, "materials: {}\n", s.materials.size());

@@ -5,6 +5,8 @@
 #include <chrono>
 #include <filesystem>
 #include <iostream>
+#include <optional>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -28,7 +30,8 @@ namespace {
 
 struct PlayOptions {
   std::string run;
-  std::string motion, animation;
+  std::vector<std::string> motions;
+  std::string animation;
   std::string live, liveHeader;  ///< --live SOURCE: a capture simulated as it comes
   double giveUp_s = 0.0;
   long frames = 0;
@@ -38,67 +41,79 @@ struct PlayOptions {
   PictureOptions picture;
 };
 
-/// The live source: the character's world steps frame by frame on its own thread and the
-/// player receives the garments (with their collision states) and the body where they are.
+/// The live source: the characters' worlds step frame by frame on a thread of their own and
+/// the player receives the garments (with their collision states) and the bodies where they are.
 int playScene(const PlayOptions& o, render::PlayerOptions options) {
   RunSetup setup = runSetupFromScene(o.run);
-  if (!setup.character)
+  if (setup.characters.empty())
     throw Error(fmt::format("{}: drape play simulates scenes with an avatar (replay a run directory otherwise)", o.run));
   // A live capture: read as the simulation asks for its frames, on the simulating thread.
   std::unique_ptr<LiveCapture> capture;
   std::unique_ptr<LiveRun> live;
   if (!o.live.empty()) {
+    const CharacterSetup& character = *oneCharacter(setup, "--live (a live capture)");
     const std::chrono::milliseconds giveUp(static_cast<long long>(1000.0 * o.giveUp_s));
     prepareLiveRun(setup);
-    capture = std::make_unique<LiveCapture>(*setup.character->avatar,
+    capture = std::make_unique<LiveCapture>(*character.avatar,
                                             LiveCapture::Options{o.live, o.liveHeader, std::chrono::seconds(5), giveUp},
                                             motionOptions(setup), stopOnSignals());
     live = std::make_unique<LiveRun>(setup, *capture, 0);
     options.close = &stopOnSignals();  // Ctrl-C closes the window
-  } else if (const MotionChoice m = sceneMotion(setup, o.run, o.motion, o.animation); !m.path.empty()) {
-    addMotion(setup, m.path, 0.0, "", m.animation, m.sampled.get());
+  } else {
+    addSceneMotions(setup, o.run, o.motions, o.animation);
   }
-  const std::unique_ptr<sim::CharacterWorld> worldPtr = buildWorld(setup);
-  sim::CharacterWorld& world = *worldPtr;
-  (void)settleWorld(setup, world);
-  const scene::Avatar* avatar = setup.character->avatar.get();
-  const cloth::StepSettings& step = setup.settings;
+  SetupWorlds worlds(setup);
+  for (std::size_t c = 0; c < worlds.size(); ++c) (void)settleWorld(setup.characters[c], worlds.world(c));
+  const std::size_t garmentCount = setup.garments.size();
 
+  // The meshes: the garments, then per character its segments and its skinned body.
   std::vector<render::MeshInfo> meshes;
-  for (std::size_t g = 0; g < world.garmentCount(); ++g) {
-    const mesh::TriMesh& m = world.garment(g).mesh;
-    meshes.push_back({world.garment(g).name, render::MeshRole::Garment, m.vertexCount(), m.triangles});
+  for (const GarmentSetup& g : setup.garments)
+    meshes.push_back({g.name, render::MeshRole::Garment, g.mesh.vertexCount(), g.mesh.triangles});
+  struct Body {
+    std::size_t firstSegment = 0;                ///< its first segment's mesh
+    std::optional<std::size_t> skinMesh;         ///< its skinned body's mesh
+    std::unique_ptr<sim::BodySkin> skin;
+    std::vector<sim::GarmentSurface> garments;   ///< what the skin is tucked under, per frame
+  };
+  std::vector<Body> bodies(worlds.size());
+  const bool several = worlds.size() > 1;
+  for (std::size_t c = 0; c < worlds.size(); ++c) {
+    const scene::Avatar& avatar = *setup.characters[c].avatar;
+    const std::string who = several ? setup.characters[c].name : "";
+    bodies[c].firstSegment = meshes.size();
+    for (const scene::Segment& seg : avatar.segments)
+      meshes.push_back({seg.name, render::MeshRole::Segment, seg.mesh.vertexCount(), seg.mesh.triangles, who});
+    if (avatar.skin) {
+      bodies[c].skinMesh = meshes.size();
+      meshes.push_back({"body", render::MeshRole::Skin, avatar.skin->mesh.vertexCount(), avatar.skin->mesh.triangles, who});
+      bodies[c].skin = std::make_unique<sim::BodySkin>(avatar, worlds.world(c).fields(), leastT0(worlds.world(c)));
+    }
   }
-  for (const scene::Segment& seg : avatar->segments)
-    meshes.push_back({seg.name, render::MeshRole::Segment, seg.mesh.vertexCount(), seg.mesh.triangles});
-  if (avatar->skin)
-    meshes.push_back({"body", render::MeshRole::Skin, avatar->skin->mesh.vertexCount(), avatar->skin->mesh.triangles});
-
-  std::unique_ptr<sim::BodySkin> skin;
-  if (avatar->skin) skin = std::make_unique<sim::BodySkin>(*avatar, world.fields(), leastT0(world));
   // The simulation runs on a thread of its own, a few frames ahead of the window, which
-  // poses the segments and the skin (fitted and tucked under the cloth) and draws.
+  // poses the segments and the skins (fitted and tucked under the cloth) and draws.
   const auto prepare = [&](FrameTaken& slot) {
-    slot.positions.resize(world.garmentCount());
-    slot.states.resize(world.garmentCount());
-    slot.joints.resize(avatar->joints.size());
+    slot.positions.resize(garmentCount);
+    slot.states.resize(garmentCount);
+    worlds.sizeJoints(slot.joints);
   };
   StageLaps stageLaps;
   FramesAhead ahead(kFramesAhead, 0, -1, prepare, [&](long frame, FrameTaken& taken) {
     if (live && !live->admit(frame)) return false;  // the capture ended
-    if (frame > 0 && !world.stepFrame(frame)) {
-      spdlog::error("{}", world.instability());
-      return false;
-    }
+    for (std::size_t c = 0; c < worlds.size() && frame > 0; ++c)
+      if (!worlds.world(c).stepFrame(frame)) {
+        spdlog::error("{}", worlds.world(c).instability());
+        return false;
+      }
     taken.frame = frame;
     StageMs totals{};
-    for (std::size_t g = 0; g < world.garmentCount(); ++g) totals += stageTotalsMs(world.solver(g).stageTimes());
+    for (std::size_t g = 0; g < garmentCount; ++g) totals += stageTotalsMs(worlds.solver(g).stageTimes());
     taken.stageMs = stageLaps.lap(totals);
-    for (std::size_t g = 0; g < world.garmentCount(); ++g) {
-      world.solver(g).state().copyPositions(taken.positions[g]);
-      garmentVertexStates(world.solver(g), world.collider(g), taken.states[g]);
+    for (std::size_t g = 0; g < garmentCount; ++g) {
+      worlds.solver(g).state().copyPositions(taken.positions[g]);
+      garmentVertexStates(worlds.solver(g), worlds.collider(g), taken.states[g]);
     }
-    world.poses().evaluate(world.frameTime(frame), taken.joints);
+    worlds.evaluateJoints(frame, taken.joints);
     return true;
   });
   // However the window closes, a capture the simulating thread waits on stops, so that it ends.
@@ -108,28 +123,33 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
       if (live) askToStop();
     }
   } stopCaptureOnLeave{capture != nullptr};
-  std::vector<sim::GarmentSurface> garments;
-  render::CallbackSource source(meshes, step.frameRate_hz, [&](render::Frame& out) {
+  render::CallbackSource source(meshes, setup.settings.frameRate_hz, [&](render::Frame& out) {
     const FrameTaken* taken = ahead.next();
     if (!taken) return false;
     out.time = frameTimeCode(setup, taken->frame);
     out.stages = stagesTaken(taken->stageMs);
     out.positions.resize(meshes.size());
     out.states.resize(meshes.size());
-    garments.clear();
-    for (std::size_t g = 0; g < world.garmentCount(); ++g) {
+    for (std::size_t g = 0; g < garmentCount; ++g) {
       out.positions[g] = taken->positions[g];
       out.states[g] = taken->states[g];
-      garments.push_back({taken->positions[g], world.garment(g).mesh.triangles});
     }
-    for (std::size_t s = 0; s < avatar->segments.size(); ++s) {
-      const scene::Segment& seg = avatar->segments[s];
-      std::vector<Vec3>& p = out.positions[world.garmentCount() + s];
-      p.clear();
-      const RigidTransform& pose = taken->joints[static_cast<std::size_t>(seg.joint)];
-      for (const Vec3& v : seg.mesh.positions) p.push_back(pose.apply(v));
+    for (std::size_t c = 0; c < worlds.size(); ++c) {
+      const scene::Avatar& avatar = *setup.characters[c].avatar;
+      const std::vector<RigidTransform>& joints = taken->joints[c];
+      for (std::size_t s = 0; s < avatar.segments.size(); ++s) {
+        const scene::Segment& seg = avatar.segments[s];
+        std::vector<Vec3>& p = out.positions[bodies[c].firstSegment + s];
+        p.clear();
+        const RigidTransform& pose = joints[static_cast<std::size_t>(seg.joint)];
+        for (const Vec3& v : seg.mesh.positions) p.push_back(pose.apply(v));
+      }
+      if (!bodies[c].skin) continue;
+      bodies[c].garments.clear();
+      for (const std::size_t g : setup.characters[c].garments)
+        bodies[c].garments.push_back({taken->positions[g], setup.garments[g].mesh.triangles});
+      bodies[c].skin->pose(joints, bodies[c].garments, out.positions[*bodies[c].skinMesh]);
     }
-    if (skin) skin->pose(taken->joints, garments, out.positions.back());
     return true;
   }, [&](std::int64_t) { return ahead.ready(); });  // live, a frame may be a while coming: the window stays live
   options.loop = false;
@@ -144,7 +164,9 @@ RunFunction setupPlay(CLI::App& app) {
   static PlayOptions o;
   app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes, or a scene to simulate live")
       ->required();
-  app.add_option("--motion", o.motion, std::string("With a scene: motion for its avatar ") + kMotionHelp);
+  app.add_option("--motion", o.motions, std::string("With a scene: motion for its avatar ") + kMotionHelp +
+                                            kMotionPerCharacterHelp)
+      ->type_name("FILE|NAME=FILE");
   app.add_option("--animation", o.animation, kAnimationHelp);
   app.add_option("--live", o.live,
                  std::string("With a scene, instead of a motion: ") + kLiveHelp + "; shown as it is simulated")
@@ -173,9 +195,9 @@ RunFunction setupPlay(CLI::App& app) {
       options.screenshot = o.screenshot;
       return playScene(o, options);
     }
-    if (!o.motion.empty() || !o.animation.empty() || !o.live.empty())
+    if (!o.motions.empty() || !o.animation.empty() || !o.live.empty())
       throw Error(fmt::format("{}: drape play takes a motion only with a scene file, not a run directory",
-                              !o.live.empty() ? "--live" : o.motion.empty() ? "--animation" : "--motion"));
+                              !o.live.empty() ? "--live" : o.motions.empty() ? "--animation" : "--motion"));
     render::RunReplay replay(o.run);
     std::tie(options.width, options.height) = o.picture.parsedSize();
     options.title = fmt::format("drape play {}", o.run);

@@ -42,9 +42,10 @@ struct PlayerRoleOptions {
 /// The part fields the skinned body is fitted to, as the cloth-servers' worlds build them
 /// (none for an avatar without a skin: the segments need none).
 std::vector<sim::PartField> skinFields(const RunSetup& setup) {
-  if (!setup.character->avatar->skin) return {};
-  spdlog::info("building distance fields ({:.4g} m voxels) to fit the skinned body", setup.character->voxel_m);
-  return sim::buildPartFields(*setup.character->avatar, setup.garments, worldSettings(setup));
+  const CharacterSetup& character = setup.characters.front();
+  if (!character.avatar->skin) return {};
+  spdlog::info("building distance fields ({:.4g} m voxels) to fit the skinned body", character.voxel_m);
+  return sim::buildPartFields(*character.avatar, setup.garments, worldSettings(setup, character));
 }
 
 /// The cloth-servers' stats for stats.json: one server's as it wrote them, several by stream.
@@ -94,7 +95,10 @@ struct Recording {
 /// or --frames), then the stats, as drape run writes them.
 Recording recordTake(const PlayerRoleOptions& o, RunSetup& setup, StudioFrames& frames, SkinFields& fields,
                      const std::atomic<bool>& stop) {
-  RunWriter writer(setup, &fields.of(setup), sim::leastT0(setup.garments, worldSettings(setup)), frames.jointsAtStart());
+  const CharacterSetup& character = setup.characters.front();
+  RunWriter writer(setup, {CharacterAtStart{&fields.of(setup),
+                                            sim::leastT0(setup.garments, worldSettings(setup, character)),
+                                            frames.jointsAtStart()}});
   FrameTaken taken;
   long last = -1;
   Recording out;
@@ -182,7 +186,8 @@ int show(const PlayerRoleOptions& o) {
   frames.followNextTake(o.take);
   // The window's meshes are the first take's garments; the feed reads on with a setup of its own.
   const std::vector<GarmentSetup> garmentsShown = setup.garments;
-  const scene::Avatar& avatar = *setup.character->avatar;
+  const CharacterSetup& character = setup.characters.front();
+  const scene::Avatar& avatar = *character.avatar;
   std::vector<render::MeshInfo> meshes;
   for (const GarmentSetup& g : garmentsShown)
     meshes.push_back({g.name, render::MeshRole::Garment, g.mesh.vertexCount(), g.mesh.triangles});
@@ -192,7 +197,8 @@ int show(const PlayerRoleOptions& o) {
     meshes.push_back({"body", render::MeshRole::Skin, avatar.skin->mesh.vertexCount(), avatar.skin->mesh.triangles});
   const std::vector<sim::PartField> fields = skinFields(setup);
   std::unique_ptr<sim::BodySkin> skin;
-  if (avatar.skin) skin = std::make_unique<sim::BodySkin>(avatar, fields, sim::leastT0(garmentsShown, worldSettings(setup)));
+  if (avatar.skin)
+    skin = std::make_unique<sim::BodySkin>(avatar, fields, sim::leastT0(garmentsShown, worldSettings(setup, character)));
   const std::string firstTake = frames.take();
   const double rate = setup.settings.frameRate_hz;
 
@@ -242,10 +248,10 @@ int show(const PlayerRoleOptions& o) {
           const scene::Segment& seg = avatar.segments[s];
           std::vector<Vec3>& p = out.positions[garmentsShown.size() + s];
           p.clear();
-          const RigidTransform& pose = taken.joints[static_cast<std::size_t>(seg.joint)];
+          const RigidTransform& pose = taken.joints.front()[static_cast<std::size_t>(seg.joint)];
           for (const Vec3& v : seg.mesh.positions) p.push_back(pose.apply(v));
         }
-        if (skin) skin->pose(taken.joints, garments, out.positions.back());
+        if (skin) skin->pose(taken.joints.front(), garments, out.positions.back());
         return true;
       },
       [&](std::int64_t) { return feed.ready(); });

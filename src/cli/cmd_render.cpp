@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <unistd.h>
 
@@ -25,7 +26,8 @@ namespace {
 
 struct RenderOptions {
   std::string run;
-  std::string motion, animation;
+  std::vector<std::string> motions;
+  std::string animation;
   std::string runOut;
   long frames = 0;
   std::string range;
@@ -42,7 +44,9 @@ RunFunction setupRender(CLI::App& app) {
   static RenderOptions o;
   app.add_option("run", o.run, "A run directory (with manifest.json), as drape run --out writes, or a scene to simulate")
       ->required();
-  app.add_option("--motion", o.motion, std::string("With a scene: motion for its avatar ") + kMotionHelp);
+  app.add_option("--motion", o.motions, std::string("With a scene: motion for its avatar ") + kMotionHelp +
+                                            kMotionPerCharacterHelp)
+      ->type_name("FILE|NAME=FILE");
   app.add_option("--animation", o.animation, kAnimationHelp);
   app.add_option("--frames", o.frames, "With a scene: frames to simulate (default: the lead-in and the whole motion)");
   app.add_option("--run-out", o.runOut, "With a scene: keep the simulated run in this directory (default: a temporary one)");
@@ -74,8 +78,7 @@ RunFunction setupRender(CLI::App& app) {
     std::filesystem::path scratch;
     if (std::filesystem::is_regular_file(o.run)) {
       RunSetup setup = runSetupFromScene(o.run);
-      if (const MotionChoice m = sceneMotion(setup, o.run, o.motion, o.animation); !m.path.empty())
-        addMotion(setup, m.path, 0.0, "", m.animation, m.sampled.get());
+      addSceneMotions(setup, o.run, o.motions, o.animation);
       setup.frames = o.frames > 0 ? o.frames : defaultFrames(setup);
       if (o.runOut.empty()) {
         scratch = std::filesystem::temp_directory_path() / fmt::format("drape-render-{}", ::getpid());
@@ -86,9 +89,9 @@ RunFunction setupRender(CLI::App& app) {
       setup.outDir = runDir;
       setup.objEvery = setup.frames;
       (void)simulateRun(setup);
-    } else if (!o.motion.empty() || !o.animation.empty()) {
+    } else if (!o.motions.empty() || !o.animation.empty()) {
       throw Error(fmt::format("{}: drape render takes a motion only with a scene file, not a run directory",
-                              o.motion.empty() ? "--animation" : "--motion"));
+                              o.motions.empty() ? "--animation" : "--motion"));
     } else if (o.frames > 0) {
       throw Error("--frames: drape render simulates frames only from a scene file; for some of a run's frames, "
                   "--range FIRST:LAST");

@@ -39,7 +39,8 @@ namespace drape::cli {
 namespace {
 
 struct RunOptions {
-  std::string scene, avatar, motion, jointMap, animation, fieldMethod = "dvdp";
+  std::string scene, avatar, jointMap, animation, fieldMethod = "dvdp";
+  std::vector<std::string> motions;  ///< --motion FILE, or NAME=FILE per character
   double motionScale = 0.0, voxel_m = 0.0, leadIn_s = 1.0, settle_s = 1.0;
   bool preview = false, countEverySubstep = false, exactSliding = false, freePinches = false, noStitches = false;
   double stitchGaps_m = 0.0;  ///< --stitch-gaps
@@ -168,7 +169,7 @@ std::vector<cloth::Stitch> stitchesAcrossGaps(const GarmentSetup& g, double gap_
 void applyCollisionOptions(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   const bool faces = app.count("--face-samples-with") > 0;
   const std::vector<std::string> faceParts = facePartsOption(o.faceSamplesWith);
-  if (faces && !setup.character && !faceParts.empty())
+  if (faces && setup.characters.empty() && !faceParts.empty())
     throw Error("--face-samples-with: there is no avatar to collide with (the scene has none; without a scene, give "
                 "--avatar FILE)");
   for (GarmentSetup& g : setup.garments) {
@@ -247,8 +248,9 @@ void stampTimeCode(const RunOptions& o, RunSetup& setup, double earlier_s = 0.0)
   if (o.timecode.empty()) return;
   TimeCode motionStart = TimeCode::parseOption(o.timecode, setup.settings.frameRate_hz);
   if (o.timecode == "now") motionStart.frame -= std::llround(earlier_s * motionStart.rate);
-  setup.timeCodeOfFrame0 =
-      setup.character ? studio::clothTimeCode(0, motionStart, setup.character->leadIn_s).frame : motionStart.frame;
+  setup.timeCodeOfFrame0 = setup.characters.empty()
+                               ? motionStart.frame
+                               : studio::clothTimeCode(0, motionStart, setup.characters.front().leadIn_s).frame;
 }
 
 /// `--live SOURCE`: the run on a capture as it comes, until the source ends (it closes, Ctrl-C,
@@ -259,8 +261,9 @@ int runLive(const RunOptions& o, RunSetup& setup, const std::function<void()>& s
   motion::MotionOptions motion = motionOptions(setup);
   if (o.motionScale > 0) motion.clip.metresPerUnit = o.motionScale;
   motion.jointMapPath = o.jointMap;
+  CharacterSetup& character = *oneCharacter(setup, "--live (a live capture)");
   prepareLiveRun(setup);
-  LiveCapture capture(*setup.character->avatar, {o.live, o.liveHeader, std::chrono::seconds(5), giveUp}, motion, stop);
+  LiveCapture capture(*character.avatar, {o.live, o.liveHeader, std::chrono::seconds(5), giveUp}, motion, stop);
   LiveRun live(setup, capture, o.frames);
   stampTimeCode(o, setup, live.lag_s());  // now: when the first frame came
   const int code = simulateRun(setup, live.gate());
@@ -279,40 +282,43 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   if (o.scene.empty() == o.garment.empty())
     throw Error("drape run: give either a scene file (drape run SCENE.wrl) or --garment FILE.obj");
   RunSetup setup;
-  std::shared_ptr<const scene::Avatar> avatar;
   if (!o.scene.empty()) {
     setup = runSetupFromScene(o.scene, app.count("--cut-at-joints")
                                            ? std::optional<std::vector<std::string>>(keepApartParts(o.cutAtJoints))
                                            : std::nullopt);
-    if (setup.character) avatar = setup.character->avatar;
     applyOverrides(app, o, setup);
     applyOffsets(o, setup);
     applyCollisionOptions(app, o, setup);
   } else {
+    std::shared_ptr<const scene::Avatar> avatar;
     if (!o.avatar.empty()) avatar = loadAvatarCut(o.avatar, keepApartParts(o.cutAtJoints));
     else if (app.count("--cut-at-joints")) throw Error("--cut-at-joints cuts an avatar's parts: give a scene or --avatar FILE");
     setupFromGarment(o, setup, avatar != nullptr);
     if (avatar) {
-      setup.character = CharacterSetup{avatar, nullptr, 0.005};
+      CharacterSetup& character = setup.characters.emplace_back();
+      character.avatar = avatar;
+      character.name = avatar->name;
+      character.garments = {0};
       for (GarmentSetup& g : setup.garments)
         for (const scene::Segment& seg : avatar->segments) g.collidesWith.push_back(seg.name);
     }
     applyOffsets(o, setup);
     applyCollisionOptions(app, o, setup);
   }
-  if (!o.events.empty() && (!o.motion.empty() || !o.animation.empty()))
+  const bool avatar = !setup.characters.empty();
+  if (!o.events.empty() && (!o.motions.empty() || !o.animation.empty()))
     throw Error("--events plays an event graph's motions: give it or --motion, not both");
-  if (!o.live.empty() && (!o.motion.empty() || !o.animation.empty() || !o.events.empty()))
+  if (!o.live.empty() && (!o.motions.empty() || !o.animation.empty() || !o.events.empty()))
     throw Error(fmt::format("--live plays the motion its source sends: give it or {}, not both",
-                            !o.events.empty() ? "--events" : !o.motion.empty() ? "--motion" : "--animation"));
+                            !o.events.empty() ? "--events" : !o.motions.empty() ? "--motion" : "--animation"));
   if (o.live.empty() && (!o.liveHeader.empty() || o.giveUp_s > 0))
     throw Error(fmt::format("{} is for a live source: give --live SOURCE", o.liveHeader.empty() ? "--give-up" : "--live-header"));
   if (!o.live.empty() && !avatar) throw Error("--live: there is no avatar for the capture to move");
   if (o.events.empty() && (!o.sets.empty() || !o.sends.empty()))
     throw Error(fmt::format("{}: it is for an event graph: give --events FILE.egml", o.sets.empty() ? "--send" : "--set"));
-  const MotionChoice motion =
-      o.events.empty() && o.live.empty() ? sceneMotion(setup, o.scene, o.motion, o.animation) : MotionChoice{};
-  if (!motion.path.empty() && !avatar)
+  const bool motionGiven =
+      std::any_of(o.motions.begin(), o.motions.end(), [](const std::string& m) { return m != "none"; });
+  if (motionGiven && !avatar)
     throw Error("--motion: there is no avatar to move (the scene has none; without a scene, give --avatar FILE)");
   for (const std::string& sphere : o.spheres) {
     const auto comma = sphere.rfind(',');
@@ -322,28 +328,28 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     setup.spheres.push_back({c, r.z()});
   }
 
-  if (app.count("--keep-apart") && !keepApartParts(o.keepApart).empty() && motion.path.empty() && o.events.empty() &&
+  if (app.count("--keep-apart") && !keepApartParts(o.keepApart).empty() && !motionGiven && o.events.empty() &&
       o.live.empty())
     throw Error("--keep-apart corrects a motion: give --motion FILE (or --events FILE, or --live SOURCE) too");
   if (!o.events.empty() && !avatar) throw Error("--events: there is no avatar for the event graph to move");
-  if (setup.character) {
-    CharacterSetup& ch = *setup.character;
+  if (!(o.leadIn_s >= 0)) throw Error(fmt::format("--lead-in must be >= 0 s, got {}", o.leadIn_s));
+  if (!(o.settle_s >= 0)) throw Error(fmt::format("--settle must be >= 0 s, got {}", o.settle_s));
+  for (CharacterSetup& ch : setup.characters) {
     if (o.voxel_m > 0) ch.voxel_m = o.voxel_m;
     ch.fieldMethod = o.fieldMethod == "exact" ? field::FieldMethod::Exact : field::FieldMethod::Dvdp;
-    if (!(o.leadIn_s >= 0)) throw Error(fmt::format("--lead-in must be >= 0 s, got {}", o.leadIn_s));
     ch.leadIn_s = o.leadIn_s;
-    if (!(o.settle_s >= 0)) throw Error(fmt::format("--settle must be >= 0 s, got {}", o.settle_s));
     ch.settle_s = o.settle_s;
     if (app.count("--keep-apart")) setKeepApart(ch, o.keepApart);
-    if (!motion.path.empty())
-      addMotion(setup, motion.path, o.motionScale, o.jointMap, motion.animation, motion.sampled.get());
-    if (!o.events.empty()) {
-      // With --frames, as many motion frames as those frames read (the lead-in before them).
-      const long motionFrames =
-          app.count("--frames") ? std::max(2L, o.frames - static_cast<long>(std::floor(ch.leadIn_s * setup.settings.frameRate_hz)) + 2)
-                                : 0;
-      addEvents(setup, o.events, o.sets, o.sends, motionFrames);
-    }
+  }
+  if (o.events.empty() && o.live.empty())
+    addSceneMotions(setup, o.scene, o.motions, o.animation, o.motionScale, o.jointMap);
+  if (!o.events.empty() && avatar) {
+    // With --frames, as many motion frames as those frames read (the lead-in before them).
+    const long motionFrames =
+        app.count("--frames")
+            ? std::max(2L, o.frames - static_cast<long>(std::floor(o.leadIn_s * setup.settings.frameRate_hz)) + 2)
+            : 0;
+    addEvents(setup, o.events, o.sets, o.sends, motionFrames);
   }
 
   if (app.count("--substeps") || o.scene.empty()) {
@@ -365,10 +371,13 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   setup.countEverySubstep = o.countEverySubstep;
   setup.exactSliding = o.exactSliding;
   setup.freePinches = o.freePinches;
-  const bool skin = setup.character && setup.character->avatar->skin;
+  const bool skin = std::any_of(setup.characters.begin(), setup.characters.end(),
+                                [](const CharacterSetup& c) { return c.avatar->skin.has_value(); });
+  const bool several = setup.characters.size() > 1;
   const auto saidResults = [&] {
     fmt::print("results in {}/: garment caches (.pc2, .states), {}frames/, result.wrl, result.glb, stats.json{}\n", o.out,
-               skin ? "the skinned body (body.pc2), " : "", o.preview ? ", preview.png" : "");
+               !skin ? "" : several ? "the skinned bodies (body-CHARACTER.pc2), " : "the skinned body (body.pc2), ",
+               o.preview ? ", preview.png" : "");
   };
   if (!o.timecode.empty() && o.timecode != "now") (void)TimeCode::parseSmpte(o.timecode, setup.settings.frameRate_hz);
   if (!o.live.empty()) return runLive(o, setup, saidResults);
@@ -393,7 +402,8 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("scene", o->scene, "VRML97 scene with ClothSet garments (and an avatar)");
   app.add_option("--garment", o->garment, "Garment mesh (OBJ), instead of a scene");
   app.add_option("--avatar", o->avatar, "Avatar to wear --garment (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel)");
-  app.add_option("--motion", o->motion, std::string("Motion for the avatar ") + kMotionHelp);
+  app.add_option("--motion", o->motions, std::string("Motion for the avatar ") + kMotionHelp + kMotionPerCharacterHelp)
+      ->type_name("FILE|NAME=FILE");
   app.add_option("--events", o->events,
                  "Instead of --motion: an EGML event graph (.egml) that plays motions on the avatar, in sequence, "
                  "blended, looped, by state, moves it along paths and sets the wind (docs/EVENTS.md)");

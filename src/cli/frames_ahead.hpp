@@ -18,7 +18,7 @@ struct FrameTaken {
   long frame = 0;
   std::vector<std::vector<Vec3>> positions;       ///< per garment
   std::vector<std::vector<std::uint8_t>> states;  ///< per garment, as the state caches store them
-  std::vector<RigidTransform> joints;             ///< the avatar's joints in the world
+  std::vector<std::vector<RigidTransform>> joints;  ///< per character: its avatar's joints in the world
   StageMs stageMs{};                              ///< what each stage took for this frame
 };
 

@@ -10,24 +10,25 @@
 namespace drape::cli {
 
 void prepareLiveRun(RunSetup& setup) {
-  if (setup.character && !setup.character->keepApart.empty())
-    buildPartFieldsOnce(setup, fmt::format("to keep {} apart", fmt::join(setup.character->keepApart, ", ")));
+  CharacterSetup* character = oneCharacter(setup, "--live (a live capture)");
+  if (character && !character->keepApart.empty())
+    buildPartFieldsOnce(setup, *character, fmt::format("to keep {} apart", fmt::join(character->keepApart, ", ")));
 }
 
 LiveRun::LiveRun(RunSetup& setup, LiveCapture& capture, long maxFrames)
     : capture_(capture),
       joints_(capture.motion().jointCount()),
       frameRate_(setup.settings.frameRate_hz),
-      leadIn_s_(setup.character->leadIn_s),
+      leadIn_s_(oneCharacter(setup, "--live (a live capture)")->leadIn_s),
       maxFrames_(maxFrames) {
   const motion::LiveMotion& live = capture.motion();
   const std::span<const int> driving = live.drivingJoint();
   animation_ = std::make_shared<motion::AvatarAnimation>(motion::AvatarAnimation::streamed(
       live.jointCount(), live.rate(), TimeCode{0, live.rate()}, std::vector<int>(driving.begin(), driving.end())));
-  CharacterSetup& character = *setup.character;
+  CharacterSetup& character = *oneCharacter(setup, "--live (a live capture)");
   // The capture keeps the parts apart on its way in, so the world is given the motion
   // corrected and keeps nothing apart itself.
-  if (std::shared_ptr<sim::LiveKeepApart> keep = liveKeepApart(setup, live.rate())) {
+  if (std::shared_ptr<sim::LiveKeepApart> keep = liveKeepApart(setup, character, live.rate())) {
     capture.keepApart(keep);
     lag_s_ = static_cast<double>(keep->delay()) / live.rate();
     character.liveKeptApart = std::move(keep);
@@ -42,7 +43,7 @@ LiveRun::LiveRun(RunSetup& setup, LiveCapture& capture, long maxFrames)
                 ExitCode::Unavailable);
   spdlog::info("live motion from {} ({} joints at {:g} Hz in {}, joint map '{}') on {} at {:g} Hz, simulated as it comes",
                capture.name(), capture.header().joints.size(), live.sourceRate(), live.report().units.name,
-               live.jointMap().name, setup.character->avatar->name, live.rate());
+               live.jointMap().name, character.avatar->name, live.rate());
 }
 
 bool LiveRun::waitForFrames(std::int64_t count) {

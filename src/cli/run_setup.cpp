@@ -101,7 +101,7 @@ std::vector<cloth::PinGroup> pinsOf(const GarmentSetup& g, const cloth::ClothMod
 /// The paper's Table 3 figures and ours: how much time went to collisions, how far points
 /// were traced, where they are, and how deep anything got.
 void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& runs, const cloth::StageTimes& total,
-                       long frames, const sim::CharacterWorld* world) {
+                       long frames, const SetupWorlds& worlds) {
   // As in the paper's Table 3, the share leaves out the animation and its interpolation: the
   // pose fetches the collider makes (timed inside its stage) and the fixtures make.
   // Nor does it count the measuring of the penetration figures below, timed inside the
@@ -160,17 +160,24 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) transitions[std::string(names[a]) + "->" + names[b]] = sum.transitions[a][b];
   stats["state_transitions"] = transitions;
-  if (world) {
+  if (worlds.size() > 0) {
     nlohmann::json fields = nlohmann::json::array();
-    for (const sim::PartField& f : world->fields()) {
-      const auto& d = f.field.dims();
-      fields.push_back({{"segment", f.segment},
-                        {"dims", {d.nx, d.ny, d.nz}},
-                        {"bytes", f.field.memoryBytes()},
-                        {"build_ms", f.field.stats().voxelizeMs + f.field.stats().propagateMs + f.field.stats().finishMs}});
+    double build_s = 0.0;
+    for (std::size_t c = 0; c < worlds.size(); ++c) {
+      for (const sim::PartField& f : worlds.world(c).fields()) {
+        const auto& d = f.field.dims();
+        nlohmann::json entry = {
+            {"segment", f.segment},
+            {"dims", {d.nx, d.ny, d.nz}},
+            {"bytes", f.field.memoryBytes()},
+            {"build_ms", f.field.stats().voxelizeMs + f.field.stats().propagateMs + f.field.stats().finishMs}};
+        if (worlds.size() > 1) entry["character"] = worlds.characterName(c);
+        fields.push_back(std::move(entry));
+      }
+      build_s += worlds.world(c).fieldBuild_s();
     }
     stats["distance_fields"] = fields;
-    stats["distance_field_build_s"] = world->fieldBuild_s();
+    stats["distance_field_build_s"] = build_s;
   }
 }
 
@@ -195,17 +202,27 @@ RunSetup runSetupFromScene(const std::string& scenePath, const std::optional<std
     for (scene::ExternalAvatar& a : sc.externalAvatars) a.cutAtJoints = *cutAtJoints;
   }
   RunSetup setup;
-  const std::shared_ptr<const scene::Avatar> avatar = sim::sceneAvatar(sc);
+  std::vector<sim::SceneCharacter> characters = sim::sceneCharacters(sc);
   setup.settings = sim::toStepSettings(sc.simulation);
-  setup.garments = sim::garmentSpecs(sc, avatar.get());
-  if (avatar) {
-    setup.character = CharacterSetup{avatar, nullptr, sc.simulation.voxelSize};
-    setup.character->keepApart = sc.simulation.keepApart;
-    for (const scene::ExternalAvatar& a : sc.externalAvatars)
-      if (!a.name.empty()) setup.character->names.push_back(a.name);
-    for (const scene::Avatar& a : sc.avatars)
-      if (!a.name.empty()) setup.character->names.push_back(a.name);
-    if (const std::string bad = unknownKeepApartPart(*setup.character); !bad.empty())
+  setup.garments = sim::garmentSpecs(sc, characters);
+  for (sim::SceneCharacter& c : characters) {
+    CharacterSetup& ch = setup.characters.emplace_back();
+    ch.avatar = std::shared_ptr<const scene::Avatar>(std::move(c.avatar));
+    ch.voxel_m = sc.simulation.voxelSize;
+    ch.keepApart = sc.simulation.keepApart;
+    ch.name = c.name;
+    ch.garments = c.garments;
+    // Alone in its scene, the character answers to every avatar name the scene has (a
+    // Humanoid inside an Avatar node's file, say); among several, to its own.
+    if (characters.size() == 1) {
+      for (const scene::ExternalAvatar& a : sc.externalAvatars)
+        if (!a.name.empty()) ch.names.push_back(a.name);
+      for (const scene::Avatar& a : sc.avatars)
+        if (!a.name.empty()) ch.names.push_back(a.name);
+    } else {
+      ch.names.push_back(c.name);
+    }
+    if (const std::string bad = unknownKeepApartPart(ch); !bad.empty())
       throw Error::at(sc.simulation.source, "Simulation keepApart: " + bad);
   }
   return setup;
@@ -214,9 +231,62 @@ RunSetup runSetupFromScene(const std::string& scenePath, const std::optional<std
 TimeCode frameTimeCode(const RunSetup& setup, long frame) {
   const double rate = setup.settings.frameRate_hz;
   if (setup.timeCodeOfFrame0) return TimeCode{*setup.timeCodeOfFrame0 + frame, rate};
-  if (!setup.character) return TimeCode{frame, rate};
-  const TimeCode motionStart = setup.character->animation ? setup.character->animation->start() : TimeCode{0, rate};
-  return studio::clothTimeCode(frame, TimeCode{motionStart.frame, rate}, setup.character->leadIn_s);
+  if (setup.characters.empty()) return TimeCode{frame, rate};
+  const CharacterSetup& first = setup.characters.front();
+  const TimeCode motionStart = first.animation ? first.animation->start() : TimeCode{0, rate};
+  return studio::clothTimeCode(frame, TimeCode{motionStart.frame, rate}, first.leadIn_s);
+}
+
+namespace {
+
+std::string characterList(const RunSetup& setup) {
+  std::vector<std::string> names;
+  for (const CharacterSetup& c : setup.characters) names.push_back(c.name);
+  return fmt::format("{}", fmt::join(names, ", "));
+}
+
+}  // namespace
+
+CharacterSetup* oneCharacter(RunSetup& setup, const std::string& what) {
+  return const_cast<CharacterSetup*>(oneCharacter(std::as_const(setup), what));
+}
+
+const CharacterSetup* oneCharacter(const RunSetup& setup, const std::string& what) {
+  if (setup.characters.size() > 1)
+    throw Error(fmt::format("{} plays one character; the scene has {} ({})", what, setup.characters.size(),
+                            characterList(setup)));
+  return setup.characters.empty() ? nullptr : &setup.characters.front();
+}
+
+CharacterSetup& characterNamed(RunSetup& setup, const std::string& name, const std::string& option) {
+  for (CharacterSetup& c : setup.characters)
+    if (c.name == name) return c;
+  throw Error(fmt::format("{}: the scene has no character called '{}' (it has: {})", option, name,
+                          setup.characters.empty() ? std::string("none") : characterList(setup)));
+}
+
+void keepGarmentsWhere(RunSetup& setup, const std::function<bool(std::size_t garment)>& keep) {
+  std::vector<std::size_t> renumbered(setup.garments.size(), setup.garments.size());
+  std::vector<GarmentSetup> kept;
+  for (std::size_t g = 0; g < setup.garments.size(); ++g)
+    if (keep(g)) {
+      renumbered[g] = kept.size();
+      kept.push_back(std::move(setup.garments[g]));
+    }
+  setup.garments = std::move(kept);
+  for (CharacterSetup& c : setup.characters) {
+    std::vector<std::size_t> worn;
+    for (const std::size_t g : c.garments)
+      if (renumbered[g] < setup.garments.size()) worn.push_back(renumbered[g]);
+    c.garments = std::move(worn);
+  }
+  std::erase_if(setup.characters, [](const CharacterSetup& c) { return c.garments.empty(); });
+}
+
+std::vector<GarmentSetup> garmentsOf(const RunSetup& setup, const CharacterSetup& character) {
+  std::vector<GarmentSetup> out;
+  for (const std::size_t g : character.garments) out.push_back(setup.garments[g]);
+  return out;
 }
 
 motion::MotionOptions motionOptions(const RunSetup& setup) {
@@ -226,10 +296,8 @@ motion::MotionOptions motionOptions(const RunSetup& setup) {
   return mo;
 }
 
-void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerUnit, const std::string& jointMap,
-               const std::string& animation, const formats::SkinnedJointMotion* sampled) {
-  if (!setup.character)
-    throw Error("--motion: there is no avatar to move (the scene has none; without a scene, give --avatar FILE)");
+void addMotion(const RunSetup& setup, CharacterSetup& character, const std::string& motionPath, double metresPerUnit,
+               const std::string& jointMap, const std::string& animation, const formats::SkinnedJointMotion* sampled) {
   motion::MotionOptions mo = motionOptions(setup);
   if (metresPerUnit > 0) mo.clip.metresPerUnit = metresPerUnit;
   mo.jointMapPath = jointMap;
@@ -237,14 +305,15 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
   mo.sampled = sampled;
   motion::ClipLoadReport report;
   motion::JointMap map;
-  setup.character->animation = std::make_shared<const motion::AvatarAnimation>(
-      motion::loadAnimation(*setup.character->avatar, motionPath, mo, &report, &map));
+  character.animation = std::make_shared<const motion::AvatarAnimation>(
+      motion::loadAnimation(*character.avatar, motionPath, mo, &report, &map));
   // What was read and how it drives the avatar: a wrong unit or a poor map shows here first.
-  const std::span<const int> driving = setup.character->animation->drivingJoint();
+  const std::span<const int> driving = character.animation->drivingJoint();
   const auto driven = std::count_if(driving.begin(), driving.end(), [](int j) { return j >= 0; });
-  spdlog::info("{}: {} frames at {:g} Hz in {}{}; joint map '{}' drives {} of the avatar's {} joints", motionPath,
+  spdlog::info("{}: {} frames at {:g} Hz in {}{}; joint map '{}' drives {} of {}'s {} joints", motionPath,
                report.sourceFrames, report.sourceRate, report.units.name, report.unitsOverridden ? " (given)" : "",
-               map.name, driven, driving.size());
+               map.name, driven, setup.characters.size() > 1 ? character.name : std::string("the avatar"),
+               driving.size());
   // Frames the motion file holds but drape does not play: say so, the timing shifts.
   if (report.referenceTPoseSkipped) spdlog::info("{}: {}", motionPath, report.referenceTPose());
   if (report.restUnfoldFramesSkipped > 0) spdlog::info("{}: {}", motionPath, report.restUnfoldSkipped());
@@ -291,17 +360,18 @@ std::vector<events::TimedEvent> timedEvents(const std::vector<std::string>& send
 
 void addEvents(RunSetup& setup, const std::string& graphPath, const std::vector<std::string>& sets,
                const std::vector<std::string>& sends, long motionFrames) {
-  if (!setup.character) throw Error("--events: there is no avatar for the event graph to move");
+  CharacterSetup* character = oneCharacter(setup, "--events (an event graph)");
+  if (!character) throw Error("--events: there is no avatar for the event graph to move");
   const events::Graph graph = events::readGraph(graphPath);
-  const scene::Avatar& avatar = *setup.character->avatar;
+  const scene::Avatar& avatar = *character->avatar;
   events::Motions motions;
   motions.load(graph, avatar, motionOptions(setup));
-  events::Rendered r = events::render(graph, motions, avatar, setup.character->names, setup.settings.frameRate_hz,
+  events::Rendered r = events::render(graph, motions, avatar, character->names, setup.settings.frameRate_hz,
                                       motionFrames, timedEvents(sends), parameterOptions(sets));
   spdlog::info("{}: the event graph runs {} frames ({:.2f} s){}", graphPath, r.frames,
                static_cast<double>(r.frames - 1) / setup.settings.frameRate_hz,
                r.ended ? "" : ", cut there (it runs on)");
-  setup.character->animation = std::make_shared<const motion::AvatarAnimation>(std::move(r.animation));
+  character->animation = std::make_shared<const motion::AvatarAnimation>(std::move(r.animation));
   const bool windy = std::any_of(r.wind.begin(), r.wind.end(), [](const auto& w) { return w.has_value(); });
   setup.motionWind = windy ? std::make_shared<const MotionWind>(std::move(r.wind)) : nullptr;
 }
@@ -321,8 +391,8 @@ std::shared_ptr<const formats::SkinnedJointMotion> humanoidMotion(const scene::A
 
 }  // namespace
 
-MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, const std::string& motion,
-                         const std::string& animation) {
+MotionChoice sceneMotion(const RunSetup& setup, const CharacterSetup* character, const std::string& scenePath,
+                         const std::string& motion, const std::string& animation) {
   if (motion == "none") {
     if (!animation.empty())
       throw Error(fmt::format("--animation {}: it chooses one of a motion file's animations, and --motion none plays none",
@@ -333,14 +403,14 @@ MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, co
   const std::string nothingToChoose = fmt::format(
       "--animation {}: the avatar's own file carries no animation to choose from; give the motion with --motion FILE",
       animation);
-  if (!setup.character) {
+  if (!character) {
     if (!animation.empty()) throw Error(nothingToChoose);
     return {};
   }
   // With no motion given, the avatar plays what its own file carries, as a viewer of that
   // file would: a glTF, Collada or FBX file's animation, or the interpolators a VRML97
   // file ROUTEs into its Humanoid. Logged, with how to keep it at rest.
-  const scene::Avatar& avatar = *setup.character->avatar;
+  const scene::Avatar& avatar = *character->avatar;
   if (!avatar.animations.empty()) {
     const std::size_t index = formats::detail::chooseAnimation(avatar.animations, animation, avatar.source);
     spdlog::info("{}: the avatar's own file carries {} animation{}; it plays '{}'{} (--motion none keeps it at rest)",
@@ -362,6 +432,41 @@ MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, co
   }
   if (!animation.empty()) throw Error(nothingToChoose);
   return {};
+}
+
+void addSceneMotions(RunSetup& setup, const std::string& scenePath, const std::vector<std::string>& motions,
+                     const std::string& animation, double metresPerUnit, const std::string& jointMap) {
+  // Per character, the motion given for it by name, else the one given for all, else "".
+  std::string forAll;
+  std::vector<std::string> given(setup.characters.size());
+  std::vector<std::uint8_t> named(setup.characters.size(), 0);
+  bool forAllGiven = false;
+  for (const std::string& m : motions) {
+    const auto eq = m.find('=');
+    if (eq != std::string::npos && eq > 0 && !std::filesystem::exists(m)) {
+      CharacterSetup& c = characterNamed(setup, m.substr(0, eq), "--motion " + m);
+      const auto i = static_cast<std::size_t>(&c - setup.characters.data());
+      if (named[i]) throw Error(fmt::format("--motion {}: '{}' is given a motion twice", m, c.name));
+      named[i] = 1;
+      given[i] = m.substr(eq + 1);
+      if (given[i].empty()) throw Error(fmt::format("--motion {}: expected NAME=FILE (or NAME=none)", m));
+      continue;
+    }
+    if (forAllGiven) throw Error(fmt::format("--motion {}: a motion for every character is given already ('{}'); name "
+                                             "the character each plays on, NAME=FILE",
+                                             m, forAll));
+    forAllGiven = true;
+    forAll = m;
+  }
+  if (setup.characters.empty()) {
+    (void)sceneMotion(setup, nullptr, scenePath, forAll, animation);  // says what cannot be chosen
+    return;
+  }
+  for (std::size_t i = 0; i < setup.characters.size(); ++i) {
+    CharacterSetup& c = setup.characters[i];
+    const MotionChoice m = sceneMotion(setup, &c, scenePath, named[i] ? given[i] : forAll, animation);
+    if (!m.path.empty()) addMotion(setup, c, m.path, metresPerUnit, jointMap, m.animation, m.sampled.get());
+  }
 }
 
 std::string ownMotionText(const scene::Avatar& avatar) {
@@ -421,58 +526,56 @@ void logKeptApart(const sim::KeepApartReport& report) {
                  short_, report.maxTurn_deg);
 }
 
-void buildPartFieldsOnce(RunSetup& setup, const std::string& why) {
-  if (!setup.character || setup.character->fields) return;
-  CharacterSetup& character = *setup.character;
-  const sim::WorldSettings ws = worldSettings(setup);
+void buildPartFieldsOnce(const RunSetup& setup, CharacterSetup& character, const std::string& why) {
+  if (character.fields) return;
+  const sim::WorldSettings ws = worldSettings(setup, character);
   spdlog::info("building distance fields ({:.4g} m voxels) {}", ws.voxel_m, why);
   const auto began = std::chrono::steady_clock::now();
-  character.fields =
-      std::make_shared<const std::vector<sim::PartField>>(sim::buildPartFields(*character.avatar, setup.garments, ws));
+  character.fields = std::make_shared<const std::vector<sim::PartField>>(
+      sim::buildPartFields(*character.avatar, garmentsOf(setup, character), ws));
   spdlog::info("{} distance fields in {:.2f} s", character.fields->size(),
                std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count());
 }
 
-std::shared_ptr<sim::LiveKeepApart> liveKeepApart(RunSetup& setup, double rate) {
-  if (!setup.character || setup.character->keepApart.empty()) return nullptr;
-  CharacterSetup& character = *setup.character;
-  buildPartFieldsOnce(setup, fmt::format("to keep {} apart", fmt::join(character.keepApart, ", ")));
-  sim::WorldSettings ws = worldSettings(setup);
+std::shared_ptr<sim::LiveKeepApart> liveKeepApart(const RunSetup& setup, CharacterSetup& character, double rate) {
+  if (character.keepApart.empty()) return nullptr;
+  buildPartFieldsOnce(setup, character, fmt::format("to keep {} apart", fmt::join(character.keepApart, ", ")));
+  sim::WorldSettings ws = worldSettings(setup, character);
   ws.keepApart.parts = character.keepApart;
   auto keep = std::make_shared<sim::LiveKeepApart>(*character.avatar, *character.fields,
-                                                   sim::keepApartSettings(setup.garments, ws), rate);
+                                                   sim::keepApartSettings(garmentsOf(setup, character), ws), rate);
   spdlog::info("keeping {} apart on the live motion: each frame corrected {} frames ({:.2f} s) after it comes, the "
                "smoothing's reach ahead",
                fmt::join(character.keepApart, ", "), keep->delay(), static_cast<double>(keep->delay()) / rate);
   return keep;
 }
 
-sim::WorldSettings worldSettings(const RunSetup& setup) {
-  if (!setup.character) throw Error("drape: the scene has no avatar to simulate on");
+sim::WorldSettings worldSettings(const RunSetup& setup, const CharacterSetup& character) {
   sim::WorldSettings ws;
   ws.step = setup.settings;
-  ws.voxel_m = setup.character->voxel_m;
-  ws.fieldMethod = setup.character->fieldMethod;
-  ws.leadIn_s = setup.character->leadIn_s;
-  if (setup.character->animation) ws.keepApart.parts = setup.character->keepApart;
+  ws.voxel_m = character.voxel_m;
+  ws.fieldMethod = character.fieldMethod;
+  ws.leadIn_s = character.leadIn_s;
+  if (character.animation) ws.keepApart.parts = character.keepApart;
   return ws;
 }
 
-std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup) {
-  const sim::WorldSettings ws = worldSettings(setup);
-  const bool built = setup.character->fields != nullptr;
-  spdlog::info("{} and binding constraint masks",
+std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup, const CharacterSetup& character) {
+  const sim::WorldSettings ws = worldSettings(setup, character);
+  const bool built = character.fields != nullptr;
+  const std::string whose = setup.characters.size() > 1 ? fmt::format("{}: ", character.name) : "";
+  spdlog::info("{}{} and binding constraint masks", whose,
                built ? "distance fields built before" : fmt::format("building distance fields ({:.4g} m voxels)", ws.voxel_m));
-  auto world = std::make_unique<sim::CharacterWorld>(*setup.character->avatar, setup.character->animation.get(),
-                                                     setup.garments, ws, setup.character->fields);
-  if (!built) spdlog::info("{} distance fields in {:.2f} s", world->fields().size(), world->fieldBuild_s());
+  auto world = std::make_unique<sim::CharacterWorld>(*character.avatar, character.animation.get(),
+                                                     garmentsOf(setup, character), ws, character.fields);
+  if (!built) spdlog::info("{}{} distance fields in {:.2f} s", whose, world->fields().size(), world->fieldBuild_s());
   logKeptApart(world->keepApartReport());
   return world;
 }
 
-sim::SettleReport settleWorld(const RunSetup& setup, sim::CharacterWorld& world) {
+sim::SettleReport settleWorld(const CharacterSetup& character, sim::CharacterWorld& world) {
   sim::SettleReport report;
-  if (!world.settle(setup.character ? setup.character->settle_s : 0.0, report))
+  if (!world.settle(character.settle_s, report))
     throw Error(world.instability(), ExitCode::Unstable);
   if (report.frames == 0) return report;
   std::string outcome = fmt::format("{} of the {} eased pairs reached T2", report.pairsEased - report.pairsTimedOut -
@@ -508,24 +611,27 @@ void setKeepApart(CharacterSetup& character, const std::vector<std::string>& opt
   if (const std::string bad = unknownKeepApartPart(character); !bad.empty()) throw Error("--keep-apart: " + bad);
 }
 
-std::vector<sim::BodyOverlap> bodyOverlaps(const RunSetup& setup, const sim::CharacterWorld& world) {
-  if (!setup.character || !setup.character->animation) return {};
+std::vector<sim::BodyOverlap> bodyOverlaps(const RunSetup& setup, const CharacterSetup& character,
+                                           const sim::CharacterWorld& world) {
+  if (!character.animation) return {};
   // Deeper than a voxel beyond rest: the fields read distances to about half a voxel.
-  return sim::findBodyOverlaps(*setup.character->avatar, world.poses(), world.fields(), setup.frames,
-                               setup.settings.frameRate_hz, setup.character->voxel_m);
+  return sim::findBodyOverlaps(*character.avatar, world.poses(), world.fields(), setup.frames,
+                               setup.settings.frameRate_hz, character.voxel_m);
 }
 
 namespace {
 
-std::vector<sim::BodyOverlap> findOverlaps(const RunSetup& setup, const sim::CharacterWorld& world) {
+std::vector<sim::BodyOverlap> findOverlaps(const RunSetup& setup, const CharacterSetup& character,
+                                           const sim::CharacterWorld& world) {
   const auto start = std::chrono::steady_clock::now();
-  std::vector<sim::BodyOverlap> found = bodyOverlaps(setup, world);
+  std::vector<sim::BodyOverlap> found = bodyOverlaps(setup, character, world);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!found.empty())
-    spdlog::info("the motion puts collidable parts of the body inside each other beyond their overlap at rest, {} "
+    spdlog::info("{} motion puts collidable parts of the body inside each other beyond their overlap at rest, {} "
                  "pairs (stats.json: body_overlaps; found in {:.2f} s); deepest: {}{}",
-                 found.size(), seconds, sim::describe(found.front()),
-                 setup.character->keepApart.empty()
+                 setup.characters.size() > 1 ? fmt::format("{}'s", character.name) : std::string("the"), found.size(),
+                 seconds, sim::describe(found.front()),
+                 character.keepApart.empty()
                      ? " (--keep-apart PARTS turns named parts out of the others before simulating)"
                      : "");
   return found;
@@ -559,15 +665,25 @@ std::string describeInstability(const GarmentRun& r, double maxSpeed_m_s,
 }  // namespace
 
 long defaultFrames(const RunSetup& setup) {
-  if (!setup.character || !setup.character->animation)
-    throw Error("--frames is required (it defaults to the motion's length only with --motion)");
-  const double seconds = setup.character->leadIn_s + setup.character->animation->duration();
+  double seconds = -1.0;
+  for (const CharacterSetup& c : setup.characters)
+    if (c.animation) seconds = std::max(seconds, c.leadIn_s + c.animation->duration());
+  if (seconds < 0.0) throw Error("--frames is required (it defaults to the motion's length only with --motion)");
   return static_cast<long>(std::ceil(seconds * setup.settings.frameRate_hz));
 }
 
 void validateRunSetup(const RunSetup& setup) {
   if (setup.garments.empty()) throw Error("drape run: no garment to simulate");
-  if (setup.character && !setup.character->avatar) throw Error("drape run: the character has no avatar", ExitCode::Internal);
+  std::vector<int> wornBy(setup.garments.size(), 0);
+  for (const CharacterSetup& c : setup.characters) {
+    if (!c.avatar) throw Error("drape run: a character has no avatar", ExitCode::Internal);
+    for (const std::size_t g : c.garments) {
+      if (g >= setup.garments.size()) throw Error("drape run: a character wears no such garment", ExitCode::Internal);
+      ++wornBy[g];
+    }
+  }
+  if (!setup.characters.empty() && std::any_of(wornBy.begin(), wornBy.end(), [](int n) { return n != 1; }))
+    throw Error("drape run: every garment is to be worn by one character", ExitCode::Internal);
   setup.settings.validate("--");
   if (setup.frames < 1 && !setup.motionStreamed) throw Error(fmt::format("--frames must be >= 1, got {}", setup.frames));
   if (setup.objEvery < 1) throw Error(fmt::format("--every must be >= 1, got {}", setup.objEvery));
@@ -610,20 +726,46 @@ void garmentVertexStates(const cloth::ClothSolver& solver, const cloth::FieldCol
   }
 }
 
+SetupWorlds::SetupWorlds(const RunSetup& setup) : place_(setup.garments.size()) {
+  for (std::size_t c = 0; c < setup.characters.size(); ++c) {
+    const CharacterSetup& character = setup.characters[c];
+    worlds_.push_back(buildWorld(setup, character));
+    names_.push_back(character.name);
+    for (std::size_t k = 0; k < character.garments.size(); ++k) place_[character.garments[k]] = {c, k};
+  }
+}
+
+std::vector<const sim::CharacterWorld*> SetupWorlds::all() const {
+  std::vector<const sim::CharacterWorld*> out;
+  for (const auto& w : worlds_) out.push_back(w.get());
+  return out;
+}
+
+void SetupWorlds::sizeJoints(std::vector<std::vector<RigidTransform>>& out) const {
+  out.resize(worlds_.size());
+  for (std::size_t c = 0; c < worlds_.size(); ++c) out[c].resize(worlds_[c]->avatar().joints.size());
+}
+
+void SetupWorlds::evaluateJoints(long frame, std::vector<std::vector<RigidTransform>>& out) const {
+  for (std::size_t c = 0; c < worlds_.size(); ++c) worlds_[c]->poses().evaluate(worlds_[c]->frameTime(frame), out[c]);
+}
+
 namespace {
 
 /// drape run's sink: the run directory's files.
 class WriterSink final : public FrameSink {
  public:
   explicit WriterSink(const RunSetup& setup) : setup_(setup) {}
-  void begin(const sim::CharacterWorld* world) override {
-    std::vector<RigidTransform> joints;
-    if (world) {
-      joints.resize(setup_.character->avatar->joints.size());
-      world->poses().evaluate(0.0, joints);
+  void begin(const std::vector<const sim::CharacterWorld*>& worlds) override {
+    std::vector<CharacterAtStart> characters;
+    for (const sim::CharacterWorld* world : worlds) {
+      CharacterAtStart& c = characters.emplace_back();
+      c.fields = &world->fields();
+      c.skinAllowance_m = leastT0(*world);
+      c.joints.resize(world->avatar().joints.size());
+      world->poses().evaluate(0.0, c.joints);
     }
-    writer_ = std::make_unique<RunWriter>(setup_, world ? &world->fields() : nullptr, world ? leastT0(*world) : 0.0,
-                                          joints);
+    writer_ = std::make_unique<RunWriter>(setup_, characters);
   }
   void write(const FrameTaken& frame) override { writer_->write(frame); }
   void end(long frames) override { writer_->close(frames); }
@@ -649,11 +791,23 @@ namespace {
 /// (the scene's during the lead-in and where the graph set none).
 Vec3 windOf(const RunSetup& setup, long frame) {
   const double rate = setup.settings.frameRate_hz;
-  const double t = static_cast<double>(frame) / rate - (setup.character ? setup.character->leadIn_s : 0.0);
+  const double t =
+      static_cast<double>(frame) / rate - (setup.characters.empty() ? 0.0 : setup.characters.front().leadIn_s);
   if (t < 0.0) return setup.settings.wind_m_s;
   const MotionWind& wind = *setup.motionWind;
   const auto f = std::min(wind.size() - 1, static_cast<std::size_t>(std::floor(t * rate + 1e-6)));
   return wind[f].value_or(setup.settings.wind_m_s);
+}
+
+/// stats.json's entry for a character: its name and garments, and what the correction of its
+/// motion changed.
+nlohmann::json characterJson(const RunSetup& setup, const CharacterSetup& character, const sim::CharacterWorld& world) {
+  nlohmann::json garments = nlohmann::json::array();
+  for (const std::size_t g : character.garments) garments.push_back(setup.garments[g].name);
+  nlohmann::json entry = {{"name", character.name}, {"avatar", character.avatar->name}, {"garments", garments}};
+  if (!world.keepApartReport().parts.empty()) entry["keep_apart"] = keepApartJson(world.keepApartReport());
+  else if (character.liveKeptApart) entry["keep_apart"] = keepApartJson(character.liveKeptApart->report());
+  return entry;
 }
 
 }  // namespace
@@ -662,26 +816,33 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
   validateRunSetup(setup);
   const cloth::StepSettings& settings = setup.settings;
 
-  // Build every garment (topology checks happen here: non-manifold, degenerate). On a
-  // character, the world builds the part fields, binds the masks and owns the solvers.
+  // Build every garment (topology checks happen here: non-manifold, degenerate). On the
+  // characters, their worlds build the part fields, bind the masks and own the solvers.
   for (const GarmentSetup& g : setup.garments) (void)mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
-  std::unique_ptr<sim::CharacterWorld> world = setup.character ? buildWorld(setup) : nullptr;
+  SetupWorlds worlds(setup);
   // A streamed motion is not all there yet: where it puts the body inside itself is found
   // at the end, for the stats.
-  std::vector<sim::BodyOverlap> overlaps =
-      world && !setup.motionStreamed ? findOverlaps(setup, *world) : std::vector<sim::BodyOverlap>{};
+  std::vector<std::vector<sim::BodyOverlap>> overlaps(worlds.size());
+  if (!setup.motionStreamed)
+    for (std::size_t c = 0; c < worlds.size(); ++c) overlaps[c] = findOverlaps(setup, setup.characters[c], worlds.world(c));
+  // Per garment, the overlaps of the body that wears it (an instability report names them).
+  const auto overlapsOf = [&](std::size_t g) -> const std::vector<sim::BodyOverlap>& {
+    static const std::vector<sim::BodyOverlap> none;
+    return worlds.size() > 0 ? overlaps[worlds.characterOf(g)] : none;
+  };
   std::vector<GarmentRun> runs;
   for (std::size_t gi = 0; gi < setup.garments.size(); ++gi) {
     const GarmentSetup& g = setup.garments[gi];
     GarmentRun r;
     r.name = g.name;
-    if (world) {
-      r.solver = &world->mutableSolver(gi);
-      r.collider = world->collider(gi);
-      world->collider(gi)->setCountEverySubstep(setup.countEverySubstep);
-      world->collider(gi)->setContactPlanes(!setup.exactSliding);
-      world->collider(gi)->setPinchHold(!setup.freePinches);
-      logEasedPairs(g.name, *world->collider(gi));
+    if (worlds.size() > 0) {
+      r.solver = &worlds.solver(gi);
+      cloth::FieldCollider* collider = worlds.collider(gi);
+      r.collider = collider;
+      collider->setCountEverySubstep(setup.countEverySubstep);
+      collider->setContactPlanes(!setup.exactSliding);
+      collider->setPinchHold(!setup.freePinches);
+      logEasedPairs(g.name, *collider);
     } else {
       const mesh::Topology topology = mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
       auto model = cloth::ClothModel::build(g.mesh, topology, g.material, settings.massScaling());
@@ -712,8 +873,7 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
                    static_cast<long>(std::ceil(1.0 / (settings.frameRate_hz * stable))));
     runs.push_back(std::move(r));
   }
-  sink.begin(world.get());
-  std::vector<RigidTransform> joints(setup.character ? setup.character->avatar->joints.size() : 0);
+  sink.begin(worlds.all());
 
   // Per-frame records for stats.json: each frame's own stage times (frame 0, the initial
   // state, simulates nothing: the settling's times are not the run's), and the output's,
@@ -739,7 +899,7 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
   const auto prepare = [&](FrameTaken& slot) {
     slot.positions.resize(runs.size());
     slot.states.resize(runs.size());
-    slot.joints.resize(joints.size());
+    worlds.sizeJoints(slot.joints);
   };
   const auto take = [&](long frame, FrameTaken& taken) {
     taken.frame = frame;
@@ -752,7 +912,7 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
       maxStrain = std::max(maxStrain, cloth::maxEdgeStrain(*runs[g].model, solver.state()));
     }
     energy.push_back(e);
-    if (world) world->poses().evaluate(world->frameTime(frame), taken.joints);
+    worlds.evaluateJoints(frame, taken.joints);
   };
   const auto write = [&](const FrameTaken& taken) {
     const Clock::time_point start = Clock::now();
@@ -764,7 +924,8 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
     frameOutputMs[f] = 1e3 * seconds;
   };
 
-  const sim::SettleReport settled = world ? settleWorld(setup, *world) : sim::SettleReport{};
+  sim::SettleReport settled;
+  for (std::size_t c = 0; c < worlds.size(); ++c) settled += settleWorld(setup.characters[c], worlds.world(c));
   Progress progress("drape run", std::max(0L, setup.frames));
   long done = 0;
   std::exception_ptr stopped;
@@ -783,7 +944,7 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
         for (std::size_t g = 0; g < runs.size() && unstable.empty(); ++g) {
           sim::logFrameRecovery(*runs[g].solver, setup.garments[g].name, frame);
           if (!stable[g]) {
-            unstable = describeInstability(runs[g], settings.maxSpeed_m_s, overlaps, frame);
+            unstable = describeInstability(runs[g], settings.maxSpeed_m_s, overlapsOf(g), frame);
             unstableNan = runs[g].solver->instability().nan;
           }
         }
@@ -811,10 +972,10 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
   }
   const double loopSeconds = std::chrono::duration<double>(Clock::now() - loopStart).count();
   progress.finish();
-  if (world && setup.motionStreamed) {
+  if (setup.motionStreamed) {
     RunSetup played = setup;
     played.frames = done;
-    overlaps = findOverlaps(played, *world);
+    for (std::size_t c = 0; c < worlds.size(); ++c) overlaps[c] = findOverlaps(played, setup.characters[c], worlds.world(c));
   }
 
   // Close the outputs and write the stats (also after an instability).
@@ -886,8 +1047,10 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
   }
   stats["garments"] = garments;
   nlohmann::json bodyOverlaps = nlohmann::json::array();
-  for (const sim::BodyOverlap& o : overlaps)
-    bodyOverlaps.push_back({{"part", o.part},
+  for (std::size_t c = 0; c < overlaps.size(); ++c)
+    for (const sim::BodyOverlap& o : overlaps[c])
+      bodyOverlaps.push_back({{"character", setup.characters[c].name},
+                            {"part", o.part},
                             {"into", o.into},
                             {"depth_m", o.depth_m},
                             {"deepest_frame", o.deepestFrame},
@@ -895,10 +1058,13 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
                             {"last_frame", o.lastFrame},
                             {"frames", o.frames}});
   stats["body_overlaps"] = bodyOverlaps;
-  if (world && !world->keepApartReport().parts.empty()) stats["keep_apart"] = keepApartJson(world->keepApartReport());
-  else if (setup.character && setup.character->liveKeptApart)
-    stats["keep_apart"] = keepApartJson(setup.character->liveKeptApart->report());
-  addCollisionStats(stats, runs, total, done, world.get());
+  nlohmann::json characters = nlohmann::json::array();
+  for (std::size_t c = 0; c < worlds.size(); ++c)
+    characters.push_back(characterJson(setup, setup.characters[c], worlds.world(c)));
+  // One character's correction where it always was; several characters' in theirs.
+  if (characters.size() == 1 && characters[0].contains("keep_apart")) stats["keep_apart"] = characters[0]["keep_apart"];
+  stats["characters"] = characters;
+  addCollisionStats(stats, runs, total, done, worlds);
   sink.stats(stats);
 
   if (stopped) std::rethrow_exception(stopped);

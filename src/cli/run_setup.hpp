@@ -30,7 +30,8 @@ namespace drape::cli {
 /// constraint mask (bound vertices), collision candidates and offsets.
 using GarmentSetup = sim::GarmentSpec;
 
-/// The character garments are worn by: a segmented avatar and, optionally, its motion.
+/// A character garments are worn by: a segmented avatar, the garments it wears and,
+/// optionally, its motion.
 struct CharacterSetup {
   std::shared_ptr<const scene::Avatar> avatar;
   std::shared_ptr<const motion::AvatarAnimation> animation;  ///< null: the avatar stands at rest
@@ -50,6 +51,11 @@ struct CharacterSetup {
   /// What the scene calls the character (its Avatar or Humanoid node), besides the avatar's
   /// own name: an event graph's Plays name it so.
   std::vector<std::string> names{};
+  /// What the run calls it (messages, --motion NAME=FILE, its files in a run directory of
+  /// several characters): the scene's name for it, unique in the setup.
+  std::string name{};
+  /// The garments it wears: indices into RunSetup::garments, ascending.
+  std::vector<std::size_t> garments{};
 };
 
 /// Per motion frame, the wind an event graph set (none: the scene's).
@@ -64,7 +70,9 @@ struct RunSetup {
   std::vector<GarmentSetup> garments;
   cloth::StepSettings settings;
   std::vector<SphereSetup> spheres;    ///< analytic sphere colliders (every garment collides)
-  std::optional<CharacterSetup> character;  ///< garments on an avatar, colliding with its parts
+  /// The characters the garments are worn by, each colliding with its own avatar's parts
+  /// (every garment worn by one of them); none: the garments hang on their pins.
+  std::vector<CharacterSetup> characters;
   long frames = 0;                     ///< frames to simulate after the initial one
   long objEvery = 1;                   ///< write an OBJ frame every K frames
   std::string outDir;
@@ -91,22 +99,35 @@ struct RunSetup {
 };
 
 /// The time code of frame `frame` of the run, as the studio numbers a cloth take's: the
-/// setup's timeCodeOfFrame0 and on; else, on a character, motion frame 0 at its motion's
-/// time code (0 where it has none) and the lead-in's frames before it; else the frame.
+/// setup's timeCodeOfFrame0 and on; else, on characters, motion frame 0 at the first one's
+/// motion's time code (0 where it has none) and the lead-in's frames before it; else the frame.
 [[nodiscard]] TimeCode frameTimeCode(const RunSetup& setup, long frame);
 
-/// Garments, materials, settings and the avatar (as the setup's character, without motion)
+/// The setup's one character, for `what` plays one (the studio's roles, a live capture): null
+/// when it has none; throws drape::Error saying so when it has several.
+[[nodiscard]] CharacterSetup* oneCharacter(RunSetup& setup, const std::string& what);
+[[nodiscard]] const CharacterSetup* oneCharacter(const RunSetup& setup, const std::string& what);
+/// The character named `name` ("NAME", as --motion NAME=FILE gives it); throws drape::Error
+/// listing the setup's characters when none is called so.
+[[nodiscard]] CharacterSetup& characterNamed(RunSetup& setup, const std::string& name, const std::string& option);
+/// Leaves out the garments `keep` refuses (by index into setup.garments), and the characters
+/// left wearing none; the others' garment indices follow.
+void keepGarmentsWhere(RunSetup& setup, const std::function<bool(std::size_t garment)>& keep);
+/// The specs of the garments `character` wears, in its order (its world's garment order).
+[[nodiscard]] std::vector<GarmentSetup> garmentsOf(const RunSetup& setup, const CharacterSetup& character);
+
+/// Garments, materials, settings and the avatars (as the setup's characters, without motion)
 /// from a VRML97 scene. Throws drape::Error on a bad scene or one with no ClothSet.
 /// `cutAtJoints`, when given, replaces the Avatar node's cutAtJoints (drape run
 /// --cut-at-joints; empty: parts by dominant weight alone).
 [[nodiscard]] RunSetup runSetupFromScene(const std::string& scenePath,
                                          const std::optional<std::vector<std::string>>& cutAtJoints = std::nullopt);
 
-/// Loads a motion file onto the setup's avatar (rate = the setup's frame rate). `metresPerUnit`
+/// Loads a motion file onto `character`'s avatar (rate = the setup's frame rate). `metresPerUnit`
 /// > 0 overrides the units guess; `jointMap` "" picks one of the shipped maps; `animation`
 /// chooses one of a glTF motion file's animations ("" the first); `sampled`, when given, is
 /// that animation already sampled at the setup's frame rate (the file is not read again).
-void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerUnit = 0.0,
+void addMotion(const RunSetup& setup, CharacterSetup& character, const std::string& motionPath, double metresPerUnit = 0.0,
                const std::string& jointMap = "", const std::string& animation = "",
                const formats::SkinnedJointMotion* sampled = nullptr);
 
@@ -114,8 +135,9 @@ void addMotion(RunSetup& setup, const std::string& motionPath, double metresPerU
 /// maps (what --motion and an event graph's Plays share).
 [[nodiscard]] motion::MotionOptions motionOptions(const RunSetup& setup);
 
-/// Plays an EGML event graph (docs/EVENTS.md) on the setup's avatar: its motion and the wind
-/// it sets. `sets` are NAME=VALUE parameters, `sends` NAME@SECONDS events; `motionFrames` > 0
+/// Plays an EGML event graph (docs/EVENTS.md) on the setup's characters: each plays the
+/// events that name it and those that name none (docs/EVENTS.md), and the wind it sets
+/// blows on all. `sets` are NAME=VALUE parameters, `sends` NAME@SECONDS events; `motionFrames` > 0
 /// renders that many motion frames at most (an endless graph needs it).
 void addEvents(RunSetup& setup, const std::string& graphPath, const std::vector<std::string>& sets,
                const std::vector<std::string>& sends, long motionFrames);
@@ -145,8 +167,20 @@ struct MotionChoice {
   /// The motion as sampled to find it (a VRML97 Humanoid's interpolators), or null.
   std::shared_ptr<const formats::SkinnedJointMotion> sampled;
 };
-[[nodiscard]] MotionChoice sceneMotion(const RunSetup& setup, const std::string& scenePath, const std::string& motion,
-                                       const std::string& animation);
+[[nodiscard]] MotionChoice sceneMotion(const RunSetup& setup, const CharacterSetup* character, const std::string& scenePath,
+                                       const std::string& motion, const std::string& animation);
+
+/// How a scene command's --motion options load: FILE (or none) for every character, NAME=FILE
+/// for the character called NAME (overriding a FILE for all), each with sceneMotion's
+/// choice where none is given (its own file's animation). `metresPerUnit` and `jointMap` as
+/// addMotion takes them. Throws drape::Error naming --motion for a NAME the scene lacks or
+/// a character given twice.
+void addSceneMotions(RunSetup& setup, const std::string& scenePath, const std::vector<std::string>& motions,
+                     const std::string& animation, double metresPerUnit = 0.0, const std::string& jointMap = "");
+/// --motion's help on commands that take it once per character (NAME=FILE).
+inline constexpr const char* kMotionPerCharacterHelp =
+    "; with several characters in the scene, FILE plays on every one and NAME=FILE on the one the scene calls NAME "
+    "(repeatable)";
 /// What `avatar` plays without --motion, as the end of "the avatar plays ..." ("its own
 /// file's animation 'walk'"), or "" when it stands at rest.
 [[nodiscard]] std::string ownMotionText(const scene::Avatar& avatar);
@@ -154,28 +188,30 @@ struct MotionChoice {
 /// `out`, and what moves `avatar` there without --motion (what sceneMotion would play).
 void printHowToRun(const std::string& out, const scene::Avatar& avatar);
 
-/// The world settings of a setup with an avatar (its step, voxel size, field method, lead-in).
-[[nodiscard]] sim::WorldSettings worldSettings(const RunSetup& setup);
+/// The world settings of one of the setup's characters (the step, its voxel size, field
+/// method, lead-in and keep-apart).
+[[nodiscard]] sim::WorldSettings worldSettings(const RunSetup& setup, const CharacterSetup& character);
 
-/// The character's world of a setup with an avatar: fields built, masks bound, solvers
-/// ready. Used by `drape run`, `drape play SCENE` and `drape bench paper` alike.
-[[nodiscard]] std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup);
+/// A character's world: fields built, masks bound, solvers ready for the garments it wears.
+/// Used by `drape run`, `drape play SCENE` and `drape bench paper` alike.
+[[nodiscard]] std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup, const CharacterSetup& character);
 /// Settles the world's garments before frame 0 for at most the character's settle_s
 /// (sim::CharacterWorld::settle) and logs what it did. Call after the colliders' settings,
 /// before the first frame. Throws drape::Error (Unstable) when a garment goes unstable.
-sim::SettleReport settleWorld(const RunSetup& setup, sim::CharacterWorld& world);
+sim::SettleReport settleWorld(const CharacterSetup& character, sim::CharacterWorld& world);
 /// The least T0 of the world's garments: how far the drawn skin may stand out of the body
 /// parts (sim::BodySkin).
 [[nodiscard]] double leastT0(const sim::CharacterWorld& world);
 
 /// Builds the character's part fields (sim::buildPartFields) into it, saying `why`, unless
 /// they were built before: a world built after takes them.
-void buildPartFieldsOnce(RunSetup& setup, const std::string& why);
+void buildPartFieldsOnce(const RunSetup& setup, CharacterSetup& character, const std::string& why);
 /// A live motion's keep-apart (sim::LiveKeepApart), as a world corrects a recorded motion:
 /// the character's keepApart parts, the margin its garments need. The part fields it reads are
 /// built here (buildPartFieldsOnce) unless they were before: build them before the capture
 /// is opened, so that its first frames do not wait for them. Null when the character keeps no parts apart. `rate` is the motion's.
-[[nodiscard]] std::shared_ptr<sim::LiveKeepApart> liveKeepApart(RunSetup& setup, double rate);
+[[nodiscard]] std::shared_ptr<sim::LiveKeepApart> liveKeepApart(const RunSetup& setup, CharacterSetup& character,
+                                                               double rate);
 /// Logs what a keep-apart changed in the motion: one line, and one per pair it moved.
 void logKeptApart(const sim::KeepApartReport& report);
 
@@ -190,13 +226,14 @@ void setKeepApart(CharacterSetup& character, const std::vector<std::string>& opt
 /// does not have; "" when it has them all.
 [[nodiscard]] std::string unknownKeepApartPart(const CharacterSetup& character);
 
-/// Where the setup's motion puts the world's collidable parts inside each other over
+/// Where a character's motion puts its world's collidable parts inside each other over
 /// setup.frames, beyond their overlap at rest and deeper than a voxel (sim::findBodyOverlaps);
 /// none without a motion. `drape run` writes them into stats.json, `drape inspect --motion`
 /// lists them.
-[[nodiscard]] std::vector<sim::BodyOverlap> bodyOverlaps(const RunSetup& setup, const sim::CharacterWorld& world);
-/// Frames to simulate when none are asked for: the lead-in plus the whole motion. Throws
-/// naming --frames when there is no motion.
+[[nodiscard]] std::vector<sim::BodyOverlap> bodyOverlaps(const RunSetup& setup, const CharacterSetup& character,
+                                                         const sim::CharacterWorld& world);
+/// Frames to simulate when none are asked for: the lead-in plus the longest motion. Throws
+/// naming --frames when no character has a motion.
 [[nodiscard]] long defaultFrames(const RunSetup& setup);
 
 /// Checks the setup (garment topology, materials, settings, pins) and throws drape::Error
@@ -214,13 +251,50 @@ void validateRunSetup(const RunSetup& setup);
 /// garment, vertex and frame.
 int simulateRun(const RunSetup& setup, const std::function<bool(long frame)>& gate = nullptr);
 
+/// Every character's world of a setup (buildWorld), and where each garment of the setup is
+/// simulated: `drape run`'s loop and `drape play SCENE`'s step them alike.
+class SetupWorlds {
+ public:
+  explicit SetupWorlds(const RunSetup& setup);
+
+  /// Characters (and worlds), in the setup's order.
+  [[nodiscard]] std::size_t size() const { return worlds_.size(); }
+  [[nodiscard]] sim::CharacterWorld& world(std::size_t c) { return *worlds_[c]; }
+  [[nodiscard]] const sim::CharacterWorld& world(std::size_t c) const { return *worlds_[c]; }
+  [[nodiscard]] std::vector<const sim::CharacterWorld*> all() const;
+  [[nodiscard]] const std::string& characterName(std::size_t c) const { return names_[c]; }
+
+  /// The character that wears garment g of the setup, and the garment in its world.
+  [[nodiscard]] std::size_t characterOf(std::size_t g) const { return place_[g].first; }
+  [[nodiscard]] cloth::ClothSolver& solver(std::size_t g) { return worlds_[place_[g].first]->mutableSolver(place_[g].second); }
+  [[nodiscard]] const cloth::ClothSolver& solver(std::size_t g) const {
+    return worlds_[place_[g].first]->solver(place_[g].second);
+  }
+  [[nodiscard]] cloth::FieldCollider* collider(std::size_t g) {
+    return worlds_[place_[g].first]->collider(place_[g].second);
+  }
+  [[nodiscard]] const cloth::FieldCollider* collider(std::size_t g) const {
+    return worlds_[place_[g].first]->collider(place_[g].second);
+  }
+
+  /// Sizes `out` to every character's joints.
+  void sizeJoints(std::vector<std::vector<RigidTransform>>& out) const;
+  /// Every character's joints in the world at `frame` into `out` (sized by sizeJoints).
+  void evaluateJoints(long frame, std::vector<std::vector<RigidTransform>>& out) const;
+
+ private:
+  std::vector<std::unique_ptr<sim::CharacterWorld>> worlds_;
+  std::vector<std::string> names_;
+  std::vector<std::pair<std::size_t, std::size_t>> place_;  ///< per garment: character, index in its world
+};
+
 /// Where a run's frames go: drape run's files (run_writer.hpp), a cloth-server's stream.
 class FrameSink {
  public:
   virtual ~FrameSink() = default;
-  /// The world is built (null without a character) and the garments' solvers made; the
-  /// settling and frame 0 come next.
-  virtual void begin(const sim::CharacterWorld* world) = 0;
+  /// The worlds are built (one per character, in the setup's order; none without a
+  /// character) and the garments' solvers made; the settling and frame 0 come next.
+  virtual void begin(const std::vector<const sim::CharacterWorld*>& worlds) = 0;
   /// Each frame in order from 0, on the calling thread while the next are simulated.
   virtual void write(const FrameTaken& frame) = 0;
   /// After the last frame written, also when the run stopped unstable: `frames` frames

@@ -50,6 +50,17 @@ struct SegmentFiles {
   std::unique_ptr<formats::Pc2Writer> cache;
 };
 
+/// One character's files: its parts, its skinned body (when the avatar has one), and its
+/// joints per frame for result.wrl.
+struct CharacterFiles {
+  const CharacterSetup* setup = nullptr;
+  std::vector<SegmentFiles> segments;
+  std::vector<std::vector<RigidTransform>> jointFrames;  ///< per joint, per frame
+  std::unique_ptr<sim::BodySkin> skin;
+  std::unique_ptr<formats::Pc2Writer> skinCache;
+  std::vector<Vec3> skinPositions;
+};
+
 }  // namespace
 
 void createOutDir(const std::string& dir) {
@@ -63,17 +74,12 @@ struct RunWriter::Impl {
   fs::path out;
   formats::RunManifest manifest;
   std::vector<GarmentFiles> garments;
-  std::vector<SegmentFiles> segments;
-  std::vector<std::vector<RigidTransform>> jointFrames;  ///< per joint, per frame (result.wrl)
-  std::unique_ptr<sim::BodySkin> skin;                   ///< the skinned body, when the avatar has one
-  std::unique_ptr<formats::Pc2Writer> skinCache;
-  std::vector<Vec3> skinPositions, positions;
+  std::vector<CharacterFiles> characters;
+  std::vector<Vec3> positions;
   std::vector<sim::GarmentSurface> surfaces;
   bool closed = false;
 
-  Impl(const RunSetup& s, const std::vector<sim::PartField>* fields, double skinAllowance_m,
-       std::span<const RigidTransform> joints)
-      : setup(s), out(s.outDir) {
+  Impl(const RunSetup& s, const std::vector<CharacterAtStart>& atStart) : setup(s), out(s.outDir) {
     createOutDir(setup.outDir);
     manifest.frameRate = setup.settings.frameRate_hz;
     manifest.startFrame = static_cast<long>(frameTimeCode(setup, 0).frame);
@@ -92,35 +98,51 @@ struct RunWriter::Impl {
       manifest.meshes.push_back({g.name, "garment", f.fileStem + ".obj", f.fileStem + ".pc2", f.fileStem + ".states"});
       garments.push_back(std::move(f));
     }
-    if (!setup.character) return;
-    const scene::Avatar& avatar = *setup.character->avatar;
-    jointFrames.resize(avatar.joints.size());
+    if (atStart.size() != setup.characters.size())
+      throw Error(fmt::format("run writer: {} characters at the start for {}", atStart.size(), setup.characters.size()),
+                  ExitCode::Internal);
+    for (std::size_t c = 0; c < setup.characters.size(); ++c) characters.push_back(characterFiles(c, atStart[c]));
+  }
+
+  /// Character c's rest files: its parts and its skinned body. Alone, its files are
+  /// segments/PART and body; among several, segments/CHARACTER/PART and body-CHARACTER.
+  CharacterFiles characterFiles(std::size_t c, const CharacterAtStart& start) {
+    CharacterFiles files;
+    files.setup = &setup.characters[c];
+    const scene::Avatar& avatar = *files.setup->avatar;
+    const bool several = setup.characters.size() > 1;
+    const std::string who = several ? files.setup->name : "";
+    const std::string segmentDir = several ? "segments/" + fileSafe(who) + "/" : "segments/";
+    files.jointFrames.resize(avatar.joints.size());
     std::error_code ec;
-    fs::create_directories(out / "segments", ec);
-    if (avatar.skin && fields) {
+    fs::create_directories(out / segmentDir, ec);
+    if (avatar.skin && start.fields) {
       // The skinned body, which players draw instead of the segments (the collision's own
       // bodies, still written for the overlays and exporters).
-      skin = std::make_unique<sim::BodySkin>(avatar, *fields, skinAllowance_m);
-      skin->pose(joints, skinPositions);
-      formats::writeObj((out / "body.obj").string(), skinPositions, avatar.skin->mesh.triangles,
-                        "drape run: the avatar's skinned body (m)");
-      skinCache = std::make_unique<formats::Pc2Writer>((out / "body.pc2").string(), skinPositions.size(), 0.0, 1.0);
-      manifest.meshes.push_back({"body", "skin", "body.obj", "body.pc2", ""});
+      const std::string stem = several ? "body-" + fileSafe(who) : "body";
+      files.skin = std::make_unique<sim::BodySkin>(avatar, *start.fields, start.skinAllowance_m);
+      files.skin->pose(start.joints, files.skinPositions);
+      formats::writeObj((out / (stem + ".obj")).string(), files.skinPositions, avatar.skin->mesh.triangles,
+                        several ? "drape run: " + who + "'s skinned body (m)" : "drape run: the avatar's skinned body (m)");
+      files.skinCache =
+          std::make_unique<formats::Pc2Writer>((out / (stem + ".pc2")).string(), files.skinPositions.size(), 0.0, 1.0);
+      manifest.meshes.push_back({"body", "skin", stem + ".obj", stem + ".pc2", "", who});
     }
     for (const scene::Segment& seg : avatar.segments) {
       SegmentFiles sf;
       sf.name = seg.name;
       sf.joint = seg.joint;
       sf.mesh = &seg.mesh;
-      sf.fileStem = "segments/" + fileSafe(seg.name);
+      sf.fileStem = segmentDir + fileSafe(seg.name);
       std::vector<Vec3> rest;
-      for (const Vec3& p : seg.mesh.positions) rest.push_back(joints[static_cast<std::size_t>(seg.joint)].apply(p));
+      for (const Vec3& p : seg.mesh.positions) rest.push_back(start.joints[static_cast<std::size_t>(seg.joint)].apply(p));
       formats::writeObj((out / (sf.fileStem + ".obj")).string(), rest, seg.mesh.triangles,
-                        "drape run: body part " + seg.name + " (m)");
+                        "drape run: body part " + seg.name + (several ? " of " + who : "") + " (m)");
       sf.cache = std::make_unique<formats::Pc2Writer>((out / (sf.fileStem + ".pc2")).string(), rest.size(), 0.0, 1.0);
-      manifest.meshes.push_back({seg.name, "segment", sf.fileStem + ".obj", sf.fileStem + ".pc2", ""});
-      segments.push_back(std::move(sf));
+      manifest.meshes.push_back({seg.name, "segment", sf.fileStem + ".obj", sf.fileStem + ".pc2", "", who});
+      files.segments.push_back(std::move(sf));
     }
+    return files;
   }
 
   /// frames/frame_NNNNN.obj (frames/garment-NAME_NNNNN.obj with several garments).
@@ -140,19 +162,23 @@ struct RunWriter::Impl {
       f.states->writeFrame(taken.states[g]);
       if (taken.frame % setup.objEvery == 0) writeObjFrame(f, taken.frame, p);
     }
-    if (!setup.character) return;
-    for (std::size_t j = 0; j < taken.joints.size(); ++j) jointFrames[j].push_back(taken.joints[j]);
-    for (SegmentFiles& sf : segments) {
+    for (std::size_t c = 0; c < characters.size(); ++c) writeCharacter(characters[c], taken.joints[c], taken);
+  }
+
+  void writeCharacter(CharacterFiles& files, const std::vector<RigidTransform>& joints, const FrameTaken& taken) {
+    for (std::size_t j = 0; j < joints.size(); ++j) files.jointFrames[j].push_back(joints[j]);
+    for (SegmentFiles& sf : files.segments) {
       positions.clear();
-      const RigidTransform& pose = taken.joints[static_cast<std::size_t>(sf.joint)];
+      const RigidTransform& pose = joints[static_cast<std::size_t>(sf.joint)];
       for (const Vec3& p : sf.mesh->positions) positions.push_back(pose.apply(p));
       sf.cache->writeFrame(positions);
     }
-    if (skinCache) {
+    if (files.skinCache) {
+      // Tucked under the garments it wears.
       surfaces.clear();
-      for (std::size_t g = 0; g < garments.size(); ++g) surfaces.push_back({taken.positions[g], *garments[g].triangles});
-      skin->pose(taken.joints, surfaces, skinPositions);
-      skinCache->writeFrame(skinPositions);
+      for (const std::size_t g : files.setup->garments) surfaces.push_back({taken.positions[g], *garments[g].triangles});
+      files.skin->pose(joints, surfaces, files.skinPositions);
+      files.skinCache->writeFrame(files.skinPositions);
     }
   }
 
@@ -163,14 +189,16 @@ struct RunWriter::Impl {
     animation.frameRate = setup.settings.frameRate_hz;
     for (const GarmentFiles& f : garments)
       animation.garments.push_back({f.name, *f.triangles, f.frames, Vec3(0.8, 0.25, 0.2)});
-    if (setup.character) {
-      const scene::Avatar& avatar = *setup.character->avatar;
+    for (const CharacterFiles& files : characters) {
+      const scene::Avatar& avatar = *files.setup->avatar;
+      // Among several characters, each joint's node named for its character too.
+      const std::string prefix = characters.size() > 1 ? fileSafe(files.setup->name) + "_" : "";
       for (std::size_t j = 0; j < avatar.joints.size(); ++j) {
         formats::vrml::JointTrack track;
-        track.name = avatar.joints[j].name;
-        for (const SegmentFiles& sf : segments)
+        track.name = prefix + avatar.joints[j].name;
+        for (const SegmentFiles& sf : files.segments)
           if (sf.joint == static_cast<int>(j)) track.segments.push_back(*sf.mesh);
-        track.frames = jointFrames[j];
+        track.frames = files.jointFrames[j];
         animation.joints.push_back(std::move(track));
       }
     }
@@ -192,17 +220,18 @@ struct RunWriter::Impl {
       const long last = static_cast<long>(f.frames.size()) - 1;
       if (last > 0 && last % setup.objEvery != 0) writeObjFrame(f, last, f.frames.back());
     }
-    for (SegmentFiles& sf : segments) sf.cache->close();
-    if (skinCache) skinCache->close();
+    for (CharacterFiles& files : characters) {
+      for (SegmentFiles& sf : files.segments) sf.cache->close();
+      if (files.skinCache) files.skinCache->close();
+    }
     manifest.frames = frames + 1;
     formats::writeRunManifest(setup.outDir, manifest);
     writeResultFiles();
   }
 };
 
-RunWriter::RunWriter(const RunSetup& setup, const std::vector<sim::PartField>* fields, double skinAllowance_m,
-                     std::span<const RigidTransform> jointsAtStart)
-    : impl_(std::make_unique<Impl>(setup, fields, skinAllowance_m, jointsAtStart)) {}
+RunWriter::RunWriter(const RunSetup& setup, const std::vector<CharacterAtStart>& characters)
+    : impl_(std::make_unique<Impl>(setup, characters)) {}
 
 RunWriter::~RunWriter() = default;
 

@@ -7,6 +7,7 @@
 //   DIR/frames/*.obj                        every objEvery-th frame of each garment
 //   DIR/segments/*.obj, *.pc2               the avatar's body parts, moving
 //   DIR/body.obj, body.pc2                  the skinned body, fitted and tucked under the cloth
+//   (with several characters, DIR/segments/CHARACTER/*.obj, *.pc2 and DIR/body-CHARACTER.obj, .pc2)
 //   DIR/manifest.json, result.wrl, result.glb, stats.json, and with preview the contact sheet
 
 #include <memory>
@@ -23,13 +24,19 @@
 
 namespace drape::cli {
 
+/// What the writer needs of a character before frame 0.
+struct CharacterAtStart {
+  /// The part fields its skinned body is fitted to (its world's); null: no skinned body.
+  const std::vector<sim::PartField>* fields = nullptr;
+  double skinAllowance_m = 0.0;        ///< how far out of them the skin may stand (leastT0)
+  std::vector<RigidTransform> joints;  ///< its joints at frame 0
+};
+
 class RunWriter {
  public:
-  /// Creates setup.outDir and writes the rest meshes. With a character, `fields` are the
-  /// part fields the skinned body is fitted to (the world's), `skinAllowance_m` how far out
-  /// of them it may stand (leastT0), `jointsAtStart` the joints at frame 0.
-  RunWriter(const RunSetup& setup, const std::vector<sim::PartField>* fields, double skinAllowance_m,
-            std::span<const RigidTransform> jointsAtStart);
+  /// Creates setup.outDir and writes the rest meshes: the garments, and per character of the
+  /// setup (`characters`, in its order) its parts and skinned body.
+  RunWriter(const RunSetup& setup, const std::vector<CharacterAtStart>& characters);
   ~RunWriter();
   RunWriter(const RunWriter&) = delete;
   RunWriter& operator=(const RunWriter&) = delete;

@@ -27,9 +27,9 @@ std::string disagreement(const studio::ClothStart& a, const studio::ClothStart& 
 
 StudioFrames::StudioFrames(studio::Bus& bus, RunSetup& setup, const std::vector<std::string>& cloth,
                            const StudioOptions& options)
-    : setup_(setup), sceneGarments_(setup.garments), options_(options), bus_(bus),
+    : setup_(setup), sceneGarments_(setup.garments), sceneCharacters_(setup.characters), options_(options), bus_(bus),
       consumer_(consumerName("player", true)) {
-  if (!setup.character) throw Error("drape player: the scene has no avatar the garments are worn by");
+  if (!oneCharacter(setup, "the studio")) throw Error("drape player: the scene has no avatar the garments are worn by");
   if (cloth.empty()) throw Error("--cloth: name at least one cloth-server");
   for (const std::string& source : cloth) {
     studio::checkSourceName(source, "--cloth");
@@ -78,21 +78,23 @@ void StudioFrames::followNextTake(const std::string& take) {
       from[i] = static_cast<int>(s);
     }
   std::vector<std::string> missing;
-  std::vector<GarmentSetup> kept;
   std::vector<std::size_t> keptIndex(sceneGarments_.size(), 0);
+  std::size_t kept = 0;
   for (std::size_t i = 0; i < sceneGarments_.size(); ++i) {
     if (from[i] < 0) {
       missing.push_back(names[i]);
       continue;
     }
-    keptIndex[i] = kept.size();
-    kept.push_back(sceneGarments_[i]);
+    keptIndex[i] = kept++;
   }
   if (!missing.empty()) spdlog::info("no cloth stream sends {}; the player shows the rest", fmt::join(missing, ", "));
   for (Cloth& c : cloth_)
     for (const studio::GarmentInfo& g : c.follower->start().garments)
       c.garment.push_back(keptIndex[static_cast<std::size_t>(std::find(names.begin(), names.end(), g.name) - names.begin())]);
-  setup_.garments = std::move(kept);
+  // The setup shows the garments sent, in the scene's order (keptIndex's).
+  setup_.garments = sceneGarments_;
+  setup_.characters = sceneCharacters_;
+  keepGarmentsWhere(setup_, [&](std::size_t g) { return from[g] >= 0; });
 
   // The poses from where the stream is: a take's poses come before its cloth.
   if (!poseStream_ || poseStream_->source() != first.poses) {
@@ -103,9 +105,10 @@ void StudioFrames::followNextTake(const std::string& take) {
     poses_ = std::make_unique<studio::PoseFollower>(*poseStream_);
   }
   avatarPoses_.reset();
-  poses_->followNextTake(*setup_.character->avatar, setup_.settings.frameRate_hz, first.poseTake);
+  const scene::Avatar& avatar = *setup_.characters.front().avatar;
+  poses_->followNextTake(avatar, setup_.settings.frameRate_hz, first.poseTake);
   if (!poses_->waitForFrames(1)) throw Error(fmt::format("pose take {} ended without a frame", first.poseTake));
-  avatarPoses_ = std::make_unique<sim::AvatarPoses>(*setup_.character->avatar, &poses_->animation(), first.leadIn_s);
+  avatarPoses_ = std::make_unique<sim::AvatarPoses>(avatar, &poses_->animation(), first.leadIn_s);
 }
 
 StudioFrames::~StudioFrames() = default;
@@ -117,7 +120,7 @@ void StudioFrames::stopOn(const std::atomic<bool>* flag) {
 }
 
 std::vector<RigidTransform> StudioFrames::jointsAtStart() const {
-  std::vector<RigidTransform> joints(setup_.character->avatar->joints.size());
+  std::vector<RigidTransform> joints(setup_.characters.front().avatar->joints.size());
   avatarPoses_->evaluate(0.0, joints);
   return joints;
 }
@@ -126,7 +129,8 @@ bool StudioFrames::next(long frame, FrameTaken& out) {
   out.frame = frame;
   out.positions.resize(setup_.garments.size());
   out.states.resize(setup_.garments.size());
-  out.joints.resize(setup_.character->avatar->joints.size());
+  out.joints.resize(1);
+  out.joints.front().resize(setup_.characters.front().avatar->joints.size());
   out.stageMs = {};
   bool ended = false;
   for (Cloth& c : cloth_) {
@@ -145,7 +149,7 @@ bool StudioFrames::next(long frame, FrameTaken& out) {
   const studio::ClothStart& s = start();
   (void)poses_->waitForFrames(studio::motionFramesNeeded(frame, s.start.rate, s.leadIn_s, s.start.rate));
   // The time as the cloth-servers' world computes a frame's (CharacterWorld::frameTime).
-  avatarPoses_->evaluate(static_cast<double>(frame) / setup_.settings.frameRate_hz, out.joints);
+  avatarPoses_->evaluate(static_cast<double>(frame) / setup_.settings.frameRate_hz, out.joints.front());
   return true;
 }
 

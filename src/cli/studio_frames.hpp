@@ -67,6 +67,7 @@ class StudioFrames {
   };
   RunSetup& setup_;
   const std::vector<GarmentSetup> sceneGarments_;
+  const std::vector<CharacterSetup> sceneCharacters_;
   const StudioOptions options_;
   studio::Bus& bus_;
   std::string consumer_;

@@ -341,6 +341,8 @@ RunExportSummary exportRunToGlb(const std::string& runDirectory, const std::stri
           fmt::format("{}: {} samples, the manifest says {} frames", pc2Path, cache.frames.size(), manifest.frames));
     }
     cache.frames.resize(static_cast<std::size_t>(manifest.frames));
+    // Among several characters, a part's node is named for its character too.
+    const std::string name = rm.character.empty() ? rm.name : rm.character + "/" + rm.name;
     if (rm.role != "garment" && rm.role != "segment") {
       throw Error(fmt::format("{}: mesh '{}' has role '{}' (expected garment, segment or skin)",
                               (dir / "manifest.json").string(), rm.name, rm.role));
@@ -364,8 +366,8 @@ RunExportSummary exportRunToGlb(const std::string& runDirectory, const std::stri
         for (const Vec3& p : cache.frames[0]) centre += p;
         centre /= static_cast<double>(cache.frames[0].size());
         GltfRigidMesh part;
-        part.name = rm.name;
-        part.mesh.name = rm.name;
+        part.name = name;
+        part.mesh.name = name;
         part.mesh.triangles = topology.triangles;
         for (const Vec3& p : cache.frames[0]) part.mesh.positions.push_back(p - centre);
         for (const RigidTransform& x : motion) part.frames.push_back({x.rotation, x.rotation * centre + x.translation});
@@ -376,7 +378,7 @@ RunExportSummary exportRunToGlb(const std::string& runDirectory, const std::stri
       }
     }
     GltfDeformingMesh m;
-    m.name = rm.name;
+    m.name = name;
     m.triangles = std::move(topology.triangles);
     m.frames = std::move(cache.frames);
     m.colour = rm.role == "garment" ? kGarmentColour : kSegmentColour;

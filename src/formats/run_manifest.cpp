@@ -64,6 +64,7 @@ void writeRunManifest(const std::string& directory, const RunManifest& manifest)
   for (const RunMesh& m : manifest.meshes) {
     nlohmann::json mesh = {{"name", m.name}, {"role", m.role}, {"topology", m.topology}, {"cache", m.cache}};
     if (!m.states.empty()) mesh["states"] = m.states;
+    if (!m.character.empty()) mesh["character"] = m.character;
     j["meshes"].push_back(std::move(mesh));
   }
   const std::string path = (std::filesystem::path(directory) / "manifest.json").string();
@@ -95,6 +96,7 @@ RunManifest parseRunManifest(std::string_view text, const std::string& name) {
     r.topology = requiredString(mesh, "topology", name);
     r.cache = requiredString(mesh, "cache", name);
     if (mesh.contains("states")) r.states = requiredString(mesh, "states", name);
+    if (mesh.contains("character")) r.character = requiredString(mesh, "character", name);
     m.meshes.push_back(std::move(r));
   }
   return m;

@@ -15,6 +15,11 @@ MeshRole parseMeshRole(const std::string& role) {
   throw Error(fmt::format("mesh role '{}' is not one of: garment, segment, skin", role));
 }
 
+bool hasSkin(const std::vector<MeshInfo>& meshes, const std::string& character) {
+  return std::any_of(meshes.begin(), meshes.end(),
+                     [&](const MeshInfo& m) { return m.role == MeshRole::Skin && m.character == character; });
+}
+
 bool hasSkin(const std::vector<MeshInfo>& meshes) {
   return std::any_of(meshes.begin(), meshes.end(), [](const MeshInfo& m) { return m.role == MeshRole::Skin; });
 }

@@ -295,7 +295,7 @@ CameraMatrices cameraFor(const Aabb& boundsIn, const ViewSettings& view, double 
 
 struct Renderer::Impl {
   std::vector<MeshInfo> meshes;
-  bool skin = false;  ///< the run has the avatar's skinned body (hasSkin)
+  std::vector<std::uint8_t> skinned;  ///< per mesh: its character's skinned body is in the run
   std::vector<GpuMesh> gpu;
   std::vector<std::vector<float>> positions;  ///< per mesh, xyz float (uploaded)
   std::vector<std::vector<float>> normals;    ///< per mesh, xyz float, area-weighted, unit
@@ -446,7 +446,7 @@ struct Renderer::Impl {
       case MeshRole::Skin:
         return !overlay.segments;
       case MeshRole::Segment:
-        return overlay.segments || !skin;
+        return overlay.segments || !skinned[m];
     }
     return true;
   }
@@ -598,7 +598,8 @@ struct Renderer::Impl {
 Renderer::Renderer(std::vector<MeshInfo> meshes) : impl_(std::make_unique<Impl>()) {
   gl::requireGl33("renderer");
   impl_->meshes = std::move(meshes);
-  impl_->skin = hasSkin(impl_->meshes);
+  impl_->skinned.clear();
+  for (const MeshInfo& m : impl_->meshes) impl_->skinned.push_back(hasSkin(impl_->meshes, m.character) ? 1 : 0);
   impl_->createPrograms();
   impl_->createQuad();
   impl_->gpu.resize(impl_->meshes.size());

@@ -75,51 +75,33 @@ WorldSettings toWorldSettings(const scene::SimulationSettings& s) {
   return w;
 }
 
-std::vector<GarmentSpec> garmentSpecs(const scene::Scene& scene, const scene::Avatar* avatar) {
-  std::vector<GarmentSpec> specs;
-  for (const scene::Garment& g : scene.garments) {
-    GarmentSpec spec;
-    spec.name = g.name;
-    spec.mesh = g.mesh;
-    if (g.material >= 0) spec.material = toClothMaterial(scene.materials[static_cast<std::size_t>(g.material)]);
-    spec.bindThreshold_m = g.bindThreshold;
-    spec.stitches = cloth::stitchesDrawnTogether(g.stitches);
-    if (avatar) {
-      spec.bound = g.maskVertices;
-      spec.collidesWith = g.collidesWith;
-      spec.faceSamplesWith = g.faceSamplesWith;
-      if (spec.collidesWith.empty())
-        for (const scene::Segment& s : avatar->segments) spec.collidesWith.push_back(s.name);
-    } else {
-      spec.pinned = g.maskVertices;  // no body to bind to: the mask pins in place
-    }
-    const auto& o = scene.simulation.offsets;
-    spec.offsets = {o[0], o[1], o[2], o[3]};
-    spec.offsetsGiven = scene.simulation.source.line > 0;
-    spec.collisionEvery = scene.simulation.collisionEvery;
-    specs.push_back(std::move(spec));
+namespace {
+
+GarmentSpec garmentSpec(const scene::Scene& scene, const scene::Garment& g, const scene::Avatar* avatar) {
+  GarmentSpec spec;
+  spec.name = g.name;
+  spec.mesh = g.mesh;
+  if (g.material >= 0) spec.material = toClothMaterial(scene.materials[static_cast<std::size_t>(g.material)]);
+  spec.bindThreshold_m = g.bindThreshold;
+  spec.stitches = cloth::stitchesDrawnTogether(g.stitches);
+  if (avatar) {
+    spec.bound = g.maskVertices;
+    spec.collidesWith = g.collidesWith;
+    spec.faceSamplesWith = g.faceSamplesWith;
+    if (spec.collidesWith.empty())
+      for (const scene::Segment& s : avatar->segments) spec.collidesWith.push_back(s.name);
+  } else {
+    spec.pinned = g.maskVertices;  // no body to bind to: the mask pins in place
   }
-  return specs;
+  const auto& o = scene.simulation.offsets;
+  spec.offsets = {o[0], o[1], o[2], o[3]};
+  spec.offsetsGiven = scene.simulation.source.line > 0;
+  spec.collisionEvery = scene.simulation.collisionEvery;
+  return spec;
 }
 
-std::unique_ptr<scene::Avatar> sceneAvatar(const scene::Scene& scene) {
-  int humanoid = -1, external = -1;
-  for (const scene::Garment& g : scene.garments) {
-    if ((g.avatar >= 0 && humanoid >= 0 && g.avatar != humanoid) ||
-        (g.externalAvatar >= 0 && external >= 0 && g.externalAvatar != external) ||
-        (g.avatar >= 0 && external >= 0) || (g.externalAvatar >= 0 && humanoid >= 0)) {
-      throw Error(fmt::format("{}: garments are worn by different avatars; drape run simulates one character", scene.source));
-    }
-    if (g.avatar >= 0) humanoid = g.avatar;
-    if (g.externalAvatar >= 0) external = g.externalAvatar;
-  }
-  if (humanoid < 0 && external < 0) {
-    if (scene.avatars.size() == 1) humanoid = 0;
-    else if (scene.externalAvatars.size() == 1 && scene.avatars.empty()) external = 0;
-  }
-  if (humanoid >= 0) return std::make_unique<scene::Avatar>(scene.avatars[static_cast<std::size_t>(humanoid)]);
-  if (external < 0) return nullptr;
-  const scene::ExternalAvatar& ext = scene.externalAvatars[static_cast<std::size_t>(external)];
+/// An Avatar node's file, loaded, placed and cut as the node says.
+std::unique_ptr<scene::Avatar> loadExternal(const scene::Scene& scene, const scene::ExternalAvatar& ext) {
   if (ext.urls.empty()) throw Error(fmt::format("{}: Avatar '{}' has no url", ext.source.str(), ext.name));
   std::string lastError;
   const std::filesystem::path base = std::filesystem::path(scene.source).parent_path();
@@ -136,6 +118,80 @@ std::unique_ptr<scene::Avatar> sceneAvatar(const scene::Scene& scene) {
     }
   }
   throw Error(fmt::format("{}: Avatar '{}': {}", ext.source.str(), ext.name, lastError));
+}
+
+}  // namespace
+
+std::vector<GarmentSpec> garmentSpecs(const scene::Scene& scene, const scene::Avatar* avatar) {
+  std::vector<GarmentSpec> specs;
+  for (const scene::Garment& g : scene.garments) specs.push_back(garmentSpec(scene, g, avatar));
+  return specs;
+}
+
+std::vector<GarmentSpec> garmentSpecs(const scene::Scene& scene, const std::vector<SceneCharacter>& characters) {
+  std::vector<const scene::Avatar*> wornBy(scene.garments.size(), nullptr);
+  for (const SceneCharacter& c : characters)
+    for (const std::size_t g : c.garments) wornBy[g] = c.avatar.get();
+  std::vector<GarmentSpec> specs;
+  for (std::size_t g = 0; g < scene.garments.size(); ++g) specs.push_back(garmentSpec(scene, scene.garments[g], wornBy[g]));
+  return specs;
+}
+
+std::vector<SceneCharacter> sceneCharacters(const scene::Scene& scene) {
+  // Avatars numbered Humanoids first, then Avatar nodes.
+  const std::size_t humanoids = scene.avatars.size(), avatars = humanoids + scene.externalAvatars.size();
+  const auto nameOf = [&](std::size_t a) {
+    return a < humanoids ? scene.avatars[a].name : scene.externalAvatars[a - humanoids].name;
+  };
+  std::vector<std::vector<std::size_t>> worn(avatars);
+  for (std::size_t g = 0; g < scene.garments.size(); ++g) {
+    const scene::Garment& garment = scene.garments[g];
+    if (garment.avatar >= 0) {
+      worn[static_cast<std::size_t>(garment.avatar)].push_back(g);
+    } else if (garment.externalAvatar >= 0) {
+      worn[humanoids + static_cast<std::size_t>(garment.externalAvatar)].push_back(g);
+    } else if (avatars == 1) {
+      worn[0].push_back(g);
+    } else if (avatars > 1) {
+      std::vector<std::string> names;
+      for (std::size_t a = 0; a < avatars; ++a) names.push_back(nameOf(a));
+      throw Error::at(garment.source,
+                      fmt::format("ClothSet '{}': the scene has {} avatars ({}); say which wears it (avatar USE NAME)",
+                                  garment.name, avatars, fmt::join(names, ", ")));
+    }
+  }
+  std::vector<SceneCharacter> out;
+  for (std::size_t a = 0; a < avatars; ++a) {
+    if (worn[a].empty()) {
+      if (avatars > 1) spdlog::warn("{}: avatar '{}' wears no garment; it is left out", scene.source, nameOf(a));
+      continue;
+    }
+    SceneCharacter c;
+    c.avatar = a < humanoids ? std::make_unique<scene::Avatar>(scene.avatars[a])
+                             : loadExternal(scene, scene.externalAvatars[a - humanoids]);
+    c.name = nameOf(a).empty() ? c.avatar->name : nameOf(a);
+    c.external = a >= humanoids;
+    c.garments = std::move(worn[a]);
+    for (const SceneCharacter& other : out)
+      if (other.name == c.name)
+        throw Error(fmt::format("{}: two characters are called '{}'; give their Avatar or Humanoid nodes different "
+                                "names (DEF)",
+                                scene.source, c.name));
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+std::unique_ptr<scene::Avatar> sceneAvatar(const scene::Scene& scene) {
+  std::vector<SceneCharacter> characters = sceneCharacters(scene);
+  if (characters.empty()) return nullptr;
+  if (characters.size() > 1) {
+    std::vector<std::string> names;
+    for (const SceneCharacter& c : characters) names.push_back(c.name);
+    throw Error(fmt::format("{}: garments are worn by {} characters ({}); this takes one", scene.source,
+                            characters.size(), fmt::join(names, ", ")));
+  }
+  return std::move(characters.front().avatar);
 }
 
 }  // namespace drape::sim

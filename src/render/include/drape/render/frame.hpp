@@ -46,10 +46,14 @@ struct MeshInfo {
   MeshRole role = MeshRole::Garment;
   std::size_t vertexCount = 0;
   std::vector<mesh::Triangle> triangles;  ///< indices into the frame's positions
+  /// The character a segment or skin belongs to, in a run of several; "": the only one.
+  std::string character{};
 };
 
-/// Whether the run has its avatar's skinned body (drawn instead of the segments).
+/// Whether the run has an avatar's skinned body (drawn instead of the segments).
 [[nodiscard]] bool hasSkin(const std::vector<MeshInfo>& meshes);
+/// Whether `character`'s skinned body is in the run (drawn instead of its segments).
+[[nodiscard]] bool hasSkin(const std::vector<MeshInfo>& meshes, const std::string& character);
 
 /// Milliseconds one simulation stage took (forces, integrate, collide, ...).
 struct StageTime {

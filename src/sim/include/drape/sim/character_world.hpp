@@ -12,6 +12,7 @@
 //
 // Used alike by `drape run`, the benchmarks and (later) the cloth server role.
 
+#include <algorithm>
 #include <functional>
 #include <memory>
 #include <string>
@@ -129,6 +130,17 @@ struct SettleReport {
   std::size_t pairsEased = 0;   ///< (vertex, part) pairs being eased out onto T2 when it began
   std::size_t pairsTimedOut = 0;  ///< of those, held below T2 by the garment: they collide as any other
   std::size_t pairsLeft = 0;    ///< of those, still being eased at frame 0 (the settling's cap came first)
+
+  /// Another world's settling with this one's: the longest, the pairs of both.
+  SettleReport& operator+=(const SettleReport& other) {
+    frames = std::max(frames, other.frames);
+    seconds = std::max(seconds, other.seconds);
+    wall_s += other.wall_s;
+    pairsEased += other.pairsEased;
+    pairsTimedOut += other.pairsTimedOut;
+    pairsLeft += other.pairsLeft;
+    return *this;
+  }
 };
 
 class CharacterWorld {
@@ -161,6 +173,7 @@ class CharacterWorld {
   /// Steps every garment to `frame` in parallel; per garment, whether it stayed stable.
   std::vector<std::uint8_t> stepGarments(long frame);
 
+  [[nodiscard]] const scene::Avatar& avatar() const { return avatar_; }
   [[nodiscard]] std::size_t garmentCount() const { return garments_.size(); }
   [[nodiscard]] const GarmentSpec& garment(std::size_t g) const { return garments_[g].spec; }
   [[nodiscard]] const cloth::ClothSolver& solver(std::size_t g) const { return *garments_[g].solver; }

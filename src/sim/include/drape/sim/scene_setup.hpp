@@ -3,6 +3,8 @@
 // (cloth/, what the solver needs). scene/ and cloth/ do not know each other; this is where
 // they meet.
 
+#include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -16,13 +18,32 @@ namespace drape::sim {
 [[nodiscard]] cloth::StepSettings toStepSettings(const scene::SimulationSettings& settings);
 [[nodiscard]] WorldSettings toWorldSettings(const scene::SimulationSettings& settings);
 
+/// A character of the scene: an avatar and the garments it wears.
+struct SceneCharacter {
+  std::unique_ptr<scene::Avatar> avatar;  ///< loaded and placed where the scene puts it
+  /// What the scene calls it: its Avatar node's or Humanoid's name (DEF or name field),
+  /// unique among the scene's characters.
+  std::string name;
+  std::vector<std::size_t> garments;  ///< indices into Scene::garments, ascending
+  bool external = false;              ///< from an Avatar node's file (else an H-Anim Humanoid of the scene)
+};
+
 /// The garments of `scene` as simulation specs: collidesWith empty in the file means every
 /// segment of `avatar`; offsets from the Simulation node.
 [[nodiscard]] std::vector<GarmentSpec> garmentSpecs(const scene::Scene& scene, const scene::Avatar* avatar);
+/// The same with each garment on the avatar of the character that wears it (none: pinned
+/// where its mask is, as without an avatar).
+[[nodiscard]] std::vector<GarmentSpec> garmentSpecs(const scene::Scene& scene, const std::vector<SceneCharacter>& characters);
 
-/// The avatar the scene's garments are worn by: its H-Anim Humanoid, or the file an Avatar
-/// node names (glTF, MakeHuman), loaded and placed. Null when the scene has no avatar.
-/// Throws drape::Error when garments name different avatars (one character per run).
+/// The scene's characters: each avatar (an H-Anim Humanoid, or the file an Avatar node names,
+/// loaded and placed) that wears a garment, with its garments, Humanoids first, each kind in
+/// file order. A garment that names no avatar is worn by the scene's only one. Empty when
+/// the scene has no avatar. Throws drape::Error naming the garment when the scene has
+/// several avatars and a garment does not say which wears it, or two characters share a name.
+[[nodiscard]] std::vector<SceneCharacter> sceneCharacters(const scene::Scene& scene);
+
+/// The avatar the scene's garments are worn by (sceneCharacters' only one); null when the
+/// scene has none. Throws drape::Error when its garments are worn by several characters.
 [[nodiscard]] std::unique_ptr<scene::Avatar> sceneAvatar(const scene::Scene& scene);
 
 }  // namespace drape::sim

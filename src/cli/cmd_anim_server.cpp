@@ -265,7 +265,8 @@ int runAnimServer(const AnimServerOptions& o) {
   if (!o.sets.empty() || o.hold || o.frames > 0)
     throw Error(fmt::format("{}: it is for an event graph: give --events FILE.egml",
                             !o.sets.empty() ? "--set" : o.hold ? "--hold" : "--frames"));
-  const MotionChoice choice = sceneMotion(setup, character, o.scene, o.motion, o.animation);
+  const MotionChoice choice =
+      sceneMotion(setup, character, o.scene, o.motion.empty() ? character->motion : o.motion, o.animation);
   if (choice.path.empty())
     throw Error(fmt::format("{}: nothing moves the avatar: give --motion FILE (its own file carries no animation)",
                             o.scene));

@@ -75,6 +75,24 @@ std::string millimetres(double distance_m) {
   return std::isinf(distance_m) ? "-" : fmt::format("{:+.1f}", distance_m * 1000.0);
 }
 
+/// The meshes of the body a garment is worn by: its character's skin and collidable
+/// segments (in a run of several characters, the manifest names each mesh's).
+struct BodyMeshes {
+  std::string character;
+  std::optional<std::size_t> skin;
+  std::vector<std::size_t> collidable;
+};
+
+BodyMeshes bodyOf(const render::RunReplay& run, std::size_t garment, const std::vector<std::size_t>& collidable) {
+  BodyMeshes body;
+  body.character = run.meshes()[garment].character;
+  for (const std::size_t m : meshesWithRole(run, MeshRole::Skin))
+    if (run.meshes()[m].character == body.character && !body.skin) body.skin = m;
+  for (const std::size_t m : collidable)
+    if (run.meshes()[m].character == body.character) body.collidable.push_back(m);
+  return body;
+}
+
 /// What garment vertices are measured against in one frame: the skin as players draw it
 /// and each collidable segment, as the run recorded them.
 struct BodyAtFrame {
@@ -90,12 +108,19 @@ BodyAtFrame bodyAt(const render::RunReplay& run, std::int64_t f, std::optional<s
   return body;
 }
 
-/// The signed distance to the skin, and which segment (collidable or not: a hand, the
-/// head) the skin's nearest point belongs to, the one it is nearest to: "-15.6 RightHand".
-std::string skinText(const render::RunReplay& run, std::int64_t f, const BodyAtFrame& body, const Vec3& p) {
+BodyAtFrame bodyAt(const render::RunReplay& run, std::int64_t f, const BodyMeshes& body) {
+  return bodyAt(run, f, body.skin, body.collidable);
+}
+
+/// The signed distance to the skin, and which segment of its character (collidable or not:
+/// a hand, the head) the skin's nearest point belongs to, the one it is nearest to:
+/// "-15.6 RightHand".
+std::string skinText(const render::RunReplay& run, std::int64_t f, const BodyAtFrame& body, const Vec3& p,
+                     const std::string& character) {
   if (!body.skin) return "-";
   const mesh::SurfacePoint onSkin = body.skin->at(p);
-  const std::vector<std::size_t> segments = meshesWithRole(run, MeshRole::Segment);
+  std::vector<std::size_t> segments = meshesWithRole(run, MeshRole::Segment);
+  std::erase_if(segments, [&](std::size_t m) { return run.meshes()[m].character != character; });
   const BodyAtFrame all = bodyAt(run, f, std::nullopt, segments);
   std::string part;
   double nearest = std::numeric_limits<double>::infinity();
@@ -177,12 +202,14 @@ void printSummary(const std::string& directory, const render::RunReplay& run, co
              timeCode(run, 0), timeCode(run, frames - 1));
   for (const std::size_t m : meshesWithRole(run, MeshRole::Garment)) {
     const render::MeshInfo& info = run.meshes()[m];
-    fmt::print(out, "  garment  {:<14} {} vertices, {} triangles{}\n", info.name, info.vertexCount, info.triangles.size(),
-               run.states(m, 0).empty() ? "" : ", collision states recorded");
+    fmt::print(out, "  garment  {:<14} {} vertices, {} triangles{}{}\n", info.name, info.vertexCount,
+               info.triangles.size(), run.states(m, 0).empty() ? "" : ", collision states recorded",
+               info.character.empty() ? "" : ", worn by " + info.character);
   }
   for (const std::size_t m : meshesWithRole(run, MeshRole::Skin))
-    fmt::print(out, "  skin     {:<14} {} vertices, {} triangles\n", run.meshes()[m].name, run.meshes()[m].vertexCount,
-               run.meshes()[m].triangles.size());
+    fmt::print(out, "  skin     {:<14} {} vertices, {} triangles{}\n", run.meshes()[m].name, run.meshes()[m].vertexCount,
+               run.meshes()[m].triangles.size(),
+               run.meshes()[m].character.empty() ? "" : ", " + run.meshes()[m].character + "'s");
   const std::size_t segments = meshesWithRole(run, MeshRole::Segment).size();
   if (segments > 0) {
     std::vector<std::string> names;
@@ -228,8 +255,9 @@ std::size_t garmentToFollow(const render::RunReplay& run, const std::string& nam
 }
 
 void printVertexTrack(const render::RunReplay& run, const RunQuery& query, const Frames& frames,
-                      std::optional<std::size_t> skin, const std::vector<std::size_t>& collidable, std::ostream& out) {
+                      const std::vector<std::size_t>& collidable, std::ostream& out) {
   const std::size_t g = garmentToFollow(run, query.garment);
+  const BodyMeshes worn = bodyOf(run, g, collidable);
   const render::MeshInfo& garment = run.meshes()[g];
   if (static_cast<std::size_t>(query.vertex) >= garment.vertexCount)
     throw Error(fmt::format("--vertex {}: {} has vertices 0 to {}", query.vertex, garment.name, garment.vertexCount - 1));
@@ -239,11 +267,11 @@ void printVertexTrack(const render::RunReplay& run, const RunQuery& query, const
   fmt::print(out, "{:>6}  {:<11}  {:<15}  {:<22}  {:<24}  {}\n", "frame", "time code", "state", "skin (there)",
              "nearest collidable part", "next");
   for (std::int64_t f = frames.first; f <= frames.last; ++f) {
-    const BodyAtFrame body = bodyAt(run, f, skin, collidable);
+    const BodyAtFrame body = bodyAt(run, f, worn);
     const Vec3& p = run.positions(g, f)[v];
     const std::vector<PartDistance> parts = nearestParts(body, p);
     fmt::print(out, "{:>6}  {:<11}  {:<15}  {:<22}  {:<24}  {}\n", f, timeCode(run, f), stateText(run.states(g, f), v),
-               skinText(run, f, body, p), partText(run, parts, 0), partText(run, parts, 1));
+               skinText(run, f, body, p, worn.character), partText(run, parts, 0), partText(run, parts, 1));
   }
 }
 
@@ -253,19 +281,29 @@ struct Deepest {
   double distance_m = std::numeric_limits<double>::infinity();
 };
 
-/// Per garment vertex, the frame it is deepest in (or nearest to) the body: the skin when
-/// the run has one, else the nearest collidable segment.
+/// Per garment vertex, the frame it is deepest in (or nearest to) the body that wears it: its
+/// skin when the run has one, else its nearest collidable segment.
 std::vector<Deepest> deepestVertices(const render::RunReplay& run, const std::vector<std::size_t>& garments,
-                                     const Frames& frames, std::optional<std::size_t> skin,
-                                     const std::vector<std::size_t>& collidable) {
+                                     const Frames& frames, const std::vector<std::size_t>& collidable) {
   std::vector<Deepest> deepest;
-  for (const std::size_t g : garments)
-    for (std::size_t v = 0; v < run.meshes()[g].vertexCount; ++v) deepest.push_back({g, v, frames.first});
+  std::vector<BodyMeshes> bodies;  // the bodies that wear the garments, once each
+  std::vector<std::size_t> bodyOfVertex;
+  for (const std::size_t g : garments) {
+    BodyMeshes worn = bodyOf(run, g, collidable);
+    auto it = std::find_if(bodies.begin(), bodies.end(), [&](const BodyMeshes& b) { return b.character == worn.character; });
+    if (it == bodies.end()) it = bodies.insert(bodies.end(), std::move(worn));
+    for (std::size_t v = 0; v < run.meshes()[g].vertexCount; ++v) {
+      deepest.push_back({g, v, frames.first});
+      bodyOfVertex.push_back(static_cast<std::size_t>(it - bodies.begin()));
+    }
+  }
   Progress progress("drape inspect", frames.last - frames.first + 1);
   for (std::int64_t f = frames.first; f <= frames.last; ++f) {
-    const BodyAtFrame body = bodyAt(run, f, skin, collidable);
+    std::vector<BodyAtFrame> atFrame;
+    for (const BodyMeshes& b : bodies) atFrame.push_back(bodyAt(run, f, b));
     tbb::parallel_for(std::size_t{0}, deepest.size(), [&](std::size_t i) {
       Deepest& d = deepest[i];
+      const BodyAtFrame& body = atFrame[bodyOfVertex[i]];
       const Vec3& p = run.positions(d.garment, f)[d.vertex];
       const double distance = body.skin ? body.skin->at(p).distance_m : nearestParts(body, p).front().distance_m;
       if (distance < d.distance_m) {
@@ -279,11 +317,11 @@ std::vector<Deepest> deepestVertices(const render::RunReplay& run, const std::ve
   return deepest;
 }
 
-void printDeepest(const render::RunReplay& run, const RunQuery& query, const Frames& frames,
-                  std::optional<std::size_t> skin, const std::vector<std::size_t>& collidable, std::ostream& out) {
+void printDeepest(const render::RunReplay& run, const RunQuery& query, const Frames& frames, bool skin,
+                  const std::vector<std::size_t>& collidable, std::ostream& out) {
   if (!skin && collidable.empty()) throw Error("--deepest: the run has no body (neither a skin nor segments) to measure against");
   const std::vector<std::size_t> garments = selectedGarments(run, query.garment);
-  const std::vector<Deepest> deepest = deepestVertices(run, garments, frames, skin, collidable);
+  const std::vector<Deepest> deepest = deepestVertices(run, garments, frames, collidable);
   const auto inside = std::count_if(deepest.begin(), deepest.end(), [](const Deepest& d) { return d.distance_m < 0; });
   const char* against = skin ? "skin" : "nearest segment";
   fmt::print(out, "\ngarment vertices deepest in the body over frames {} to {}: {} of {} are inside the {} in some frame\n",
@@ -293,12 +331,14 @@ void printDeepest(const render::RunReplay& run, const RunQuery& query, const Fra
   const std::size_t shown = std::min(deepest.size(), static_cast<std::size_t>(query.deepest));
   for (std::size_t i = 0; i < shown; ++i) {
     const Deepest& d = deepest[i];
-    const BodyAtFrame body = bodyAt(run, d.frame, skin, collidable);
+    const BodyMeshes worn = bodyOf(run, d.garment, collidable);
+    const BodyAtFrame body = bodyAt(run, d.frame, worn);
     const Vec3& p = run.positions(d.garment, d.frame)[d.vertex];
     const std::vector<PartDistance> parts = nearestParts(body, p);
     fmt::print(out, "{:<14}  {:>6}  {:>6}  {:<11}  {:<15}  {:<22}  {:<24}  {}\n", run.meshes()[d.garment].name,
                d.vertex, d.frame, timeCode(run, d.frame), stateText(run.states(d.garment, d.frame), d.vertex),
-               skin ? skinText(run, d.frame, body, p) : "", partText(run, parts, 0), partText(run, parts, 1));
+               skin ? skinText(run, d.frame, body, p, worn.character) : "", partText(run, parts, 0),
+               partText(run, parts, 1));
   }
   if (shown > 0)
     fmt::print(out, "follow one: drape inspect RUN --vertex V{} --range FIRST:LAST\n",
@@ -311,8 +351,7 @@ void inspectRun(const std::string& directory, const RunQuery& query, std::ostrea
   const render::RunReplay run(directory);
   const nlohmann::json stats = readStats(directory);
   const std::vector<std::size_t> collidable = collidableSegments(run, stats);
-  const std::vector<std::size_t> skins = meshesWithRole(run, MeshRole::Skin);
-  const std::optional<std::size_t> skin = skins.empty() ? std::nullopt : std::optional(skins.front());
+  const bool skin = !meshesWithRole(run, MeshRole::Skin).empty();
   printSummary(directory, run, stats, collidable, out);
   if (query.vertex < 0 && query.deepest <= 0) {
     if (query.any()) throw Error("--range and --garment go with --vertex V or --deepest N");
@@ -322,7 +361,7 @@ void inspectRun(const std::string& directory, const RunQuery& query, std::ostrea
   }
   const Frames frames = framesOf(run, query.range);
   if (query.deepest > 0) printDeepest(run, query, frames, skin, collidable, out);
-  if (query.vertex >= 0) printVertexTrack(run, query, frames, skin, collidable, out);
+  if (query.vertex >= 0) printVertexTrack(run, query, frames, collidable, out);
 }
 
 }  // namespace drape::cli

@@ -212,6 +212,7 @@ RunSetup runSetupFromScene(const std::string& scenePath, const std::optional<std
     ch.keepApart = sc.simulation.keepApart;
     ch.name = c.name;
     ch.garments = c.garments;
+    ch.motion = c.motion;
     // Alone in its scene, the character answers to every avatar name the scene has (a
     // Humanoid inside an Avatar node's file, say); among several, to its own.
     if (characters.size() == 1) {
@@ -464,7 +465,9 @@ void addSceneMotions(RunSetup& setup, const std::string& scenePath, const std::v
   }
   for (std::size_t i = 0; i < setup.characters.size(); ++i) {
     CharacterSetup& c = setup.characters[i];
-    const MotionChoice m = sceneMotion(setup, &c, scenePath, named[i] ? given[i] : forAll, animation);
+    // Given for it, given for all, or the one its Avatar node names.
+    const std::string motion = named[i] ? given[i] : forAllGiven ? forAll : c.motion;
+    const MotionChoice m = sceneMotion(setup, &c, scenePath, motion, animation);
     if (!m.path.empty()) addMotion(setup, c, m.path, metresPerUnit, jointMap, m.animation, m.sampled.get());
   }
 }

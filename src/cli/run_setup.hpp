@@ -56,6 +56,8 @@ struct CharacterSetup {
   std::string name{};
   /// The garments it wears: indices into RunSetup::garments, ascending.
   std::vector<std::size_t> garments{};
+  /// The motion its Avatar node names (`motion`), played when a command gives it none; "": none.
+  std::string motion{};
 };
 
 /// Per motion frame, the wind an event graph set (none: the scene's).

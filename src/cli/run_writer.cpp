@@ -1,5 +1,6 @@
 #include "run_writer.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
@@ -95,13 +96,22 @@ struct RunWriter::Impl {
                                                      1.0);
       f.states = std::make_unique<formats::StateCacheWriter>((out / (f.fileStem + ".states")).string(),
                                                              g.mesh.vertexCount());
-      manifest.meshes.push_back({g.name, "garment", f.fileStem + ".obj", f.fileStem + ".pc2", f.fileStem + ".states"});
+      manifest.meshes.push_back({g.name, "garment", f.fileStem + ".obj", f.fileStem + ".pc2", f.fileStem + ".states",
+                                 wearer(garments.size())});
       garments.push_back(std::move(f));
     }
     if (atStart.size() != setup.characters.size())
       throw Error(fmt::format("run writer: {} characters at the start for {}", atStart.size(), setup.characters.size()),
                   ExitCode::Internal);
     for (std::size_t c = 0; c < setup.characters.size(); ++c) characters.push_back(characterFiles(c, atStart[c]));
+  }
+
+  /// Who wears garment g, in a run of several characters; "" otherwise.
+  [[nodiscard]] std::string wearer(std::size_t g) const {
+    if (setup.characters.size() < 2) return "";
+    for (const CharacterSetup& c : setup.characters)
+      if (std::find(c.garments.begin(), c.garments.end(), g) != c.garments.end()) return c.name;
+    return "";
   }
 
   /// Character c's rest files: its parts and its skinned body. Alone, its files are

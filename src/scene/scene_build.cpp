@@ -316,6 +316,7 @@ class Builder {
     a.urls = strings(n, "url");
     a.jointMap = strings(n, "jointMap");
     a.cutAtJoints = strings(n, "cutAtJoints");
+    a.motion = strings(n, "motion");
     a.source = where(n);
     if (a.urls.empty())
       throw Error::at(where(n),

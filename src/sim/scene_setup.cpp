@@ -120,6 +120,19 @@ std::unique_ptr<scene::Avatar> loadExternal(const scene::Scene& scene, const sce
   throw Error(fmt::format("{}: Avatar '{}': {}", ext.source.str(), ext.name, lastError));
 }
 
+/// The first of an Avatar node's motion URLs that is a file, resolved against the scene's
+/// directory; "" when it names none. Throws drape::Error at the node when none exists.
+std::string motionFile(const scene::Scene& scene, const scene::ExternalAvatar& ext) {
+  if (ext.motion.empty()) return "";
+  const std::filesystem::path base = std::filesystem::path(scene.source).parent_path();
+  for (const std::string& url : ext.motion) {
+    const std::filesystem::path p(url);
+    const std::string path = p.is_absolute() ? url : (base / p).lexically_normal().string();
+    if (std::filesystem::is_regular_file(path)) return path;
+  }
+  throw Error::at(ext.source, fmt::format("Avatar {}: motion: no such file ({})", ext.name, fmt::join(ext.motion, ", ")));
+}
+
 }  // namespace
 
 std::vector<GarmentSpec> garmentSpecs(const scene::Scene& scene, const scene::Avatar* avatar) {
@@ -171,6 +184,7 @@ std::vector<SceneCharacter> sceneCharacters(const scene::Scene& scene) {
                              : loadExternal(scene, scene.externalAvatars[a - humanoids]);
     c.name = nameOf(a).empty() ? c.avatar->name : nameOf(a);
     c.external = a >= humanoids;
+    if (c.external) c.motion = motionFile(scene, scene.externalAvatars[a - humanoids]);
     c.garments = std::move(worn[a]);
     for (const SceneCharacter& other : out)
       if (other.name == c.name)

@@ -24,14 +24,14 @@ using testing::runDrape;
 using testing::ScratchDir;
 using testing::statsOf;
 
-const std::string kSource = DRAPE_SOURCE_DIR;
-const std::string kDressScene = kSource + "/examples/walking_dress/scene.wrl";
+const std::string kDressSource = DRAPE_SOURCE_DIR;
+const std::string kDressScene = kDressSource + "/examples/walking_dress/scene.wrl";
 
 TEST(WalkingDress, WalksStablyWithFewPointsInsideTheBody) {
   DRAPE_LONG_SCENARIO();
   ScratchDir dir("walking-dress");
   const std::string out = dir / "out";
-  const CliResult r = runDrape("run '" + kSource + "/examples/walking_dress/scene.wrl' --motion '" + kSource +
+  const CliResult r = runDrape("run '" + kDressSource + "/examples/walking_dress/scene.wrl' --motion '" + kDressSource +
                                    "/examples/walking_skirt/walk.bvh' --frames 45 --every 45 --out '" + out + "'",
                                dir);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -85,20 +85,20 @@ TEST(WalkingDress, WalksStablyWithFewPointsInsideTheBody) {
     EXPECT_LT(clothTop - skinTop, 0.009) << "side " << side;
   }
   const std::string unsewn = dir / "unsewn";
-  const CliResult open = runDrape("run '" + kDressScene + "' --motion '" + kSource +
+  const CliResult open = runDrape("run '" + kDressScene + "' --motion '" + kDressSource +
                                       "/examples/walking_skirt/walk.bvh' --frames 1 --no-stitches --out '" + unsewn + "'",
                                   dir);
   ASSERT_EQ(open.code, 0) << open.err;
   EXPECT_EQ(statsOf(unsewn)["garments"][0]["stitches"].get<int>(), 0);
   // --stitch-gaps finds them as make-scene does; a garment with no such opening says so.
   const std::string resewn = dir / "resewn";
-  const CliResult sewn = runDrape("run '" + kDressScene + "' --motion '" + kSource +
+  const CliResult sewn = runDrape("run '" + kDressScene + "' --motion '" + kDressSource +
                                       "/examples/walking_skirt/walk.bvh' --frames 1 --stitch-gaps 0.02 --out '" + resewn +
                                       "'",
                                   dir);
   ASSERT_EQ(sewn.code, 0) << sewn.err;
   EXPECT_EQ(statsOf(resewn)["garments"][0]["stitches"].get<int>(), 16);
-  const CliResult none = runDrape("run '" + kSource + "/examples/walking_skirt/scene.wrl' --frames 1 --stitch-gaps 0.02 "
+  const CliResult none = runDrape("run '" + kDressSource + "/examples/walking_skirt/scene.wrl' --frames 1 --stitch-gaps 0.02 "
                                   "--out '" + (dir / "skirt") + "'",
                                   dir);
   EXPECT_EQ(none.code, 2) << none.err;
@@ -133,7 +133,7 @@ TEST(WalkingDress, WalksStablyWithFewPointsInsideTheBody) {
       << r.err;
   // --settle 0: frame 0 is the dress as modelled, eased out in the walk's first frames.
   const std::string unsettled = dir / "unsettled";
-  const CliResult asModelled = runDrape("run '" + kDressScene + "' --motion '" + kSource +
+  const CliResult asModelled = runDrape("run '" + kDressScene + "' --motion '" + kDressSource +
                                             "/examples/walking_skirt/walk.bvh' --frames 1 --settle 0 --out '" +
                                             unsettled + "'",
                                         dir);
@@ -197,7 +197,7 @@ TEST(WalkingDress, TheUpperArmsAreCutAtTheShoulders) {
   const CliResult root = run("--cut-at-joints Hips", "root");
   EXPECT_EQ(root.code, 2) << root.err;
   EXPECT_NE(root.err.find("cutAtJoints names 'Hips', the root joint"), std::string::npos) << root.err;
-  const CliResult noAvatar = runDrape("run --garment '" + kSource + "/examples/walking_dress/dress.obj' --frames 1 "
+  const CliResult noAvatar = runDrape("run --garment '" + kDressSource + "/examples/walking_dress/dress.obj' --frames 1 "
                                       "--cut-at-joints LeftArm --out '" + (dir / "bare") + "'",
                                       dir);
   EXPECT_EQ(noAvatar.code, 2) << noAvatar.err;
@@ -209,7 +209,7 @@ TEST(WalkingDress, AnUnstableBendingStepIsRefusedBeforeTheFieldsAreBuilt) {
   // The dress's bending forces are stable for 1.5 ms; 33 substeps of its 155 per frame are
   // 7.1 ms. Refused at once, naming the largest stable choice, not after the distance fields.
   ScratchDir dir("walking-dress-bend");
-  const CliResult r = runDrape("run '" + kSource + "/examples/walking_dress/scene.wrl' --motion '" + kSource +
+  const CliResult r = runDrape("run '" + kDressSource + "/examples/walking_dress/scene.wrl' --motion '" + kDressSource +
                                    "/examples/walking_skirt/walk.bvh' --bend-every 33 --frames 2 --out '" +
                                    (dir / "out") + "'",
                                dir);
@@ -225,7 +225,7 @@ TEST(WalkingDress, RunsTheDazStyleWalkToTheEnd) {
   // Spine1 and the upper arm at once gathered speed from test to test and the run stopped in
   // frame 69.
   ScratchDir dir("walking-dress-daz");
-  const std::string out = testing::runInto(dir, "out", "'" + kDressScene + "' --motion '" + kSource +
+  const std::string out = testing::runInto(dir, "out", "'" + kDressScene + "' --motion '" + kDressSource +
                                                          "/data/mocap/cmu_02_02_walk_dazstyle.bvh' --every 1000");
   const nlohmann::json stats = statsOf(out);
   EXPECT_FALSE(stats["unstable"].get<bool>());
@@ -242,7 +242,7 @@ TEST(WalkingDress, RunsTheDazStyleWalkToTheEnd) {
 /// build/native), this one in frame 26; with the sanitizers (build/asan), one at the left
 /// elbow in frame 27.
 CliResult runDelfem2AsCaptured(const ScratchDir& dir, const std::string& options) {
-  return runDrape("run '" + kDressScene + "' --motion '" + kSource +
+  return runDrape("run '" + kDressScene + "' --motion '" + kDressSource +
                       "/data/mocap/cmu_walk_delfem2.bvh' --keep-apart none --cut-at-joints none --every 1000 " +
                       options + " --out '" + (dir / "out") + "'",
                   dir);
@@ -317,7 +317,7 @@ TEST(WalkingDress, InspectListsWhereTheMotionPutsTheBodyInsideItself) {
   // Before any simulation: the same pairs drape run lists in stats.json, for the motion as
   // captured (--keep-apart none) ...
   ScratchDir dir("walking-dress-inspect");
-  const CliResult r = runDrape("inspect '" + kDressScene + "' --motion '" + kSource +
+  const CliResult r = runDrape("inspect '" + kDressScene + "' --motion '" + kDressSource +
                                    "/data/mocap/cmu_walk_delfem2.bvh' --keep-apart none",
                                dir);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -332,7 +332,7 @@ TEST(WalkingDress, InspectListsWhereTheMotionPutsTheBodyInsideItself) {
   // ... and as the scene plays it, the arms kept out of the body: the thighs still press
   // into each other (the scene does not move the legs), the arms no longer go anywhere.
   const CliResult kept =
-      runDrape("inspect '" + kDressScene + "' --motion '" + kSource + "/data/mocap/cmu_walk_delfem2.bvh'", dir);
+      runDrape("inspect '" + kDressScene + "' --motion '" + kDressSource + "/data/mocap/cmu_walk_delfem2.bvh'", dir);
   ASSERT_EQ(kept.code, 0) << kept.err;
   EXPECT_NE(kept.out.find("  the motion is corrected to keep LeftForeArm, RightForeArm, LeftArm, RightArm out of the "
                           "collidable parts"),
@@ -348,7 +348,7 @@ TEST(WalkingDress, InspectListsWhereTheMotionPutsTheBodyInsideItself) {
                           "into LeftForeArm", "into RightForeArm", "into LeftArm", "into RightArm"})
     EXPECT_EQ(kept.out.find(arm), std::string::npos) << arm << "\n" << kept.out;
 
-  const CliResult mesh = runDrape("inspect '" + kSource + "/examples/walking_dress/dress.obj' --motion '" + kSource +
+  const CliResult mesh = runDrape("inspect '" + kDressSource + "/examples/walking_dress/dress.obj' --motion '" + kDressSource +
                                       "/data/mocap/cmu_walk_delfem2.bvh'",
                                   dir);
   EXPECT_EQ(mesh.code, 2) << mesh.err;
@@ -361,7 +361,7 @@ TEST(WalkingDress, WithTheArmsKeptOutOfTheBodyTheWholeDelfem2WalkRuns) {
   // stops in frame 92 with the jacket's back torn (the tests above). The scene keeps the
   // arms out of the body, and the whole walk runs without a frame computed again.
   ScratchDir dir("walking-dress-kept-apart");
-  const std::string out = testing::runInto(dir, "out", "'" + kDressScene + "' --motion '" + kSource +
+  const std::string out = testing::runInto(dir, "out", "'" + kDressScene + "' --motion '" + kDressSource +
                                                          "/data/mocap/cmu_walk_delfem2.bvh' --every 1000");
   const nlohmann::json stats = statsOf(out);
   EXPECT_FALSE(stats["unstable"].get<bool>());
@@ -389,7 +389,7 @@ TEST(WalkingDress, StaysStableWithMoreSubsteps) {
   // frame 4, when a point the collider put back on T2 kept its velocity into the part
   // wherever the distance read there said it was above T2.
   ScratchDir dir("walking-dress-300");
-  const std::string out = testing::runInto(dir, "out", "'" + kDressScene + "' --motion '" + kSource +
+  const std::string out = testing::runInto(dir, "out", "'" + kDressScene + "' --motion '" + kDressSource +
                                                          "/examples/walking_skirt/walk.bvh' --substeps 300 --damping 0 "
                                                          "--frames 8 --every 8");
   EXPECT_EQ(statsOf(out)["frames"].get<int>(), 8);

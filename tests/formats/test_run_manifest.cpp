@@ -23,20 +23,24 @@ TEST(RunManifest, RoundTrips) {
   m.frames = 12;
   m.startFrame = 3;
   m.meshes = {{"skirt", "garment", "skirt.obj", "skirt.pc2", "skirt.states"},
-              {"hips", "segment", "segments/hips.obj", "segments/hips.pc2", ""}};
+              {"hips", "segment", "segments/hips.obj", "segments/hips.pc2", ""},
+              {"hips", "segment", "segments/Bea/hips.obj", "segments/Bea/hips.pc2", "", "Bea"}};
   writeRunManifest(dir, m);
   const RunManifest r = readRunManifest(dir);
   EXPECT_EQ(r.frameRate, 25);
   EXPECT_EQ(r.frames, 12);
   EXPECT_EQ(r.startFrame, 3);
-  ASSERT_EQ(r.meshes.size(), 2u);
+  ASSERT_EQ(r.meshes.size(), 3u);
   EXPECT_EQ(r.meshes[1].cache, "segments/hips.pc2");
+  EXPECT_EQ(r.meshes[1].character, "");  // the run's only character: no key
+  EXPECT_EQ(r.meshes[2].character, "Bea");
   EXPECT_EQ(r.meshes[1].role, "segment");
   EXPECT_EQ(r.meshes[0].states, "skirt.states");
   EXPECT_EQ(r.meshes[1].states, "");  // no key written, none read
   std::ifstream written(dir + "/manifest.json");
   const std::string text((std::istreambuf_iterator<char>(written)), std::istreambuf_iterator<char>());
   EXPECT_EQ(text.find("\"states\": \"\""), std::string::npos) << text;
+  EXPECT_EQ(text.find("\"character\": \"\""), std::string::npos) << text;
 }
 
 TEST(RunManifest, StatesMustBeAString) {

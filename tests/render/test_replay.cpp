@@ -9,6 +9,7 @@
 
 #include "../formats/test_run_fixture.hpp"
 #include "drape/core/error.hpp"
+#include "drape/formats/run_manifest.hpp"
 #include "drape/render/headless.hpp"
 #include "drape/render/outputs.hpp"
 #include "drape/render/run_replay.hpp"
@@ -41,6 +42,25 @@ TEST(RunReplay, ReadsFramesTimeCodesAndStageTimes) {
   // The run's bounds hold every frame: the flag's wave reaches 12 cm in z.
   EXPECT_GT(replay.bounds().max.z(), 0.1);
   EXPECT_NEAR(replay.bounds().min.y(), 0.35, 1e-6);
+}
+
+// In a run of several characters, each mesh says whose it is, and a character's segments
+// are drawn unless that character's skinned body is in the run.
+TEST(RunReplay, SaysWhoseEachMeshIs) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("replay-characters"), 3);
+  formats::RunManifest manifest = formats::readRunManifest(dir);
+  for (formats::RunMesh& m : manifest.meshes) m.character = "Bea";
+  formats::writeRunManifest(dir, manifest);
+  const RunReplay replay(dir);
+  ASSERT_EQ(replay.meshes().size(), 2u);
+  EXPECT_EQ(replay.meshes()[0].character, "Bea");
+  EXPECT_EQ(replay.meshes()[1].character, "Bea");
+  std::vector<MeshInfo> meshes = replay.meshes();
+  EXPECT_FALSE(hasSkin(meshes, "Bea"));
+  meshes.push_back({"body", MeshRole::Skin, 3, {{0, 1, 2}}, "Ada"});
+  EXPECT_TRUE(hasSkin(meshes));
+  EXPECT_TRUE(hasSkin(meshes, "Ada"));
+  EXPECT_FALSE(hasSkin(meshes, "Bea"));
 }
 
 // Each frame shows its own stage times: frame 0 (the initial state) none, a frame computed

@@ -5,7 +5,7 @@
 // sample per frame, Y up. Garments, avatar segments and the avatar's skinned body are listed
 // alike; `role` tells a renderer how to draw them.
 //
-// In a run of several characters, each segment and skin names its character.
+// In a run of several characters, each segment, skin and garment names its character.
 //
 // A garment may also have a state cache (formats/state_cache.hpp): per vertex and frame,
 // its collision state and whether it is pinned or bound, for the overlays.
@@ -26,8 +26,8 @@ struct RunMesh {
   std::string topology;  ///< OBJ file, relative to the run directory
   std::string cache;     ///< PC2 file, relative to the run directory
   std::string states;    ///< state cache, relative to the run directory; "": none (optional key)
-  /// The character a segment or skin belongs to, in a run of several characters; "": the
-  /// run's only one (optional key).
+  /// The character a segment or skin belongs to, or that wears a garment, in a run of
+  /// several characters; "": the run's only one (optional key).
   std::string character;
 };
 

@@ -46,7 +46,8 @@ struct MeshInfo {
   MeshRole role = MeshRole::Garment;
   std::size_t vertexCount = 0;
   std::vector<mesh::Triangle> triangles;  ///< indices into the frame's positions
-  /// The character a segment or skin belongs to, in a run of several; "": the only one.
+  /// The character a segment or skin belongs to, or that wears a garment, in a run of
+  /// several; "": the only one.
   std::string character{};
 };
 

@@ -93,6 +93,9 @@ struct ExternalAvatar {
   /// Joints whose rigid parts are cut across the joint, what lies behind it going to the
   /// parent's part (scene::segmentSkinnedAvatar); empty: parts by dominant weight alone.
   std::vector<std::string> cutAtJoints;
+  /// URL(s) of the motion it plays when a command gives it none (a BVH, AMC, or animated
+  /// avatar file), relative to the scene; the first that exists is played. Empty: none.
+  std::vector<std::string> motion;
   RigidTransform placement;           ///< m, world placement of the character's root
   double scale = 1.0;                 ///< the node's scale times unitScale
   SourcePos source;

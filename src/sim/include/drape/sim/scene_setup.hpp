@@ -26,6 +26,9 @@ struct SceneCharacter {
   std::string name;
   std::vector<std::size_t> garments;  ///< indices into Scene::garments, ascending
   bool external = false;              ///< from an Avatar node's file (else an H-Anim Humanoid of the scene)
+  /// The motion file its Avatar node's `motion` names (the first of its URLs that exists),
+  /// which it plays when a command gives it none; "" when the node names none.
+  std::string motion;
 };
 
 /// The garments of `scene` as simulation specs: collidesWith empty in the file means every

@@ -1,0 +1,173 @@
+// Several characters in one scene, end to end: each simulated in a world of its own, so that
+// a character's files in the run directory are, to the byte, what the scene of that character
+// alone writes; the run directory says whose each part, skin and garment is, and what plays
+// one character only says so.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.hpp"
+#include "drape/formats/run_manifest.hpp"
+
+namespace drape {
+namespace {
+
+using testing::CliResult;
+using testing::kSkirtDir;
+using testing::runDrape;
+using testing::ScratchDir;
+using testing::slurp;
+using testing::statsOf;
+
+namespace fs = std::filesystem;
+
+const std::string kTwoCharacters = std::string(DRAPE_SOURCE_DIR) + "/examples/two_characters/scene.wrl";
+const std::string kDelfem2Walk = std::string(DRAPE_DATA_DIR) + "/mocap/cmu_walk_delfem2.bvh";
+constexpr int kCharacterFrames = 40;
+
+/// The walking skirt's scene with its avatar and skirt moved `dx` m along x, as the two
+/// characters' scene places Bea, written into `dir`.
+std::string skirtSceneMoved(const ScratchDir& dir, const std::string& name, double dx) {
+  std::string text = slurp(kSkirtDir + "/scene.wrl");
+  const std::string relative = "url \"../../data/", body = "DEF Body Avatar";
+  text.replace(text.find(relative), relative.size(), "url \"" + std::string(DRAPE_SOURCE_DIR) + "/data/");
+  const std::size_t from = text.find(body);
+  text.insert(from, "Transform {\n  translation " + std::to_string(dx) + " 0 0\n  children [\n");
+  text += "  ]\n}\n";
+  const std::string path = dir / name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+bool sameFile(const std::string& a, const std::string& b) {
+  return fs::exists(a) && fs::exists(b) && slurp(a) == slurp(b);
+}
+
+TEST(Characters, EachCharacterOfTheSceneIsWhatItsSceneAloneMakesToTheByte) {
+  ScratchDir dir("characters");
+  const std::string both = dir / "both";
+  const std::string frames = " --frames " + std::to_string(kCharacterFrames);
+  const CliResult r = runDrape("run '" + kTwoCharacters + "'" + frames + " --out '" + both + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  // Each plays the motion its Avatar node names.
+  EXPECT_NE(r.err.find("walk.bvh: 566 frames at 120 Hz in CMU units (0.0564 m); joint map 'motionbuilder' drives 31 of "
+                       "Ada's 31 joints"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("cmu_walk_delfem2.bvh: 344 frames at 120 Hz in CMU units (0.0564 m); joint map 'motionbuilder' "
+                       "drives 31 of Bea's 31 joints"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.out.find("the skinned bodies (body-CHARACTER.pc2)"), std::string::npos) << r.out;
+
+  // Ada stands where the walking skirt's body stands and walks its walk; Bea, 1.2 m along x,
+  // the other walk. Alone in their scenes, each writes what the scene of two wrote for it.
+  const std::string ada = dir / "ada";
+  ASSERT_EQ(runDrape("run '" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir + "/walk.bvh'" + frames + " --out '" +
+                         ada + "'",
+                     dir)
+                .code,
+            0);
+  const std::string bea = dir / "bea";
+  const CliResult alone = runDrape("run '" + skirtSceneMoved(dir, "bea.wrl", 1.2) + "' --motion '" + kDelfem2Walk +
+                                       "'" + frames + " --out '" + bea + "'",
+                                   dir);
+  ASSERT_EQ(alone.code, 0) << alone.err;
+  for (const auto& [who, single] : {std::pair{std::string("Ada"), ada}, std::pair{std::string("Bea"), bea}}) {
+    SCOPED_TRACE(who);
+    EXPECT_TRUE(sameFile(both + "/garment-" + who + "_skirt.pc2", single + "/garment.pc2"));
+    EXPECT_TRUE(sameFile(both + "/garment-" + who + "_skirt.states", single + "/garment.states"));
+    EXPECT_TRUE(sameFile(both + "/body-" + who + ".pc2", single + "/body.pc2"));
+    for (const char* part : {"Hips", "LeftUpLeg", "RightLeg", "LeftForeArm"})
+      EXPECT_TRUE(sameFile(both + "/segments/" + who + "/" + part + ".pc2", single + "/segments/" + part + ".pc2"))
+          << part;
+  }
+  EXPECT_FALSE(sameFile(both + "/garment-Ada_skirt.pc2", both + "/garment-Bea_skirt.pc2"));
+
+  // The manifest names whose each mesh is; stats.json lists the characters.
+  const formats::RunManifest manifest = formats::readRunManifest(both);
+  int skins = 0, segments = 0;
+  for (const formats::RunMesh& m : manifest.meshes) {
+    EXPECT_TRUE(m.character == "Ada" || m.character == "Bea") << m.name;
+    if (m.role == "garment") EXPECT_EQ(m.name, m.character + " skirt");
+    skins += m.role == "skin";
+    segments += m.role == "segment";
+  }
+  EXPECT_EQ(skins, 2);
+  EXPECT_EQ(segments, 2 * 31);
+  const nlohmann::json stats = statsOf(both);
+  ASSERT_EQ(stats["characters"].size(), 2u);
+  EXPECT_EQ(stats["characters"][1]["name"], "Bea");
+  EXPECT_EQ(stats["characters"][1]["garments"], nlohmann::json::array({"Bea skirt"}));
+  EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
+  EXPECT_EQ(stats["vertex_substeps"].get<long>(),
+            statsOf(ada)["vertex_substeps"].get<long>() + statsOf(bea)["vertex_substeps"].get<long>());
+
+  // inspect measures each garment against the body that wears it: Bea's skirt is as deep in
+  // Bea's skin as in the run of Bea alone (measured against Ada's, it would be a metre out).
+  const CliResult deepBoth = runDrape("inspect '" + both + "' --deepest 1 --garment 'Bea skirt'", dir);
+  const CliResult deepBea = runDrape("inspect '" + bea + "' --deepest 1", dir);
+  ASSERT_EQ(deepBoth.code, 0) << deepBoth.err;
+  ASSERT_EQ(deepBea.code, 0) << deepBea.err;
+  EXPECT_NE(deepBoth.out.find("worn by Bea"), std::string::npos) << deepBoth.out;
+  const auto deepestLine = [](const std::string& out) {
+    const std::size_t header = out.find("\ngarment ");
+    const std::size_t line = out.find('\n', out.find('\n', header + 1) + 1);
+    return out.substr(line + 1, out.find('\n', line + 1) - line - 1);
+  };
+  // The line after the garment's name: vertex, frame, time code, state, skin, parts.
+  const auto afterName = [](const std::string& line, const std::string& name) {
+    const std::size_t from = line.find_first_not_of(' ', line.find(name) + name.size());
+    return from == std::string::npos ? std::string() : line.substr(from);
+  };
+  const std::string a = afterName(deepestLine(deepBoth.out), "Bea skirt"), b = afterName(deepestLine(deepBea.out), "Skirt");
+  ASSERT_FALSE(b.empty()) << deepBea.out;
+  EXPECT_EQ(a, b) << deepBoth.out << deepBea.out;
+}
+
+TEST(Characters, MotionsAreGivenByNameAndWhatPlaysOneCharacterSaysSo) {
+  ScratchDir dir("characters-errors");
+  const std::string out = " --out '" + (dir / "x") + "'";
+  const auto expectError = [&](const std::string& args, const std::string& message) {
+    const CliResult r = runDrape(args, dir);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << args << "\n" << r.err;
+  };
+  expectError("run '" + kTwoCharacters + "' --motion 'Carl=" + kDelfem2Walk + "'" + out,
+              "--motion Carl=" + kDelfem2Walk + ": the scene has no character called 'Carl' (it has: Ada, Bea)");
+  expectError("run '" + kTwoCharacters + "' --motion 'Ada=" + kDelfem2Walk + "' --motion 'Ada=none'" + out,
+              "--motion Ada=none: 'Ada' is given a motion twice");
+  expectError("run '" + kTwoCharacters + "' --motion '" + kDelfem2Walk + "' --motion none" + out,
+              "--motion none: a motion for every character is given already");
+  expectError("run '" + kTwoCharacters + "' --live -" + out + " < /dev/null",
+              "--live (a live capture) plays one character; the scene has 2 (Ada, Bea)");
+  expectError("run '" + kTwoCharacters + "' --events '" + std::string(DRAPE_SOURCE_DIR) + "/examples/event_graph/day.egml'" + out,
+              "--events (an event graph) plays one character; the scene has 2 (Ada, Bea)");
+  expectError("anim-server '" + kTwoCharacters + "' --server nats://127.0.0.1:1 --give-up 1",
+              "the studio plays one character; the scene has 2 (Ada, Bea)");
+
+  // NAME=FILE for one, FILE for the others: Ada plays the file for all, Bea her own; none
+  // keeps one at rest.
+  const CliResult r = runDrape("run '" + kTwoCharacters + "' --motion '" + kDelfem2Walk + "' --motion Bea=none --frames 2" + out, dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("drives 31 of Ada's 31 joints"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("Bea's 31 joints"), std::string::npos) << r.err;
+
+  // A garment among several avatars says which wears it.
+  std::string text = slurp(kTwoCharacters);
+  const std::string worn = "      avatar USE Bea\n";
+  text.erase(text.find(worn), worn.size());
+  text.replace(text.find("url \"../../data/"), 16, "url \"" + std::string(DRAPE_SOURCE_DIR) + "/data/");
+  text.replace(text.find("url \"../../data/"), 16, "url \"" + std::string(DRAPE_SOURCE_DIR) + "/data/");
+  std::ofstream(dir / "unworn.wrl") << text;
+  expectError("run '" + (dir / "unworn.wrl") + "' --motion none --frames 2" + out,
+              "ClothSet 'Bea skirt': the scene has 2 avatars (Ada, Bea); say which wears it (avatar USE NAME)");
+}
+
+}  // namespace
+}  // namespace drape

@@ -35,6 +35,7 @@ namespace {
 struct AnimServerOptions {
   std::string scene, motion, animation, name = "anim", take, events, live, liveHeader;
   std::string timecode;  ///< --timecode: motion frame 0's time code, HH:MM:SS:FF or now
+  std::string character;  ///< --character: which of the scene's characters it plays
   std::vector<std::string> sets;
   long frames = 0;
   bool fast = false, hold = false;
@@ -49,13 +50,19 @@ TimeCode takeStart(const AnimServerOptions& o, TimeCode own) {
   return o.timecode.empty() ? own : TimeCode::parseOption(o.timecode, own.rate);
 }
 
-/// A pose take's first message: the avatar and its joints (every frame lists them in this
-/// order), the motion joints driving them, and how the frames are numbered (`frames` 0:
-/// not known ahead, a live take).
-studio::PoseStart poseStart(const scene::Avatar& avatar, std::span<const int> driving, TimeCode start,
-                            std::int64_t frames) {
+/// What the take calls the character it moves: the scene's name for it, --character's, or in a
+/// scene of one its avatar's.
+std::string whoOf(const AnimServerOptions& o, const scene::Avatar& avatar) {
+  return o.character.empty() ? avatar.name : o.character;
+}
+
+/// A pose take's first message: the character and its joints (every frame lists them in
+/// this order), the motion joints driving them, and how the frames are numbered (`frames`
+/// 0: not known ahead, a live take).
+studio::PoseStart poseStart(const std::string& character, const scene::Avatar& avatar, std::span<const int> driving,
+                            TimeCode start, std::int64_t frames) {
   studio::PoseStart p;
-  p.character = avatar.name;
+  p.character = character;
   for (const scene::Joint& j : avatar.joints) p.joints.push_back(j.name);
   p.driving.assign(driving.begin(), driving.end());
   p.start = start;
@@ -110,12 +117,12 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup, CharacterSetup& c
   studio::Listener requests = bus.listen(studio::requestSubjectOf(o.name));
   const std::string take = o.take.empty() ? studio::newTakeId() : o.take;
   // Its length known ahead only when it holds to --frames; else 0: live, as long as its graphs run.
-  publisher.beginTake(take, poseStart(avatar, std::vector<int>(avatar.joints.size(), -1),
+  publisher.beginTake(take, poseStart(whoOf(o, avatar), avatar, std::vector<int>(avatar.joints.size(), -1),
                                       takeStart(o, TimeCode{0, rate}), o.hold ? o.frames : 0));
   (void)stopOnSignals();
   spdlog::info("take {}: the event graph {} on {} at {:g} Hz, on {} ({}); drape inject --to {} starts graphs and sends "
                "events while it runs",
-               take, o.events, avatar.name, rate, studio::subjectOf(o.name), o.fast ? "as fast as the server takes it" : "in real time",
+               take, o.events, whoOf(o, avatar), rate, studio::subjectOf(o.name), o.fast ? "as fast as the server takes it" : "in real time",
                o.name);
 
   const auto began = std::chrono::steady_clock::now();
@@ -176,7 +183,7 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup, CharacterSetup& c
   publisher.send(studio::End{sent, "", stopAsked ? "stopped (a signal)" : "", 0});
   if (keep) logKeptApart(keep->report());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
-  fmt::print("sent take {}: {} pose frames of {}'s event graph to {} on {} in {:.1f} s\n", take, sent, avatar.name,
+  fmt::print("sent take {}: {} pose frames of {}'s event graph to {} on {} in {:.1f} s\n", take, sent, whoOf(o, avatar),
              studio::subjectOf(o.name), bus.url(), seconds);
   return 0;
 }
@@ -200,14 +207,15 @@ int runLiveMotion(const AnimServerOptions& o, RunSetup& setup, CharacterSetup& c
   const std::string take = o.take.empty() ? studio::newTakeId() : o.take;
   // Live: as long as the source sends. A capture does not come again, so a take of this name
   // in the stream cannot be completed.
-  if (publisher.beginTake(take, poseStart(avatar, live.drivingJoint(), takeStart(o, TimeCode{0, live.rate()}), 0)) > 0)
+  if (publisher.beginTake(take, poseStart(whoOf(o, avatar), avatar, live.drivingJoint(),
+                                          takeStart(o, TimeCode{0, live.rate()}), 0)) > 0)
     throw Error(fmt::format("--take {}: {} holds that take already, and a live capture cannot be sent again to "
                             "complete it; give the take another name",
                             take, studio::subjectOf(o.name)));
   spdlog::info("take {}: live motion from {} ({} joints at {:g} Hz in {}, joint map '{}') on {}, sent at {:g} Hz as it "
                "comes, on {} ({})",
                take, capture.name(), capture.header().joints.size(), live.sourceRate(), live.report().units.name,
-               live.jointMap().name, avatar.name, live.rate(), studio::subjectOf(o.name), bus.url());
+               live.jointMap().name, whoOf(o, avatar), live.rate(), studio::subjectOf(o.name), bus.url());
 
   const auto began = std::chrono::steady_clock::now();
   studio::PoseFrame frame;
@@ -224,7 +232,7 @@ int runLiveMotion(const AnimServerOptions& o, RunSetup& setup, CharacterSetup& c
   if (capture.keptApart()) logKeptApart(capture.keptApart()->report());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
   fmt::print("sent take {}: {} pose frames of {} from {} ({} source frames{}) to {} on {} in {:.1f} s{}\n", take, sent,
-             avatar.name, capture.name(), live.sourceFrames(),
+             whoOf(o, avatar), capture.name(), live.sourceFrames(),
              capture.badLines() > 0
                  ? fmt::format(", {} bad line{}", capture.badLines(), capture.badLines() == 1 ? "" : "s")
                  : std::string(),
@@ -234,8 +242,9 @@ int runLiveMotion(const AnimServerOptions& o, RunSetup& setup, CharacterSetup& c
 
 /// A recorded motion's take: its frames numbered from the motion's own time code, counted in
 /// its frames at the rate it plays.
-studio::PoseStart poseStart(const scene::Avatar& avatar, const motion::AvatarAnimation& motion) {
-  return poseStart(avatar, motion.drivingJoint(),
+studio::PoseStart poseStart(const std::string& character, const scene::Avatar& avatar,
+                            const motion::AvatarAnimation& motion) {
+  return poseStart(character, avatar, motion.drivingJoint(),
                    TimeCode{static_cast<std::int64_t>(std::llround(motion.start().seconds() * motion.rate())), motion.rate()},
                    static_cast<std::int64_t>(motion.frameCount()));
 }
@@ -243,7 +252,7 @@ studio::PoseStart poseStart(const scene::Avatar& avatar, const motion::AvatarAni
 int runAnimServer(const AnimServerOptions& o) {
   studio::checkSourceName(o.name, "--name");
   RunSetup setup = runSetupFromScene(o.scene);
-  CharacterSetup* character = oneCharacter(setup, "the studio");
+  CharacterSetup* character = chooseCharacter(setup, o.character, "--character");
   if (!character) throw Error(fmt::format("{}: the scene has no avatar to move", o.scene));
   if (!o.timecode.empty() && o.timecode != "now")
     (void)TimeCode::parseSmpte(o.timecode, setup.settings.frameRate_hz);  // said before anything waits
@@ -281,14 +290,14 @@ int runAnimServer(const AnimServerOptions& o) {
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape anim-server " + o.name);
   studio::Publisher publisher(bus, o.name, studio::Precision::Double, o.studio.giveUp());
   const std::string take = o.take.empty() ? studio::newTakeId() : o.take;
-  studio::PoseStart start = poseStart(avatar, motion);
+  studio::PoseStart start = poseStart(whoOf(o, avatar), avatar, motion);
   start.start = takeStart(o, start.start);
   publisher.beginTake(take, start);
   if (publisher.complete()) {
     fmt::print("take {} is in {} already, to its end\n", take, studio::subjectOf(o.name));
     return 0;
   }
-  spdlog::info("take {}: {} frames of {} at {:g} Hz from {}, on {} ({})", take, motion.frameCount(), avatar.name,
+  spdlog::info("take {}: {} frames of {} at {:g} Hz from {}, on {} ({})", take, motion.frameCount(), whoOf(o, avatar),
                motion.rate(), start.start.smpte(), studio::subjectOf(o.name), bus.url(),
                o.fast ? "as fast as the server takes them" : "in real time");
 
@@ -308,7 +317,7 @@ int runAnimServer(const AnimServerOptions& o) {
   publisher.send(studio::End{static_cast<std::int64_t>(motion.frameCount()), "", "", 0});
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
-  fmt::print("sent take {}: {} pose frames of {} to {} on {} in {:.1f} s\n", take, motion.frameCount(), avatar.name,
+  fmt::print("sent take {}: {} pose frames of {} to {} on {} in {:.1f} s\n", take, motion.frameCount(), whoOf(o, avatar),
              studio::subjectOf(o.name), bus.url(), seconds);
   return 0;
 }
@@ -319,6 +328,9 @@ RunFunction setupAnimServer(CLI::App& app) {
       ->required();
   app.add_option("--motion", o.motion, std::string("Motion for the avatar ") + kMotionHelp);
   app.add_option("--animation", o.animation, kAnimationHelp);
+  app.add_option("--character", o.character,
+                 "Which of the scene's characters it moves (its Avatar or Humanoid node's name); needed in a scene of "
+                 "several, each played by an anim-server of its own");
   app.add_option("--name", o.name, "This broadcaster's name: it publishes on drape.NAME, into the stream DRAPE_NAME")
       ->capture_default_str();
   app.add_option("--take", o.take,

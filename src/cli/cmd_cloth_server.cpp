@@ -21,7 +21,7 @@ namespace drape::cli {
 namespace {
 
 struct ClothServerOptions {
-  std::string scene, poses = "anim", name = "cloth", positions = "double";
+  std::string scene, poses = "anim", name = "cloth", positions = "double", character;
   std::vector<std::string> garments;
   long takes = 0;
   StudioOptions studio;
@@ -38,6 +38,19 @@ void keepGarments(RunSetup& setup, const std::vector<std::string>& names, const 
   keepGarmentsWhere(setup, [&](std::size_t g) {
     return std::find(names.begin(), names.end(), setup.garments[g].name) != names.end();
   });
+}
+
+/// The character whose garments `garments` names, when they are all one's (so that
+/// --character need not be given); "" otherwise.
+std::string wearerOf(const RunSetup& setup, const std::vector<std::string>& garments) {
+  std::string wearer;
+  for (const CharacterSetup& c : setup.characters)
+    for (const std::size_t g : c.garments)
+      if (std::find(garments.begin(), garments.end(), setup.garments[g].name) != garments.end()) {
+        if (!wearer.empty() && wearer != c.name) return "";
+        wearer = c.name;
+      }
+  return wearer;
 }
 
 /// The cloth take's frames onto the stream, garment by garment.
@@ -135,9 +148,11 @@ int runClothServer(const ClothServerOptions& o) {
   if (o.positions != "double" && o.positions != "float")
     throw Error(fmt::format("--positions {}: expected double or float", o.positions));
   RunSetup setup = runSetupFromScene(o.scene);
-  if (!oneCharacter(setup, "the studio"))
-    throw Error(fmt::format("{}: the scene has no avatar for its garments to move with", o.scene));
   keepGarments(setup, o.garments, o.scene);
+  const std::string chosen =
+      o.character.empty() && setup.characters.size() > 1 ? wearerOf(setup, o.garments) : o.character;
+  if (!chooseCharacter(setup, chosen, "--character"))
+    throw Error(fmt::format("{}: the scene has no avatar for its garments to move with", o.scene));
   CharacterSetup& character = setup.characters.front();
   {
     RunSetup check = setup;  // bad garments or settings are said before any waiting
@@ -168,6 +183,10 @@ int runClothServer(const ClothServerOptions& o) {
   int exitCode = 0;
   for (long served = 0; o.takes == 0 || served < o.takes;) {
     poses.followNextTake(avatar, setup.settings.frameRate_hz);
+    if (!chosen.empty() && poses.start().character != chosen)
+      throw Error(fmt::format("pose take {} of '{}' moves {}, and this cloth-server simulates {}'s garments: give it the "
+                              "--poses of {}'s anim-server",
+                              poses.take(), o.poses, poses.start().character, chosen, chosen));
     if (!poses.waitForFrames(1)) throw Error(fmt::format("pose take {} ended without a frame", poses.take()));
     const auto began = std::chrono::steady_clock::now();
     const TakeOutcome outcome = simulateTake(setup, poses, publisher, o.poses);
@@ -195,6 +214,9 @@ RunFunction setupClothServer(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--garments", o.garments, "Simulate only these of the scene's garments (another cloth-server the rest)")
       ->delimiter(',');
+  app.add_option("--character", o.character,
+                 "Which of the scene's characters' garments it simulates (needed in a scene of several unless --garments "
+                 "names one's); its --poses are the anim-server's of that --character");
   app.add_option("--positions", o.positions,
                  "How positions travel: double (a player records what drape run writes, to the byte) or float (half "
                  "the bytes)")

@@ -23,6 +23,7 @@
 #include "live_capture.hpp"
 #include "live_run.hpp"
 #include "run_setup.hpp"
+#include "shown_bodies.hpp"
 #include "stop_signal.hpp"
 
 namespace drape::cli {
@@ -70,26 +71,13 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
   std::vector<render::MeshInfo> meshes;
   for (const GarmentSetup& g : setup.garments)
     meshes.push_back({g.name, render::MeshRole::Garment, g.mesh.vertexCount(), g.mesh.triangles});
-  struct Body {
-    std::size_t firstSegment = 0;                ///< its first segment's mesh
-    std::optional<std::size_t> skinMesh;         ///< its skinned body's mesh
-    std::unique_ptr<sim::BodySkin> skin;
-    std::vector<sim::GarmentSurface> garments;   ///< what the skin is tucked under, per frame
-  };
-  std::vector<Body> bodies(worlds.size());
-  const bool several = worlds.size() > 1;
+  std::vector<const std::vector<sim::PartField>*> fields;
+  std::vector<double> allowances;
   for (std::size_t c = 0; c < worlds.size(); ++c) {
-    const scene::Avatar& avatar = *setup.characters[c].avatar;
-    const std::string who = several ? setup.characters[c].name : "";
-    bodies[c].firstSegment = meshes.size();
-    for (const scene::Segment& seg : avatar.segments)
-      meshes.push_back({seg.name, render::MeshRole::Segment, seg.mesh.vertexCount(), seg.mesh.triangles, who});
-    if (avatar.skin) {
-      bodies[c].skinMesh = meshes.size();
-      meshes.push_back({"body", render::MeshRole::Skin, avatar.skin->mesh.vertexCount(), avatar.skin->mesh.triangles, who});
-      bodies[c].skin = std::make_unique<sim::BodySkin>(avatar, worlds.world(c).fields(), leastT0(worlds.world(c)));
-    }
+    fields.push_back(&worlds.world(c).fields());
+    allowances.push_back(leastT0(worlds.world(c)));
   }
+  ShownBodies bodies(setup, meshes, fields, allowances);
   // The simulation runs on a thread of its own, a few frames ahead of the window, which
   // poses the segments and the skins (fitted and tucked under the cloth) and draws.
   const auto prepare = [&](FrameTaken& slot) {
@@ -134,22 +122,7 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
       out.positions[g] = taken->positions[g];
       out.states[g] = taken->states[g];
     }
-    for (std::size_t c = 0; c < worlds.size(); ++c) {
-      const scene::Avatar& avatar = *setup.characters[c].avatar;
-      const std::vector<RigidTransform>& joints = taken->joints[c];
-      for (std::size_t s = 0; s < avatar.segments.size(); ++s) {
-        const scene::Segment& seg = avatar.segments[s];
-        std::vector<Vec3>& p = out.positions[bodies[c].firstSegment + s];
-        p.clear();
-        const RigidTransform& pose = joints[static_cast<std::size_t>(seg.joint)];
-        for (const Vec3& v : seg.mesh.positions) p.push_back(pose.apply(v));
-      }
-      if (!bodies[c].skin) continue;
-      bodies[c].garments.clear();
-      for (const std::size_t g : setup.characters[c].garments)
-        bodies[c].garments.push_back({taken->positions[g], setup.garments[g].mesh.triangles});
-      bodies[c].skin->pose(joints, bodies[c].garments, out.positions[*bodies[c].skinMesh]);
-    }
+    bodies.pose(taken->joints, taken->positions, out.positions);
     return true;
   }, [&](std::int64_t) { return ahead.ready(); });  // live, a frame may be a while coming: the window stays live
   options.loop = false;

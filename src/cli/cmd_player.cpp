@@ -22,6 +22,7 @@
 #include "render_options.hpp"
 #include "run_writer.hpp"
 #include "stop_signal.hpp"
+#include "shown_bodies.hpp"
 #include "studio_frames.hpp"
 #include "take_feed.hpp"
 
@@ -39,13 +40,18 @@ struct PlayerRoleOptions {
   PictureOptions picture;
 };
 
-/// The part fields the skinned body is fitted to, as the cloth-servers' worlds build them
-/// (none for an avatar without a skin: the segments need none).
-std::vector<sim::PartField> skinFields(const RunSetup& setup) {
-  const CharacterSetup& character = setup.characters.front();
+/// The part fields a character's skinned body is fitted to, as the cloth-servers' worlds
+/// build them (none for an avatar without a skin: the segments need none).
+std::vector<sim::PartField> skinFields(const RunSetup& setup, const CharacterSetup& character) {
   if (!character.avatar->skin) return {};
-  spdlog::info("building distance fields ({:.4g} m voxels) to fit the skinned body", character.voxel_m);
-  return sim::buildPartFields(*character.avatar, setup.garments, worldSettings(setup, character));
+  spdlog::info("building distance fields ({:.4g} m voxels) to fit {}'s skinned body", character.voxel_m,
+               setup.characters.size() > 1 ? character.name : std::string("the avatar"));
+  return sim::buildPartFields(*character.avatar, garmentsOf(setup, character), worldSettings(setup, character));
+}
+
+/// How far a character's skin may stand out of its parts: the least T0 of what it wears.
+double skinAllowance(const RunSetup& setup, const CharacterSetup& character) {
+  return sim::leastT0(garmentsOf(setup, character), worldSettings(setup, character));
 }
 
 /// The cloth-servers' stats for stats.json: one server's as it wrote them, several by stream.
@@ -64,22 +70,21 @@ std::string takeDirName(const std::string& take) {
   return name.empty() || name == "." || name == ".." ? "take" : name;
 }
 
-/// The part fields of the skinned body, built again only when a take sends other garments.
+/// The part fields of each character's skinned body, built again only when a take sends it
+/// other garments.
 class SkinFields {
  public:
-  const std::vector<sim::PartField>& of(const RunSetup& setup) {
-    std::vector<std::string> names;
-    for (const GarmentSetup& g : setup.garments) names.push_back(g.name);
-    if (!fields_ || names != names_) {
-      fields_ = skinFields(setup);
-      names_ = std::move(names);
-    }
-    return *fields_;
+  const std::vector<sim::PartField>& of(const RunSetup& setup, const CharacterSetup& character) {
+    std::vector<std::string> key{character.name};
+    for (const std::size_t g : character.garments) key.push_back(setup.garments[g].name);
+    for (const auto& [k, fields] : built_)
+      if (k == key) return *fields;
+    return *built_.emplace_back(std::move(key), std::make_unique<std::vector<sim::PartField>>(skinFields(setup, character)))
+                .second;
   }
 
  private:
-  std::optional<std::vector<sim::PartField>> fields_;
-  std::vector<std::string> names_;
+  std::vector<std::pair<std::vector<std::string>, std::unique_ptr<std::vector<sim::PartField>>>> built_;
 };
 
 /// How one take's recording ended.
@@ -95,10 +100,11 @@ struct Recording {
 /// or --frames), then the stats, as drape run writes them.
 Recording recordTake(const PlayerRoleOptions& o, RunSetup& setup, StudioFrames& frames, SkinFields& fields,
                      const std::atomic<bool>& stop) {
-  const CharacterSetup& character = setup.characters.front();
-  RunWriter writer(setup, {CharacterAtStart{&fields.of(setup),
-                                            sim::leastT0(setup.garments, worldSettings(setup, character)),
-                                            frames.jointsAtStart()}});
+  std::vector<CharacterAtStart> characters;
+  const std::vector<std::vector<RigidTransform>> joints = frames.jointsAtStart();
+  for (std::size_t c = 0; c < setup.characters.size(); ++c)
+    characters.push_back({&fields.of(setup, setup.characters[c]), skinAllowance(setup, setup.characters[c]), joints[c]});
+  RunWriter writer(setup, characters);
   FrameTaken taken;
   long last = -1;
   Recording out;
@@ -184,21 +190,21 @@ int show(const PlayerRoleOptions& o) {
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape player");
   StudioFrames frames(bus, setup, o.cloth, o.studio);
   frames.followNextTake(o.take);
-  // The window's meshes are the first take's garments; the feed reads on with a setup of its own.
-  const std::vector<GarmentSetup> garmentsShown = setup.garments;
-  const CharacterSetup& character = setup.characters.front();
-  const scene::Avatar& avatar = *character.avatar;
+  // The window's meshes are the first take's garments and characters; the feed reads on with
+  // a setup of its own.
+  const RunSetup shownSetup = setup;
+  const std::size_t garmentsShown = shownSetup.garments.size();
   std::vector<render::MeshInfo> meshes;
-  for (const GarmentSetup& g : garmentsShown)
+  for (const GarmentSetup& g : shownSetup.garments)
     meshes.push_back({g.name, render::MeshRole::Garment, g.mesh.vertexCount(), g.mesh.triangles});
-  for (const scene::Segment& seg : avatar.segments)
-    meshes.push_back({seg.name, render::MeshRole::Segment, seg.mesh.vertexCount(), seg.mesh.triangles});
-  if (avatar.skin)
-    meshes.push_back({"body", render::MeshRole::Skin, avatar.skin->mesh.vertexCount(), avatar.skin->mesh.triangles});
-  const std::vector<sim::PartField> fields = skinFields(setup);
-  std::unique_ptr<sim::BodySkin> skin;
-  if (avatar.skin)
-    skin = std::make_unique<sim::BodySkin>(avatar, fields, sim::leastT0(garmentsShown, worldSettings(setup, character)));
+  SkinFields skinFieldsOf;
+  std::vector<const std::vector<sim::PartField>*> fields;
+  std::vector<double> allowances;
+  for (const CharacterSetup& c : shownSetup.characters) {
+    fields.push_back(&skinFieldsOf.of(shownSetup, c));
+    allowances.push_back(skinAllowance(shownSetup, c));
+  }
+  ShownBodies bodies(shownSetup, meshes, fields, allowances);
   const std::string firstTake = frames.take();
   const double rate = setup.settings.frameRate_hz;
 
@@ -206,7 +212,6 @@ int show(const PlayerRoleOptions& o) {
   TakeFeed feed(frames, firstShown, o.takes);
   Shown shown;
   std::optional<std::size_t> showing;  // which take of the feed
-  std::vector<sim::GarmentSurface> garments;
   std::optional<std::chrono::steady_clock::time_point> first;
   long firstOfTake = firstShown;
   render::CallbackSource source(
@@ -238,20 +243,11 @@ int show(const PlayerRoleOptions& o) {
         const FrameTaken& taken = item->taken;
         out.positions.resize(meshes.size());
         out.states.resize(meshes.size());
-        garments.clear();
-        for (std::size_t g = 0; g < garmentsShown.size(); ++g) {
+        for (std::size_t g = 0; g < garmentsShown; ++g) {
           out.positions[g] = taken.positions[g];
           out.states[g] = taken.states[g];
-          garments.push_back({taken.positions[g], garmentsShown[g].mesh.triangles});
         }
-        for (std::size_t s = 0; s < avatar.segments.size(); ++s) {
-          const scene::Segment& seg = avatar.segments[s];
-          std::vector<Vec3>& p = out.positions[garmentsShown.size() + s];
-          p.clear();
-          const RigidTransform& pose = taken.joints.front()[static_cast<std::size_t>(seg.joint)];
-          for (const Vec3& v : seg.mesh.positions) p.push_back(pose.apply(v));
-        }
-        if (skin) skin->pose(taken.joints.front(), garments, out.positions.back());
+        bodies.pose(taken.joints, taken.positions, out.positions);
         return true;
       },
       [&](std::int64_t) { return feed.ready(); });

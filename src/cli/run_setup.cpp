@@ -259,6 +259,20 @@ const CharacterSetup* oneCharacter(const RunSetup& setup, const std::string& wha
   return setup.characters.empty() ? nullptr : &setup.characters.front();
 }
 
+CharacterSetup* chooseCharacter(RunSetup& setup, const std::string& name, const std::string& option) {
+  if (setup.characters.empty()) return nullptr;
+  if (name.empty()) {
+    if (setup.characters.size() > 1)
+      throw Error(fmt::format("the scene has {} characters ({}): say which this one plays, {} NAME",
+                              setup.characters.size(), characterList(setup), option));
+    return &setup.characters.front();
+  }
+  const CharacterSetup& chosen = characterNamed(setup, name, option + " " + name);
+  const std::vector<std::size_t> worn = chosen.garments;
+  keepGarmentsWhere(setup, [&](std::size_t g) { return std::find(worn.begin(), worn.end(), g) != worn.end(); });
+  return &setup.characters.front();
+}
+
 CharacterSetup& characterNamed(RunSetup& setup, const std::string& name, const std::string& option) {
   for (CharacterSetup& c : setup.characters)
     if (c.name == name) return c;

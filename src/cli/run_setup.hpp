@@ -109,6 +109,11 @@ struct RunSetup {
 /// when it has none; throws drape::Error saying so when it has several.
 [[nodiscard]] CharacterSetup* oneCharacter(RunSetup& setup, const std::string& what);
 [[nodiscard]] const CharacterSetup* oneCharacter(const RunSetup& setup, const std::string& what);
+/// The one character a studio role plays: the one `name` names, its garments and no other's
+/// kept in `setup`, or (`name` empty) the scene's only one. Throws drape::Error naming
+/// `option` when none is called so, or the scene has several and `name` is empty; null when
+/// the scene has no character.
+CharacterSetup* chooseCharacter(RunSetup& setup, const std::string& name, const std::string& option);
 /// The character named `name` ("NAME", as --motion NAME=FILE gives it); throws drape::Error
 /// listing the setup's characters when none is called so.
 [[nodiscard]] CharacterSetup& characterNamed(RunSetup& setup, const std::string& name, const std::string& option);

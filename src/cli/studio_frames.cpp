@@ -29,7 +29,7 @@ StudioFrames::StudioFrames(studio::Bus& bus, RunSetup& setup, const std::vector<
                            const StudioOptions& options)
     : setup_(setup), sceneGarments_(setup.garments), sceneCharacters_(setup.characters), options_(options), bus_(bus),
       consumer_(consumerName("player", true)) {
-  if (!oneCharacter(setup, "the studio")) throw Error("drape player: the scene has no avatar the garments are worn by");
+  if (setup.characters.empty()) throw Error("drape player: the scene has no avatar the garments are worn by");
   if (cloth.empty()) throw Error("--cloth: name at least one cloth-server");
   for (const std::string& source : cloth) {
     studio::checkSourceName(source, "--cloth");
@@ -42,23 +42,63 @@ StudioFrames::StudioFrames(studio::Bus& bus, RunSetup& setup, const std::vector<
   }
 }
 
+std::size_t StudioFrames::sceneCharacterOf(std::size_t s) const {
+  if (sceneCharacters_.size() == 1) return 0;  // a scene of one: whatever its takes call it
+  const std::string& character = cloth_[s].follower->start().character;
+  for (std::size_t c = 0; c < sceneCharacters_.size(); ++c)
+    if (sceneCharacters_[c].name == character) return c;
+  std::vector<std::string> names;
+  for (const CharacterSetup& c : sceneCharacters_) names.push_back(c.name);
+  throw Error(fmt::format("cloth stream '{}' simulates character '{}', which the scene does not have (it has: {}); give "
+                          "its anim-server --character NAME",
+                          cloth_[s].source, character, fmt::join(names, ", ")));
+}
+
+StudioFrames::Poses& StudioFrames::posesFrom(const std::string& source) {
+  for (auto& [name, poses] : poses_)
+    if (name == source) return *poses;
+  Poses& p = *poses_.emplace_back(source, std::make_unique<Poses>()).second;
+  p.stream = std::make_unique<studio::StreamReader>(bus_, source, consumer_, options_.patience(), options_.giveUp());
+  p.stream->stopOn(stop_);
+  p.follower = std::make_unique<studio::PoseFollower>(*p.stream);
+  return p;
+}
+
 void StudioFrames::followNextTake(const std::string& take) {
   for (Cloth& c : cloth_) {
     const std::string before = c.follower->take();
     c.follower->followNextTake(take, before);
     c.garment.clear();
   }
+  // Each stream's character; the streams of one character simulate one pose take, and every
+  // character's take runs at the scene's rate, with the same lead-in and time code.
+  std::vector<std::size_t> characterOf(cloth_.size());
+  std::vector<std::optional<std::size_t>> firstOf(sceneCharacters_.size());
+  for (std::size_t s = 0; s < cloth_.size(); ++s) {
+    characterOf[s] = sceneCharacterOf(s);
+    std::optional<std::size_t>& first = firstOf[characterOf[s]];
+    if (!first) first = s;
+    const Cloth& a = cloth_[*first];
+    if (const std::string bad = disagreement(a.follower->start(), cloth_[s].follower->start()); !bad.empty())
+      throw Error(fmt::format("--cloth: '{}' and '{}' simulate {}: a player collates the cloth of one pose take per "
+                              "character",
+                              a.source, cloth_[s].source, bad));
+  }
   const studio::ClothStart& first = cloth_.front().follower->start();
-  for (const Cloth& c : cloth_)
-    if (const std::string bad = disagreement(first, c.follower->start()); !bad.empty())
-      throw Error(fmt::format("--cloth: '{}' and '{}' simulate {}: a player collates the cloth of one pose take",
-                              cloth_.front().source, c.source, bad));
+  for (const Cloth& c : cloth_) {
+    const studio::ClothStart& other = c.follower->start();
+    if (other.start.rate != first.start.rate || other.leadIn_s != first.leadIn_s || other.start.frame != first.start.frame)
+      throw Error(fmt::format("--cloth: '{}' and '{}' simulate takes of different frame rates, lead-ins or time codes "
+                              "({} and {}): give the anim-servers the same --timecode",
+                              cloth_.front().source, c.source, first.start.smpte(), other.start.smpte()));
+  }
   if (first.start.rate != setup_.settings.frameRate_hz)
     throw Error(fmt::format("cloth take {} runs at {:g} frames per second, the scene at {:g}: give the player the "
                             "cloth-servers' scene",
                             cloth_.front().follower->take(), first.start.rate, setup_.settings.frameRate_hz));
 
-  // The garments the streams send, in the scene's order.
+  // The garments the streams send, in the scene's order, each of the character its stream's
+  // take simulates.
   std::vector<std::string> names;
   for (const GarmentSetup& g : sceneGarments_) names.push_back(g.name);
   std::vector<int> from(sceneGarments_.size(), -1);  // the stream sending each scene garment
@@ -75,6 +115,10 @@ void StudioFrames::followNextTake(const std::string& take) {
       if (g.vertices != sceneGarments_[i].mesh.vertexCount())
         throw Error(fmt::format("cloth stream '{}' sends garment '{}' with {} vertices, the scene's has {}",
                                 cloth_[s].source, g.name, g.vertices, sceneGarments_[i].mesh.vertexCount()));
+      const std::vector<std::size_t>& worn = sceneCharacters_[characterOf[s]].garments;
+      if (std::find(worn.begin(), worn.end(), i) == worn.end())
+        throw Error(fmt::format("cloth stream '{}' sends garment '{}' on {}, which the scene does not dress in it",
+                                cloth_[s].source, g.name, sceneCharacters_[characterOf[s]].name));
       from[i] = static_cast<int>(s);
     }
   std::vector<std::string> missing;
@@ -91,24 +135,27 @@ void StudioFrames::followNextTake(const std::string& take) {
   for (Cloth& c : cloth_)
     for (const studio::GarmentInfo& g : c.follower->start().garments)
       c.garment.push_back(keptIndex[static_cast<std::size_t>(std::find(names.begin(), names.end(), g.name) - names.begin())]);
-  // The setup shows the garments sent, in the scene's order (keptIndex's).
+  // The setup shows the garments sent, in the scene's order (keptIndex's), on the
+  // characters that wear them.
   setup_.garments = sceneGarments_;
   setup_.characters = sceneCharacters_;
   keepGarmentsWhere(setup_, [&](std::size_t g) { return from[g] >= 0; });
 
-  // The poses from where the stream is: a take's poses come before its cloth.
-  if (!poseStream_ || poseStream_->source() != first.poses) {
-    poses_.reset();
-    poseStream_ = std::make_unique<studio::StreamReader>(bus_, first.poses, consumer_, options_.patience(),
-                                                         options_.giveUp());
-    poseStream_->stopOn(stop_);
-    poses_ = std::make_unique<studio::PoseFollower>(*poseStream_);
+  // Each character's poses from where its stream is: a take's poses come before its cloth.
+  bodies_.clear();
+  for (std::size_t c = 0; c < sceneCharacters_.size(); ++c) {
+    if (!firstOf[c]) continue;  // no stream sends its garments: it is not in the setup
+    const std::size_t s = *firstOf[c];
+    const studio::ClothStart& start = cloth_[s].follower->start();
+    Body& body = bodies_.emplace_back();
+    body.firstCloth = s;
+    body.poses = &posesFrom(start.poses);
+    const scene::Avatar& avatar = *sceneCharacters_[c].avatar;
+    body.poses->follower->followNextTake(avatar, setup_.settings.frameRate_hz, start.poseTake);
+    if (!body.poses->follower->waitForFrames(1))
+      throw Error(fmt::format("pose take {} ended without a frame", start.poseTake));
+    body.avatarPoses = std::make_unique<sim::AvatarPoses>(avatar, &body.poses->follower->animation(), start.leadIn_s);
   }
-  avatarPoses_.reset();
-  const scene::Avatar& avatar = *setup_.characters.front().avatar;
-  poses_->followNextTake(avatar, setup_.settings.frameRate_hz, first.poseTake);
-  if (!poses_->waitForFrames(1)) throw Error(fmt::format("pose take {} ended without a frame", first.poseTake));
-  avatarPoses_ = std::make_unique<sim::AvatarPoses>(avatar, &poses_->animation(), first.leadIn_s);
 }
 
 StudioFrames::~StudioFrames() = default;
@@ -116,12 +163,15 @@ StudioFrames::~StudioFrames() = default;
 void StudioFrames::stopOn(const std::atomic<bool>* flag) {
   stop_ = flag;
   for (Cloth& c : cloth_) c.stream->stopOn(flag);
-  if (poseStream_) poseStream_->stopOn(flag);
+  for (auto& [name, poses] : poses_) poses->stream->stopOn(flag);
 }
 
-std::vector<RigidTransform> StudioFrames::jointsAtStart() const {
-  std::vector<RigidTransform> joints(setup_.characters.front().avatar->joints.size());
-  avatarPoses_->evaluate(0.0, joints);
+std::vector<std::vector<RigidTransform>> StudioFrames::jointsAtStart() const {
+  std::vector<std::vector<RigidTransform>> joints(bodies_.size());
+  for (std::size_t c = 0; c < bodies_.size(); ++c) {
+    joints[c].resize(setup_.characters[c].avatar->joints.size());
+    bodies_[c].avatarPoses->evaluate(0.0, joints[c]);
+  }
   return joints;
 }
 
@@ -129,8 +179,8 @@ bool StudioFrames::next(long frame, FrameTaken& out) {
   out.frame = frame;
   out.positions.resize(setup_.garments.size());
   out.states.resize(setup_.garments.size());
-  out.joints.resize(1);
-  out.joints.front().resize(setup_.characters.front().avatar->joints.size());
+  out.joints.resize(bodies_.size());
+  for (std::size_t c = 0; c < bodies_.size(); ++c) out.joints[c].resize(setup_.characters[c].avatar->joints.size());
   out.stageMs = {};
   bool ended = false;
   for (Cloth& c : cloth_) {
@@ -146,10 +196,13 @@ bool StudioFrames::next(long frame, FrameTaken& out) {
     }
   }
   if (ended) return false;
-  const studio::ClothStart& s = start();
-  (void)poses_->waitForFrames(studio::motionFramesNeeded(frame, s.start.rate, s.leadIn_s, s.start.rate));
-  // The time as the cloth-servers' world computes a frame's (CharacterWorld::frameTime).
-  avatarPoses_->evaluate(static_cast<double>(frame) / setup_.settings.frameRate_hz, out.joints.front());
+  for (std::size_t c = 0; c < bodies_.size(); ++c) {
+    const studio::ClothStart& s = cloth_[bodies_[c].firstCloth].follower->start();
+    (void)bodies_[c].poses->follower->waitForFrames(
+        studio::motionFramesNeeded(frame, s.start.rate, s.leadIn_s, s.start.rate));
+    // The time as the cloth-servers' world computes a frame's (CharacterWorld::frameTime).
+    bodies_[c].avatarPoses->evaluate(static_cast<double>(frame) / setup_.settings.frameRate_hz, out.joints[c]);
+  }
   return true;
 }
 

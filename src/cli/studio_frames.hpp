@@ -1,8 +1,9 @@
 #pragma once
 // What `drape player` collates (docs/STUDIO.md): the cloth takes of one or more
-// cloth-servers and the pose take they simulated, frame by frame as drape run's outputs
-// see them: every garment's positions and vertex states, and the avatar's joints at the
-// frame's time, from the same poses the cloth-servers played (the lead-in included).
+// cloth-servers and the pose takes they simulated (one per character of the scene), frame by
+// frame as drape run's outputs see them: every garment's positions and vertex states, and
+// each character's joints at the frame's time, from the same poses its cloth-servers played
+// (the lead-in included).
 
 #include <atomic>
 #include <memory>
@@ -29,11 +30,12 @@ class StudioFrames {
   ~StudioFrames();
 
   /// Follows the next take of each cloth stream (the take `take`, if given; never the one
-  /// followed before, which a stream may still hold) and the pose take they simulated,
-  /// reading on from where the streams are. Keeps of the scene's garments in `setup` the
-  /// ones the streams send, in the scene's order; throws drape::Error (BadInput) when a
-  /// stream sends a garment the scene does not have or has otherwise, or two streams send
-  /// the same one, or they follow different poses.
+  /// followed before, which a stream may still hold) and the pose takes they simulated,
+  /// reading on from where the streams are. Keeps of the scene's garments and characters in
+  /// `setup` the ones the streams send, in the scene's order; throws drape::Error (BadInput)
+  /// when a stream sends a garment the scene does not have or has otherwise, or another
+  /// character's, or two streams send the same one, or streams of one character follow
+  /// different poses, or the characters' takes run at different rates, lead-ins or times.
   void followNextTake(const std::string& take = "");
 
   /// Frame `frame` (the next after the last, from 0) of the take followed into `out`
@@ -51,8 +53,8 @@ class StudioFrames {
   /// A flag that ends every wait of the streams (studio::Stopped) once set.
   void stopOn(const std::atomic<bool>* flag);
 
-  /// The joints at frame 0 (the rest pose, where the lead-in starts).
-  [[nodiscard]] std::vector<RigidTransform> jointsAtStart() const;
+  /// Each character's joints at frame 0 (the rest pose, where the lead-in starts).
+  [[nodiscard]] std::vector<std::vector<RigidTransform>> jointsAtStart() const;
   [[nodiscard]] const studio::ClothStart& start() const { return cloth_.front().follower->start(); }
   [[nodiscard]] const std::string& take() const { return cloth_.front().follower->take(); }
   /// The cloth-servers' stats, by stream (after next() returned false).
@@ -71,10 +73,24 @@ class StudioFrames {
   const StudioOptions options_;
   studio::Bus& bus_;
   std::string consumer_;
+  /// A pose stream and its take, read since the stream was first followed.
+  struct Poses {
+    std::unique_ptr<studio::StreamReader> stream;
+    std::unique_ptr<studio::PoseFollower> follower;
+  };
+  /// A character of the take: the poses its cloth-servers played, at any time.
+  struct Body {
+    Poses* poses = nullptr;
+    std::unique_ptr<sim::AvatarPoses> avatarPoses;
+    std::size_t firstCloth = 0;  ///< a cloth stream of it (its start says the lead-in)
+  };
+  /// Which character of the scene cloth stream s's take simulates.
+  [[nodiscard]] std::size_t sceneCharacterOf(std::size_t s) const;
+  Poses& posesFrom(const std::string& source);
+
   std::vector<Cloth> cloth_;
-  std::unique_ptr<studio::StreamReader> poseStream_;
-  std::unique_ptr<studio::PoseFollower> poses_;
-  std::unique_ptr<sim::AvatarPoses> avatarPoses_;
+  std::vector<std::pair<std::string, std::unique_ptr<Poses>>> poses_;  ///< by stream name
+  std::vector<Body> bodies_;                          ///< per character of the setup
   const std::atomic<bool>* stop_ = nullptr;
 };
 

@@ -1,7 +1,7 @@
 // Several characters in one scene, end to end: each simulated in a world of its own, so that
 // a character's files in the run directory are, to the byte, what the scene of that character
 // alone writes; the run directory says whose each part, skin and garment is, and what plays
-// one character only says so.
+// one character only says so (the studio's roles are each given theirs: test_studio.cpp).
 
 #include <gtest/gtest.h>
 
@@ -149,7 +149,9 @@ TEST(Characters, MotionsAreGivenByNameAndWhatPlaysOneCharacterSaysSo) {
   expectError("run '" + kTwoCharacters + "' --events '" + std::string(DRAPE_SOURCE_DIR) + "/examples/event_graph/day.egml'" + out,
               "--events (an event graph) plays one character; the scene has 2 (Ada, Bea)");
   expectError("anim-server '" + kTwoCharacters + "' --server nats://127.0.0.1:1 --give-up 1",
-              "the studio plays one character; the scene has 2 (Ada, Bea)");
+              "the scene has 2 characters (Ada, Bea): say which this one plays, --character NAME");
+  expectError("anim-server '" + kTwoCharacters + "' --character Carl --server nats://127.0.0.1:1 --give-up 1",
+              "--character Carl: the scene has no character called 'Carl' (it has: Ada, Bea)");
 
   // NAME=FILE for one, FILE for the others: Ada plays the file for all, Bea her own; none
   // keeps one at rest.

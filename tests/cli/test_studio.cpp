@@ -176,6 +176,57 @@ TEST(Studio, TwoClothServersSplitTheGarmentsAndThePlayerCollatesThem) {
   EXPECT_EQ(stats["cloth_servers"]["back"]["garments"][0]["name"], "Skirt2");
 }
 
+TEST(Studio, TwoCharactersEachOnServersOfItsOwnAreDrapeRunsToTheByte) {
+  // Ada and Bea of the two characters' scene, each moved by an anim-server of her own and
+  // dressed by a cloth-server of her own (Bea's told by the garments it simulates); the
+  // player collates the four streams into what drape run writes of the scene.
+  ScratchDir dir("studio-characters");
+  NatsServer server;
+  const std::string scene = std::string(DRAPE_SOURCE_DIR) + "/examples/two_characters/scene.wrl";
+  const std::string reference = runInto(dir, "reference", "'" + scene + "' --frames 45");
+  DrapeProcess adaCloth("cloth-server '" + scene + "' --character Ada --poses ada --name ada-cloth --takes 1" +
+                            roles(server),
+                        dir, "ada-cloth");
+  DrapeProcess beaCloth("cloth-server '" + scene + "' --garments 'Bea skirt' --poses bea --name bea-cloth --takes 1" +
+                            roles(server),
+                        dir, "bea-cloth");
+  for (const char* who : {"Ada", "Bea"}) {
+    std::string name = who;
+    name[0] = static_cast<char>(std::tolower(static_cast<unsigned char>(name[0])));
+    const CliResult sent = runDrape("anim-server '" + scene + "' --character " + who + " --name " + name +
+                                        " --take scene1 --fast" + roles(server),
+                                    dir);
+    ASSERT_EQ(sent.code, 0) << sent.err;
+    EXPECT_NE(sent.out.find(std::string("pose frames of ") + who), std::string::npos) << sent.out;
+  }
+  const CliResult ada = adaCloth.wait(), bea = beaCloth.wait();
+  ASSERT_EQ(ada.code, 0) << ada.err;
+  ASSERT_EQ(bea.code, 0) << bea.err;
+  EXPECT_NE(bea.out.find("take scene1: 115 cloth frames of Bea skirt"), std::string::npos) << bea.out;
+  const CliResult recorded = runDrape("player '" + scene + "' --cloth ada-cloth,bea-cloth --frames 45 --record '" +
+                                          (dir / "recorded") + "'" + roles(server),
+                                      dir);
+  ASSERT_EQ(recorded.code, 0) << recorded.err;
+  for (const char* file :
+       {"garment-Ada_skirt.pc2", "garment-Bea_skirt.pc2", "garment-Bea_skirt.states", "body-Ada.pc2", "body-Bea.pc2",
+        "segments/Ada/Hips.pc2", "segments/Bea/LeftUpLeg.pc2", "manifest.json"})
+    EXPECT_TRUE(slurp(dir / ("recorded/" + std::string(file))) == slurp(reference + "/" + file)) << file;
+
+  // A cloth-server given another character's poses says so.
+  const CliResult wrong =
+      runDrape("cloth-server '" + scene + "' --character Ada --poses bea --name wrong --takes 1" + roles(server), dir);
+  EXPECT_EQ(wrong.code, 2) << wrong.err;
+  EXPECT_NE(wrong.err.find("pose take scene1 of 'bea' moves Bea, and this cloth-server simulates Ada's garments: give it "
+                           "the --poses of Ada's anim-server"),
+            std::string::npos)
+      << wrong.err;
+  const CliResult which = runDrape("cloth-server '" + scene + "' --name which --takes 1" + roles(server), dir);
+  EXPECT_EQ(which.code, 2) << which.err;
+  EXPECT_NE(which.err.find("the scene has 2 characters (Ada, Bea): say which this one plays, --character NAME"),
+            std::string::npos)
+      << which.err;
+}
+
 TEST(Studio, AnUnstableTakeIsRecordedUpToItsLastGoodFrame) {
   ScratchDir dir("studio-unstable");
   NatsServer server;

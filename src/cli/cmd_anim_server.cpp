@@ -72,13 +72,13 @@ studio::PoseStart poseStart(const std::string& character, const scene::Avatar& a
 
 /// What an Inject asks of a live take: a graph started at once, an event sent; the answer.
 studio::InjectReply injected(const studio::Inject& in, long frame, events::Scheduler& scheduler,
-                             events::Motions& motions, std::list<events::Graph>& graphs, const scene::Avatar& avatar,
+                             events::Motions& motions, std::list<events::Graph>& graphs,
                              const motion::MotionOptions& options) {
   std::vector<std::string> done;
   try {
     if (!in.graph.empty()) {
       events::Graph g = events::parseGraph(in.graph, fmt::format("graph injected at frame {}", frame), in.baseDir);
-      motions.load(g, avatar, options);
+      motions.load(g, scheduler.actors(), options);
       graphs.push_back(std::move(g));
       scheduler.start(graphs.back(), motions);
       done.push_back(fmt::format("started graph{} at frame {}",
@@ -97,8 +97,11 @@ studio::InjectReply injected(const studio::Inject& in, long frame, events::Sched
 }
 
 /// `--events`: plays an event graph live, frame by frame, taking graphs and events injected
-/// while it runs (drape inject).
-int runEventGraph(const AnimServerOptions& o, RunSetup& setup, CharacterSetup& character) {
+/// while it runs (drape inject). The graph runs for every character of the scene (`cast`),
+/// so that what one character's events wait for takes the time it takes in drape run, and the
+/// take carries `character`'s poses.
+int runEventGraph(const AnimServerOptions& o, RunSetup& setup, CharacterSetup& character,
+                  const std::vector<CharacterSetup>& cast) {
   const scene::Avatar& avatar = *character.avatar;
   const double rate = setup.settings.frameRate_hz;
   // Kept apart as drape run keeps a graph's motion apart: each frame goes out the
@@ -107,9 +110,12 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup, CharacterSetup& c
   const motion::MotionOptions mo = motionOptions(setup);
   std::list<events::Graph> graphs;
   graphs.push_back(events::readGraph(o.events));
+  const std::vector<events::Actor> actors = eventActors(cast);
+  std::size_t actor = 0;
+  while (actor + 1 < cast.size() && cast[actor].name != character.name) ++actor;
   events::Motions motions;
-  motions.load(graphs.back(), avatar, mo);
-  events::Scheduler scheduler(avatar, character.names, rate, parameterOptions(o.sets));
+  motions.load(graphs.back(), actors, mo);
+  events::Scheduler scheduler(actors, rate, parameterOptions(o.sets));
   scheduler.start(graphs.back(), motions);
 
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape anim-server " + o.name);
@@ -136,7 +142,7 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup, CharacterSetup& c
   const auto sendReady = [&] {
     if (!keep) {
       frame.frame = sent++;
-      frame.joints = tick.joints;
+      frame.joints = tick.poses[actor];
       frame.wind = tick.wind;
       publisher.send(frame);
       return;
@@ -158,7 +164,7 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup, CharacterSetup& c
       try {
         const studio::Message m = studio::decode(r->data);
         if (const auto* in = std::get_if<studio::Inject>(&m.payload))
-          reply = injected(*in, f, scheduler, motions, graphs, avatar, mo);
+          reply = injected(*in, f, scheduler, motions, graphs, mo);
       } catch (const Error& e) {
         reply.message = e.what();
       }
@@ -167,7 +173,7 @@ int runEventGraph(const AnimServerOptions& o, RunSetup& setup, CharacterSetup& c
     }
     const bool more = scheduler.tick(tick);
     if (keep) {
-      keep->push(tick.joints);
+      keep->push(tick.poses[actor]);
       winds.push_back(tick.wind);
     }
     sendReady();
@@ -252,6 +258,7 @@ studio::PoseStart poseStart(const std::string& character, const scene::Avatar& a
 int runAnimServer(const AnimServerOptions& o) {
   studio::checkSourceName(o.name, "--name");
   RunSetup setup = runSetupFromScene(o.scene);
+  const std::vector<CharacterSetup> cast = setup.characters;  // an event graph moves them all
   CharacterSetup* character = chooseCharacter(setup, o.character, "--character");
   if (!character) throw Error(fmt::format("{}: the scene has no avatar to move", o.scene));
   if (!o.timecode.empty() && o.timecode != "now")
@@ -269,7 +276,7 @@ int runAnimServer(const AnimServerOptions& o) {
   if (!o.events.empty()) {
     if (!o.motion.empty() || !o.animation.empty())
       throw Error("--events plays an event graph's motions: give it or --motion, not both");
-    return runEventGraph(o, setup, *character);
+    return runEventGraph(o, setup, *character, cast);
   }
   if (!o.sets.empty() || o.hold || o.frames > 0)
     throw Error(fmt::format("{}: it is for an event graph: give --events FILE.egml",

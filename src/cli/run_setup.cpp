@@ -334,6 +334,12 @@ void addMotion(const RunSetup& setup, CharacterSetup& character, const std::stri
   if (report.restUnfoldFramesSkipped > 0) spdlog::info("{}: {}", motionPath, report.restUnfoldSkipped());
 }
 
+std::vector<events::Actor> eventActors(const std::vector<CharacterSetup>& characters) {
+  std::vector<events::Actor> actors;
+  for (const CharacterSetup& c : characters) actors.push_back({c.avatar.get(), c.names});
+  return actors;
+}
+
 std::vector<std::pair<std::string, std::string>> parameterOptions(const std::vector<std::string>& sets) {
   std::vector<std::pair<std::string, std::string>> out;
   for (const std::string& set : sets) {
@@ -375,18 +381,18 @@ std::vector<events::TimedEvent> timedEvents(const std::vector<std::string>& send
 
 void addEvents(RunSetup& setup, const std::string& graphPath, const std::vector<std::string>& sets,
                const std::vector<std::string>& sends, long motionFrames) {
-  CharacterSetup* character = oneCharacter(setup, "--events (an event graph)");
-  if (!character) throw Error("--events: there is no avatar for the event graph to move");
+  if (setup.characters.empty()) throw Error("--events: there is no avatar for the event graph to move");
   const events::Graph graph = events::readGraph(graphPath);
-  const scene::Avatar& avatar = *character->avatar;
+  const std::vector<events::Actor> actors = eventActors(setup.characters);
   events::Motions motions;
-  motions.load(graph, avatar, motionOptions(setup));
-  events::Rendered r = events::render(graph, motions, avatar, character->names, setup.settings.frameRate_hz,
-                                      motionFrames, timedEvents(sends), parameterOptions(sets));
+  motions.load(graph, actors, motionOptions(setup));
+  events::RenderedCast r = events::render(graph, motions, actors, setup.settings.frameRate_hz, motionFrames,
+                                          timedEvents(sends), parameterOptions(sets));
   spdlog::info("{}: the event graph runs {} frames ({:.2f} s){}", graphPath, r.frames,
                static_cast<double>(r.frames - 1) / setup.settings.frameRate_hz,
                r.ended ? "" : ", cut there (it runs on)");
-  character->animation = std::make_shared<const motion::AvatarAnimation>(std::move(r.animation));
+  for (std::size_t c = 0; c < setup.characters.size(); ++c)
+    setup.characters[c].animation = std::make_shared<const motion::AvatarAnimation>(std::move(r.animations[c]));
   const bool windy = std::any_of(r.wind.begin(), r.wind.end(), [](const auto& w) { return w.has_value(); });
   setup.motionWind = windy ? std::make_shared<const MotionWind>(std::move(r.wind)) : nullptr;
 }

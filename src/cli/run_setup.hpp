@@ -16,6 +16,7 @@
 
 #include "drape/cloth/collider.hpp"
 #include "drape/core/timecode.hpp"
+#include "drape/events/runtime.hpp"
 #include "drape/cloth/material.hpp"
 #include "drape/mesh/trimesh.hpp"
 #include "drape/motion/animation.hpp"
@@ -148,6 +149,9 @@ void addMotion(const RunSetup& setup, CharacterSetup& character, const std::stri
 /// renders that many motion frames at most (an endless graph needs it).
 void addEvents(RunSetup& setup, const std::string& graphPath, const std::vector<std::string>& sets,
                const std::vector<std::string>& sends, long motionFrames);
+
+/// The characters as an event graph's actors (each answering to the names the scene gives it).
+[[nodiscard]] std::vector<events::Actor> eventActors(const std::vector<CharacterSetup>& characters);
 
 /// --set NAME=VALUE options as parameters; throws naming --set.
 [[nodiscard]] std::vector<std::pair<std::string, std::string>> parameterOptions(const std::vector<std::string>& sets);

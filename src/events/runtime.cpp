@@ -275,7 +275,11 @@ class Wind : public Running {
 class Play : public Running {
  public:
   Play(Scheduler& s, const Event& e, const Scheduler::Context& c)
-      : s_(s), e_(e), motion_(c.motions->of(e)), pose_(motion_.jointCount()) {
+      : s_(s),
+        e_(e),
+        actor_(s.actorFor(e.character.empty() ? c.character : e.character)),
+        motion_(c.motions->of(e, *s.actors()[actor_].avatar)),
+        pose_(motion_.jointCount()) {
     end_s_ = e.to_s < 0.0 ? motion_.duration() : std::min(e.to_s, motion_.duration());
     if (e.from_s > end_s_)
       throw Error::at(e.where, fmt::format("Play: from {:g} s is past the end of {} ({:g} s)", e.from_s, e.motion, end_s_));
@@ -284,7 +288,7 @@ class Play : public Running {
     // composed: the motion's root at `from` is carried there.
     std::optional<RigidTransform> root;
     if (e.anchor) root = pose_.front();
-    id_ = s_.addLayer(pose_, weight(), root);
+    id_ = s_.addLayer(actor_, pose_, weight(), root);
   }
   double advance(double dt) override {
     if (id_ == 0) return dt;
@@ -313,6 +317,7 @@ class Play : public Running {
   }
   Scheduler& s_;
   const Event& e_;
+  std::size_t actor_;
   const motion::AvatarAnimation& motion_;
   std::vector<RigidTransform> pose_;
   double end_s_ = 0.0, elapsed_ = 0.0;
@@ -421,10 +426,15 @@ namespace {
 
 class Path : public Running {
  public:
-  Path(Scheduler& s, const Event& e) : s_(s), state_(std::make_shared<PathState>(e)) { s_.follow(state_); }
+  Path(Scheduler& s, const Event& e, const Scheduler::Context& c)
+      : s_(s),
+        actor_(s.actorFor(e.character.empty() ? c.character : e.character)),
+        state_(std::make_shared<PathState>(e)) {
+    s_.follow(actor_, state_);
+  }
   ~Path() override { stop(); }
   double advance(double dt) override {
-    if (s_.following() != state_.get()) return dt;  // a later Path took over
+    if (s_.following(actor_) != state_.get()) return dt;  // a later Path took over
     if (state_->carried) {
       const double total = state_->course.duration();
       const double left = state_->elapsed + dt - total;
@@ -440,44 +450,84 @@ class Path : public Running {
   }
   /// Cut before its end: the character stays where this tick moves it to.
   void stop() override {
-    if (s_.following() == state_.get() && !state_->ended) state_->stopped = true;
+    if (s_.following(actor_) == state_.get() && !state_->ended) state_->stopped = true;
   }
 
  private:
   Scheduler& s_;
+  std::size_t actor_;
   std::shared_ptr<PathState> state_;
 };
 
 }  // namespace
 
-void Motions::load(const Graph& graph, const scene::Avatar& avatar, const motion::MotionOptions& options) {
-  for (const auto& key : graph.motions()) {
-    if (loaded_.contains(key)) continue;
-    motion::MotionOptions o = options;
-    o.jointMapPath = std::get<2>(key);
-    o.animation = std::get<1>(key);
-    o.sampled = nullptr;
-    motion::ClipLoadReport report;
-    loaded_[key] = std::make_unique<motion::AvatarAnimation>(motion::loadAnimation(avatar, std::get<0>(key), o, &report));
-    spdlog::info("{}: {} frames at {:g} Hz, played by the event graph{}", std::get<0>(key), report.sourceFrames,
-                 report.sourceRate, std::get<1>(key).empty() ? "" : fmt::format(" ('{}')", std::get<1>(key)));
+int actorOf(const std::vector<Actor>& actors, const std::string& character) {
+  if (character.empty()) return actors.size() == 1 ? 0 : -1;
+  for (std::size_t a = 0; a < actors.size(); ++a) {
+    const std::vector<std::string>& names = actors[a].names;
+    if (std::find(names.begin(), names.end(), character) != names.end()) return static_cast<int>(a);
   }
+  // Alone, an actor answers to its avatar's own name too.
+  if (actors.size() == 1 && actors.front().avatar->name == character) return 0;
+  return -1;
 }
 
-const motion::AvatarAnimation& Motions::of(const Event& play) const {
-  const auto it = loaded_.find(std::make_tuple(play.motion, play.animation, play.jointMap));
+void Motions::load(const Graph& graph, const std::vector<Actor>& actors, const motion::MotionOptions& options) {
+  load(graph.root, graph.root.character, actors, options);
+}
+
+void Motions::load(const Event& e, const std::string& inherited, const std::vector<Actor>& actors,
+                   const motion::MotionOptions& options) {
+  const std::string character = e.character.empty() ? inherited : e.character;
+  if (e.kind == Kind::Play) {
+    // A single avatar plays every Play; among several, the one the Play names (none: the
+    // graph's start says what is wrong).
+    const int a = actors.size() == 1 ? 0 : actorOf(actors, character);
+    if (a >= 0) {
+      const scene::Avatar* avatar = actors[static_cast<std::size_t>(a)].avatar;
+      const auto key = std::make_tuple(avatar, e.motion, e.animation, e.jointMap);
+      if (!loaded_.contains(key)) {
+        motion::MotionOptions o = options;
+        o.jointMapPath = e.jointMap;
+        o.animation = e.animation;
+        o.sampled = nullptr;
+        motion::ClipLoadReport report;
+        loaded_[key] = std::make_unique<motion::AvatarAnimation>(motion::loadAnimation(*avatar, e.motion, o, &report));
+        spdlog::info("{}: {} frames at {:g} Hz, played by the event graph{}{}", e.motion, report.sourceFrames,
+                     report.sourceRate, e.animation.empty() ? "" : fmt::format(" ('{}')", e.animation),
+                     actors.size() > 1 ? fmt::format(" on {}", character) : "");
+      }
+    }
+  }
+  for (const Event& c : e.children) load(c, character, actors, options);
+}
+
+const motion::AvatarAnimation& Motions::of(const Event& play, const scene::Avatar& avatar) const {
+  const auto it = loaded_.find(std::make_tuple(&avatar, play.motion, play.animation, play.jointMap));
   if (it == loaded_.end()) throw Error(play.where.str() + ": Play: its motion was not loaded", ExitCode::Internal);
   return *it->second;
 }
 
+Scheduler::Scheduler(std::vector<Actor> actors, double rate, std::vector<std::pair<std::string, std::string>> parameters)
+    : actors_(std::move(actors)), rate_(rate) {
+  if (!(rate > 0.0)) throw Error(fmt::format("the event graph's rate {} must be > 0", rate), ExitCode::Internal);
+  if (actors_.empty()) throw Error("an event graph needs a character to move", ExitCode::Internal);
+  for (auto& [name, value] : parameters) parameters_[name] = value;
+  // Alone, the actor answers to its avatar's own name too.
+  if (actors_.size() == 1) {
+    std::vector<std::string>& names = actors_.front().names;
+    if (std::find(names.begin(), names.end(), actors_.front().avatar->name) == names.end())
+      names.push_back(actors_.front().avatar->name);
+  }
+  for (const Actor& a : actors_) {
+    Figure& f = figures_.emplace_back();
+    for (const scene::Joint& j : a.avatar->joints) f.composite.push_back(j.restWorld());
+  }
+}
+
 Scheduler::Scheduler(const scene::Avatar& avatar, std::vector<std::string> names, double rate,
                      std::vector<std::pair<std::string, std::string>> parameters)
-    : avatar_(avatar), names_(std::move(names)), rate_(rate) {
-  if (!(rate > 0.0)) throw Error(fmt::format("the event graph's rate {} must be > 0", rate), ExitCode::Internal);
-  for (auto& [name, value] : parameters) parameters_[name] = value;
-  if (std::find(names_.begin(), names_.end(), avatar.name) == names_.end()) names_.push_back(avatar.name);
-  for (const scene::Joint& j : avatar.joints) composite_.push_back(j.restWorld());
-}
+    : Scheduler({Actor{&avatar, std::move(names)}}, rate, std::move(parameters)) {}
 
 Scheduler::~Scheduler() {
   // Events first: their destructors hand back what they hold (a wind).
@@ -487,11 +537,29 @@ Scheduler::~Scheduler() {
 
 void Scheduler::checkCharacters(const Event& e, const std::string& inherited) const {
   const std::string character = e.character.empty() ? inherited : e.character;
-  if ((e.kind == Kind::Play || e.kind == Kind::Path) && !character.empty() &&
-      std::find(names_.begin(), names_.end(), character) == names_.end())
-    throw Error::at(e.where, fmt::format("{}: character '{}' is not in the scene (its character answers to: {})",
-                                         kindName(e.kind), character, fmt::join(names_, ", ")));
+  if ((e.kind == Kind::Play || e.kind == Kind::Path) && actorOf(actors_, character) < 0) {
+    if (character.empty()) {
+      std::vector<std::string> names;
+      for (const Actor& a : actors_) names.push_back(a.names.empty() ? a.avatar->name : a.names.front());
+      throw Error::at(e.where, fmt::format("{}: the scene has {} characters ({}): say which it moves (character "
+                                           "\"NAME\", here or on an event above it)",
+                                           kindName(e.kind), actors_.size(), fmt::join(names, ", ")));
+    }
+    if (actors_.size() == 1)
+      throw Error::at(e.where, fmt::format("{}: character '{}' is not in the scene (its character answers to: {})",
+                                           kindName(e.kind), character, fmt::join(actors_.front().names, ", ")));
+    std::vector<std::string> names;
+    for (const Actor& a : actors_) names.insert(names.end(), a.names.begin(), a.names.end());
+    throw Error::at(e.where, fmt::format("{}: character '{}' is not in the scene (its characters: {})",
+                                         kindName(e.kind), character, fmt::join(names, ", ")));
+  }
   for (const Event& c : e.children) checkCharacters(c, character);
+}
+
+std::size_t Scheduler::actorFor(const std::string& character) const {
+  const int a = actorOf(actors_, character);
+  if (a < 0) throw Error(fmt::format("no actor answers to '{}'", character), ExitCode::Internal);
+  return static_cast<std::size_t>(a);
 }
 
 void Scheduler::start(const Graph& graph, const Motions& motions) {
@@ -516,27 +584,30 @@ std::unique_ptr<Running> Scheduler::launch(const Event& e, const Context& contex
     case Kind::Wait: return std::make_unique<Wait>(e);
     case Kind::Play: return std::make_unique<Play>(*this, e, context);
     case Kind::Wind: return std::make_unique<Wind>(*this, e);
-    case Kind::Path: return std::make_unique<Path>(*this, e);
+    case Kind::Path: return std::make_unique<Path>(*this, e, context);
   }
   throw Error(e.where.str() + ": an event of no known kind", ExitCode::Internal);
 }
 
-std::uint64_t Scheduler::addLayer(std::vector<RigidTransform> pose, double weight, std::optional<RigidTransform> root) {
-  layers_.push_back({nextId_, std::move(pose), weight, root, std::nullopt});
+std::uint64_t Scheduler::addLayer(std::size_t a, std::vector<RigidTransform> pose, double weight,
+                                  std::optional<RigidTransform> root) {
+  figures_[a].layers.push_back({nextId_, std::move(pose), weight, root, std::nullopt});
   return nextId_++;
 }
 
 void Scheduler::setLayer(std::uint64_t id, std::span<const RigidTransform> pose, double weight) {
-  for (Layer& l : layers_)
-    if (l.id == id) {
-      std::copy(pose.begin(), pose.end(), l.pose.begin());
-      l.weight = weight;
-    }
+  for (Figure& f : figures_)
+    for (Layer& l : f.layers)
+      if (l.id == id) {
+        std::copy(pose.begin(), pose.end(), l.pose.begin());
+        l.weight = weight;
+      }
 }
 
-void Scheduler::follow(std::shared_ptr<PathState> path) {
-  if (path_ && !path_->done()) leaving_ = std::move(path_);
-  path_ = std::move(path);
+void Scheduler::follow(std::size_t a, std::shared_ptr<PathState> path) {
+  Figure& f = figures_[a];
+  if (f.path && !f.path->done()) f.leaving = std::move(f.path);
+  f.path = std::move(path);
 }
 
 std::uint64_t Scheduler::pushWind(const Vec3& velocity) {
@@ -548,33 +619,34 @@ void Scheduler::popWind(std::uint64_t id) {
   std::erase_if(winds_, [id](const auto& w) { return w.first == id; });
 }
 
-void Scheduler::compose() {
+void Scheduler::compose(const scene::Avatar& avatar, Figure& f) {
   // From the rest pose, each layer over what is below it; an anchored layer is carried, the
   // first time, onto where what is below it stands.
-  for (std::size_t j = 0; j < composite_.size(); ++j) composite_[j] = avatar_.joints[j].restWorld();
-  for (Layer& l : layers_) {
-    if (l.root && !l.anchor) l.anchor = anchorOnto(composite_.front(), *l.root);
-    for (std::size_t j = 0; j < composite_.size(); ++j) {
+  std::vector<RigidTransform>& composite = f.composite;
+  for (std::size_t j = 0; j < composite.size(); ++j) composite[j] = avatar.joints[j].restWorld();
+  for (Layer& l : f.layers) {
+    if (l.root && !l.anchor) l.anchor = anchorOnto(composite.front(), *l.root);
+    for (std::size_t j = 0; j < composite.size(); ++j) {
       const RigidTransform joint = l.anchor ? *l.anchor * l.pose[j] : l.pose[j];
-      composite_[j] = l.weight >= 1.0 ? joint : motion::interpolate(composite_[j], joint, l.weight);
+      composite[j] = l.weight >= 1.0 ? joint : motion::interpolate(composite[j], joint, l.weight);
     }
   }
   // The Path followed moves the character from where the last tick left it.
-  const RigidTransform root = composite_.front();
-  if (leaving_ && lastRoot_) carrier_ = leaving_->carry(carrier_, *lastRoot_, *lastRoot_);  // its course, up to now
-  leaving_.reset();
-  if (path_) {
-    if (lastRoot_) {  // a Path cut at this tick still makes the step up to the cut
-      carrier_ = path_->carry(carrier_, *lastRoot_, root);
-      carried_ = true;
+  const RigidTransform root = composite.front();
+  if (f.leaving && f.lastRoot) f.carrier = f.leaving->carry(f.carrier, *f.lastRoot, *f.lastRoot);  // its course, up to now
+  f.leaving.reset();
+  if (f.path) {
+    if (f.lastRoot) {  // a Path cut at this tick still makes the step up to the cut
+      f.carrier = f.path->carry(f.carrier, *f.lastRoot, root);
+      f.carried = true;
     }
-    if (path_->done()) path_.reset();
+    if (f.path->done()) f.path.reset();
   }
-  lastRoot_ = root;
+  f.lastRoot = root;
   // Layers a later one covers whole are gone: nothing of them shows any more.
-  for (std::size_t k = layers_.size(); k-- > 1;)
-    if (layers_[k].weight >= 1.0) {
-      layers_.erase(layers_.begin(), layers_.begin() + static_cast<long>(k));
+  for (std::size_t k = f.layers.size(); k-- > 1;)
+    if (f.layers[k].weight >= 1.0) {
+      f.layers.erase(f.layers.begin(), f.layers.begin() + static_cast<long>(k));
       break;
     }
 }
@@ -600,22 +672,29 @@ bool Scheduler::tick(Tick& out) {
   for (auto& g : starting_)
     if (g->advance(0.0) < 0.0) graphs_.push_back(std::move(g));
   starting_.clear();
-  compose();
-  out.joints = composite_;
-  if (carried_)
-    for (RigidTransform& j : out.joints) j = carrier_ * j;
+  out.poses.resize(figures_.size());
+  for (std::size_t a = 0; a < figures_.size(); ++a) {
+    Figure& f = figures_[a];
+    compose(*actors_[a].avatar, f);
+    out.poses[a] = f.composite;
+    if (f.carried)
+      for (RigidTransform& j : out.poses[a]) j = f.carrier * j;
+  }
   out.wind = !winds_.empty() ? std::optional<Vec3>(winds_.back().second) : baseWind_;
   ++ticks_;
   return !graphs_.empty();
 }
 
-Rendered render(const Graph& graph, const Motions& motions, const scene::Avatar& avatar,
-                const std::vector<std::string>& names, double rate, long maxFrames,
-                const std::vector<TimedEvent>& events, const std::vector<std::pair<std::string, std::string>>& parameters) {
-  Scheduler scheduler(avatar, names, rate, parameters);
+RenderedCast render(const Graph& graph, const Motions& motions, const std::vector<Actor>& actors, double rate,
+                    long maxFrames, const std::vector<TimedEvent>& events,
+                    const std::vector<std::pair<std::string, std::string>>& parameters) {
+  Scheduler scheduler(actors, rate, parameters);
   scheduler.start(graph, motions);
-  std::vector<int> driving(avatar.joints.size(), -1);
-  Rendered r{motion::AvatarAnimation::streamed(avatar.joints.size(), rate, TimeCode{0, rate}, driving), {}, 0, false};
+  RenderedCast r;
+  for (const Actor& a : actors) {
+    std::vector<int> driving(a.avatar->joints.size(), -1);
+    r.animations.push_back(motion::AvatarAnimation::streamed(a.avatar->joints.size(), rate, TimeCode{0, rate}, driving));
+  }
   std::vector<TimedEvent> toSend = events;
   std::sort(toSend.begin(), toSend.end(), [](const TimedEvent& a, const TimedEvent& b) { return a.at_s < b.at_s; });
   std::size_t sent = 0;
@@ -626,7 +705,7 @@ Rendered render(const Graph& graph, const Motions& motions, const scene::Avatar&
     // An event at time t acts at the first tick at or after it.
     while (sent < toSend.size() && toSend[sent].at_s <= static_cast<double>(f) / rate) scheduler.send(toSend[sent++].name);
     const bool more = scheduler.tick(tick);
-    r.animation.appendFrame(tick.joints);
+    for (std::size_t a = 0; a < actors.size(); ++a) r.animations[a].appendFrame(tick.poses[a]);
     r.wind.push_back(tick.wind);
     ++r.frames;
     if (!more) {
@@ -639,6 +718,13 @@ Rendered render(const Graph& graph, const Motions& motions, const scene::Avatar&
                             "ends, or a steering Path longer than the walk it steers): give the frames to render",
                             graph.file.empty() ? "the graph" : graph.file));
   return r;
+}
+
+Rendered render(const Graph& graph, const Motions& motions, const scene::Avatar& avatar,
+                const std::vector<std::string>& names, double rate, long maxFrames,
+                const std::vector<TimedEvent>& events, const std::vector<std::pair<std::string, std::string>>& parameters) {
+  RenderedCast cast = render(graph, motions, {Actor{&avatar, names}}, rate, maxFrames, events, parameters);
+  return {std::move(cast.animations.front()), std::move(cast.wind), cast.frames, cast.ended};
 }
 
 }  // namespace drape::events

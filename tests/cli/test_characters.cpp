@@ -146,8 +146,10 @@ TEST(Characters, MotionsAreGivenByNameAndWhatPlaysOneCharacterSaysSo) {
               "--motion none: a motion for every character is given already");
   expectError("run '" + kTwoCharacters + "' --live -" + out + " < /dev/null",
               "--live (a live capture) plays one character; the scene has 2 (Ada, Bea)");
+  // An event graph of one character's Plays, on a scene of two.
   expectError("run '" + kTwoCharacters + "' --events '" + std::string(DRAPE_SOURCE_DIR) + "/examples/event_graph/day.egml'" + out,
-              "--events (an event graph) plays one character; the scene has 2 (Ada, Bea)");
+              "day.egml:14: Play: the scene has 2 characters (Ada, Bea): say which it moves (character \"NAME\", here "
+              "or on an event above it)");
   expectError("anim-server '" + kTwoCharacters + "' --server nats://127.0.0.1:1 --give-up 1",
               "the scene has 2 characters (Ada, Bea): say which this one plays, --character NAME");
   expectError("anim-server '" + kTwoCharacters + "' --character Carl --server nats://127.0.0.1:1 --give-up 1",

@@ -227,6 +227,40 @@ TEST(Studio, TwoCharactersEachOnServersOfItsOwnAreDrapeRunsToTheByte) {
       << which.err;
 }
 
+TEST(Studio, AnEventGraphOfTwoCharactersThroughTheStudioIsDrapeRunsToTheByte) {
+  // The bundled duet (Ada walks; Bea waits, walks after her and kicks): each anim-server runs
+  // the whole graph, so that Bea's wait takes the time it takes in drape run, and sends its
+  // character's poses.
+  ScratchDir dir("studio-duet");
+  NatsServer server;
+  const std::string scene = std::string(DRAPE_SOURCE_DIR) + "/examples/two_characters/scene.wrl";
+  const std::string duet = std::string(DRAPE_SOURCE_DIR) + "/examples/event_graph/duet.egml";
+  const std::string reference = runInto(dir, "reference", "'" + scene + "' --events '" + duet + "'");
+  DrapeProcess adaCloth("cloth-server '" + scene + "' --character Ada --poses ada --name ada-cloth --takes 1" +
+                            roles(server),
+                        dir, "ada-cloth");
+  DrapeProcess beaCloth("cloth-server '" + scene + "' --character Bea --poses bea --name bea-cloth --takes 1" +
+                            roles(server),
+                        dir, "bea-cloth");
+  for (const std::string who : {"Ada", "Bea"}) {
+    const CliResult sent = runDrape("anim-server '" + scene + "' --character " + who + " --events '" + duet +
+                                        "' --name " + (who == "Ada" ? "ada" : "bea") + " --take duet --fast" +
+                                        roles(server),
+                                    dir);
+    ASSERT_EQ(sent.code, 0) << sent.err;
+    EXPECT_NE(sent.out.find("sent take duet: 169 pose frames of " + who + "'s event graph"), std::string::npos)
+        << sent.out;
+  }
+  ASSERT_EQ(adaCloth.wait().code, 0);
+  ASSERT_EQ(beaCloth.wait().code, 0);
+  const CliResult recorded = runDrape(
+      "player '" + scene + "' --cloth ada-cloth,bea-cloth --record '" + (dir / "recorded") + "'" + roles(server), dir);
+  ASSERT_EQ(recorded.code, 0) << recorded.err;
+  for (const char* file : {"garment-Ada_skirt.pc2", "garment-Bea_skirt.pc2", "body-Ada.pc2", "body-Bea.pc2",
+                           "segments/Ada/Hips.pc2", "segments/Bea/LeftFoot.pc2", "manifest.json"})
+    EXPECT_TRUE(slurp(dir / ("recorded/" + std::string(file))) == slurp(reference + "/" + file)) << file;
+}
+
 TEST(Studio, AnUnstableTakeIsRecordedUpToItsLastGoodFrame) {
   ScratchDir dir("studio-unstable");
   NatsServer server;

@@ -1,7 +1,7 @@
 // The scheduler: when random graphs of control events end, against their durations worked
 // out by hand; Plays against the motions they play, to the bit; anchoring, blending,
 // conditions, state machines, wind, paths against their speed profile and turns worked out
-// by hand, and graphs started while others run.
+// by hand, graphs started while others run, and a cast of several characters.
 
 #include <gtest/gtest.h>
 
@@ -273,12 +273,12 @@ TEST(Scheduler, AGraphStartedWhileAnotherRunsTakesTheCharacterOver) {
   for (int k = 0; k < 20; ++k) ASSERT_TRUE(s.tick(tick));
   s.start(second, w.motions);  // at once: the next tick shows it
   ASSERT_TRUE(s.tick(tick));
-  expectSameJoints(tick.joints, w.alone.frame(60), "the injected graph's first frame");
+  expectSameJoints(tick.poses[0], w.alone.frame(60), "the injected graph's first frame");
   for (int k = 1; k <= 30; ++k) ASSERT_TRUE(s.tick(tick));
-  expectSameJoints(tick.joints, w.alone.frame(90), "its last frame");
+  expectSameJoints(tick.poses[0], w.alone.frame(90), "its last frame");
   // It ended and holds its pose over the first, which runs on to its end.
   ASSERT_TRUE(s.tick(tick));
-  expectSameJoints(tick.joints, w.alone.frame(90), "held");
+  expectSameJoints(tick.poses[0], w.alone.frame(90), "held");
   long more = 0;
   while (s.tick(tick)) ++more;
   EXPECT_EQ(more, static_cast<long>(w.alone.frameCount()) - 1 - 52);
@@ -412,6 +412,61 @@ TEST(Scheduler, APathSteersAWalkAlongItsTurns) {
   EXPECT_LT((Vec3(went.x(), 0, went.z()) - want).norm(), 0.25) << went.transpose() << " against " << want.transpose();
   for (long f = ended; f < b.frames; f += 10)
     ASSERT_NEAR(std::remainder(yawOfRoot(root(b, f)) - yawOfRoot(root(a, f)) + M_PI / 2, 2 * M_PI), 0.0, 1e-9) << f;
+}
+
+TEST(Scheduler, EachCharacterOfACastPlaysWhatNamesItAsItWouldAlone) {
+  // Ada walks two seconds; Bea, a metre to her side, waits half a second, walks a second and
+  // a half, then is carried along a path; a gust blows on both. Each comes out of the cast,
+  // frame for frame and to the bit, as the part that names it comes out for her alone (then
+  // holding where it ended while the other goes on), and the wind is the graph's.
+  Walk w;
+  scene::Avatar bea = w.avatar;
+  for (scene::Joint& j : bea.joints) j.restCenter += Vec3(1, 0, 0);
+  const std::vector<Actor> cast{{&w.avatar, {"Ada"}}, {&bea, {"Bea"}}};
+  Event ada = control(Kind::Sequence, {w.play(0.0, 2.0)});
+  ada.character = "Ada";
+  Event beas = control(Kind::Sequence, {wait(0.5), w.play(0.0, 1.5, 1.0, 0.0, true),
+                                        pathEvent({Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(2, 0, 1)}, 1.0, 0.3, 0.4)});
+  beas.character = "Bea";
+  const Graph g = graphOf(control(Kind::Parallel, {ada, beas, control(Kind::Sequence, {wait(1.0), [] {
+                                                                    Event gust;
+                                                                    gust.kind = Kind::Wind;
+                                                                    gust.velocity = Vec3(3, 0, 0);
+                                                                    gust.duration_s = 0.5;
+                                                                    return gust;
+                                                                  }()})}));
+  Motions motions;
+  motions.load(g, cast, w.options);
+  const RenderedCast both = render(g, motions, cast, kRate, 0, {}, {});
+  ASSERT_EQ(both.animations.size(), 2u);
+  for (std::size_t a = 0; a < 2; ++a) {
+    SCOPED_TRACE(a == 0 ? "Ada" : "Bea");
+    const Graph part = graphOf(a == 0 ? ada : beas);
+    Motions own;
+    own.load(part, *cast[a].avatar, w.options);
+    const Rendered alone = render(part, own, *cast[a].avatar, cast[a].names, kRate, 0, {}, {});
+    ASSERT_LE(alone.frames, both.frames);
+    for (long f = 0; f < both.frames; ++f)
+      expectSameJoints(both.animations[a].frame(static_cast<std::size_t>(f)),
+                       alone.animation.frame(static_cast<std::size_t>(std::min(f, alone.frames - 1))),
+                       fmt::format("frame {}", f));
+  }
+  EXPECT_FALSE(both.wind[29].has_value());
+  ASSERT_TRUE(both.wind[30].has_value());
+  EXPECT_EQ(*both.wind[30], Vec3(3, 0, 0));
+  EXPECT_FALSE(both.wind[46].has_value());
+
+  // Among several, a Play that names none, or another, is refused where it is.
+  Event unnamed = w.play();
+  unnamed.where = {"cast.egml", 5, 0};
+  EXPECT_EQ(testing::errorOf([&] { (void)render(graphOf(unnamed), motions, cast, kRate, 0, {}, {}); }),
+            "cast.egml:5: Play: the scene has 2 characters (Ada, Bea): say which it moves (character \"NAME\", here or "
+            "on an event above it)");
+  Event carl = w.play();
+  carl.character = "Carl";
+  carl.where = {"cast.egml", 9, 0};
+  EXPECT_EQ(testing::errorOf([&] { (void)render(graphOf(carl), motions, cast, kRate, 0, {}, {}); }),
+            "cast.egml:9: Play: character 'Carl' is not in the scene (its characters: Ada, Bea)");
 }
 
 TEST(Scheduler, WhatCannotRunIsSaid) {

@@ -70,7 +70,7 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
   // The meshes: the garments, then per character its segments and its skinned body.
   std::vector<render::MeshInfo> meshes;
   for (const GarmentSetup& g : setup.garments)
-    meshes.push_back({g.name, render::MeshRole::Garment, g.mesh.vertexCount(), g.mesh.triangles});
+    meshes.push_back({g.name, render::MeshRole::Garment, g.mesh.vertexCount(), g.mesh.triangles, "", g.colour});
   std::vector<const std::vector<sim::PartField>*> fields;
   std::vector<double> allowances;
   for (std::size_t c = 0; c < worlds.size(); ++c) {

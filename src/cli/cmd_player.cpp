@@ -196,7 +196,7 @@ int show(const PlayerRoleOptions& o) {
   const std::size_t garmentsShown = shownSetup.garments.size();
   std::vector<render::MeshInfo> meshes;
   for (const GarmentSetup& g : shownSetup.garments)
-    meshes.push_back({g.name, render::MeshRole::Garment, g.mesh.vertexCount(), g.mesh.triangles});
+    meshes.push_back({g.name, render::MeshRole::Garment, g.mesh.vertexCount(), g.mesh.triangles, "", g.colour});
   SkinFields skinFieldsOf;
   std::vector<const std::vector<sim::PartField>*> fields;
   std::vector<double> allowances;

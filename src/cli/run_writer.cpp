@@ -97,7 +97,7 @@ struct RunWriter::Impl {
       f.states = std::make_unique<formats::StateCacheWriter>((out / (f.fileStem + ".states")).string(),
                                                              g.mesh.vertexCount());
       manifest.meshes.push_back({g.name, "garment", f.fileStem + ".obj", f.fileStem + ".pc2", f.fileStem + ".states",
-                                 wearer(garments.size())});
+                                 wearer(garments.size()), g.colour});
       garments.push_back(std::move(f));
     }
     if (atStart.size() != setup.characters.size())
@@ -197,8 +197,9 @@ struct RunWriter::Impl {
   void writeResultFiles() const {
     formats::vrml::Animation animation;
     animation.frameRate = setup.settings.frameRate_hz;
-    for (const GarmentFiles& f : garments)
-      animation.garments.push_back({f.name, *f.triangles, f.frames, Vec3(0.8, 0.25, 0.2)});
+    for (std::size_t g = 0; g < garments.size(); ++g)
+      animation.garments.push_back({garments[g].name, *garments[g].triangles, garments[g].frames,
+                                    setup.garments[g].colour.value_or(Vec3(0.8, 0.25, 0.2))});
     for (const CharacterFiles& files : characters) {
       const scene::Avatar& avatar = *files.setup->avatar;
       // Among several characters, each joint's node named for its character too.

@@ -261,6 +261,12 @@ void addRigid(ModelBuilder& b, const GltfRigidMesh& m, int timeAccessor, std::si
 constexpr std::array<float, 4> kGarmentColour = {0.60f, 0.04f, 0.05f, 1.0f};  // linear, the renderer's cloth red
 constexpr std::array<float, 4> kSegmentColour = {0.61f, 0.51f, 0.43f, 1.0f};  // linear, clay
 
+/// A scene's sRGB colour as glTF's linear base colour (the renderer's 2.2 gamma).
+std::array<float, 4> linearColour(const Vec3& srgb) {
+  return {static_cast<float>(std::pow(srgb.x(), 2.2)), static_cast<float>(std::pow(srgb.y(), 2.2)),
+          static_cast<float>(std::pow(srgb.z(), 2.2)), 1.0f};
+}
+
 }  // namespace
 
 void writeGlb(const std::string& path, const GltfAnimation& animation) {
@@ -381,7 +387,7 @@ RunExportSummary exportRunToGlb(const std::string& runDirectory, const std::stri
     m.name = name;
     m.triangles = std::move(topology.triangles);
     m.frames = std::move(cache.frames);
-    m.colour = rm.role == "garment" ? kGarmentColour : kSegmentColour;
+    m.colour = rm.role != "garment" ? kSegmentColour : rm.colour ? linearColour(*rm.colour) : kGarmentColour;
     m.doubleSided = rm.role == "garment";
     animation.deforming.push_back(std::move(m));
     ++summary.deforming;

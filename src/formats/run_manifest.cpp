@@ -51,6 +51,18 @@ double requiredNumber(const nlohmann::json& j, const char* key, const std::strin
   return v.get<double>();
 }
 
+/// Three numbers from 0 to 1.
+Vec3 colourOf(const nlohmann::json& v, const std::string& file) {
+  if (!v.is_array() || v.size() != 3) wrongType("colour", file);
+  Vec3 c;
+  for (int k = 0; k < 3; ++k) {
+    if (!v[static_cast<std::size_t>(k)].is_number()) wrongType("colour", file);
+    c[k] = v[static_cast<std::size_t>(k)].get<double>();
+    if (!(c[k] >= 0.0 && c[k] <= 1.0)) throw Error(fmt::format("{}: key 'colour' must hold numbers from 0 to 1", file));
+  }
+  return c;
+}
+
 }  // namespace
 
 void writeRunManifest(const std::string& directory, const RunManifest& manifest) {
@@ -65,6 +77,7 @@ void writeRunManifest(const std::string& directory, const RunManifest& manifest)
     nlohmann::json mesh = {{"name", m.name}, {"role", m.role}, {"topology", m.topology}, {"cache", m.cache}};
     if (!m.states.empty()) mesh["states"] = m.states;
     if (!m.character.empty()) mesh["character"] = m.character;
+    if (m.colour) mesh["colour"] = {m.colour->x(), m.colour->y(), m.colour->z()};
     j["meshes"].push_back(std::move(mesh));
   }
   const std::string path = (std::filesystem::path(directory) / "manifest.json").string();
@@ -97,6 +110,7 @@ RunManifest parseRunManifest(std::string_view text, const std::string& name) {
     r.cache = requiredString(mesh, "cache", name);
     if (mesh.contains("states")) r.states = requiredString(mesh, "states", name);
     if (mesh.contains("character")) r.character = requiredString(mesh, "character", name);
+    if (mesh.contains("colour")) r.colour = colourOf(mesh["colour"], name);
     m.meshes.push_back(std::move(r));
   }
   return m;

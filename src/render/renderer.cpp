@@ -484,7 +484,11 @@ struct Renderer::Impl {
     for (std::size_t m = 0; m < gpu.size(); ++m) {
       if (!drawn(m, overlay)) continue;
       const bool garment = meshes[m].role == MeshRole::Garment;
-      const V3 colour = srgbToLinear(garment ? kGarmentSrgb : kSegmentSrgb);
+      const std::optional<Vec3>& own = meshes[m].colour;
+      const V3 colour = srgbToLinear(!garment ? kSegmentSrgb
+                                     : own ? std::array<float, 3>{static_cast<float>(own->x()), static_cast<float>(own->y()),
+                                                                  static_cast<float>(own->z())}
+                                           : kGarmentSrgb);
       glUniform3fv(glGetUniformLocation(meshProgram, "uColour"), 1, colour.data());
       glUniform1i(glGetUniformLocation(meshProgram, "uStateColours"), garment && overlay.collisionColours ? 1 : 0);
       glBindVertexArray(gpu[m].vao);

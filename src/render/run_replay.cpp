@@ -91,6 +91,7 @@ RunReplay::RunReplay(const std::string& directory) : directory_(directory) {
     MeshInfo info;
     info.name = m.name;
     info.character = m.character;
+    info.colour = m.colour;
     try {
       info.role = parseMeshRole(m.role);
     } catch (const Error& e) {

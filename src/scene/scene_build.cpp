@@ -374,6 +374,21 @@ class Builder {
     return &m.compressionScale;
   }
 
+  /// The diffuse colour of a Shape's Material (VRML97's default where the Material gives
+  /// none); none for a Shape without one, or a bare IndexedFaceSet.
+  std::optional<Vec3> shapeColour(std::int32_t index) const {
+    const Node& shape = at(index);
+    if (shape.type != "Shape") return std::nullopt;
+    const std::int32_t appearance = node(shape, "appearance");
+    if (appearance < 0) return std::nullopt;
+    const std::int32_t material = node(at(appearance), "material");
+    if (material < 0 || at(material).type != "Material") return std::nullopt;
+    const Vec3 c = vec3(at(material), "diffuseColor", Vec3(0.8, 0.8, 0.8));
+    // The reader holds floats: 0.7 comes as 0.69999999; four decimals are colour enough.
+    const auto channel = [](double v) { return std::round(std::clamp(v, 0.0, 1.0) * 1e4) / 1e4; };
+    return Vec3(channel(c.x()), channel(c.y()), channel(c.z()));
+  }
+
   /// The IndexedFaceSet of a cloth or mask entry (itself, or a Shape's geometry).
   const Node& faceSet(std::int32_t index, const Node& clothSet, const char* field) const {
     const Node* n = &at(index);
@@ -396,7 +411,10 @@ class Builder {
     if (cloth.empty())
       throw Error::at(where(n),
                       fmt::format("ClothSet {} has no cloth (an IndexedFaceSet or a Shape holding one)", g.name));
-    for (std::int32_t c : cloth) append(g.mesh, transformed(faceSet(c, n, "cloth"), pending.world, g.name));
+    for (std::int32_t c : cloth) {
+      append(g.mesh, transformed(faceSet(c, n, "cloth"), pending.world, g.name));
+      if (!g.colour) g.colour = shapeColour(c);
+    }
     if (g.mesh.triangles.empty())
       throw Error::at(where(n, "cloth"), fmt::format("ClothSet {}: the cloth has no faces", g.name));
     g.material = material(node(n, "material"));

@@ -97,6 +97,7 @@ GarmentSpec garmentSpec(const scene::Scene& scene, const scene::Garment& g, cons
   spec.offsets = {o[0], o[1], o[2], o[3]};
   spec.offsetsGiven = scene.simulation.source.line > 0;
   spec.collisionEvery = scene.simulation.collisionEvery;
+  spec.colour = g.colour;
   return spec;
 }
 

@@ -25,6 +25,7 @@ TEST(RunManifest, RoundTrips) {
   m.meshes = {{"skirt", "garment", "skirt.obj", "skirt.pc2", "skirt.states"},
               {"hips", "segment", "segments/hips.obj", "segments/hips.pc2", ""},
               {"hips", "segment", "segments/Bea/hips.obj", "segments/Bea/hips.pc2", "", "Bea"}};
+  m.meshes[0].colour = Vec3(0.15, 0.25, 0.5);
   writeRunManifest(dir, m);
   const RunManifest r = readRunManifest(dir);
   EXPECT_EQ(r.frameRate, 25);
@@ -34,6 +35,8 @@ TEST(RunManifest, RoundTrips) {
   EXPECT_EQ(r.meshes[1].cache, "segments/hips.pc2");
   EXPECT_EQ(r.meshes[1].character, "");  // the run's only character: no key
   EXPECT_EQ(r.meshes[2].character, "Bea");
+  EXPECT_EQ(r.meshes[0].colour, std::optional<Vec3>(Vec3(0.15, 0.25, 0.5)));
+  EXPECT_FALSE(r.meshes[1].colour.has_value());
   EXPECT_EQ(r.meshes[1].role, "segment");
   EXPECT_EQ(r.meshes[0].states, "skirt.states");
   EXPECT_EQ(r.meshes[1].states, "");  // no key written, none read
@@ -41,6 +44,21 @@ TEST(RunManifest, RoundTrips) {
   const std::string text((std::istreambuf_iterator<char>(written)), std::istreambuf_iterator<char>());
   EXPECT_EQ(text.find("\"states\": \"\""), std::string::npos) << text;
   EXPECT_EQ(text.find("\"character\": \"\""), std::string::npos) << text;
+}
+
+TEST(RunManifest, AColourIsThreeNumbersFromZeroToOne) {
+  const std::string dir = tempDir("colour");
+  for (const char* colour : {"[0.5, 0.5]", "\"red\"", "[0.5, \"x\", 0.5]", "[0.5, 1.5, 0.5]"}) {
+    std::ofstream(dir + "/manifest.json") << R"({"format": "drape-run", "version": 1, "frame_rate": 30, "frames": 1,
+      "meshes": [{"name": "a", "role": "garment", "topology": "a.obj", "cache": "a.pc2", "colour": )"
+                                          << colour << "}]}";
+    try {
+      (void)readRunManifest(dir);
+      ADD_FAILURE() << colour;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("key 'colour'"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(RunManifest, StatesMustBeAString) {

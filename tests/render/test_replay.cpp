@@ -50,11 +50,14 @@ TEST(RunReplay, SaysWhoseEachMeshIs) {
   const std::string dir = testrun::writeTestRun(testrun::freshDir("replay-characters"), 3);
   formats::RunManifest manifest = formats::readRunManifest(dir);
   for (formats::RunMesh& m : manifest.meshes) m.character = "Bea";
+  manifest.meshes[1].colour = Vec3(0.15, 0.25, 0.55);
   formats::writeRunManifest(dir, manifest);
   const RunReplay replay(dir);
   ASSERT_EQ(replay.meshes().size(), 2u);
   EXPECT_EQ(replay.meshes()[0].character, "Bea");
   EXPECT_EQ(replay.meshes()[1].character, "Bea");
+  EXPECT_EQ(replay.meshes()[1].colour, std::optional<Vec3>(Vec3(0.15, 0.25, 0.55)));  // the garment's
+  EXPECT_FALSE(replay.meshes()[0].colour.has_value());
   std::vector<MeshInfo> meshes = replay.meshes();
   EXPECT_FALSE(hasSkin(meshes, "Bea"));
   meshes.push_back({"body", MeshRole::Skin, 3, {{0, 1, 2}}, "Ada"});

@@ -63,6 +63,9 @@ TEST(SceneCharacters, TheTwoCharactersExampleHasEachAvatarWithItsGarmentMotionAn
   EXPECT_EQ(specs[0].bound.size(), 24u);
   EXPECT_EQ(specs[1].collidesWith, specs[0].collidesWith);
   EXPECT_LT((specs[1].mesh.positions[0] - specs[0].mesh.positions[0] - Vec3(1.2, 0, 0)).norm(), 1e-6);
+  // Each skirt in the colour its Shape's Material gives it.
+  EXPECT_EQ(specs[0].colour, std::optional<Vec3>(Vec3(0.7, 0.15, 0.2)));
+  EXPECT_EQ(specs[1].colour, std::optional<Vec3>(Vec3(0.15, 0.25, 0.55)));
   // What takes one avatar says there are two.
   EXPECT_NE(testing::errorOf([&] { (void)sceneAvatar(scene); })
                 .find("garments are worn by 2 characters (Ada, Bea); this takes one"),
@@ -70,14 +73,22 @@ TEST(SceneCharacters, TheTwoCharactersExampleHasEachAvatarWithItsGarmentMotionAn
 }
 
 TEST(SceneCharacters, AnAvatarThatWearsNothingIsLeftOut) {
-  // The second humanoid wears nothing: the scene has one character, the first.
-  const scene::Scene scene = scene::loadScene(twoHumanoids("bare.wrl", "2", ""));
+  // The second humanoid wears nothing: the scene has one character, the first, in its skirt
+  // and a shawl.
+  const std::string shawl = "DEF Shawl ClothSet {\n  name \"shawl\"\n  avatar USE Body\n  cloth IndexedFaceSet { coord "
+                            "Coordinate { point [ 0 1 0, 0.2 1 0, 0 1.2 0 ] } coordIndex [ 0 1 2 -1 ] }\n}\n";
+  const scene::Scene scene = scene::loadScene(twoHumanoids("bare.wrl", "2", shawl));
   ASSERT_EQ(scene.avatars.size(), 2u);
   const std::vector<SceneCharacter> characters = sceneCharacters(scene);
   ASSERT_EQ(characters.size(), 1u);
   EXPECT_EQ(characters[0].name, "body");
+  EXPECT_EQ(characters[0].garments, (std::vector<std::size_t>{0, 1}));
+  // The skirt's Shape has a Material; the shawl, a bare IndexedFaceSet, no colour of its own.
+  ASSERT_EQ(scene.garments.size(), 2u);
+  EXPECT_FALSE(scene.garments[1].colour.has_value());
   EXPECT_FALSE(characters[0].external);
   EXPECT_EQ(characters[0].motion, "");
+  EXPECT_EQ(scene.garments[0].colour, std::optional<Vec3>(Vec3(0.7, 0.2, 0.2)));
 }
 
 TEST(SceneCharacters, RefusesWhatItCannotTellApart) {

@@ -14,8 +14,11 @@
 //    "meshes": [{"name": "dress", "role": "garment", "topology": "garment.obj",
 //                "cache": "garment.pc2", "states": "garment.states"}, ...]}
 
+#include <optional>
 #include <string>
 #include <string_view>
+
+#include "drape/core/math.hpp"
 #include <vector>
 
 namespace drape::formats {
@@ -29,6 +32,9 @@ struct RunMesh {
   /// The character a segment or skin belongs to, or that wears a garment, in a run of
   /// several characters; "": the run's only one (optional key).
   std::string character;
+  /// The garment's colour as its scene gives it (sRGB, 0 to 1); none: the players' own
+  /// (optional key `colour`, three numbers).
+  std::optional<Vec3> colour;
 };
 
 struct RunManifest {

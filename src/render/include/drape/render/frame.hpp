@@ -49,6 +49,8 @@ struct MeshInfo {
   /// The character a segment or skin belongs to, or that wears a garment, in a run of
   /// several; "": the only one.
   std::string character{};
+  /// A garment's colour as its scene gives it (sRGB, 0 to 1); none: the renderer's cloth red.
+  std::optional<Vec3> colour{};
 };
 
 /// Whether the run has an avatar's skinned body (drawn instead of the segments).

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -80,6 +81,9 @@ struct Garment {
   /// Pairs of cloth vertices sewn together (a closure the mesh leaves open): each pair is
   /// drawn to one point and held there. Indices into `mesh`, two different ones, in range.
   std::vector<std::array<std::uint32_t, 2>> stitches;
+  /// The diffuse colour (sRGB, 0 to 1) of the Material of its first cloth Shape that has
+  /// one; none: the players' own cloth colour.
+  std::optional<Vec3> colour;
   int avatar = -1;                          ///< index into Scene::avatars (a Humanoid), or -1
   int externalAvatar = -1;                  ///< index into Scene::externalAvatars, or -1
   SourcePos source;

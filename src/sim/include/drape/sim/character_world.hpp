@@ -44,6 +44,8 @@ struct GarmentSpec {
   cloth::OffsetSurfaces offsets;            ///< used when offsetsGiven, else from the voxel size
   bool offsetsGiven = false;
   int collisionEvery = 1;                   ///< collision tests every k substeps
+  /// For display only: the scene's colour of the cloth (sRGB, 0 to 1), or none.
+  std::optional<Vec3> colour;
 };
 
 struct WorldSettings {

@@ -176,20 +176,27 @@ TEST(Studio, TwoClothServersSplitTheGarmentsAndThePlayerCollatesThem) {
   EXPECT_EQ(stats["cloth_servers"]["back"]["garments"][0]["name"], "Skirt2");
 }
 
+const std::string kTwoCharacters = std::string(DRAPE_SOURCE_DIR) + "/examples/two_characters/scene.wrl";
+
+/// A cloth-server of one character of the two characters' scene (`which`: --character NAME,
+/// or --garments of one character's), following the poses `poses`, publishing as `name`.
+DrapeProcess characterCloth(const std::string& which, const std::string& poses, const std::string& name,
+                            const NatsServer& server, const ScratchDir& dir) {
+  return DrapeProcess("cloth-server '" + kTwoCharacters + "' " + which + " --poses " + poses + " --name " + name +
+                          " --takes 1" + roles(server),
+                      dir, name);
+}
+
 TEST(Studio, TwoCharactersEachOnServersOfItsOwnAreDrapeRunsToTheByte) {
   // Ada and Bea of the two characters' scene, each moved by an anim-server of her own and
   // dressed by a cloth-server of her own (Bea's told by the garments it simulates); the
   // player collates the four streams into what drape run writes of the scene.
   ScratchDir dir("studio-characters");
   NatsServer server;
-  const std::string scene = std::string(DRAPE_SOURCE_DIR) + "/examples/two_characters/scene.wrl";
+  const std::string& scene = kTwoCharacters;
   const std::string reference = runInto(dir, "reference", "'" + scene + "' --frames 45");
-  DrapeProcess adaCloth("cloth-server '" + scene + "' --character Ada --poses ada --name ada-cloth --takes 1" +
-                            roles(server),
-                        dir, "ada-cloth");
-  DrapeProcess beaCloth("cloth-server '" + scene + "' --garments 'Bea skirt' --poses bea --name bea-cloth --takes 1" +
-                            roles(server),
-                        dir, "bea-cloth");
+  DrapeProcess adaCloth = characterCloth("--character Ada", "ada", "ada-cloth", server, dir);
+  DrapeProcess beaCloth = characterCloth("--garments 'Bea skirt'", "bea", "bea-cloth", server, dir);
   for (const char* who : {"Ada", "Bea"}) {
     std::string name = who;
     name[0] = static_cast<char>(std::tolower(static_cast<unsigned char>(name[0])));
@@ -233,15 +240,11 @@ TEST(Studio, AnEventGraphOfTwoCharactersThroughTheStudioIsDrapeRunsToTheByte) {
   // character's poses.
   ScratchDir dir("studio-duet");
   NatsServer server;
-  const std::string scene = std::string(DRAPE_SOURCE_DIR) + "/examples/two_characters/scene.wrl";
+  const std::string& scene = kTwoCharacters;
   const std::string duet = std::string(DRAPE_SOURCE_DIR) + "/examples/event_graph/duet.egml";
   const std::string reference = runInto(dir, "reference", "'" + scene + "' --events '" + duet + "'");
-  DrapeProcess adaCloth("cloth-server '" + scene + "' --character Ada --poses ada --name ada-cloth --takes 1" +
-                            roles(server),
-                        dir, "ada-cloth");
-  DrapeProcess beaCloth("cloth-server '" + scene + "' --character Bea --poses bea --name bea-cloth --takes 1" +
-                            roles(server),
-                        dir, "bea-cloth");
+  DrapeProcess adaCloth = characterCloth("--character Ada", "ada", "ada-cloth", server, dir);
+  DrapeProcess beaCloth = characterCloth("--character Bea", "bea", "bea-cloth", server, dir);
   for (const std::string who : {"Ada", "Bea"}) {
     const CliResult sent = runDrape("anim-server '" + scene + "' --character " + who + " --events '" + duet +
                                         "' --name " + (who == "Ada" ? "ada" : "bea") + " --take duet --fast" +

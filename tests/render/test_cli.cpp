@@ -9,6 +9,7 @@
 #include <set>
 
 #include "../formats/test_run_fixture.hpp"
+#include "drape/formats/run_manifest.hpp"
 #include "drape/render/image.hpp"
 
 namespace drape::render {
@@ -46,6 +47,38 @@ TEST(RenderCli, PngFramesAtTheAskedSize) {
     EXPECT_EQ(image.height, 150);
   }
   EXPECT_FALSE(fs::exists(dir + "/png/frame_00006.png"));
+}
+
+/// Pixels of `image` that are plainly red (red above green and blue by `margin` of 255), and
+/// plainly blue.
+std::pair<int, int> redAndBluePixels(const Image& image, int margin = 60) {
+  int red = 0, blue = 0;
+  for (std::size_t p = 0; p + 2 < image.rgb.size(); p += 3) {
+    const int r = image.rgb[p], g = image.rgb[p + 1], b = image.rgb[p + 2];
+    red += r > g + margin && r > b + margin;
+    blue += b > r + margin && b > g + margin;
+  }
+  return {red, blue};
+}
+
+TEST(RenderCli, AGarmentIsDrawnInItsScenesColour) {
+  // The test run's flag in the renderer's cloth red; given a blue in the manifest (as a scene's
+  // Material gives it), blue, and no red left.
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("cli_colour"), 2);
+  Result r = run(drape() + " render " + dir + " --png " + dir + "/red --size 200x150 --range 0:0");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto [red, noBlue] = redAndBluePixels(readPng(dir + "/red/frame_00000.png"));
+  EXPECT_GT(red, 500);
+  EXPECT_EQ(noBlue, 0);
+  formats::RunManifest manifest = formats::readRunManifest(dir);
+  for (formats::RunMesh& m : manifest.meshes)
+    if (m.role == "garment") m.colour = Vec3(0.15, 0.25, 0.55);
+  formats::writeRunManifest(dir, manifest);
+  r = run(drape() + " render " + dir + " --png " + dir + "/blue --size 200x150 --range 0:0");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto [noRed, blue] = redAndBluePixels(readPng(dir + "/blue/frame_00000.png"));
+  EXPECT_EQ(noRed, 0);
+  EXPECT_GT(blue, 100);  // shaded darker than the red: fewer pixels clear the margin
 }
 
 TEST(RenderCli, ARangeRendersThoseFramesAsTheWholeRunDoes) {

@@ -202,7 +202,7 @@ int runLiveMotion(const AnimServerOptions& o, RunSetup& setup, CharacterSetup& c
   // The server first: a studio with no NATS server is said before the capture is waited for;
   // then the keep-apart's fields, so that the capture's first frames do not wait for them.
   studio::Bus bus = studio::Bus::connect(o.studio.server, "drape anim-server " + o.name);
-  prepareLiveRun(setup);
+  prepareLiveRun(setup, character);
   LiveCapture capture(avatar, {o.live, o.liveHeader, o.studio.patience(), o.studio.giveUp()}, motionOptions(setup),
                       stopAsked);
   const motion::LiveMotion& live = capture.motion();

@@ -33,7 +33,8 @@ struct PlayOptions {
   std::string run;
   std::vector<std::string> motions;
   std::string animation;
-  std::string live, liveHeader;  ///< --live SOURCE: a capture simulated as it comes
+  std::vector<std::string> lives;  ///< --live SOURCE (NAME=SOURCE per character): captures simulated as they come
+  std::string liveHeader;
   double giveUp_s = 0.0;
   long frames = 0;
   bool once = false;
@@ -48,17 +49,14 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
   RunSetup setup = runSetupFromScene(o.run);
   if (setup.characters.empty())
     throw Error(fmt::format("{}: drape play simulates scenes with an avatar (replay a run directory otherwise)", o.run));
-  // A live capture: read as the simulation asks for its frames, on the simulating thread.
-  std::unique_ptr<LiveCapture> capture;
-  std::unique_ptr<LiveRun> live;
-  if (!o.live.empty()) {
-    const CharacterSetup& character = *oneCharacter(setup, "--live (a live capture)");
+  // Live captures: read as the simulation asks for their frames, on the simulating thread.
+  std::unique_ptr<LiveCast> live;
+  if (!o.lives.empty()) {
     const std::chrono::milliseconds giveUp(static_cast<long long>(1000.0 * o.giveUp_s));
-    prepareLiveRun(setup);
-    capture = std::make_unique<LiveCapture>(*character.avatar,
-                                            LiveCapture::Options{o.live, o.liveHeader, std::chrono::seconds(5), giveUp},
-                                            motionOptions(setup), stopOnSignals());
-    live = std::make_unique<LiveRun>(setup, *capture, 0);
+    const std::vector<std::pair<std::size_t, std::string>> sources = liveSources(setup, o.lives);
+    addMotionsOfTheOthers(setup, sources, o.run);
+    live = std::make_unique<LiveCast>(setup, sources, LiveCast::Options{o.liveHeader, giveUp, 0}, motionOptions(setup),
+                                      stopOnSignals());
     options.close = &stopOnSignals();  // Ctrl-C closes the window
   } else {
     addSceneMotions(setup, o.run, o.motions, o.animation);
@@ -110,7 +108,7 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
     ~StopCaptureOnLeave() {
       if (live) askToStop();
     }
-  } stopCaptureOnLeave{capture != nullptr};
+  } stopCaptureOnLeave{live != nullptr};
   render::CallbackSource source(meshes, setup.settings.frameRate_hz, [&](render::Frame& out) {
     const FrameTaken* taken = ahead.next();
     if (!taken) return false;
@@ -129,7 +127,7 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
   render::SubdividedSource shown(source, o.picture.subdivide);
   const render::PlayerStats stats = render::Player(options).run(shown);
   std::cout << fmt::format("simulated and showed {} frames in {:.1f} s{}\n", stats.framesDrawn, stats.seconds,
-                           capture ? " of the live motion from " + capture->name() : std::string());
+                           live ? " of the live motion from " + live->names() : std::string());
   return 0;
 }
 
@@ -141,9 +139,10 @@ RunFunction setupPlay(CLI::App& app) {
                                             kMotionPerCharacterHelp)
       ->type_name("FILE|NAME=FILE");
   app.add_option("--animation", o.animation, kAnimationHelp);
-  app.add_option("--live", o.live,
-                 std::string("With a scene, instead of a motion: ") + kLiveHelp + "; shown as it is simulated")
-      ->type_name("SOURCE");
+  app.add_option("--live", o.lives,
+                 std::string("With a scene, instead of a motion: ") + kLiveHelp +
+                     "; shown as it is simulated; NAME=SOURCE for each character a capture moves in a scene of several")
+      ->type_name("SOURCE|NAME=SOURCE");
   app.add_option("--live-header", o.liveHeader, kLiveHeaderHelp)->type_name("FILE.bvh");
   app.add_option("--give-up", o.giveUp_s, "With --live: stop simulating after S seconds without a line")
       ->check(CLI::PositiveNumber);
@@ -168,9 +167,9 @@ RunFunction setupPlay(CLI::App& app) {
       options.screenshot = o.screenshot;
       return playScene(o, options);
     }
-    if (!o.motions.empty() || !o.animation.empty() || !o.live.empty())
+    if (!o.motions.empty() || !o.animation.empty() || !o.lives.empty())
       throw Error(fmt::format("{}: drape play takes a motion only with a scene file, not a run directory",
-                              !o.live.empty() ? "--live" : o.motions.empty() ? "--animation" : "--motion"));
+                              !o.lives.empty() ? "--live" : o.motions.empty() ? "--animation" : "--motion"));
     render::RunReplay replay(o.run);
     std::tie(options.width, options.height) = o.picture.parsedSize();
     options.title = fmt::format("drape play {}", o.run);

@@ -46,7 +46,8 @@ struct RunOptions {
   double stitchGaps_m = 0.0;  ///< --stitch-gaps
   std::vector<std::string> faceSamplesWith, keepApart, cutAtJoints;
   std::string events;                       ///< --events: an EGML event graph instead of --motion
-  std::string live, liveHeader;             ///< --live SOURCE, --live-header FILE.bvh: a capture as it comes
+  std::vector<std::string> lives;           ///< --live SOURCE, or NAME=SOURCE per character: captures as they come
+  std::string liveHeader;                   ///< --live-header FILE.bvh: the sources' skeleton
   double giveUp_s = 0.0;                    ///< --give-up: a live source silent this long ends the run
   std::string timecode;                     ///< --timecode: motion frame 0's time code, HH:MM:SS:FF or now
   std::vector<std::string> sets, sends;     ///< --set NAME=VALUE, --send EVENT@SECONDS
@@ -253,29 +254,25 @@ void stampTimeCode(const RunOptions& o, RunSetup& setup, double earlier_s = 0.0)
                                : studio::clothTimeCode(0, motionStart, setup.characters.front().leadIn_s).frame;
 }
 
-/// `--live SOURCE`: the run on a capture as it comes, until the source ends (it closes, Ctrl-C,
-/// or silence past --give-up: exit code 4) or --frames; what came is written as any run is.
+/// `--live SOURCE` (or NAME=SOURCE per character): the run on captures as they come, until a
+/// source ends (it closes, Ctrl-C, or silence past --give-up: exit code 4) or --frames; what
+/// came is written as any run is. The characters without a source play their Avatar node's
+/// motion, or stand.
 int runLive(const RunOptions& o, RunSetup& setup, const std::function<void()>& saidResults) {
   const std::atomic<bool>& stop = stopOnSignals();
   const std::chrono::milliseconds giveUp(static_cast<long long>(1000.0 * o.giveUp_s));
   motion::MotionOptions motion = motionOptions(setup);
   if (o.motionScale > 0) motion.clip.metresPerUnit = o.motionScale;
   motion.jointMapPath = o.jointMap;
-  CharacterSetup& character = *oneCharacter(setup, "--live (a live capture)");
-  prepareLiveRun(setup);
-  LiveCapture capture(*character.avatar, {o.live, o.liveHeader, std::chrono::seconds(5), giveUp}, motion, stop);
-  LiveRun live(setup, capture, o.frames);
+  const std::vector<std::pair<std::size_t, std::string>> sources = liveSources(setup, o.lives);
+  addMotionsOfTheOthers(setup, sources, o.scene, o.motionScale, o.jointMap);
+  LiveCast live(setup, sources, {o.liveHeader, giveUp, o.frames}, motion, stop);
   stampTimeCode(o, setup, live.lag_s());  // now: when the first frame came
   const int code = simulateRun(setup, live.gate());
-  if (capture.keptApart()) logKeptApart(capture.keptApart()->report());
+  live.logKeptApart();
   saidResults();
-  const std::string ended = capture.ended();
-  fmt::print("live: {} motion frames from {} ({} source frames{}){}\n", live.motionFrames(), capture.name(),
-             capture.motion().sourceFrames(),
-             capture.badLines() > 0 ? fmt::format(", {} bad line{}", capture.badLines(), capture.badLines() == 1 ? "" : "s")
-                                    : std::string(),
-             ended.empty() ? "" : "; " + ended);
-  return capture.silent() ? static_cast<int>(ExitCode::Unavailable) : code;
+  for (const std::string& line : live.summary()) fmt::print("{}\n", line);
+  return live.silent() ? static_cast<int>(ExitCode::Unavailable) : code;
 }
 
 int runCommand(const CLI::App& app, RunOptions& o) {
@@ -308,12 +305,12 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   const bool avatar = !setup.characters.empty();
   if (!o.events.empty() && (!o.motions.empty() || !o.animation.empty()))
     throw Error("--events plays an event graph's motions: give it or --motion, not both");
-  if (!o.live.empty() && (!o.motions.empty() || !o.animation.empty() || !o.events.empty()))
+  if (!o.lives.empty() && (!o.motions.empty() || !o.animation.empty() || !o.events.empty()))
     throw Error(fmt::format("--live plays the motion its source sends: give it or {}, not both",
                             !o.events.empty() ? "--events" : !o.motions.empty() ? "--motion" : "--animation"));
-  if (o.live.empty() && (!o.liveHeader.empty() || o.giveUp_s > 0))
+  if (o.lives.empty() && (!o.liveHeader.empty() || o.giveUp_s > 0))
     throw Error(fmt::format("{} is for a live source: give --live SOURCE", o.liveHeader.empty() ? "--give-up" : "--live-header"));
-  if (!o.live.empty() && !avatar) throw Error("--live: there is no avatar for the capture to move");
+  if (!o.lives.empty() && !avatar) throw Error("--live: there is no avatar for the capture to move");
   if (o.events.empty() && (!o.sets.empty() || !o.sends.empty()))
     throw Error(fmt::format("{}: it is for an event graph: give --events FILE.egml", o.sets.empty() ? "--send" : "--set"));
   const bool motionGiven =
@@ -329,7 +326,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   }
 
   if (app.count("--keep-apart") && !keepApartParts(o.keepApart).empty() && !motionGiven && o.events.empty() &&
-      o.live.empty())
+      o.lives.empty())
     throw Error("--keep-apart corrects a motion: give --motion FILE (or --events FILE, or --live SOURCE) too");
   if (!o.events.empty() && !avatar) throw Error("--events: there is no avatar for the event graph to move");
   if (!(o.leadIn_s >= 0)) throw Error(fmt::format("--lead-in must be >= 0 s, got {}", o.leadIn_s));
@@ -341,7 +338,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     ch.settle_s = o.settle_s;
     if (app.count("--keep-apart")) setKeepApart(ch, o.keepApart);
   }
-  if (o.events.empty() && o.live.empty())
+  if (o.events.empty() && o.lives.empty())
     addSceneMotions(setup, o.scene, o.motions, o.animation, o.motionScale, o.jointMap);
   if (!o.events.empty() && avatar) {
     // With --frames, as many motion frames as those frames read (the lead-in before them).
@@ -364,7 +361,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   }
   // Frames: as asked, or the lead-in plus the whole motion (a live one: as long as it comes).
   setup.frames = o.frames;
-  if (!app.count("--frames") && o.live.empty()) setup.frames = defaultFrames(setup);
+  if (!app.count("--frames") && o.lives.empty()) setup.frames = defaultFrames(setup);
   setup.objEvery = o.every;
   setup.outDir = o.out;
   setup.preview = o.preview;
@@ -380,7 +377,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
                o.preview ? ", preview.png" : "");
   };
   if (!o.timecode.empty() && o.timecode != "now") (void)TimeCode::parseSmpte(o.timecode, setup.settings.frameRate_hz);
-  if (!o.live.empty()) return runLive(o, setup, saidResults);
+  if (!o.lives.empty()) return runLive(o, setup, saidResults);
   stampTimeCode(o, setup);
   const int code = simulateRun(setup);
   saidResults();
@@ -411,8 +408,10 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--send", o->sends,
                  "With --events: an event for the graph's state machines at a time of the script, EVENT@SECONDS; "
                  "repeatable");
-  app.add_option("--live", o->live, std::string("Instead of a motion: ") + kLiveHelp)
-      ->type_name("SOURCE");
+  app.add_option("--live", o->lives,
+                 std::string("Instead of a motion: ") + kLiveHelp +
+                     "; with several characters in the scene, NAME=SOURCE for each that a capture moves (repeatable)")
+      ->type_name("SOURCE|NAME=SOURCE");
   app.add_option("--live-header", o->liveHeader, kLiveHeaderHelp)->type_name("FILE.bvh");
   app.add_option("--give-up", o->giveUp_s, "With --live: end the run after S seconds without a line (exit code 4)")
       ->check(CLI::PositiveNumber);

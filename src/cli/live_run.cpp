@@ -1,5 +1,8 @@
 #include "live_run.hpp"
 
+#include <algorithm>
+#include <optional>
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -9,23 +12,21 @@
 
 namespace drape::cli {
 
-void prepareLiveRun(RunSetup& setup) {
-  CharacterSetup* character = oneCharacter(setup, "--live (a live capture)");
-  if (character && !character->keepApart.empty())
-    buildPartFieldsOnce(setup, *character, fmt::format("to keep {} apart", fmt::join(character->keepApart, ", ")));
+void prepareLiveRun(const RunSetup& setup, CharacterSetup& character) {
+  if (!character.keepApart.empty())
+    buildPartFieldsOnce(setup, character, fmt::format("to keep {} apart", fmt::join(character.keepApart, ", ")));
 }
 
-LiveRun::LiveRun(RunSetup& setup, LiveCapture& capture, long maxFrames)
+LiveRun::LiveRun(RunSetup& setup, CharacterSetup& character, LiveCapture& capture, long maxFrames)
     : capture_(capture),
       joints_(capture.motion().jointCount()),
       frameRate_(setup.settings.frameRate_hz),
-      leadIn_s_(oneCharacter(setup, "--live (a live capture)")->leadIn_s),
+      leadIn_s_(character.leadIn_s),
       maxFrames_(maxFrames) {
   const motion::LiveMotion& live = capture.motion();
   const std::span<const int> driving = live.drivingJoint();
   animation_ = std::make_shared<motion::AvatarAnimation>(motion::AvatarAnimation::streamed(
       live.jointCount(), live.rate(), TimeCode{0, live.rate()}, std::vector<int>(driving.begin(), driving.end())));
-  CharacterSetup& character = *oneCharacter(setup, "--live (a live capture)");
   // The capture keeps the parts apart on its way in, so the world is given the motion
   // corrected and keeps nothing apart itself.
   if (std::shared_ptr<sim::LiveKeepApart> keep = liveKeepApart(setup, character, live.rate())) {
@@ -61,6 +62,112 @@ bool LiveRun::admit(long frame) {
   if (waitForFrames(studio::motionFramesNeeded(frame, frameRate_, leadIn_s_, motionRate))) return true;
   // The capture ended: the frames up to its last motion frame's time are still simulated.
   return frame <= studio::clothFramesOf(motionFrames(), frameRate_, leadIn_s_, motionRate);
+}
+
+}  // namespace drape::cli
+
+namespace drape::cli {
+
+std::vector<std::pair<std::size_t, std::string>> liveSources(const RunSetup& setup,
+                                                             const std::vector<std::string>& options) {
+  std::vector<std::pair<std::size_t, std::string>> out;
+  for (const std::string& option : options) {
+    // NAME=SOURCE where NAME is one of the scene's characters; else the whole is the source.
+    const auto eq = option.find('=');
+    std::optional<std::size_t> named;
+    if (eq != std::string::npos)
+      for (std::size_t c = 0; c < setup.characters.size(); ++c)
+        if (setup.characters[c].name == option.substr(0, eq)) named = c;
+    if (!named) {
+      if (setup.characters.size() > 1) {
+        std::vector<std::string> names;
+        for (const CharacterSetup& c : setup.characters) names.push_back(c.name);
+        throw Error(fmt::format("--live {}: the scene has {} characters ({}): say which the capture moves, --live "
+                                "NAME=SOURCE",
+                                option, setup.characters.size(), fmt::join(names, ", ")));
+      }
+      if (!out.empty()) throw Error(fmt::format("--live {}: the scene's one character has a source already", option));
+      out.emplace_back(0, option);
+      continue;
+    }
+    for (const auto& [c, source] : out)
+      if (c == *named)
+        throw Error(fmt::format("--live {}: {} has a source already ({})", option, setup.characters[c].name, source));
+    const std::string source = option.substr(eq + 1);
+    if (source.empty()) throw Error(fmt::format("--live {}: expected NAME=SOURCE", option));
+    out.emplace_back(*named, source);
+  }
+  const auto stdins = std::count_if(out.begin(), out.end(), [](const auto& s) { return s.second == "-"; });
+  if (stdins > 1) throw Error("--live: standard input (-) is one source; give the others theirs");
+  return out;
+}
+
+void addMotionsOfTheOthers(RunSetup& setup, const std::vector<std::pair<std::size_t, std::string>>& sources,
+                           const std::string& scenePath, double metresPerUnit, const std::string& jointMap) {
+  for (std::size_t c = 0; c < setup.characters.size(); ++c) {
+    CharacterSetup& character = setup.characters[c];
+    const bool live = std::any_of(sources.begin(), sources.end(), [c](const auto& s) { return s.first == c; });
+    if (live || character.motion.empty()) continue;
+    const MotionChoice m = sceneMotion(setup, &character, scenePath, character.motion, "");
+    addMotion(setup, character, m.path, metresPerUnit, jointMap, m.animation, m.sampled.get());
+  }
+}
+
+LiveCast::LiveCast(RunSetup& setup, const std::vector<std::pair<std::size_t, std::string>>& sources,
+                   const Options& options, const motion::MotionOptions& motion, const std::atomic<bool>& stop)
+    : several_(sources.size() > 1) {
+  for (const auto& [c, source] : sources) prepareLiveRun(setup, setup.characters[c]);
+  for (const auto& [c, source] : sources) {
+    Member& m = members_.emplace_back();
+    m.character = setup.characters[c].name;
+    m.capture = std::make_unique<LiveCapture>(
+        *setup.characters[c].avatar, LiveCapture::Options{source, options.headerFile, std::chrono::seconds(5), options.giveUp},
+        motion, stop);
+  }
+  for (std::size_t k = 0; k < sources.size(); ++k)
+    members_[k].run =
+        std::make_unique<LiveRun>(setup, setup.characters[sources[k].first], *members_[k].capture, options.maxFrames);
+}
+
+bool LiveCast::admit(long frame) {
+  for (Member& m : members_)
+    if (!m.run->admit(frame)) return false;
+  return true;
+}
+
+double LiveCast::lag_s() const {
+  double lag = 0.0;
+  for (const Member& m : members_) lag = std::max(lag, m.run->lag_s());
+  return lag;
+}
+
+bool LiveCast::silent() const {
+  return std::any_of(members_.begin(), members_.end(), [](const Member& m) { return m.capture->silent(); });
+}
+
+std::vector<std::string> LiveCast::summary() const {
+  std::vector<std::string> lines;
+  for (const Member& m : members_) {
+    const LiveCapture& c = *m.capture;
+    const std::string ended = c.ended();
+    lines.push_back(fmt::format(
+        "live: {} motion frames{} from {} ({} source frames{}){}", m.run->motionFrames(),
+        several_ ? " of " + m.character : std::string(), c.name(), c.motion().sourceFrames(),
+        c.badLines() > 0 ? fmt::format(", {} bad line{}", c.badLines(), c.badLines() == 1 ? "" : "s") : std::string(),
+        ended.empty() ? "" : "; " + ended));
+  }
+  return lines;
+}
+
+void LiveCast::logKeptApart() const {
+  for (const Member& m : members_)
+    if (m.capture->keptApart()) cli::logKeptApart(m.capture->keptApart()->report());
+}
+
+std::string LiveCast::names() const {
+  std::vector<std::string> names;
+  for (const Member& m : members_) names.push_back(m.capture->name());
+  return fmt::format("{}", fmt::join(names, ", "));
 }
 
 }  // namespace drape::cli

@@ -130,6 +130,55 @@ TEST(Characters, EachCharacterOfTheSceneIsWhatItsSceneAloneMakesToTheByte) {
   EXPECT_EQ(a, b) << deepBoth.out << deepBea.out;
 }
 
+TEST(Characters, TwoCapturesMoveTheirCharactersAsEachMovesItsSceneAlone) {
+  // Each character's capture read as it comes (here from files, as a named pipe would give
+  // them): each character's files are those of its scene alone on its capture, to the byte.
+  ScratchDir dir("characters-live");
+  const std::string frames = " --frames 45";  // the lead-in's 30, then 15 of the captures
+  const std::string walk = kSkirtDir + "/walk.bvh";
+  const std::string both = dir / "both", ada = dir / "ada", bea = dir / "bea";
+  const CliResult r = runDrape("run '" + kTwoCharacters + "' --live 'Ada=" + walk + "' --live 'Bea=" + kDelfem2Walk +
+                                   "'" + frames + " --out '" + both + "'",
+                               dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("live: 17 motion frames of Ada from " + walk), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("live: 17 motion frames of Bea from " + kDelfem2Walk), std::string::npos) << r.out;
+  ASSERT_EQ(runDrape("run '" + kSkirtDir + "/scene.wrl' --live '" + walk + "'" + frames + " --out '" + ada + "'", dir).code,
+            0);
+  ASSERT_EQ(runDrape("run '" + skirtSceneMoved(dir, "bea.wrl", 1.2) + "' --live '" + kDelfem2Walk + "'" + frames +
+                         " --out '" + bea + "'",
+                     dir)
+                .code,
+            0);
+  for (const auto& [who, single] : {std::pair{std::string("Ada"), ada}, std::pair{std::string("Bea"), bea}}) {
+    SCOPED_TRACE(who);
+    EXPECT_TRUE(sameFile(both + "/garment-" + who + "_skirt.pc2", single + "/garment.pc2"));
+    EXPECT_TRUE(sameFile(both + "/body-" + who + ".pc2", single + "/body.pc2"));
+    EXPECT_TRUE(sameFile(both + "/segments/" + who + "/LeftUpLeg.pc2", single + "/segments/LeftUpLeg.pc2"));
+  }
+
+  // A capture for one of them: the other plays what her Avatar node names.
+  const CliResult one = runDrape("run '" + kTwoCharacters + "' --live 'Bea=" + kDelfem2Walk + "' --frames 2 --out '" +
+                                     (dir / "one") + "'",
+                                 dir);
+  ASSERT_EQ(one.code, 0) << one.err;
+  EXPECT_NE(one.err.find("walk.bvh: 566 frames at 120 Hz"), std::string::npos) << one.err;
+  EXPECT_NE(one.out.find("live: "), std::string::npos) << one.out;
+
+  const std::string out = " --out '" + (dir / "x") + "'";
+  const auto expectError = [&](const std::string& args, const std::string& message) {
+    const CliResult e = runDrape(args, dir);
+    EXPECT_EQ(e.code, 2) << args << "\n" << e.err;
+    EXPECT_NE(e.err.find(message), std::string::npos) << args << "\n" << e.err;
+  };
+  expectError("run '" + kTwoCharacters + "' --live '" + walk + "'" + out,
+              "--live " + walk + ": the scene has 2 characters (Ada, Bea): say which the capture moves, --live NAME=SOURCE");
+  expectError("run '" + kTwoCharacters + "' --live Ada=- --live Bea=-" + out,
+              "--live: standard input (-) is one source; give the others theirs");
+  expectError("run '" + kTwoCharacters + "' --live 'Ada=" + walk + "' --live Ada=-" + out,
+              "--live Ada=-: Ada has a source already (" + walk + ")");
+}
+
 TEST(Characters, MotionsAreGivenByNameAndWhatPlaysOneCharacterSaysSo) {
   ScratchDir dir("characters-errors");
   const std::string out = " --out '" + (dir / "x") + "'";
@@ -144,8 +193,6 @@ TEST(Characters, MotionsAreGivenByNameAndWhatPlaysOneCharacterSaysSo) {
               "--motion Ada=none: 'Ada' is given a motion twice");
   expectError("run '" + kTwoCharacters + "' --motion '" + kDelfem2Walk + "' --motion none" + out,
               "--motion none: a motion for every character is given already");
-  expectError("run '" + kTwoCharacters + "' --live -" + out + " < /dev/null",
-              "--live (a live capture) plays one character; the scene has 2 (Ada, Bea)");
   // An event graph of one character's Plays, on a scene of two.
   expectError("run '" + kTwoCharacters + "' --events '" + std::string(DRAPE_SOURCE_DIR) + "/examples/event_graph/day.egml'" + out,
               "day.egml:14: Play: the scene has 2 characters (Ada, Bea): say which it moves (character \"NAME\", here "

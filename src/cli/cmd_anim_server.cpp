@@ -337,7 +337,8 @@ RunFunction setupAnimServer(CLI::App& app) {
   app.add_option("--animation", o.animation, kAnimationHelp);
   app.add_option("--character", o.character,
                  "Which of the scene's characters it moves (its Avatar or Humanoid node's name); needed in a scene of "
-                 "several, each played by an anim-server of its own");
+                 "several, each played by an anim-server of its own")
+      ->type_name("NAME");
   app.add_option("--name", o.name, "This broadcaster's name: it publishes on drape.NAME, into the stream DRAPE_NAME")
       ->capture_default_str();
   app.add_option("--take", o.take,

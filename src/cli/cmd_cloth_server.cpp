@@ -216,7 +216,8 @@ RunFunction setupClothServer(CLI::App& app) {
       ->delimiter(',');
   app.add_option("--character", o.character,
                  "Which of the scene's characters' garments it simulates (needed in a scene of several unless --garments "
-                 "names one's); its --poses are the anim-server's of that --character");
+                 "names one's); its --poses are the anim-server's of that --character")
+      ->type_name("NAME");
   app.add_option("--positions", o.positions,
                  "How positions travel: double (a player records what drape run writes, to the byte) or float (half "
                  "the bytes)")

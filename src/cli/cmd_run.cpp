@@ -325,9 +325,6 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     setup.spheres.push_back({c, r.z()});
   }
 
-  if (app.count("--keep-apart") && !keepApartParts(o.keepApart).empty() && !motionGiven && o.events.empty() &&
-      o.lives.empty())
-    throw Error("--keep-apart corrects a motion: give --motion FILE (or --events FILE, or --live SOURCE) too");
   if (!o.events.empty() && !avatar) throw Error("--events: there is no avatar for the event graph to move");
   if (!(o.leadIn_s >= 0)) throw Error(fmt::format("--lead-in must be >= 0 s, got {}", o.leadIn_s));
   if (!(o.settle_s >= 0)) throw Error(fmt::format("--settle must be >= 0 s, got {}", o.settle_s));
@@ -340,6 +337,11 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   }
   if (o.events.empty() && o.lives.empty())
     addSceneMotions(setup, o.scene, o.motions, o.animation, o.motionScale, o.jointMap);
+  const bool moving = std::any_of(setup.characters.begin(), setup.characters.end(),
+                                  [](const CharacterSetup& c) { return c.animation != nullptr; });
+  if (app.count("--keep-apart") && !keepApartParts(o.keepApart).empty() && !moving && o.events.empty() &&
+      o.lives.empty())
+    throw Error("--keep-apart corrects a motion: give --motion FILE (or --events FILE, or --live SOURCE) too");
   if (!o.events.empty() && avatar) {
     // With --frames, as many motion frames as those frames read (the lead-in before them).
     const long motionFrames =

@@ -246,6 +246,7 @@ FieldCollider::FieldCollider(std::string garmentName, std::vector<CollisionPart>
   poses_.resize(2 * parts_.size());
   steps_.resize(parts_.size());
   holds_.assign(parts_.size(), 0);
+  outOfReach_.assign(parts_.size(), 0);
 }
 
 FieldCollider::~FieldCollider() = default;
@@ -407,6 +408,20 @@ void FieldCollider::collide(const ClothModel& model, double t0_s, double t1_s, C
   }
   framesEnd_s_ = t1_s;
   ++tests_;
+  // Parts the free points cannot reach at this test are left out of it (exact: the cull
+  // would keep none of their pairs).
+  if (boxCulling_) {
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (std::size_t i = 0; i < io.size(); ++i)
+      if (free_[i]) {
+        lo = lo.cwiseMin(io.position(i));
+        hi = hi.cwiseMax(io.position(i));
+      }
+    for (std::size_t k = 0; k < parts_.size(); ++k) {
+      outOfReach_[k] = outOfReach(k, frames_[k], lo, hi) ? 1 : 0;
+      field_.partsOutOfReach += outOfReach_[k];
+    }
+  }
   // Where the points are before this test's corrections: where the walks of the pairs
   // resting now would start at the next test (wake).
   std::copy(io.x.begin(), io.x.end(), nextTestX_.begin());
@@ -446,6 +461,7 @@ void FieldCollider::collideRange(std::size_t range, double dt_s, ClothState& io)
   t.correctedPoints.clear();
   const std::size_t first = rangeStart_[range], last = rangeStart_[range + 1];
   for (std::size_t k = 0; k < parts_.size(); ++k) {
+    if (outOfReach_[k]) continue;
     const PartFrame& frame = frames_[k];
     std::size_t resting = 0;
     const std::size_t kept = selectCandidates(k, frame, io, first, last, resting);
@@ -519,6 +535,27 @@ void FieldCollider::setRanges(std::size_t vertices, std::size_t rangeVertices) {
     tallies_[r].corrected.reserve(size * parts_.size());
     tallies_[r].correctedPoints.reserve(size);
   }
+}
+
+bool FieldCollider::outOfReach(std::size_t k, const PartFrame& frame, const Vec3& lo, const Vec3& hi) const {
+  if (!(lo.x() <= hi.x())) return true;  // no free point
+  // The box's corners in the part's voxels, bounded, a voxel wider than rounding could need.
+  Vec3 vlo = Vec3::Constant(std::numeric_limits<double>::infinity()), vhi = -vlo;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 corner((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(), (c & 4) ? hi.z() : lo.z());
+    const Vec3 v = frame.toVoxel1.apply(corner);
+    vlo = vlo.cwiseMin(v);
+    vhi = vhi.cwiseMax(v);
+  }
+  const field::GridDims& d = parts_[k].field->dims();
+  const Vec3 boxMax(d.nx - 1.5, d.ny - 1.5, d.nz - 1.5);  // as selectCandidates' walkable box
+  const bool clear = (vhi.array() + 1.0 < 0.5).any() || (vlo.array() - 1.0 >= boxMax.array()).any();
+  if (!clear) return false;
+  const std::vector<PointState>& states = states_[k];
+  const std::vector<double>& balls = ballR2_[k];
+  for (std::size_t i = 0; i < states.size(); ++i)
+    if ((free_[i] && states[i] != PointState::OutsideVol) || balls[i] >= 0) return false;
+  return true;
 }
 
 std::size_t FieldCollider::selectCandidates(std::size_t k, const PartFrame& frame, const ClothState& io,
@@ -1202,7 +1239,8 @@ FieldCollisionCounters& FieldCollisionCounters::operator+=(const FieldCollisionC
                       {&embeddedTimedOut, o.embeddedTimedOut},
                       {&planeEstimates, o.planeEstimates}, {&planeReads, o.planeReads},
                       {&heldVertexSubsteps, o.heldVertexSubsteps}, {&pinchedVertexTests, o.pinchedVertexTests},
-                      {&faceTests, o.faceTests}, {&faceContacts, o.faceContacts}, {&facesInsideBody, o.facesInsideBody}})
+                      {&faceTests, o.faceTests}, {&faceContacts, o.faceContacts}, {&facesInsideBody, o.facesInsideBody},
+                      {&partsOutOfReach, o.partsOutOfReach}})
     *a += b;
   maxPenetration_m = std::max(maxPenetration_m, o.maxPenetration_m);
   for (int from = 0; from < 3; ++from)

@@ -193,6 +193,7 @@ struct FieldCollisionCounters {
   std::uint64_t faceTests = 0;     ///< (triangle, part) pairs whose centroid was read (face samples)
   std::uint64_t faceContacts = 0;  ///< of those, centroids below T2: their triangle moved out
   std::uint64_t facesInsideBody = 0;  ///< of those, centroids inside the body (signed distance < 0) before the move
+  std::uint64_t partsOutOfReach = 0;  ///< (test, part) pairs left out: no point could reach the part (its pairs culled)
   std::array<std::array<std::uint64_t, 3>, 3> transitions{};  ///< [from][to] PointState counts
 
   /// Mean voxel path per tested (vertex, part) pair: the paper's "average collision path
@@ -341,6 +342,13 @@ class FieldCollider final : public Collider {
 
  private:
   struct PartFrame;  // one part's transforms over the interval (field_collider.cpp)
+  /// Whether part k, at the end of this test's interval, can hold none of the points ending
+  /// in the box [lo, hi] (world): every pair of it OutsideVol without a resting ball, and the
+  /// box, mapped into the part's voxels and widened by a voxel, clear of its walkable box.
+  /// The cull would then keep none of its pairs, which go OutsideVol -> OutsideVol untraced:
+  /// leaving the part out of the test changes nothing but time (a part of another character
+  /// across the room, a shin far below a cape).
+  [[nodiscard]] bool outOfReach(std::size_t k, const PartFrame& frame, const Vec3& lo, const Vec3& hi) const;
   struct PartStep;   // one part's rigid motion over an untested substep (field_collider.cpp)
   PartFrame framePart(const CollisionPart& part, const RigidTransform& pose0, const RigidTransform& pose1) const;
   /// The interval's end transforms of `frame` (framePart's, the start's left as they are).
@@ -491,6 +499,8 @@ class FieldCollider final : public Collider {
   // Per-substep scratch, sized by initialise (the step does not allocate).
   std::vector<double> endVoxelX_, endVoxelY_, endVoxelZ_;  ///< per vertex, the current part's voxel coordinates
   std::vector<std::uint8_t> keep_;                ///< per vertex: the current part must test it
+  /// Per part, at this test: out of the garment's reach (outOfReach), its pairs left as they are.
+  std::vector<std::uint8_t> outOfReach_;
   std::vector<std::uint32_t> candidates_;         ///< the vertices kept, ascending, each range's from its first
   std::size_t rangeVertices_ = kRange_vertices;   ///< setParallelRanges
   std::size_t parallelFrom_ = kParallelFrom_vertices;

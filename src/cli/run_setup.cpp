@@ -584,14 +584,15 @@ sim::WorldSettings worldSettings(const RunSetup& setup, const CharacterSetup& ch
   return ws;
 }
 
-std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup, const CharacterSetup& character) {
+std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup, const CharacterSetup& character,
+                                                std::vector<sim::Guest> guests) {
   const sim::WorldSettings ws = worldSettings(setup, character);
   const bool built = character.fields != nullptr;
   const std::string whose = setup.characters.size() > 1 ? fmt::format("{}: ", character.name) : "";
   spdlog::info("{}{} and binding constraint masks", whose,
                built ? "distance fields built before" : fmt::format("building distance fields ({:.4g} m voxels)", ws.voxel_m));
   auto world = std::make_unique<sim::CharacterWorld>(*character.avatar, character.animation.get(),
-                                                     garmentsOf(setup, character), ws, character.fields);
+                                                     garmentsOf(setup, character), ws, character.fields, std::move(guests));
   if (!built) spdlog::info("{}{} distance fields in {:.2f} s", whose, world->fields().size(), world->fieldBuild_s());
   logKeptApart(world->keepApartReport());
   return world;
@@ -751,12 +752,42 @@ void garmentVertexStates(const cloth::ClothSolver& solver, const cloth::FieldCol
 }
 
 SetupWorlds::SetupWorlds(const RunSetup& setup) : place_(setup.garments.size()) {
-  for (std::size_t c = 0; c < setup.characters.size(); ++c) {
-    const CharacterSetup& character = setup.characters[c];
-    worlds_.push_back(buildWorld(setup, character));
-    names_.push_back(character.name);
-    for (std::size_t k = 0; k < character.garments.size(); ++k) place_[character.garments[k]] = {c, k};
+  const std::size_t n = setup.characters.size();
+  keepApartReports_.resize(n);
+  for (std::size_t c = 0; c < n; ++c) {
+    names_.push_back(setup.characters[c].name);
+    for (std::size_t k = 0; k < setup.characters[c].garments.size(); ++k) place_[setup.characters[c].garments[k]] = {c, k};
   }
+  if (n == 1) {  // one world, which keeps its parts apart itself
+    worlds_.push_back(buildWorld(setup, setup.characters.front()));
+    return;
+  }
+  // Every body first, as its own world will move it: its fields, and its motion kept apart.
+  std::vector<CharacterSetup> played = setup.characters;
+  for (std::size_t c = 0; c < n; ++c) {
+    CharacterSetup& character = played[c];
+    buildPartFieldsOnce(setup, character, fmt::format("for {}", character.name));
+    fields_.push_back(character.fields);
+    keptApart_.emplace_back();
+    if (character.keepApart.empty() || !character.animation) continue;
+    sim::WorldSettings ws = worldSettings(setup, character);
+    keptApart_[c] = std::make_unique<motion::AvatarAnimation>(*character.animation);
+    keepApartReports_[c] = sim::keepBodyApart(*character.avatar, *keptApart_[c], *character.fields,
+                                              sim::keepApartSettings(garmentsOf(setup, character), ws));
+    logKeptApart(keepApartReports_[c]);
+    character.animation = std::shared_ptr<const motion::AvatarAnimation>(std::shared_ptr<void>(), keptApart_[c].get());
+    character.keepApart.clear();
+  }
+  for (std::size_t c = 0; c < n; ++c) {
+    std::vector<sim::Guest> guests;
+    for (std::size_t o = 0; o < n; ++o)
+      if (o != c) guests.push_back({played[o].name, played[o].avatar.get(), played[o].animation.get(), fields_[o]});
+    worlds_.push_back(buildWorld(setup, played[c], std::move(guests)));
+  }
+}
+
+const sim::KeepApartReport& SetupWorlds::keepApartReport(std::size_t c) const {
+  return worlds_.size() == 1 ? worlds_.front()->keepApartReport() : keepApartReports_[c];
 }
 
 std::vector<const sim::CharacterWorld*> SetupWorlds::all() const {
@@ -825,11 +856,12 @@ Vec3 windOf(const RunSetup& setup, long frame) {
 
 /// stats.json's entry for a character: its name and garments, and what the correction of its
 /// motion changed.
-nlohmann::json characterJson(const RunSetup& setup, const CharacterSetup& character, const sim::CharacterWorld& world) {
+nlohmann::json characterJson(const RunSetup& setup, const CharacterSetup& character,
+                             const sim::KeepApartReport& keptApart) {
   nlohmann::json garments = nlohmann::json::array();
   for (const std::size_t g : character.garments) garments.push_back(setup.garments[g].name);
   nlohmann::json entry = {{"name", character.name}, {"avatar", character.avatar->name}, {"garments", garments}};
-  if (!world.keepApartReport().parts.empty()) entry["keep_apart"] = keepApartJson(world.keepApartReport());
+  if (!keptApart.parts.empty()) entry["keep_apart"] = keepApartJson(keptApart);
   else if (character.liveKeptApart) entry["keep_apart"] = keepApartJson(character.liveKeptApart->report());
   return entry;
 }
@@ -1084,7 +1116,7 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
   stats["body_overlaps"] = bodyOverlaps;
   nlohmann::json characters = nlohmann::json::array();
   for (std::size_t c = 0; c < worlds.size(); ++c)
-    characters.push_back(characterJson(setup, setup.characters[c], worlds.world(c)));
+    characters.push_back(characterJson(setup, setup.characters[c], worlds.keepApartReport(c)));
   // One character's correction where it always was; several characters' in theirs.
   if (characters.size() == 1 && characters[0].contains("keep_apart")) stats["keep_apart"] = characters[0]["keep_apart"];
   stats["characters"] = characters;

@@ -203,9 +203,11 @@ void printHowToRun(const std::string& out, const scene::Avatar& avatar);
 /// method, lead-in and keep-apart).
 [[nodiscard]] sim::WorldSettings worldSettings(const RunSetup& setup, const CharacterSetup& character);
 
-/// A character's world: fields built, masks bound, solvers ready for the garments it wears.
-/// Used by `drape run`, `drape play SCENE` and `drape bench paper` alike.
-[[nodiscard]] std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup, const CharacterSetup& character);
+/// A character's world: fields built, masks bound, solvers ready for the garments it wears,
+/// which collide with `guests`' bodies too. Used by `drape run`, `drape play SCENE` and
+/// `drape bench paper` alike.
+[[nodiscard]] std::unique_ptr<sim::CharacterWorld> buildWorld(const RunSetup& setup, const CharacterSetup& character,
+                                                              std::vector<sim::Guest> guests = {});
 /// Settles the world's garments before frame 0 for at most the character's settle_s
 /// (sim::CharacterWorld::settle) and logs what it did. Call after the colliders' settings,
 /// before the first frame. Throws drape::Error (Unstable) when a garment goes unstable.
@@ -263,10 +265,15 @@ void validateRunSetup(const RunSetup& setup);
 int simulateRun(const RunSetup& setup, const std::function<bool(long frame)>& gate = nullptr);
 
 /// Every character's world of a setup (buildWorld), and where each garment of the setup is
-/// simulated: `drape run`'s loop and `drape play SCENE`'s step them alike.
+/// simulated: `drape run`'s loop and `drape play SCENE`'s step them alike. Among several
+/// characters, each world's garments collide with the others' bodies too (sim::Guest): their
+/// fields are built and their motions kept apart first, so that every world sees each body
+/// where its own world moves it.
 class SetupWorlds {
  public:
   explicit SetupWorlds(const RunSetup& setup);
+  /// What keeping character c's parts apart changed in its motion (empty: nothing asked).
+  [[nodiscard]] const sim::KeepApartReport& keepApartReport(std::size_t c) const;
 
   /// Characters (and worlds), in the setup's order.
   [[nodiscard]] std::size_t size() const { return worlds_.size(); }
@@ -296,6 +303,11 @@ class SetupWorlds {
  private:
   std::vector<std::unique_ptr<sim::CharacterWorld>> worlds_;
   std::vector<std::string> names_;
+  /// Among several characters: each one's part fields and motion as played (kept apart
+  /// where asked, before the worlds, which then keep nothing apart themselves) and the report.
+  std::vector<std::shared_ptr<const std::vector<sim::PartField>>> fields_;
+  std::vector<std::unique_ptr<motion::AvatarAnimation>> keptApart_;
+  std::vector<sim::KeepApartReport> keepApartReports_;
   std::vector<std::pair<std::size_t, std::size_t>> place_;  ///< per garment: character, index in its world
 };
 

@@ -102,7 +102,7 @@ const RigidTransform& AvatarPoses::jointAt(double t_s, int jointIndex) const {
 
 CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::AvatarAnimation* animation,
                                std::vector<GarmentSpec> garments, const WorldSettings& settings,
-                               std::shared_ptr<const std::vector<PartField>> fields)
+                               std::shared_ptr<const std::vector<PartField>> fields, std::vector<Guest> guests)
     : avatar_(avatar), animation_(animation), settings_(settings) {
   settings_.step.validate();
   if (animation && animation->jointCount() != avatar.joints.size()) {
@@ -148,6 +148,23 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
       const bool faces = std::find(spec.faceSamplesWith.begin(), spec.faceSamplesWith.end(), (*fields_)[p].segment) !=
                          spec.faceSamplesWith.end();
       collisionParts.push_back({(*fields_)[p].segment, &(*fields_)[p].field, run.motions[static_cast<std::size_t>(p)], faces});
+    }
+    // The other characters' parts, after the avatar's own (whose indices the masks, face
+    // samples and pinches use), each moved by the garment's own cache of that character's
+    // poses. A part too far to reach costs a box test per collision test
+    // (FieldCollider::outOfReach).
+    for (const Guest& guest : guests) {
+      run.guestPoses.push_back(std::make_unique<AvatarPoses>(*guest.avatar, guest.animation, settings.leadIn_s));
+      for (const PartField& f : *guest.fields) {
+        if (f.field.shell_m() + 1e-12 < spec.offsets.t3_m) {
+          spdlog::warn("garment '{}': {}'s part {} keeps normals within {:.4f} m, less than its T3 {:.4f} m: it does not "
+                       "collide with it",
+                       spec.name, guest.name, f.segment, f.field.shell_m(), spec.offsets.t3_m);
+          continue;
+        }
+        collisionParts.push_back({guest.name + "/" + f.segment, &f.field,
+                                  std::make_shared<SegmentMotion>(*run.guestPoses.back(), f.joint), false});
+      }
     }
     run.collider = std::make_unique<cloth::FieldCollider>(spec.name, std::move(collisionParts), spec.offsets,
                                                           spec.material.staticFriction, spec.material.dynamicFriction,

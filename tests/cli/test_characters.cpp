@@ -7,12 +7,16 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
+#include "drape/formats/obj.hpp"
+#include "drape/formats/pc2.hpp"
 #include "drape/formats/run_manifest.hpp"
+#include "drape/mesh/surface_distance.hpp"
 
 namespace drape {
 namespace {
@@ -177,6 +181,53 @@ TEST(Characters, TwoCapturesMoveTheirCharactersAsEachMovesItsSceneAlone) {
               "--live: standard input (-) is one source; give the others theirs");
   expectError("run '" + kTwoCharacters + "' --live 'Ada=" + walk + "' --live Ada=-" + out,
               "--live Ada=-: Ada has a source already (" + walk + ")");
+}
+
+/// The deepest any vertex of the garment of run `garmentRun` goes into the parts `parts` (OBJ
+/// and PC2 stems) of run `bodyRun`, over every frame both have (m, signed: negative is inside).
+double deepestInto(const std::string& garmentRun, const std::string& garment, const std::string& bodyRun,
+                   const std::vector<std::string>& parts) {
+  const formats::Pc2Cache cloth = formats::readPc2(garmentRun + "/" + garment + ".pc2");
+  double deepest = std::numeric_limits<double>::infinity();
+  for (const std::string& part : parts) {
+    const mesh::TriMesh rest = formats::readObj(bodyRun + "/" + part + ".obj");
+    const formats::Pc2Cache moving = formats::readPc2(bodyRun + "/" + part + ".pc2");
+    for (std::size_t f = 0; f < std::min(cloth.frames.size(), moving.frames.size()); ++f) {
+      const mesh::SurfaceDistance body(moving.frames[f], rest.triangles);
+      for (const Vec3& p : cloth.frames[f]) deepest = std::min(deepest, body.at(p).distance_m);
+    }
+  }
+  return deepest;
+}
+
+TEST(Characters, ASkirtBrushingPastAnotherCharacterStaysOutOfHerLegs) {
+  // Bea stands two metres ahead of Ada and half a metre to her side, and Ada walks past her: alone
+  // in its scene, Ada's skirt sweeps through where Bea's legs stand; with Bea in the scene it
+  // collides with them too (sim::Guest), as with Ada's own.
+  ScratchDir dir("characters-contact");
+  std::string text = slurp(kTwoCharacters);
+  text.replace(text.find("translation 1.2 0 0"), 19, "translation 0.5 0 2");
+  // The files it names, from its own directory.
+  for (const std::string relative : {"\"../../data/", "\"../walking_skirt/"})
+    while (text.find(relative) != std::string::npos)
+      text.replace(text.find(relative), relative.size(),
+                   "\"" + std::string(DRAPE_SOURCE_DIR) + (relative[4] == '.' ? "/data/" : "/examples/walking_skirt/"));
+  const std::string scene = dir / "close.wrl";
+  std::ofstream(scene) << text;
+  const std::string walk = kSkirtDir + "/walk.bvh", frames = " --frames 130";
+  const std::string close = dir / "close", ada = dir / "ada";
+  const CliResult r =
+      runDrape("run '" + scene + "' --motion 'Ada=" + walk + "' --motion Bea=none" + frames + " --out '" + close + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_EQ(runDrape("run '" + kSkirtDir + "/scene.wrl' --motion '" + walk + "'" + frames + " --out '" + ada + "'", dir).code,
+            0);
+  const std::vector<std::string> beasLegs{"segments/Bea/LeftUpLeg", "segments/Bea/RightUpLeg", "segments/Bea/LeftLeg",
+                                          "segments/Bea/RightLeg", "segments/Bea/Hips"};
+  const double alone = deepestInto(ada, "garment", close, beasLegs);
+  const double together = deepestInto(close, "garment-Ada_skirt", close, beasLegs);
+  EXPECT_LT(alone, -0.005) << "Ada's skirt alone was to go into Bea's legs (15 mm deep on 2026-12-04)";
+  EXPECT_GT(together, 0.0) << "deepest " << together << " m into Bea's legs (on T2, 15 mm out, on 2026-12-04)";
+  EXPECT_EQ(statsOf(close)["vertex_substeps_inside_body"], 0);
 }
 
 TEST(Characters, MotionsAreGivenByNameAndWhatPlaysOneCharacterSaysSo) {

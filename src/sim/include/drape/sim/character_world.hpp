@@ -145,16 +145,29 @@ struct SettleReport {
   }
 };
 
+/// Another character of the scene, whose body a world's garments collide with too (two
+/// characters that touch): its avatar, the motion it plays (as its own world plays it, kept
+/// apart where it keeps parts apart; null: at rest) with the same lead-in, and its part
+/// fields, the parts its own garments collide with. Its parts are named "NAME/PART".
+struct Guest {
+  std::string name;
+  const scene::Avatar* avatar = nullptr;
+  const motion::AvatarAnimation* animation = nullptr;
+  std::shared_ptr<const std::vector<PartField>> fields;
+};
+
 class CharacterWorld {
  public:
   /// Builds the part fields, binds every garment's mask and establishes the initial
   /// collision states. `animation` may be null (the avatar stands in its rest pose).
   /// `fields`, when given, are the part fields buildPartFields built for the same avatar,
-  /// garments and settings (a cloth-server builds them once for all its takes).
-  /// Throws drape::Error on unknown segment names or unbindable mask vertices.
+  /// garments and settings (a cloth-server builds them once for all its takes). Each
+  /// garment also collides with the parts of `guests` (which, and what they point to, must
+  /// outlive the world) whose fields keep normals out to its T3; masks bind to the avatar's
+  /// own parts only. Throws drape::Error on unknown segment names or unbindable mask vertices.
   CharacterWorld(const scene::Avatar& avatar, const motion::AvatarAnimation* animation,
                  std::vector<GarmentSpec> garments, const WorldSettings& settings,
-                 std::shared_ptr<const std::vector<PartField>> fields = nullptr);
+                 std::shared_ptr<const std::vector<PartField>> fields = nullptr, std::vector<Guest> guests = {});
   ~CharacterWorld();
   CharacterWorld(const CharacterWorld&) = delete;
   CharacterWorld& operator=(const CharacterWorld&) = delete;
@@ -204,6 +217,7 @@ class CharacterWorld {
     GarmentSpec spec;
     std::unique_ptr<AvatarPoses> poses;  ///< its own pose cache: garments step in parallel
     std::vector<std::shared_ptr<const cloth::FixtureMotion>> motions;  ///< per field, from poses
+    std::vector<std::unique_ptr<AvatarPoses>> guestPoses;  ///< its own pose cache of each guest
     std::unique_ptr<cloth::FieldCollider> collider;
     std::unique_ptr<cloth::ClothSolver> solver;
   };

@@ -52,6 +52,13 @@ bool sameFile(const std::string& a, const std::string& b) {
   return fs::exists(a) && fs::exists(b) && slurp(a) == slurp(b);
 }
 
+/// `drape ARGS` must refuse its input (exit code 2) with `message` on standard error.
+void expectRefused(const std::string& args, const std::string& message, const ScratchDir& dir) {
+  const CliResult r = runDrape(args, dir);
+  EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
+  EXPECT_NE(r.err.find(message), std::string::npos) << args << "\n" << r.err;
+}
+
 TEST(Characters, EachCharacterOfTheSceneIsWhatItsSceneAloneMakesToTheByte) {
   ScratchDir dir("characters");
   const std::string both = dir / "both";
@@ -170,11 +177,7 @@ TEST(Characters, TwoCapturesMoveTheirCharactersAsEachMovesItsSceneAlone) {
   EXPECT_NE(one.out.find("live: "), std::string::npos) << one.out;
 
   const std::string out = " --out '" + (dir / "x") + "'";
-  const auto expectError = [&](const std::string& args, const std::string& message) {
-    const CliResult e = runDrape(args, dir);
-    EXPECT_EQ(e.code, 2) << args << "\n" << e.err;
-    EXPECT_NE(e.err.find(message), std::string::npos) << args << "\n" << e.err;
-  };
+  const auto expectError = [&](const std::string& args, const std::string& message) { expectRefused(args, message, dir); };
   expectError("run '" + kTwoCharacters + "' --live '" + walk + "'" + out,
               "--live " + walk + ": the scene has 2 characters (Ada, Bea): say which the capture moves, --live NAME=SOURCE");
   expectError("run '" + kTwoCharacters + "' --live Ada=- --live Bea=-" + out,
@@ -238,11 +241,7 @@ TEST(Characters, ASkirtBrushingPastAnotherCharacterStaysOutOfHerLegs) {
 TEST(Characters, MotionsAreGivenByNameAndWhatPlaysOneCharacterSaysSo) {
   ScratchDir dir("characters-errors");
   const std::string out = " --out '" + (dir / "x") + "'";
-  const auto expectError = [&](const std::string& args, const std::string& message) {
-    const CliResult r = runDrape(args, dir);
-    EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
-    EXPECT_NE(r.err.find(message), std::string::npos) << args << "\n" << r.err;
-  };
+  const auto expectError = [&](const std::string& args, const std::string& message) { expectRefused(args, message, dir); };
   expectError("run '" + kTwoCharacters + "' --motion 'Carl=" + kDelfem2Walk + "'" + out,
               "--motion Carl=" + kDelfem2Walk + ": the scene has no character called 'Carl' (it has: Ada, Bea)");
   expectError("run '" + kTwoCharacters + "' --motion 'Ada=" + kDelfem2Walk + "' --motion 'Ada=none'" + out,

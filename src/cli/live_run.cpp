@@ -64,38 +64,24 @@ bool LiveRun::admit(long frame) {
   return frame <= studio::clothFramesOf(motionFrames(), frameRate_, leadIn_s_, motionRate);
 }
 
-}  // namespace drape::cli
-
-namespace drape::cli {
-
 std::vector<std::pair<std::size_t, std::string>> liveSources(const RunSetup& setup,
                                                              const std::vector<std::string>& options) {
   std::vector<std::pair<std::size_t, std::string>> out;
   for (const std::string& option : options) {
-    // NAME=SOURCE where NAME is one of the scene's characters; else the whole is the source.
-    const auto eq = option.find('=');
-    std::optional<std::size_t> named;
-    if (eq != std::string::npos)
-      for (std::size_t c = 0; c < setup.characters.size(); ++c)
-        if (setup.characters[c].name == option.substr(0, eq)) named = c;
+    const std::optional<std::pair<std::size_t, std::string>> named = forCharacter(setup, option, "--live");
     if (!named) {
-      if (setup.characters.size() > 1) {
-        std::vector<std::string> names;
-        for (const CharacterSetup& c : setup.characters) names.push_back(c.name);
+      if (setup.characters.size() > 1)
         throw Error(fmt::format("--live {}: the scene has {} characters ({}): say which the capture moves, --live "
                                 "NAME=SOURCE",
-                                option, setup.characters.size(), fmt::join(names, ", ")));
-      }
+                                option, setup.characters.size(), characterNames(setup)));
       if (!out.empty()) throw Error(fmt::format("--live {}: the scene's one character has a source already", option));
       out.emplace_back(0, option);
       continue;
     }
     for (const auto& [c, source] : out)
-      if (c == *named)
+      if (c == named->first)
         throw Error(fmt::format("--live {}: {} has a source already ({})", option, setup.characters[c].name, source));
-    const std::string source = option.substr(eq + 1);
-    if (source.empty()) throw Error(fmt::format("--live {}: expected NAME=SOURCE", option));
-    out.emplace_back(*named, source);
+    out.push_back(*named);
   }
   const auto stdins = std::count_if(out.begin(), out.end(), [](const auto& s) { return s.second == "-"; });
   if (stdins > 1) throw Error("--live: standard input (-) is one source; give the others theirs");

@@ -239,15 +239,20 @@ TimeCode frameTimeCode(const RunSetup& setup, long frame) {
   return studio::clothTimeCode(frame, TimeCode{motionStart.frame, rate}, first.leadIn_s);
 }
 
-namespace {
-
-std::string characterList(const RunSetup& setup) {
+std::string characterNames(const RunSetup& setup) {
   std::vector<std::string> names;
   for (const CharacterSetup& c : setup.characters) names.push_back(c.name);
   return fmt::format("{}", fmt::join(names, ", "));
 }
 
-}  // namespace
+std::optional<std::pair<std::size_t, std::string>> forCharacter(const RunSetup& setup, const std::string& value,
+                                                                const std::string& option) {
+  const auto eq = value.find('=');
+  if (eq == std::string::npos || eq == 0 || std::filesystem::exists(value)) return std::nullopt;
+  const CharacterSetup& c = characterNamed(setup, value.substr(0, eq), option + " " + value);
+  if (eq + 1 == value.size()) throw Error(fmt::format("{} {}: expected NAME=VALUE after the name", option, value));
+  return std::pair{static_cast<std::size_t>(&c - setup.characters.data()), value.substr(eq + 1)};
+}
 
 CharacterSetup* oneCharacter(RunSetup& setup, const std::string& what) {
   return const_cast<CharacterSetup*>(oneCharacter(std::as_const(setup), what));
@@ -256,7 +261,7 @@ CharacterSetup* oneCharacter(RunSetup& setup, const std::string& what) {
 const CharacterSetup* oneCharacter(const RunSetup& setup, const std::string& what) {
   if (setup.characters.size() > 1)
     throw Error(fmt::format("{} plays one character; the scene has {} ({})", what, setup.characters.size(),
-                            characterList(setup)));
+                            characterNames(setup)));
   return setup.characters.empty() ? nullptr : &setup.characters.front();
 }
 
@@ -264,8 +269,8 @@ CharacterSetup* chooseCharacter(RunSetup& setup, const std::string& name, const 
   if (setup.characters.empty()) return nullptr;
   if (name.empty()) {
     if (setup.characters.size() > 1)
-      throw Error(fmt::format("the scene has {} characters ({}): say which this one plays, {} NAME",
-                              setup.characters.size(), characterList(setup), option));
+      throw Error(fmt::format("the scene has {} characters ({}), and a studio role plays one: give {} NAME",
+                              setup.characters.size(), characterNames(setup), option));
     return &setup.characters.front();
   }
   const CharacterSetup& chosen = characterNamed(setup, name, option + " " + name);
@@ -274,11 +279,11 @@ CharacterSetup* chooseCharacter(RunSetup& setup, const std::string& name, const 
   return &setup.characters.front();
 }
 
-CharacterSetup& characterNamed(RunSetup& setup, const std::string& name, const std::string& option) {
-  for (CharacterSetup& c : setup.characters)
+const CharacterSetup& characterNamed(const RunSetup& setup, const std::string& name, const std::string& option) {
+  for (const CharacterSetup& c : setup.characters)
     if (c.name == name) return c;
   throw Error(fmt::format("{}: the scene has no character called '{}' (it has: {})", option, name,
-                          setup.characters.empty() ? std::string("none") : characterList(setup)));
+                          setup.characters.empty() ? std::string("none") : characterNames(setup)));
 }
 
 void keepGarmentsWhere(RunSetup& setup, const std::function<bool(std::size_t garment)>& keep) {
@@ -464,14 +469,11 @@ void addSceneMotions(RunSetup& setup, const std::string& scenePath, const std::v
   std::vector<std::uint8_t> named(setup.characters.size(), 0);
   bool forAllGiven = false;
   for (const std::string& m : motions) {
-    const auto eq = m.find('=');
-    if (eq != std::string::npos && eq > 0 && !std::filesystem::exists(m)) {
-      CharacterSetup& c = characterNamed(setup, m.substr(0, eq), "--motion " + m);
-      const auto i = static_cast<std::size_t>(&c - setup.characters.data());
-      if (named[i]) throw Error(fmt::format("--motion {}: '{}' is given a motion twice", m, c.name));
+    if (const auto named_ = forCharacter(setup, m, "--motion")) {
+      const auto [i, file] = *named_;
+      if (named[i]) throw Error(fmt::format("--motion {}: '{}' is given a motion twice", m, setup.characters[i].name));
       named[i] = 1;
-      given[i] = m.substr(eq + 1);
-      if (given[i].empty()) throw Error(fmt::format("--motion {}: expected NAME=FILE (or NAME=none)", m));
+      given[i] = file;
       continue;
     }
     if (forAllGiven) throw Error(fmt::format("--motion {}: a motion for every character is given already ('{}'); name "

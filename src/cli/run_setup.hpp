@@ -115,9 +115,19 @@ struct RunSetup {
 /// `option` when none is called so, or the scene has several and `name` is empty; null when
 /// the scene has no character.
 CharacterSetup* chooseCharacter(RunSetup& setup, const std::string& name, const std::string& option);
+/// The setup's characters' names, "Ada, Bea", for messages.
+[[nodiscard]] std::string characterNames(const RunSetup& setup);
+/// A per-character option's value, NAME=VALUE (`--motion`, `--live`): the index of the
+/// character the scene calls NAME, and VALUE; none when `value` names no one (it has no
+/// '=' after its first character, or a file of its whole name exists). Throws drape::Error
+/// naming `option` for a NAME the scene does not have, or an empty VALUE.
+[[nodiscard]] std::optional<std::pair<std::size_t, std::string>> forCharacter(const RunSetup& setup,
+                                                                            const std::string& value,
+                                                                            const std::string& option);
 /// The character named `name` ("NAME", as --motion NAME=FILE gives it); throws drape::Error
 /// listing the setup's characters when none is called so.
-[[nodiscard]] CharacterSetup& characterNamed(RunSetup& setup, const std::string& name, const std::string& option);
+[[nodiscard]] const CharacterSetup& characterNamed(const RunSetup& setup, const std::string& name,
+                                                   const std::string& option);
 /// Leaves out the garments `keep` refuses (by index into setup.garments), and the characters
 /// left wearing none; the others' garment indices follow.
 void keepGarmentsWhere(RunSetup& setup, const std::function<bool(std::size_t garment)>& keep);

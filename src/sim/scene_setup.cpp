@@ -101,14 +101,18 @@ GarmentSpec garmentSpec(const scene::Scene& scene, const scene::Garment& g, cons
   return spec;
 }
 
+/// A URL of the scene's, as a path: absolute as it is, else from the scene's directory.
+std::string resolved(const scene::Scene& scene, const std::string& url) {
+  const std::filesystem::path p(url);
+  return p.is_absolute() ? url : (std::filesystem::path(scene.source).parent_path() / p).lexically_normal().string();
+}
+
 /// An Avatar node's file, loaded, placed and cut as the node says.
 std::unique_ptr<scene::Avatar> loadExternal(const scene::Scene& scene, const scene::ExternalAvatar& ext) {
   if (ext.urls.empty()) throw Error(fmt::format("{}: Avatar '{}' has no url", ext.source.str(), ext.name));
   std::string lastError;
-  const std::filesystem::path base = std::filesystem::path(scene.source).parent_path();
   for (const std::string& url : ext.urls) {
-    const std::filesystem::path p(url);
-    const std::string path = p.is_absolute() ? url : (base / p).lexically_normal().string();
+    const std::string path = resolved(scene, url);
     try {
       auto avatar = std::make_unique<scene::Avatar>(scene::loadAvatarFile(path));
       place(*avatar, ext.placement, ext.scale);
@@ -124,13 +128,9 @@ std::unique_ptr<scene::Avatar> loadExternal(const scene::Scene& scene, const sce
 /// The first of an Avatar node's motion URLs that is a file, resolved against the scene's
 /// directory; "" when it names none. Throws drape::Error at the node when none exists.
 std::string motionFile(const scene::Scene& scene, const scene::ExternalAvatar& ext) {
+  for (const std::string& url : ext.motion)
+    if (const std::string path = resolved(scene, url); std::filesystem::is_regular_file(path)) return path;
   if (ext.motion.empty()) return "";
-  const std::filesystem::path base = std::filesystem::path(scene.source).parent_path();
-  for (const std::string& url : ext.motion) {
-    const std::filesystem::path p(url);
-    const std::string path = p.is_absolute() ? url : (base / p).lexically_normal().string();
-    if (std::filesystem::is_regular_file(path)) return path;
-  }
   throw Error::at(ext.source, fmt::format("Avatar {}: motion: no such file ({})", ext.name, fmt::join(ext.motion, ", ")));
 }
 

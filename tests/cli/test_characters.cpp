@@ -253,7 +253,7 @@ TEST(Characters, MotionsAreGivenByNameAndWhatPlaysOneCharacterSaysSo) {
               "day.egml:14: Play: the scene has 2 characters (Ada, Bea): say which it moves (character \"NAME\", here "
               "or on an event above it)");
   expectError("anim-server '" + kTwoCharacters + "' --server nats://127.0.0.1:1 --give-up 1",
-              "the scene has 2 characters (Ada, Bea): say which this one plays, --character NAME");
+              "the scene has 2 characters (Ada, Bea), and a studio role plays one: give --character NAME");
   expectError("anim-server '" + kTwoCharacters + "' --character Carl --server nats://127.0.0.1:1 --give-up 1",
               "--character Carl: the scene has no character called 'Carl' (it has: Ada, Bea)");
 

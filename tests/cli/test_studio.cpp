@@ -229,7 +229,7 @@ TEST(Studio, TwoCharactersEachOnServersOfItsOwnAreDrapeRunsToTheByte) {
       << wrong.err;
   const CliResult which = runDrape("cloth-server '" + scene + "' --name which --takes 1" + roles(server), dir);
   EXPECT_EQ(which.code, 2) << which.err;
-  EXPECT_NE(which.err.find("the scene has 2 characters (Ada, Bea): say which this one plays, --character NAME"),
+  EXPECT_NE(which.err.find("the scene has 2 characters (Ada, Bea), and a studio role plays one: give --character NAME"),
             std::string::npos)
       << which.err;
 }

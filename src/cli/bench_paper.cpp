@@ -54,6 +54,7 @@ struct PaperBenchOptions {
   std::optional<std::vector<std::string>> keepApart;  // parts kept out of the others, instead of the scene's
   bool noRestingBalls = false;  // every pair inside a part's volume goes through the per-pair test
   std::optional<std::vector<std::string>> faceSamplesWith;  // set: overrides the scene's
+  std::optional<double> selfCollision_m;                    // set: overrides the scene's
   bool json = false;
 };
 
@@ -66,6 +67,8 @@ struct PaperRun {
   int collisionEvery = 1;
   int bendEvery = 1;
   cloth::FieldCollisionCounters counters;
+  cloth::SelfCounters self;  ///< the garments' self collision, summed
+  double selfThickness_m = 0;  ///< the largest
   std::size_t triangles = 0;
   int substeps = 0;
   double fieldBuildSeconds = 0;
@@ -97,6 +100,8 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
   if (o.bendEvery > 0) setup.settings.bendEvery = o.bendEvery;
   if (o.faceSamplesWith)
     for (GarmentSetup& g : setup.garments) g.faceSamplesWith = *o.faceSamplesWith;
+  if (o.selfCollision_m)
+    for (GarmentSetup& g : setup.garments) g.selfCollision_m = *o.selfCollision_m;
   if (o.keepApart) setKeepApart(*character, *o.keepApart);
   addMotion(setup, *character, o.motion);
   const std::unique_ptr<sim::CharacterWorld> worldPtr = buildWorld(setup, *character);
@@ -144,6 +149,13 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
     r.colliderPoseSeconds += world.collider(g)->poseSeconds();
     r.poseSeconds += world.collider(g)->poseSeconds() + t.fixturePoses_s;
     r.counters += world.collider(g)->fieldCounters();
+    if (const cloth::SelfCollider* self = world.selfCollider(g)) {
+      r.self.tests += self->selfCounters().tests;
+      r.self.candidates += self->selfCounters().candidates;
+      r.self.contacts += self->selfCounters().contacts;
+      r.self.crossings += self->selfCounters().crossings;
+      r.selfThickness_m = std::max(r.selfThickness_m, self->thickness_m());
+    }
     r.framesRefined += world.solver(g).refinedFrames();
   }
   return r;
@@ -185,6 +197,12 @@ RunFunction setupPaperBench(CLI::App& app) {
          "Body parts against which the triangles' centroids collide too, overriding the scene's "
          "faceSamplesWith; 'none' for none")
       ->delimiter(',');
+  app.add_option_function<double>(
+         "--self-collision", [](double m) { o.selfCollision_m = m; },
+         "Keep each garment's own layers this many m apart, overriding the scene's selfCollision (0: none); its "
+         "time counts in the collision's")
+      ->type_name("M")
+      ->check(CLI::NonNegativeNumber);
   app.add_flag("--json", o.json, "Print JSON (the only format)");
   return [] {
     const int threads = benchThreads();
@@ -242,6 +260,9 @@ RunFunction setupPaperBench(CLI::App& app) {
     j["vertex_tests_pinched"] = r.counters.pinchedVertexTests;
     j["face_tests"] = r.counters.faceTests;
     j["face_contacts"] = r.counters.faceContacts;
+    j["self_collision_m"] = r.selfThickness_m;  // 0: none (its time is in the collision's)
+    j["self_collision_contacts"] = r.self.contacts;
+    j["self_collision_crossings"] = r.self.crossings;
     j["vertex_substeps"] = penetration.vertexSubsteps;  // free vertices x substeps: all of them
     j["vertex_substeps_inside_body"] = penetration.vertexSubstepsInsideBody;
     j["vertex_substeps_below_T1_fraction"] =

@@ -54,6 +54,7 @@ struct MakeSceneOptions {
   int bendEvery = 0;  ///< --bend-every, or 0: chosen by makeScene from the garment
   int collisionEvery = 1;  ///< --collision-every
   double bindThreshold_m = 0.04;
+  double selfCollision_m = 0.0;  ///< --self-collision: the ClothSet's selfCollision (0: none)
   double stitchGaps_m = 0.0;  ///< --stitch-gaps: sew boundary vertices facing each other within this, m (0: none)
   StitchPairs stitches;        ///< found from stitchGaps_m
   cloth::Material material = knit();
@@ -161,6 +162,7 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
                  i + 1 < o.stitches.size() ? "," : "");
     fmt::print(os, "\n  ]\n");
   }
+  if (o.selfCollision_m > 0) fmt::print(os, "  selfCollision {:g}\n", o.selfCollision_m);
   fmt::print(os, "  maskTolerance 0.0005\n  bindThreshold {:.3f}\n}}\n", o.bindThreshold_m);
   if (!os) throw Error(fmt::format("{}: cannot be written", path));
 }
@@ -268,6 +270,11 @@ RunFunction setupMakeScene(CLI::App& app) {
                  "Of the collidable segments, those the garment's triangle centroids collide with too, not only "
                  "its vertices (where its triangles are large against the segment's curvature)")
       ->delimiter(',');
+  app.add_option("--self-collision", o.selfCollision_m,
+                 "Keep the garment's own layers this many m apart, written as its selfCollision (default 0: they "
+                 "pass through one another)")
+      ->type_name("M")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--keep-apart", o.keepApart,
                  "Body parts whose motion is corrected to keep them out of the collidable parts they go into, "
                  "written as the scene's keepApart (e.g. LeftForeArm,RightForeArm,LeftArm,RightArm)")

@@ -44,6 +44,7 @@ struct RunOptions {
   double motionScale = 0.0, voxel_m = 0.0, leadIn_s = 1.0, settle_s = 1.0;
   bool preview = false, countEverySubstep = false, exactSliding = false, freePinches = false, noStitches = false;
   double stitchGaps_m = 0.0;  ///< --stitch-gaps
+  double selfCollision_m = 0.0;  ///< --self-collision
   std::vector<std::string> faceSamplesWith, keepApart, cutAtJoints;
   std::string events;                       ///< --events: an EGML event graph instead of --motion
   std::vector<std::string> lives;           ///< --live SOURCE, or NAME=SOURCE per character: captures as they come
@@ -166,7 +167,8 @@ std::vector<cloth::Stitch> stitchesAcrossGaps(const GarmentSetup& g, double gap_
   return stitches;
 }
 
-/// --collision-every, --face-samples-with, --no-stitches and --stitch-gaps for every garment (a scene's or --garment's).
+/// --collision-every, --face-samples-with, --self-collision, --no-stitches and --stitch-gaps for every garment (a
+/// scene's or --garment's).
 void applyCollisionOptions(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   const bool faces = app.count("--face-samples-with") > 0;
   const std::vector<std::string> faceParts = facePartsOption(o.faceSamplesWith);
@@ -176,6 +178,7 @@ void applyCollisionOptions(const CLI::App& app, const RunOptions& o, RunSetup& s
   for (GarmentSetup& g : setup.garments) {
     if (app.count("--collision-every")) g.collisionEvery = o.collisionEvery;
     if (faces) g.faceSamplesWith = faceParts;
+    if (app.count("--self-collision")) g.selfCollision_m = o.selfCollision_m;
     if (o.noStitches) g.stitches.clear();
     if (app.count("--stitch-gaps")) g.stitches = stitchesAcrossGaps(g, o.stitchGaps_m);
   }
@@ -472,6 +475,11 @@ RunFunction setupRun(CLI::App& app) {
                  "vertices, overriding the scene's faceSamplesWith (e.g. LeftUpLeg,RightUpLeg): the parts no "
                  "longer bulge through triangles that are large against their curvature; 'none' for none")
       ->delimiter(',');
+  app.add_option("--self-collision", o->selfCollision_m,
+                 "Keep each garment's own layers this many m apart (a skirt folding between the legs, a jacket's "
+                 "hem over its skirt), overriding the scene's selfCollision; 0: they pass through each other")
+      ->type_name("M")
+      ->check(CLI::NonNegativeNumber);
   auto* unsewn = app.add_flag("--no-stitches", o->noStitches,
                               "Leave the scene's stitches out: the openings they sew shut (a jacket's fronts) hang free");
   app.add_option("--stitch-gaps", o->stitchGaps_m,

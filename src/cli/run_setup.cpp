@@ -15,6 +15,7 @@
 
 #include "drape/cloth/forces.hpp"
 #include "drape/cloth/model.hpp"
+#include "drape/cloth/self_collider.hpp"
 #include "drape/cloth/solver.hpp"
 #include "drape/core/error.hpp"
 #include "drape/core/files.hpp"
@@ -90,6 +91,8 @@ struct GarmentRun {
   std::unique_ptr<cloth::ClothSolver> ownedSolver;  ///< without a character
   cloth::ClothSolver* solver = nullptr;             ///< owned here or by the character world
   const cloth::FieldCollider* collider = nullptr;   ///< on a character
+  std::unique_ptr<cloth::SelfCollider> ownedSelf;   ///< without a character
+  const cloth::SelfCollider* self = nullptr;        ///< its layers kept apart, or null
   std::vector<cloth::SphereCollider> spheres;       ///< its own static spheres (--sphere)
 };
 
@@ -901,13 +904,24 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
       collider->setContactPlanes(!setup.exactSliding);
       collider->setPinchHold(!setup.freePinches);
       logEasedPairs(g.name, *collider);
+      r.self = worlds.world(worlds.characterOf(gi)).selfCollider(worlds.indexInWorld(gi));
     } else {
       const mesh::Topology topology = mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
       auto model = cloth::ClothModel::build(g.mesh, topology, g.material, settings.massScaling());
       r.ownedSolver = std::make_unique<cloth::ClothSolver>(model, settings, pinsOf(g, *model));
       r.ownedSolver->setStitches(g.stitches, g.name);
       r.solver = r.ownedSolver.get();
+      if (g.selfCollision_m > 0) {  // before the spheres: where they disagree, a sphere wins
+        r.ownedSelf = std::make_unique<cloth::SelfCollider>(*model, g.name, g.selfCollision_m, g.collisionEvery);
+        r.ownedSelf->setFixedVertices(g.pinned);
+        r.ownedSelf->setStitches(g.stitches);
+        r.ownedSolver->addCollider(*r.ownedSelf);
+        r.self = r.ownedSelf.get();
+      }
     }
+    if (r.self)
+      spdlog::info("{}: its layers kept {:.4g} mm apart (self collision, tested every {} substeps)", g.name,
+                   1e3 * r.self->thickness_m(), r.self->every());
     r.model = &r.solver->model();
     // Each garment its own spheres: garments step in parallel, and a collider keeps counts.
     r.spheres.reserve(setup.spheres.size());  // the solver keeps references
@@ -1100,6 +1114,15 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
       for (const cloth::CollisionPart& p : runs[g].collider->parts())
         if (p.faceSamples) faces.push_back(p.name);
       entry["face_samples_with"] = faces;
+    }
+    if (const cloth::SelfCollider* self = runs[g].self) {
+      const cloth::SelfCounters& s = self->selfCounters();
+      entry["self_collision"] = {{"thickness_m", self->thickness_m()},
+                                 {"tests", s.tests},
+                                 {"candidate_pairs", s.candidates},
+                                 {"candidate_lists_made", s.rebuilds},
+                                 {"contacts", s.contacts},
+                                 {"crossings", s.crossings}};
     }
     garments.push_back(std::move(entry));
   }

@@ -294,6 +294,7 @@ class SetupWorlds {
 
   /// The character that wears garment g of the setup, and the garment in its world.
   [[nodiscard]] std::size_t characterOf(std::size_t g) const { return place_[g].first; }
+  [[nodiscard]] std::size_t indexInWorld(std::size_t g) const { return place_[g].second; }
   [[nodiscard]] cloth::ClothSolver& solver(std::size_t g) { return worlds_[place_[g].first]->mutableSolver(place_[g].second); }
   [[nodiscard]] const cloth::ClothSolver& solver(std::size_t g) const {
     return worlds_[place_[g].first]->solver(place_[g].second);

@@ -136,7 +136,7 @@ struct RunWriter::Impl {
                         several ? "drape run: " + who + "'s skinned body (m)" : "drape run: the avatar's skinned body (m)");
       files.skinCache =
           std::make_unique<formats::Pc2Writer>((out / (stem + ".pc2")).string(), files.skinPositions.size(), 0.0, 1.0);
-      manifest.meshes.push_back({"body", "skin", stem + ".obj", stem + ".pc2", "", who});
+      manifest.meshes.push_back({"body", "skin", stem + ".obj", stem + ".pc2", "", who, std::nullopt});
     }
     for (const scene::Segment& seg : avatar.segments) {
       SegmentFiles sf;
@@ -149,7 +149,7 @@ struct RunWriter::Impl {
       formats::writeObj((out / (sf.fileStem + ".obj")).string(), rest, seg.mesh.triangles,
                         "drape run: body part " + seg.name + (several ? " of " + who : "") + " (m)");
       sf.cache = std::make_unique<formats::Pc2Writer>((out / (sf.fileStem + ".pc2")).string(), rest.size(), 0.0, 1.0);
-      manifest.meshes.push_back({seg.name, "segment", sf.fileStem + ".obj", sf.fileStem + ".pc2", "", who});
+      manifest.meshes.push_back({seg.name, "segment", sf.fileStem + ".obj", sf.fileStem + ".pc2", "", who, std::nullopt});
       files.segments.push_back(std::move(sf));
     }
     return files;

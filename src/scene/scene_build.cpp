@@ -426,6 +426,11 @@ class Builder {
     if (!(g.bindThreshold >= 0.0))
       throw Error::at(where(n, "bindThreshold"),
                       fmt::format("ClothSet {}: bindThreshold {:g} m is negative", g.name, g.bindThreshold));
+    g.selfCollision = number(n, "selfCollision", g.selfCollision);
+    if (!(g.selfCollision >= 0.0) || !std::isfinite(g.selfCollision))
+      throw Error::at(where(n, "selfCollision"),
+                      fmt::format("ClothSet {}: selfCollision {:g} m: expected a thickness, 0 (none) or more", g.name,
+                                  g.selfCollision));
     g.collidesWith = strings(n, "collidesWith");
     g.faceSamplesWith = strings(n, "faceSamplesWith");
     for (const std::string& s : g.faceSamplesWith)

@@ -175,6 +175,14 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
     run.solver = std::make_unique<cloth::ClothSolver>(model, settings_.step, std::move(pins));
     run.solver->setStitches(spec.stitches, spec.name);
     run.collider->initialise(run.solver->state(), 0.0);
+    // Its layers apart first, then the body: where the two disagree, the body wins.
+    if (spec.selfCollision_m > 0) {
+      run.self = std::make_unique<cloth::SelfCollider>(*model, spec.name, spec.selfCollision_m, spec.collisionEvery);
+      run.self->setFixedVertices(fixed);
+      run.self->setStitches(spec.stitches);
+      run.self->initialise(run.solver->state());
+      run.solver->addCollider(*run.self);
+    }
     run.solver->addCollider(*run.collider);
     run.spec = std::move(spec);
     garments_.push_back(std::move(run));

@@ -84,6 +84,7 @@ GarmentSpec garmentSpec(const scene::Scene& scene, const scene::Garment& g, cons
   if (g.material >= 0) spec.material = toClothMaterial(scene.materials[static_cast<std::size_t>(g.material)]);
   spec.bindThreshold_m = g.bindThreshold;
   spec.stitches = cloth::stitchesDrawnTogether(g.stitches);
+  spec.selfCollision_m = g.selfCollision;
   if (avatar) {
     spec.bound = g.maskVertices;
     spec.collidesWith = g.collidesWith;

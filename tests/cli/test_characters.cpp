@@ -105,7 +105,9 @@ TEST(Characters, EachCharacterOfTheSceneIsWhatItsSceneAloneMakesToTheByte) {
   int skins = 0, segments = 0;
   for (const formats::RunMesh& m : manifest.meshes) {
     EXPECT_TRUE(m.character == "Ada" || m.character == "Bea") << m.name;
-    if (m.role == "garment") EXPECT_EQ(m.name, m.character + " skirt");
+    if (m.role == "garment") {
+      EXPECT_EQ(m.name, m.character + " skirt");
+    }
     skins += m.role == "skin";
     segments += m.role == "segment";
   }

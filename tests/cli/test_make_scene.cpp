@@ -59,7 +59,7 @@ TEST(MakeScene, DressOnTheWalkingBody) {
                                                   "--name dress --offsets 0.002,0.004,0.006,0.016 --collides-with "
                                                   "Hips,LowerBack,Spine,Spine1,Neck,LeftShoulder,RightShoulder,"
                                                   "LeftArm,RightArm,LeftUpLeg,RightUpLeg --face-samples-with "
-                                                  "LeftUpLeg,RightUpLeg --keep-apart LeftForeArm,RightForeArm",
+                                                  "LeftUpLeg,RightUpLeg --keep-apart LeftForeArm,RightForeArm --self-collision 0.003",
                                                   sceneDir),
                                    dir);
   ASSERT_EQ(made.code, 0) << made.err;
@@ -71,6 +71,7 @@ TEST(MakeScene, DressOnTheWalkingBody) {
   EXPECT_EQ(sc.garments[0].maskVertices.size(), 222u);
   EXPECT_EQ(sc.garments[0].faceSamplesWith, (std::vector<std::string>{"LeftUpLeg", "RightUpLeg"}));
   EXPECT_EQ(sc.simulation.keepApart, (std::vector<std::string>{"LeftForeArm", "RightForeArm"}));
+  EXPECT_NEAR(sc.garments[0].selfCollision, 0.003, 1e-9);
   ASSERT_EQ(sc.externalAvatars.size(), 1u);
   EXPECT_TRUE(sc.externalAvatars[0].cutAtJoints.empty());
   EXPECT_GT(sc.simulation.stepsPerFrame, 33) << "the dress's slivers need more substeps than the skirt";
@@ -78,7 +79,7 @@ TEST(MakeScene, DressOnTheWalkingBody) {
 
   const std::string out = dir / "out";
   const CliResult ran = runDrape("run '" + sceneDir + "/scene.wrl' --motion '" + kSource +
-                                     "/examples/walking_skirt/walk.bvh' --lead-in 0.2 --frames 3 --out '" + out + "'",
+                                     "/examples/walking_skirt/walk.bvh' --lead-in 0.2 --frames 3 --self-collision 0 --out '" + out + "'",
                                  dir);
   ASSERT_EQ(ran.code, 0) << ran.err;
   const nlohmann::json stats = statsOf(out);
@@ -89,6 +90,7 @@ TEST(MakeScene, DressOnTheWalkingBody) {
   EXPECT_GT(g["added_mass_kg"].get<double>(), 0.0);
   EXPECT_LT(g["added_mass_kg"].get<double>(), 0.02 * g["mass_kg"].get<double>());
   EXPECT_EQ(g["face_samples_with"], nlohmann::json({"LeftUpLeg", "RightUpLeg"}));
+  EXPECT_FALSE(g.contains("self_collision")) << "--self-collision 0 overrides the scene's";
   // 'none' takes the scene's face samples away.
   const std::string plain = dir / "plain";
   const CliResult none = runDrape("run '" + sceneDir + "/scene.wrl' --motion '" + kSource +

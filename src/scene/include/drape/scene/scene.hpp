@@ -78,6 +78,9 @@ struct Garment {
   double bindThreshold = 0.02;              ///< m, farthest a mask vertex binds to a body part
   std::vector<std::string> collidesWith;    ///< segment names; empty: every segment
   std::vector<std::string> faceSamplesWith;  ///< of those, where triangle centroids collide too
+  /// m: how far apart the garment's own layers keep (cloth::SelfCollider); 0: they pass
+  /// through one another, as in the paper.
+  double selfCollision = 0.0;
   /// Pairs of cloth vertices sewn together (a closure the mesh leaves open): each pair is
   /// drawn to one point and held there. Indices into `mesh`, two different ones, in range.
   std::vector<std::array<std::uint32_t, 2>> stitches;

@@ -20,6 +20,7 @@
 
 #include "drape/cloth/field_collider.hpp"
 #include "drape/cloth/material.hpp"
+#include "drape/cloth/self_collider.hpp"
 #include "drape/cloth/solver.hpp"
 #include "drape/field/distance_field.hpp"
 #include "drape/mesh/trimesh.hpp"
@@ -44,6 +45,8 @@ struct GarmentSpec {
   cloth::OffsetSurfaces offsets;            ///< used when offsetsGiven, else from the voxel size
   bool offsetsGiven = false;
   int collisionEvery = 1;                   ///< collision tests every k substeps
+  /// How far apart its own layers keep (cloth::SelfCollider, tested with the body); 0: none.
+  double selfCollision_m = 0.0;
   /// For display only: the scene's colour of the cloth (sRGB, 0 to 1), or none.
   std::optional<Vec3> colour;
 };
@@ -196,6 +199,8 @@ class CharacterWorld {
   [[nodiscard]] cloth::ClothSolver& mutableSolver(std::size_t g) { return *garments_[g].solver; }
   [[nodiscard]] const cloth::FieldCollider* collider(std::size_t g) const { return garments_[g].collider.get(); }
   [[nodiscard]] cloth::FieldCollider* collider(std::size_t g) { return garments_[g].collider.get(); }
+  /// The garment's self collision, or null when its layers may pass through each other.
+  [[nodiscard]] const cloth::SelfCollider* selfCollider(std::size_t g) const { return garments_[g].self.get(); }
   [[nodiscard]] const std::vector<PartField>& fields() const { return *fields_; }
   [[nodiscard]] const AvatarPoses& poses() const { return *poses_; }
   /// The garment whose step failed and why, after stepFrame returned false.
@@ -219,6 +224,7 @@ class CharacterWorld {
     std::vector<std::shared_ptr<const cloth::FixtureMotion>> motions;  ///< per field, from poses
     std::vector<std::unique_ptr<AvatarPoses>> guestPoses;  ///< its own pose cache of each guest
     std::unique_ptr<cloth::FieldCollider> collider;
+    std::unique_ptr<cloth::SelfCollider> self;  ///< null: its layers pass through each other
     std::unique_ptr<cloth::ClothSolver> solver;
   };
   void buildFields(const std::vector<GarmentSpec>& garments, std::shared_ptr<const std::vector<PartField>> given);

@@ -1,0 +1,164 @@
+#pragma once
+// Self collision: a garment's layers kept apart (beyond the paper, which collides cloth with
+// the body only). A skirt folding between the legs, a jacket's hem over its skirt, a sleeve
+// against the side: without it one layer passes through the other.
+//
+// Vertex against face, with a thickness h. At each test (every k substeps, as the body's
+// collision) the candidate pairs are checked: every (vertex, triangle) pair that could come
+// within h while no vertex moves more than a margin m / 2 (m = 2 h) from where the list was
+// made, the garment's common motion left out (a walk carries the whole skirt along without
+// changing a distance). The list is made again when a vertex has moved farther: each
+// triangle's box over the interval, grown by h + m, against the vertices' boxes in a hashed
+// uniform grid (arrays sized once). A pair is a contact when the
+// vertex ends within h of the triangle's face (its projection inside the triangle) on the
+// side it was on at the last test, or has crossed to the other side since. Contacts are
+// resolved in three Jacobi sweeps (every pair's push summed per vertex, then averaged, so the
+// result does not depend on the order): the vertex and the triangle's corners move apart
+// along the face normal to h, shared by inverse mass and barycentric weight (the corners a
+// fixture moves count as infinitely heavy); then the pair loses its approaching normal
+// velocity and, by Coulomb friction with the material's coefficients, up to mu times that
+// of its sliding velocity.
+//
+// Left out: edge against edge (two edges crossing with no vertex over a face: rare at cloth
+// resolutions, where the neighbouring vertex-face pairs catch the layers first), and garment
+// against garment (each garment steps on its own, in parallel).
+// docs/PHYSICS.md says what each means for a scene.
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "drape/cloth/collider.hpp"
+#include "drape/cloth/strain_limit.hpp"
+#include "drape/core/math.hpp"
+
+namespace drape::cloth {
+
+/// A vertex within the thickness of a triangle's face, or through it.
+struct SelfContact {
+  std::uint32_t vertex = 0;
+  std::uint32_t triangle = 0;
+  /// +1 or -1: the side of the face (along its normal) the vertex keeps to: the one it was
+  /// on at the last test.
+  double side = 1.0;
+  bool crossed = false;             ///< it ended on the other side
+  /// Barycentric weights of its projection on the face (crossed: of where it went through).
+  std::array<double, 3> weights{};
+};
+
+/// The narrow test of one pair: vertex p moving p0 -> p1 while the triangle moves t0 -> t1
+/// (its corners). A contact when p1 lies less than `thickness` from the face on the side p0
+/// was on and projects inside the triangle; or when p1 is on the other side (crossed) and,
+/// where its distance to the plane (taken as linear over the interval) was zero, it lay in
+/// the triangle as it was then. None for a degenerate triangle.
+[[nodiscard]] std::optional<SelfContact> selfContact(const Vec3& p0, const Vec3& p1, const std::array<Vec3, 3>& t0,
+                                                     const std::array<Vec3, 3>& t1, double thickness);
+
+/// What the self collision did so far (accumulated over calls).
+struct SelfCounters {
+  std::uint64_t tests = 0;       ///< substeps it tested
+  std::uint64_t candidates = 0;  ///< (vertex, triangle) pairs whose boxes met
+  std::uint64_t contacts = 0;    ///< pairs within the thickness or crossed, resolved
+  std::uint64_t crossings = 0;   ///< of those, crossed
+  std::uint64_t rebuilds = 0;    ///< tests that made the candidate list again
+};
+
+class SelfCollider final : public Collider {
+ public:
+  /// Keeps `model`'s layers `thickness_m` apart, testing every `every` substeps. A vertex
+  /// is never tested against the triangles around it or around its neighbours (those lie
+  /// on the same sheet). Throws drape::Error naming `garment` for a thickness <= 0.
+  SelfCollider(const ClothModel& model, std::string garment, double thickness_m, int every = 1);
+
+  /// Vertices a fixture moves after the colliders: infinitely heavy here.
+  void setFixedVertices(const std::vector<std::uint32_t>& vertices);
+  /// Stitched vertices are one point of the cloth: neither is tested against the triangles
+  /// around the other (which a stitch holds it among).
+  void setStitches(const std::vector<Stitch>& stitches);
+  /// Where the garment starts (the sides of its first test): its rest shape unless given.
+  void initialise(const ClothState& state);
+
+  [[nodiscard]] std::string name() const override { return "self"; }
+  void collide(const ClothModel& model, double t0_s, double t1_s, ClothState& io) override;
+  [[nodiscard]] ColliderCounters counters() const override { return counters_; }
+  [[nodiscard]] const SelfCounters& selfCounters() const { return self_; }
+  void beginFrame() override;
+  void restartFrame(const ClothState& state, double t_s) override;
+
+  [[nodiscard]] double thickness_m() const { return thickness_; }
+  [[nodiscard]] int every() const { return every_; }
+  /// Whether the pair is never tested (the triangle has v, or a neighbour of v, as a corner;
+  /// stitched vertices are neighbours).
+  [[nodiscard]] bool excluded(std::uint32_t vertex, std::uint32_t triangle) const;
+  /// Whether anything of the pair can move (not all four held by fixtures, which keep them
+  /// as the garment was modelled): pairs that cannot are never tested.
+  [[nodiscard]] bool movable(std::uint32_t vertex, std::uint32_t triangle) const;
+  /// The contacts between positions `before` (the last test's) and `after`, as a test finds
+  /// them (by vertex, then triangle), without resolving them.
+  const std::vector<SelfContact>& findContacts(const ClothState& before, const ClothState& after);
+  /// The contacts of the next test at positions `now`, as collide() finds them (from the
+  /// candidate list, kept or made again), without resolving them; `now` is then the last
+  /// test's.
+  const std::vector<SelfContact>& nextContacts(const ClothState& now);
+
+ private:
+  void remember(const ClothState& state);
+  /// The neighbour lists (sorted and made unique here) as the CSR arrays.
+  void setNeighbours(std::vector<std::vector<std::uint32_t>>& around);
+  void buildGrid(const ClothState& after);
+  /// The pairs whose vertex's box meets its triangle's box over the interval grown by `grow`.
+  void gatherPairs(const ClothState& after, double grow);
+  /// The candidate pairs' contacts.
+  void narrow(const ClothState& after);
+  [[nodiscard]] static Vec3 meanPosition(const std::vector<double>& x, const std::vector<double>& y,
+                                         const std::vector<double>& z);
+  /// Whether the candidate list still holds for the interval from the last test to `now`.
+  [[nodiscard]] bool pairsHold(const ClothState& now) const;
+  void updatePairs(const ClothState& now);
+  void resolvePositions(ClothState& io);
+  void resolveVelocities(ClothState& io);
+  void clearPushes();
+  /// Adds the contact's push, `lambda` along its normal per unit of inverse mass, to its
+  /// vertex and (by weight) to its triangle's corners.
+  void pushApart(const SelfContact& c, const std::array<double, 4>& im, const Vec3& lambda);
+  /// Moves every pushed vertex's (x, y, z) by the average of its pushes.
+  void applyPushes(std::vector<double>& x, std::vector<double>& y, std::vector<double>& z) const;
+  /// The inverse masses of the contact's vertex and corners, and their weighted sum.
+  [[nodiscard]] double pairWeight(const SelfContact& c, std::array<double, 4>& im) const;
+  [[nodiscard]] std::uint32_t bucketOf(std::int64_t ix, std::int64_t iy, std::int64_t iz) const;
+  /// Calls visit(bucket) for every cell the box [lo, hi] touches.
+  template <typename Visit>
+  void forCells(const double* lo, const double* hi, Visit&& visit) const;
+
+  std::string garment_;
+  double thickness_;
+  int every_;
+  double staticFriction_, dynamicFriction_;  ///< the material's, layer on layer as on the body
+  double cell_m_;  ///< edge of a grid cell
+  std::vector<std::array<std::uint32_t, 3>> triangles_;
+  std::vector<std::uint32_t> neighbourStart_, neighbours_;  ///< per vertex (CSR), sorted
+  std::vector<double> inverseMass_;                         ///< 0 for the fixed vertices
+  std::vector<double> lastX_, lastY_, lastZ_;               ///< positions at the last test
+  bool remembered_ = false;
+  // The grid: per bucket (a hash of the cell) the vertices whose boxes touch a cell of it.
+  std::vector<double> vertexLo_, vertexHi_;  ///< per vertex, xyz: its box over the interval
+  std::vector<std::uint32_t> bucketStart_, bucketFill_, entries_;
+  std::uint32_t bucketMask_ = 0;
+  std::vector<std::uint32_t> seen_;  ///< per vertex: the triangle (+1) that met it last
+  // The candidate list and where the vertices were when it was made.
+  double margin_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;  ///< (vertex, triangle), sorted
+  std::vector<double> builtX_, builtY_, builtZ_;
+  Vec3 builtMean_ = Vec3::Zero();
+  bool pairsBuilt_ = false;
+  std::vector<SelfContact> contacts_;
+  std::vector<double> pushX_, pushY_, pushZ_;  ///< per vertex, summed over a sweep's contacts
+  std::vector<std::uint32_t> pushes_;
+  std::uint64_t calls_ = 0;
+  ColliderCounters counters_, frameStartCounters_;
+  SelfCounters self_, frameStartSelf_;
+};
+
+}  // namespace drape::cloth

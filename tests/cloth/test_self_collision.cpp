@@ -1,0 +1,335 @@
+// Self collision (cloth/self_collider.hpp): the grid finds the pairs brute force finds, a
+// layer dropped on another comes to rest one thickness above it, and a folded strip does
+// not pass through itself; without the collider the same layers pass through.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <set>
+#include <tuple>
+
+#include <fmt/format.h>
+
+#include "cloth_fixture.hpp"
+#include "drape/cloth/self_collider.hpp"
+
+namespace drape::cloth {
+namespace self_collision_test {
+
+using testing::knit;
+using testing::makeModel;
+using testing::pinAt;
+using testing::run;
+using testing::settingsWithStep;
+
+/// `b`'s vertices and triangles appended to `a`'s.
+mesh::TriMesh joined(mesh::TriMesh a, const mesh::TriMesh& b) {
+  const auto offset = static_cast<std::uint32_t>(a.positions.size());
+  a.positions.insert(a.positions.end(), b.positions.begin(), b.positions.end());
+  for (mesh::Triangle t : b.triangles) a.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  return a;
+}
+
+/// A sheet of `cells` x `cells` in the xz plane, folded in two across x = 0: the half with
+/// u > 0.5 lies back over the other, `gap` above it, each point moved by up to `noise`.
+mesh::TriMesh foldedSheet(int cells, double gap, double noise, std::mt19937& random) {
+  SheetSpec spec{1.0, 0.5, cells, cells / 2, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), "folded"};
+  mesh::TriMesh m = irregularSheet(spec, 0.3, random());
+  std::uniform_real_distribution<double> jitter(-noise, noise);
+  for (Vec3& p : m.positions) {
+    const double u = p.x();
+    p = Vec3(u < 0.5 ? u : 1.0 - u, u < 0.5 ? 0.0 : gap, p.z()) + Vec3(jitter(random), jitter(random), jitter(random));
+  }
+  return m;
+}
+
+ClothState statesAt(const mesh::TriMesh& m) {
+  ClothState s;
+  for (const Vec3& p : m.positions) {
+    s.x.push_back(p.x());
+    s.y.push_back(p.y());
+    s.z.push_back(p.z());
+  }
+  s.vx.assign(s.x.size(), 0.0);
+  s.vy = s.vz = s.vx;
+  return s;
+}
+
+/// The pairs brute force finds between `s0` and `s1` of mesh `m`, as the set the tests compare.
+std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> bruteContacts(const SelfCollider& collider,
+                                                                               const mesh::TriMesh& m, const ClothState& s0,
+                                                                               const ClothState& s1, double thickness) {
+  std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> out;
+  for (std::uint32_t v = 0; v < m.positions.size(); ++v)
+    for (std::uint32_t t = 0; t < m.triangles.size(); ++t) {
+      if (collider.excluded(v, t) || !collider.movable(v, t)) continue;
+      const mesh::Triangle& tri = m.triangles[t];
+      const std::array<Vec3, 3> t0{s0.position(tri[0]), s0.position(tri[1]), s0.position(tri[2])};
+      const std::array<Vec3, 3> t1{s1.position(tri[0]), s1.position(tri[1]), s1.position(tri[2])};
+      if (auto c = selfContact(s0.position(v), s1.position(v), t0, t1, thickness)) out.insert({v, t, c->side, c->crossed});
+    }
+  return out;
+}
+
+TEST(SelfCollision, TheGridFindsWhatBruteForceFinds) {
+  std::mt19937 random(7);
+  std::size_t total = 0, crossed = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const int cells = 8 + 2 * static_cast<int>(unit(random) * 5);
+    const double cell = 1.0 / cells, thickness = cell * (0.1 + 0.5 * unit(random));
+    const mesh::TriMesh before = foldedSheet(cells, thickness * 2.0 * unit(random), 0.2 * thickness, random);
+    mesh::TriMesh after = before;
+    std::uniform_real_distribution<double> move(-0.4 * thickness, 0.4 * thickness);
+    for (Vec3& p : after.positions) p += Vec3(move(random), move(random), move(random));
+    const auto model = makeModel(before, knit());
+    SelfCollider collider(*model, "folded", thickness);
+    const ClothState s0 = statesAt(before), s1 = statesAt(after);
+
+    std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> grid;
+    for (const SelfContact& c : collider.findContacts(s0, s1)) grid.insert({c.vertex, c.triangle, c.side, c.crossed});
+    const auto brute = bruteContacts(collider, before, s0, s1, thickness);
+    std::string missing, extra;
+    for (const auto& c : brute)
+      if (!grid.count(c)) missing += fmt::format(" ({}, {})", std::get<0>(c), std::get<1>(c));
+    for (const auto& c : grid)
+      if (!brute.count(c)) extra += fmt::format(" ({}, {})", std::get<0>(c), std::get<1>(c));
+    EXPECT_TRUE(missing.empty() && extra.empty()) << "trial " << trial << ": " << cells << " cells, thickness "
+                                                  << thickness << "; missed:" << missing << "; extra:" << extra;
+    total += brute.size();
+    for (const auto& c : brute) crossed += std::get<3>(c);
+  }
+  // Enough contacts of both kinds that a wrong grid could not pass.
+  EXPECT_GT(total, 1000u);
+  EXPECT_GT(crossed, 50u);
+}
+
+TEST(SelfCollision, TheListKeptBetweenTestsFindsWhatBruteForceFinds) {
+  // A folded sheet carried along (a walk's common motion, which keeps the list) while its
+  // points wander (which, past half the margin, makes it again), test after test.
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const int cells = 12;
+  const double thickness = 0.3 / cells;
+  const mesh::TriMesh rest = foldedSheet(cells, thickness, 0.2 * thickness, random);
+  const auto model = makeModel(rest, knit());
+  SelfCollider collider(*model, "folded", thickness);
+  ClothState before = statesAt(rest), now = before;
+  collider.initialise(before);
+  std::size_t total = 0;
+  for (int test = 0; test < 120; ++test) {
+    const Vec3 carried(0.02 * unit(random), 0.01 * unit(random), -0.015 * unit(random));
+    const double wander = (test % 10 == 9 ? 1.5 : 0.12) * thickness;
+    for (std::size_t v = 0; v < now.size(); ++v)
+      now.setPosition(v, now.position(v) + carried + wander * Vec3(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5));
+    std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> kept;
+    for (const SelfContact& c : collider.nextContacts(now)) kept.insert({c.vertex, c.triangle, c.side, c.crossed});
+    const auto brute = bruteContacts(collider, rest, before, now, thickness);
+    EXPECT_EQ(kept, brute) << "test " << test;
+    total += brute.size();
+    before = now;
+  }
+  EXPECT_GT(total, 1000u);
+  // The list was kept over most tests and made again when the points had wandered.
+  EXPECT_GE(collider.selfCounters().rebuilds, 10u);
+  EXPECT_LT(collider.selfCounters().rebuilds, 60u);
+}
+
+TEST(SelfCollision, ExcludesTheTrianglesAroundAVertexAndItsNeighbours) {
+  SheetSpec spec{0.8, 0.8, 8, 8, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), "sheet"};
+  const auto model = makeModel(gridSheet(spec), knit());
+  SelfCollider collider(*model, "sheet", 0.01);
+  const std::uint32_t centre = sheetVertex(spec, 4, 4);
+  std::size_t kept = 0;
+  for (std::uint32_t t = 0; t < model->triangleCount(); ++t) {
+    bool near = false;
+    for (std::uint32_t c : model->triangles()[t])
+      for (int di = -1; di <= 1; ++di)
+        for (int dj = -1; dj <= 1; ++dj) near |= c == sheetVertex(spec, 4 + di, 4 + dj);
+    // Every triangle with a corner in the centre's 3 x 3 block touches its one-ring, and
+    // those are exactly the excluded ones (the grid's diagonals alternate).
+    if (!collider.excluded(centre, t)) {
+      ++kept;
+      for (std::uint32_t c : model->triangles()[t]) EXPECT_NE(c, centre);
+    }
+    if (!near) {
+      EXPECT_FALSE(collider.excluded(centre, t)) << "triangle " << t;
+    }
+  }
+  EXPECT_GT(kept, 0u);
+}
+
+TEST(SelfCollision, ANarrowTestSaysWhichSideAndWhetherItCrossed) {
+  const std::array<Vec3, 3> tri{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 0, 1)};  // normal -y
+  const double h = 0.01;
+  // Above (on -normal's side), coming within h: a contact on side -1, not crossed.
+  auto c = selfContact(Vec3(0.2, 0.05, 0.2), Vec3(0.2, 0.005, 0.2), tri, tri, h);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->side, -1.0);
+  EXPECT_FALSE(c->crossed);
+  EXPECT_NEAR(c->weights[0], 0.6, 1e-12);
+  EXPECT_NEAR(c->weights[1], 0.2, 1e-12);
+  EXPECT_NEAR(c->weights[2], 0.2, 1e-12);
+  // Through it: crossed, still side -1.
+  c = selfContact(Vec3(0.2, 0.005, 0.2), Vec3(0.2, -0.02, 0.2), tri, tri, h);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->side, -1.0);
+  EXPECT_TRUE(c->crossed);
+  // Farther than h, or beside the triangle: none.
+  EXPECT_FALSE(selfContact(Vec3(0.2, 0.05, 0.2), Vec3(0.2, 0.02, 0.2), tri, tri, h));
+  EXPECT_FALSE(selfContact(Vec3(0.8, 0.05, 0.8), Vec3(0.8, 0.0, 0.8), tri, tri, h));
+  // Staying on the other side, far below: none (another layer, not a crossing).
+  EXPECT_FALSE(selfContact(Vec3(0.2, -0.05, 0.2), Vec3(0.2, -0.04, 0.2), tri, tri, h));
+}
+
+/// Two squares in one garment: a lower one held flat at y = 0 and a smaller free one `drop`
+/// above it, falling for `seconds`. The upper square's lowest and highest vertex heights.
+std::pair<double, double> dropLayer(double thickness, double seconds, bool selfCollision) {
+  SheetSpec lower{0.4, 0.4, 10, 10, Vec3(-0.2, 0, -0.2), Vec3::UnitX(), Vec3::UnitZ(), "lower"};
+  SheetSpec upper{0.3, 0.3, 9, 9, Vec3(-0.15, 0.03, -0.15), Vec3::UnitX(), Vec3::UnitZ(), "upper"};
+  const mesh::TriMesh m = joined(irregularSheet(lower, 0.3, 3), irregularSheet(upper, 0.3, 4));
+  Material mat = knit();
+  mat.damping_s = 1e-4;
+  const auto model = makeModel(m, mat);
+  std::vector<std::uint32_t> held(121);
+  for (std::uint32_t v = 0; v < 121; ++v) held[v] = v;
+  const StepSettings settings = settingsWithStep(0.5 * model->estimatedStableStep_s(), 0.02);
+  ClothSolver solver(model, settings, {pinAt(*model, held)});
+  SelfCollider collider(*model, "layers", thickness);
+  collider.setFixedVertices(held);
+  if (selfCollision) solver.addCollider(collider);
+  EXPECT_TRUE(run(solver, static_cast<long>(seconds / settings.substep_s())));
+  double lo = 1e9, hi = -1e9;
+  for (std::size_t v = 121; v < m.positions.size(); ++v) {
+    lo = std::min(lo, solver.state().y[v]);
+    hi = std::max(hi, solver.state().y[v]);
+  }
+  if (selfCollision) {
+    EXPECT_GT(collider.selfCounters().contacts, 0u);
+  }
+  return {lo, hi};
+}
+
+TEST(SelfCollision, ALayerDroppedOnAnotherRestsOneThicknessAboveIt) {
+  const double h = 0.004;
+  const auto [lo, hi] = dropLayer(h, 0.8, true);
+  // Resting on the lower layer: every vertex within a tenth of h of h above it (gravity
+  // draws it down by g dt^2 between tests, the collider lifts it back to h).
+  EXPECT_NEAR(lo, h, 0.1 * h);
+  EXPECT_NEAR(hi, h, 0.1 * h);
+  // Without the collider the same layer falls through (0.03 m in 0.08 s; 0.8 s: ~3 m).
+  const auto [loFree, hiFree] = dropLayer(h, 0.8, false);
+  EXPECT_LT(hiFree, -1.0);
+}
+
+/// A strip bent in a U: its lower leg (0.4 m) held flat at y = 0, the fold a half circle of
+/// radius 15 mm at x = 0.4, the upper leg (0.25 m) free, coming back over the lower. After
+/// 0.3 s (it lands at about 0.1 s), the lowest height of the upper leg's vertices 5 cm or
+/// more from the fold.
+double foldedStripGap(double thickness, bool selfCollision, std::uint64_t& crossings) {
+  const double legs = 0.4, upper = 0.25, radius = 0.015, arc = M_PI * radius, length = legs + arc + upper;
+  SheetSpec spec{length, 0.1, 60, 6, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), "strip"};
+  mesh::TriMesh m = gridSheet(spec);
+  std::vector<std::uint32_t> held;
+  for (std::uint32_t v = 0; v < m.positions.size(); ++v) {
+    Vec3& p = m.positions[v];
+    const double s = p.x();
+    if (s <= legs) {
+      held.push_back(v);
+    } else if (s <= legs + arc) {
+      const double a = (s - legs) / radius;
+      p = Vec3(legs + radius * std::sin(a), radius * (1 - std::cos(a)), p.z());
+    } else {
+      p = Vec3(legs - (s - legs - arc), 2 * radius, p.z());
+    }
+  }
+  Material mat = knit();
+  mat.damping_s = 1e-4;
+  const auto model = makeModel(m, mat);
+  const StepSettings settings = settingsWithStep(0.5 * model->estimatedStableStep_s(), 0.02);
+  ClothSolver solver(model, settings, {pinAt(*model, held)});
+  SelfCollider collider(*model, "strip", thickness);
+  collider.setFixedVertices(held);
+  if (selfCollision) solver.addCollider(collider);
+  EXPECT_TRUE(run(solver, static_cast<long>(0.3 / settings.substep_s())));
+  crossings = collider.selfCounters().crossings;
+  double gap = 1e9;
+  for (std::size_t v = 0; v < m.positions.size(); ++v)
+    if (model->restX()[v] < legs - 0.05 && model->restY()[v] > radius) {
+      gap = std::min(gap, solver.state().y[v]);
+      if (selfCollision) {
+        EXPECT_GT(solver.state().x[v], 0.0);  // still over the lower leg
+      }
+    }
+  return gap;
+}
+
+TEST(SelfCollision, AFoldedStripDoesNotPassThroughItself) {
+  const double h = 0.004;
+  std::uint64_t crossings = 0;
+  // The upper leg sags onto the lower one and rests a thickness above it.
+  const double gap = foldedStripGap(h, true, crossings);
+  EXPECT_GT(gap, 0.9 * h);
+  EXPECT_LT(gap, 1.1 * h);
+  EXPECT_EQ(crossings, 0u);
+  // Without: the upper leg goes through the lower one.
+  EXPECT_LT(foldedStripGap(h, false, crossings), -0.05);
+}
+
+/// A 0.1 m square resting one thickness above a held 0.4 m one, sliding along x at 0.5 m/s
+/// from t = 0: its mean x velocity at `times`.
+std::vector<double> slidingSpeeds(const std::vector<double>& times, double mu) {
+  const double h = 0.004;
+  SheetSpec lower{0.4, 0.4, 10, 10, Vec3(-0.2, 0, -0.2), Vec3::UnitX(), Vec3::UnitZ(), "lower"};
+  SheetSpec upper{0.1, 0.1, 3, 3, Vec3(-0.15, h, -0.05), Vec3::UnitX(), Vec3::UnitZ(), "upper"};
+  const mesh::TriMesh m = joined(irregularSheet(lower, 0.3, 3), gridSheet(upper));
+  Material mat = knit();
+  mat.staticFriction = 2 * mu;
+  mat.dynamicFriction = mu;
+  const auto model = makeModel(m, mat);
+  std::vector<std::uint32_t> held(121);
+  for (std::uint32_t v = 0; v < 121; ++v) held[v] = v;
+  const StepSettings settings = settingsWithStep(0.5 * model->estimatedStableStep_s());
+  ClothSolver solver(model, settings, {pinAt(*model, held)});
+  SelfCollider collider(*model, "layers", h);
+  collider.setFixedVertices(held);
+  solver.addCollider(collider);
+  for (std::size_t v = 121; v < m.positions.size(); ++v) solver.mutableState().vx[v] = 0.5;
+  std::vector<double> speeds;
+  const double dt = settings.substep_s();
+  long k = 0;
+  for (const double t : times) {
+    for (; static_cast<double>(k) * dt < t; ++k)
+      EXPECT_TRUE(solver.substep(static_cast<double>(k) * dt, k / settings.substepsPerFrame + 1,
+                                 static_cast<int>(k % settings.substepsPerFrame)));
+    double sum = 0;
+    for (std::size_t v = 121; v < m.positions.size(); ++v) sum += solver.state().vx[v] * model->mass()[v];
+    double mass = 0;
+    for (std::size_t v = 121; v < m.positions.size(); ++v) mass += model->mass()[v];
+    speeds.push_back(sum / mass);
+  }
+  return speeds;
+}
+
+TEST(SelfCollision, ALayerSlidingOnAnotherDeceleratesAtMuG) {
+  for (const double mu : {0.2, 0.4}) {
+    const std::vector<double> v = slidingSpeeds({0.02, 0.08}, mu);
+    const double deceleration = (v[0] - v[1]) / 0.06;
+    EXPECT_NEAR(deceleration, mu * 9.81, 0.05 * mu * 9.81) << "mu " << mu;
+  }
+}
+
+TEST(SelfCollision, AThicknessMustBePositive) {
+  SheetSpec spec{0.4, 0.4, 2, 2, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), "sheet"};
+  const auto model = makeModel(gridSheet(spec), knit());
+  try {
+    SelfCollider collider(*model, "skirt", 0.0);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("garment 'skirt': self-collision thickness 0 m"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace self_collision_test
+}  // namespace drape::cloth

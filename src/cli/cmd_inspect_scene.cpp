@@ -68,6 +68,8 @@ void printGarment(std::ostream& out, const scene::Scene& s, const scene::Garment
       g.collidesWith.empty() ? std::string("every segment") : fmt::format("{}", fmt::join(g.collidesWith, ", ")));
   if (!g.faceSamplesWith.empty())
     fmt::print(out, "    triangle centroids collide too with {}\n", fmt::join(g.faceSamplesWith, ", "));
+  if (g.selfCollision > 0)
+    fmt::print(out, "    its own layers kept {:.4g} mm apart (selfCollision)\n", 1e3 * g.selfCollision);
   if (!g.stitches.empty())
     fmt::print(out, "    {} stitches, drawing together vertices up to {:.1f} mm apart\n", g.stitches.size(),
                1e3 * widestStitch_m(g.mesh, g.stitches));

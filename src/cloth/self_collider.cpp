@@ -71,8 +71,8 @@ std::optional<SelfContact> selfContact(const Vec3& p0, const Vec3& p1, const std
     // the point must lie in the triangle as it was then.
     const double s = side * d0 / std::sqrt(n0.squaredNorm() > 0 ? n0.squaredNorm() : area2);
     const double e = d1 / std::sqrt(area2);
-    const double at = s / (s - e);
-    const auto mix = [at](const Vec3& a, const Vec3& b) -> Vec3 { return a + at * (b - a); };
+    const double when = s / (s - e);
+    const auto mix = [when](const Vec3& a, const Vec3& b) -> Vec3 { return a + when * (b - a); };
     weights = barycentric(mix(p0, p1), {mix(t0[0], t1[0]), mix(t0[1], t1[1]), mix(t0[2], t1[2])});
   }
   if (!weights) return std::nullopt;
@@ -87,7 +87,8 @@ SelfCollider::SelfCollider(const ClothModel& model, std::string garment, double 
       staticFriction_(model.material().staticFriction),
       dynamicFriction_(model.material().dynamicFriction) {
   if (!(thickness_m > 0) || !std::isfinite(thickness_m))
-    throw Error(fmt::format("garment '{}': self-collision thickness {} m must be a positive length", garment_, thickness_m));
+    throw Error(
+        fmt::format("garment '{}': self-collision thickness {} m must be a positive length", garment_, thickness_m));
   const std::size_t n = model.vertexCount(), m = model.triangleCount();
   triangles_.assign(model.triangles().begin(), model.triangles().end());
   // Neighbours (CSR) and the mean edge length, from the triangles' edges.
@@ -98,7 +99,8 @@ SelfCollider::SelfCollider(const ClothModel& model, std::string garment, double 
       const std::uint32_t a = t[e], b = t[(e + 1) % 3];
       around[a].push_back(b);
       around[b].push_back(a);
-      edges += (at(model.restX(), model.restY(), model.restZ(), a) - at(model.restX(), model.restY(), model.restZ(), b)).norm();
+      edges += (at(model.restX(), model.restY(), model.restZ(), a) - at(model.restX(), model.restY(), model.restZ(), b))
+                   .norm();
     }
   setNeighbours(around);
   // Cells as wide as a triangle's box grown by h + m on each side (an edge and a little
@@ -136,7 +138,8 @@ void SelfCollider::setStitches(const std::vector<Stitch>& stitches) {
   // other's neighbours as its own.
   const std::size_t n = neighbourStart_.size() - 1;
   std::vector<std::vector<std::uint32_t>> around(n);
-  for (std::size_t v = 0; v < n; ++v) around[v].assign(neighbours_.begin() + neighbourStart_[v], neighbours_.begin() + neighbourStart_[v + 1]);
+  for (std::size_t v = 0; v < n; ++v)
+    around[v].assign(neighbours_.begin() + neighbourStart_[v], neighbours_.begin() + neighbourStart_[v + 1]);
   const std::vector<std::vector<std::uint32_t>> edges = around;
   for (const Stitch& s : stitches) {
     if (s.a >= n || s.b >= n) continue;
@@ -165,7 +168,8 @@ void SelfCollider::setNeighbours(std::vector<std::vector<std::uint32_t>>& around
 void SelfCollider::initialise(const ClothState& state) { remember(state); }
 
 bool SelfCollider::excluded(std::uint32_t vertex, std::uint32_t triangle) const {
-  const auto first = neighbours_.begin() + neighbourStart_[vertex], last = neighbours_.begin() + neighbourStart_[vertex + 1];
+  const auto first = neighbours_.begin() + neighbourStart_[vertex],
+             last = neighbours_.begin() + neighbourStart_[vertex + 1];
   for (const std::uint32_t corner : triangles_[triangle])
     if (corner == vertex || std::binary_search(first, last, corner)) return true;
   return false;
@@ -203,9 +207,12 @@ std::uint32_t SelfCollider::bucketOf(std::int64_t ix, std::int64_t iy, std::int6
 template <typename Visit>
 void SelfCollider::forCells(const double* lo, const double* hi, Visit&& visit) const {
   const double inv = 1.0 / cell_m_;
-  const auto x0 = static_cast<std::int64_t>(std::floor(lo[0] * inv)), x1 = static_cast<std::int64_t>(std::floor(hi[0] * inv));
-  const auto y0 = static_cast<std::int64_t>(std::floor(lo[1] * inv)), y1 = static_cast<std::int64_t>(std::floor(hi[1] * inv));
-  const auto z0 = static_cast<std::int64_t>(std::floor(lo[2] * inv)), z1 = static_cast<std::int64_t>(std::floor(hi[2] * inv));
+  const auto x0 = static_cast<std::int64_t>(std::floor(lo[0] * inv)),
+             x1 = static_cast<std::int64_t>(std::floor(hi[0] * inv));
+  const auto y0 = static_cast<std::int64_t>(std::floor(lo[1] * inv)),
+             y1 = static_cast<std::int64_t>(std::floor(hi[1] * inv));
+  const auto z0 = static_cast<std::int64_t>(std::floor(lo[2] * inv)),
+             z1 = static_cast<std::int64_t>(std::floor(hi[2] * inv));
   for (std::int64_t ix = x0; ix <= x1; ++ix)
     for (std::int64_t iy = y0; iy <= y1; ++iy)
       for (std::int64_t iz = z0; iz <= z1; ++iz) visit(bucketOf(ix, iy, iz));
@@ -254,8 +261,8 @@ void SelfCollider::gatherPairs(const ClothState& after, double grow) {
         seen_[v] = t + 1;
         const double* vlo = &vertexLo_[3 * v];
         const double* vhi = &vertexHi_[3 * v];
-        const bool apart = vlo[0] > hi[0] || vhi[0] < lo[0] || vlo[1] > hi[1] || vhi[1] < lo[1] || vlo[2] > hi[2] ||
-                           vhi[2] < lo[2];
+        const bool apart =
+            vlo[0] > hi[0] || vhi[0] < lo[0] || vlo[1] > hi[1] || vhi[1] < lo[1] || vlo[2] > hi[2] || vhi[2] < lo[2];
         if (!apart && !excluded(v, t) && movable(v, t)) pairs_.push_back({v, t});
       }
     });
@@ -271,7 +278,8 @@ void SelfCollider::narrow(const ClothState& after) {
     const std::array<Vec3, 3> t0{at(lastX_, lastY_, lastZ_, c[0]), at(lastX_, lastY_, lastZ_, c[1]),
                                  at(lastX_, lastY_, lastZ_, c[2])};
     const std::array<Vec3, 3> t1{after.position(c[0]), after.position(c[1]), after.position(c[2])};
-    if (std::optional<SelfContact> contact = selfContact(at(lastX_, lastY_, lastZ_, v), after.position(v), t0, t1, thickness_)) {
+    if (std::optional<SelfContact> contact =
+            selfContact(at(lastX_, lastY_, lastZ_, v), after.position(v), t0, t1, thickness_)) {
       contact->vertex = v;
       contact->triangle = t;
       contacts_.push_back(*contact);
@@ -279,7 +287,8 @@ void SelfCollider::narrow(const ClothState& after) {
   }
 }
 
-Vec3 SelfCollider::meanPosition(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& z) {
+Vec3 SelfCollider::meanPosition(const std::vector<double>& x, const std::vector<double>& y,
+                                const std::vector<double>& z) {
   double sx = 0, sy = 0, sz = 0;
   for (std::size_t v = 0; v < x.size(); ++v) {
     sx += x[v];
@@ -297,7 +306,8 @@ bool SelfCollider::pairsHold(const ClothState& now) const {
     const Vec3 shift = mean - builtMean_;
     const double reach2 = 0.25 * margin_ * margin_;
     for (std::size_t v = 0; v < now.size(); ++v) {
-      const double dx = x[v] - builtX_[v] - shift.x(), dy = y[v] - builtY_[v] - shift.y(), dz = z[v] - builtZ_[v] - shift.z();
+      const double dx = x[v] - builtX_[v] - shift.x(), dy = y[v] - builtY_[v] - shift.y(),
+                   dz = z[v] - builtZ_[v] - shift.z();
       if (dx * dx + dy * dy + dz * dz > reach2) return false;
     }
     return true;
@@ -412,8 +422,8 @@ void SelfCollider::resolveVelocities(ClothState& io) {
     const auto& tri = triangles_[c.triangle];
     const Vec3 n = c.side * unitNormal({io.position(tri[0]), io.position(tri[1]), io.position(tri[2])});
     if (n.isZero()) continue;
-    const Vec3 vq = c.weights[0] * io.velocity(tri[0]) + c.weights[1] * io.velocity(tri[1]) +
-                    c.weights[2] * io.velocity(tri[2]);
+    const Vec3 vq =
+        c.weights[0] * io.velocity(tri[0]) + c.weights[1] * io.velocity(tri[1]) + c.weights[2] * io.velocity(tri[2]);
     const Vec3 relative = io.velocity(c.vertex) - vq;
     const double approach = relative.dot(n);
     if (approach >= 0) continue;
@@ -423,7 +433,9 @@ void SelfCollider::resolveVelocities(ClothState& io) {
     const Vec3 sliding = relative - approach * n;
     const double speed = sliding.norm(), removed = -approach;
     Vec3 change = removed * n;
-    if (speed > 0) change -= (speed <= staticFriction_ * removed ? 1.0 : std::min(1.0, dynamicFriction_ * removed / speed)) * sliding;
+    if (speed > 0)
+      change -=
+          (speed <= staticFriction_ * removed ? 1.0 : std::min(1.0, dynamicFriction_ * removed / speed)) * sliding;
     pushApart(c, im, change / w);
     any = true;
   }

@@ -71,9 +71,7 @@ std::vector<double> upperHeights(const std::string& objPath) {
 
 TEST(RunLayers, ASceneKeepsItsLayersOneThicknessApartAndSaysSo) {
   const ScratchDir dir("run-layers");
-  {
-    std::ofstream(dir / "layers.wrl") << layersScene("selfCollision 0.004");
-  }
+  { std::ofstream(dir / "layers.wrl") << layersScene("selfCollision 0.004"); }
   const CliResult r = runDrape("run '" + (dir / "layers.wrl") + "' --frames 24 --out '" + (dir / "kept") + "'", dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("layers: its layers kept 4 mm apart"), std::string::npos) << r.err;
@@ -89,9 +87,13 @@ TEST(RunLayers, ASceneKeepsItsLayersOneThicknessApartAndSaysSo) {
   EXPECT_NEAR(*std::min_element(kept.begin(), kept.end()), 0.004, 0.0004);
   EXPECT_NEAR(*std::max_element(kept.begin(), kept.end()), 0.004, 0.0004);
 
+  const CliResult inspected = runDrape("inspect '" + (dir / "layers.wrl") + "'", dir);
+  ASSERT_EQ(inspected.code, 0) << inspected.err;
+  EXPECT_NE(inspected.out.find("its own layers kept 4 mm apart (selfCollision)"), std::string::npos) << inspected.out;
+
   // --self-collision 0 overrides the scene: the layers pass through each other.
-  const CliResult free = runDrape(
-      "run '" + (dir / "layers.wrl") + "' --frames 24 --self-collision 0 --out '" + (dir / "free") + "'", dir);
+  const CliResult free =
+      runDrape("run '" + (dir / "layers.wrl") + "' --frames 24 --self-collision 0 --out '" + (dir / "free") + "'", dir);
   ASSERT_EQ(free.code, 0) << free.err;
   EXPECT_FALSE(nlohmann::json::parse(slurp(dir / "free/stats.json"))["garments"][0].contains("self_collision"));
   const std::vector<double> through = upperHeights(dir / "free/frames/frame_00024.obj");
@@ -101,9 +103,7 @@ TEST(RunLayers, ASceneKeepsItsLayersOneThicknessApartAndSaysSo) {
 
 TEST(RunLayers, TheCommandLineTurnsItOnAndRefusesANegativeThickness) {
   const ScratchDir dir("run-layers-cli");
-  {
-    std::ofstream(dir / "layers.wrl") << layersScene("");
-  }
+  { std::ofstream(dir / "layers.wrl") << layersScene(""); }
   const CliResult r = runDrape(
       "run '" + (dir / "layers.wrl") + "' --frames 24 --self-collision 0.004 --out '" + (dir / "on") + "'", dir);
   ASSERT_EQ(r.code, 0) << r.err;

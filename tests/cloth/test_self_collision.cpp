@@ -1,6 +1,7 @@
-// Self collision (cloth/self_collider.hpp): the grid finds the pairs brute force finds, a
-// layer dropped on another comes to rest one thickness above it, and a folded strip does
-// not pass through itself; without the collider the same layers pass through.
+// Self collision (cloth/self_collider.hpp): the grid and the list kept between tests find
+// the pairs brute force finds; a layer dropped on another comes to rest one thickness above
+// it, a folded strip does not pass through itself (without the collider both pass through),
+// and a layer sliding on another decelerates at mu g.
 
 #include <gtest/gtest.h>
 
@@ -58,7 +59,8 @@ ClothState statesAt(const mesh::TriMesh& m) {
 
 /// The pairs brute force finds between `s0` and `s1` of mesh `m`, as the set the tests compare.
 std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> bruteContacts(const SelfCollider& collider,
-                                                                               const mesh::TriMesh& m, const ClothState& s0,
+                                                                               const mesh::TriMesh& m,
+                                                                               const ClothState& s0,
                                                                                const ClothState& s1, double thickness) {
   std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> out;
   for (std::uint32_t v = 0; v < m.positions.size(); ++v)
@@ -67,7 +69,8 @@ std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> bruteContacts(c
       const mesh::Triangle& tri = m.triangles[t];
       const std::array<Vec3, 3> t0{s0.position(tri[0]), s0.position(tri[1]), s0.position(tri[2])};
       const std::array<Vec3, 3> t1{s1.position(tri[0]), s1.position(tri[1]), s1.position(tri[2])};
-      if (auto c = selfContact(s0.position(v), s1.position(v), t0, t1, thickness)) out.insert({v, t, c->side, c->crossed});
+      if (auto c = selfContact(s0.position(v), s1.position(v), t0, t1, thickness))
+        out.insert({v, t, c->side, c->crossed});
     }
   return out;
 }
@@ -122,7 +125,8 @@ TEST(SelfCollision, TheListKeptBetweenTestsFindsWhatBruteForceFinds) {
     const Vec3 carried(0.02 * unit(random), 0.01 * unit(random), -0.015 * unit(random));
     const double wander = (test % 10 == 9 ? 1.5 : 0.12) * thickness;
     for (std::size_t v = 0; v < now.size(); ++v)
-      now.setPosition(v, now.position(v) + carried + wander * Vec3(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5));
+      now.setPosition(
+          v, now.position(v) + carried + wander * Vec3(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5));
     std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> kept;
     for (const SelfContact& c : collider.nextContacts(now)) kept.insert({c.vertex, c.triangle, c.side, c.crossed});
     const auto brute = bruteContacts(collider, rest, before, now, thickness);
@@ -327,7 +331,8 @@ TEST(SelfCollision, AThicknessMustBePositive) {
     SelfCollider collider(*model, "skirt", 0.0);
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("garment 'skirt': self-collision thickness 0 m"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("garment 'skirt': self-collision thickness 0 m"), std::string::npos)
+        << e.what();
   }
 }
 

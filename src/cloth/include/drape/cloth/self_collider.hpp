@@ -43,7 +43,7 @@ struct SelfContact {
   /// +1 or -1: the side of the face (along its normal) the vertex keeps to: the one it was
   /// on at the last test.
   double side = 1.0;
-  bool crossed = false;             ///< it ended on the other side
+  bool crossed = false;  ///< it ended on the other side
   /// Barycentric weights of its projection on the face (crossed: of where it went through).
   std::array<double, 3> weights{};
 };
@@ -136,7 +136,7 @@ class SelfCollider final : public Collider {
   double thickness_;
   int every_;
   double staticFriction_, dynamicFriction_;  ///< the material's, layer on layer as on the body
-  double cell_m_;  ///< edge of a grid cell
+  double cell_m_;                            ///< edge of a grid cell
   std::vector<std::array<std::uint32_t, 3>> triangles_;
   std::vector<std::uint32_t> neighbourStart_, neighbours_;  ///< per vertex (CSR), sorted
   std::vector<double> inverseMass_;                         ///< 0 for the fixed vertices

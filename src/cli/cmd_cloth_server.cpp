@@ -23,6 +23,7 @@ namespace {
 struct ClothServerOptions {
   std::string scene, poses = "anim", name = "cloth", positions = "double", character;
   std::vector<std::string> garments;
+  std::vector<std::string> guests;  ///< --guest NAME=POSES
   long takes = 0;
   StudioOptions studio;
 };
@@ -51,6 +52,54 @@ std::string wearerOf(const RunSetup& setup, const std::vector<std::string>& garm
         wearer = c.name;
       }
   return wearer;
+}
+
+/// Another character of the scene whose body the garments collide with too, moved by its
+/// anim-server's pose stream (--guest NAME=POSES): its part fields, built once, and its
+/// take of the same name as the take simulated, followed as it comes.
+struct GuestPoses {
+  CharacterSetup character;  ///< its avatar, name and part fields
+  std::string poses;         ///< the stream
+  std::unique_ptr<studio::StreamReader> stream;
+  std::unique_ptr<studio::PoseFollower> follower;
+};
+
+/// The --guest options as guests of `full` (the scene before a character was chosen), in
+/// the scene's order, their fields built. Throws drape::Error naming --guest for a NAME the
+/// scene lacks, the character simulated, one given twice or a bad stream name.
+std::vector<GuestPoses> guestsOf(const RunSetup& full, const std::vector<std::string>& options,
+                                 const std::string& simulated, const std::string& posesName) {
+  std::vector<std::pair<std::size_t, std::string>> given;
+  for (const std::string& option : options) {
+    const std::size_t eq = option.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == option.size())
+      throw Error(fmt::format("--guest {}: expected NAME=POSES, a character of the scene and the --name of its "
+                              "anim-server",
+                              option));
+    const std::string name = option.substr(0, eq), poses = option.substr(eq + 1);
+    studio::checkSourceName(poses, "--guest " + name);
+    const CharacterSetup& c = characterNamed(full, name, "--guest " + option);
+    if (c.name == simulated)
+      throw Error(fmt::format("--guest {}: {} is the character this cloth-server dresses; its poses are --poses", option,
+                              name));
+    if (poses == posesName)
+      throw Error(fmt::format("--guest {}: '{}' is the stream of the poses simulated (--poses)", option, poses));
+    const std::size_t index = static_cast<std::size_t>(&c - full.characters.data());
+    for (const auto& [other, stream] : given)
+      if (other == index) throw Error(fmt::format("--guest {}: {} is a guest twice", option, name));
+    given.emplace_back(index, poses);
+  }
+  std::sort(given.begin(), given.end());
+  std::vector<GuestPoses> guests;
+  for (const auto& [index, poses] : given) {
+    GuestPoses g;
+    g.character = full.characters[index];
+    g.character.keepApart.clear();  // its anim-server sends the motion corrected
+    buildPartFieldsOnce(full, g.character, fmt::format("for the guest {}", g.character.name));
+    g.poses = poses;
+    guests.push_back(std::move(g));
+  }
+  return guests;
 }
 
 /// The cloth take's frames onto the stream, garment by garment.
@@ -88,8 +137,8 @@ struct TakeOutcome {
 };
 
 /// Simulates the take `poses` follows and publishes it; the take's End says how it ended.
-TakeOutcome simulateTake(const RunSetup& scene, studio::PoseFollower& poses, studio::Publisher& publisher,
-                         const std::string& posesName) {
+TakeOutcome simulateTake(const RunSetup& scene, studio::PoseFollower& poses, std::vector<GuestPoses>& guests,
+                         studio::Publisher& publisher, const std::string& posesName) {
   const studio::PoseStart& ps = poses.start();
   RunSetup setup = scene;
   CharacterSetup& character = setup.characters.front();
@@ -123,11 +172,25 @@ TakeOutcome simulateTake(const RunSetup& scene, studio::PoseFollower& poses, stu
   ClothSink sink(publisher);
   const FrameGate gate = [&](long frame) {
     if (frame == 0) return true;  // motion frame 0 came before the world was built
-    if (poses.waitForFrames(studio::motionFramesNeeded(frame, rate, leadIn, rate))) return true;
+    const std::int64_t needed = studio::motionFramesNeeded(frame, rate, leadIn, rate);
+    // A guest whose take ended holds its last pose, as drape run plays a motion past its end.
+    for (GuestPoses& g : guests) (void)g.follower->waitForFrames(needed);
+    if (poses.waitForFrames(needed)) return true;
     return frame <= studio::clothFramesOf(poses.frames(), rate, leadIn, rate);
   };
   TakeOutcome outcome;
   try {
+    // Each guest's take of this take's name, its motion growing as it comes.
+    for (GuestPoses& g : guests) {
+      g.follower->followNextTake(*g.character.avatar, rate, poses.take());
+      if (!g.follower->waitForFrames(1))
+        throw Error(fmt::format("the guest {}'s pose take {} on '{}' ended without a frame", g.character.name,
+                                poses.take(), g.poses));
+      CharacterSetup guest = g.character;
+      guest.animation =
+          std::shared_ptr<const motion::AvatarAnimation>(std::shared_ptr<void>(), &g.follower->animation());
+      setup.guests.push_back(std::move(guest));
+    }
     simulateInto(setup, sink, gate);
   } catch (const studio::NewTake& e) {
     outcome.error = e.what();
@@ -148,12 +211,14 @@ int runClothServer(const ClothServerOptions& o) {
   if (o.positions != "double" && o.positions != "float")
     throw Error(fmt::format("--positions {}: expected double or float", o.positions));
   RunSetup setup = runSetupFromScene(o.scene);
+  const RunSetup full = setup;  // every character, for the guests
   keepGarments(setup, o.garments, o.scene);
   const std::string chosen =
       o.character.empty() && setup.characters.size() > 1 ? wearerOf(setup, o.garments) : o.character;
   if (!chooseCharacter(setup, chosen, "--character"))
     throw Error(fmt::format("{}: the scene has no avatar for its garments to move with", o.scene));
   CharacterSetup& character = setup.characters.front();
+  std::vector<GuestPoses> guests = guestsOf(full, o.guests, character.name, o.poses);
   {
     RunSetup check = setup;  // bad garments or settings are said before any waiting
     check.motionStreamed = true;
@@ -173,6 +238,15 @@ int runClothServer(const ClothServerOptions& o) {
   studio::StreamReader stream(bus, o.poses, consumerName("cloth-server-" + o.name, false), o.studio.patience(),
                               o.studio.giveUp());
   studio::PoseFollower poses(stream);
+  for (GuestPoses& g : guests) {
+    g.stream = std::make_unique<studio::StreamReader>(bus, g.poses,
+                                                      consumerName("cloth-server-" + o.name + "-guest-" + g.poses, false),
+                                                      o.studio.patience(), o.studio.giveUp());
+    g.follower = std::make_unique<studio::PoseFollower>(*g.stream);
+    spdlog::info("its garments collide with {}'s body too, as the poses of '{}' move it (in each take, its take of "
+                 "the same name)",
+                 g.character.name, g.poses);
+  }
   studio::Publisher publisher(bus, o.name, o.positions == "float" ? studio::Precision::Float : studio::Precision::Double,
                               o.studio.giveUp());
   std::vector<std::string> names;
@@ -189,7 +263,7 @@ int runClothServer(const ClothServerOptions& o) {
                               poses.take(), o.poses, poses.start().character, chosen, chosen));
     if (!poses.waitForFrames(1)) throw Error(fmt::format("pose take {} ended without a frame", poses.take()));
     const auto began = std::chrono::steady_clock::now();
-    const TakeOutcome outcome = simulateTake(setup, poses, publisher, o.poses);
+    const TakeOutcome outcome = simulateTake(setup, poses, guests, publisher, o.poses);
     if (outcome.held) continue;  // a take served before: it does not count
     ++served;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
@@ -218,6 +292,11 @@ RunFunction setupClothServer(CLI::App& app) {
                  "Which of the scene's characters' garments it simulates (needed in a scene of several unless --garments "
                  "names one's); its --poses are the anim-server's of that --character")
       ->type_name("NAME");
+  app.add_option("--guest", o.guests,
+                 "Another character of the scene whose body the garments collide with too (two characters that "
+                 "touch), moved by the pose stream POSES (its anim-server's --name): in each take, its take of the "
+                 "same name (give the cast's anim-servers one --take); repeatable")
+      ->type_name("NAME=POSES");
   app.add_option("--positions", o.positions,
                  "How positions travel: double (a player records what drape run writes, to the byte) or float (half "
                  "the bytes)")

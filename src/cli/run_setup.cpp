@@ -763,8 +763,13 @@ SetupWorlds::SetupWorlds(const RunSetup& setup) : place_(setup.garments.size()) 
     names_.push_back(setup.characters[c].name);
     for (std::size_t k = 0; k < setup.characters[c].garments.size(); ++k) place_[setup.characters[c].garments[k]] = {c, k};
   }
+  // The setup's guests, after the characters (in the scene's order, as a run of them all
+  // would give them to each world).
+  std::vector<sim::Guest> visitors;
+  for (const CharacterSetup& g : setup.guests)
+    visitors.push_back({g.name, g.avatar.get(), g.animation.get(), g.fields});
   if (n == 1) {  // one world, which keeps its parts apart itself
-    worlds_.push_back(buildWorld(setup, setup.characters.front()));
+    worlds_.push_back(buildWorld(setup, setup.characters.front(), visitors));
     return;
   }
   // Every body first, as its own world will move it: its fields, and its motion kept apart.
@@ -787,6 +792,7 @@ SetupWorlds::SetupWorlds(const RunSetup& setup) : place_(setup.garments.size()) 
     std::vector<sim::Guest> guests;
     for (std::size_t o = 0; o < n; ++o)
       if (o != c) guests.push_back({played[o].name, played[o].avatar.get(), played[o].animation.get(), fields_[o]});
+    guests.insert(guests.end(), visitors.begin(), visitors.end());
     worlds_.push_back(buildWorld(setup, played[c], std::move(guests)));
   }
 }

@@ -76,6 +76,11 @@ struct RunSetup {
   /// The characters the garments are worn by, each colliding with its own avatar's parts
   /// (every garment worn by one of them); none: the garments hang on their pins.
   std::vector<CharacterSetup> characters;
+  /// Other characters of the scene whose bodies every world's garments collide with too,
+  /// whose garments this run does not simulate (a cloth-server's --guest): each with its
+  /// part fields built and the motion it plays (a pose stream's, corrected where the scene
+  /// keeps parts apart), in the scene's order.
+  std::vector<CharacterSetup> guests;
   long frames = 0;                     ///< frames to simulate after the initial one
   long objEvery = 1;                   ///< write an OBJ frame every K frames
   std::string outDir;

@@ -175,10 +175,7 @@ bool SelfCollider::excluded(std::uint32_t vertex, std::uint32_t triangle) const 
   return false;
 }
 
-bool SelfCollider::movable(std::uint32_t vertex, std::uint32_t triangle) const {
-  const auto& c = triangles_[triangle];
-  return inverseMass_[vertex] > 0 || inverseMass_[c[0]] > 0 || inverseMass_[c[1]] > 0 || inverseMass_[c[2]] > 0;
-}
+bool SelfCollider::movable(std::uint32_t vertex, std::uint32_t) const { return inverseMass_[vertex] > 0; }
 
 void SelfCollider::remember(const ClothState& state) {
   lastX_ = state.x;  // sizes equal after the first: copies, no allocation

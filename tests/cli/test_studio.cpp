@@ -178,6 +178,12 @@ TEST(Studio, TwoClothServersSplitTheGarmentsAndThePlayerCollatesThem) {
 
 const std::string kTwoCharacters = std::string(DRAPE_SOURCE_DIR) + "/examples/two_characters/scene.wrl";
 
+/// A character's name as its roles' streams are named: "Ada" -> "ada".
+std::string streamNameOf(std::string name) {
+  for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return name;
+}
+
 /// A cloth-server of one character of the two characters' scene (`which`: --character NAME,
 /// or --garments of one character's), following the poses `poses`, publishing as `name`.
 DrapeProcess characterCloth(const std::string& which, const std::string& poses, const std::string& name,
@@ -232,6 +238,69 @@ TEST(Studio, TwoCharactersEachOnServersOfItsOwnAreDrapeRunsToTheByte) {
   EXPECT_NE(which.err.find("the scene has 2 characters (Ada, Bea), and a studio role plays one: give --character NAME"),
             std::string::npos)
       << which.err;
+}
+
+/// The two characters' scene with Bea 35 cm to Ada's side instead of 1.2 m: walking side by
+/// side, each skirt brushes the other's legs. Written into `dir` as close.wrl.
+std::string closeCharactersScene(const ScratchDir& dir) {
+  std::string text = slurp(kTwoCharacters);
+  text.replace(text.find("translation 1.2 0 0"), 19, "translation 0.35 0 0");
+  for (const std::string relative : {"\"../../data/", "\"../walking_skirt/"})
+    while (text.find(relative) != std::string::npos)
+      text.replace(text.find(relative), relative.size(),
+                   "\"" + std::string(DRAPE_SOURCE_DIR) + (relative[4] == '.' ? "/data/" : "/examples/walking_skirt/"));
+  const std::string scene = dir / "close.wrl";
+  std::ofstream(scene) << text;
+  return scene;
+}
+
+TEST(Studio, CharactersThatTouchCollideThroughTheStudioAsInDrapeRun) {
+  // Ada and Bea walk side by side, close: each cloth-server follows the other character's
+  // poses too (--guest), so that each skirt collides with the other's legs as in drape run.
+  ScratchDir dir("studio-touch");
+  NatsServer server;
+  const std::string scene = closeCharactersScene(dir);
+  const std::string reference = runInto(dir, "reference", "'" + scene + "' --motion '" + kWalk + "' --frames 90");
+  // Ada's skirt alone, on the same walk: the skirts' runs must differ where they touch.
+  const std::string alone = runInto(dir, "alone", "'" + kScene + "' --motion '" + kWalk + "' --frames 90");
+  ASSERT_TRUE(slurp(alone + "/garment.pc2") != slurp(reference + "/garment-Ada_skirt.pc2"))
+      << "the skirts were to touch the other's legs";
+
+  const auto cloth = [&](const std::string& who, const std::string& guest) {
+    return DrapeProcess("cloth-server '" + scene + "' --character " + who + " --poses " + streamNameOf(who) + " --guest " +
+                            guest + "=" + streamNameOf(guest) + " --name " + streamNameOf(who) + "-cloth --takes 1" + roles(server),
+                        dir, streamNameOf(who) + "-cloth");
+  };
+  DrapeProcess adaCloth = cloth("Ada", "Bea"), beaCloth = cloth("Bea", "Ada");
+  for (const std::string who : {"Ada", "Bea"}) {
+    const CliResult sent = runDrape("anim-server '" + scene + "' --character " + who + " --motion '" + kWalk +
+                                        "' --name " + streamNameOf(who) + " --take close --fast" + roles(server),
+                                    dir);
+    ASSERT_EQ(sent.code, 0) << sent.err;
+  }
+  const CliResult ada = adaCloth.wait(), bea = beaCloth.wait();
+  ASSERT_EQ(ada.code, 0) << ada.err;
+  ASSERT_EQ(bea.code, 0) << bea.err;
+  EXPECT_NE(ada.err.find("its garments collide with Bea's body too, as the poses of 'bea' move it"), std::string::npos)
+      << ada.err;
+  const CliResult recorded = runDrape("player '" + scene + "' --cloth ada-cloth,bea-cloth --frames 90 --record '" +
+                                          (dir / "recorded") + "'" + roles(server),
+                                      dir);
+  ASSERT_EQ(recorded.code, 0) << recorded.err;
+  for (const char* file : {"garment-Ada_skirt.pc2", "garment-Bea_skirt.pc2", "garment-Ada_skirt.states"})
+    EXPECT_TRUE(slurp(dir / ("recorded/" + std::string(file))) == slurp(reference + "/" + file)) << file;
+
+  // Refused: a guest the scene lacks, the character dressed, a guest twice.
+  for (const auto& [guests, message] : std::vector<std::pair<std::string, std::string>>{
+           {"--guest Carl=carl", "--guest Carl=carl: the scene has no character called 'Carl' (it has: Ada, Bea)"},
+           {"--guest Ada=bea", "--guest Ada=bea: Ada is the character this cloth-server dresses"},
+           {"--guest Bea=bea --guest Bea=bea2", "--guest Bea=bea2: Bea is a guest twice"},
+           {"--guest Bea", "--guest Bea: expected NAME=POSES"}}) {
+    const CliResult refused = runDrape(
+        "cloth-server '" + scene + "' --character Ada --poses ada " + guests + " --takes 1" + roles(server), dir);
+    EXPECT_EQ(refused.code, 2) << refused.err;
+    EXPECT_NE(refused.err.find(message), std::string::npos) << refused.err;
+  }
 }
 
 TEST(Studio, AnEventGraphOfTwoCharactersThroughTheStudioIsDrapeRunsToTheByte) {

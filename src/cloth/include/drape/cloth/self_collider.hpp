@@ -9,7 +9,7 @@
 // made, the garment's common motion left out (a walk carries the whole skirt along without
 // changing a distance). The list is made again when a vertex has moved farther: each
 // triangle's box over the interval, grown by h + m, against the vertices' boxes in a hashed
-// uniform grid (arrays sized once). A pair is a contact when the
+// uniform grid (arrays sized once). A free vertex and a triangle are a contact when the
 // vertex ends within h of the triangle's face (its projection inside the triangle) on the
 // side it was on at the last test, or has crossed to the other side since. Contacts are
 // resolved in three Jacobi sweeps (every pair's push summed per vertex, then averaged, so the
@@ -20,8 +20,9 @@
 // of its sliding velocity.
 //
 // Left out: edge against edge (two edges crossing with no vertex over a face: rare at cloth
-// resolutions, where the neighbouring vertex-face pairs catch the layers first), and garment
-// against garment (each garment steps on its own, in parallel).
+// resolutions, where the neighbouring vertex-face pairs catch the layers first), a vertex a
+// fixture moves against the free layers (their own vertices are tested against its
+// triangles), and garment against garment (each garment steps on its own, in parallel).
 // docs/PHYSICS.md says what each means for a scene.
 
 #include <array>
@@ -92,8 +93,9 @@ class SelfCollider final : public Collider {
   /// Whether the pair is never tested (the triangle has v, or a neighbour of v, as a corner;
   /// stitched vertices are neighbours).
   [[nodiscard]] bool excluded(std::uint32_t vertex, std::uint32_t triangle) const;
-  /// Whether anything of the pair can move (not all four held by fixtures, which keep them
-  /// as the garment was modelled): pairs that cannot are never tested.
+  /// Whether the pair is tested: its vertex is free. A vertex a fixture moves is never
+  /// pushed into the free layers around it (they are tested by their own vertices against
+  /// its triangles): its fixture would move it back through them at every substep.
   [[nodiscard]] bool movable(std::uint32_t vertex, std::uint32_t triangle) const;
   /// The contacts between positions `before` (the last test's) and `after`, as a test finds
   /// them (by vertex, then triangle), without resolving them.

@@ -173,10 +173,16 @@ TakeOutcome simulateTake(const RunSetup& scene, studio::PoseFollower& poses, std
   const FrameGate gate = [&](long frame) {
     if (frame == 0) return true;  // motion frame 0 came before the world was built
     const std::int64_t needed = studio::motionFramesNeeded(frame, rate, leadIn, rate);
-    // A guest whose take ended holds its last pose, as drape run plays a motion past its end.
-    for (GuestPoses& g : guests) (void)g.follower->waitForFrames(needed);
-    if (poses.waitForFrames(needed)) return true;
-    return frame <= studio::clothFramesOf(poses.frames(), rate, leadIn, rate);
+    // A take whose motion ended holds its last pose, as drape run plays a motion past its
+    // end; the take runs as long as the longest of the character's and its guests', as
+    // drape run simulates a cast for its longest motion.
+    bool more = poses.waitForFrames(needed);
+    std::int64_t longest = poses.frames();
+    for (GuestPoses& g : guests) {
+      more = g.follower->waitForFrames(needed) || more;
+      longest = std::max(longest, g.follower->frames());
+    }
+    return more || frame <= studio::clothFramesOf(longest, rate, leadIn, rate);
   };
   TakeOutcome outcome;
   try {

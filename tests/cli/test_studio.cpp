@@ -255,14 +255,17 @@ std::string closeCharactersScene(const ScratchDir& dir) {
 }
 
 TEST(Studio, CharactersThatTouchCollideThroughTheStudioAsInDrapeRun) {
-  // Ada and Bea walk side by side, close: each cloth-server follows the other character's
-  // poses too (--guest), so that each skirt collides with the other's legs as in drape run.
+  // Ada and Bea set off side by side, close, each on her own walk (Ada's 170 frames long,
+  // Bea's 115): each cloth-server follows the other character's poses too (--guest), so
+  // that each skirt collides with the other's legs, and each take runs as long as the
+  // longest walk, Bea standing at her last pose after hers, as in drape run.
   ScratchDir dir("studio-touch");
   NatsServer server;
   const std::string scene = closeCharactersScene(dir);
-  const std::string reference = runInto(dir, "reference", "'" + scene + "' --motion '" + kWalk + "' --frames 90");
+  const std::string reference = runInto(dir, "reference", "'" + scene + "'");
+  EXPECT_EQ(statsOf(reference)["frames"].get<int>(), 170);
   // Ada's skirt alone, on the same walk: the skirts' runs must differ where they touch.
-  const std::string alone = runInto(dir, "alone", "'" + kScene + "' --motion '" + kWalk + "' --frames 90");
+  const std::string alone = runInto(dir, "alone", "'" + kScene + "' --motion '" + kWalk + "' --frames 170");
   ASSERT_TRUE(slurp(alone + "/garment.pc2") != slurp(reference + "/garment-Ada_skirt.pc2"))
       << "the skirts were to touch the other's legs";
 
@@ -273,8 +276,8 @@ TEST(Studio, CharactersThatTouchCollideThroughTheStudioAsInDrapeRun) {
   };
   DrapeProcess adaCloth = cloth("Ada", "Bea"), beaCloth = cloth("Bea", "Ada");
   for (const std::string who : {"Ada", "Bea"}) {
-    const CliResult sent = runDrape("anim-server '" + scene + "' --character " + who + " --motion '" + kWalk +
-                                        "' --name " + streamNameOf(who) + " --take close --fast" + roles(server),
+    const CliResult sent = runDrape("anim-server '" + scene + "' --character " + who + " --name " + streamNameOf(who) +
+                                        " --take close --fast" + roles(server),
                                     dir);
     ASSERT_EQ(sent.code, 0) << sent.err;
   }
@@ -283,11 +286,12 @@ TEST(Studio, CharactersThatTouchCollideThroughTheStudioAsInDrapeRun) {
   ASSERT_EQ(bea.code, 0) << bea.err;
   EXPECT_NE(ada.err.find("its garments collide with Bea's body too, as the poses of 'bea' move it"), std::string::npos)
       << ada.err;
-  const CliResult recorded = runDrape("player '" + scene + "' --cloth ada-cloth,bea-cloth --frames 90 --record '" +
+  EXPECT_NE(bea.out.find("take close: 170 cloth frames of Bea skirt"), std::string::npos) << bea.out;
+  const CliResult recorded = runDrape("player '" + scene + "' --cloth ada-cloth,bea-cloth --record '" +
                                           (dir / "recorded") + "'" + roles(server),
                                       dir);
   ASSERT_EQ(recorded.code, 0) << recorded.err;
-  for (const char* file : {"garment-Ada_skirt.pc2", "garment-Bea_skirt.pc2", "garment-Ada_skirt.states"})
+  for (const char* file : {"garment-Ada_skirt.pc2", "garment-Bea_skirt.pc2", "garment-Ada_skirt.states", "body-Bea.pc2"})
     EXPECT_TRUE(slurp(dir / ("recorded/" + std::string(file))) == slurp(reference + "/" + file)) << file;
 
   // Refused: a guest the scene lacks, the character dressed, a guest twice.

@@ -68,6 +68,9 @@ void printGarment(std::ostream& out, const scene::Scene& s, const scene::Garment
       g.collidesWith.empty() ? std::string("every segment") : fmt::format("{}", fmt::join(g.collidesWith, ", ")));
   if (!g.faceSamplesWith.empty())
     fmt::print(out, "    triangle centroids collide too with {}\n", fmt::join(g.faceSamplesWith, ", "));
+  if (g.offsets)
+    fmt::print(out, "    its own offset surfaces T0..T3 {:.4g}, {:.4g}, {:.4g}, {:.4g} mm\n", 1e3 * (*g.offsets)[0],
+               1e3 * (*g.offsets)[1], 1e3 * (*g.offsets)[2], 1e3 * (*g.offsets)[3]);
   if (g.selfCollision > 0)
     fmt::print(out, "    its own layers kept {:.4g} mm apart (selfCollision)\n", 1e3 * g.selfCollision);
   if (!g.stitches.empty())

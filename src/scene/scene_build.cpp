@@ -431,6 +431,7 @@ class Builder {
       throw Error::at(where(n, "selfCollision"),
                       fmt::format("ClothSet {}: selfCollision {:g} m: expected a thickness, 0 (none) or more", g.name,
                                   g.selfCollision));
+    g.offsets = garmentOffsets(n, g.name);
     g.collidesWith = strings(n, "collidesWith");
     g.faceSamplesWith = strings(n, "faceSamplesWith");
     for (const std::string& s : g.faceSamplesWith)
@@ -443,6 +444,27 @@ class Builder {
     if (const std::int32_t mask = node(n, "constraintMask"); mask >= 0)
       g.maskVertices = matchMask(transformed(faceSet(mask, n, "constraintMask"), pending.world, g.name), g, n);
     scene_.garments.push_back(std::move(g));
+  }
+
+  /// The ClothSet's `offsets` (T0..T3, m, non-negative, non-decreasing), or none when it
+  /// gives none.
+  static std::optional<std::array<double, 4>> garmentOffsets(const Node& n, const std::string& name) {
+    const Field* f = n.field("offsets");
+    if (f == nullptr || f->numbers.empty()) return std::nullopt;
+    if (f->numbers.size() != 4)
+      throw Error::at(where(n, "offsets"), fmt::format("ClothSet {}: offsets needs 4 values (T0 T1 T2 T3 in m), found {}",
+                                                       name, f->numbers.size()));
+    std::array<double, 4> t{};
+    for (std::size_t i = 0; i < 4; ++i) {
+      t[i] = f->numbers[i];
+      if (!std::isfinite(t[i]) || t[i] < 0.0)
+        throw Error::at(where(n, "offsets"), fmt::format("ClothSet {}: offsets: T{} = {:g} m is negative", name, i, t[i]));
+      if (i > 0 && t[i] < t[i - 1])
+        throw Error::at(where(n, "offsets"), fmt::format("ClothSet {}: offsets must not decrease (T{} = {:g} m < T{} = "
+                                                         "{:g} m)",
+                                                         name, i, t[i], i - 1, t[i - 1]));
+    }
+    return t;
   }
 
   /// The ClothSet's `stitches`: pairs of cloth vertex indices.

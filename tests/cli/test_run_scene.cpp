@@ -286,6 +286,20 @@ TEST(RunScene, OffsetsGivenOverrideTheScenesAndAreChecked) {
   EXPECT_NE(bad.err.find("--offsets must satisfy 0 <= T0 < T1 < T2 < T3 (m), got 0.004 0.003 0.012 0.024"),
             std::string::npos)
       << bad.err;
+
+  // A garment's own offsets (ClothSet offsets) instead of the Simulation node's, the other
+  // garment keeping the scene's.
+  const std::string two = twoSkirtScene(dir);
+  std::string text = slurp(two);
+  text.replace(text.find("DEF Skirt2 ClothSet {"), 21, "DEF Skirt2 ClothSet {\n  offsets [ 0.003 0.006 0.009 0.02 ]");
+  std::ofstream(two) << text;
+  const nlohmann::json own =
+      statsOf(testing::runInto(dir, "own", "'" + two + "' --motion '" + kSkirtDir + "/walk.bvh' --frames 2"));
+  const std::vector<double> skirt2{0.003, 0.006, 0.009, 0.02};
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_NEAR(own["garments"][0]["offsets_m"][k].get<double>(), 0.005 * double(k == 3 ? 6 : k + 1), 1e-8);
+    EXPECT_NEAR(own["garments"][1]["offsets_m"][k].get<double>(), skirt2[k], 1e-8);
+  }
 }
 
 TEST(RunScene, FaceSamplesAreChosenByPartAndChecked) {

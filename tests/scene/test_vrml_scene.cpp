@@ -100,7 +100,7 @@ TEST(VrmlScene, EveryFieldWithValues) {
       "bendingStiffness 1e-6\n"
       "  damping 0.1 staticFriction 0.4 dynamicFriction 0.2 compressionScale 0.5 }\n"
       "DEF Scarf ClothSet { name \"scarf\" material USE Silk avatar USE Body collidesWith [ \"hips\" ] faceSamplesWith "
-      "[ \"hips\" ] stitches [ 0 2, 1 0 ] selfCollision 0.004 maskTolerance "
+      "[ \"hips\" ] stitches [ 0 2, 1 0 ] selfCollision 0.004 offsets [ 0.001 0.002 0.003 0.012 ] maskTolerance "
       "0.002 "
       "bindThreshold 0.03\n  cloth " +
       kTriangle + "\n  constraintMask " + kTriangle +
@@ -151,6 +151,8 @@ TEST(VrmlScene, EveryFieldWithValues) {
   EXPECT_NEAR(g.maskTolerance, 0.002, 1e-9);
   EXPECT_NEAR(g.bindThreshold, 0.03, 1e-9);
   EXPECT_NEAR(g.selfCollision, 0.004, 1e-9);  // metres, as maskTolerance: not scaled
+  ASSERT_TRUE(g.offsets.has_value());
+  EXPECT_NEAR((*g.offsets)[3], 0.012, 1e-9);
   EXPECT_EQ(g.maskVertices, (std::vector<std::uint32_t>{0, 1, 2}));
   EXPECT_NEAR(g.mesh.positions[1].x(), 0.01, 1e-9);  // 1 file unit at unitScale 0.01
 
@@ -205,6 +207,7 @@ TEST(VrmlScene, EveryFieldDefaults) {
   EXPECT_TRUE(s.garments[0].collidesWith.empty());
   EXPECT_TRUE(s.garments[0].stitches.empty());
   EXPECT_EQ(s.garments[0].selfCollision, 0.0);  // layers pass through one another, as in the paper
+  EXPECT_FALSE(s.garments[0].offsets.has_value());  // the Simulation node's
   EXPECT_EQ(s.garments[0].avatar, -1);
   // No Simulation node at all: the same defaults, flagged.
   EXPECT_FALSE(fromText("#VRML V2.0 utf8\nGroup { }\n").hasSimulationNode);
@@ -323,6 +326,15 @@ TEST(VrmlScene, MoreDomainErrors) {
   EXPECT_NE(errorOf([&] {
               (void)fromText("#VRML V2.0 utf8\nClothSet {\n  selfCollision -0.002 cloth " + kTriangle + " }\n");
             }).find("scene.wrl:3: ClothSet garment 1: selfCollision -0.002 m: expected a thickness, 0 (none) or more"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] {
+              (void)fromText("#VRML V2.0 utf8\nClothSet {\n  offsets [ 0.002 0.004 0.006 ] cloth " + kTriangle + " }\n");
+            }).find("scene.wrl:3: ClothSet garment 1: offsets needs 4 values (T0 T1 T2 T3 in m), found 3"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] {
+              (void)fromText("#VRML V2.0 utf8\nClothSet {\n  offsets [ 0.002 0.004 0.003 0.008 ] cloth " + kTriangle +
+                             " }\n");
+            }).find("ClothSet garment 1: offsets must not decrease (T2 = 0.003 m < T1 = 0.004 m)"),
             std::string::npos);
   // Face samples: with parts the garment collides with, on its avatar.
   EXPECT_NE(errorOf([&] {

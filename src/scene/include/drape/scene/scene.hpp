@@ -81,6 +81,8 @@ struct Garment {
   /// m: how far apart the garment's own layers keep (cloth::SelfCollider); 0: they pass
   /// through one another, as in the paper.
   double selfCollision = 0.0;
+  /// m: its own offset surfaces T0..T3, instead of the Simulation node's; none: those.
+  std::optional<std::array<double, 4>> offsets;
   /// Pairs of cloth vertices sewn together (a closure the mesh leaves open): each pair is
   /// drawn to one point and held there. Indices into `mesh`, two different ones, in range.
   std::vector<std::array<std::uint32_t, 2>> stitches;

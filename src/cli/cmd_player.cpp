@@ -158,7 +158,7 @@ int record(const PlayerRoleOptions& o) {
       continue;
     }
     exitCode = 0;
-    fmt::print("recorded take {}: {} frames of {} in {}/{}\n", frames.take(), r.frames, frames.start().character, dir,
+    fmt::print("recorded take {}: {} frames of {} in {}/{}\n", frames.take(), r.frames, characterNames(setup), dir,
                r.stopped              ? " (stopped by a signal)"
                : !r.cutShort.empty() ? " (cut short: " + r.cutShort + ")"
                                      : "");

@@ -150,10 +150,7 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
     r.poseSeconds += world.collider(g)->poseSeconds() + t.fixturePoses_s;
     r.counters += world.collider(g)->fieldCounters();
     if (const cloth::SelfCollider* self = world.selfCollider(g)) {
-      r.self.tests += self->selfCounters().tests;
-      r.self.candidates += self->selfCounters().candidates;
-      r.self.contacts += self->selfCounters().contacts;
-      r.self.crossings += self->selfCounters().crossings;
+      r.self += self->selfCounters();
       r.selfThickness_m = std::max(r.selfThickness_m, self->thickness_m());
     }
     r.framesRefined += world.solver(g).refinedFrames();

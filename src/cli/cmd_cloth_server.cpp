@@ -71,23 +71,22 @@ std::vector<GuestPoses> guestsOf(const RunSetup& full, const std::vector<std::st
                                  const std::string& simulated, const std::string& posesName) {
   std::vector<std::pair<std::size_t, std::string>> given;
   for (const std::string& option : options) {
-    const std::size_t eq = option.find('=');
-    if (eq == std::string::npos || eq == 0 || eq + 1 == option.size())
+    const std::optional<std::pair<std::size_t, std::string>> named = forCharacter(full, option, "--guest");
+    if (!named)
       throw Error(fmt::format("--guest {}: expected NAME=POSES, a character of the scene and the --name of its "
                               "anim-server",
                               option));
-    const std::string name = option.substr(0, eq), poses = option.substr(eq + 1);
+    const auto& [index, poses] = *named;
+    const std::string& name = full.characters[index].name;
     studio::checkSourceName(poses, "--guest " + name);
-    const CharacterSetup& c = characterNamed(full, name, "--guest " + option);
-    if (c.name == simulated)
+    if (name == simulated)
       throw Error(fmt::format("--guest {}: {} is the character this cloth-server dresses; its poses are --poses", option,
                               name));
     if (poses == posesName)
       throw Error(fmt::format("--guest {}: '{}' is the stream of the poses simulated (--poses)", option, poses));
-    const std::size_t index = static_cast<std::size_t>(&c - full.characters.data());
     for (const auto& [other, stream] : given)
       if (other == index) throw Error(fmt::format("--guest {}: {} is a guest twice", option, name));
-    given.emplace_back(index, poses);
+    given.push_back(*named);
   }
   std::sort(given.begin(), given.end());
   std::vector<GuestPoses> guests;

@@ -337,21 +337,23 @@ const std::vector<SelfContact>& SelfCollider::findContacts(const ClothState& bef
 }
 
 const std::vector<SelfContact>& SelfCollider::nextContacts(const ClothState& now) {
-  if (lastX_.size() != now.size()) remember(now);
   updatePairs(now);
   narrow(now);
   remember(now);
   return contacts_;
 }
 
-double SelfCollider::pairWeight(const SelfContact& c, std::array<double, 4>& im) const {
-  im[0] = inverseMass_[c.vertex];
-  double w = im[0];
+bool SelfCollider::now(const SelfContact& c, const ClothState& io, ContactNow& out) const {
+  const auto& tri = triangles_[c.triangle];
+  out.inverseMass[0] = inverseMass_[c.vertex];
+  out.weight = out.inverseMass[0];
   for (int k = 0; k < 3; ++k) {
-    im[k + 1] = inverseMass_[triangles_[c.triangle][k]];
-    w += c.weights[k] * c.weights[k] * im[k + 1];
+    out.inverseMass[k + 1] = inverseMass_[tri[k]];
+    out.weight += c.weights[k] * c.weights[k] * out.inverseMass[k + 1];
+    out.corners[k] = io.position(tri[k]);
   }
-  return w;
+  out.normal = c.side * unitNormal(out.corners);
+  return out.weight > 0 && !out.normal.isZero();
 }
 
 void SelfCollider::clearPushes() {
@@ -388,20 +390,14 @@ void SelfCollider::resolvePositions(ClothState& io) {
     clearPushes();
     bool any = false;
     for (const SelfContact& c : contacts_) {
-      std::array<double, 4> im;
-      const double w = pairWeight(c, im);
-      if (!(w > 0)) continue;
-      const auto& tri = triangles_[c.triangle];
-      const std::array<Vec3, 3> t{io.position(tri[0]), io.position(tri[1]), io.position(tri[2])};
-      const Vec3 n = c.side * unitNormal(t);
-      if (n.isZero()) continue;
-      const Vec3 q = c.weights[0] * t[0] + c.weights[1] * t[1] + c.weights[2] * t[2];
-      const double d = (io.position(c.vertex) - q).dot(n);
+      ContactNow f;
+      if (!now(c, io, f)) continue;
+      const Vec3 q = c.weights[0] * f.corners[0] + c.weights[1] * f.corners[1] + c.weights[2] * f.corners[2];
+      const double d = (io.position(c.vertex) - q).dot(f.normal);
       if (d >= thickness_) continue;
       if (sweep == 0) counters_.maxPenetration_m = std::max(counters_.maxPenetration_m, thickness_ - d);
       // The constraint (p - sum w_k t_k) . n >= h projected by inverse masses.
-      const Vec3 lambda = (thickness_ - d) / w * n;
-      pushApart(c, im, lambda);
+      pushApart(c, f.inverseMass, (thickness_ - d) / f.weight * f.normal);
       any = true;
     }
     if (!any) return;
@@ -413,12 +409,10 @@ void SelfCollider::resolveVelocities(ClothState& io) {
   clearPushes();
   bool any = false;
   for (const SelfContact& c : contacts_) {
-    std::array<double, 4> im;
-    const double w = pairWeight(c, im);
-    if (!(w > 0)) continue;
+    ContactNow f;
+    if (!now(c, io, f)) continue;
     const auto& tri = triangles_[c.triangle];
-    const Vec3 n = c.side * unitNormal({io.position(tri[0]), io.position(tri[1]), io.position(tri[2])});
-    if (n.isZero()) continue;
+    const Vec3& n = f.normal;
     const Vec3 vq =
         c.weights[0] * io.velocity(tri[0]) + c.weights[1] * io.velocity(tri[1]) + c.weights[2] * io.velocity(tri[2]);
     const Vec3 relative = io.velocity(c.vertex) - vq;
@@ -433,7 +427,7 @@ void SelfCollider::resolveVelocities(ClothState& io) {
     if (speed > 0)
       change -=
           (speed <= staticFriction_ * removed ? 1.0 : std::min(1.0, dynamicFriction_ * removed / speed)) * sliding;
-    pushApart(c, im, change / w);
+    pushApart(c, f.inverseMass, change / f.weight);
     any = true;
   }
   if (any) applyPushes(io.vx, io.vy, io.vz);
@@ -441,7 +435,6 @@ void SelfCollider::resolveVelocities(ClothState& io) {
 
 void SelfCollider::collide(const ClothModel&, double, double, ClothState& io) {
   ++counters_.calls;
-  if (lastX_.size() != io.size()) remember(io);
   if ((calls_++ % static_cast<std::uint64_t>(every_)) != 0) return;
   updatePairs(io);
   narrow(io);

@@ -50,6 +50,15 @@ void validate(const ClothMaterial& m) {
     bad(m.source, node, fmt::format("compressionScale {:g} is outside [0, 1]", m.compressionScale));
 }
 
+std::string offsetsProblem(const std::array<double, 4>& t) {
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (!std::isfinite(t[i]) || t[i] < 0.0) return fmt::format("offsets: T{} = {:g} m is negative", i, t[i]);
+    if (i > 0 && t[i] < t[i - 1])
+      return fmt::format("offsets must not decrease (T{} = {:g} m < T{} = {:g} m)", i, t[i], i - 1, t[i - 1]);
+  }
+  return "";
+}
+
 void validate(const SimulationSettings& s) {
   const std::string node = "Simulation";
   const auto positive = [&](double v, const char* field) {
@@ -78,14 +87,7 @@ void validate(const SimulationSettings& s) {
   if (!std::isfinite(s.airViscosity) || s.airViscosity < 0.0)
     bad(s.source, node, fmt::format("airViscosity {:g} is negative", s.airViscosity));
   if (!s.gravity.allFinite() || !s.wind.allFinite()) bad(s.source, node, "gravity and wind must be finite");
-  for (std::size_t i = 0; i < s.offsets.size(); ++i) {
-    if (!std::isfinite(s.offsets[i]) || s.offsets[i] < 0.0)
-      bad(s.source, node, fmt::format("offsets: T{} = {:g} m is negative", i, s.offsets[i]));
-    if (i > 0 && s.offsets[i] < s.offsets[i - 1])
-      bad(s.source, node,
-          fmt::format("offsets must not decrease (T{} = {:g} m < T{} = {:g} m)", i, s.offsets[i], i - 1,
-                      s.offsets[i - 1]));
-  }
+  if (const std::string problem = offsetsProblem(s.offsets); !problem.empty()) bad(s.source, node, problem);
   if (s.integrator.empty()) bad(s.source, node, "integrator is empty");
 }
 

@@ -153,14 +153,7 @@ class Builder {
       take("stepsPerFrame", [&] { s.stepsPerFrame = static_cast<int>(number(n, "stepsPerFrame", s.stepsPerFrame)); });
       take("airViscosity", [&] { s.airViscosity = number(n, "airViscosity", s.airViscosity); });
       take("wind", [&] { s.wind = vec3(n, "wind", s.wind); });
-      take("offsets", [&] {
-        const Field* f = n.field("offsets");
-        if (f->numbers.size() != 4)
-          throw Error::at(
-              where(n, "offsets"),
-              fmt::format("Simulation: offsets needs 4 values (T0 T1 T2 T3 in m), found {}", f->numbers.size()));
-        std::copy(f->numbers.begin(), f->numbers.end(), s.offsets.begin());
-      });
+      take("offsets", [&] { s.offsets = fourOffsets(n, "Simulation"); });
       take("voxelSize", [&] { s.voxelSize = number(n, "voxelSize", s.voxelSize); });
       take("integrator", [&] { s.integrator = string(n, "integrator"); });
       take("collisionEvery",
@@ -446,25 +439,24 @@ class Builder {
     scene_.garments.push_back(std::move(g));
   }
 
-  /// The ClothSet's `offsets` (T0..T3, m, non-negative, non-decreasing), or none when it
-  /// gives none.
+  /// The node's `offsets`, T0..T3 in m (four values, as offsetsProblem wants them); `label`
+  /// names the node in the error at the field's line.
+  static std::array<double, 4> fourOffsets(const Node& n, const std::string& label) {
+    const std::vector<double>& v = n.field("offsets")->numbers;
+    if (v.size() != 4)
+      throw Error::at(where(n, "offsets"),
+                      fmt::format("{}: offsets needs 4 values (T0 T1 T2 T3 in m), found {}", label, v.size()));
+    const std::array<double, 4> t{v[0], v[1], v[2], v[3]};
+    if (const std::string problem = offsetsProblem(t); !problem.empty())
+      throw Error::at(where(n, "offsets"), fmt::format("{}: {}", label, problem));
+    return t;
+  }
+
+  /// The ClothSet's own `offsets`, or none when it gives none (the Simulation node's hold).
   static std::optional<std::array<double, 4>> garmentOffsets(const Node& n, const std::string& name) {
     const Field* f = n.field("offsets");
     if (f == nullptr || f->numbers.empty()) return std::nullopt;
-    if (f->numbers.size() != 4)
-      throw Error::at(where(n, "offsets"), fmt::format("ClothSet {}: offsets needs 4 values (T0 T1 T2 T3 in m), found {}",
-                                                       name, f->numbers.size()));
-    std::array<double, 4> t{};
-    for (std::size_t i = 0; i < 4; ++i) {
-      t[i] = f->numbers[i];
-      if (!std::isfinite(t[i]) || t[i] < 0.0)
-        throw Error::at(where(n, "offsets"), fmt::format("ClothSet {}: offsets: T{} = {:g} m is negative", name, i, t[i]));
-      if (i > 0 && t[i] < t[i - 1])
-        throw Error::at(where(n, "offsets"), fmt::format("ClothSet {}: offsets must not decrease (T{} = {:g} m < T{} = "
-                                                         "{:g} m)",
-                                                         name, i, t[i], i - 1, t[i - 1]));
-    }
-    return t;
+    return fourOffsets(n, "ClothSet " + name);
   }
 
   /// The ClothSet's `stitches`: pairs of cloth vertex indices.

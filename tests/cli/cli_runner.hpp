@@ -83,6 +83,24 @@ DEF Skirt2 ClothSet {
   return path;
 }
 
+/// The two characters' example scene: Ada and Bea in the walking skirt, 1.2 m apart.
+inline const std::string kTwoCharacters = std::string(DRAPE_SOURCE_DIR) + "/examples/two_characters/scene.wrl";
+
+/// The two characters' scene with Bea at `translation` ("X Y Z", m) instead of 1.2 m to
+/// Ada's side, the files it names found from its own directory, written into `scratch` as
+/// close.wrl.
+inline std::string twoCharactersWithBeaAt(const ScratchDir& scratch, const std::string& translation) {
+  std::string text = slurp(kTwoCharacters);
+  text.replace(text.find("translation 1.2 0 0"), 19, "translation " + translation);
+  for (const std::string relative : {"\"../../data/", "\"../walking_skirt/"})
+    while (text.find(relative) != std::string::npos)
+      text.replace(text.find(relative), relative.size(),
+                   "\"" + std::string(DRAPE_SOURCE_DIR) + (relative[4] == '.' ? "/data/" : "/examples/walking_skirt/"));
+  const std::string scene = scratch / "close.wrl";
+  std::ofstream(scene) << text;
+  return scene;
+}
+
 /// A drape command running in the background (a studio role), its standard output and
 /// error in files of the scratch directory; killed, if still running, when it goes.
 class DrapeProcess {

@@ -23,14 +23,15 @@ namespace {
 
 using testing::CliResult;
 using testing::kSkirtDir;
+using testing::kTwoCharacters;
 using testing::runDrape;
 using testing::ScratchDir;
 using testing::slurp;
 using testing::statsOf;
+using testing::twoCharactersWithBeaAt;
 
 namespace fs = std::filesystem;
 
-const std::string kTwoCharacters = std::string(DRAPE_SOURCE_DIR) + "/examples/two_characters/scene.wrl";
 const std::string kDelfem2Walk = std::string(DRAPE_DATA_DIR) + "/mocap/cmu_walk_delfem2.bvh";
 constexpr int kCharacterFrames = 40;
 
@@ -213,15 +214,7 @@ TEST(Characters, ASkirtBrushingPastAnotherCharacterStaysOutOfHerLegs) {
   // in its scene, Ada's skirt sweeps through where Bea's legs stand; with Bea in the scene it
   // collides with them too (sim::Guest), as with Ada's own.
   ScratchDir dir("characters-contact");
-  std::string text = slurp(kTwoCharacters);
-  text.replace(text.find("translation 1.2 0 0"), 19, "translation 0.5 0 2");
-  // The files it names, from its own directory.
-  for (const std::string relative : {"\"../../data/", "\"../walking_skirt/"})
-    while (text.find(relative) != std::string::npos)
-      text.replace(text.find(relative), relative.size(),
-                   "\"" + std::string(DRAPE_SOURCE_DIR) + (relative[4] == '.' ? "/data/" : "/examples/walking_skirt/"));
-  const std::string scene = dir / "close.wrl";
-  std::ofstream(scene) << text;
+  const std::string scene = twoCharactersWithBeaAt(dir, "0.5 0 2");
   const std::string walk = kSkirtDir + "/walk.bvh", frames = " --frames 130";
   const std::string close = dir / "close", ada = dir / "ada";
   const CliResult r =

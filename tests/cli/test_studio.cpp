@@ -176,7 +176,6 @@ TEST(Studio, TwoClothServersSplitTheGarmentsAndThePlayerCollatesThem) {
   EXPECT_EQ(stats["cloth_servers"]["back"]["garments"][0]["name"], "Skirt2");
 }
 
-const std::string kTwoCharacters = std::string(DRAPE_SOURCE_DIR) + "/examples/two_characters/scene.wrl";
 
 /// A character's name as its roles' streams are named: "Ada" -> "ada".
 std::string streamNameOf(std::string name) {
@@ -240,20 +239,6 @@ TEST(Studio, TwoCharactersEachOnServersOfItsOwnAreDrapeRunsToTheByte) {
       << which.err;
 }
 
-/// The two characters' scene with Bea 35 cm to Ada's side instead of 1.2 m: walking side by
-/// side, each skirt brushes the other's legs. Written into `dir` as close.wrl.
-std::string closeCharactersScene(const ScratchDir& dir) {
-  std::string text = slurp(kTwoCharacters);
-  text.replace(text.find("translation 1.2 0 0"), 19, "translation 0.35 0 0");
-  for (const std::string relative : {"\"../../data/", "\"../walking_skirt/"})
-    while (text.find(relative) != std::string::npos)
-      text.replace(text.find(relative), relative.size(),
-                   "\"" + std::string(DRAPE_SOURCE_DIR) + (relative[4] == '.' ? "/data/" : "/examples/walking_skirt/"));
-  const std::string scene = dir / "close.wrl";
-  std::ofstream(scene) << text;
-  return scene;
-}
-
 TEST(Studio, CharactersThatTouchCollideThroughTheStudioAsInDrapeRun) {
   // Ada and Bea set off side by side, close, each on her own walk (Ada's 170 frames long,
   // Bea's 115): each cloth-server follows the other character's poses too (--guest), so
@@ -261,7 +246,8 @@ TEST(Studio, CharactersThatTouchCollideThroughTheStudioAsInDrapeRun) {
   // longest walk, Bea standing at her last pose after hers, as in drape run.
   ScratchDir dir("studio-touch");
   NatsServer server;
-  const std::string scene = closeCharactersScene(dir);
+  // Bea 35 cm to Ada's side: walking side by side, each skirt brushes the other's legs.
+  const std::string scene = twoCharactersWithBeaAt(dir, "0.35 0 0");
   const std::string reference = runInto(dir, "reference", "'" + scene + "'");
   EXPECT_EQ(statsOf(reference)["frames"].get<int>(), 170);
   // Ada's skirt alone, on the same walk: the skirts' runs must differ where they touch.

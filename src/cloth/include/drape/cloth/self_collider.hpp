@@ -64,6 +64,16 @@ struct SelfCounters {
   std::uint64_t contacts = 0;    ///< pairs within the thickness or crossed, resolved
   std::uint64_t crossings = 0;   ///< of those, crossed
   std::uint64_t rebuilds = 0;    ///< tests that made the candidate list again
+
+  /// Another garment's counts with these (a benchmark's sum).
+  SelfCounters& operator+=(const SelfCounters& other) {
+    tests += other.tests;
+    candidates += other.candidates;
+    contacts += other.contacts;
+    crossings += other.crossings;
+    rebuilds += other.rebuilds;
+    return *this;
+  }
 };
 
 class SelfCollider final : public Collider {
@@ -127,8 +137,18 @@ class SelfCollider final : public Collider {
   void pushApart(const SelfContact& c, const std::array<double, 4>& im, const Vec3& lambda);
   /// Moves every pushed vertex's (x, y, z) by the average of its pushes.
   void applyPushes(std::vector<double>& x, std::vector<double>& y, std::vector<double>& z) const;
-  /// The inverse masses of the contact's vertex and corners, and their weighted sum.
-  [[nodiscard]] double pairWeight(const SelfContact& c, std::array<double, 4>& im) const;
+  /// A contact as the state stands now: the inverse masses of its vertex and corners and
+  /// their weighted sum (the constraint's), the corners, and the face normal on the vertex's
+  /// side.
+  struct ContactNow {
+    std::array<double, 4> inverseMass{};
+    double weight = 0;
+    std::array<Vec3, 3> corners;
+    Vec3 normal;
+  };
+  /// The contact at `io` into `out`; false when nothing of it can move or its triangle has
+  /// collapsed.
+  [[nodiscard]] bool now(const SelfContact& c, const ClothState& io, ContactNow& out) const;
   [[nodiscard]] std::uint32_t bucketOf(std::int64_t ix, std::int64_t iy, std::int64_t iz) const;
   /// Calls visit(bucket) for every cell the box [lo, hi] touches.
   template <typename Visit>

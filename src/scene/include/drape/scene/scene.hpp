@@ -138,5 +138,8 @@ struct Scene {
 void validate(const ClothMaterial& material);
 /// Checks simulation settings the same way.
 void validate(const SimulationSettings& settings);
+/// What is wrong with offset surfaces T0..T3 (m: finite, non-negative, non-decreasing), as
+/// "offsets: ..."; "" when nothing is (a Simulation node's, a ClothSet's).
+[[nodiscard]] std::string offsetsProblem(const std::array<double, 4>& offsets);
 
 }  // namespace drape::scene

@@ -67,7 +67,7 @@ struct PaperRun {
   int collisionEvery = 1;
   int bendEvery = 1;
   cloth::FieldCollisionCounters counters;
-  cloth::SelfCounters self;  ///< the garments' self collision, summed
+  cloth::LayerCounters self;  ///< the garments' self collision, summed
   double selfThickness_m = 0;  ///< the largest
   std::size_t triangles = 0;
   int substeps = 0;
@@ -149,8 +149,8 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
     r.colliderPoseSeconds += world.collider(g)->poseSeconds();
     r.poseSeconds += world.collider(g)->poseSeconds() + t.fixturePoses_s;
     r.counters += world.collider(g)->fieldCounters();
-    if (const cloth::SelfCollider* self = world.selfCollider(g)) {
-      r.self += self->selfCounters();
+    if (const cloth::LayerCollider* self = world.layerCollider(g)) {
+      r.self += self->layerCounters();
       r.selfThickness_m = std::max(r.selfThickness_m, self->thickness_m());
     }
     r.framesRefined += world.solver(g).refinedFrames();

@@ -73,6 +73,9 @@ void printGarment(std::ostream& out, const scene::Scene& s, const scene::Garment
                1e3 * (*g.offsets)[1], 1e3 * (*g.offsets)[2], 1e3 * (*g.offsets)[3]);
   if (g.selfCollision > 0)
     fmt::print(out, "    its own layers kept {:.4g} mm apart (selfCollision)\n", 1e3 * g.selfCollision);
+  if (!g.over.empty())
+    fmt::print(out, "    worn {:.4g} mm over {} (over, overGap; stepped after them)\n", 1e3 * g.overGap,
+               fmt::join(g.over, ", "));
   if (!g.stitches.empty())
     fmt::print(out, "    {} stitches, drawing together vertices up to {:.1f} mm apart\n", g.stitches.size(),
                1e3 * widestStitch_m(g.mesh, g.stitches));

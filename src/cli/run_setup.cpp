@@ -15,7 +15,7 @@
 
 #include "drape/cloth/forces.hpp"
 #include "drape/cloth/model.hpp"
-#include "drape/cloth/self_collider.hpp"
+#include "drape/cloth/layer_collider.hpp"
 #include "drape/cloth/solver.hpp"
 #include "drape/core/error.hpp"
 #include "drape/core/files.hpp"
@@ -28,6 +28,7 @@
 #include "drape/render/frame.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/body_overlap.hpp"
+#include "drape/sim/garment_layers.hpp"
 #include "drape/sim/scene_setup.hpp"
 #include "frames_ahead.hpp"
 #include "measure.hpp"
@@ -91,8 +92,8 @@ struct GarmentRun {
   std::unique_ptr<cloth::ClothSolver> ownedSolver;  ///< without a character
   cloth::ClothSolver* solver = nullptr;             ///< owned here or by the character world
   const cloth::FieldCollider* collider = nullptr;   ///< on a character
-  std::unique_ptr<cloth::SelfCollider> ownedSelf;   ///< without a character
-  const cloth::SelfCollider* self = nullptr;        ///< its layers kept apart, or null
+  std::unique_ptr<cloth::LayerCollider> ownedLayers;  ///< without a character
+  const cloth::LayerCollider* layers = nullptr;        ///< its layers kept apart, or null
   std::vector<cloth::SphereCollider> spheres;       ///< its own static spheres (--sphere)
 };
 
@@ -897,10 +898,25 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
     static const std::vector<sim::BodyOverlap> none;
     return worlds.size() > 0 ? overlaps[worlds.characterOf(g)] : none;
   };
-  std::vector<GarmentRun> runs;
+  std::vector<GarmentRun> runs(setup.garments.size());
+  // Without a character every solver first, then the layer colliders, which read the
+  // solvers of the garments below.
+  std::vector<std::vector<std::size_t>> below;
+  std::vector<int> layers(setup.garments.size(), 0);
+  if (worlds.size() == 0) {
+    below = sim::garmentsBelow(setup.garments);
+    layers = sim::layersOf(below);
+    for (std::size_t gi = 0; gi < setup.garments.size(); ++gi) {
+      const GarmentSetup& g = setup.garments[gi];
+      const mesh::Topology topology = mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
+      auto model = cloth::ClothModel::build(g.mesh, topology, g.material, settings.massScaling());
+      runs[gi].ownedSolver = std::make_unique<cloth::ClothSolver>(model, settings, pinsOf(g, *model));
+      runs[gi].ownedSolver->setStitches(g.stitches, g.name);
+    }
+  }
   for (std::size_t gi = 0; gi < setup.garments.size(); ++gi) {
     const GarmentSetup& g = setup.garments[gi];
-    GarmentRun r;
+    GarmentRun& r = runs[gi];
     r.name = g.name;
     if (worlds.size() > 0) {
       r.solver = &worlds.solver(gi);
@@ -910,24 +926,24 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
       collider->setContactPlanes(!setup.exactSliding);
       collider->setPinchHold(!setup.freePinches);
       logEasedPairs(g.name, *collider);
-      r.self = worlds.world(worlds.characterOf(gi)).selfCollider(worlds.indexInWorld(gi));
+      const sim::CharacterWorld& world = worlds.world(worlds.characterOf(gi));
+      r.layers = world.layerCollider(worlds.indexInWorld(gi));
+      layers[gi] = world.layer(worlds.indexInWorld(gi));
     } else {
-      const mesh::Topology topology = mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
-      auto model = cloth::ClothModel::build(g.mesh, topology, g.material, settings.massScaling());
-      r.ownedSolver = std::make_unique<cloth::ClothSolver>(model, settings, pinsOf(g, *model));
-      r.ownedSolver->setStitches(g.stitches, g.name);
       r.solver = r.ownedSolver.get();
-      if (g.selfCollision_m > 0) {  // before the spheres: where they disagree, a sphere wins
-        r.ownedSelf = std::make_unique<cloth::SelfCollider>(*model, g.name, g.selfCollision_m, g.collisionEvery);
-        r.ownedSelf->setFixedVertices(g.pinned);
-        r.ownedSelf->setStitches(g.stitches);
-        r.ownedSolver->addCollider(*r.ownedSelf);
-        r.self = r.ownedSelf.get();
-      }
+      // Before the spheres: where they disagree, a sphere wins.
+      r.ownedLayers = sim::makeLayerCollider(
+          setup.garments, gi, below[gi], g.pinned,
+          [&](std::size_t i) -> const cloth::ClothSolver& { return *runs[i].ownedSolver; }, 1.0 / settings.frameRate_hz);
+      if (r.ownedLayers) r.ownedSolver->addCollider(*r.ownedLayers);
+      r.layers = r.ownedLayers.get();
     }
-    if (r.self)
+    if (r.layers && r.layers->thickness_m() > 0)
       spdlog::info("{}: its layers kept {:.4g} mm apart (self collision, tested every {} substeps)", g.name,
-                   1e3 * r.self->thickness_m(), r.self->every());
+                   1e3 * r.layers->thickness_m(), r.layers->every());
+    if (r.layers && !r.layers->garmentsBelow().empty())
+      spdlog::info("{}: kept {:.4g} mm over {} (stepped after them, tested every {} substeps)", g.name,
+                   1e3 * r.layers->gap_m(), fmt::join(r.layers->garmentsBelow(), ", "), r.layers->every());
     r.model = &r.solver->model();
     // Each garment its own spheres: garments step in parallel, and a collider keeps counts.
     r.spheres.reserve(setup.spheres.size());  // the solver keeps references
@@ -949,7 +965,6 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
                    "the run may diverge (try --substeps {} or more)",
                    g.name, settings.substep_s(), stable,
                    static_cast<long>(std::ceil(1.0 / (settings.frameRate_hz * stable))));
-    runs.push_back(std::move(r));
   }
   sink.begin(worlds.all());
 
@@ -1018,7 +1033,8 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
         }
         const Clock::time_point start = Clock::now();
         const std::vector<std::uint8_t> stable =
-            sim::stepInParallel(runs.size(), frame, [&](std::size_t g) -> cloth::ClothSolver& { return *runs[g].solver; });
+            sim::stepInParallel(runs.size(), frame, [&](std::size_t g) -> cloth::ClothSolver& { return *runs[g].solver; },
+                                layers);
         for (std::size_t g = 0; g < runs.size() && unstable.empty(); ++g) {
           sim::logFrameRecovery(*runs[g].solver, setup.garments[g].name, frame);
           if (!stable[g]) {
@@ -1121,14 +1137,23 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
         if (p.faceSamples) faces.push_back(p.name);
       entry["face_samples_with"] = faces;
     }
-    if (const cloth::SelfCollider* self = runs[g].self) {
-      const cloth::SelfCounters& s = self->selfCounters();
-      entry["self_collision"] = {{"thickness_m", self->thickness_m()},
-                                 {"tests", s.tests},
-                                 {"candidate_pairs", s.candidates},
-                                 {"candidate_lists_made", s.rebuilds},
-                                 {"contacts", s.contacts},
-                                 {"crossings", s.crossings}};
+    if (const cloth::LayerCollider* layers = runs[g].layers) {
+      const cloth::LayerCounters& s = layers->layerCounters();
+      if (layers->thickness_m() > 0)
+        entry["self_collision"] = {{"thickness_m", layers->thickness_m()},
+                                   {"tests", s.tests},
+                                   {"candidate_pairs", s.candidates},
+                                   {"candidate_lists_made", s.rebuilds},
+                                   {"contacts", s.contacts},
+                                   {"crossings", s.crossings}};
+      if (!layers->garmentsBelow().empty())
+        entry["worn_over"] = {{"garments", layers->garmentsBelow()},
+                              {"gap_m", layers->gap_m()},
+                              {"tests", s.tests},
+                              {"candidate_pairs", s.candidates},
+                              {"candidate_lists_made", s.rebuilds},
+                              {"contacts", s.contactsBelow},
+                              {"crossings", s.crossingsBelow}};
     }
     garments.push_back(std::move(entry));
   }

@@ -99,6 +99,7 @@ class Builder {
     const Affine root = Affine(Eigen::Scaling(scene_.simulation.unitScale));
     for (std::int32_t r : doc_.roots) walk(r, root);
     for (const PendingGarment& g : pending_) garment(g);
+    checkLayers();
     return std::move(scene_);
   }
 
@@ -424,6 +425,13 @@ class Builder {
       throw Error::at(where(n, "selfCollision"),
                       fmt::format("ClothSet {}: selfCollision {:g} m: expected a thickness, 0 (none) or more", g.name,
                                   g.selfCollision));
+    g.over = strings(n, "over");
+    g.overGap = number(n, "overGap", g.overGap);
+    if (!(g.overGap > 0.0) || !std::isfinite(g.overGap))
+      throw Error::at(where(n, "overGap"),
+                      fmt::format("ClothSet {}: overGap {:g} m: expected a gap above the garments it is worn over, more "
+                                  "than 0",
+                                  g.name, g.overGap));
     g.offsets = garmentOffsets(n, g.name);
     g.collidesWith = strings(n, "collidesWith");
     g.faceSamplesWith = strings(n, "faceSamplesWith");
@@ -483,6 +491,65 @@ class Builder {
       out.push_back({static_cast<std::uint32_t>(v[i]), static_cast<std::uint32_t>(v[i + 1])});
     }
     return out;
+  }
+
+  /// Every garment's `over`: garments of the scene, worn by the same character, neither
+  /// itself nor, through others, over itself (garments are stepped from the innermost out).
+  void checkLayers() const {
+    const std::vector<Garment>& all = scene_.garments;
+    const auto indexOf = [&](const std::string& name) {
+      for (std::size_t i = 0; i < all.size(); ++i)
+        if (all[i].name == name) return static_cast<int>(i);
+      return -1;
+    };
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      const Garment& g = all[i];
+      const Node& n = at(pending_[i].node);
+      for (const std::string& name : g.over) {
+        const int below = indexOf(name);
+        if (below < 0) {
+          std::vector<std::string> names;
+          for (const Garment& other : all) names.push_back(other.name);
+          throw Error::at(where(n, "over"), fmt::format("ClothSet {}: over names '{}', which is no garment of the "
+                                                        "scene (it has: {})",
+                                                        g.name, name, fmt::join(names, ", ")));
+        }
+        if (static_cast<std::size_t>(below) == i)
+          throw Error::at(where(n, "over"), fmt::format("ClothSet {}: over names itself", g.name));
+        const Garment& b = all[static_cast<std::size_t>(below)];
+        if (b.avatar != g.avatar || b.externalAvatar != g.externalAvatar)
+          throw Error::at(where(n, "over"),
+                          fmt::format("ClothSet {}: over names '{}', which another character wears (or none): a "
+                                      "garment is kept over its own character's garments only",
+                                      g.name, name));
+      }
+    }
+    // A cycle: some garment reached again from itself through the `over` names.
+    for (std::size_t start = 0; start < all.size(); ++start) {
+      std::vector<std::size_t> path{start}, next{0};
+      while (!path.empty()) {
+        const Garment& g = all[path.back()];
+        if (next.back() >= g.over.size()) {
+          path.pop_back();
+          next.pop_back();
+          continue;
+        }
+        const auto below = static_cast<std::size_t>(indexOf(g.over[next.back()++]));
+        if (below == start) {
+          std::vector<std::string> names;
+          for (std::size_t p : path) names.push_back(all[p].name);
+          names.push_back(all[start].name);
+          throw Error::at(where(at(pending_[start].node), "over"),
+                          fmt::format("ClothSet {}: worn over itself through {}: the garments' over names must not "
+                                      "go round",
+                                      all[start].name, fmt::join(names, " over ")));
+        }
+        if (std::find(path.begin(), path.end(), below) == path.end() && path.size() <= all.size()) {
+          path.push_back(below);
+          next.push_back(0);
+        }
+      }
+    }
   }
 
   void avatarOf(const Node& n, Garment& g) {

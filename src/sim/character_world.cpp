@@ -14,6 +14,7 @@
 #include "drape/core/log.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/motion/interpolate.hpp"
+#include "drape/sim/garment_layers.hpp"
 
 namespace drape::sim {
 namespace {
@@ -110,6 +111,8 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
                             animation->jointCount(), avatar.joints.size()), ExitCode::Internal);
   }
   poses_ = std::make_unique<AvatarPoses>(avatar, animation, settings.leadIn_s);
+  const std::vector<std::vector<std::size_t>> below = garmentsBelow(garments);  // refused before any work
+  layers_ = layersOf(below);
   for (GarmentSpec& g : garments)
     if (!g.offsetsGiven) g.offsets = cloth::OffsetSurfaces::fromVoxelSize(settings.voxel_m);
   // The garments' models first: a material or a step they cannot take is refused before the
@@ -175,18 +178,20 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
     run.solver = std::make_unique<cloth::ClothSolver>(model, settings_.step, std::move(pins));
     run.solver->setStitches(spec.stitches, spec.name);
     run.collider->initialise(run.solver->state(), 0.0);
-    // Its layers apart first, then the body: where the two disagree, the body wins.
-    if (spec.selfCollision_m > 0) {
-      run.self = std::make_unique<cloth::SelfCollider>(*model, spec.name, spec.selfCollision_m, spec.collisionEvery);
-      run.self->setFixedVertices(fixed);
-      run.self->setStitches(spec.stitches);
-      run.self->initialise(run.solver->state());
-      run.solver->addCollider(*run.self);
-    }
-    run.solver->addCollider(*run.collider);
-    run.spec = std::move(spec);
+    run.fixed = std::move(fixed);
     garments_.push_back(std::move(run));
   }
+  // Every solver made: the layers apart first (its own, the garments it is worn over), then
+  // the body: where the two disagree, the body wins.
+  for (std::size_t g = 0; g < garments.size(); ++g) {
+    GarmentRun& run = garments_[g];
+    run.layers = makeLayerCollider(garments, g, below[g], run.fixed, [&](std::size_t i) -> const cloth::ClothSolver& {
+      return *garments_[i].solver;
+    }, 1.0 / settings_.step.frameRate_hz);
+    if (run.layers) run.solver->addCollider(*run.layers);
+    run.solver->addCollider(*run.collider);
+  }
+  for (std::size_t g = 0; g < garments.size(); ++g) garments_[g].spec = std::move(garments[g]);
 }
 
 CharacterWorld::~CharacterWorld() = default;
@@ -629,7 +634,8 @@ bool CharacterWorld::checkStable(const std::vector<std::uint8_t>& stables, long 
 }
 
 std::vector<std::uint8_t> CharacterWorld::stepGarments(long frame) {
-  return stepInParallel(garments_.size(), frame, [&](std::size_t g) -> cloth::ClothSolver& { return *garments_[g].solver; });
+  return stepInParallel(
+      garments_.size(), frame, [&](std::size_t g) -> cloth::ClothSolver& { return *garments_[g].solver; }, layers_);
 }
 
 void logFrameRecovery(const cloth::ClothSolver& solver, const std::string& garment, long frame) {
@@ -640,15 +646,25 @@ void logFrameRecovery(const cloth::ClothSolver& solver, const std::string& garme
 }
 
 std::vector<std::uint8_t> stepInParallel(std::size_t count, long frame,
-                                         const std::function<cloth::ClothSolver&(std::size_t)>& solver) {
-  // Garments do not touch each other: each steps on whichever thread is free, with its own
-  // poses and colliders, and comes out the same on any number of threads.
+                                         const std::function<cloth::ClothSolver&(std::size_t)>& solver,
+                                         std::span<const int> layers) {
+  // Garments of one layer do not touch each other: each steps on whichever thread is free,
+  // with its own poses and colliders, and comes out the same on any number of threads. A
+  // garment worn over others steps after them (a layer above), reading the frame they made.
   std::vector<std::uint8_t> stable(count, 0);
   if (count == 1) {  // one garment: on this thread, without a task
     stable[0] = solver(0).stepFrame(frame) ? 1 : 0;
     return stable;
   }
-  tbb::parallel_for(std::size_t{0}, count, [&](std::size_t g) { stable[g] = solver(g).stepFrame(frame) ? 1 : 0; });
+  const int top = layers.empty() ? 0 : *std::max_element(layers.begin(), layers.end());
+  std::vector<std::size_t> these;
+  for (int layer = 0; layer <= top; ++layer) {
+    these.clear();
+    for (std::size_t g = 0; g < count; ++g)
+      if (layers.empty() || layers[g] == layer) these.push_back(g);
+    tbb::parallel_for(std::size_t{0}, these.size(),
+                      [&](std::size_t i) { stable[these[i]] = solver(these[i]).stepFrame(frame) ? 1 : 0; });
+  }
   return stable;
 }
 

@@ -85,6 +85,8 @@ GarmentSpec garmentSpec(const scene::Scene& scene, const scene::Garment& g, cons
   spec.bindThreshold_m = g.bindThreshold;
   spec.stitches = cloth::stitchesDrawnTogether(g.stitches);
   spec.selfCollision_m = g.selfCollision;
+  spec.over = g.over;
+  spec.overGap_m = g.overGap;
   if (avatar) {
     spec.bound = g.maskVertices;
     spec.collidesWith = g.collidesWith;

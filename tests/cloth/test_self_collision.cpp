@@ -1,4 +1,4 @@
-// Self collision (cloth/self_collider.hpp): the grid and the list kept between tests find
+// Self collision (cloth/layer_collider.hpp): the grid and the list kept between tests find
 // the pairs brute force finds; a layer dropped on another comes to rest one thickness above
 // it, a folded strip does not pass through itself (without the collider both pass through),
 // and a layer sliding on another decelerates at mu g.
@@ -13,7 +13,7 @@
 #include <fmt/format.h>
 
 #include "cloth_fixture.hpp"
-#include "drape/cloth/self_collider.hpp"
+#include "drape/cloth/layer_collider.hpp"
 
 namespace drape::cloth {
 namespace self_collision_test {
@@ -57,19 +57,22 @@ ClothState statesAt(const mesh::TriMesh& m) {
   return s;
 }
 
-/// The pairs brute force finds between `s0` and `s1` of mesh `m`, as the set the tests compare.
-std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> bruteContacts(const SelfCollider& collider,
+/// The pairs brute force finds between `s0` and `s1` of mesh `m` (the collider's numbering:
+/// its own garment's and those below), as the set the tests compare: every pair the
+/// collider tests, at the thickness it keeps it at.
+std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> bruteContacts(const LayerCollider& collider,
                                                                                const mesh::TriMesh& m,
                                                                                const ClothState& s0,
-                                                                               const ClothState& s1, double thickness) {
+                                                                               const ClothState& s1) {
   std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> out;
   for (std::uint32_t v = 0; v < m.positions.size(); ++v)
     for (std::uint32_t t = 0; t < m.triangles.size(); ++t) {
-      if (collider.excluded(v, t) || !collider.movable(v, t)) continue;
+      const double thickness = collider.pairThickness(v, t);
+      if (thickness == 0) continue;
       const mesh::Triangle& tri = m.triangles[t];
       const std::array<Vec3, 3> t0{s0.position(tri[0]), s0.position(tri[1]), s0.position(tri[2])};
       const std::array<Vec3, 3> t1{s1.position(tri[0]), s1.position(tri[1]), s1.position(tri[2])};
-      if (auto c = selfContact(s0.position(v), s1.position(v), t0, t1, thickness))
+      if (auto c = layerContact(s0.position(v), s1.position(v), t0, t1, thickness))
         out.insert({v, t, c->side, c->crossed});
     }
   return out;
@@ -87,12 +90,12 @@ TEST(SelfCollision, TheGridFindsWhatBruteForceFinds) {
     std::uniform_real_distribution<double> move(-0.4 * thickness, 0.4 * thickness);
     for (Vec3& p : after.positions) p += Vec3(move(random), move(random), move(random));
     const auto model = makeModel(before, knit());
-    SelfCollider collider(*model, "folded", thickness);
+    LayerCollider collider(*model, "folded", thickness);
     const ClothState s0 = statesAt(before), s1 = statesAt(after);
 
     std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> grid;
-    for (const SelfContact& c : collider.findContacts(s0, s1)) grid.insert({c.vertex, c.triangle, c.side, c.crossed});
-    const auto brute = bruteContacts(collider, before, s0, s1, thickness);
+    for (const LayerContact& c : collider.findContacts(s0, s1)) grid.insert({c.vertex, c.triangle, c.side, c.crossed});
+    const auto brute = bruteContacts(collider, before, s0, s1);
     std::string missing, extra;
     for (const auto& c : brute)
       if (!grid.count(c)) missing += fmt::format(" ({}, {})", std::get<0>(c), std::get<1>(c));
@@ -117,7 +120,7 @@ TEST(SelfCollision, TheListKeptBetweenTestsFindsWhatBruteForceFinds) {
   const double thickness = 0.3 / cells;
   const mesh::TriMesh rest = foldedSheet(cells, thickness, 0.2 * thickness, random);
   const auto model = makeModel(rest, knit());
-  SelfCollider collider(*model, "folded", thickness);
+  LayerCollider collider(*model, "folded", thickness);
   ClothState before = statesAt(rest), now = before;
   collider.initialise(before);
   std::size_t total = 0;
@@ -128,22 +131,22 @@ TEST(SelfCollision, TheListKeptBetweenTestsFindsWhatBruteForceFinds) {
       now.setPosition(
           v, now.position(v) + carried + wander * Vec3(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5));
     std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> kept;
-    for (const SelfContact& c : collider.nextContacts(now)) kept.insert({c.vertex, c.triangle, c.side, c.crossed});
-    const auto brute = bruteContacts(collider, rest, before, now, thickness);
+    for (const LayerContact& c : collider.nextContacts(now)) kept.insert({c.vertex, c.triangle, c.side, c.crossed});
+    const auto brute = bruteContacts(collider, rest, before, now);
     EXPECT_EQ(kept, brute) << "test " << test;
     total += brute.size();
     before = now;
   }
   EXPECT_GT(total, 1000u);
   // The list was kept over most tests and made again when the points had wandered.
-  EXPECT_GE(collider.selfCounters().rebuilds, 10u);
-  EXPECT_LT(collider.selfCounters().rebuilds, 60u);
+  EXPECT_GE(collider.layerCounters().rebuilds, 10u);
+  EXPECT_LT(collider.layerCounters().rebuilds, 60u);
 }
 
 TEST(SelfCollision, ExcludesTheTrianglesAroundAVertexAndItsNeighbours) {
   SheetSpec spec{0.8, 0.8, 8, 8, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), "sheet"};
   const auto model = makeModel(gridSheet(spec), knit());
-  SelfCollider collider(*model, "sheet", 0.01);
+  LayerCollider collider(*model, "sheet", 0.01);
   const std::uint32_t centre = sheetVertex(spec, 4, 4);
   std::size_t kept = 0;
   for (std::uint32_t t = 0; t < model->triangleCount(); ++t) {
@@ -168,7 +171,7 @@ TEST(SelfCollision, ANarrowTestSaysWhichSideAndWhetherItCrossed) {
   const std::array<Vec3, 3> tri{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 0, 1)};  // normal -y
   const double h = 0.01;
   // Above (on -normal's side), coming within h: a contact on side -1, not crossed.
-  auto c = selfContact(Vec3(0.2, 0.05, 0.2), Vec3(0.2, 0.005, 0.2), tri, tri, h);
+  auto c = layerContact(Vec3(0.2, 0.05, 0.2), Vec3(0.2, 0.005, 0.2), tri, tri, h);
   ASSERT_TRUE(c);
   EXPECT_EQ(c->side, -1.0);
   EXPECT_FALSE(c->crossed);
@@ -176,15 +179,15 @@ TEST(SelfCollision, ANarrowTestSaysWhichSideAndWhetherItCrossed) {
   EXPECT_NEAR(c->weights[1], 0.2, 1e-12);
   EXPECT_NEAR(c->weights[2], 0.2, 1e-12);
   // Through it: crossed, still side -1.
-  c = selfContact(Vec3(0.2, 0.005, 0.2), Vec3(0.2, -0.02, 0.2), tri, tri, h);
+  c = layerContact(Vec3(0.2, 0.005, 0.2), Vec3(0.2, -0.02, 0.2), tri, tri, h);
   ASSERT_TRUE(c);
   EXPECT_EQ(c->side, -1.0);
   EXPECT_TRUE(c->crossed);
   // Farther than h, or beside the triangle: none.
-  EXPECT_FALSE(selfContact(Vec3(0.2, 0.05, 0.2), Vec3(0.2, 0.02, 0.2), tri, tri, h));
-  EXPECT_FALSE(selfContact(Vec3(0.8, 0.05, 0.8), Vec3(0.8, 0.0, 0.8), tri, tri, h));
+  EXPECT_FALSE(layerContact(Vec3(0.2, 0.05, 0.2), Vec3(0.2, 0.02, 0.2), tri, tri, h));
+  EXPECT_FALSE(layerContact(Vec3(0.8, 0.05, 0.8), Vec3(0.8, 0.0, 0.8), tri, tri, h));
   // Staying on the other side, far below: none (another layer, not a crossing).
-  EXPECT_FALSE(selfContact(Vec3(0.2, -0.05, 0.2), Vec3(0.2, -0.04, 0.2), tri, tri, h));
+  EXPECT_FALSE(layerContact(Vec3(0.2, -0.05, 0.2), Vec3(0.2, -0.04, 0.2), tri, tri, h));
 }
 
 /// Two squares in one garment: a lower one held flat at y = 0 and a smaller free one `drop`
@@ -200,7 +203,7 @@ std::pair<double, double> dropLayer(double thickness, double seconds, bool selfC
   for (std::uint32_t v = 0; v < 121; ++v) held[v] = v;
   const StepSettings settings = settingsWithStep(0.5 * model->estimatedStableStep_s(), 0.02);
   ClothSolver solver(model, settings, {pinAt(*model, held)});
-  SelfCollider collider(*model, "layers", thickness);
+  LayerCollider collider(*model, "layers", thickness);
   collider.setFixedVertices(held);
   if (selfCollision) solver.addCollider(collider);
   EXPECT_TRUE(run(solver, static_cast<long>(seconds / settings.substep_s())));
@@ -210,7 +213,7 @@ std::pair<double, double> dropLayer(double thickness, double seconds, bool selfC
     hi = std::max(hi, solver.state().y[v]);
   }
   if (selfCollision) {
-    EXPECT_GT(collider.selfCounters().contacts, 0u);
+    EXPECT_GT(collider.layerCounters().contacts, 0u);
   }
   return {lo, hi};
 }
@@ -231,7 +234,7 @@ TEST(SelfCollision, ALayerDroppedOnAnotherRestsOneThicknessAboveIt) {
 /// radius 15 mm at x = 0.4, the upper leg (0.25 m) free, coming back over the lower. After
 /// 0.3 s (it lands at about 0.1 s), the lowest height of the upper leg's vertices 5 cm or
 /// more from the fold.
-double foldedStripGap(double thickness, bool selfCollision, SelfCounters& counters) {
+double foldedStripGap(double thickness, bool selfCollision, LayerCounters& counters) {
   const double legs = 0.4, upper = 0.25, radius = 0.015, arc = M_PI * radius, length = legs + arc + upper;
   SheetSpec spec{length, 0.1, 60, 6, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), "strip"};
   mesh::TriMesh m = gridSheet(spec);
@@ -253,11 +256,11 @@ double foldedStripGap(double thickness, bool selfCollision, SelfCounters& counte
   const auto model = makeModel(m, mat);
   const StepSettings settings = settingsWithStep(0.5 * model->estimatedStableStep_s(), 0.02);
   ClothSolver solver(model, settings, {pinAt(*model, held)});
-  SelfCollider collider(*model, "strip", thickness);
+  LayerCollider collider(*model, "strip", thickness);
   collider.setFixedVertices(held);
   if (selfCollision) solver.addCollider(collider);
   EXPECT_TRUE(run(solver, static_cast<long>(0.3 / settings.substep_s())));
-  counters = collider.selfCounters();
+  counters = collider.layerCounters();
   double gap = 1e9;
   for (std::size_t v = 0; v < m.positions.size(); ++v)
     if (model->restX()[v] < legs - 0.05 && model->restY()[v] > radius) {
@@ -271,7 +274,7 @@ double foldedStripGap(double thickness, bool selfCollision, SelfCounters& counte
 
 TEST(SelfCollision, AFoldedStripDoesNotPassThroughItself) {
   const double h = 0.004;
-  SelfCounters counters;
+  LayerCounters counters;
   // The upper leg sags onto the lower one and rests a thickness above it.
   const double gap = foldedStripGap(h, true, counters);
   EXPECT_GT(gap, 0.9 * h);
@@ -299,7 +302,7 @@ std::vector<double> slidingSpeeds(const std::vector<double>& times, double mu) {
   for (std::uint32_t v = 0; v < 121; ++v) held[v] = v;
   const StepSettings settings = settingsWithStep(0.5 * model->estimatedStableStep_s());
   ClothSolver solver(model, settings, {pinAt(*model, held)});
-  SelfCollider collider(*model, "layers", h);
+  LayerCollider collider(*model, "layers", h);
   collider.setFixedVertices(held);
   solver.addCollider(collider);
   for (std::size_t v = 121; v < m.positions.size(); ++v) solver.mutableState().vx[v] = 0.5;
@@ -327,16 +330,22 @@ TEST(SelfCollision, ALayerSlidingOnAnotherDeceleratesAtMuG) {
   }
 }
 
-TEST(SelfCollision, AThicknessMustBePositive) {
+TEST(SelfCollision, AThicknessMustBeAPositiveLengthOrNone) {
   SheetSpec spec{0.4, 0.4, 2, 2, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), "sheet"};
   const auto model = makeModel(gridSheet(spec), knit());
   try {
-    SelfCollider collider(*model, "skirt", 0.0);
+    LayerCollider collider(*model, "skirt", -0.001);
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("garment 'skirt': self-collision thickness 0 m"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("garment 'skirt': self-collision thickness -0.001 m must be 0 (none) or a "
+                                         "positive length"),
+              std::string::npos)
         << e.what();
   }
+  // 0: its own layers are never tested against each other.
+  const LayerCollider none(*model, "skirt", 0.0);
+  for (std::uint32_t v = 0; v < model->vertexCount(); ++v)
+    for (std::uint32_t t = 0; t < model->triangleCount(); ++t) EXPECT_EQ(none.pairThickness(v, t), 0.0);
 }
 
 }  // namespace self_collision_test

@@ -315,6 +315,40 @@ TEST(VrmlScene, DomainErrorsFromTheBadCorpus) {
   at("simulation_zero_steps.wrl", 4, "stepsPerFrame 0 must be at least 1");
 }
 
+TEST(VrmlScene, GarmentsWornOverGarments) {
+  const std::string body = "#VRML V2.0 utf8\nDEF H Humanoid { humanoidBody Joint { children Segment { name \"hips\" } } }\n"
+                           "DEF G Humanoid { humanoidBody Joint { children Segment { name \"hips\" } } }\n";
+  const Scene s = fromText(body + "DEF Shirt ClothSet { avatar USE H cloth " + kTriangle +
+                           " }\nDEF Vest ClothSet { avatar USE H over [ \"Shirt\" ] cloth " + kTriangle +
+                           " }\nDEF Coat ClothSet { avatar USE H over [ \"Vest\", \"Shirt\" ] overGap 0.006 cloth " +
+                           kTriangle + " }\n");
+  ASSERT_EQ(s.garments.size(), 3u);
+  EXPECT_TRUE(s.garments[0].over.empty());
+  EXPECT_EQ(s.garments[1].over, std::vector<std::string>{"Shirt"});
+  EXPECT_NEAR(s.garments[1].overGap, 0.004, 1e-9);  // the default (an SFFloat)
+  EXPECT_EQ(s.garments[2].over, (std::vector<std::string>{"Vest", "Shirt"}));
+  EXPECT_NEAR(s.garments[2].overGap, 0.006, 1e-9);
+
+  const auto expectError = [&](const std::string& garments, const std::string& text) {
+    const std::string message = errorOf([&] { (void)fromText(body + garments); });
+    EXPECT_NE(message.find(text), std::string::npos) << message;
+  };
+  expectError("DEF Shirt ClothSet { avatar USE H cloth " + kTriangle + " }\nDEF Vest ClothSet { avatar USE H\n over [ "
+              "\"Shrit\" ] cloth " + kTriangle + " }\n",
+              "scene.wrl:6: ClothSet Vest: over names 'Shrit', which is no garment of the scene (it has: Shirt, Vest)");
+  expectError("DEF Vest ClothSet { avatar USE H over [ \"Vest\" ] cloth " + kTriangle + " }\n",
+              "ClothSet Vest: over names itself");
+  expectError("DEF Shirt ClothSet { avatar USE G cloth " + kTriangle + " }\nDEF Vest ClothSet { avatar USE H over [ "
+              "\"Shirt\" ] cloth " + kTriangle + " }\n",
+              "ClothSet Vest: over names 'Shirt', which another character wears (or none)");
+  expectError("DEF A ClothSet { avatar USE H over [ \"C\" ] cloth " + kTriangle +
+                  " }\nDEF B ClothSet { avatar USE H over [ \"A\" ] cloth " + kTriangle +
+                  " }\nDEF C ClothSet { avatar USE H over [ \"B\" ] cloth " + kTriangle + " }\n",
+              "scene.wrl:4: ClothSet A: worn over itself through A over C over B over A");
+  expectError("DEF Vest ClothSet { avatar USE H\n overGap 0 cloth " + kTriangle + " }\n",
+              "scene.wrl:5: ClothSet Vest: overGap 0 m: expected a gap above the garments it is worn over, more than 0");
+}
+
 TEST(VrmlScene, MoreDomainErrors) {
   EXPECT_NE(errorOf([&] {
               (void)fromText(

@@ -78,9 +78,14 @@ struct Garment {
   double bindThreshold = 0.02;              ///< m, farthest a mask vertex binds to a body part
   std::vector<std::string> collidesWith;    ///< segment names; empty: every segment
   std::vector<std::string> faceSamplesWith;  ///< of those, where triangle centroids collide too
-  /// m: how far apart the garment's own layers keep (cloth::SelfCollider); 0: they pass
+  /// m: how far apart the garment's own layers keep (cloth::LayerCollider); 0: they pass
   /// through one another, as in the paper.
   double selfCollision = 0.0;
+  /// Names of the garments it is worn over (a jacket over a shirt): kept overGap above them,
+  /// one way (they do not feel it; cloth::LayerCollider). The same character's, never itself
+  /// nor, through others, over itself.
+  std::vector<std::string> over;
+  double overGap = 0.004;                   ///< m, above the garments it is worn over
   /// m: its own offset surfaces T0..T3, instead of the Simulation node's; none: those.
   std::optional<std::array<double, 4>> offsets;
   /// Pairs of cloth vertices sewn together (a closure the mesh leaves open): each pair is

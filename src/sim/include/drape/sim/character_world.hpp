@@ -15,12 +15,13 @@
 #include <algorithm>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "drape/cloth/field_collider.hpp"
 #include "drape/cloth/material.hpp"
-#include "drape/cloth/self_collider.hpp"
+#include "drape/cloth/layer_collider.hpp"
 #include "drape/cloth/solver.hpp"
 #include "drape/field/distance_field.hpp"
 #include "drape/mesh/trimesh.hpp"
@@ -45,8 +46,12 @@ struct GarmentSpec {
   cloth::OffsetSurfaces offsets;            ///< used when offsetsGiven, else from the voxel size
   bool offsetsGiven = false;
   int collisionEvery = 1;                   ///< collision tests every k substeps
-  /// How far apart its own layers keep (cloth::SelfCollider, tested with the body); 0: none.
+  /// How far apart its own layers keep (cloth::LayerCollider, tested with the body); 0: none.
   double selfCollision_m = 0.0;
+  /// The garments of the same world it is worn over, by name: kept overGap_m above them,
+  /// one way (cloth::LayerCollider), and stepped after them each frame.
+  std::vector<std::string> over;
+  double overGap_m = 0.004;
   /// For display only: the scene's colour of the cloth (sRGB, 0 to 1), or none.
   std::optional<Vec3> colour;
 };
@@ -119,9 +124,13 @@ struct PartField {
 [[nodiscard]] KeepApartSettings keepApartSettings(const std::vector<GarmentSpec>& garments, const WorldSettings& settings);
 
 /// Steps `count` solvers to `frame` in parallel (TBB); per solver, whether it stayed stable.
-/// The solvers must share nothing that changes (each garment has its own poses and colliders).
+/// With `layers` (one per solver, sim/garment_layers.hpp), layer by layer from 0: a garment is
+/// worn over garments of lower layers, whose frame its layer collider reads once they have
+/// stepped it. The solvers
+/// of one layer must share nothing that changes (each garment has its own poses and colliders).
 std::vector<std::uint8_t> stepInParallel(std::size_t count, long frame,
-                                         const std::function<cloth::ClothSolver&(std::size_t)>& solver);
+                                         const std::function<cloth::ClothSolver&(std::size_t)>& solver,
+                                         std::span<const int> layers = {});
 
 /// Logs what a garment's solver did to get through `frame`: an info line when the frame
 /// was computed again with more substeps, a warning when strain limiting came on in it.
@@ -199,8 +208,11 @@ class CharacterWorld {
   [[nodiscard]] cloth::ClothSolver& mutableSolver(std::size_t g) { return *garments_[g].solver; }
   [[nodiscard]] const cloth::FieldCollider* collider(std::size_t g) const { return garments_[g].collider.get(); }
   [[nodiscard]] cloth::FieldCollider* collider(std::size_t g) { return garments_[g].collider.get(); }
-  /// The garment's self collision, or null when its layers may pass through each other.
-  [[nodiscard]] const cloth::SelfCollider* selfCollider(std::size_t g) const { return garments_[g].self.get(); }
+  /// The garment's layer collision (its own layers, the garments it is worn over), or null
+  /// when it has none.
+  [[nodiscard]] const cloth::LayerCollider* layerCollider(std::size_t g) const { return garments_[g].layers.get(); }
+  /// The garment's layer (layersOf): the world steps the garments layer by layer.
+  [[nodiscard]] int layer(std::size_t g) const { return layers_[g]; }
   [[nodiscard]] const std::vector<PartField>& fields() const { return *fields_; }
   [[nodiscard]] const AvatarPoses& poses() const { return *poses_; }
   /// The garment whose step failed and why, after stepFrame returned false.
@@ -224,7 +236,8 @@ class CharacterWorld {
     std::vector<std::shared_ptr<const cloth::FixtureMotion>> motions;  ///< per field, from poses
     std::vector<std::unique_ptr<AvatarPoses>> guestPoses;  ///< its own pose cache of each guest
     std::unique_ptr<cloth::FieldCollider> collider;
-    std::unique_ptr<cloth::SelfCollider> self;  ///< null: its layers pass through each other
+    std::vector<std::uint32_t> fixed;  ///< the vertices its fixtures move (after the colliders)
+    std::unique_ptr<cloth::LayerCollider> layers;  ///< null: no layers kept apart
     std::unique_ptr<cloth::ClothSolver> solver;
   };
   void buildFields(const std::vector<GarmentSpec>& garments, std::shared_ptr<const std::vector<PartField>> given);
@@ -251,6 +264,7 @@ class CharacterWorld {
   std::shared_ptr<const std::vector<PartField>> fields_;
   std::vector<std::shared_ptr<const cloth::FixtureMotion>> partMotions_;  ///< per field
   std::vector<GarmentRun> garments_;
+  std::vector<int> layers_;  ///< per garment (layersOf)
   std::string instability_;
   double fieldBuild_s_ = 0;
 };

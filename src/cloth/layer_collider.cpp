@@ -1,4 +1,4 @@
-#include "drape/cloth/self_collider.hpp"
+#include "drape/cloth/layer_collider.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -46,7 +46,7 @@ std::optional<std::array<double, 3>> barycentric(const Vec3& p, const std::array
 
 }  // namespace
 
-std::optional<SelfContact> selfContact(const Vec3& p0, const Vec3& p1, const std::array<Vec3, 3>& t0,
+std::optional<LayerContact> layerContact(const Vec3& p0, const Vec3& p1, const std::array<Vec3, 3>& t0,
                                        const std::array<Vec3, 3>& t1, double thickness) {
   // Most pairs a test reads are farther than h on their side: said with the normals as they
   // come (twice the areas), without a square root.
@@ -60,7 +60,7 @@ std::optional<SelfContact> selfContact(const Vec3& p0, const Vec3& p1, const std
   const double side = d0 >= 0 ? 1.0 : -1.0;
   const double d1 = side * (p1 - t1[0]).dot(n1);  // times |n1|
   if (d1 >= 0 && d1 * d1 >= thickness * thickness * area2) return std::nullopt;
-  SelfContact contact;
+  LayerContact contact;
   contact.side = side;
   contact.crossed = d1 < 0;
   std::optional<std::array<double, 3>> weights;
@@ -80,60 +80,137 @@ std::optional<SelfContact> selfContact(const Vec3& p0, const Vec3& p1, const std
   return contact;
 }
 
-SelfCollider::SelfCollider(const ClothModel& model, std::string garment, double thickness_m, int every)
+LayerCollider::LayerCollider(const ClothModel& model, std::string garment, double thickness_m, int every)
     : garment_(std::move(garment)),
       thickness_(thickness_m),
       every_(std::max(1, every)),
       staticFriction_(model.material().staticFriction),
       dynamicFriction_(model.material().dynamicFriction) {
-  if (!(thickness_m > 0) || !std::isfinite(thickness_m))
-    throw Error(
-        fmt::format("garment '{}': self-collision thickness {} m must be a positive length", garment_, thickness_m));
-  const std::size_t n = model.vertexCount(), m = model.triangleCount();
+  if (!(thickness_m >= 0) || !std::isfinite(thickness_m))
+    throw Error(fmt::format("garment '{}': self-collision thickness {} m must be 0 (none) or a positive length",
+                            garment_, thickness_m));
+  const std::size_t n = model.vertexCount();
+  ownVertices_ = static_cast<std::uint32_t>(n);
+  ownTriangles_ = static_cast<std::uint32_t>(model.triangleCount());
   triangles_.assign(model.triangles().begin(), model.triangles().end());
-  // Neighbours (CSR) and the mean edge length, from the triangles' edges.
+  // Neighbours (CSR) and the edge lengths, from the triangles' edges.
   std::vector<std::vector<std::uint32_t>> around(n);
-  double edges = 0;
   for (const auto& t : triangles_)
     for (int e = 0; e < 3; ++e) {
       const std::uint32_t a = t[e], b = t[(e + 1) % 3];
       around[a].push_back(b);
       around[b].push_back(a);
-      edges += (at(model.restX(), model.restY(), model.restZ(), a) - at(model.restX(), model.restY(), model.restZ(), b))
-                   .norm();
+      edgeSum_ += (at(model.restX(), model.restY(), model.restZ(), a) - at(model.restX(), model.restY(), model.restZ(), b))
+                      .norm();
+      ++edgeCount_;
     }
   setNeighbours(around);
-  // Cells as wide as a triangle's box grown by h + m on each side (an edge and a little
-  // more): a triangle's box touches at most two along each axis, and a vertex's mostly one.
-  const double meanEdge = m > 0 ? edges / (3.0 * static_cast<double>(m)) : thickness_m;
-  margin_ = kMarginThicknesses * thickness_m;
-  cell_m_ = meanEdge + 2.0 * (thickness_m + margin_);
   inverseMass_ = model.inverseMass();
   lastX_ = model.restX();
   lastY_ = model.restY();
   lastZ_ = model.restZ();
+  sizeForPoints();
+}
+
+void LayerCollider::addGarmentBelow(const ClothModel& model, std::string name, const ClothState& state, double gap_m,
+                                    double frame_s) {
+  if (!(gap_m > 0) || !std::isfinite(gap_m))
+    throw Error(fmt::format("garment '{}': the gap over '{}', {} m, must be a positive length", garment_, name, gap_m));
+  if (!(frame_s > 0) || !std::isfinite(frame_s))
+    throw Error(fmt::format("garment '{}': a frame of {} s over '{}'", garment_, frame_s, name), ExitCode::Internal);
+  if (state.size() != model.vertexCount())
+    throw Error(fmt::format("garment '{}': the state of '{}' has {} points, its model {}", garment_, name, state.size(),
+                            model.vertexCount()),
+                ExitCode::Internal);
+  gap_ = gap_m;
+  frame_s_ = frame_s;
+  Below b;
+  b.name = std::move(name);
+  b.state = &state;
+  b.first = static_cast<std::uint32_t>(inverseMass_.size());
+  b.count = static_cast<std::uint32_t>(model.vertexCount());
+  b.startX = b.endX = state.x;
+  b.startY = b.endY = state.y;
+  b.startZ = b.endZ = state.z;
+  for (const auto& t : model.triangles()) {
+    triangles_.push_back({t[0] + b.first, t[1] + b.first, t[2] + b.first});
+    for (int e = 0; e < 3; ++e) {
+      edgeSum_ += (at(model.restX(), model.restY(), model.restZ(), t[e]) -
+                   at(model.restX(), model.restY(), model.restZ(), t[(e + 1) % 3]))
+                      .norm();
+      ++edgeCount_;
+    }
+  }
+  // Its points have no neighbours here (none of its triangles is ever excluded) and do not
+  // move here.
+  neighbourStart_.insert(neighbourStart_.end(), b.count, neighbourStart_.back());
+  inverseMass_.insert(inverseMass_.end(), b.count, 0.0);
+  lastX_.insert(lastX_.end(), state.x.begin(), state.x.end());
+  lastY_.insert(lastY_.end(), state.y.begin(), state.y.end());
+  lastZ_.insert(lastZ_.end(), state.z.begin(), state.z.end());
+  below_.push_back(std::move(b));
+  held_ = false;
+  sizeForPoints();
+}
+
+std::vector<std::string> LayerCollider::garmentsBelow() const {
+  std::vector<std::string> names;
+  for (const Below& b : below_) names.push_back(b.name);
+  return names;
+}
+
+void LayerCollider::sizeForPoints() {
+  const std::size_t n = inverseMass_.size();
+  // Cells as wide as a triangle's box grown by the thickness + m on each side (an edge and a
+  // little more): a triangle's box touches at most two along each axis, and a vertex's
+  // mostly one.
+  const double thickest = std::max(thickness_, gap_);
+  const double meanEdge = edgeCount_ > 0 ? edgeSum_ / static_cast<double>(edgeCount_) : thickest;
+  margin_ = kMarginThicknesses * thickest;
+  cell_m_ = std::max(meanEdge + 2.0 * (thickest + margin_), 1e-9);
   vertexLo_.resize(3 * n);
   vertexHi_.resize(3 * n);
   const std::size_t buckets = std::bit_ceil(std::max<std::size_t>(64, 2 * n));
   bucketMask_ = static_cast<std::uint32_t>(buckets - 1);
-  bucketStart_.resize(buckets + 1);
-  bucketFill_.resize(buckets);
+  bucketStart_.assign(buckets + 1, 0u);
+  bucketFill_.assign(buckets, 0u);
   entries_.resize(2 * n);
-  seen_.resize(n);
+  seen_.assign(n, 0u);
+  tested_.assign(n, 0u);
   contacts_.reserve(n);
   pairs_.reserve(4 * n);
-  pushX_.resize(n);
-  pushY_.resize(n);
-  pushZ_.resize(n);
-  pushes_.resize(n);
+  pushX_.assign(n, 0.0);
+  pushY_.assign(n, 0.0);
+  pushZ_.assign(n, 0.0);
+  pushes_.assign(n, 0u);
+  work_.x.resize(n);
+  work_.y.resize(n);
+  work_.z.resize(n);
+  work_.vx.resize(n);
+  work_.vy.resize(n);
+  work_.vz.resize(n);
+  // Which vertices any pair can hold: its own free ones (against its own layers or those
+  // below), and those below when a triangle of its own can move.
+  bool anyTriangleMoves = false;
+  for (std::uint32_t t = 0; t < ownTriangles_ && !anyTriangleMoves; ++t) anyTriangleMoves = triangleMoves(t);
+  for (std::size_t v = 0; v < n; ++v)
+    tested_[v] = v < ownVertices_ ? inverseMass_[v] > 0 && (thickness_ > 0 || !below_.empty()) : anyTriangleMoves;
+  pairsBuilt_ = false;
 }
 
-void SelfCollider::setFixedVertices(const std::vector<std::uint32_t>& vertices) {
+bool LayerCollider::triangleMoves(std::uint32_t triangle) const {
+  for (const std::uint32_t corner : triangles_[triangle])
+    if (inverseMass_[corner] > 0) return true;
+  return false;
+}
+
+void LayerCollider::setFixedVertices(const std::vector<std::uint32_t>& vertices) {
   for (const std::uint32_t v : vertices)
-    if (v < inverseMass_.size()) inverseMass_[v] = 0.0;
+    if (v < ownVertices_) inverseMass_[v] = 0.0;
+  sizeForPoints();
 }
 
-void SelfCollider::setStitches(const std::vector<Stitch>& stitches) {
+void LayerCollider::setStitches(const std::vector<Stitch>& stitches) {
   // A stitch makes its two vertices one point of the cloth: each takes the other and the
   // other's neighbours as its own.
   const std::size_t n = neighbourStart_.size() - 1;
@@ -152,7 +229,7 @@ void SelfCollider::setStitches(const std::vector<Stitch>& stitches) {
   pairsBuilt_ = false;
 }
 
-void SelfCollider::setNeighbours(std::vector<std::vector<std::uint32_t>>& around) {
+void LayerCollider::setNeighbours(std::vector<std::vector<std::uint32_t>>& around) {
   neighbourStart_.assign(1, 0);
   neighbours_.clear();
   for (std::size_t v = 0; v < around.size(); ++v) {
@@ -165,9 +242,20 @@ void SelfCollider::setNeighbours(std::vector<std::vector<std::uint32_t>>& around
   }
 }
 
-void SelfCollider::initialise(const ClothState& state) { remember(state); }
+void LayerCollider::initialise(const ClothState& state) {
+  remember(state);
+  for (Below& b : below_) {
+    b.startX = b.endX = b.state->x;  // sizes equal: copies, no allocation
+    b.startY = b.endY = b.state->y;
+    b.startZ = b.endZ = b.state->z;
+    std::copy(b.endX.begin(), b.endX.end(), lastX_.begin() + b.first);
+    std::copy(b.endY.begin(), b.endY.end(), lastY_.begin() + b.first);
+    std::copy(b.endZ.begin(), b.endZ.end(), lastZ_.begin() + b.first);
+  }
+  held_ = false;
+}
 
-bool SelfCollider::excluded(std::uint32_t vertex, std::uint32_t triangle) const {
+bool LayerCollider::excluded(std::uint32_t vertex, std::uint32_t triangle) const {
   const auto first = neighbours_.begin() + neighbourStart_[vertex],
              last = neighbours_.begin() + neighbourStart_[vertex + 1];
   for (const std::uint32_t corner : triangles_[triangle])
@@ -175,34 +263,84 @@ bool SelfCollider::excluded(std::uint32_t vertex, std::uint32_t triangle) const 
   return false;
 }
 
-bool SelfCollider::movable(std::uint32_t vertex, std::uint32_t) const { return inverseMass_[vertex] > 0; }
-
-void SelfCollider::remember(const ClothState& state) {
-  lastX_ = state.x;  // sizes equal after the first: copies, no allocation
-  lastY_ = state.y;
-  lastZ_ = state.z;
+double LayerCollider::pairThickness(std::uint32_t vertex, std::uint32_t triangle) const {
+  const bool ownVertex = vertex < ownVertices_, ownTriangle = triangle < ownTriangles_;
+  if (ownVertex && ownTriangle)
+    return thickness_ > 0 && inverseMass_[vertex] > 0 && !excluded(vertex, triangle) ? thickness_ : 0.0;
+  if (ownVertex) return inverseMass_[vertex] > 0 ? gap_ : 0.0;  // against a garment below
+  if (ownTriangle) return triangleMoves(triangle) ? gap_ : 0.0;  // a point below against its own
+  return 0.0;                                                    // below against below: not here
 }
 
-void SelfCollider::beginFrame() {
+void LayerCollider::remember(const ClothState& state) {
+  std::copy(state.x.begin(), state.x.end(), lastX_.begin());
+  std::copy(state.y.begin(), state.y.end(), lastY_.begin());
+  std::copy(state.z.begin(), state.z.end(), lastZ_.begin());
+}
+
+void LayerCollider::followBelow(double t_s) {
+  if (below_.empty()) return;
+  // Frames end at multiples of frame_s; a substep starts within its frame, never at its end.
+  const auto frame = static_cast<long>(std::floor(t_s / frame_s_ + 1e-6));
+  if (held_ && frame == heldFrame_) return;
+  for (Below& b : below_) {
+    std::swap(b.startX, b.endX);
+    std::swap(b.startY, b.endY);
+    std::swap(b.startZ, b.endZ);
+    b.endX = b.state->x;
+    b.endY = b.state->y;
+    b.endZ = b.state->z;
+  }
+  heldFrame_ = frame;
+  held_ = true;
+}
+
+void LayerCollider::placeBelow(double t_s, ClothState& out, bool velocities) const {
+  const double s = std::clamp(t_s / frame_s_ - static_cast<double>(heldFrame_), 0.0, 1.0), rate = 1.0 / frame_s_;
+  for (const Below& b : below_)
+    for (std::uint32_t i = 0; i < b.count; ++i) {
+      const std::uint32_t v = b.first + i;
+      out.x[v] = b.startX[i] + s * (b.endX[i] - b.startX[i]);
+      out.y[v] = b.startY[i] + s * (b.endY[i] - b.startY[i]);
+      out.z[v] = b.startZ[i] + s * (b.endZ[i] - b.startZ[i]);
+      if (velocities) {
+        out.vx[v] = (b.endX[i] - b.startX[i]) * rate;
+        out.vy[v] = (b.endY[i] - b.startY[i]) * rate;
+        out.vz[v] = (b.endZ[i] - b.startZ[i]) * rate;
+      }
+    }
+}
+
+void LayerCollider::beginFrame() {
   frameStartCounters_ = counters_;
   frameStartSelf_ = self_;
 }
 
-void SelfCollider::restartFrame(const ClothState& state, double) {
+void LayerCollider::restartFrame(const ClothState& state, double t_s) {
   counters_ = frameStartCounters_;
   self_ = frameStartSelf_;
   remember(state);
+  if (!below_.empty()) {  // where the garments below were at the frame's start
+    followBelow(t_s);
+    ClothState& last = work_;
+    placeBelow(t_s, last, false);
+    for (const Below& b : below_) {
+      std::copy(last.x.begin() + b.first, last.x.begin() + b.first + b.count, lastX_.begin() + b.first);
+      std::copy(last.y.begin() + b.first, last.y.begin() + b.first + b.count, lastY_.begin() + b.first);
+      std::copy(last.z.begin() + b.first, last.z.begin() + b.first + b.count, lastZ_.begin() + b.first);
+    }
+  }
   pairsBuilt_ = false;  // the attempt's list: built again, so the frame is computed as before
 }
 
-std::uint32_t SelfCollider::bucketOf(std::int64_t ix, std::int64_t iy, std::int64_t iz) const {
+std::uint32_t LayerCollider::bucketOf(std::int64_t ix, std::int64_t iy, std::int64_t iz) const {
   const auto h = static_cast<std::uint64_t>(ix) * 73856093u ^ static_cast<std::uint64_t>(iy) * 19349663u ^
                  static_cast<std::uint64_t>(iz) * 83492791u;
   return static_cast<std::uint32_t>(h ^ (h >> 32)) & bucketMask_;
 }
 
 template <typename Visit>
-void SelfCollider::forCells(const double* lo, const double* hi, Visit&& visit) const {
+void LayerCollider::forCells(const double* lo, const double* hi, Visit&& visit) const {
   const double inv = 1.0 / cell_m_;
   const auto x0 = static_cast<std::int64_t>(std::floor(lo[0] * inv)),
              x1 = static_cast<std::int64_t>(std::floor(hi[0] * inv));
@@ -215,7 +353,7 @@ void SelfCollider::forCells(const double* lo, const double* hi, Visit&& visit) c
       for (std::int64_t iz = z0; iz <= z1; ++iz) visit(bucketOf(ix, iy, iz));
 }
 
-void SelfCollider::buildGrid(const ClothState& after) {
+void LayerCollider::buildGrid(const ClothState& after) {
   // Each vertex's box over the interval (where it was at the last test and is now): most
   // lie in one cell.
   const std::size_t n = after.size();
@@ -226,22 +364,26 @@ void SelfCollider::buildGrid(const ClothState& after) {
       vertexHi_[3 * v + k] = std::max(p0[k], p1[k]);
     }
   }
-  // Counted, then placed: every bucket's vertices in one array, in vertex order.
+  // Counted, then placed: every bucket's vertices in one array, in vertex order. A vertex
+  // no pair can hold (a fixed one) is left out.
   std::fill(bucketStart_.begin(), bucketStart_.end(), 0u);
   for (std::size_t v = 0; v < n; ++v)
-    forCells(&vertexLo_[3 * v], &vertexHi_[3 * v], [&](std::uint32_t b) { ++bucketStart_[b + 1]; });
+    if (tested_[v]) forCells(&vertexLo_[3 * v], &vertexHi_[3 * v], [&](std::uint32_t b) { ++bucketStart_[b + 1]; });
   for (std::size_t b = 1; b < bucketStart_.size(); ++b) bucketStart_[b] += bucketStart_[b - 1];
   if (bucketStart_.back() > entries_.size()) entries_.resize(bucketStart_.back() + bucketStart_.back() / 4);
   std::copy(bucketStart_.begin(), bucketStart_.end() - 1, bucketFill_.begin());
   for (std::size_t v = 0; v < n; ++v)
-    forCells(&vertexLo_[3 * v], &vertexHi_[3 * v],
-             [&](std::uint32_t b) { entries_[bucketFill_[b]++] = static_cast<std::uint32_t>(v); });
+    if (tested_[v])
+      forCells(&vertexLo_[3 * v], &vertexHi_[3 * v],
+               [&](std::uint32_t b) { entries_[bucketFill_[b]++] = static_cast<std::uint32_t>(v); });
 }
 
-void SelfCollider::gatherPairs(const ClothState& after, double grow) {
+void LayerCollider::gatherPairs(const ClothState& after, double grow) {
   pairs_.clear();
   std::fill(seen_.begin(), seen_.end(), 0u);
-  for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
+  // Its own triangles hold pairs with its own layers kept apart or with points below.
+  const std::uint32_t first = thickness_ > 0 || !below_.empty() ? 0 : ownTriangles_;
+  for (std::uint32_t t = first; t < triangles_.size(); ++t) {
     // The triangle's box over the interval, grown: the vertices whose boxes meet it.
     const auto& c = triangles_[t];
     double lo[3], hi[3];
@@ -260,14 +402,14 @@ void SelfCollider::gatherPairs(const ClothState& after, double grow) {
         const double* vhi = &vertexHi_[3 * v];
         const bool apart =
             vlo[0] > hi[0] || vhi[0] < lo[0] || vlo[1] > hi[1] || vhi[1] < lo[1] || vlo[2] > hi[2] || vhi[2] < lo[2];
-        if (!apart && !excluded(v, t) && movable(v, t)) pairs_.push_back({v, t});
+        if (!apart && pairThickness(v, t) > 0) pairs_.push_back({v, t});
       }
     });
   }
   std::sort(pairs_.begin(), pairs_.end());
 }
 
-void SelfCollider::narrow(const ClothState& after) {
+void LayerCollider::narrow(const ClothState& after) {
   contacts_.clear();
   self_.candidates += pairs_.size();
   for (const auto& [v, t] : pairs_) {
@@ -275,8 +417,8 @@ void SelfCollider::narrow(const ClothState& after) {
     const std::array<Vec3, 3> t0{at(lastX_, lastY_, lastZ_, c[0]), at(lastX_, lastY_, lastZ_, c[1]),
                                  at(lastX_, lastY_, lastZ_, c[2])};
     const std::array<Vec3, 3> t1{after.position(c[0]), after.position(c[1]), after.position(c[2])};
-    if (std::optional<SelfContact> contact =
-            selfContact(at(lastX_, lastY_, lastZ_, v), after.position(v), t0, t1, thickness_)) {
+    if (std::optional<LayerContact> contact =
+            layerContact(at(lastX_, lastY_, lastZ_, v), after.position(v), t0, t1, listedThickness(v, t))) {
       contact->vertex = v;
       contact->triangle = t;
       contacts_.push_back(*contact);
@@ -284,7 +426,7 @@ void SelfCollider::narrow(const ClothState& after) {
   }
 }
 
-Vec3 SelfCollider::meanPosition(const std::vector<double>& x, const std::vector<double>& y,
+Vec3 LayerCollider::meanPosition(const std::vector<double>& x, const std::vector<double>& y,
                                 const std::vector<double>& z) {
   double sx = 0, sy = 0, sz = 0;
   for (std::size_t v = 0; v < x.size(); ++v) {
@@ -295,7 +437,7 @@ Vec3 SelfCollider::meanPosition(const std::vector<double>& x, const std::vector<
   return Vec3(sx, sy, sz) / static_cast<double>(std::max<std::size_t>(1, x.size()));
 }
 
-bool SelfCollider::pairsHold(const ClothState& now) const {
+bool LayerCollider::pairsHold(const ClothState& now) const {
   if (!pairsBuilt_) return false;
   // Translation-free: what moved with the garment as a whole changes no pair's distance.
   // Both ends of the interval: the last test's positions are where its corrections left them.
@@ -313,12 +455,12 @@ bool SelfCollider::pairsHold(const ClothState& now) const {
          within(lastX_.data(), lastY_.data(), lastZ_.data(), meanPosition(lastX_, lastY_, lastZ_));
 }
 
-void SelfCollider::updatePairs(const ClothState& now) {
+void LayerCollider::updatePairs(const ClothState& now) {
   if (pairsHold(now)) return;
   // Every pair whose vertex could come within h of the triangle (or through it) while no
   // vertex moves more than margin / 2 from here, the garment's common motion left out.
   buildGrid(now);
-  gatherPairs(now, thickness_ + margin_);
+  gatherPairs(now, std::max(thickness_, gap_) + margin_);
   builtX_ = now.x;
   builtY_ = now.y;
   builtZ_ = now.z;
@@ -327,23 +469,23 @@ void SelfCollider::updatePairs(const ClothState& now) {
   ++self_.rebuilds;
 }
 
-const std::vector<SelfContact>& SelfCollider::findContacts(const ClothState& before, const ClothState& after) {
+const std::vector<LayerContact>& LayerCollider::findContacts(const ClothState& before, const ClothState& after) {
   remember(before);
   buildGrid(after);
-  gatherPairs(after, thickness_);
+  gatherPairs(after, std::max(thickness_, gap_));
   pairsBuilt_ = false;  // a list for this interval alone
   narrow(after);
   return contacts_;
 }
 
-const std::vector<SelfContact>& SelfCollider::nextContacts(const ClothState& now) {
+const std::vector<LayerContact>& LayerCollider::nextContacts(const ClothState& now) {
   updatePairs(now);
   narrow(now);
   remember(now);
   return contacts_;
 }
 
-bool SelfCollider::now(const SelfContact& c, const ClothState& io, ContactNow& out) const {
+bool LayerCollider::now(const LayerContact& c, const ClothState& io, ContactNow& out) const {
   const auto& tri = triangles_[c.triangle];
   out.inverseMass[0] = inverseMass_[c.vertex];
   out.weight = out.inverseMass[0];
@@ -356,14 +498,14 @@ bool SelfCollider::now(const SelfContact& c, const ClothState& io, ContactNow& o
   return out.weight > 0 && !out.normal.isZero();
 }
 
-void SelfCollider::clearPushes() {
+void LayerCollider::clearPushes() {
   std::fill(pushX_.begin(), pushX_.end(), 0.0);
   std::fill(pushY_.begin(), pushY_.end(), 0.0);
   std::fill(pushZ_.begin(), pushZ_.end(), 0.0);
   std::fill(pushes_.begin(), pushes_.end(), 0u);
 }
 
-void SelfCollider::pushApart(const SelfContact& c, const std::array<double, 4>& im, const Vec3& lambda) {
+void LayerCollider::pushApart(const LayerContact& c, const std::array<double, 4>& im, const Vec3& lambda) {
   const auto push = [&](std::uint32_t i, const Vec3& by) {
     pushX_[i] += by.x();
     pushY_[i] += by.y();
@@ -375,7 +517,7 @@ void SelfCollider::pushApart(const SelfContact& c, const std::array<double, 4>& 
     if (im[k + 1] > 0) push(triangles_[c.triangle][k], -c.weights[k] * im[k + 1] * lambda);
 }
 
-void SelfCollider::applyPushes(std::vector<double>& x, std::vector<double>& y, std::vector<double>& z) const {
+void LayerCollider::applyPushes(std::vector<double>& x, std::vector<double>& y, std::vector<double>& z) const {
   for (std::size_t i = 0; i < x.size(); ++i)
     if (pushes_[i] > 0) {
       const double share = 1.0 / pushes_[i];
@@ -385,19 +527,19 @@ void SelfCollider::applyPushes(std::vector<double>& x, std::vector<double>& y, s
     }
 }
 
-void SelfCollider::resolvePositions(ClothState& io) {
+void LayerCollider::resolvePositions(ClothState& io) {
   for (int sweep = 0; sweep < kPositionSweeps; ++sweep) {
     clearPushes();
     bool any = false;
-    for (const SelfContact& c : contacts_) {
+    for (const LayerContact& c : contacts_) {
       ContactNow f;
       if (!now(c, io, f)) continue;
       const Vec3 q = c.weights[0] * f.corners[0] + c.weights[1] * f.corners[1] + c.weights[2] * f.corners[2];
-      const double d = (io.position(c.vertex) - q).dot(f.normal);
-      if (d >= thickness_) continue;
-      if (sweep == 0) counters_.maxPenetration_m = std::max(counters_.maxPenetration_m, thickness_ - d);
+      const double d = (io.position(c.vertex) - q).dot(f.normal), h = listedThickness(c.vertex, c.triangle);
+      if (d >= h) continue;
+      if (sweep == 0) counters_.maxPenetration_m = std::max(counters_.maxPenetration_m, h - d);
       // The constraint (p - sum w_k t_k) . n >= h projected by inverse masses.
-      pushApart(c, f.inverseMass, (thickness_ - d) / f.weight * f.normal);
+      pushApart(c, f.inverseMass, (h - d) / f.weight * f.normal);
       any = true;
     }
     if (!any) return;
@@ -405,10 +547,10 @@ void SelfCollider::resolvePositions(ClothState& io) {
   }
 }
 
-void SelfCollider::resolveVelocities(ClothState& io) {
+void LayerCollider::resolveVelocities(ClothState& io) {
   clearPushes();
   bool any = false;
-  for (const SelfContact& c : contacts_) {
+  for (const LayerContact& c : contacts_) {
     ContactNow f;
     if (!now(c, io, f)) continue;
     const auto& tri = triangles_[c.triangle];
@@ -433,21 +575,38 @@ void SelfCollider::resolveVelocities(ClothState& io) {
   if (any) applyPushes(io.vx, io.vy, io.vz);
 }
 
-void SelfCollider::collide(const ClothModel&, double, double, ClothState& io) {
+void LayerCollider::collide(const ClothModel&, double t0_s, double t1_s, ClothState& io) {
   ++counters_.calls;
   if ((calls_++ % static_cast<std::uint64_t>(every_)) != 0) return;
-  updatePairs(io);
-  narrow(io);
+  // With garments below, the test runs on its own points followed by theirs as they are at
+  // t1 (copies of a few arrays per test); without, on the state itself.
+  ClothState& state = below_.empty() ? io : work_;
+  if (!below_.empty()) {
+    followBelow(t0_s);
+    for (auto [from, to] : {std::pair{&io.x, &work_.x}, {&io.y, &work_.y}, {&io.z, &work_.z}, {&io.vx, &work_.vx},
+                            {&io.vy, &work_.vy}, {&io.vz, &work_.vz}})
+      std::copy(from->begin(), from->end(), to->begin());
+    placeBelow(t1_s, work_, true);
+  }
+  updatePairs(state);
+  narrow(state);
   ++self_.tests;
   counters_.pointsTested += io.size();
-  self_.contacts += contacts_.size();
   counters_.contacts += contacts_.size();
-  for (const SelfContact& c : contacts_) self_.crossings += c.crossed;
-  if (!contacts_.empty()) {
-    resolvePositions(io);
-    resolveVelocities(io);
+  for (const LayerContact& c : contacts_) {
+    const bool own = c.vertex < ownVertices_ && c.triangle < ownTriangles_;
+    (own ? self_.contacts : self_.contactsBelow) += 1;
+    (own ? self_.crossings : self_.crossingsBelow) += c.crossed;
   }
-  remember(io);
+  if (!contacts_.empty()) {
+    resolvePositions(state);
+    resolveVelocities(state);
+  }
+  remember(state);
+  if (!below_.empty())
+    for (auto [from, to] : {std::pair{&work_.x, &io.x}, {&work_.y, &io.y}, {&work_.z, &io.z}, {&work_.vx, &io.vx},
+                            {&work_.vy, &io.vy}, {&work_.vz, &io.vz}})
+      std::copy(from->begin(), from->begin() + static_cast<std::ptrdiff_t>(io.size()), to->begin());
 }
 
 }  // namespace drape::cloth

@@ -1,0 +1,253 @@
+#pragma once
+// Cloth layers kept apart (beyond the paper, which collides cloth with the body only): a
+// garment's own layers (self collision: a skirt folding between the legs, a jacket's hem over
+// its skirt, a sleeve against the side) and the garments it is worn over (a jacket over a
+// shirt, a skirt over a petticoat). Without it one layer passes through the other.
+//
+// Vertex against face, with a thickness h (its own layers) or a gap g (the garments below).
+// At each test (every k substeps, as the body's collision) the candidate pairs are checked:
+// every (vertex, triangle) pair that could come within its thickness while no vertex moves
+// more than a margin m / 2 (m = twice the larger of h and g) from where the list was made,
+// the common motion left out (a walk carries the whole skirt along without changing a
+// distance). The list is made again when a vertex has moved farther: each triangle's box
+// over the interval, grown by the thickness + m, against the vertices' boxes in a hashed
+// uniform grid (arrays sized once). A vertex and a triangle are a contact when the vertex
+// ends within the thickness of the triangle's face (its projection inside the triangle) on
+// the side it was on at the last test, or has crossed to the other side since. Contacts are
+// resolved in three Jacobi sweeps (every pair's push summed per vertex, then averaged, so the
+// result does not depend on the order): the vertex and the triangle's corners move apart
+// along the face normal to the thickness, shared by inverse mass and barycentric weight (the
+// corners a fixture moves, and every vertex of a garment below, count as infinitely heavy);
+// then the pair loses its approaching normal velocity and, by Coulomb friction with the
+// material's coefficients, up to mu times that of its sliding velocity.
+//
+// A garment below is one way: its own solver steps it first, each frame, and here it moves
+// from where it was at the frame's start to where that step left it, linearly over the frame
+// (sim::stepInParallel steps garments in layers). Its vertices are tested against this
+// garment's triangles and this garment's vertices against its triangles, so a coarse garment
+// over a fine one holds as well as a fine one over a coarse one; only this garment moves.
+//
+// Left out: edge against edge (two edges crossing with no vertex over a face: rare at cloth
+// resolutions, where the neighbouring vertex-face pairs catch the layers first), a vertex a
+// fixture moves against its own free layers (their own vertices are tested against its
+// triangles), and two garments pushing each other (the one below does not feel the one
+// above). docs/PHYSICS.md says what each means for a scene.
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "drape/cloth/collider.hpp"
+#include "drape/cloth/strain_limit.hpp"
+#include "drape/core/math.hpp"
+
+namespace drape::cloth {
+
+/// A vertex within the thickness of a triangle's face, or through it.
+struct LayerContact {
+  std::uint32_t vertex = 0;
+  std::uint32_t triangle = 0;
+  /// +1 or -1: the side of the face (along its normal) the vertex keeps to: the one it was
+  /// on at the last test.
+  double side = 1.0;
+  bool crossed = false;  ///< it ended on the other side
+  /// Barycentric weights of its projection on the face (crossed: of where it went through).
+  std::array<double, 3> weights{};
+};
+
+/// The narrow test of one pair: vertex p moving p0 -> p1 while the triangle moves t0 -> t1
+/// (its corners). A contact when p1 lies less than `thickness` from the face on the side p0
+/// was on and projects inside the triangle; or when p1 is on the other side (crossed) and,
+/// where its distance to the plane (taken as linear over the interval) was zero, it lay in
+/// the triangle as it was then. None for a degenerate triangle.
+[[nodiscard]] std::optional<LayerContact> layerContact(const Vec3& p0, const Vec3& p1, const std::array<Vec3, 3>& t0,
+                                                     const std::array<Vec3, 3>& t1, double thickness);
+
+/// What the layer collision did so far (accumulated over calls).
+struct LayerCounters {
+  std::uint64_t tests = 0;       ///< substeps it tested
+  std::uint64_t candidates = 0;  ///< (vertex, triangle) pairs whose boxes met
+  std::uint64_t contacts = 0;    ///< pairs of its own layers within the thickness or crossed, resolved
+  std::uint64_t crossings = 0;   ///< of those, crossed
+  std::uint64_t contactsBelow = 0;   ///< pairs with a garment below within the gap or crossed, resolved
+  std::uint64_t crossingsBelow = 0;  ///< of those, crossed
+  std::uint64_t rebuilds = 0;    ///< tests that made the candidate list again
+
+  /// Another garment's counts with these (a benchmark's sum).
+  LayerCounters& operator+=(const LayerCounters& other) {
+    tests += other.tests;
+    candidates += other.candidates;
+    contacts += other.contacts;
+    crossings += other.crossings;
+    contactsBelow += other.contactsBelow;
+    crossingsBelow += other.crossingsBelow;
+    rebuilds += other.rebuilds;
+    return *this;
+  }
+};
+
+class LayerCollider final : public Collider {
+ public:
+  /// Keeps `model`'s own layers `thickness_m` apart (0: they pass through each other; the
+  /// collider then keeps it off the garments below alone), testing every `every` substeps. A
+  /// vertex is never tested against the triangles around it or around its neighbours (those
+  /// lie on the same sheet). Throws drape::Error naming `garment` for a negative thickness.
+  LayerCollider(const ClothModel& model, std::string garment, double thickness_m, int every = 1);
+
+  /// A garment this one is worn over, kept `gap_m` below it: its model, the name errors
+  /// and counts give it, and its solver's state, which must outlive the collider and be
+  /// stepped through each frame (frame_s long, frames ending at multiples of frame_s) before
+  /// this garment's. Before initialise(). Throws drape::Error for a gap <= 0 or a frame
+  /// length <= 0.
+  void addGarmentBelow(const ClothModel& model, std::string name, const ClothState& state, double gap_m,
+                       double frame_s);
+  /// Vertices a fixture moves after the colliders: infinitely heavy here.
+  void setFixedVertices(const std::vector<std::uint32_t>& vertices);
+  /// Stitched vertices are one point of the cloth: neither is tested against the triangles
+  /// around the other (which a stitch holds it among).
+  void setStitches(const std::vector<Stitch>& stitches);
+  /// Where the garment starts (the sides of its first test): its rest shape unless given;
+  /// the garments below where their states are now.
+  void initialise(const ClothState& state);
+
+  [[nodiscard]] std::string name() const override { return "layers"; }
+  void collide(const ClothModel& model, double t0_s, double t1_s, ClothState& io) override;
+  [[nodiscard]] ColliderCounters counters() const override { return counters_; }
+  [[nodiscard]] const LayerCounters& layerCounters() const { return self_; }
+  void beginFrame() override;
+  void restartFrame(const ClothState& state, double t_s) override;
+
+  /// Its own layers' thickness (0: not kept apart).
+  [[nodiscard]] double thickness_m() const { return thickness_; }
+  /// How far above the garments below it keeps (0: none below).
+  [[nodiscard]] double gap_m() const { return gap_; }
+  /// The garments below, in the order given.
+  [[nodiscard]] std::vector<std::string> garmentsBelow() const;
+  [[nodiscard]] int every() const { return every_; }
+  /// Vertices and triangles are numbered over its own and then each garment's below, in
+  /// the order given (the states findContacts and nextContacts take).
+  [[nodiscard]] std::size_t vertexCount() const { return inverseMass_.size(); }
+  [[nodiscard]] std::size_t triangleCount() const { return triangles_.size(); }
+  /// Whether the pair is never tested (the triangle has v, or a neighbour of v, as a corner;
+  /// stitched vertices are neighbours).
+  [[nodiscard]] bool excluded(std::uint32_t vertex, std::uint32_t triangle) const;
+  /// The thickness the pair is kept at: its own layers' for its own vertex and triangle
+  /// (when not excluded and the vertex is free), the gap between one of its vertices and a
+  /// triangle below, or between a vertex below and one of its triangles that can move; 0:
+  /// never tested. A vertex a fixture moves is never pushed into its own free layers around
+  /// it (they are tested by their own vertices against its triangles): its fixture would
+  /// move it back through them at every substep.
+  [[nodiscard]] double pairThickness(std::uint32_t vertex, std::uint32_t triangle) const;
+  /// The contacts between positions `before` (the last test's) and `after`, as a test finds
+  /// them (by vertex, then triangle), without resolving them. Both hold vertexCount() points.
+  const std::vector<LayerContact>& findContacts(const ClothState& before, const ClothState& after);
+  /// The contacts of the next test at positions `now` (vertexCount() points), as collide()
+  /// finds them (from the candidate list, kept or made again), without resolving them; `now`
+  /// is then the last test's.
+  const std::vector<LayerContact>& nextContacts(const ClothState& now);
+
+ private:
+  /// A garment below: where its points start in the numbering, and where it was at the start
+  /// and end of the frame being stepped.
+  struct Below {
+    std::string name;
+    const ClothState* state = nullptr;
+    std::uint32_t first = 0, count = 0;
+    std::vector<double> startX, startY, startZ, endX, endY, endZ;
+  };
+  /// Sizes the per-vertex arrays, the grid and the margin for the vertices and triangles
+  /// numbered so far.
+  void sizeForPoints();
+  /// Copies the state's positions (its own vertices, or all) as the last test's.
+  void remember(const ClothState& state);
+  /// The garments below, for the frame that contains time t_s: when it is a frame after the
+  /// one they were held for, their end becomes its start and their states now its end (they
+  /// were stepped through it first).
+  void followBelow(double t_s);
+  /// The garments below as they are at time t_s (linear over the frame) into `out`'s
+  /// positions and, when `velocities`, their velocities over the frame.
+  void placeBelow(double t_s, ClothState& out, bool velocities) const;
+  /// The thickness of a pair the list holds: its own layers' or the gap.
+  [[nodiscard]] double listedThickness(std::uint32_t vertex, std::uint32_t triangle) const {
+    return vertex < ownVertices_ && triangle < ownTriangles_ ? thickness_ : gap_;
+  }
+  /// Whether a corner of the triangle can move (a vertex below is kept off it).
+  [[nodiscard]] bool triangleMoves(std::uint32_t triangle) const;
+  /// The neighbour lists (sorted and made unique here) as the CSR arrays.
+  void setNeighbours(std::vector<std::vector<std::uint32_t>>& around);
+  void buildGrid(const ClothState& after);
+  /// The pairs whose vertex's box meets its triangle's box over the interval grown by `grow`.
+  void gatherPairs(const ClothState& after, double grow);
+  /// The candidate pairs' contacts.
+  void narrow(const ClothState& after);
+  [[nodiscard]] static Vec3 meanPosition(const std::vector<double>& x, const std::vector<double>& y,
+                                         const std::vector<double>& z);
+  /// Whether the candidate list still holds for the interval from the last test to `now`.
+  [[nodiscard]] bool pairsHold(const ClothState& now) const;
+  void updatePairs(const ClothState& now);
+  void resolvePositions(ClothState& io);
+  void resolveVelocities(ClothState& io);
+  void clearPushes();
+  /// Adds the contact's push, `lambda` along its normal per unit of inverse mass, to its
+  /// vertex and (by weight) to its triangle's corners.
+  void pushApart(const LayerContact& c, const std::array<double, 4>& im, const Vec3& lambda);
+  /// Moves every pushed vertex's (x, y, z) by the average of its pushes.
+  void applyPushes(std::vector<double>& x, std::vector<double>& y, std::vector<double>& z) const;
+  /// A contact as the state stands now: the inverse masses of its vertex and corners and
+  /// their weighted sum (the constraint's), the corners, and the face normal on the vertex's
+  /// side.
+  struct ContactNow {
+    std::array<double, 4> inverseMass{};
+    double weight = 0;
+    std::array<Vec3, 3> corners;
+    Vec3 normal;
+  };
+  /// The contact at `io` into `out`; false when nothing of it can move or its triangle has
+  /// collapsed.
+  [[nodiscard]] bool now(const LayerContact& c, const ClothState& io, ContactNow& out) const;
+  [[nodiscard]] std::uint32_t bucketOf(std::int64_t ix, std::int64_t iy, std::int64_t iz) const;
+  /// Calls visit(bucket) for every cell the box [lo, hi] touches.
+  template <typename Visit>
+  void forCells(const double* lo, const double* hi, Visit&& visit) const;
+
+  std::string garment_;
+  double thickness_;
+  int every_;
+  std::uint32_t ownVertices_ = 0, ownTriangles_ = 0;
+  double gap_ = 0.0;      ///< above the garments below
+  double frame_s_ = 0.0;  ///< their frames' length
+  std::vector<Below> below_;
+  long heldFrame_ = 0;    ///< the frame (numbered from 0 at time 0) the garments below are held for
+  bool held_ = false;     ///< whether they are held for one yet
+  ClothState work_;       ///< its own points and those below, for a test with garments below
+  double edgeSum_ = 0.0;  ///< of the triangles' edges (cells sized from their mean)
+  std::size_t edgeCount_ = 0;
+  double staticFriction_, dynamicFriction_;  ///< the material's, layer on layer as on the body
+  double cell_m_;                            ///< edge of a grid cell
+  std::vector<std::array<std::uint32_t, 3>> triangles_;
+  std::vector<std::uint32_t> neighbourStart_, neighbours_;  ///< per vertex (CSR), sorted
+  std::vector<double> inverseMass_;                         ///< 0 for the fixed vertices and those below
+  std::vector<std::uint8_t> tested_;                        ///< per vertex: whether it is in some pair
+  std::vector<double> lastX_, lastY_, lastZ_;               ///< positions at the last test
+  // The grid: per bucket (a hash of the cell) the vertices whose boxes touch a cell of it.
+  std::vector<double> vertexLo_, vertexHi_;  ///< per vertex, xyz: its box over the interval
+  std::vector<std::uint32_t> bucketStart_, bucketFill_, entries_;
+  std::uint32_t bucketMask_ = 0;
+  std::vector<std::uint32_t> seen_;  ///< per vertex: the triangle (+1) that met it last
+  // The candidate list and where the vertices were when it was made.
+  double margin_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;  ///< (vertex, triangle), sorted
+  std::vector<double> builtX_, builtY_, builtZ_;
+  Vec3 builtMean_ = Vec3::Zero();
+  bool pairsBuilt_ = false;
+  std::vector<LayerContact> contacts_;
+  std::vector<double> pushX_, pushY_, pushZ_;  ///< per vertex, summed over a sweep's contacts
+  std::vector<std::uint32_t> pushes_;
+  std::uint64_t calls_ = 0;
+  ColliderCounters counters_, frameStartCounters_;
+  LayerCounters self_, frameStartSelf_;
+};
+
+}  // namespace drape::cloth

@@ -1,0 +1,74 @@
+#include "drape/sim/garment_layers.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "drape/core/error.hpp"
+
+namespace drape::sim {
+
+std::vector<std::vector<std::size_t>> garmentsBelow(const std::vector<GarmentSpec>& garments) {
+  std::vector<std::vector<std::size_t>> below(garments.size());
+  for (std::size_t g = 0; g < garments.size(); ++g)
+    for (const std::string& name : garments[g].over) {
+      const auto it = std::find_if(garments.begin(), garments.end(), [&](const GarmentSpec& s) { return s.name == name; });
+      if (it == garments.end()) {
+        std::vector<std::string> names;
+        for (const GarmentSpec& s : garments) names.push_back(s.name);
+        throw Error(fmt::format("garment '{}' is worn over '{}', which its character does not wear (it wears: {})",
+                                garments[g].name, name, fmt::join(names, ", ")));
+      }
+      const auto b = static_cast<std::size_t>(it - garments.begin());
+      if (b == g) throw Error(fmt::format("garment '{}' is worn over itself", garments[g].name));
+      if (std::find(below[g].begin(), below[g].end(), b) == below[g].end()) below[g].push_back(b);
+    }
+  // Layers, found by rounds: a garment whose garments below all have theirs takes one more.
+  // A round that places none leaves only garments that go round.
+  const std::vector<int> layers = layersOf(below);
+  for (std::size_t g = 0; g < garments.size(); ++g)
+    if (layers[g] < 0)
+      throw Error(fmt::format("garment '{}' is worn, through the garments it is worn over, over itself: the over "
+                              "names must not go round",
+                              garments[g].name));
+  return below;
+}
+
+std::vector<int> layersOf(const std::vector<std::vector<std::size_t>>& below) {
+  std::vector<int> layer(below.size(), -1);
+  for (bool placed = true; placed;) {
+    placed = false;
+    for (std::size_t g = 0; g < below.size(); ++g) {
+      if (layer[g] >= 0) continue;
+      int highest = -1;
+      bool ready = true;
+      for (const std::size_t b : below[g]) {
+        ready = ready && layer[b] >= 0;
+        highest = std::max(highest, layer[b]);
+      }
+      if (!ready) continue;
+      layer[g] = highest + 1;
+      placed = true;
+    }
+  }
+  return layer;  // -1 where the names go round
+}
+
+std::unique_ptr<cloth::LayerCollider> makeLayerCollider(
+    const std::vector<GarmentSpec>& garments, std::size_t g, std::span<const std::size_t> below,
+    const std::vector<std::uint32_t>& fixed, const std::function<const cloth::ClothSolver&(std::size_t)>& solver,
+    double frame_s) {
+  const GarmentSpec& spec = garments[g];
+  if (!(spec.selfCollision_m > 0) && below.empty()) return nullptr;
+  const cloth::ClothSolver& own = solver(g);
+  auto layers = std::make_unique<cloth::LayerCollider>(own.model(), spec.name, spec.selfCollision_m, spec.collisionEvery);
+  layers->setFixedVertices(fixed);
+  layers->setStitches(spec.stitches);
+  for (const std::size_t b : below)
+    layers->addGarmentBelow(solver(b).model(), garments[b].name, solver(b).state(), spec.overGap_m, frame_s);
+  layers->initialise(own.state());
+  return layers;
+}
+
+}  // namespace drape::sim

@@ -1,0 +1,291 @@
+// A garment worn over another (cloth/layer_collider.hpp, addGarmentBelow): the grid and the
+// list kept between tests find the pairs brute force finds, with the points of both
+// garments; a sheet dropped on a garment below that rises through every frame rides one gap
+// above it (it moves linearly over each frame, not in jumps); a sheet on a garment below that
+// slides away is dragged along at mu g.
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <set>
+#include <tuple>
+
+#include <fmt/format.h>
+
+#include "cloth_fixture.hpp"
+#include "drape/cloth/layer_collider.hpp"
+#include "drape/core/error.hpp"
+
+namespace drape::cloth {
+namespace garment_below_test {
+
+using testing::knit;
+using testing::makeModel;
+using testing::pinAt;
+using testing::settingsWithStep;
+
+constexpr double kFrame_s = 1.0 / 30.0;
+
+using ContactSet = std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>>;
+
+ClothState pointsOf(const std::vector<Vec3>& points) {
+  ClothState s;
+  for (const Vec3& p : points) {
+    s.x.push_back(p.x());
+    s.y.push_back(p.y());
+    s.z.push_back(p.z());
+  }
+  s.vx.assign(s.x.size(), 0.0);
+  s.vy = s.vz = s.vx;
+  return s;
+}
+
+/// `b`'s points and triangles after `a`'s: the collider's numbering.
+mesh::TriMesh joinedMeshes(mesh::TriMesh a, const mesh::TriMesh& b) {
+  const auto offset = static_cast<std::uint32_t>(a.positions.size());
+  a.positions.insert(a.positions.end(), b.positions.begin(), b.positions.end());
+  for (mesh::Triangle t : b.triangles) a.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  return a;
+}
+
+/// Every pair the collider tests, checked one by one between `s0` and `s1`.
+ContactSet everyPair(const LayerCollider& collider, const mesh::TriMesh& both, const ClothState& s0,
+                     const ClothState& s1) {
+  ContactSet out;
+  for (std::uint32_t v = 0; v < both.positions.size(); ++v)
+    for (std::uint32_t t = 0; t < both.triangles.size(); ++t) {
+      const double thickness = collider.pairThickness(v, t);
+      if (thickness == 0) continue;
+      const mesh::Triangle& tri = both.triangles[t];
+      const std::array<Vec3, 3> t0{s0.position(tri[0]), s0.position(tri[1]), s0.position(tri[2])};
+      const std::array<Vec3, 3> t1{s1.position(tri[0]), s1.position(tri[1]), s1.position(tri[2])};
+      if (auto c = layerContact(s0.position(v), s1.position(v), t0, t1, thickness))
+        out.insert({v, t, c->side, c->crossed});
+    }
+  return out;
+}
+
+/// A wavy sheet of `cells` x `cells` over [0, 1]^2 in xz at height `y`, its points moved by up
+/// to `noise`.
+mesh::TriMesh wavySheet(int cells, double y, double wave, double noise, unsigned seed, std::mt19937& random) {
+  SheetSpec spec{1.0, 1.0, cells, cells, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), "sheet"};
+  mesh::TriMesh m = irregularSheet(spec, 0.3, seed);
+  std::uniform_real_distribution<double> jitter(-noise, noise);
+  for (Vec3& p : m.positions)
+    p = Vec3(p.x(), y + wave * std::sin(7 * p.x()) * std::cos(5 * p.z()), p.z()) +
+        Vec3(jitter(random), jitter(random), jitter(random));
+  return m;
+}
+
+struct Kinds {
+  std::size_t overBelow = 0;  ///< its own vertex, a triangle below
+  std::size_t belowOver = 0;  ///< a vertex below, its own triangle
+  std::size_t crossed = 0;
+  void add(const ContactSet& contacts, std::uint32_t ownVertices) {
+    for (const auto& [v, t, side, cross] : contacts) {
+      (v < ownVertices ? overBelow : belowOver) += 1;
+      crossed += cross;
+    }
+  }
+};
+
+TEST(GarmentBelow, TheGridFindsWhatBruteForceFinds) {
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  Kinds kinds;
+  for (int trial = 0; trial < 40; ++trial) {
+    // Two garments of different resolutions, the one over it a gap or so above, some of its
+    // points held by a fixture; both move, each point its own way.
+    const int cellsOver = 6 + static_cast<int>(unit(random) * 8), cellsBelow = 6 + static_cast<int>(unit(random) * 8);
+    const double gap = 0.01 + 0.04 * unit(random), self = trial % 2 == 0 ? 0.0 : gap;
+    const mesh::TriMesh over = wavySheet(cellsOver, gap * 1.5 * unit(random), 0.02, 0.3 * gap, trial, random);
+    const mesh::TriMesh below = wavySheet(cellsBelow, 0.0, 0.02, 0.3 * gap, 100 + trial, random);
+    const auto overModel = makeModel(over, knit()), belowModel = makeModel(below, knit());
+    const mesh::TriMesh both = joinedMeshes(over, below);
+    std::vector<Vec3> after = both.positions;
+    std::uniform_real_distribution<double> move(-0.6 * gap, 0.6 * gap);
+    for (Vec3& p : after) p += Vec3(move(random), move(random), move(random));
+    const ClothState belowState = pointsOf(below.positions);
+    LayerCollider collider(*overModel, "over", self);
+    std::vector<std::uint32_t> held;
+    for (std::uint32_t v = 0; v < over.positions.size(); ++v)
+      if (unit(random) < 0.15) held.push_back(v);
+    collider.setFixedVertices(held);
+    collider.addGarmentBelow(*belowModel, "below", belowState, gap, kFrame_s);
+    ASSERT_EQ(collider.vertexCount(), both.positions.size());
+    ASSERT_EQ(collider.triangleCount(), both.triangles.size());
+    const ClothState s0 = pointsOf(both.positions), s1 = pointsOf(after);
+
+    ContactSet grid;
+    for (const LayerContact& c : collider.findContacts(s0, s1)) grid.insert({c.vertex, c.triangle, c.side, c.crossed});
+    const ContactSet brute = everyPair(collider, both, s0, s1);
+    std::string missing, extra;
+    for (const auto& c : brute)
+      if (!grid.count(c)) missing += fmt::format(" ({}, {})", std::get<0>(c), std::get<1>(c));
+    for (const auto& c : grid)
+      if (!brute.count(c)) extra += fmt::format(" ({}, {})", std::get<0>(c), std::get<1>(c));
+    EXPECT_TRUE(missing.empty() && extra.empty()) << "trial " << trial << "; missed:" << missing << "; extra:" << extra;
+    kinds.add(brute, static_cast<std::uint32_t>(over.positions.size()));
+  }
+  // Enough of each kind that a wrong grid could not pass.
+  EXPECT_GT(kinds.overBelow, 500u);
+  EXPECT_GT(kinds.belowOver, 500u);
+  EXPECT_GT(kinds.crossed, 50u);
+}
+
+TEST(GarmentBelow, TheListKeptBetweenTestsFindsWhatBruteForceFinds) {
+  // Both garments carried along together (a walk) while their points wander, test after test.
+  std::mt19937 random(13);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double gap = 0.02;
+  const mesh::TriMesh over = wavySheet(10, gap, 0.02, 0.2 * gap, 1, random);
+  const mesh::TriMesh below = wavySheet(13, 0.0, 0.02, 0.2 * gap, 2, random);
+  const auto overModel = makeModel(over, knit()), belowModel = makeModel(below, knit());
+  const mesh::TriMesh both = joinedMeshes(over, below);
+  const ClothState belowState = pointsOf(below.positions);
+  LayerCollider collider(*overModel, "over", 0.0);
+  collider.addGarmentBelow(*belowModel, "below", belowState, gap, kFrame_s);
+  ClothState before = pointsOf(both.positions), now = before;
+  collider.findContacts(before, before);  // the sides as they start
+  Kinds kinds;
+  for (int test = 0; test < 120; ++test) {
+    const Vec3 carried(0.02 * unit(random), 0.01 * unit(random), -0.015 * unit(random));
+    const double wander = (test % 10 == 9 ? 1.5 : 0.12) * gap;
+    for (std::size_t v = 0; v < now.size(); ++v)
+      now.setPosition(
+          v, now.position(v) + carried + wander * Vec3(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5));
+    ContactSet kept;
+    for (const LayerContact& c : collider.nextContacts(now)) kept.insert({c.vertex, c.triangle, c.side, c.crossed});
+    const ContactSet brute = everyPair(collider, both, before, now);
+    EXPECT_EQ(kept, brute) << "test " << test;
+    kinds.add(brute, static_cast<std::uint32_t>(over.positions.size()));
+    before = now;
+  }
+  EXPECT_GT(kinds.overBelow, 500u);
+  EXPECT_GT(kinds.belowOver, 500u);
+  EXPECT_GE(collider.layerCounters().rebuilds, 10u);
+  EXPECT_LT(collider.layerCounters().rebuilds, 60u);
+}
+
+/// A rigid translation at constant velocity from the origin.
+class Gliding final : public FixtureMotion {
+ public:
+  explicit Gliding(const Vec3& velocity) : velocity_(velocity) {}
+  [[nodiscard]] RigidTransform poseAt(double t_s) const override { return {Quat::Identity(), velocity_ * t_s}; }
+
+ private:
+  Vec3 velocity_;
+};
+
+/// A 0.4 m square held by a fixture gliding at `below`'s velocity, and a free 0.1 m square
+/// `height` above it with velocity `start`: the two garments stepped frame by frame, the one
+/// below first. Calls look(t, over's solver, below's solver) after each frame.
+struct TwoGarments {
+  std::shared_ptr<const ClothModel> belowModel, overModel;
+  std::unique_ptr<ClothSolver> belowSolver, overSolver;
+  std::unique_ptr<LayerCollider> layers;
+};
+
+TwoGarments twoGarments(const Vec3& below, double height, double gap, double mu, bool keepApart) {
+  SheetSpec lower{0.4, 0.4, 10, 10, Vec3(-0.2, 0, -0.2), Vec3::UnitX(), Vec3::UnitZ(), "lower"};
+  SheetSpec upper{0.1, 0.1, 4, 4, Vec3(-0.05, height, -0.05), Vec3::UnitX(), Vec3::UnitZ(), "upper"};
+  Material mat = knit();
+  mat.damping_s = 1e-4;
+  mat.staticFriction = 2 * mu;
+  mat.dynamicFriction = mu;
+  TwoGarments g;
+  g.belowModel = makeModel(irregularSheet(lower, 0.3, 3), mat);
+  g.overModel = makeModel(gridSheet(upper), mat);
+  std::vector<std::uint32_t> all(g.belowModel->vertexCount());
+  for (std::uint32_t v = 0; v < all.size(); ++v) all[v] = v;
+  StepSettings settings = settingsWithStep(0.5 * g.overModel->estimatedStableStep_s());
+  g.belowSolver = std::make_unique<ClothSolver>(
+      g.belowModel, settings,
+      std::vector<PinGroup>{PinGroup::atRest(all, g.belowModel->restX(), g.belowModel->restY(), g.belowModel->restZ(),
+                                             std::make_shared<Gliding>(below))});
+  g.overSolver = std::make_unique<ClothSolver>(g.overModel, settings);
+  if (keepApart) {
+    g.layers = std::make_unique<LayerCollider>(*g.overModel, "upper", 0.0);
+    g.layers->addGarmentBelow(*g.belowModel, "lower", g.belowSolver->state(), gap, 1.0 / settings.frameRate_hz);
+    g.layers->initialise(g.overSolver->state());
+    g.overSolver->addCollider(*g.layers);
+  }
+  return g;
+}
+
+/// Frames 1..frames of both garments, the one below first; after each, `look(frame)`.
+template <typename Look>
+void stepBoth(TwoGarments& g, long frames, Look&& look) {
+  for (long f = 1; f <= frames; ++f) {
+    ASSERT_TRUE(g.belowSolver->stepFrame(f));
+    ASSERT_TRUE(g.overSolver->stepFrame(f));
+    look(f);
+  }
+}
+
+TEST(GarmentBelow, ASheetOnARisingGarmentRidesOneGapAboveIt) {
+  // The garment below rises 10 mm a frame, two and a half gaps: the sheet over it lands and is
+  // carried up one gap above it at every frame, as it would be if the one below moved
+  // smoothly (taken where it was at the frame's end, the sheet would ride up to 10 mm higher;
+  // where it was at the start, it would sink through).
+  const double gap = 0.004, rise = 0.3;
+  TwoGarments g = twoGarments(Vec3(0, rise, 0), 0.03, gap, 0.3, true);
+  double lowest = 1e9, highest = -1e9;
+  stepBoth(g, 30, [&](long f) {
+    if (f < 15) return;  // landed by then (it falls 30 mm while the one below rises)
+    const double floor = rise * static_cast<double>(f) * kFrame_s;
+    for (std::size_t v = 0; v < g.overModel->vertexCount(); ++v) {
+      lowest = std::min(lowest, g.overSolver->state().y[v] - floor);
+      highest = std::max(highest, g.overSolver->state().y[v] - floor);
+    }
+  });
+  EXPECT_NEAR(lowest, gap, 0.1 * gap);
+  EXPECT_NEAR(highest, gap, 0.1 * gap);
+  EXPECT_GT(g.layers->layerCounters().contactsBelow, 0u);
+  EXPECT_EQ(g.layers->layerCounters().contacts, 0u);  // none of its own layers: none kept
+
+  // Without the collider it falls through.
+  TwoGarments free = twoGarments(Vec3(0, rise, 0), 0.03, gap, 0.3, false);
+  stepBoth(free, 30, [](long) {});
+  for (std::size_t v = 0; v < free.overModel->vertexCount(); ++v) EXPECT_LT(free.overSolver->state().y[v], -0.5);
+}
+
+TEST(GarmentBelow, ASheetOnAGarmentSlidingAwayIsDraggedAtMuG) {
+  // The garment below slides along x at 1 m/s under a sheet at rest one gap above it:
+  // friction accelerates the sheet at mu g (it is still far slower than the one below).
+  const double gap = 0.004;
+  for (const double mu : {0.2, 0.4}) {
+    TwoGarments g = twoGarments(Vec3(1.0, 0, 0), gap, gap, mu, true);
+    std::vector<double> speeds;
+    stepBoth(g, 6, [&](long f) {
+      if (f != 2 && f != 6) return;
+      double momentum = 0, mass = 0;
+      for (std::size_t v = 0; v < g.overModel->vertexCount(); ++v) {
+        momentum += g.overSolver->state().vx[v] * g.overModel->mass()[v];
+        mass += g.overModel->mass()[v];
+      }
+      speeds.push_back(momentum / mass);
+    });
+    ASSERT_EQ(speeds.size(), 2u);
+    const double acceleration = (speeds[1] - speeds[0]) / (4 * kFrame_s);
+    EXPECT_NEAR(acceleration, mu * 9.81, 0.05 * mu * 9.81) << "mu " << mu;
+  }
+}
+
+TEST(GarmentBelow, AGapMustBeAPositiveLength) {
+  SheetSpec spec{0.4, 0.4, 2, 2, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), "sheet"};
+  const auto model = makeModel(gridSheet(spec), knit());
+  const ClothState state = ClothState::atRest(*model);
+  LayerCollider collider(*model, "jacket", 0.0);
+  try {
+    collider.addGarmentBelow(*model, "shirt", state, 0.0, kFrame_s);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("garment 'jacket': the gap over 'shirt', 0 m, must be a positive length"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace garment_below_test
+}  // namespace drape::cloth

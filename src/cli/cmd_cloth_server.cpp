@@ -39,6 +39,12 @@ void keepGarments(RunSetup& setup, const std::vector<std::string>& names, const 
   keepGarmentsWhere(setup, [&](std::size_t g) {
     return std::find(names.begin(), names.end(), setup.garments[g].name) != names.end();
   });
+  // A garment steps with the garments it is worn over: refused here, not at the first take.
+  for (const GarmentSetup& g : setup.garments)
+    for (const std::string& below : g.over)
+      if (std::find(names.begin(), names.end(), below) == names.end())
+        throw Error(fmt::format("--garments: '{}' is worn over '{}' (its over): give both, as in --garments {},{}",
+                                g.name, below, below, g.name));
 }
 
 /// The character whose garments `garments` names, when they are all one's (so that

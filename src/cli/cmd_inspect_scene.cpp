@@ -74,8 +74,8 @@ void printGarment(std::ostream& out, const scene::Scene& s, const scene::Garment
   if (g.selfCollision > 0)
     fmt::print(out, "    its own layers kept {:.4g} mm apart (selfCollision)\n", 1e3 * g.selfCollision);
   if (!g.over.empty())
-    fmt::print(out, "    worn {:.4g} mm over {} (over, overGap; stepped after them)\n", 1e3 * g.overGap,
-               fmt::join(g.over, ", "));
+    fmt::print(out, "    worn {:.4g} mm over {} (over, overGap; stepped after {})\n", 1e3 * g.overGap,
+               fmt::join(g.over, ", "), g.over.size() == 1 ? "it" : "them");
   if (!g.stitches.empty())
     fmt::print(out, "    {} stitches, drawing together vertices up to {:.1f} mm apart\n", g.stitches.size(),
                1e3 * widestStitch_m(g.mesh, g.stitches));

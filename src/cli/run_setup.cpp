@@ -942,8 +942,9 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
       spdlog::info("{}: its layers kept {:.4g} mm apart (self collision, tested every {} substeps)", g.name,
                    1e3 * r.layers->thickness_m(), r.layers->every());
     if (r.layers && !r.layers->garmentsBelow().empty())
-      spdlog::info("{}: kept {:.4g} mm over {} (stepped after them, tested every {} substeps)", g.name,
-                   1e3 * r.layers->gap_m(), fmt::join(r.layers->garmentsBelow(), ", "), r.layers->every());
+      spdlog::info("{}: kept {:.4g} mm over {} (stepped after {}, tested every {} substeps)", g.name,
+                   1e3 * r.layers->gap_m(), fmt::join(r.layers->garmentsBelow(), ", "),
+                   r.layers->garmentsBelow().size() == 1 ? "it" : "them", r.layers->every());
     r.model = &r.solver->model();
     // Each garment its own spheres: garments step in parallel, and a collider keeps counts.
     r.spheres.reserve(setup.spheres.size());  // the solver keeps references

@@ -17,7 +17,8 @@ std::vector<std::vector<std::size_t>> garmentsBelow(const std::vector<GarmentSpe
       if (it == garments.end()) {
         std::vector<std::string> names;
         for (const GarmentSpec& s : garments) names.push_back(s.name);
-        throw Error(fmt::format("garment '{}' is worn over '{}', which its character does not wear (it wears: {})",
+        throw Error(fmt::format("garment '{}' is worn over '{}', which is not among the garments simulated with it "
+                                "({}): a garment steps with the garments it is worn over",
                                 garments[g].name, name, fmt::join(names, ", ")));
       }
       const auto b = static_cast<std::size_t>(it - garments.begin());

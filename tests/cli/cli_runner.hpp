@@ -92,10 +92,13 @@ inline const std::string kTwoCharacters = std::string(DRAPE_SOURCE_DIR) + "/exam
 inline std::string twoCharactersWithBeaAt(const ScratchDir& scratch, const std::string& translation) {
   std::string text = slurp(kTwoCharacters);
   text.replace(text.find("translation 1.2 0 0"), 19, "translation " + translation);
-  for (const std::string relative : {"\"../../data/", "\"../walking_skirt/"})
-    while (text.find(relative) != std::string::npos)
-      text.replace(text.find(relative), relative.size(),
-                   "\"" + std::string(DRAPE_SOURCE_DIR) + (relative[4] == '.' ? "/data/" : "/examples/walking_skirt/"));
+  for (const std::string relative : {"\"../../data/", "\"../walking_skirt/"}) {
+    std::string to = "\"";
+    to += DRAPE_SOURCE_DIR;
+    to += relative[4] == '.' ? "/data/" : "/examples/walking_skirt/";
+    for (std::size_t at = text.find(relative); at != std::string::npos; at = text.find(relative))
+      text.replace(at, relative.size(), to);
+  }
   const std::string scene = scratch / "close.wrl";
   std::ofstream(scene) << text;
   return scene;

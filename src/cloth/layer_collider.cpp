@@ -21,6 +21,8 @@ constexpr double kMarginThicknesses = 2.0;
 /// How far outside a triangle (in barycentric weight) a projection may fall and still count:
 /// a vertex over the edge between two faces belongs to both.
 constexpr double kEdgeTolerance = 1e-9;
+/// LayerCollider::tested_: a point of its own in some pair, a point below in some pair.
+constexpr std::uint8_t kOwnPoint = 1, kPointBelow = 2;
 
 Vec3 at(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& z, std::uint32_t i) {
   return {x[i], y[i], z[i]};
@@ -194,7 +196,8 @@ void LayerCollider::sizeForPoints() {
   bool anyTriangleMoves = false;
   for (std::uint32_t t = 0; t < ownTriangles_ && !anyTriangleMoves; ++t) anyTriangleMoves = triangleMoves(t);
   for (std::size_t v = 0; v < n; ++v)
-    tested_[v] = v < ownVertices_ ? inverseMass_[v] > 0 && (thickness_ > 0 || !below_.empty()) : anyTriangleMoves;
+    tested_[v] = v < ownVertices_ ? (inverseMass_[v] > 0 && (thickness_ > 0 || !below_.empty()) ? kOwnPoint : 0)
+                                  : (anyTriangleMoves ? kPointBelow : 0);
   pairsBuilt_ = false;
 }
 
@@ -393,10 +396,13 @@ void LayerCollider::gatherPairs(const ClothState& after, double grow) {
       lo[a] = std::min({last[c[0]], last[c[1]], last[c[2]], now[c[0]], now[c[1]], now[c[2]]}) - grow;
       hi[a] = std::max({last[c[0]], last[c[1]], last[c[2]], now[c[0]], now[c[1]], now[c[2]]}) + grow;
     }
+    // Which points it can hold pairs with: its own triangles the points below (and its own
+    // with its own layers kept apart), a triangle below its own points.
+    const std::uint8_t accept = t < ownTriangles_ ? (thickness_ > 0 ? kOwnPoint : 0) | kPointBelow : kOwnPoint;
     forCells(lo, hi, [&](std::uint32_t b) {
       for (std::uint32_t e = bucketStart_[b]; e < bucketStart_[b + 1]; ++e) {
         const std::uint32_t v = entries_[e];
-        if (seen_[v] == t + 1) continue;
+        if (!(tested_[v] & accept) || seen_[v] == t + 1) continue;
         seen_[v] = t + 1;
         const double* vlo = &vertexLo_[3 * v];
         const double* vhi = &vertexHi_[3 * v];

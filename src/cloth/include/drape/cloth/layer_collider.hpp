@@ -229,7 +229,7 @@ class LayerCollider final : public Collider {
   std::vector<std::array<std::uint32_t, 3>> triangles_;
   std::vector<std::uint32_t> neighbourStart_, neighbours_;  ///< per vertex (CSR), sorted
   std::vector<double> inverseMass_;                         ///< 0 for the fixed vertices and those below
-  std::vector<std::uint8_t> tested_;                        ///< per vertex: whether it is in some pair
+  std::vector<std::uint8_t> tested_;  ///< per vertex: whether it can be in a pair, and as whose (kOwnPoint, kPointBelow)
   std::vector<double> lastX_, lastY_, lastZ_;               ///< positions at the last test
   // The grid: per bucket (a hash of the cell) the vertices whose boxes touch a cell of it.
   std::vector<double> vertexLo_, vertexHi_;  ///< per vertex, xyz: its box over the interval

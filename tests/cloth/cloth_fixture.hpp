@@ -44,6 +44,28 @@ inline std::vector<std::uint32_t> row(const SheetSpec& s, int j) {
   return out;
 }
 
+/// `b`'s vertices and triangles appended to `a`'s (two sheets as one mesh, or in the
+/// numbering of a layer collider: a garment's own points, then those below it).
+inline mesh::TriMesh joinedMeshes(mesh::TriMesh a, const mesh::TriMesh& b) {
+  const auto offset = static_cast<std::uint32_t>(a.positions.size());
+  a.positions.insert(a.positions.end(), b.positions.begin(), b.positions.end());
+  for (mesh::Triangle t : b.triangles) a.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  return a;
+}
+
+/// A state with these positions, at rest (no forces or workspace).
+inline ClothState stateAt(const std::vector<Vec3>& points) {
+  ClothState s;
+  for (const Vec3& p : points) {
+    s.x.push_back(p.x());
+    s.y.push_back(p.y());
+    s.z.push_back(p.z());
+  }
+  s.vx.assign(s.x.size(), 0.0);
+  s.vy = s.vz = s.vx;
+  return s;
+}
+
 /// Runs `steps` substeps; returns false on instability.
 inline bool run(ClothSolver& solver, long steps) {
   const double dt = solver.settings().substep_s();

@@ -15,55 +15,22 @@
 #include "cloth_fixture.hpp"
 #include "drape/cloth/layer_collider.hpp"
 #include "drape/core/error.hpp"
+#include "layer_fixture.hpp"
 
 namespace drape::cloth {
 namespace garment_below_test {
 
+using testing::ContactSet;
+using testing::contactSet;
+using testing::everyPair;
+using testing::joinedMeshes;
 using testing::knit;
 using testing::makeModel;
 using testing::pinAt;
 using testing::settingsWithStep;
+using testing::stateAt;
 
 constexpr double kFrame_s = 1.0 / 30.0;
-
-using ContactSet = std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>>;
-
-ClothState pointsOf(const std::vector<Vec3>& points) {
-  ClothState s;
-  for (const Vec3& p : points) {
-    s.x.push_back(p.x());
-    s.y.push_back(p.y());
-    s.z.push_back(p.z());
-  }
-  s.vx.assign(s.x.size(), 0.0);
-  s.vy = s.vz = s.vx;
-  return s;
-}
-
-/// `b`'s points and triangles after `a`'s: the collider's numbering.
-mesh::TriMesh joinedMeshes(mesh::TriMesh a, const mesh::TriMesh& b) {
-  const auto offset = static_cast<std::uint32_t>(a.positions.size());
-  a.positions.insert(a.positions.end(), b.positions.begin(), b.positions.end());
-  for (mesh::Triangle t : b.triangles) a.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
-  return a;
-}
-
-/// Every pair the collider tests, checked one by one between `s0` and `s1`.
-ContactSet everyPair(const LayerCollider& collider, const mesh::TriMesh& both, const ClothState& s0,
-                     const ClothState& s1) {
-  ContactSet out;
-  for (std::uint32_t v = 0; v < both.positions.size(); ++v)
-    for (std::uint32_t t = 0; t < both.triangles.size(); ++t) {
-      const double thickness = collider.pairThickness(v, t);
-      if (thickness == 0) continue;
-      const mesh::Triangle& tri = both.triangles[t];
-      const std::array<Vec3, 3> t0{s0.position(tri[0]), s0.position(tri[1]), s0.position(tri[2])};
-      const std::array<Vec3, 3> t1{s1.position(tri[0]), s1.position(tri[1]), s1.position(tri[2])};
-      if (auto c = layerContact(s0.position(v), s1.position(v), t0, t1, thickness))
-        out.insert({v, t, c->side, c->crossed});
-    }
-  return out;
-}
 
 /// A wavy sheet of `cells` x `cells` over [0, 1]^2 in xz at height `y`, its points moved by up
 /// to `noise`.
@@ -105,7 +72,7 @@ TEST(GarmentBelow, TheGridFindsWhatBruteForceFinds) {
     std::vector<Vec3> after = both.positions;
     std::uniform_real_distribution<double> move(-0.6 * gap, 0.6 * gap);
     for (Vec3& p : after) p += Vec3(move(random), move(random), move(random));
-    const ClothState belowState = pointsOf(below.positions);
+    const ClothState belowState = stateAt(below.positions);
     LayerCollider collider(*overModel, "over", self);
     std::vector<std::uint32_t> held;
     for (std::uint32_t v = 0; v < over.positions.size(); ++v)
@@ -114,10 +81,9 @@ TEST(GarmentBelow, TheGridFindsWhatBruteForceFinds) {
     collider.addGarmentBelow(*belowModel, "below", belowState, gap, kFrame_s);
     ASSERT_EQ(collider.vertexCount(), both.positions.size());
     ASSERT_EQ(collider.triangleCount(), both.triangles.size());
-    const ClothState s0 = pointsOf(both.positions), s1 = pointsOf(after);
+    const ClothState s0 = stateAt(both.positions), s1 = stateAt(after);
 
-    ContactSet grid;
-    for (const LayerContact& c : collider.findContacts(s0, s1)) grid.insert({c.vertex, c.triangle, c.side, c.crossed});
+    const ContactSet grid = contactSet(collider.findContacts(s0, s1));
     const ContactSet brute = everyPair(collider, both, s0, s1);
     std::string missing, extra;
     for (const auto& c : brute)
@@ -142,10 +108,10 @@ TEST(GarmentBelow, TheListKeptBetweenTestsFindsWhatBruteForceFinds) {
   const mesh::TriMesh below = wavySheet(13, 0.0, 0.02, 0.2 * gap, 2, random);
   const auto overModel = makeModel(over, knit()), belowModel = makeModel(below, knit());
   const mesh::TriMesh both = joinedMeshes(over, below);
-  const ClothState belowState = pointsOf(below.positions);
+  const ClothState belowState = stateAt(below.positions);
   LayerCollider collider(*overModel, "over", 0.0);
   collider.addGarmentBelow(*belowModel, "below", belowState, gap, kFrame_s);
-  ClothState before = pointsOf(both.positions), now = before;
+  ClothState before = stateAt(both.positions), now = before;
   collider.findContacts(before, before);  // the sides as they start
   Kinds kinds;
   for (int test = 0; test < 120; ++test) {
@@ -154,8 +120,7 @@ TEST(GarmentBelow, TheListKeptBetweenTestsFindsWhatBruteForceFinds) {
     for (std::size_t v = 0; v < now.size(); ++v)
       now.setPosition(
           v, now.position(v) + carried + wander * Vec3(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5));
-    ContactSet kept;
-    for (const LayerContact& c : collider.nextContacts(now)) kept.insert({c.vertex, c.triangle, c.side, c.crossed});
+    const ContactSet kept = contactSet(collider.nextContacts(now));
     const ContactSet brute = everyPair(collider, both, before, now);
     EXPECT_EQ(kept, brute) << "test " << test;
     kinds.add(brute, static_cast<std::uint32_t>(over.positions.size()));

@@ -14,23 +14,20 @@
 
 #include "cloth_fixture.hpp"
 #include "drape/cloth/layer_collider.hpp"
+#include "layer_fixture.hpp"
 
 namespace drape::cloth {
 namespace self_collision_test {
 
+using testing::ContactSet;
+using testing::contactSet;
+using testing::everyPair;
+using testing::joinedMeshes;
 using testing::knit;
 using testing::makeModel;
 using testing::pinAt;
 using testing::run;
 using testing::settingsWithStep;
-
-/// `b`'s vertices and triangles appended to `a`'s.
-mesh::TriMesh joined(mesh::TriMesh a, const mesh::TriMesh& b) {
-  const auto offset = static_cast<std::uint32_t>(a.positions.size());
-  a.positions.insert(a.positions.end(), b.positions.begin(), b.positions.end());
-  for (mesh::Triangle t : b.triangles) a.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
-  return a;
-}
 
 /// A sheet of `cells` x `cells` in the xz plane, folded in two across x = 0: the half with
 /// u > 0.5 lies back over the other, `gap` above it, each point moved by up to `noise`.
@@ -45,38 +42,7 @@ mesh::TriMesh foldedSheet(int cells, double gap, double noise, std::mt19937& ran
   return m;
 }
 
-ClothState statesAt(const mesh::TriMesh& m) {
-  ClothState s;
-  for (const Vec3& p : m.positions) {
-    s.x.push_back(p.x());
-    s.y.push_back(p.y());
-    s.z.push_back(p.z());
-  }
-  s.vx.assign(s.x.size(), 0.0);
-  s.vy = s.vz = s.vx;
-  return s;
-}
-
-/// The pairs brute force finds between `s0` and `s1` of mesh `m` (the collider's numbering:
-/// its own garment's and those below), as the set the tests compare: every pair the
-/// collider tests, at the thickness it keeps it at.
-std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> bruteContacts(const LayerCollider& collider,
-                                                                               const mesh::TriMesh& m,
-                                                                               const ClothState& s0,
-                                                                               const ClothState& s1) {
-  std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> out;
-  for (std::uint32_t v = 0; v < m.positions.size(); ++v)
-    for (std::uint32_t t = 0; t < m.triangles.size(); ++t) {
-      const double thickness = collider.pairThickness(v, t);
-      if (thickness == 0) continue;
-      const mesh::Triangle& tri = m.triangles[t];
-      const std::array<Vec3, 3> t0{s0.position(tri[0]), s0.position(tri[1]), s0.position(tri[2])};
-      const std::array<Vec3, 3> t1{s1.position(tri[0]), s1.position(tri[1]), s1.position(tri[2])};
-      if (auto c = layerContact(s0.position(v), s1.position(v), t0, t1, thickness))
-        out.insert({v, t, c->side, c->crossed});
-    }
-  return out;
-}
+ClothState statesAt(const mesh::TriMesh& m) { return testing::stateAt(m.positions); }
 
 TEST(SelfCollision, TheGridFindsWhatBruteForceFinds) {
   std::mt19937 random(7);
@@ -93,9 +59,8 @@ TEST(SelfCollision, TheGridFindsWhatBruteForceFinds) {
     LayerCollider collider(*model, "folded", thickness);
     const ClothState s0 = statesAt(before), s1 = statesAt(after);
 
-    std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> grid;
-    for (const LayerContact& c : collider.findContacts(s0, s1)) grid.insert({c.vertex, c.triangle, c.side, c.crossed});
-    const auto brute = bruteContacts(collider, before, s0, s1);
+    const ContactSet grid = contactSet(collider.findContacts(s0, s1));
+    const auto brute = everyPair(collider, before, s0, s1);
     std::string missing, extra;
     for (const auto& c : brute)
       if (!grid.count(c)) missing += fmt::format(" ({}, {})", std::get<0>(c), std::get<1>(c));
@@ -130,9 +95,8 @@ TEST(SelfCollision, TheListKeptBetweenTestsFindsWhatBruteForceFinds) {
     for (std::size_t v = 0; v < now.size(); ++v)
       now.setPosition(
           v, now.position(v) + carried + wander * Vec3(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5));
-    std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>> kept;
-    for (const LayerContact& c : collider.nextContacts(now)) kept.insert({c.vertex, c.triangle, c.side, c.crossed});
-    const auto brute = bruteContacts(collider, rest, before, now);
+    const ContactSet kept = contactSet(collider.nextContacts(now));
+    const auto brute = everyPair(collider, rest, before, now);
     EXPECT_EQ(kept, brute) << "test " << test;
     total += brute.size();
     before = now;
@@ -195,7 +159,7 @@ TEST(SelfCollision, ANarrowTestSaysWhichSideAndWhetherItCrossed) {
 std::pair<double, double> dropLayer(double thickness, double seconds, bool selfCollision) {
   SheetSpec lower{0.4, 0.4, 10, 10, Vec3(-0.2, 0, -0.2), Vec3::UnitX(), Vec3::UnitZ(), "lower"};
   SheetSpec upper{0.3, 0.3, 9, 9, Vec3(-0.15, 0.03, -0.15), Vec3::UnitX(), Vec3::UnitZ(), "upper"};
-  const mesh::TriMesh m = joined(irregularSheet(lower, 0.3, 3), irregularSheet(upper, 0.3, 4));
+  const mesh::TriMesh m = joinedMeshes(irregularSheet(lower, 0.3, 3), irregularSheet(upper, 0.3, 4));
   Material mat = knit();
   mat.damping_s = 1e-4;
   const auto model = makeModel(m, mat);
@@ -293,7 +257,7 @@ std::vector<double> slidingSpeeds(const std::vector<double>& times, double mu) {
   const double h = 0.004;
   SheetSpec lower{0.4, 0.4, 10, 10, Vec3(-0.2, 0, -0.2), Vec3::UnitX(), Vec3::UnitZ(), "lower"};
   SheetSpec upper{0.1, 0.1, 3, 3, Vec3(-0.15, h, -0.05), Vec3::UnitX(), Vec3::UnitZ(), "upper"};
-  const mesh::TriMesh m = joined(irregularSheet(lower, 0.3, 3), gridSheet(upper));
+  const mesh::TriMesh m = joinedMeshes(irregularSheet(lower, 0.3, 3), gridSheet(upper));
   Material mat = knit();
   mat.staticFriction = 2 * mu;
   mat.dynamicFriction = mu;

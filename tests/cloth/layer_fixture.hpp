@@ -1,0 +1,43 @@
+#pragma once
+// Shared by the layer collision tests: every pair a LayerCollider tests, checked one by one.
+
+#include <array>
+#include <cstdint>
+#include <set>
+#include <tuple>
+
+#include "drape/cloth/layer_collider.hpp"
+#include "drape/mesh/trimesh.hpp"
+
+namespace drape::cloth::testing {
+
+/// (vertex, triangle, side, crossed) of each contact.
+using ContactSet = std::set<std::tuple<std::uint32_t, std::uint32_t, double, bool>>;
+
+/// The contacts brute force finds between `s0` and `s1` of mesh `m` (the collider's
+/// numbering: a garment's own points and triangles, then those below it): every pair the
+/// collider tests, at the thickness it keeps it at.
+inline ContactSet everyPair(const LayerCollider& collider, const mesh::TriMesh& m, const ClothState& s0,
+                            const ClothState& s1) {
+  ContactSet out;
+  for (std::uint32_t v = 0; v < m.positions.size(); ++v)
+    for (std::uint32_t t = 0; t < m.triangles.size(); ++t) {
+      const double thickness = collider.pairThickness(v, t);
+      if (thickness == 0) continue;
+      const mesh::Triangle& tri = m.triangles[t];
+      const std::array<Vec3, 3> t0{s0.position(tri[0]), s0.position(tri[1]), s0.position(tri[2])};
+      const std::array<Vec3, 3> t1{s1.position(tri[0]), s1.position(tri[1]), s1.position(tri[2])};
+      if (auto c = layerContact(s0.position(v), s1.position(v), t0, t1, thickness))
+        out.insert({v, t, c->side, c->crossed});
+    }
+  return out;
+}
+
+/// The contacts a collider's test found, as everyPair gives them.
+inline ContactSet contactSet(const std::vector<LayerContact>& contacts) {
+  ContactSet out;
+  for (const LayerContact& c : contacts) out.insert({c.vertex, c.triangle, c.side, c.crossed});
+  return out;
+}
+
+}  // namespace drape::cloth::testing

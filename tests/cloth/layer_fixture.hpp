@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cstdint>
+#include <random>
 #include <set>
 #include <tuple>
 
@@ -38,6 +39,18 @@ inline ContactSet contactSet(const std::vector<LayerContact>& contacts) {
   ContactSet out;
   for (const LayerContact& c : contacts) out.insert({c.vertex, c.triangle, c.side, c.crossed});
   return out;
+}
+
+/// Test `test` of a run whose points are carried along together (a walk's common motion,
+/// which keeps a candidate list) while each wanders a little; every tenth test they wander
+/// 1.5 `scale` (which makes the list again).
+inline void carryAndWander(ClothState& points, int test, double scale, std::mt19937& random) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const Vec3 carried(0.02 * unit(random), 0.01 * unit(random), -0.015 * unit(random));
+  const double wander = (test % 10 == 9 ? 1.5 : 0.12) * scale;
+  for (std::size_t v = 0; v < points.size(); ++v)
+    points.setPosition(
+        v, points.position(v) + carried + wander * Vec3(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5));
 }
 
 }  // namespace drape::cloth::testing

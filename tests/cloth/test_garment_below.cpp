@@ -21,6 +21,7 @@ namespace drape::cloth {
 namespace garment_below_test {
 
 using testing::ContactSet;
+using testing::carryAndWander;
 using testing::contactSet;
 using testing::everyPair;
 using testing::joinedMeshes;
@@ -115,11 +116,7 @@ TEST(GarmentBelow, TheListKeptBetweenTestsFindsWhatBruteForceFinds) {
   collider.findContacts(before, before);  // the sides as they start
   Kinds kinds;
   for (int test = 0; test < 120; ++test) {
-    const Vec3 carried(0.02 * unit(random), 0.01 * unit(random), -0.015 * unit(random));
-    const double wander = (test % 10 == 9 ? 1.5 : 0.12) * gap;
-    for (std::size_t v = 0; v < now.size(); ++v)
-      now.setPosition(
-          v, now.position(v) + carried + wander * Vec3(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5));
+    carryAndWander(now, test, gap, random);
     const ContactSet kept = contactSet(collider.nextContacts(now));
     const ContactSet brute = everyPair(collider, both, before, now);
     EXPECT_EQ(kept, brute) << "test " << test;

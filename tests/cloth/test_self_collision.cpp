@@ -20,6 +20,7 @@ namespace drape::cloth {
 namespace self_collision_test {
 
 using testing::ContactSet;
+using testing::carryAndWander;
 using testing::contactSet;
 using testing::everyPair;
 using testing::joinedMeshes;
@@ -90,11 +91,7 @@ TEST(SelfCollision, TheListKeptBetweenTestsFindsWhatBruteForceFinds) {
   collider.initialise(before);
   std::size_t total = 0;
   for (int test = 0; test < 120; ++test) {
-    const Vec3 carried(0.02 * unit(random), 0.01 * unit(random), -0.015 * unit(random));
-    const double wander = (test % 10 == 9 ? 1.5 : 0.12) * thickness;
-    for (std::size_t v = 0; v < now.size(); ++v)
-      now.setPosition(
-          v, now.position(v) + carried + wander * Vec3(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5));
+    carryAndWander(now, test, thickness, random);
     const ContactSet kept = contactSet(collider.nextContacts(now));
     const auto brute = everyPair(collider, rest, before, now);
     EXPECT_EQ(kept, brute) << "test " << test;

@@ -67,7 +67,7 @@ struct PaperRun {
   int collisionEvery = 1;
   int bendEvery = 1;
   cloth::FieldCollisionCounters counters;
-  cloth::LayerCounters self;  ///< the garments' self collision, summed
+  cloth::LayerCounters self;  ///< the garments' layer collision (their own, those below), summed
   double selfThickness_m = 0;  ///< the largest
   std::size_t triangles = 0;
   int substeps = 0;
@@ -260,6 +260,8 @@ RunFunction setupPaperBench(CLI::App& app) {
     j["self_collision_m"] = r.selfThickness_m;  // 0: none (its time is in the collision's)
     j["self_collision_contacts"] = r.self.contacts;
     j["self_collision_crossings"] = r.self.crossings;
+    j["worn_over_contacts"] = r.self.contactsBelow;  // with the garments worn under (the scene's over)
+    j["worn_over_crossings"] = r.self.crossingsBelow;
     j["vertex_substeps"] = penetration.vertexSubsteps;  // free vertices x substeps: all of them
     j["vertex_substeps_inside_body"] = penetration.vertexSubstepsInsideBody;
     j["vertex_substeps_below_T1_fraction"] =

@@ -15,8 +15,9 @@ namespace {
 /// Jacobi sweeps over the contacts' positions: each moves every pair by the average of its
 /// pushes, so that a vertex in several contacts converges instead of overshooting.
 constexpr int kPositionSweeps = 3;
-/// The candidate pairs hold while no vertex moves more than half this many thicknesses
-/// (beyond the garment's common motion) from where they were found.
+/// The candidate pairs hold while no vertex moves more than half this many thicknesses (the
+/// larger of its own layers' and the gap; beyond the garments' common motion) from where
+/// they were found.
 constexpr double kMarginThicknesses = 2.0;
 /// How far outside a triangle (in barycentric weight) a projection may fall and still count:
 /// a vertex over the edge between two faces belongs to both.
@@ -95,18 +96,15 @@ LayerCollider::LayerCollider(const ClothModel& model, std::string garment, doubl
   ownVertices_ = static_cast<std::uint32_t>(n);
   ownTriangles_ = static_cast<std::uint32_t>(model.triangleCount());
   triangles_.assign(model.triangles().begin(), model.triangles().end());
-  // Neighbours (CSR) and the edge lengths, from the triangles' edges.
+  // Neighbours (CSR), from the triangles' edges.
   std::vector<std::vector<std::uint32_t>> around(n);
   for (const auto& t : triangles_)
     for (int e = 0; e < 3; ++e) {
-      const std::uint32_t a = t[e], b = t[(e + 1) % 3];
-      around[a].push_back(b);
-      around[b].push_back(a);
-      edgeSum_ += (at(model.restX(), model.restY(), model.restZ(), a) - at(model.restX(), model.restY(), model.restZ(), b))
-                      .norm();
-      ++edgeCount_;
+      around[t[e]].push_back(t[(e + 1) % 3]);
+      around[t[(e + 1) % 3]].push_back(t[e]);
     }
   setNeighbours(around);
+  addEdgeLengths(model);
   inverseMass_ = model.inverseMass();
   lastX_ = model.restX();
   lastY_ = model.restY();
@@ -134,15 +132,8 @@ void LayerCollider::addGarmentBelow(const ClothModel& model, std::string name, c
   b.startX = b.endX = state.x;
   b.startY = b.endY = state.y;
   b.startZ = b.endZ = state.z;
-  for (const auto& t : model.triangles()) {
-    triangles_.push_back({t[0] + b.first, t[1] + b.first, t[2] + b.first});
-    for (int e = 0; e < 3; ++e) {
-      edgeSum_ += (at(model.restX(), model.restY(), model.restZ(), t[e]) -
-                   at(model.restX(), model.restY(), model.restZ(), t[(e + 1) % 3]))
-                      .norm();
-      ++edgeCount_;
-    }
-  }
+  for (const auto& t : model.triangles()) triangles_.push_back({t[0] + b.first, t[1] + b.first, t[2] + b.first});
+  addEdgeLengths(model);
   // Its points have no neighbours here (none of its triangles is ever excluded) and do not
   // move here.
   neighbourStart_.insert(neighbourStart_.end(), b.count, neighbourStart_.back());
@@ -153,6 +144,16 @@ void LayerCollider::addGarmentBelow(const ClothModel& model, std::string name, c
   below_.push_back(std::move(b));
   held_ = false;
   sizeForPoints();
+}
+
+void LayerCollider::addEdgeLengths(const ClothModel& model) {
+  for (const auto& t : model.triangles())
+    for (int e = 0; e < 3; ++e) {
+      edgeSum_ += (at(model.restX(), model.restY(), model.restZ(), t[e]) -
+                   at(model.restX(), model.restY(), model.restZ(), t[(e + 1) % 3]))
+                      .norm();
+      ++edgeCount_;
+    }
 }
 
 std::vector<std::string> LayerCollider::garmentsBelow() const {

@@ -157,6 +157,8 @@ class LayerCollider final : public Collider {
     std::uint32_t first = 0, count = 0;
     std::vector<double> startX, startY, startZ, endX, endY, endZ;
   };
+  /// The model's triangles' edges into the mean edge length (cells are sized from it).
+  void addEdgeLengths(const ClothModel& model);
   /// Sizes the per-vertex arrays, the grid and the margin for the vertices and triangles
   /// numbered so far.
   void sizeForPoints();

@@ -19,6 +19,10 @@ constexpr int kPositionSweeps = 3;
 /// larger of its own layers' and the gap; beyond the garments' common motion) from where
 /// they were found.
 constexpr double kMarginThicknesses = 2.0;
+/// A point that moves past its reach (half its margin) gets twice the reach at the next list,
+/// up to this many times the first, and a point that did not gives back a quarter of what
+/// it has above the first: a swinging hem gets room, and the list is made again less often.
+constexpr double kMostReach = 8.0, kReachKept = 0.75;
 /// How far outside a triangle (in barycentric weight) a projection may fall and still count:
 /// a vertex over the edge between two faces belongs to both.
 constexpr double kEdgeTolerance = 1e-9;
@@ -171,6 +175,7 @@ void LayerCollider::sizeForPoints() {
   const double meanEdge = edgeCount_ > 0 ? edgeSum_ / static_cast<double>(edgeCount_) : thickest;
   margin_ = kMarginThicknesses * thickest;
   cell_m_ = std::max(meanEdge + 2.0 * (thickest + margin_), 1e-9);
+  reach_.assign(n, 0.5 * margin_);
   vertexLo_.resize(3 * n);
   vertexHi_.resize(3 * n);
   const std::size_t buckets = std::bit_ceil(std::max<std::size_t>(64, 2 * n));
@@ -358,14 +363,14 @@ void LayerCollider::forCells(const double* lo, const double* hi, Visit&& visit) 
 }
 
 void LayerCollider::buildGrid(const ClothState& after) {
-  // Each vertex's box over the interval (where it was at the last test and is now): most
-  // lie in one cell.
+  // Each vertex's box over the interval (where it was at the last test and is now), grown by
+  // its reach: where it may be until the list is made again. Most lie in one cell.
   const std::size_t n = after.size();
   for (std::size_t v = 0; v < n; ++v) {
     const double p0[3] = {lastX_[v], lastY_[v], lastZ_[v]}, p1[3] = {after.x[v], after.y[v], after.z[v]};
     for (int k = 0; k < 3; ++k) {
-      vertexLo_[3 * v + k] = std::min(p0[k], p1[k]);
-      vertexHi_[3 * v + k] = std::max(p0[k], p1[k]);
+      vertexLo_[3 * v + k] = std::min(p0[k], p1[k]) - reach_[v];
+      vertexHi_[3 * v + k] = std::max(p0[k], p1[k]) + reach_[v];
     }
   }
   // Counted, then placed: every bucket's vertices in one array, in vertex order. A vertex
@@ -388,14 +393,12 @@ void LayerCollider::gatherPairs(const ClothState& after, double grow) {
   // Its own triangles hold pairs with its own layers kept apart or with points below.
   const std::uint32_t first = thickness_ > 0 || !below_.empty() ? 0 : ownTriangles_;
   for (std::uint32_t t = first; t < triangles_.size(); ++t) {
-    // The triangle's box over the interval, grown: the vertices whose boxes meet it.
+    // Its corners' boxes, grown by the thickness: the vertices whose boxes meet it.
     const auto& c = triangles_[t];
     double lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
-      const double* last = a == 0 ? lastX_.data() : a == 1 ? lastY_.data() : lastZ_.data();
-      const double* now = a == 0 ? after.x.data() : a == 1 ? after.y.data() : after.z.data();
-      lo[a] = std::min({last[c[0]], last[c[1]], last[c[2]], now[c[0]], now[c[1]], now[c[2]]}) - grow;
-      hi[a] = std::max({last[c[0]], last[c[1]], last[c[2]], now[c[0]], now[c[1]], now[c[2]]}) + grow;
+      lo[a] = std::min({vertexLo_[3 * c[0] + a], vertexLo_[3 * c[1] + a], vertexLo_[3 * c[2] + a]}) - grow;
+      hi[a] = std::max({vertexHi_[3 * c[0] + a], vertexHi_[3 * c[1] + a], vertexHi_[3 * c[2] + a]}) + grow;
     }
     // Which points it can hold pairs with: its own triangles the points below (and its own
     // with its own layers kept apart), a triangle below its own points.
@@ -444,30 +447,34 @@ Vec3 LayerCollider::meanPosition(const std::vector<double>& x, const std::vector
   return Vec3(sx, sy, sz) / static_cast<double>(std::max<std::size_t>(1, x.size()));
 }
 
-bool LayerCollider::pairsHold(const ClothState& now) const {
-  if (!pairsBuilt_) return false;
-  // Translation-free: what moved with the garment as a whole changes no pair's distance.
+bool LayerCollider::beyondReach(const ClothState& now, std::size_t v, const Vec3& shiftNow,
+                                const Vec3& shiftLast) const {
   // Both ends of the interval: the last test's positions are where its corrections left them.
-  const auto within = [&](const double* x, const double* y, const double* z, const Vec3& mean) {
-    const Vec3 shift = mean - builtMean_;
-    const double reach2 = 0.25 * margin_ * margin_;
-    for (std::size_t v = 0; v < now.size(); ++v) {
-      const double dx = x[v] - builtX_[v] - shift.x(), dy = y[v] - builtY_[v] - shift.y(),
-                   dz = z[v] - builtZ_[v] - shift.z();
-      if (dx * dx + dy * dy + dz * dz > reach2) return false;
-    }
-    return true;
+  const auto farther = [&](double x, double y, double z, const Vec3& shift) {
+    const double dx = x - builtX_[v] - shift.x(), dy = y - builtY_[v] - shift.y(), dz = z - builtZ_[v] - shift.z();
+    return dx * dx + dy * dy + dz * dz > reach_[v] * reach_[v];
   };
-  return within(now.x.data(), now.y.data(), now.z.data(), meanPosition(now.x, now.y, now.z)) &&
-         within(lastX_.data(), lastY_.data(), lastZ_.data(), meanPosition(lastX_, lastY_, lastZ_));
+  return farther(now.x[v], now.y[v], now.z[v], shiftNow) || farther(lastX_[v], lastY_[v], lastZ_[v], shiftLast);
 }
 
 void LayerCollider::updatePairs(const ClothState& now) {
-  if (pairsHold(now)) return;
-  // Every pair whose vertex could come within h of the triangle (or through it) while no
-  // vertex moves more than margin / 2 from here, the garment's common motion left out.
+  // Translation-free: what moved with the garments as a whole changes no pair's distance.
+  if (pairsBuilt_) {
+    const Vec3 shiftNow = meanPosition(now.x, now.y, now.z) - builtMean_,
+               shiftLast = meanPosition(lastX_, lastY_, lastZ_) - builtMean_;
+    std::size_t v = 0;
+    while (v < now.size() && !beyondReach(now, v, shiftNow, shiftLast)) ++v;
+    if (v == now.size()) return;  // the list holds
+    // Every point's reach for the next list: twice for those beyond it, less for the others.
+    const double first = 0.5 * margin_;
+    for (v = 0; v < now.size(); ++v)
+      reach_[v] = beyondReach(now, v, shiftNow, shiftLast) ? std::min(2.0 * reach_[v], kMostReach * first)
+                                                           : std::max(first, first + kReachKept * (reach_[v] - first));
+  }
+  // Every pair whose vertex could come within the thickness of the triangle (or through it)
+  // while no point moves farther than its reach from here, the common motion left out.
   buildGrid(now);
-  gatherPairs(now, std::max(thickness_, gap_) + margin_);
+  gatherPairs(now, std::max(thickness_, gap_));
   builtX_ = now.x;
   builtY_ = now.y;
   builtZ_ = now.z;

@@ -7,11 +7,13 @@
 // Vertex against face, with a thickness h (its own layers) or a gap g (the garments below).
 // At each test (every k substeps, as the body's collision) the candidate pairs are checked:
 // every (vertex, triangle) pair that could come within its thickness while no vertex moves
-// more than a margin m / 2 (m = twice the larger of h and g) from where the list was made,
-// the common motion left out (a walk carries the whole skirt along without changing a
-// distance). The list is made again when a vertex has moved farther: each triangle's box
-// over the interval, grown by the thickness + m, against the vertices' boxes in a hashed
-// uniform grid (arrays sized once). A vertex and a triangle are a contact when the vertex
+// farther than its reach from where the list was made (at first m / 2, m = twice the larger
+// of h and g), the common motion left out (a walk carries the whole skirt along without
+// changing a distance). The list is made again when a vertex has moved farther: each
+// triangle's corners' boxes over the interval, grown by their reach and the thickness,
+// against the vertices' boxes grown by theirs, in a hashed uniform grid (arrays sized once).
+// A vertex that went past its reach gets more at the next list (a swinging hem), one that
+// did not gives some back. A vertex and a triangle are a contact when the vertex
 // ends within the thickness of the triangle's face (its projection inside the triangle) on
 // the side it was on at the last test, or has crossed to the other side since. Contacts are
 // resolved in three Jacobi sweeps (every pair's push summed per vertex, then averaged, so the
@@ -186,8 +188,10 @@ class LayerCollider final : public Collider {
   void narrow(const ClothState& after);
   [[nodiscard]] static Vec3 meanPosition(const std::vector<double>& x, const std::vector<double>& y,
                                          const std::vector<double>& z);
-  /// Whether the candidate list still holds for the interval from the last test to `now`.
-  [[nodiscard]] bool pairsHold(const ClothState& now) const;
+  /// Whether point v is farther than its reach from where it was when the list was made, at
+  /// either end of the interval to `now`, the common motion (the shifts of the mean) left out.
+  [[nodiscard]] bool beyondReach(const ClothState& now, std::size_t v, const Vec3& shiftNow,
+                                 const Vec3& shiftLast) const;
   void updatePairs(const ClothState& now);
   void resolvePositions(ClothState& io);
   void resolveVelocities(ClothState& io);
@@ -240,6 +244,7 @@ class LayerCollider final : public Collider {
   std::vector<std::uint32_t> seen_;  ///< per vertex: the triangle (+1) that met it last
   // The candidate list and where the vertices were when it was made.
   double margin_;
+  std::vector<double> reach_;  ///< per point: how far it may move before the list is made again (first margin_ / 2)
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;  ///< (vertex, triangle), sorted
   std::vector<double> builtX_, builtY_, builtZ_;
   Vec3 builtMean_ = Vec3::Zero();

@@ -1,8 +1,8 @@
 // The studio's three roles as separate processes on a real nats-server: what the player
 // records is what drape run writes, to the byte, also when a cloth-server is killed in the
 // middle of the take and started again, when junk arrives on the pose stream, when two
-// cloth-servers split the garments, and when the take goes unstable; a window shows a take
-// live or from a time code; errors say what to do.
+// cloth-servers split the garments, when one garment is worn over another, and when the take
+// goes unstable; a window shows a take live or from a time code; errors say what to do.
 
 #include <gtest/gtest.h>
 
@@ -176,6 +176,25 @@ TEST(Studio, TwoClothServersSplitTheGarmentsAndThePlayerCollatesThem) {
   EXPECT_EQ(stats["cloth_servers"]["back"]["garments"][0]["name"], "Skirt2");
 }
 
+
+TEST(Studio, AGarmentWornOverAnotherIsSimulatedThroughTheStudioAsInDrapeRun) {
+  // The skirt over its petticoat: one cloth-server steps the petticoat first each frame and
+  // keeps the skirt over it, as drape run does.
+  ScratchDir dir("studio-layers");
+  NatsServer server;
+  const std::string scene = std::string(DRAPE_SOURCE_DIR) + "/examples/layered_skirts/scene.wrl";
+  const std::string reference = runInto(dir, "reference", "'" + scene + "' --motion '" + kWalk + "'");
+  DrapeProcess cloth("cloth-server '" + scene + "' --takes 1" + roles(server), dir, "cloth");
+  const CliResult sent = runDrape("anim-server '" + scene + "' --motion '" + kWalk + "' --fast" + roles(server), dir);
+  ASSERT_EQ(sent.code, 0) << sent.err;
+  const CliResult simulated = cloth.wait();
+  ASSERT_EQ(simulated.code, 0) << simulated.err;
+  EXPECT_NE(simulated.err.find("Skirt: kept 4 mm over Petticoat"), std::string::npos) << simulated.err;
+  const CliResult recorded = runDrape("player '" + scene + "' --record '" + (dir / "recorded") + "'" + roles(server), dir);
+  ASSERT_EQ(recorded.code, 0) << recorded.err;
+  expectSameRun(dir / "recorded", reference);
+  EXPECT_GT(statsOf(dir / "recorded")["garments"][1]["worn_over"]["contacts"].get<long>(), 1000);
+}
 
 /// A character's name as its roles' streams are named: "Ada" -> "ada".
 std::string streamNameOf(std::string name) {

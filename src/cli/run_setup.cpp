@@ -93,7 +93,7 @@ struct GarmentRun {
   cloth::ClothSolver* solver = nullptr;             ///< owned here or by the character world
   const cloth::FieldCollider* collider = nullptr;   ///< on a character
   std::unique_ptr<cloth::LayerCollider> ownedLayers;  ///< without a character
-  const cloth::LayerCollider* layers = nullptr;        ///< its layers kept apart, or null
+  const cloth::LayerCollider* layers = nullptr;        ///< its own layers and the garments below kept apart, or null
   std::vector<cloth::SphereCollider> spheres;       ///< its own static spheres (--sphere)
 };
 
@@ -902,10 +902,10 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
   // Without a character every solver first, then the layer colliders, which read the
   // solvers of the garments below.
   std::vector<std::vector<std::size_t>> below;
-  std::vector<int> layers(setup.garments.size(), 0);
+  std::vector<int> stepLayers(setup.garments.size(), 0);  // per garment (sim::layersOf)
   if (worlds.size() == 0) {
     below = sim::garmentsBelow(setup.garments);
-    layers = sim::layersOf(below);
+    stepLayers = sim::layersOf(below);
     for (std::size_t gi = 0; gi < setup.garments.size(); ++gi) {
       const GarmentSetup& g = setup.garments[gi];
       const mesh::Topology topology = mesh::Topology::build(g.mesh, kMinTriangleArea_m2);
@@ -928,7 +928,7 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
       logEasedPairs(g.name, *collider);
       const sim::CharacterWorld& world = worlds.world(worlds.characterOf(gi));
       r.layers = world.layerCollider(worlds.indexInWorld(gi));
-      layers[gi] = world.layer(worlds.indexInWorld(gi));
+      stepLayers[gi] = world.layer(worlds.indexInWorld(gi));
     } else {
       r.solver = r.ownedSolver.get();
       // Before the spheres: where they disagree, a sphere wins.
@@ -1035,7 +1035,7 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
         const Clock::time_point start = Clock::now();
         const std::vector<std::uint8_t> stable =
             sim::stepInParallel(runs.size(), frame, [&](std::size_t g) -> cloth::ClothSolver& { return *runs[g].solver; },
-                                layers);
+                                stepLayers);
         for (std::size_t g = 0; g < runs.size() && unstable.empty(); ++g) {
           sim::logFrameRecovery(*runs[g].solver, setup.garments[g].name, frame);
           if (!stable[g]) {

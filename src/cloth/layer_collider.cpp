@@ -304,19 +304,26 @@ void LayerCollider::followBelow(double t_s) {
   held_ = true;
 }
 
-void LayerCollider::placeBelow(double t_s, ClothState& out, bool velocities) const {
-  const double s = std::clamp(t_s / frame_s_ - static_cast<double>(heldFrame_), 0.0, 1.0), rate = 1.0 / frame_s_;
+void LayerCollider::placeBelow(double t_s, std::vector<double>& x, std::vector<double>& y,
+                               std::vector<double>& z) const {
+  const double s = std::clamp(t_s / frame_s_ - static_cast<double>(heldFrame_), 0.0, 1.0);
   for (const Below& b : below_)
     for (std::uint32_t i = 0; i < b.count; ++i) {
       const std::uint32_t v = b.first + i;
-      out.x[v] = b.startX[i] + s * (b.endX[i] - b.startX[i]);
-      out.y[v] = b.startY[i] + s * (b.endY[i] - b.startY[i]);
-      out.z[v] = b.startZ[i] + s * (b.endZ[i] - b.startZ[i]);
-      if (velocities) {
-        out.vx[v] = (b.endX[i] - b.startX[i]) * rate;
-        out.vy[v] = (b.endY[i] - b.startY[i]) * rate;
-        out.vz[v] = (b.endZ[i] - b.startZ[i]) * rate;
-      }
+      x[v] = b.startX[i] + s * (b.endX[i] - b.startX[i]);
+      y[v] = b.startY[i] + s * (b.endY[i] - b.startY[i]);
+      z[v] = b.startZ[i] + s * (b.endZ[i] - b.startZ[i]);
+    }
+}
+
+void LayerCollider::velocitiesBelow(ClothState& out) const {
+  const double rate = 1.0 / frame_s_;
+  for (const Below& b : below_)
+    for (std::uint32_t i = 0; i < b.count; ++i) {
+      const std::uint32_t v = b.first + i;
+      out.vx[v] = (b.endX[i] - b.startX[i]) * rate;
+      out.vy[v] = (b.endY[i] - b.startY[i]) * rate;
+      out.vz[v] = (b.endZ[i] - b.startZ[i]) * rate;
     }
 }
 
@@ -331,13 +338,7 @@ void LayerCollider::restartFrame(const ClothState& state, double t_s) {
   remember(state);
   if (!below_.empty()) {  // where the garments below were at the frame's start
     followBelow(t_s);
-    ClothState& last = work_;
-    placeBelow(t_s, last, false);
-    for (const Below& b : below_) {
-      std::copy(last.x.begin() + b.first, last.x.begin() + b.first + b.count, lastX_.begin() + b.first);
-      std::copy(last.y.begin() + b.first, last.y.begin() + b.first + b.count, lastY_.begin() + b.first);
-      std::copy(last.z.begin() + b.first, last.z.begin() + b.first + b.count, lastZ_.begin() + b.first);
-    }
+    placeBelow(t_s, lastX_, lastY_, lastZ_);
   }
   pairsBuilt_ = false;  // the attempt's list: built again, so the frame is computed as before
 }
@@ -387,7 +388,8 @@ void LayerCollider::buildGrid(const ClothState& after) {
                [&](std::uint32_t b) { entries_[bucketFill_[b]++] = static_cast<std::uint32_t>(v); });
 }
 
-void LayerCollider::gatherPairs(const ClothState& after, double grow) {
+void LayerCollider::gatherPairs() {
+  const double grow = std::max(thickness_, gap_);
   pairs_.clear();
   std::fill(seen_.begin(), seen_.end(), 0u);
   // Its own triangles hold pairs with its own layers kept apart or with points below.
@@ -474,7 +476,7 @@ void LayerCollider::updatePairs(const ClothState& now) {
   // Every pair whose vertex could come within the thickness of the triangle (or through it)
   // while no point moves farther than its reach from here, the common motion left out.
   buildGrid(now);
-  gatherPairs(now, std::max(thickness_, gap_));
+  gatherPairs();
   builtX_ = now.x;
   builtY_ = now.y;
   builtZ_ = now.z;
@@ -486,7 +488,7 @@ void LayerCollider::updatePairs(const ClothState& now) {
 const std::vector<LayerContact>& LayerCollider::findContacts(const ClothState& before, const ClothState& after) {
   remember(before);
   buildGrid(after);
-  gatherPairs(after, std::max(thickness_, gap_));
+  gatherPairs();
   pairsBuilt_ = false;  // a list for this interval alone
   narrow(after);
   return contacts_;
@@ -600,7 +602,8 @@ void LayerCollider::collide(const ClothModel&, double t0_s, double t1_s, ClothSt
     for (auto [from, to] : {std::pair{&io.x, &work_.x}, {&io.y, &work_.y}, {&io.z, &work_.z}, {&io.vx, &work_.vx},
                             {&io.vy, &work_.vy}, {&io.vz, &work_.vz}})
       std::copy(from->begin(), from->end(), to->begin());
-    placeBelow(t1_s, work_, true);
+    placeBelow(t1_s, work_.x, work_.y, work_.z);
+    velocitiesBelow(work_);
   }
   updatePairs(state);
   narrow(state);

@@ -1,5 +1,6 @@
 #include "drape/scene/scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -57,6 +58,47 @@ std::string offsetsProblem(const std::array<double, 4>& t) {
       return fmt::format("offsets must not decrease (T{} = {:g} m < T{} = {:g} m)", i, t[i], i - 1, t[i - 1]);
   }
   return "";
+}
+
+std::vector<int> layersOf(const std::vector<std::vector<std::size_t>>& below) {
+  // By rounds: a garment whose garments below all have their layers takes one more than the
+  // highest. A round that places none leaves only garments that go round or lie over them.
+  std::vector<int> layer(below.size(), -1);
+  for (bool placed = true; placed;) {
+    placed = false;
+    for (std::size_t g = 0; g < below.size(); ++g) {
+      if (layer[g] >= 0) continue;
+      int highest = -1;
+      bool ready = true;
+      for (const std::size_t b : below[g]) {
+        ready = ready && layer[b] >= 0;
+        highest = std::max(highest, layer[b]);
+      }
+      if (!ready) continue;
+      layer[g] = highest + 1;
+      placed = true;
+    }
+  }
+  return layer;
+}
+
+std::vector<std::size_t> roundOfLayers(const std::vector<std::vector<std::size_t>>& below,
+                                       const std::vector<int>& layers) {
+  // A garment left at -1 is worn over one left at -1 too (else it would have a layer): going
+  // down from one, a garment comes again, and what lies between is the round.
+  const auto unplaced = std::find(layers.begin(), layers.end(), -1);
+  if (unplaced == layers.end()) return {};
+  std::vector<std::size_t> path{static_cast<std::size_t>(unplaced - layers.begin())};
+  for (;;) {
+    const std::vector<std::size_t>& under = below[path.back()];
+    const std::size_t next = *std::find_if(under.begin(), under.end(), [&](std::size_t b) { return layers[b] < 0; });
+    if (const auto again = std::find(path.begin(), path.end(), next); again != path.end()) {
+      path.erase(path.begin(), again);
+      path.push_back(next);
+      return path;
+    }
+    path.push_back(next);
+  }
 }
 
 void validate(const SimulationSettings& s) {

@@ -502,53 +502,38 @@ class Builder {
         if (all[i].name == name) return static_cast<int>(i);
       return -1;
     };
+    std::vector<std::vector<std::size_t>> below(all.size());  // per garment, those it is worn over
     for (std::size_t i = 0; i < all.size(); ++i) {
       const Garment& g = all[i];
       const Node& n = at(pending_[i].node);
       for (const std::string& name : g.over) {
-        const int below = indexOf(name);
-        if (below < 0) {
+        const int under = indexOf(name);
+        if (under < 0) {
           std::vector<std::string> names;
           for (const Garment& other : all) names.push_back(other.name);
           throw Error::at(where(n, "over"), fmt::format("ClothSet {}: over names '{}', which is no garment of the "
                                                         "scene (it has: {})",
                                                         g.name, name, fmt::join(names, ", ")));
         }
-        if (static_cast<std::size_t>(below) == i)
+        if (static_cast<std::size_t>(under) == i)
           throw Error::at(where(n, "over"), fmt::format("ClothSet {}: over names itself", g.name));
-        const Garment& b = all[static_cast<std::size_t>(below)];
+        const Garment& b = all[static_cast<std::size_t>(under)];
         if (b.avatar != g.avatar || b.externalAvatar != g.externalAvatar)
           throw Error::at(where(n, "over"),
                           fmt::format("ClothSet {}: over names '{}', which another character wears (or none): a "
                                       "garment is kept over its own character's garments only",
                                       g.name, name));
+        below[i].push_back(static_cast<std::size_t>(under));
       }
     }
-    // A cycle: some garment reached again from itself through the `over` names.
-    for (std::size_t start = 0; start < all.size(); ++start) {
-      std::vector<std::size_t> path{start}, next{0};
-      while (!path.empty()) {
-        const Garment& g = all[path.back()];
-        if (next.back() >= g.over.size()) {
-          path.pop_back();
-          next.pop_back();
-          continue;
-        }
-        const auto below = static_cast<std::size_t>(indexOf(g.over[next.back()++]));
-        if (below == start) {
-          std::vector<std::string> names;
-          for (std::size_t p : path) names.push_back(all[p].name);
-          names.push_back(all[start].name);
-          throw Error::at(where(at(pending_[start].node), "over"),
-                          fmt::format("ClothSet {}: worn over itself through {}: the garments' over names must not "
-                                      "go round",
-                                      all[start].name, fmt::join(names, " over ")));
-        }
-        if (std::find(path.begin(), path.end(), below) == path.end() && path.size() <= all.size()) {
-          path.push_back(below);
-          next.push_back(0);
-        }
-      }
+    // The names must not go round: garments step from the innermost out.
+    const std::vector<std::size_t> round = roundOfLayers(below, layersOf(below));
+    if (!round.empty()) {
+      std::vector<std::string> names;
+      for (const std::size_t g : round) names.push_back(all[g].name);
+      throw Error::at(where(at(pending_[round.front()].node), "over"),
+                      fmt::format("ClothSet {}: worn over itself through {}: the garments' over names must not go round",
+                                  names.front(), fmt::join(names, " over ")));
     }
   }
 

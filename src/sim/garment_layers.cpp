@@ -25,8 +25,6 @@ std::vector<std::vector<std::size_t>> garmentsBelow(const std::vector<GarmentSpe
       if (b == g) throw Error(fmt::format("garment '{}' is worn over itself", garments[g].name));
       if (std::find(below[g].begin(), below[g].end(), b) == below[g].end()) below[g].push_back(b);
     }
-  // Layers, found by rounds: a garment whose garments below all have theirs takes one more.
-  // A round that places none leaves only garments that go round.
   const std::vector<int> layers = layersOf(below);
   for (std::size_t g = 0; g < garments.size(); ++g)
     if (layers[g] < 0)
@@ -34,26 +32,6 @@ std::vector<std::vector<std::size_t>> garmentsBelow(const std::vector<GarmentSpe
                               "names must not go round",
                               garments[g].name));
   return below;
-}
-
-std::vector<int> layersOf(const std::vector<std::vector<std::size_t>>& below) {
-  std::vector<int> layer(below.size(), -1);
-  for (bool placed = true; placed;) {
-    placed = false;
-    for (std::size_t g = 0; g < below.size(); ++g) {
-      if (layer[g] >= 0) continue;
-      int highest = -1;
-      bool ready = true;
-      for (const std::size_t b : below[g]) {
-        ready = ready && layer[b] >= 0;
-        highest = std::max(highest, layer[b]);
-      }
-      if (!ready) continue;
-      layer[g] = highest + 1;
-      placed = true;
-    }
-  }
-  return layer;  // -1 where the names go round
 }
 
 std::unique_ptr<cloth::LayerCollider> makeLayerCollider(

@@ -56,17 +56,26 @@ inline CliResult runDrape(const std::string& args, const ScratchDir& scratch) {
   return r;
 }
 
+/// Replaces the first `from` in `text` with `to`; a test failure when there is none.
+inline void replaceOnce(std::string& text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+}
+
+/// A bundled example's scene text with its URLs into data/ made absolute (for a copy in a
+/// scratch directory).
+inline std::string exampleSceneWithDataFound(const std::string& scene) {
+  std::string text = slurp(scene);
+  replaceOnce(text, "url \"../../data/", "url \"" + std::string(DRAPE_DATA_DIR) + "/");
+  return text;
+}
+
 /// The walking skirt twice over, as two garments 'Skirt' and 'Skirt2' of one scene (they do
 /// not touch each other: each comes out as the skirt alone), written into `scratch`.
 inline std::string twoSkirtScene(const ScratchDir& scratch) {
-  std::string scene = slurp(kSkirtDir + "/scene.wrl");
-  const auto replace = [&](const std::string& from, const std::string& to) {
-    const std::size_t at = scene.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) scene.replace(at, from.size(), to);
-  };
-  replace("url \"../../data/", "url \"" + std::string(DRAPE_DATA_DIR) + "/");
-  replace("constraintMask IndexedFaceSet {", "constraintMask DEF SkirtMask IndexedFaceSet {");
+  std::string scene = exampleSceneWithDataFound(kSkirtDir + "/scene.wrl");
+  replaceOnce(scene, "constraintMask IndexedFaceSet {", "constraintMask DEF SkirtMask IndexedFaceSet {");
   scene += R"(
 DEF Skirt2 ClothSet {
   cloth Shape { geometry USE SkirtMesh }

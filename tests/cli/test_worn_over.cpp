@@ -32,14 +32,8 @@ const std::string kLayeredDir = std::string(DRAPE_SOURCE_DIR) + "/examples/layer
 /// The example's scene with its avatar's URL made absolute (for a copy in a scratch
 /// directory), each of `cuts` taken out.
 std::string layeredScene(const std::vector<std::string>& cuts) {
-  std::string scene = slurp(kLayeredDir + "/scene.wrl");
-  const auto replace = [&](const std::string& from, const std::string& to) {
-    const std::size_t at = scene.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) scene.replace(at, from.size(), to);
-  };
-  replace("url \"../../data/", "url \"" + std::string(DRAPE_DATA_DIR) + "/");
-  for (const std::string& cut : cuts) replace(cut, "");
+  std::string scene = exampleSceneWithDataFound(kLayeredDir + "/scene.wrl");
+  for (const std::string& cut : cuts) replaceOnce(scene, cut, "");
   return scene;
 }
 

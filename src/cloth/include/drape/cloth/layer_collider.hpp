@@ -170,9 +170,11 @@ class LayerCollider final : public Collider {
   /// one they were held for, their end becomes its start and their states now its end (they
   /// were stepped through it first).
   void followBelow(double t_s);
-  /// The garments below as they are at time t_s (linear over the frame) into `out`'s
-  /// positions and, when `velocities`, their velocities over the frame.
-  void placeBelow(double t_s, ClothState& out, bool velocities) const;
+  /// The garments below as they are at time t_s (linear over the frame) into positions
+  /// x, y, z (numbered as here).
+  void placeBelow(double t_s, std::vector<double>& x, std::vector<double>& y, std::vector<double>& z) const;
+  /// Their velocities over the frame into `out`.
+  void velocitiesBelow(ClothState& out) const;
   /// The thickness of a pair the list holds: its own layers' or the gap.
   [[nodiscard]] double listedThickness(std::uint32_t vertex, std::uint32_t triangle) const {
     return vertex < ownVertices_ && triangle < ownTriangles_ ? thickness_ : gap_;
@@ -182,8 +184,9 @@ class LayerCollider final : public Collider {
   /// The neighbour lists (sorted and made unique here) as the CSR arrays.
   void setNeighbours(std::vector<std::vector<std::uint32_t>>& around);
   void buildGrid(const ClothState& after);
-  /// The pairs whose vertex's box meets its triangle's box over the interval grown by `grow`.
-  void gatherPairs(const ClothState& after, double grow);
+  /// The pairs whose vertex's box (buildGrid's) comes within the thickness of its triangle's
+  /// corners' boxes.
+  void gatherPairs();
   /// The candidate pairs' contacts.
   void narrow(const ClothState& after);
   [[nodiscard]] static Vec3 meanPosition(const std::vector<double>& x, const std::vector<double>& y,

@@ -147,4 +147,14 @@ void validate(const SimulationSettings& settings);
 /// "offsets: ..."; "" when nothing is (a Simulation node's, a ClothSet's).
 [[nodiscard]] std::string offsetsProblem(const std::array<double, 4>& offsets);
 
+/// Per garment, its layer, given the garments each is worn over (indices, its `over`): 0
+/// when it is worn over nothing, else one more than the highest layer of those; -1 where the
+/// names go round (a over b over a), and for the garments worn over those. Garments step
+/// layer by layer.
+[[nodiscard]] std::vector<int> layersOf(const std::vector<std::vector<std::size_t>>& below);
+/// A round in the `over` names, when layersOf left a garment at -1: garments each worn over
+/// the next, the last the first again; empty when there is none.
+[[nodiscard]] std::vector<std::size_t> roundOfLayers(const std::vector<std::vector<std::size_t>>& below,
+                                                     const std::vector<int>& layers);
+
 }  // namespace drape::scene

@@ -126,8 +126,8 @@ struct PartField {
 /// Steps `count` solvers to `frame` in parallel (TBB); per solver, whether it stayed stable.
 /// With `layers` (one per solver, sim/garment_layers.hpp), layer by layer from 0: a garment is
 /// worn over garments of lower layers, whose frame its layer collider reads once they have
-/// stepped it. The solvers
-/// of one layer must share nothing that changes (each garment has its own poses and colliders).
+/// stepped it. The solvers of one layer must share nothing that changes (each garment has
+/// its own poses and colliders).
 std::vector<std::uint8_t> stepInParallel(std::size_t count, long frame,
                                          const std::function<cloth::ClothSolver&(std::size_t)>& solver,
                                          std::span<const int> layers = {});

@@ -12,6 +12,7 @@
 
 #include "drape/cloth/layer_collider.hpp"
 #include "drape/cloth/solver.hpp"
+#include "drape/scene/scene.hpp"
 #include "drape/sim/character_world.hpp"
 
 namespace drape::sim {
@@ -21,9 +22,8 @@ namespace drape::sim {
 /// names that go round (a over b over a).
 [[nodiscard]] std::vector<std::vector<std::size_t>> garmentsBelow(const std::vector<GarmentSpec>& garments);
 
-/// Per garment, its layer: 0 when it is worn over nothing, else one more than the highest
-/// layer of the garments it is worn over (garmentsBelow's lists, which must not go round).
-[[nodiscard]] std::vector<int> layersOf(const std::vector<std::vector<std::size_t>>& below);
+/// Per garment, its layer (garmentsBelow's lists, which do not go round): the scene's.
+using scene::layersOf;
 
 /// The layer collider garment `g` of `garments` needs: its own layers kept apart
 /// (selfCollision_m) and the garments it is worn over (`below`, garmentsBelow's list for

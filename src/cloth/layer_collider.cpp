@@ -180,10 +180,14 @@ void LayerCollider::sizeForPoints() {
   vertexHi_.resize(3 * n);
   const std::size_t buckets = std::bit_ceil(std::max<std::size_t>(64, 2 * n));
   bucketMask_ = static_cast<std::uint32_t>(buckets - 1);
-  bucketStart_.assign(buckets + 1, 0u);
-  bucketFill_.assign(buckets, 0u);
-  entries_.resize(2 * n);
-  seen_.assign(n, 0u);
+  inverseCell_ = 1.0 / cell_m_;
+  for (PointGrid& grid : grids_) {
+    grid.start.assign(buckets + 1, 0u);
+    grid.fill.assign(buckets, 0u);
+    grid.point.resize(2 * n);
+    grid.box.resize(6 * grid.point.size());
+  }
+  bucketsOfPoint_.reserve(64);
   tested_.assign(n, 0u);
   contacts_.reserve(n);
   pairs_.reserve(4 * n);
@@ -349,18 +353,31 @@ std::uint32_t LayerCollider::bucketOf(std::int64_t ix, std::int64_t iy, std::int
   return static_cast<std::uint32_t>(h ^ (h >> 32)) & bucketMask_;
 }
 
+std::int64_t LayerCollider::cellOf(double coordinate) const {
+  return static_cast<std::int64_t>(std::floor(coordinate * inverseCell_));
+}
+
 template <typename Visit>
 void LayerCollider::forCells(const double* lo, const double* hi, Visit&& visit) const {
-  const double inv = 1.0 / cell_m_;
-  const auto x0 = static_cast<std::int64_t>(std::floor(lo[0] * inv)),
-             x1 = static_cast<std::int64_t>(std::floor(hi[0] * inv));
-  const auto y0 = static_cast<std::int64_t>(std::floor(lo[1] * inv)),
-             y1 = static_cast<std::int64_t>(std::floor(hi[1] * inv));
-  const auto z0 = static_cast<std::int64_t>(std::floor(lo[2] * inv)),
-             z1 = static_cast<std::int64_t>(std::floor(hi[2] * inv));
+  const std::int64_t x0 = cellOf(lo[0]), x1 = cellOf(hi[0]), y0 = cellOf(lo[1]), y1 = cellOf(hi[1]),
+                     z0 = cellOf(lo[2]), z1 = cellOf(hi[2]);
   for (std::int64_t ix = x0; ix <= x1; ++ix)
     for (std::int64_t iy = y0; iy <= y1; ++iy)
-      for (std::int64_t iz = z0; iz <= z1; ++iz) visit(bucketOf(ix, iy, iz));
+      for (std::int64_t iz = z0; iz <= z1; ++iz) visit(ix, iy, iz);
+}
+
+template <typename Visit>
+void LayerCollider::forBucketsOnce(std::size_t v, Visit&& visit) {
+  // Two cells of a box can share a bucket: the point is listed in it once, so that a scan
+  // of the bucket meets it once.
+  bucketsOfPoint_.clear();
+  forCells(&vertexLo_[3 * v], &vertexHi_[3 * v],
+           [&](std::int64_t ix, std::int64_t iy, std::int64_t iz) { bucketsOfPoint_.push_back(bucketOf(ix, iy, iz)); });
+  if (bucketsOfPoint_.size() > 1) {
+    std::sort(bucketsOfPoint_.begin(), bucketsOfPoint_.end());
+    bucketsOfPoint_.erase(std::unique(bucketsOfPoint_.begin(), bucketsOfPoint_.end()), bucketsOfPoint_.end());
+  }
+  for (const std::uint32_t b : bucketsOfPoint_) visit(b);
 }
 
 void LayerCollider::buildGrid(const ClothState& after) {
@@ -374,24 +391,35 @@ void LayerCollider::buildGrid(const ClothState& after) {
       vertexHi_[3 * v + k] = std::max(p0[k], p1[k]) + reach_[v];
     }
   }
-  // Counted, then placed: every bucket's vertices in one array, in vertex order. A vertex
-  // no pair can hold (a fixed one) is left out.
-  std::fill(bucketStart_.begin(), bucketStart_.end(), 0u);
-  for (std::size_t v = 0; v < n; ++v)
-    if (tested_[v]) forCells(&vertexLo_[3 * v], &vertexHi_[3 * v], [&](std::uint32_t b) { ++bucketStart_[b + 1]; });
-  for (std::size_t b = 1; b < bucketStart_.size(); ++b) bucketStart_[b] += bucketStart_[b - 1];
-  if (bucketStart_.back() > entries_.size()) entries_.resize(bucketStart_.back() + bucketStart_.back() / 4);
-  std::copy(bucketStart_.begin(), bucketStart_.end() - 1, bucketFill_.begin());
-  for (std::size_t v = 0; v < n; ++v)
-    if (tested_[v])
-      forCells(&vertexLo_[3 * v], &vertexHi_[3 * v],
-               [&](std::uint32_t b) { entries_[bucketFill_[b]++] = static_cast<std::uint32_t>(v); });
+  // A grid of its own points and one of the points below (a triangle scans only the grid
+  // of the points it can hold pairs with). Counted, then placed: every bucket's points in
+  // one array, in point order, each with its box. A point no pair can hold (a fixed one) is
+  // in neither.
+  for (const std::uint8_t kind : {kOwnPoint, kPointBelow}) {
+    PointGrid& grid = grids_[kind == kOwnPoint ? 0 : 1];
+    std::fill(grid.start.begin(), grid.start.end(), 0u);
+    for (std::size_t v = 0; v < n; ++v)
+      if (tested_[v] & kind) forBucketsOnce(v, [&](std::uint32_t b) { ++grid.start[b + 1]; });
+    for (std::size_t b = 1; b < grid.start.size(); ++b) grid.start[b] += grid.start[b - 1];
+    if (grid.start.back() > grid.point.size()) {
+      grid.point.resize(grid.start.back() + grid.start.back() / 4);
+      grid.box.resize(6 * grid.point.size());
+    }
+    std::copy(grid.start.begin(), grid.start.end() - 1, grid.fill.begin());
+    for (std::size_t v = 0; v < n; ++v)
+      if (tested_[v] & kind)
+        forBucketsOnce(v, [&](std::uint32_t b) {
+          const std::uint32_t e = grid.fill[b]++;
+          grid.point[e] = static_cast<std::uint32_t>(v);
+          std::copy_n(&vertexLo_[3 * v], 3, &grid.box[6 * e]);
+          std::copy_n(&vertexHi_[3 * v], 3, &grid.box[6 * e + 3]);
+        });
+  }
 }
 
 void LayerCollider::gatherPairs() {
   const double grow = std::max(thickness_, gap_);
   pairs_.clear();
-  std::fill(seen_.begin(), seen_.end(), 0u);
   // Its own triangles hold pairs with its own layers kept apart or with points below.
   const std::uint32_t first = thickness_ > 0 || !below_.empty() ? 0 : ownTriangles_;
   for (std::uint32_t t = first; t < triangles_.size(); ++t) {
@@ -402,19 +430,29 @@ void LayerCollider::gatherPairs() {
       lo[a] = std::min({vertexLo_[3 * c[0] + a], vertexLo_[3 * c[1] + a], vertexLo_[3 * c[2] + a]}) - grow;
       hi[a] = std::max({vertexHi_[3 * c[0] + a], vertexHi_[3 * c[1] + a], vertexHi_[3 * c[2] + a]}) + grow;
     }
-    // Which points it can hold pairs with: its own triangles the points below (and its own
+    // The points it can hold pairs with: its own triangles the points below (and its own
     // with its own layers kept apart), a triangle below its own points.
-    const std::uint8_t accept = t < ownTriangles_ ? (thickness_ > 0 ? kOwnPoint : 0) | kPointBelow : kOwnPoint;
-    forCells(lo, hi, [&](std::uint32_t b) {
-      for (std::uint32_t e = bucketStart_[b]; e < bucketStart_[b + 1]; ++e) {
-        const std::uint32_t v = entries_[e];
-        if (!(tested_[v] & accept) || seen_[v] == t + 1) continue;
-        seen_[v] = t + 1;
-        const double* vlo = &vertexLo_[3 * v];
-        const double* vhi = &vertexHi_[3 * v];
-        const bool apart =
-            vlo[0] > hi[0] || vhi[0] < lo[0] || vlo[1] > hi[1] || vhi[1] < lo[1] || vlo[2] > hi[2] || vhi[2] < lo[2];
-        if (!apart && pairThickness(v, t) > 0) pairs_.push_back({v, t});
+    const bool own = t < ownTriangles_;
+    const bool scan[2] = {!own || thickness_ > 0, own};
+    forCells(lo, hi, [&](std::int64_t ix, std::int64_t iy, std::int64_t iz) {
+      const std::uint32_t b = bucketOf(ix, iy, iz);
+      for (int g = 0; g < 2; ++g) {
+        if (!scan[g]) continue;
+        const PointGrid& grid = grids_[g];
+        for (std::uint32_t e = grid.start[b]; e < grid.start[b + 1]; ++e) {
+          const double* box = &grid.box[6 * e];
+          if (box[0] > hi[0] || box[3] < lo[0] || box[1] > hi[1] || box[4] < lo[1] || box[2] > hi[2] ||
+              box[5] < lo[2])
+            continue;
+          // The two boxes meet in a box whose lowest corner lies in one cell, which both
+          // touch: the pair is taken there alone (cells that share a bucket, and boxes that
+          // touch several cells, would find it again).
+          if (cellOf(std::max(lo[0], box[0])) != ix || cellOf(std::max(lo[1], box[1])) != iy ||
+              cellOf(std::max(lo[2], box[2])) != iz)
+            continue;
+          const std::uint32_t v = grid.point[e];
+          if (pairThickness(v, t) > 0) pairs_.push_back({v, t});
+        }
       }
     });
   }

@@ -7,6 +7,8 @@
 #include <set>
 #include <tuple>
 
+#include <gtest/gtest.h>
+
 #include "drape/cloth/layer_collider.hpp"
 #include "drape/mesh/trimesh.hpp"
 
@@ -34,10 +36,13 @@ inline ContactSet everyPair(const LayerCollider& collider, const mesh::TriMesh& 
   return out;
 }
 
-/// The contacts a collider's test found, as everyPair gives them.
+/// The contacts a collider's test found, as everyPair gives them; a pair found twice (which
+/// the test would resolve twice) is a failure.
 inline ContactSet contactSet(const std::vector<LayerContact>& contacts) {
   ContactSet out;
-  for (const LayerContact& c : contacts) out.insert({c.vertex, c.triangle, c.side, c.crossed});
+  for (const LayerContact& c : contacts)
+    if (!out.insert({c.vertex, c.triangle, c.side, c.crossed}).second)
+      ADD_FAILURE() << "vertex " << c.vertex << " and triangle " << c.triangle << " found twice";
   return out;
 }
 

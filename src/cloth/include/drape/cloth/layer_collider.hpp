@@ -217,9 +217,14 @@ class LayerCollider final : public Collider {
   /// collapsed.
   [[nodiscard]] bool now(const LayerContact& c, const ClothState& io, ContactNow& out) const;
   [[nodiscard]] std::uint32_t bucketOf(std::int64_t ix, std::int64_t iy, std::int64_t iz) const;
-  /// Calls visit(bucket) for every cell the box [lo, hi] touches.
+  /// The grid cell a coordinate falls in, along any axis.
+  [[nodiscard]] std::int64_t cellOf(double coordinate) const;
+  /// Calls visit(ix, iy, iz) for every cell the box [lo, hi] touches.
   template <typename Visit>
   void forCells(const double* lo, const double* hi, Visit&& visit) const;
+  /// Calls visit(bucket) once for every bucket a cell of point v's box lies in.
+  template <typename Visit>
+  void forBucketsOnce(std::size_t v, Visit&& visit);
 
   std::string garment_;
   double thickness_;
@@ -240,11 +245,17 @@ class LayerCollider final : public Collider {
   std::vector<double> inverseMass_;                         ///< 0 for the fixed vertices and those below
   std::vector<std::uint8_t> tested_;  ///< per vertex: whether it can be in a pair, and as whose (kOwnPoint, kPointBelow)
   std::vector<double> lastX_, lastY_, lastZ_;               ///< positions at the last test
-  // The grid: per bucket (a hash of the cell) the vertices whose boxes touch a cell of it.
+  // The grids: per bucket (a hash of the cell) the points whose boxes touch a cell of it,
+  // each once, with its box beside it so that a scan reads in order.
+  struct PointGrid {
+    std::vector<std::uint32_t> start, fill, point;  ///< per bucket: where its points start; per entry: the point
+    std::vector<double> box;                         ///< per entry: lo xyz, hi xyz
+  };
   std::vector<double> vertexLo_, vertexHi_;  ///< per vertex, xyz: its box over the interval
-  std::vector<std::uint32_t> bucketStart_, bucketFill_, entries_;
+  std::array<PointGrid, 2> grids_;           ///< [0]: its own points; [1]: the points below
   std::uint32_t bucketMask_ = 0;
-  std::vector<std::uint32_t> seen_;  ///< per vertex: the triangle (+1) that met it last
+  double inverseCell_ = 1.0;
+  std::vector<std::uint32_t> bucketsOfPoint_;  ///< forBucketsOnce's
   // The candidate list and where the vertices were when it was made.
   double margin_;
   std::vector<double> reach_;  ///< per point: how far it may move before the list is made again (first margin_ / 2)

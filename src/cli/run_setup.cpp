@@ -1145,6 +1145,7 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
                                    {"tests", s.tests},
                                    {"candidate_pairs", s.candidates},
                                    {"candidate_lists_made", s.rebuilds},
+                                   {"candidate_lists_mended", s.mends},
                                    {"contacts", s.contacts},
                                    {"crossings", s.crossings}};
       if (!layers->garmentsBelow().empty())
@@ -1153,6 +1154,7 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
                               {"tests", s.tests},
                               {"candidate_pairs", s.candidates},
                               {"candidate_lists_made", s.rebuilds},
+                              {"candidate_lists_mended", s.mends},
                               {"contacts", s.contactsBelow},
                               {"crossings", s.crossingsBelow}};
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 
 #include <fmt/format.h>
 
@@ -23,6 +24,11 @@ constexpr double kMarginThicknesses = 2.0;
 /// up to this many times the first, and a point that did not gives back a quarter of what
 /// it has above the first: a swinging hem gets room, and the list is made again less often.
 constexpr double kMostReach = 8.0, kReachKept = 0.75;
+/// When at most this many points went past their reach, the list is mended (their pairs
+/// found again) instead of made again: a hem's few swinging points, not the whole list.
+/// Measured at 2 to 64 on the layered skirts: 8 is the fastest; past 16 a mend costs more
+/// than a new list.
+constexpr std::size_t kMostMended = 8;
 /// How far outside a triangle (in barycentric weight) a projection may fall and still count:
 /// a vertex over the edge between two faces belongs to both.
 constexpr double kEdgeTolerance = 1e-9;
@@ -75,12 +81,19 @@ std::optional<LayerContact> layerContact(const Vec3& p0, const Vec3& p1, const s
     weights = barycentric(p1, t1);  // within h over the face
   } else {
     // Through the plane: where its distance, taken as linear over the interval, was zero,
-    // the point must lie in the triangle as it was then.
+    // the point must lie in the triangle as it was then, within the thickness of its plane.
+    // (A triangle that turns over in the interval flips its normal, not the point's side:
+    // then the point may be far from it when the linear distance says zero.)
     const double s = side * d0 / std::sqrt(n0.squaredNorm() > 0 ? n0.squaredNorm() : area2);
     const double e = d1 / std::sqrt(area2);
     const double when = s / (s - e);
     const auto mix = [when](const Vec3& a, const Vec3& b) -> Vec3 { return a + when * (b - a); };
-    weights = barycentric(mix(p0, p1), {mix(t0[0], t1[0]), mix(t0[1], t1[1]), mix(t0[2], t1[2])});
+    const Vec3 p = mix(p0, p1);
+    const std::array<Vec3, 3> t{mix(t0[0], t1[0]), mix(t0[1], t1[1]), mix(t0[2], t1[2])};
+    const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
+    const double d = (p - t[0]).dot(n);
+    if (d * d > thickness * thickness * n.squaredNorm()) return std::nullopt;
+    weights = barycentric(p, t);
   }
   if (!weights) return std::nullopt;
   contact.weights = *weights;
@@ -176,8 +189,10 @@ void LayerCollider::sizeForPoints() {
   margin_ = kMarginThicknesses * thickest;
   cell_m_ = std::max(meanEdge + 2.0 * (thickest + margin_), 1e-9);
   reach_.assign(n, 0.5 * margin_);
-  vertexLo_.resize(3 * n);
-  vertexHi_.resize(3 * n);
+  for (int a = 0; a < 3; ++a) {
+    pointLo_[a].resize(n);
+    pointHi_[a].resize(n);
+  }
   const std::size_t buckets = std::bit_ceil(std::max<std::size_t>(64, 2 * n));
   bucketMask_ = static_cast<std::uint32_t>(buckets - 1);
   inverseCell_ = 1.0 / cell_m_;
@@ -188,6 +203,26 @@ void LayerCollider::sizeForPoints() {
     grid.box.resize(6 * grid.point.size());
   }
   bucketsOfPoint_.reserve(64);
+  const std::size_t triangles = triangles_.size();
+  for (int a = 0; a < 3; ++a) {
+    triangleLo_[a].assign(triangles, 0.0);
+    triangleHi_[a].assign(triangles, 0.0);
+  }
+  triangleMended_.assign(triangles, 0u);
+  mended_.assign(n, 0u);
+  meets_.assign(std::max(n, triangles), 0u);
+  moved_.reserve(n);
+  mendedTriangles_.reserve(triangles);
+  merged_.reserve(4 * n);
+  // The triangles around each point (CSR), whose boxes follow it when it is anchored again.
+  trianglesAroundStart_.assign(n + 1, 0u);
+  for (const auto& t : triangles_)
+    for (const std::uint32_t corner : t) ++trianglesAroundStart_[corner + 1];
+  for (std::size_t v = 0; v < n; ++v) trianglesAroundStart_[v + 1] += trianglesAroundStart_[v];
+  trianglesAround_.resize(trianglesAroundStart_[n]);
+  std::vector<std::uint32_t> fill(trianglesAroundStart_.begin(), trianglesAroundStart_.end() - 1);
+  for (std::uint32_t t = 0; t < triangles; ++t)
+    for (const std::uint32_t corner : triangles_[t]) trianglesAround_[fill[corner]++] = t;
   tested_.assign(n, 0u);
   contacts_.reserve(n);
   pairs_.reserve(4 * n);
@@ -371,7 +406,9 @@ void LayerCollider::forBucketsOnce(std::size_t v, Visit&& visit) {
   // Two cells of a box can share a bucket: the point is listed in it once, so that a scan
   // of the bucket meets it once.
   bucketsOfPoint_.clear();
-  forCells(&vertexLo_[3 * v], &vertexHi_[3 * v],
+  const double lo[3] = {pointLo_[0][v], pointLo_[1][v], pointLo_[2][v]},
+               hi[3] = {pointHi_[0][v], pointHi_[1][v], pointHi_[2][v]};
+  forCells(lo, hi,
            [&](std::int64_t ix, std::int64_t iy, std::int64_t iz) { bucketsOfPoint_.push_back(bucketOf(ix, iy, iz)); });
   if (bucketsOfPoint_.size() > 1) {
     std::sort(bucketsOfPoint_.begin(), bucketsOfPoint_.end());
@@ -387,8 +424,8 @@ void LayerCollider::buildGrid(const ClothState& after) {
   for (std::size_t v = 0; v < n; ++v) {
     const double p0[3] = {lastX_[v], lastY_[v], lastZ_[v]}, p1[3] = {after.x[v], after.y[v], after.z[v]};
     for (int k = 0; k < 3; ++k) {
-      vertexLo_[3 * v + k] = std::min(p0[k], p1[k]) - reach_[v];
-      vertexHi_[3 * v + k] = std::max(p0[k], p1[k]) + reach_[v];
+      pointLo_[k][v] = std::min(p0[k], p1[k]) - reach_[v];
+      pointHi_[k][v] = std::max(p0[k], p1[k]) + reach_[v];
     }
   }
   // A grid of its own points and one of the points below (a triangle scans only the grid
@@ -411,29 +448,42 @@ void LayerCollider::buildGrid(const ClothState& after) {
         forBucketsOnce(v, [&](std::uint32_t b) {
           const std::uint32_t e = grid.fill[b]++;
           grid.point[e] = static_cast<std::uint32_t>(v);
-          std::copy_n(&vertexLo_[3 * v], 3, &grid.box[6 * e]);
-          std::copy_n(&vertexHi_[3 * v], 3, &grid.box[6 * e + 3]);
+          for (int a = 0; a < 3; ++a) {
+            grid.box[6 * e + a] = pointLo_[a][v];
+            grid.box[6 * e + 3 + a] = pointHi_[a][v];
+          }
         });
   }
 }
 
-void LayerCollider::gatherPairs() {
+void LayerCollider::placeTriangleBox(std::uint32_t t) {
   const double grow = std::max(thickness_, gap_);
+  const auto& c = triangles_[t];
+  for (int a = 0; a < 3; ++a) {
+    const std::vector<double>& lo = pointLo_[a];
+    const std::vector<double>& hi = pointHi_[a];
+    triangleLo_[a][t] = std::min({lo[c[0]], lo[c[1]], lo[c[2]]}) - grow;
+    triangleHi_[a][t] = std::max({hi[c[0]], hi[c[1]], hi[c[2]]}) + grow;
+  }
+}
+
+std::uint8_t LayerCollider::pointsAccepted(std::uint32_t t) const {
+  return t < ownTriangles_ ? (thickness_ > 0 ? kOwnPoint : 0) | kPointBelow : kOwnPoint;
+}
+
+void LayerCollider::gatherPairs() {
   pairs_.clear();
   // Its own triangles hold pairs with its own layers kept apart or with points below.
   const std::uint32_t first = thickness_ > 0 || !below_.empty() ? 0 : ownTriangles_;
   for (std::uint32_t t = first; t < triangles_.size(); ++t) {
     // Its corners' boxes, grown by the thickness: the vertices whose boxes meet it.
-    const auto& c = triangles_[t];
-    double lo[3], hi[3];
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min({vertexLo_[3 * c[0] + a], vertexLo_[3 * c[1] + a], vertexLo_[3 * c[2] + a]}) - grow;
-      hi[a] = std::max({vertexHi_[3 * c[0] + a], vertexHi_[3 * c[1] + a], vertexHi_[3 * c[2] + a]}) + grow;
-    }
+    placeTriangleBox(t);
+    const double lo[3] = {triangleLo_[0][t], triangleLo_[1][t], triangleLo_[2][t]},
+                 hi[3] = {triangleHi_[0][t], triangleHi_[1][t], triangleHi_[2][t]};
     // The points it can hold pairs with: its own triangles the points below (and its own
     // with its own layers kept apart), a triangle below its own points.
-    const bool own = t < ownTriangles_;
-    const bool scan[2] = {!own || thickness_ > 0, own};
+    const std::uint8_t accept = pointsAccepted(t);
+    const bool scan[2] = {(accept & kOwnPoint) != 0, (accept & kPointBelow) != 0};
     forCells(lo, hi, [&](std::int64_t ix, std::int64_t iy, std::int64_t iz) {
       const std::uint32_t b = bucketOf(ix, iy, iz);
       for (int g = 0; g < 2; ++g) {
@@ -502,12 +552,17 @@ void LayerCollider::updatePairs(const ClothState& now) {
   if (pairsBuilt_) {
     const Vec3 shiftNow = meanPosition(now.x, now.y, now.z) - builtMean_,
                shiftLast = meanPosition(lastX_, lastY_, lastZ_) - builtMean_;
-    std::size_t v = 0;
-    while (v < now.size() && !beyondReach(now, v, shiftNow, shiftLast)) ++v;
-    if (v == now.size()) return;  // the list holds
+    moved_.clear();
+    for (std::size_t v = 0; v < now.size(); ++v)
+      if (beyondReach(now, v, shiftNow, shiftLast)) moved_.push_back(static_cast<std::uint32_t>(v));
+    if (moved_.empty()) return;  // the list holds
+    if (moved_.size() <= kMostMended) {
+      mendPairs(now, shiftNow, shiftLast);
+      return;
+    }
     // Every point's reach for the next list: twice for those beyond it, less for the others.
     const double first = 0.5 * margin_;
-    for (v = 0; v < now.size(); ++v)
+    for (std::size_t v = 0; v < now.size(); ++v)
       reach_[v] = beyondReach(now, v, shiftNow, shiftLast) ? std::min(2.0 * reach_[v], kMostReach * first)
                                                            : std::max(first, first + kReachKept * (reach_[v] - first));
   }
@@ -521,6 +576,108 @@ void LayerCollider::updatePairs(const ClothState& now) {
   builtMean_ = meanPosition(now.x, now.y, now.z);
   pairsBuilt_ = true;
   ++self_.rebuilds;
+}
+
+void LayerCollider::mendPairs(const ClothState& now, const Vec3& shiftNow, const Vec3& shiftLast) {
+  // The moved points are anchored where they are now, in the list's frame (the common
+  // motion taken out, as beyondReach measures), keeping their reach (a new list sets it), or
+  // what holds where they were at the last test if that is more: then the list covers this
+  // test's interval too. Their boxes, and those of the triangles around them, are placed again; every other
+  // box is the one the list was made or mended with, and so are the pairs between them.
+  const double first = 0.5 * margin_;
+  for (const std::uint32_t p : moved_) {
+    const Vec3 anchor(now.x[p] - shiftNow.x(), now.y[p] - shiftNow.y(), now.z[p] - shiftNow.z());
+    const Vec3 last(lastX_[p] - shiftLast.x(), lastY_[p] - shiftLast.y(), lastZ_[p] - shiftLast.z());
+    builtX_[p] = anchor.x();
+    builtY_[p] = anchor.y();
+    builtZ_[p] = anchor.z();
+    reach_[p] = std::max(std::min(reach_[p], kMostReach * first), (last - anchor).norm());
+    for (int a = 0; a < 3; ++a) {
+      pointLo_[a][p] = anchor[a] - reach_[p];
+      pointHi_[a][p] = anchor[a] + reach_[p];
+    }
+    mended_[p] = 1;
+  }
+  mendedTriangles_.clear();
+  for (const std::uint32_t p : moved_)
+    for (std::uint32_t i = trianglesAroundStart_[p]; i < trianglesAroundStart_[p + 1]; ++i) {
+      const std::uint32_t t = trianglesAround_[i];
+      if (triangleMended_[t]) continue;
+      triangleMended_[t] = 1;
+      placeTriangleBox(t);
+      mendedTriangles_.push_back(t);
+    }
+  // Their pairs found again: each moved point against every triangle, each triangle around
+  // one against every point that did not move (a pair of both is found by the first).
+  std::erase_if(pairs_, [&](const auto& pair) { return mended_[pair.first] || triangleMended_[pair.second]; });
+  const std::size_t kept = pairs_.size();
+  const std::uint32_t firstTriangle = thickness_ > 0 || !below_.empty() ? 0 : ownTriangles_;
+  const auto triangles = static_cast<std::uint32_t>(triangles_.size());
+  for (const std::uint32_t p : moved_) {
+    if (!tested_[p]) continue;
+    const double lo[3] = {pointLo_[0][p], pointLo_[1][p], pointLo_[2][p]},
+                 hi[3] = {pointHi_[0][p], pointHi_[1][p], pointHi_[2][p]};
+    // Its own points pair with the triangles below (and its own, with its own layers kept
+    // apart); a point below with its own triangles.
+    const std::uint32_t begin = p < ownVertices_ ? (thickness_ > 0 ? firstTriangle : ownTriangles_) : 0;
+    const std::uint32_t end = p < ownVertices_ ? triangles : ownTriangles_;
+    markMeeting(lo, hi, triangleLo_, triangleHi_, begin, end);
+    forEachMet(begin, end, [&](std::uint32_t t) {
+      if ((tested_[p] & pointsAccepted(t)) && pairThickness(p, t) > 0) pairs_.push_back({p, t});
+    });
+  }
+  const auto points = static_cast<std::uint32_t>(vertexCount());
+  for (const std::uint32_t t : mendedTriangles_) {
+    const std::uint8_t accept = pointsAccepted(t);
+    if (t < firstTriangle || accept == 0) continue;
+    const double lo[3] = {triangleLo_[0][t], triangleLo_[1][t], triangleLo_[2][t]},
+                 hi[3] = {triangleHi_[0][t], triangleHi_[1][t], triangleHi_[2][t]};
+    const std::uint32_t begin = accept & kOwnPoint ? 0 : ownVertices_;
+    const std::uint32_t end = accept & kPointBelow ? points : ownVertices_;
+    markMeeting(lo, hi, pointLo_, pointHi_, begin, end);
+    forEachMet(begin, end, [&](std::uint32_t v) {
+      if (!mended_[v] && (tested_[v] & accept) && pairThickness(v, t) > 0) pairs_.push_back({v, t});
+    });
+  }
+  // In order again (by vertex, then triangle), as a new list would be: the contacts are
+  // resolved in this order, so a mended list gives the same positions to the last bit.
+  std::sort(pairs_.begin() + static_cast<std::ptrdiff_t>(kept), pairs_.end());
+  merged_.resize(pairs_.size());
+  std::merge(pairs_.begin(), pairs_.begin() + static_cast<std::ptrdiff_t>(kept),
+             pairs_.begin() + static_cast<std::ptrdiff_t>(kept), pairs_.end(), merged_.begin());
+  pairs_.swap(merged_);
+  for (const std::uint32_t p : moved_) mended_[p] = 0;
+  for (const std::uint32_t t : mendedTriangles_) triangleMended_[t] = 0;
+  ++self_.mends;
+}
+
+template <typename Visit>
+void LayerCollider::forEachMet(std::uint32_t begin, std::uint32_t end, Visit&& visit) const {
+  // Eight marks at a time: most are 0.
+  std::uint32_t i = begin;
+  for (; i + 8 <= end; i += 8) {
+    std::uint64_t word;
+    std::memcpy(&word, &meets_[i], sizeof word);
+    while (word != 0) {
+      visit(i + static_cast<std::uint32_t>(std::countr_zero(word) / 8));
+      word &= word - 1;
+    }
+  }
+  for (; i < end; ++i)
+    if (meets_[i]) visit(i);
+}
+
+void LayerCollider::markMeeting(const double* lo, const double* hi, const std::array<std::vector<double>, 3>& boxLo,
+                                const std::array<std::vector<double>, 3>& boxHi, std::uint32_t begin,
+                                std::uint32_t end) {
+  // One pass of compares without branches over the boxes' columns (it vectorises); the few
+  // that meet are read after.
+  const double *lx = boxLo[0].data(), *ly = boxLo[1].data(), *lz = boxLo[2].data();
+  const double *hx = boxHi[0].data(), *hy = boxHi[1].data(), *hz = boxHi[2].data();
+  std::uint8_t* out = meets_.data();
+  for (std::uint32_t i = begin; i < end; ++i)
+    out[i] = static_cast<std::uint8_t>((lx[i] <= hi[0]) & (hx[i] >= lo[0]) & (ly[i] <= hi[1]) & (hy[i] >= lo[1]) &
+                                       (lz[i] <= hi[2]) & (hz[i] >= lo[2]));
 }
 
 const std::vector<LayerContact>& LayerCollider::findContacts(const ClothState& before, const ClothState& after) {

@@ -2,6 +2,7 @@
 // Shared by the layer collision tests: every pair a LayerCollider tests, checked one by one.
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <set>
@@ -46,16 +47,30 @@ inline ContactSet contactSet(const std::vector<LayerContact>& contacts) {
   return out;
 }
 
-/// Test `test` of a run whose points are carried along together (a walk's common motion,
-/// which keeps a candidate list) while each wanders a little; every tenth test they wander
-/// 1.5 `scale` (which makes the list again).
-inline void carryAndWander(ClothState& points, int test, double scale, std::mt19937& random) {
+/// Test `test` of a run of layers along y whose points are carried along together (a walk's
+/// common motion, which keeps a candidate list) while each wanders a little and two of them,
+/// at random, jump, one 5 `scale` up or down through the layer beside it, the other 3 along its
+/// layer (which mends the list: their pairs, and those of the triangles around them, change);
+/// with `scatter`, every tenth test they all wander 1.5 `scale` instead (which makes the list
+/// again).
+inline void carryAndWander(ClothState& points, int test, double scale, std::mt19937& random, bool scatter) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   const Vec3 carried(0.02 * unit(random), 0.01 * unit(random), -0.015 * unit(random));
-  const double wander = (test % 10 == 9 ? 1.5 : 0.12) * scale;
+  scatter = scatter && test % 10 == 9;
+  const double wander = (scatter ? 1.5 : 0.12) * scale;
   for (std::size_t v = 0; v < points.size(); ++v)
     points.setPosition(
         v, points.position(v) + carried + wander * Vec3(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5));
+  if (scatter) return;
+  std::uniform_int_distribution<std::size_t> anyPoint(0, points.size() - 1);
+  for (int jumper = 0; jumper < 2; ++jumper) {
+    const std::size_t v = anyPoint(random);
+    const double sign = unit(random) < 0.5 ? -1.0 : 1.0;
+    const double angle = 6.283185307179586 * unit(random);
+    const Vec3 jump = jumper == 0 ? Vec3(0.3 * (unit(random) - 0.5), sign, 0.3 * (unit(random) - 0.5))
+                                  : Vec3(std::cos(angle), 0.1 * sign, std::sin(angle));
+    points.setPosition(v, points.position(v) + (jumper == 0 ? 5.0 : 3.0) * scale * jump.normalized());
+  }
 }
 
 }  // namespace drape::cloth::testing

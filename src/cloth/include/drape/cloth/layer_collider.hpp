@@ -13,7 +13,10 @@
 // triangle's corners' boxes over the interval, grown by their reach and the thickness,
 // against the vertices' boxes grown by theirs, in a hashed uniform grid (arrays sized once).
 // A vertex that went past its reach gets more at the next list (a swinging hem), one that
-// did not gives some back. A vertex and a triangle are a contact when the vertex
+// did not gives some back. When only a few went past, the list is mended instead: they are
+// anchored where they are, and their pairs and those of the triangles around them are found
+// again (against every box, in one vectorised pass each). A vertex and a triangle are a
+// contact when the vertex
 // ends within the thickness of the triangle's face (its projection inside the triangle) on
 // the side it was on at the last test, or has crossed to the other side since. Contacts are
 // resolved in three Jacobi sweeps (every pair's push summed per vertex, then averaged, so the
@@ -63,7 +66,8 @@ struct LayerContact {
 /// (its corners). A contact when p1 lies less than `thickness` from the face on the side p0
 /// was on and projects inside the triangle; or when p1 is on the other side (crossed) and,
 /// where its distance to the plane (taken as linear over the interval) was zero, it lay in
-/// the triangle as it was then. None for a degenerate triangle.
+/// the triangle as it was then, within `thickness` of its plane. None for a degenerate
+/// triangle.
 [[nodiscard]] std::optional<LayerContact> layerContact(const Vec3& p0, const Vec3& p1, const std::array<Vec3, 3>& t0,
                                                      const std::array<Vec3, 3>& t1, double thickness);
 
@@ -76,6 +80,7 @@ struct LayerCounters {
   std::uint64_t contactsBelow = 0;   ///< pairs with a garment below within the gap or crossed, resolved
   std::uint64_t crossingsBelow = 0;  ///< of those, crossed
   std::uint64_t rebuilds = 0;    ///< tests that made the candidate list again
+  std::uint64_t mends = 0;       ///< tests that found again the pairs of the few points past their reach
 
   /// Another garment's counts with these (a benchmark's sum).
   LayerCounters& operator+=(const LayerCounters& other) {
@@ -86,6 +91,7 @@ struct LayerCounters {
     contactsBelow += other.contactsBelow;
     crossingsBelow += other.crossingsBelow;
     rebuilds += other.rebuilds;
+    mends += other.mends;
     return *this;
   }
 };
@@ -196,6 +202,18 @@ class LayerCollider final : public Collider {
   [[nodiscard]] bool beyondReach(const ClothState& now, std::size_t v, const Vec3& shiftNow,
                                  const Vec3& shiftLast) const;
   void updatePairs(const ClothState& now);
+  /// The list mended for the points in moved_: anchored again and their pairs found again.
+  void mendPairs(const ClothState& now, const Vec3& shiftNow, const Vec3& shiftLast);
+  /// meets_[i] for i in [begin, end): whether box i of the columns boxLo, boxHi meets [lo, hi].
+  void markMeeting(const double* lo, const double* hi, const std::array<std::vector<double>, 3>& boxLo,
+                   const std::array<std::vector<double>, 3>& boxHi, std::uint32_t begin, std::uint32_t end);
+  /// Calls visit(i) for each i in [begin, end) that markMeeting marked (in order).
+  template <typename Visit>
+  void forEachMet(std::uint32_t begin, std::uint32_t end, Visit&& visit) const;
+  /// Triangle t's box (its corners' boxes grown by the thickness) into triangleLo_/Hi_.
+  void placeTriangleBox(std::uint32_t t);
+  /// The points (kOwnPoint, kPointBelow) triangle t can hold pairs with.
+  [[nodiscard]] std::uint8_t pointsAccepted(std::uint32_t t) const;
   void resolvePositions(ClothState& io);
   void resolveVelocities(ClothState& io);
   void clearPushes();
@@ -251,7 +269,8 @@ class LayerCollider final : public Collider {
     std::vector<std::uint32_t> start, fill, point;  ///< per bucket: where its points start; per entry: the point
     std::vector<double> box;                         ///< per entry: lo xyz, hi xyz
   };
-  std::vector<double> vertexLo_, vertexHi_;  ///< per vertex, xyz: its box over the interval
+  std::array<std::vector<double>, 3> pointLo_, pointHi_;        ///< per axis, per point: its box in the list
+  std::array<std::vector<double>, 3> triangleLo_, triangleHi_;  ///< per axis, per triangle: its box in the list
   std::array<PointGrid, 2> grids_;           ///< [0]: its own points; [1]: the points below
   std::uint32_t bucketMask_ = 0;
   double inverseCell_ = 1.0;
@@ -260,7 +279,12 @@ class LayerCollider final : public Collider {
   double margin_;
   std::vector<double> reach_;  ///< per point: how far it may move before the list is made again (first margin_ / 2)
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;  ///< (vertex, triangle), sorted
-  std::vector<double> builtX_, builtY_, builtZ_;
+  std::vector<double> builtX_, builtY_, builtZ_;  ///< where each point was anchored, in the list's frame
+  std::vector<std::uint32_t> trianglesAroundStart_, trianglesAround_;  ///< per point (CSR)
+  std::vector<std::uint32_t> moved_, mendedTriangles_;  ///< a mend's points and triangles
+  std::vector<std::uint8_t> mended_, triangleMended_;   ///< per point and triangle: in the mend
+  std::vector<std::uint8_t> meets_;                     ///< markMeeting's
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> merged_;  ///< a mended list, merged
   Vec3 builtMean_ = Vec3::Zero();
   bool pairsBuilt_ = false;
   std::vector<LayerContact> contacts_;

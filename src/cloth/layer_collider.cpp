@@ -32,6 +32,17 @@ constexpr std::size_t kMostMended = 8;
 /// How far outside a triangle (in barycentric weight) a projection may fall and still count:
 /// a vertex over the edge between two faces belongs to both.
 constexpr double kEdgeTolerance = 1e-9;
+/// The candidate list's order: by triangle, then vertex (the narrow test reads each
+/// triangle's plane once for all its vertices).
+constexpr auto kByTriangle = [](const std::pair<std::uint32_t, std::uint32_t>& a,
+                                const std::pair<std::uint32_t, std::uint32_t>& b) {
+  return a.second != b.second ? a.second < b.second : a.first < b.first;
+};
+/// The contacts' order, whatever the list's: by vertex, then triangle. Their pushes are
+/// summed in it.
+constexpr auto kByVertex = [](const LayerContact& a, const LayerContact& b) {
+  return a.vertex != b.vertex ? a.vertex < b.vertex : a.triangle < b.triangle;
+};
 /// LayerCollider::tested_: a point of its own in some pair, a point below in some pair.
 constexpr std::uint8_t kOwnPoint = 1, kPointBelow = 2;
 
@@ -506,24 +517,41 @@ void LayerCollider::gatherPairs() {
       }
     });
   }
-  std::sort(pairs_.begin(), pairs_.end());
+  std::sort(pairs_.begin(), pairs_.end(), kByTriangle);
 }
 
 void LayerCollider::narrow(const ClothState& after) {
   contacts_.clear();
   self_.candidates += pairs_.size();
-  for (const auto& [v, t] : pairs_) {
+  for (std::size_t i = 0, end; i < pairs_.size(); i = end) {
+    const std::uint32_t t = pairs_[i].second;
+    for (end = i + 1; end < pairs_.size() && pairs_[end].second == t;) ++end;
     const auto& c = triangles_[t];
     const std::array<Vec3, 3> t0{at(lastX_, lastY_, lastZ_, c[0]), at(lastX_, lastY_, lastZ_, c[1]),
                                  at(lastX_, lastY_, lastZ_, c[2])};
     const std::array<Vec3, 3> t1{after.position(c[0]), after.position(c[1]), after.position(c[2])};
-    if (std::optional<LayerContact> contact =
-            layerContact(at(lastX_, lastY_, lastZ_, v), after.position(v), t0, t1, listedThickness(v, t))) {
-      contact->vertex = v;
-      contact->triangle = t;
-      contacts_.push_back(*contact);
+    // layerContact's first test, its planes found once for the triangle's vertices: the same
+    // expressions, so the same pairs go on to the whole test.
+    const Vec3 n1 = (t1[1] - t1[0]).cross(t1[2] - t1[0]);
+    const double area2 = n1.squaredNorm();
+    if (!(area2 > 0)) continue;
+    const Vec3 n0 = (t0[1] - t0[0]).cross(t0[2] - t0[0]);
+    const Vec3& sideNormal = n0.squaredNorm() > 0 ? n0 : n1;
+    for (std::size_t k = i; k < end; ++k) {
+      const std::uint32_t v = pairs_[k].first;
+      const double thickness = listedThickness(v, t);
+      const Vec3 p0 = at(lastX_, lastY_, lastZ_, v), p1 = after.position(v);
+      const double side = (p0 - t0[0]).dot(sideNormal) >= 0 ? 1.0 : -1.0;
+      const double d1 = side * (p1 - t1[0]).dot(n1);
+      if (d1 >= 0 && d1 * d1 >= thickness * thickness * area2) continue;
+      if (std::optional<LayerContact> contact = layerContact(p0, p1, t0, t1, thickness)) {
+        contact->vertex = v;
+        contact->triangle = t;
+        contacts_.push_back(*contact);
+      }
     }
   }
+  std::sort(contacts_.begin(), contacts_.end(), kByVertex);
 }
 
 Vec3 LayerCollider::meanPosition(const std::vector<double>& x, const std::vector<double>& y,
@@ -641,10 +669,10 @@ void LayerCollider::mendPairs(const ClothState& now, const Vec3& shiftNow, const
   }
   // In order again (by vertex, then triangle), as a new list would be: the contacts are
   // resolved in this order, so a mended list gives the same positions to the last bit.
-  std::sort(pairs_.begin() + static_cast<std::ptrdiff_t>(kept), pairs_.end());
+  std::sort(pairs_.begin() + static_cast<std::ptrdiff_t>(kept), pairs_.end(), kByTriangle);
   merged_.resize(pairs_.size());
   std::merge(pairs_.begin(), pairs_.begin() + static_cast<std::ptrdiff_t>(kept),
-             pairs_.begin() + static_cast<std::ptrdiff_t>(kept), pairs_.end(), merged_.begin());
+             pairs_.begin() + static_cast<std::ptrdiff_t>(kept), pairs_.end(), merged_.begin(), kByTriangle);
   pairs_.swap(merged_);
   for (const std::uint32_t p : moved_) mended_[p] = 0;
   for (const std::uint32_t t : mendedTriangles_) triangleMended_[t] = 0;

@@ -278,7 +278,7 @@ class LayerCollider final : public Collider {
   // The candidate list and where the vertices were when it was made.
   double margin_;
   std::vector<double> reach_;  ///< per point: how far it may move before the list is made again (first margin_ / 2)
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;  ///< (vertex, triangle), sorted
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;  ///< (vertex, triangle), by triangle then vertex
   std::vector<double> builtX_, builtY_, builtZ_;  ///< where each point was anchored, in the list's frame
   std::vector<std::uint32_t> trianglesAroundStart_, trianglesAround_;  ///< per point (CSR)
   std::vector<std::uint32_t> moved_, mendedTriangles_;  ///< a mend's points and triangles

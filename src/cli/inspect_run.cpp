@@ -195,6 +195,35 @@ void printSlowestFrame(const render::RunReplay& run, const nlohmann::json& stats
              timeCode(run, static_cast<std::int64_t>(slowest)), simulated(slowest), fmt::join(parts, ", "));
 }
 
+/// What each garment's layer collision did, from stats.json: its own layers kept apart
+/// (self_collision) and the garments it is worn over (worn_over). A crossing is a vertex found
+/// through a layer at a test and put back on its side.
+void printLayers(const nlohmann::json& stats, std::ostream& out) {
+  if (!stats.contains("garments") || !stats["garments"].is_array()) return;
+  const auto count = [](const nlohmann::json& o, const char* key) {
+    return o.contains(key) && o[key].is_number() ? o[key].get<double>() : 0.0;
+  };
+  for (const nlohmann::json& g : stats["garments"]) {
+    if (!g.is_object() || !g.contains("name") || !g["name"].is_string()) continue;
+    const std::string name = g["name"].get<std::string>();
+    const auto print = [&](const nlohmann::json& layer, const std::string& what, const char* size) {
+      fmt::print(out, "  {:<14} {} {:.4g} mm: {:.0f} contacts at {:.0f} tests, {:.0f} of them crossed through and put back\n",
+                 name, what, 1e3 * count(layer, size), count(layer, "contacts"), count(layer, "tests"),
+                 count(layer, "crossings"));
+    };
+    if (g.contains("self_collision") && g["self_collision"].is_object())
+      print(g["self_collision"], "its own layers kept apart by", "thickness_m");
+    if (g.contains("worn_over") && g["worn_over"].is_object()) {
+      const nlohmann::json& over = g["worn_over"];
+      std::vector<std::string> below;
+      if (over.contains("garments") && over["garments"].is_array())
+        for (const nlohmann::json& b : over["garments"])
+          if (b.is_string()) below.push_back(b.get<std::string>());
+      print(over, fmt::format("worn over {}, kept above by", fmt::join(below, ", ")), "gap_m");
+    }
+  }
+}
+
 void printSummary(const std::string& directory, const render::RunReplay& run, const nlohmann::json& stats,
                   const std::vector<std::size_t>& collidable, std::ostream& out) {
   const std::int64_t frames = *run.frameCount();
@@ -227,6 +256,7 @@ void printSummary(const std::string& directory, const render::RunReplay& run, co
              number("frames"), number("ms_per_frame"), number("vertex_substeps_inside_body"), number("vertex_substeps"),
              number("max_penetration_m") * 1000.0, number("vertex_substeps_below_T1"),
              unstable ? "went unstable (see its \"instability\")" : "stable");
+  printLayers(stats, out);
   printSlowestFrame(run, stats, out);
 }
 

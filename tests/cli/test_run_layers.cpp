@@ -90,6 +90,14 @@ TEST(RunLayers, ASceneKeepsItsLayersOneThicknessApartAndSaysSo) {
   const CliResult inspected = runDrape("inspect '" + (dir / "layers.wrl") + "'", dir);
   ASSERT_EQ(inspected.code, 0) << inspected.err;
   EXPECT_NE(inspected.out.find("its own layers kept 4 mm apart (selfCollision)"), std::string::npos) << inspected.out;
+  const CliResult inspectedRun = runDrape("inspect '" + (dir / "kept") + "'", dir);
+  ASSERT_EQ(inspectedRun.code, 0) << inspectedRun.err;
+  EXPECT_NE(inspectedRun.out.find(fmt::format("its own layers kept apart by 4 mm: {} contacts at {} tests, {} of them "
+                                              "crossed through and put back",
+                                              self["contacts"].get<long>(), self["tests"].get<long>(),
+                                              self["crossings"].get<long>())),
+            std::string::npos)
+      << inspectedRun.out;
 
   // --self-collision 0 overrides the scene: the layers pass through each other.
   const CliResult free =

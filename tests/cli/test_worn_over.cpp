@@ -129,6 +129,15 @@ TEST(WornOver, TheSkirtStaysOverThePetticoatWhichDoesNotFeelIt) {
   ASSERT_EQ(inspected.code, 0) << inspected.err;
   EXPECT_NE(inspected.out.find("worn 4 mm over Petticoat (over, overGap; stepped after it)"), std::string::npos)
       << inspected.out;
+  // The run says what the layer collision did, as its stats.json counts it.
+  const CliResult run = runDrape("inspect '" + (dir / "over") + "'", dir);
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.out.find(fmt::format("  Skirt          worn over Petticoat, kept above by 4 mm: {} contacts at {} "
+                                     "tests, {} of them crossed through and put back",
+                                     over["contacts"].get<long>(), over["tests"].get<long>(),
+                                     over["crossings"].get<long>())),
+            std::string::npos)
+      << run.out;
 }
 
 /// A 0.4 m square pinned flat at y = 0 ("Table", its constraint mask with no avatar to bind

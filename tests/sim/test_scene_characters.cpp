@@ -10,6 +10,8 @@
 #include <regex>
 #include <string>
 
+#include <fmt/format.h>
+
 #include "drape/scene/scene.hpp"
 #include "drape/sim/scene_setup.hpp"
 #include "drape/testing/errors.hpp"
@@ -127,7 +129,7 @@ TEST(SceneCharacters, RefusesWhatItCannotTellApart) {
   const std::string noMotion = testing::processTempDir("scene-characters").string() + "/no-motion.wrl";
   std::ofstream(noMotion) << text;
   const auto ada = static_cast<long>(text.find("DEF Ada Avatar"));
-  const std::string at = ":" + std::to_string(std::count(text.begin(), text.begin() + ada, '\n') + 1) + ": ";
+  const std::string at = fmt::format(":{}: ", std::count(text.begin(), text.begin() + ada, '\n') + 1);
   EXPECT_EQ(testing::errorOf([&] { (void)sceneCharacters(scene::loadScene(noMotion)); }),
             noMotion + at + "Avatar Ada: motion: no such file (no-such-walk.bvh)");
 }

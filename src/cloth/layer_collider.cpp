@@ -495,6 +495,7 @@ void LayerCollider::gatherPairs() {
     // with its own layers kept apart), a triangle below its own points.
     const std::uint8_t accept = pointsAccepted(t);
     const bool scan[2] = {(accept & kOwnPoint) != 0, (accept & kPointBelow) != 0};
+    const std::size_t its = pairs_.size();
     forCells(lo, hi, [&](std::int64_t ix, std::int64_t iy, std::int64_t iz) {
       const std::uint32_t b = bucketOf(ix, iy, iz);
       for (int g = 0; g < 2; ++g) {
@@ -516,8 +517,9 @@ void LayerCollider::gatherPairs() {
         }
       }
     });
+    // The triangles come in order; each one's few pairs are put in vertex order here.
+    std::sort(pairs_.begin() + static_cast<std::ptrdiff_t>(its), pairs_.end());
   }
-  std::sort(pairs_.begin(), pairs_.end(), kByTriangle);
 }
 
 void LayerCollider::narrow(const ClothState& after) {

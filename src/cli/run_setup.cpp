@@ -945,6 +945,15 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
       spdlog::info("{}: kept {:.4g} mm over {} (stepped after {}, tested every {} substeps)", g.name,
                    1e3 * r.layers->gap_m(), fmt::join(r.layers->garmentsBelow(), ", "),
                    r.layers->garmentsBelow().size() == 1 ? "it" : "them", r.layers->every());
+    if (r.layers && r.layers->startUnder().vertices > 0) {
+      const cloth::StartUnder& under = r.layers->startUnder();
+      const std::string below = fmt::format("{}", fmt::join(r.layers->garmentsBelow(), ", "));
+      spdlog::warn("{}: {} of its {} vertices over {} start under {}, on the other side from the rest (the deepest, "
+                   "vertex {}, {:.1f} mm): the layers keep the side each starts on, so those stay under. Model {} over "
+                   "{}, or check that the faces of {} are all wound one way",
+                   g.name, under.vertices, under.over, below, r.layers->garmentsBelow().size() == 1 ? "it" : "them",
+                   under.deepestVertex, 1e3 * under.deepest_m, g.name, below, below);
+    }
     r.model = &r.solver->model();
     // Each garment its own spheres: garments step in parallel, and a collider keeps counts.
     r.spheres.reserve(setup.spheres.size());  // the solver keeps references
@@ -1155,6 +1164,7 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
                               {"candidate_pairs", s.candidates},
                               {"candidate_lists_made", s.rebuilds},
                               {"candidate_lists_mended", s.mends},
+                              {"vertices_starting_under", layers->startUnder().vertices},
                               {"contacts", s.contactsBelow},
                               {"crossings", s.crossingsBelow}};
     }

@@ -9,6 +9,7 @@
 
 #include "drape/cloth/model.hpp"
 #include "drape/core/error.hpp"
+#include "drape/mesh/closest_point.hpp"
 
 namespace drape::cloth {
 namespace {
@@ -32,6 +33,9 @@ constexpr std::size_t kMostMended = 8;
 /// How far outside a triangle (in barycentric weight) a projection may fall and still count:
 /// a vertex over the edge between two faces belongs to both.
 constexpr double kEdgeTolerance = 1e-9;
+/// How far from the garments below, in gaps, a vertex of its own is looked at for the side it
+/// starts on (LayerCollider::startUnder): a garment modelled over another lies within a few.
+constexpr double kUnderDepthGaps = 4.0;
 /// The candidate list's order: by triangle, then vertex (the narrow test reads each
 /// triangle's plane once for all its vertices).
 constexpr auto kByTriangle = [](const std::pair<std::uint32_t, std::uint32_t>& a,
@@ -312,6 +316,45 @@ void LayerCollider::initialise(const ClothState& state) {
     std::copy(b.endZ.begin(), b.endZ.end(), lastZ_.begin() + b.first);
   }
   held_ = false;
+  findStartUnder();
+}
+
+void LayerCollider::findStartUnder() {
+  // Each free vertex of its own near the garments below takes the side of the nearest of
+  // their triangles, along its normal, where it lies over or under it (more along the normal
+  // than beside it: not past a hem); the side most take is the one it is worn on.
+  startUnder_ = {};
+  if (below_.empty()) return;
+  const double depth = kUnderDepthGaps * gap_;
+  std::vector<std::pair<std::uint32_t, double>> sides;  // (vertex, signed distance): once, at set-up
+  for (std::uint32_t v = 0; v < ownVertices_; ++v) {
+    if (!(inverseMass_[v] > 0)) continue;
+    const Vec3 p = at(lastX_, lastY_, lastZ_, v);
+    double nearest = depth, along = 0.0;
+    for (std::uint32_t t = ownTriangles_; t < triangles_.size(); ++t) {
+      const auto& c = triangles_[t];
+      const std::array<Vec3, 3> corners{at(lastX_, lastY_, lastZ_, c[0]), at(lastX_, lastY_, lastZ_, c[1]),
+                                        at(lastX_, lastY_, lastZ_, c[2])};
+      const double distance = (p - mesh::closestOnTriangle(p, corners[0], corners[1], corners[2])).norm();
+      if (distance > nearest) continue;
+      const Vec3 n = unitNormal(corners);
+      if (n.isZero()) continue;
+      nearest = distance;
+      along = (p - corners[0]).dot(n);
+    }
+    if (along != 0.0 && std::abs(along) >= 0.5 * nearest) sides.emplace_back(v, along);
+  }
+  const auto above = std::count_if(sides.begin(), sides.end(), [](const auto& side) { return side.second > 0; });
+  const double wornSide = 2 * above >= static_cast<std::ptrdiff_t>(sides.size()) ? 1.0 : -1.0;
+  startUnder_.over = sides.size();
+  for (const auto& [v, d] : sides)
+    if (d * wornSide < 0) {
+      ++startUnder_.vertices;
+      if (std::abs(d) > startUnder_.deepest_m) {
+        startUnder_.deepest_m = std::abs(d);
+        startUnder_.deepestVertex = v;
+      }
+    }
 }
 
 bool LayerCollider::excluded(std::uint32_t vertex, std::uint32_t triangle) const {

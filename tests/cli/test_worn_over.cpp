@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <array>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -141,13 +142,15 @@ TEST(WornOver, TheSkirtStaysOverThePetticoatWhichDoesNotFeelIt) {
 }
 
 /// A 0.4 m square pinned flat at y = 0 ("Table", its constraint mask with no avatar to bind
-/// to) and a free 0.24 m square 3 cm above it ("Cloth"), `clothFields` in its ClothSet.
-std::string tableScene(const std::string& clothFields) {
-  const auto grid = [](int n, double size, double y) {
+/// to) and a free 0.24 m square of 5 x 5 points 3 cm above it, or at `clothHeight(point)`
+/// ("Cloth"), `clothFields` in its ClothSet.
+std::string tableScene(const std::string& clothFields,
+                       const std::function<double(int)>& clothHeight = [](int) { return 0.03; }) {
+  const auto grid = [](int n, double size, const std::function<double(int)>& y) {
     std::string points, quads;
     for (int j = 0; j <= n; ++j)
       for (int i = 0; i <= n; ++i)
-        points += fmt::format("{} {} {}, ", size * (double(i) / n - 0.5), y, size * (double(j) / n - 0.5));
+        points += fmt::format("{} {} {}, ", size * (double(i) / n - 0.5), y(j * (n + 1) + i), size * (double(j) / n - 0.5));
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
         const int a = j * (n + 1) + i;
@@ -155,14 +158,14 @@ std::string tableScene(const std::string& clothFields) {
       }
     return fmt::format("IndexedFaceSet {{ coord Coordinate {{ point [ {} ] }} coordIndex [ {} ] }}", points, quads);
   };
-  const std::string table = grid(7, 0.4, 0.0);
+  const std::string table = grid(7, 0.4, [](int) { return 0.0; });
   return fmt::format(
       "#VRML V2.0 utf8\n"
       "Simulation {{ frameRate 30 stepsPerFrame 40 }}\n"
       "DEF Knit ClothMaterial {{ youngsModulus 50000 damping 0.0001 }}\n"
       "DEF Table ClothSet {{ material USE Knit cloth {} constraintMask {} }}\n"
       "DEF Cloth ClothSet {{ material USE Knit {} cloth {} }}\n",
-      table, table, clothFields, grid(4, 0.24, 0.03));
+      table, table, clothFields, grid(4, 0.24, clothHeight));
 }
 
 /// The heights of the points in a run's OBJ frame.
@@ -191,6 +194,33 @@ TEST(WornOver, WithoutACharacterASheetOverAPinnedOneRestsOneGapAboveIt) {
   const std::vector<double> fallen = heightsIn(dir / "through/frames/garment-Cloth_00024.obj");
   ASSERT_FALSE(fallen.empty());
   EXPECT_LT(*std::max_element(fallen.begin(), fallen.end()), -0.1);
+}
+
+TEST(WornOver, AGarmentModelledPartlyUnderTheOneItIsWornOverSaysSoAndStaysThere) {
+  // The cloth modelled 8 mm over the table but for its middle row, 4 mm under it.
+  const ScratchDir dir("worn-over-under");
+  const auto middleRowUnder = [](int point) { return point / 5 == 2 ? -0.004 : 0.008; };
+  { std::ofstream(dir / "under.wrl") << tableScene("over [ \"Table\" ]", middleRowUnder); }
+  const CliResult r = runDrape("run '" + (dir / "under.wrl") + "' --frames 24 --out '" + (dir / "under") + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("Cloth: 5 of its 25 vertices over Table start under it, on the other side from the rest (the "
+                       "deepest, vertex 10, 4.0 mm): the layers keep the side each starts on, so those stay under. "
+                       "Model Cloth over Table, or check that the faces of Table are all wound one way"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(statsOf(dir / "under")["garments"][1]["worn_over"]["vertices_starting_under"].get<long>(), 5);
+  // And so they do: the middle row under the table, the rest on it.
+  const std::vector<double> heights = heightsIn(dir / "under/frames/garment-Cloth_00024.obj");
+  ASSERT_EQ(heights.size(), 25u);
+  for (int point = 0; point < 25; ++point)
+    EXPECT_EQ(heights[point] < 0, point / 5 == 2) << "point " << point << " at " << heights[point];
+
+  // Modelled over it, no word of it.
+  { std::ofstream(dir / "over.wrl") << tableScene("over [ \"Table\" ]", [](int) { return 0.008; }); }
+  const CliResult over = runDrape("run '" + (dir / "over.wrl") + "' --frames 2 --out '" + (dir / "over") + "'", dir);
+  ASSERT_EQ(over.code, 0) << over.err;
+  EXPECT_EQ(over.err.find("start under"), std::string::npos) << over.err;
+  EXPECT_EQ(statsOf(dir / "over")["garments"][1]["worn_over"]["vertices_starting_under"].get<long>(), 0);
 }
 
 }  // namespace

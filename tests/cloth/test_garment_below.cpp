@@ -241,6 +241,45 @@ TEST(GarmentBelow, ASheetOnAGarmentSlidingAwayIsDraggedAtMuG) {
   }
 }
 
+TEST(GarmentBelow, SaysWhichVerticesStartUnderTheGarmentBelow) {
+  // A sheet modelled one gap over another, the same waves: every vertex over it. Pushed
+  // through it by half a gap, `pushed` of them start under it, which the layers would keep.
+  std::mt19937 random(17);
+  const double gap = 0.01;
+  const mesh::TriMesh below = wavySheet(12, 0.0, 0.02, 0.0, 3, random);
+  mesh::TriMesh over = below;
+  for (Vec3& p : over.positions) p.y() += gap;
+  const std::vector<std::uint32_t> pushed{15, 40, 41, 77, 120};
+  for (const std::uint32_t v : pushed) over.positions[v].y() -= 1.5 * gap;
+  const auto overModel = makeModel(over, knit()), belowModel = makeModel(below, knit());
+  const ClothState belowState = stateAt(below.positions);
+  LayerCollider collider(*overModel, "over", 0.0);
+  collider.setFixedVertices({0, 1, 2});  // bound: never pushed, not counted
+  collider.addGarmentBelow(*belowModel, "below", belowState, 0.004, kFrame_s);
+  collider.initialise(stateAt(over.positions));
+  const StartUnder& under = collider.startUnder();
+  // The sheets' edges are over the other's edges: inside its triangles within the tolerance.
+  EXPECT_EQ(under.over, over.positions.size() - 3);
+  EXPECT_EQ(under.vertices, pushed.size());
+  EXPECT_TRUE(std::find(pushed.begin(), pushed.end(), under.deepestVertex) != pushed.end());
+  EXPECT_NEAR(under.deepest_m, 0.5 * gap, 0.25 * gap);  // the wave's slope tilts the faces
+
+  // Modelled over it, none; and turned over as a whole (the garment under the other), the
+  // few that poke out are the ones on the other side.
+  LayerCollider clean(*overModel, "over", 0.0);
+  clean.addGarmentBelow(*belowModel, "below", belowState, 0.004, kFrame_s);
+  mesh::TriMesh lifted = below;
+  for (Vec3& p : lifted.positions) p.y() += gap;
+  clean.initialise(stateAt(lifted.positions));
+  EXPECT_EQ(clean.startUnder().vertices, 0u);
+  EXPECT_EQ(clean.startUnder().over, lifted.positions.size());
+  mesh::TriMesh sunk = below;
+  for (Vec3& p : sunk.positions) p.y() -= gap;
+  for (const std::uint32_t v : pushed) sunk.positions[v].y() += 1.5 * gap;
+  clean.initialise(stateAt(sunk.positions));
+  EXPECT_EQ(clean.startUnder().vertices, pushed.size());
+}
+
 TEST(GarmentBelow, AGapMustBeAPositiveLength) {
   SheetSpec spec{0.4, 0.4, 2, 2, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), "sheet"};
   const auto model = makeModel(gridSheet(spec), knit());

@@ -96,6 +96,15 @@ struct LayerCounters {
   }
 };
 
+/// The vertices of a garment that start on the other side of the garments it is worn over
+/// than the rest of it (modelled partly under them): the layers keep the side they start on.
+struct StartUnder {
+  std::size_t over = 0;      ///< free vertices over the garments below (within a few gaps of a triangle, projecting into it)
+  std::size_t vertices = 0;  ///< of those, on the side fewer are on
+  std::uint32_t deepestVertex = 0;
+  double deepest_m = 0.0;  ///< its distance from the triangle it is under
+};
+
 class LayerCollider final : public Collider {
  public:
   /// Keeps `model`'s own layers `thickness_m` apart (0: they pass through each other; the
@@ -127,6 +136,8 @@ class LayerCollider final : public Collider {
   void beginFrame() override;
   void restartFrame(const ClothState& state, double t_s) override;
 
+  /// Its vertices that start under the garments below, as initialise() found them.
+  [[nodiscard]] const StartUnder& startUnder() const { return startUnder_; }
   /// Its own layers' thickness (0: not kept apart).
   [[nodiscard]] double thickness_m() const { return thickness_; }
   /// How far above the garments below it keeps (0: none below).
@@ -202,6 +213,8 @@ class LayerCollider final : public Collider {
   [[nodiscard]] bool beyondReach(const ClothState& now, std::size_t v, const Vec3& shiftNow,
                                  const Vec3& shiftLast) const;
   void updatePairs(const ClothState& now);
+  /// startUnder_ from the positions of the last test (initialise()'s).
+  void findStartUnder();
   /// The list mended for the points in moved_: anchored again and their pairs found again.
   void mendPairs(const ClothState& now, const Vec3& shiftNow, const Vec3& shiftLast);
   /// meets_[i] for i in [begin, end): whether box i of the columns boxLo, boxHi meets [lo, hi].
@@ -293,6 +306,7 @@ class LayerCollider final : public Collider {
   std::uint64_t calls_ = 0;
   ColliderCounters counters_, frameStartCounters_;
   LayerCounters self_, frameStartSelf_;
+  StartUnder startUnder_;
 };
 
 }  // namespace drape::cloth

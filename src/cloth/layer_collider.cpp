@@ -335,12 +335,13 @@ void LayerCollider::findStartUnder() {
       const auto& c = triangles_[t];
       const std::array<Vec3, 3> corners{at(lastX_, lastY_, lastZ_, c[0]), at(lastX_, lastY_, lastZ_, c[1]),
                                         at(lastX_, lastY_, lastZ_, c[2])};
+      const Vec3 n = unitNormal(corners);
+      const double off = (p - corners[0]).dot(n);  // no farther from the triangle than from its plane
+      if (n.isZero() || std::abs(off) > nearest) continue;
       const double distance = (p - mesh::closestOnTriangle(p, corners[0], corners[1], corners[2])).norm();
       if (distance > nearest) continue;
-      const Vec3 n = unitNormal(corners);
-      if (n.isZero()) continue;
       nearest = distance;
-      along = (p - corners[0]).dot(n);
+      along = off;
     }
     if (along != 0.0 && std::abs(along) >= 0.5 * nearest) sides.emplace_back(v, along);
   }

@@ -934,7 +934,7 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
       // Before the spheres: where they disagree, a sphere wins.
       r.ownedLayers = sim::makeLayerCollider(
           setup.garments, gi, below[gi], g.pinned,
-          [&](std::size_t i) -> const cloth::ClothSolver& { return *runs[i].ownedSolver; }, 1.0 / settings.frameRate_hz);
+          [&](std::size_t i) -> cloth::ClothSolver& { return *runs[i].ownedSolver; }, 1.0 / settings.frameRate_hz);
       if (r.ownedLayers) r.ownedSolver->addCollider(*r.ownedLayers);
       r.layers = r.ownedLayers.get();
     }
@@ -948,11 +948,19 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
     if (r.layers && r.layers->startUnder().vertices > 0) {
       const cloth::StartUnder& under = r.layers->startUnder();
       const std::string below = fmt::format("{}", fmt::join(r.layers->garmentsBelow(), ", "));
-      spdlog::warn("{}: {} of its {} vertices over {} start under {}, on the other side from the rest (the deepest, "
-                   "vertex {}, {:.1f} mm): the layers keep the side each starts on, so those stay under. Model {} over "
-                   "{}, or check that the faces of {} are all wound one way",
-                   g.name, under.vertices, under.over, below, r.layers->garmentsBelow().size() == 1 ? "it" : "them",
-                   under.deepestVertex, 1e3 * under.deepest_m, g.name, below, below);
+      const char* them = r.layers->garmentsBelow().size() == 1 ? "it" : "them";
+      if (r.layers->liftedOver().vertices > 0)
+        spdlog::info("{}: {} of its {} vertices over {} were modelled under {} (the deepest, vertex {}, {:.1f} mm): "
+                     "moved out over {}, {:.4g} mm above",
+                     g.name, under.vertices, under.over, below, them, under.deepestVertex, 1e3 * under.deepest_m, them,
+                     1e3 * r.layers->gap_m());
+      else
+        spdlog::warn("{}: {} of its {} vertices over {} start under {}, on the other side from the rest (the deepest, "
+                     "vertex {}, {:.1f} mm), and the faces of {} are not all wound one way, so which side is over "
+                     "cannot be told: they were left where they are, and the layers keep the side each starts on. Wind "
+                     "the faces of {} one way, or model {} over {}",
+                     g.name, under.vertices, under.over, below, them, under.deepestVertex, 1e3 * under.deepest_m, below,
+                     below, g.name, them);
     }
     r.model = &r.solver->model();
     // Each garment its own spheres: garments step in parallel, and a collider keeps counts.
@@ -1165,6 +1173,7 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
                               {"candidate_lists_made", s.rebuilds},
                               {"candidate_lists_mended", s.mends},
                               {"vertices_starting_under", layers->startUnder().vertices},
+                              {"vertices_lifted_over", layers->liftedOver().vertices},
                               {"contacts", s.contactsBelow},
                               {"crossings", s.crossingsBelow}};
     }

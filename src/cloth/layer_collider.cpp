@@ -229,6 +229,16 @@ void LayerCollider::sizeForPoints() {
   moved_.reserve(n);
   mendedTriangles_.reserve(triangles);
   merged_.reserve(4 * n);
+  // The connected pieces of the garments below (a union-find forest over their vertices).
+  componentBelow_.resize(n);
+  for (std::uint32_t v = 0; v < n; ++v) componentBelow_[v] = v;
+  for (std::size_t t = ownTriangles_; t < triangles; ++t) {
+    const std::uint32_t root = componentBelow(triangles_[t][0]);
+    for (int k = 1; k < 3; ++k) {
+      const std::uint32_t other = componentBelow(triangles_[t][k]);
+      if (other != root) componentBelow_[other] = root;
+    }
+  }
   // The triangles around each point (CSR), whose boxes follow it when it is anchored again.
   trianglesAroundStart_.assign(n + 1, 0u);
   for (const auto& t : triangles_)
@@ -319,18 +329,30 @@ void LayerCollider::initialise(const ClothState& state) {
   findStartUnder();
 }
 
+std::uint32_t LayerCollider::componentBelow(std::uint32_t vertex) const {
+  while (componentBelow_[vertex] != vertex) vertex = componentBelow_[vertex];
+  return vertex;
+}
+
 void LayerCollider::findStartUnder() {
   // Each free vertex of its own near the garments below takes the side of the nearest of
   // their triangles, along its normal, where it lies over or under it (more along the normal
-  // than beside it: not past a hem); the side most take is the one it is worn on.
+  // than beside it: not past a hem); the side most take over a connected piece of them is
+  // the one it is worn on there.
   startUnder_ = {};
+  under_.clear();
   if (below_.empty()) return;
   const double depth = kUnderDepthGaps * gap_;
-  std::vector<std::pair<std::uint32_t, double>> sides;  // (vertex, signed distance): once, at set-up
+  struct Side {
+    std::uint32_t vertex, triangle;
+    double along;
+  };
+  std::vector<Side> sides;  // once, at set-up
   for (std::uint32_t v = 0; v < ownVertices_; ++v) {
     if (!(inverseMass_[v] > 0)) continue;
     const Vec3 p = at(lastX_, lastY_, lastZ_, v);
     double nearest = depth, along = 0.0;
+    std::uint32_t under = 0;
     for (std::uint32_t t = ownTriangles_; t < triangles_.size(); ++t) {
       const auto& c = triangles_[t];
       const std::array<Vec3, 3> corners{at(lastX_, lastY_, lastZ_, c[0]), at(lastX_, lastY_, lastZ_, c[1]),
@@ -342,20 +364,59 @@ void LayerCollider::findStartUnder() {
       if (distance > nearest) continue;
       nearest = distance;
       along = off;
+      under = t;
     }
-    if (along != 0.0 && std::abs(along) >= 0.5 * nearest) sides.emplace_back(v, along);
+    if (along != 0.0 && std::abs(along) >= 0.5 * nearest) sides.push_back({v, under, along});
   }
-  const auto above = std::count_if(sides.begin(), sides.end(), [](const auto& side) { return side.second > 0; });
-  const double wornSide = 2 * above >= static_cast<std::ptrdiff_t>(sides.size()) ? 1.0 : -1.0;
+  // Per connected piece below (root vertex): how many take each side.
+  std::vector<std::uint32_t> above(vertexCount(), 0u), total(vertexCount(), 0u);
+  for (const Side& side : sides) {
+    const std::uint32_t piece = componentBelow(triangles_[side.triangle][0]);
+    above[piece] += side.along > 0 ? 1u : 0u;
+    ++total[piece];
+  }
   startUnder_.over = sides.size();
-  for (const auto& [v, d] : sides)
-    if (d * wornSide < 0) {
-      ++startUnder_.vertices;
-      if (std::abs(d) > startUnder_.deepest_m) {
-        startUnder_.deepest_m = std::abs(d);
-        startUnder_.deepestVertex = v;
-      }
+  for (const Side& side : sides) {
+    const std::uint32_t piece = componentBelow(triangles_[side.triangle][0]);
+    const double wornSide = 2 * above[piece] >= total[piece] ? 1.0 : -1.0;
+    if (side.along * wornSide >= 0) continue;
+    under_.push_back({side.vertex, side.triangle, side.along, wornSide});
+    ++startUnder_.vertices;
+    if (std::abs(side.along) > startUnder_.deepest_m) {
+      startUnder_.deepest_m = std::abs(side.along);
+      startUnder_.deepestVertex = side.vertex;
     }
+  }
+}
+
+bool LayerCollider::belowWoundOneWay() const {
+  // Faces wound one way go along each edge they share in opposite directions: no directed
+  // edge twice.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+  edges.reserve(3 * (triangles_.size() - ownTriangles_));
+  for (std::size_t t = ownTriangles_; t < triangles_.size(); ++t)
+    for (int e = 0; e < 3; ++e) edges.emplace_back(triangles_[t][e], triangles_[t][(e + 1) % 3]);
+  std::sort(edges.begin(), edges.end());
+  return std::adjacent_find(edges.begin(), edges.end()) == edges.end();
+}
+
+std::size_t LayerCollider::liftOver(ClothState& state) {
+  lifted_ = {};
+  if (under_.empty() || !belowWoundOneWay()) return 0;
+  for (const Under& u : under_) {
+    const auto& c = triangles_[u.triangle];
+    const Vec3 n = unitNormal({at(lastX_, lastY_, lastZ_, c[0]), at(lastX_, lastY_, lastZ_, c[1]),
+                               at(lastX_, lastY_, lastZ_, c[2])});
+    const double move = u.wornSide * gap_ - u.along;  // to the gap on the side it is worn on
+    state.setPosition(u.vertex, state.position(u.vertex) + move * n);
+    state.setVelocity(u.vertex, Vec3::Zero());
+    lifted_.largest_m = std::max(lifted_.largest_m, std::abs(move));
+  }
+  lifted_.vertices = under_.size();
+  const StartUnder before = startUnder_;
+  initialise(state);
+  startUnder_ = before;  // what was modelled, for the log and stats
+  return lifted_.vertices;
 }
 
 bool LayerCollider::excluded(std::uint32_t vertex, std::uint32_t triangle) const {

@@ -185,7 +185,7 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
   // the body: where the two disagree, the body wins.
   for (std::size_t g = 0; g < garments.size(); ++g) {
     GarmentRun& run = garments_[g];
-    run.layers = makeLayerCollider(garments, g, below[g], run.fixed, [&](std::size_t i) -> const cloth::ClothSolver& {
+    run.layers = makeLayerCollider(garments, g, below[g], run.fixed, [&](std::size_t i) -> cloth::ClothSolver& {
       return *garments_[i].solver;
     }, 1.0 / settings_.step.frameRate_hz);
     if (run.layers) run.solver->addCollider(*run.layers);

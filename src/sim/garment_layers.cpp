@@ -36,17 +36,18 @@ std::vector<std::vector<std::size_t>> garmentsBelow(const std::vector<GarmentSpe
 
 std::unique_ptr<cloth::LayerCollider> makeLayerCollider(
     const std::vector<GarmentSpec>& garments, std::size_t g, std::span<const std::size_t> below,
-    const std::vector<std::uint32_t>& fixed, const std::function<const cloth::ClothSolver&(std::size_t)>& solver,
+    const std::vector<std::uint32_t>& fixed, const std::function<cloth::ClothSolver&(std::size_t)>& solver,
     double frame_s) {
   const GarmentSpec& spec = garments[g];
   if (!(spec.selfCollision_m > 0) && below.empty()) return nullptr;
-  const cloth::ClothSolver& own = solver(g);
+  cloth::ClothSolver& own = solver(g);
   auto layers = std::make_unique<cloth::LayerCollider>(own.model(), spec.name, spec.selfCollision_m, spec.collisionEvery);
   layers->setFixedVertices(fixed);
   layers->setStitches(spec.stitches);
   for (const std::size_t b : below)
     layers->addGarmentBelow(solver(b).model(), garments[b].name, solver(b).state(), spec.overGap_m, frame_s);
   layers->initialise(own.state());
+  layers->liftOver(own.mutableState());  // what was modelled under the garments below, out over them
   return layers;
 }
 

@@ -196,30 +196,48 @@ TEST(WornOver, WithoutACharacterASheetOverAPinnedOneRestsOneGapAboveIt) {
   EXPECT_LT(*std::max_element(fallen.begin(), fallen.end()), -0.1);
 }
 
-TEST(WornOver, AGarmentModelledPartlyUnderTheOneItIsWornOverSaysSoAndStaysThere) {
+TEST(WornOver, AGarmentModelledPartlyUnderTheOneItIsWornOverIsMovedOutOverIt) {
   // The cloth modelled 8 mm over the table but for its middle row, 4 mm under it.
   const ScratchDir dir("worn-over-under");
   const auto middleRowUnder = [](int point) { return point / 5 == 2 ? -0.004 : 0.008; };
-  { std::ofstream(dir / "under.wrl") << tableScene("over [ \"Table\" ]", middleRowUnder); }
+  const std::string scene = tableScene("over [ \"Table\" ]", middleRowUnder);
+  { std::ofstream(dir / "under.wrl") << scene; }
   const CliResult r = runDrape("run '" + (dir / "under.wrl") + "' --frames 24 --out '" + (dir / "under") + "'", dir);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find("Cloth: 5 of its 25 vertices over Table start under it, on the other side from the rest (the "
-                       "deepest, vertex 10, 4.0 mm): the layers keep the side each starts on, so those stay under. "
-                       "Model Cloth over Table, or check that the faces of Table are all wound one way"),
+  EXPECT_NE(r.err.find("Cloth: 5 of its 25 vertices over Table were modelled under it (the deepest, vertex 10, 4.0 "
+                       "mm): moved out over it, 4 mm above"),
             std::string::npos)
       << r.err;
-  EXPECT_EQ(statsOf(dir / "under")["garments"][1]["worn_over"]["vertices_starting_under"].get<long>(), 5);
-  // And so they do: the middle row under the table, the rest on it.
+  const nlohmann::json over = statsOf(dir / "under")["garments"][1]["worn_over"];
+  EXPECT_EQ(over["vertices_starting_under"].get<long>(), 5);
+  EXPECT_EQ(over["vertices_lifted_over"].get<long>(), 5);
+  // The whole cloth rests on the table, one gap above it.
   const std::vector<double> heights = heightsIn(dir / "under/frames/garment-Cloth_00024.obj");
   ASSERT_EQ(heights.size(), 25u);
+  for (int point = 0; point < 25; ++point) EXPECT_NEAR(heights[point], 0.004, 0.0004) << "point " << point;
+
+  // A table whose faces are not all wound one way cannot say which side is over: the row is
+  // left under it, which the run says, and there it stays.
+  std::string mixed = scene;
+  replaceOnce(mixed, "0 8 9 1 -1", "1 9 8 0 -1");
+  { std::ofstream(dir / "mixed.wrl") << mixed; }
+  const CliResult m = runDrape("run '" + (dir / "mixed.wrl") + "' --frames 24 --out '" + (dir / "mixed") + "'", dir);
+  ASSERT_EQ(m.code, 0) << m.err;
+  EXPECT_NE(m.err.find("Cloth: 5 of its 25 vertices over Table start under it, on the other side from the rest (the "
+                       "deepest, vertex 10, 4.0 mm), and the faces of Table are not all wound one way"),
+            std::string::npos)
+      << m.err;
+  EXPECT_EQ(statsOf(dir / "mixed")["garments"][1]["worn_over"]["vertices_lifted_over"].get<long>(), 0);
+  const std::vector<double> kept = heightsIn(dir / "mixed/frames/garment-Cloth_00024.obj");
+  ASSERT_EQ(kept.size(), 25u);
   for (int point = 0; point < 25; ++point)
-    EXPECT_EQ(heights[point] < 0, point / 5 == 2) << "point " << point << " at " << heights[point];
+    EXPECT_EQ(kept[point] < 0, point / 5 == 2) << "point " << point << " at " << kept[point];
 
   // Modelled over it, no word of it.
   { std::ofstream(dir / "over.wrl") << tableScene("over [ \"Table\" ]", [](int) { return 0.008; }); }
-  const CliResult over = runDrape("run '" + (dir / "over.wrl") + "' --frames 2 --out '" + (dir / "over") + "'", dir);
-  ASSERT_EQ(over.code, 0) << over.err;
-  EXPECT_EQ(over.err.find("start under"), std::string::npos) << over.err;
+  const CliResult clean = runDrape("run '" + (dir / "over.wrl") + "' --frames 2 --out '" + (dir / "over") + "'", dir);
+  ASSERT_EQ(clean.code, 0) << clean.err;
+  EXPECT_EQ(clean.err.find("modelled under"), std::string::npos) << clean.err;
   EXPECT_EQ(statsOf(dir / "over")["garments"][1]["worn_over"]["vertices_starting_under"].get<long>(), 0);
 }
 

@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <limits>
 #include <random>
 #include <set>
 #include <tuple>
@@ -44,6 +46,27 @@ mesh::TriMesh wavySheet(int cells, double y, double wave, double noise, unsigned
         Vec3(jitter(random), jitter(random), jitter(random));
   return m;
 }
+
+/// Heights above a sheet that lies along y: where a vertical line through p meets it.
+class SurfaceHeight {
+ public:
+  explicit SurfaceHeight(const mesh::TriMesh& sheet) : sheet_(sheet) {}
+  [[nodiscard]] double above(const Vec3& p) const {
+    for (const mesh::Triangle& t : sheet_.triangles) {
+      const Vec3 &a = sheet_.positions[t[0]], &b = sheet_.positions[t[1]], &c = sheet_.positions[t[2]];
+      // Barycentric weights in the xz plane.
+      const double det = (b.x() - a.x()) * (c.z() - a.z()) - (c.x() - a.x()) * (b.z() - a.z());
+      const double u = ((b.x() - p.x()) * (c.z() - p.z()) - (c.x() - p.x()) * (b.z() - p.z())) / det;
+      const double v = ((c.x() - p.x()) * (a.z() - p.z()) - (a.x() - p.x()) * (c.z() - p.z())) / det;
+      const double w = 1.0 - u - v;
+      if (u >= -1e-12 && v >= -1e-12 && w >= -1e-12) return p.y() - (u * a.y() + v * b.y() + w * c.y());
+    }
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+
+ private:
+  const mesh::TriMesh& sheet_;
+};
 
 struct Kinds {
   std::size_t overBelow = 0;  ///< its own vertex, a triangle below
@@ -278,6 +301,55 @@ TEST(GarmentBelow, SaysWhichVerticesStartUnderTheGarmentBelow) {
   for (const std::uint32_t v : pushed) sunk.positions[v].y() += 1.5 * gap;
   clean.initialise(stateAt(sunk.positions));
   EXPECT_EQ(clean.startUnder().vertices, pushed.size());
+}
+
+TEST(GarmentBelow, VerticesThatStartUnderItAreMovedOutOneGapOverIt) {
+  std::mt19937 random(19);
+  const double gap = 0.004;
+  const mesh::TriMesh below = wavySheet(12, 0.0, 0.02, 0.0, 5, random);
+  mesh::TriMesh over = below;
+  for (Vec3& p : over.positions) p.y() += 2 * gap;
+  const std::vector<std::uint32_t> pushed{20, 21, 60, 100};
+  for (const std::uint32_t v : pushed) over.positions[v].y() -= 3 * gap;
+  const auto overModel = makeModel(over, knit()), belowModel = makeModel(below, knit());
+  const ClothState belowState = stateAt(below.positions);
+  LayerCollider collider(*overModel, "over", 0.0);
+  collider.addGarmentBelow(*belowModel, "below", belowState, gap, kFrame_s);
+  ClothState state = stateAt(over.positions);
+  state.setVelocity(20, Vec3(0, -1, 0));
+  collider.initialise(state);
+  ASSERT_TRUE(collider.belowWoundOneWay());
+  EXPECT_EQ(collider.liftOver(state), pushed.size());
+  EXPECT_EQ(collider.startUnder().vertices, pushed.size());  // what was modelled
+  EXPECT_NEAR(collider.liftedOver().largest_m, 2 * gap, 0.5 * gap);
+  // Each moved one gap over the garment below, at rest; the others where they were.
+  const SurfaceHeight height(below);
+  for (std::uint32_t v = 0; v < over.positions.size(); ++v) {
+    const bool moved = std::find(pushed.begin(), pushed.end(), v) != pushed.end();
+    if (moved) {
+      EXPECT_NEAR(height.above(state.position(v)), gap, 0.1 * gap) << "vertex " << v;
+      EXPECT_EQ(state.velocity(v), Vec3::Zero()) << "vertex " << v;
+    } else {
+      EXPECT_EQ(state.position(v), over.positions[v]) << "vertex " << v;
+    }
+  }
+  // Found again from there: none under.
+  LayerCollider again(*overModel, "over", 0.0);
+  again.addGarmentBelow(*belowModel, "below", belowState, gap, kFrame_s);
+  again.initialise(state);
+  EXPECT_EQ(again.startUnder().vertices, 0u);
+
+  // A garment below with a face wound the other way: its sides cannot be told; nothing moves.
+  mesh::TriMesh mixed = below;
+  std::swap(mixed.triangles[30][0], mixed.triangles[30][1]);
+  const auto mixedModel = makeModel(mixed, knit());
+  LayerCollider unsure(*overModel, "over", 0.0);
+  unsure.addGarmentBelow(*mixedModel, "below", belowState, gap, kFrame_s);
+  ClothState untouched = stateAt(over.positions);
+  unsure.initialise(untouched);
+  EXPECT_FALSE(unsure.belowWoundOneWay());
+  EXPECT_EQ(unsure.liftOver(untouched), 0u);
+  for (std::uint32_t v = 0; v < over.positions.size(); ++v) EXPECT_EQ(untouched.position(v), over.positions[v]);
 }
 
 TEST(GarmentBelow, AGapMustBeAPositiveLength) {

@@ -105,6 +105,12 @@ struct StartUnder {
   double deepest_m = 0.0;  ///< its distance from the triangle it is under
 };
 
+/// The vertices liftOver moved out over the garments below.
+struct LiftedOver {
+  std::size_t vertices = 0;
+  double largest_m = 0.0;  ///< the largest move
+};
+
 class LayerCollider final : public Collider {
  public:
   /// Keeps `model`'s own layers `thickness_m` apart (0: they pass through each other; the
@@ -138,6 +144,14 @@ class LayerCollider final : public Collider {
 
   /// Its vertices that start under the garments below, as initialise() found them.
   [[nodiscard]] const StartUnder& startUnder() const { return startUnder_; }
+  /// Moves the vertices that start under the garments below (startUnder) out over them,
+  /// `gap` above the triangle each is under, with no velocity, and initialises again; but
+  /// not when the faces of the garments below are not all wound one way (their sides could
+  /// not be told). How many it moved. startUnder() keeps what was modelled.
+  std::size_t liftOver(ClothState& state);
+  [[nodiscard]] const LiftedOver& liftedOver() const { return lifted_; }
+  /// Whether the garments below go along each edge two of their faces share once each way.
+  [[nodiscard]] bool belowWoundOneWay() const;
   /// Its own layers' thickness (0: not kept apart).
   [[nodiscard]] double thickness_m() const { return thickness_; }
   /// How far above the garments below it keeps (0: none below).
@@ -215,6 +229,8 @@ class LayerCollider final : public Collider {
   void updatePairs(const ClothState& now);
   /// startUnder_ from the positions of the last test (initialise()'s).
   void findStartUnder();
+  /// The root of a vertex's connected piece of the garments below (itself for its own).
+  [[nodiscard]] std::uint32_t componentBelow(std::uint32_t vertex) const;
   /// The list mended for the points in moved_: anchored again and their pairs found again.
   void mendPairs(const ClothState& now, const Vec3& shiftNow, const Vec3& shiftLast);
   /// meets_[i] for i in [begin, end): whether box i of the columns boxLo, boxHi meets [lo, hi].
@@ -307,6 +323,15 @@ class LayerCollider final : public Collider {
   ColliderCounters counters_, frameStartCounters_;
   LayerCounters self_, frameStartSelf_;
   StartUnder startUnder_;
+  /// A vertex that starts under a garment below: the triangle, its distance along the
+  /// triangle's normal, and the side it is worn on.
+  struct Under {
+    std::uint32_t vertex, triangle;
+    double along, wornSide;
+  };
+  std::vector<Under> under_;
+  LiftedOver lifted_;
+  std::vector<std::uint32_t> componentBelow_;  ///< per point: its parent in the pieces below
 };
 
 }  // namespace drape::cloth

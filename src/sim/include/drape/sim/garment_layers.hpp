@@ -33,7 +33,7 @@ using scene::layersOf;
 /// states now; the caller adds it to g's solver before the body's collider.
 [[nodiscard]] std::unique_ptr<cloth::LayerCollider> makeLayerCollider(
     const std::vector<GarmentSpec>& garments, std::size_t g, std::span<const std::size_t> below,
-    const std::vector<std::uint32_t>& fixed, const std::function<const cloth::ClothSolver&(std::size_t)>& solver,
+    const std::vector<std::uint32_t>& fixed, const std::function<cloth::ClothSolver&(std::size_t)>& solver,
     double frame_s);
 
 }  // namespace drape::sim

@@ -125,8 +125,8 @@ inline std::string writeTestRun(const std::string& dir, long frames = 24) {
   manifest.frameRate = kRate;
   manifest.frames = frames;
   manifest.startFrame = 0;
-  manifest.meshes = {{"torso", "segment", "torso.obj", "torso.pc2", ""},
-                     {"flag", "garment", "flag.obj", "flag.pc2", "flag.states"}};
+  manifest.meshes = {{"torso", "segment", "torso.obj", "torso.pc2", "", "", std::nullopt},
+                     {"flag", "garment", "flag.obj", "flag.pc2", "flag.states", "", std::nullopt}};
   formats::writeRunManifest(dir, manifest);
   return dir;
 }

@@ -22,9 +22,9 @@ TEST(RunManifest, RoundTrips) {
   m.frameRate = 25;
   m.frames = 12;
   m.startFrame = 3;
-  m.meshes = {{"skirt", "garment", "skirt.obj", "skirt.pc2", "skirt.states"},
-              {"hips", "segment", "segments/hips.obj", "segments/hips.pc2", ""},
-              {"hips", "segment", "segments/Bea/hips.obj", "segments/Bea/hips.pc2", "", "Bea"}};
+  m.meshes = {{"skirt", "garment", "skirt.obj", "skirt.pc2", "skirt.states", "", std::nullopt},
+              {"hips", "segment", "segments/hips.obj", "segments/hips.pc2", "", "", std::nullopt},
+              {"hips", "segment", "segments/Bea/hips.obj", "segments/Bea/hips.pc2", "", "Bea", std::nullopt}};
   m.meshes[0].colour = Vec3(0.15, 0.25, 0.5);
   writeRunManifest(dir, m);
   const RunManifest r = readRunManifest(dir);

@@ -173,6 +173,7 @@ void LayerCollider::addGarmentBelow(const ClothModel& model, std::string name, c
   lastX_.insert(lastX_.end(), state.x.begin(), state.x.end());
   lastY_.insert(lastY_.end(), state.y.begin(), state.y.end());
   lastZ_.insert(lastZ_.end(), state.z.begin(), state.z.end());
+  belowNames_.push_back(b.name);
   below_.push_back(std::move(b));
   held_ = false;
   sizeForPoints();
@@ -186,12 +187,6 @@ void LayerCollider::addEdgeLengths(const ClothModel& model) {
                       .norm();
       ++edgeCount_;
     }
-}
-
-std::vector<std::string> LayerCollider::garmentsBelow() const {
-  std::vector<std::string> names;
-  for (const Below& b : below_) names.push_back(b.name);
-  return names;
 }
 
 void LayerCollider::sizeForPoints() {

@@ -157,7 +157,7 @@ class LayerCollider final : public Collider {
   /// How far above the garments below it keeps (0: none below).
   [[nodiscard]] double gap_m() const { return gap_; }
   /// The garments below, in the order given.
-  [[nodiscard]] std::vector<std::string> garmentsBelow() const;
+  [[nodiscard]] const std::vector<std::string>& garmentsBelow() const { return belowNames_; }
   [[nodiscard]] int every() const { return every_; }
   /// Vertices and triangles are numbered over its own and then each garment's below, in
   /// the order given (the states findContacts and nextContacts take).
@@ -280,6 +280,7 @@ class LayerCollider final : public Collider {
   double gap_ = 0.0;      ///< above the garments below
   double frame_s_ = 0.0;  ///< their frames' length
   std::vector<Below> below_;
+  std::vector<std::string> belowNames_;  ///< their names, in the order given
   long heldFrame_ = 0;    ///< the frame (numbered from 0 at time 0) the garments below are held for
   bool held_ = false;     ///< whether they are held for one yet
   ClothState work_;       ///< its own points and those below, for a test with garments below

@@ -408,9 +408,8 @@ std::size_t LayerCollider::liftOver(ClothState& state) {
     lifted_.largest_m = std::max(lifted_.largest_m, std::abs(move));
   }
   lifted_.vertices = under_.size();
-  const StartUnder before = startUnder_;
-  initialise(state);
-  startUnder_ = before;  // what was modelled, for the log and stats
+  under_.clear();      // over them now; startUnder_ keeps what was modelled, for the log and stats
+  remember(state);     // its own points start where they were moved to
   return lifted_.vertices;
 }
 

@@ -145,9 +145,10 @@ class LayerCollider final : public Collider {
   /// Its vertices that start under the garments below, as initialise() found them.
   [[nodiscard]] const StartUnder& startUnder() const { return startUnder_; }
   /// Moves the vertices that start under the garments below (startUnder) out over them,
-  /// `gap` above the triangle each is under, with no velocity, and initialises again; but
+  /// `gap` above the triangle each is under, with no velocity, and starts them there; but
   /// not when the faces of the garments below are not all wound one way (their sides could
-  /// not be told). How many it moved. startUnder() keeps what was modelled.
+  /// not be told). How many it moved. After initialise(); startUnder() keeps what was
+  /// modelled.
   std::size_t liftOver(ClothState& state);
   [[nodiscard]] const LiftedOver& liftedOver() const { return lifted_; }
   /// Whether the garments below go along each edge two of their faces share once each way.

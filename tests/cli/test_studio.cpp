@@ -68,6 +68,22 @@ void expectSameRun(const std::string& got, const std::string& want) {
 
 std::string roles(const NatsServer& server) { return " --server " + server.url() + " --give-up 120"; }
 
+/// One take through the studio on `server`: a cloth-server of `scene` for one take, the
+/// anim-server sending `motion` (its --motion or --events arguments) as fast as it can, and
+/// a player recording the take into dir/recorded. What each said, for the test to look at.
+struct StudioTake {
+  CliResult sent, served, recorded;
+};
+StudioTake takeThroughTheStudio(const ScratchDir& dir, const NatsServer& server, const std::string& scene,
+                                const std::string& motion) {
+  DrapeProcess cloth("cloth-server '" + scene + "' --takes 1" + roles(server), dir, "cloth");
+  StudioTake take;
+  take.sent = runDrape("anim-server '" + scene + "' " + motion + " --fast" + roles(server), dir);
+  take.served = cloth.wait();
+  take.recorded = runDrape("player '" + scene + "' --record '" + (dir / "recorded") + "'" + roles(server), dir);
+  return take;
+}
+
 TEST(Studio, ThePlayerRecordsWhatDrapeRunWritesThroughAKilledClothServerAndJunk) {
   ScratchDir dir("studio-roles");
   NatsServer server;
@@ -184,14 +200,11 @@ TEST(Studio, AGarmentWornOverAnotherIsSimulatedThroughTheStudioAsInDrapeRun) {
   NatsServer server;
   const std::string scene = std::string(DRAPE_SOURCE_DIR) + "/examples/layered_skirts/scene.wrl";
   const std::string reference = runInto(dir, "reference", "'" + scene + "' --motion '" + kWalk + "'");
-  DrapeProcess cloth("cloth-server '" + scene + "' --takes 1" + roles(server), dir, "cloth");
-  const CliResult sent = runDrape("anim-server '" + scene + "' --motion '" + kWalk + "' --fast" + roles(server), dir);
-  ASSERT_EQ(sent.code, 0) << sent.err;
-  const CliResult simulated = cloth.wait();
-  ASSERT_EQ(simulated.code, 0) << simulated.err;
-  EXPECT_NE(simulated.err.find("Skirt: kept 4 mm over Petticoat"), std::string::npos) << simulated.err;
-  const CliResult recorded = runDrape("player '" + scene + "' --record '" + (dir / "recorded") + "'" + roles(server), dir);
-  ASSERT_EQ(recorded.code, 0) << recorded.err;
+  const StudioTake take = takeThroughTheStudio(dir, server, scene, "--motion '" + kWalk + "'");
+  ASSERT_EQ(take.sent.code, 0) << take.sent.err;
+  ASSERT_EQ(take.served.code, 0) << take.served.err;
+  EXPECT_NE(take.served.err.find("Skirt: kept 4 mm over Petticoat"), std::string::npos) << take.served.err;
+  ASSERT_EQ(take.recorded.code, 0) << take.recorded.err;
   expectSameRun(dir / "recorded", reference);
   EXPECT_GT(statsOf(dir / "recorded")["garments"][1]["worn_over"]["contacts"].get<long>(), 1000);
 }
@@ -355,14 +368,12 @@ TEST(Studio, AnUnstableTakeIsRecordedUpToItsLastGoodFrame) {
     text.replace(text.find(from), from.size(), to);
   const std::string scene = dir / "unstable.wrl";
   std::ofstream(scene) << text;
-  DrapeProcess cloth("cloth-server '" + scene + "' --takes 1" + roles(server), dir, "cloth");
-  ASSERT_EQ(runDrape("anim-server '" + scene + "' --motion '" + kWalk + "' --fast" + roles(server), dir).code, 0);
-  const CliResult served = cloth.wait();
-  EXPECT_EQ(served.code, 3) << served.err;
-  const CliResult recorded = runDrape("player '" + scene + "' --record '" + (dir / "recorded") + "'" + roles(server), dir);
-  EXPECT_EQ(recorded.code, 3) << recorded.err;
-  EXPECT_NE(recorded.err.find("garment 'Skirt': vertex"), std::string::npos) << recorded.err;
-  EXPECT_NE(recorded.err.find("the 2 frames before it recorded in"), std::string::npos) << recorded.err;
+  const StudioTake take = takeThroughTheStudio(dir, server, scene, "--motion '" + kWalk + "'");
+  ASSERT_EQ(take.sent.code, 0) << take.sent.err;
+  EXPECT_EQ(take.served.code, 3) << take.served.err;
+  EXPECT_EQ(take.recorded.code, 3) << take.recorded.err;
+  EXPECT_NE(take.recorded.err.find("garment 'Skirt': vertex"), std::string::npos) << take.recorded.err;
+  EXPECT_NE(take.recorded.err.find("the 2 frames before it recorded in"), std::string::npos) << take.recorded.err;
   EXPECT_EQ(formats::readPc2(dir / "recorded/garment.pc2").frames.size(), 2u);
   EXPECT_TRUE(statsOf(dir / "recorded")["unstable"].get<bool>());
 }
@@ -521,13 +532,11 @@ TEST(Studio, AnEventGraphThroughTheStudioIsDrapeRunsToTheByte) {
   NatsServer server;
   const std::string day = std::string(DRAPE_SOURCE_DIR) + "/examples/event_graph/day.egml";
   const std::string reference = runInto(dir, "reference", "'" + kScene + "' --events '" + day + "'");
-  DrapeProcess cloth("cloth-server '" + kScene + "' --takes 1" + roles(server), dir, "cloth");
-  const CliResult sent = runDrape("anim-server '" + kScene + "' --events '" + day + "' --fast" + roles(server), dir);
-  ASSERT_EQ(sent.code, 0) << sent.err;
-  EXPECT_NE(sent.out.find("223 pose frames"), std::string::npos) << sent.out;
-  ASSERT_EQ(cloth.wait().code, 0);
-  const CliResult recorded = runDrape("player '" + kScene + "' --record '" + (dir / "recorded") + "'" + roles(server), dir);
-  ASSERT_EQ(recorded.code, 0) << recorded.err;
+  const StudioTake take = takeThroughTheStudio(dir, server, kScene, "--events '" + day + "'");
+  ASSERT_EQ(take.sent.code, 0) << take.sent.err;
+  EXPECT_NE(take.sent.out.find("223 pose frames"), std::string::npos) << take.sent.out;
+  ASSERT_EQ(take.served.code, 0) << take.served.err;
+  ASSERT_EQ(take.recorded.code, 0) << take.recorded.err;
   for (const char* file : {"garment.pc2", "garment.states", "body.pc2", "segments/Hips.pc2"})
     EXPECT_TRUE(slurp(dir / ("recorded/" + std::string(file))) == slurp(reference + "/" + file)) << file;
 }
@@ -558,17 +567,16 @@ TEST(Studio, AMotionKeptApartIsCorrectedAsItComesAsDrapeRunCorrectsItWhole) {
   const std::string reference = runInto(dir, "reference", "'" + scene + "' --events '" + day + "'");
   const nlohmann::json kept = statsOf(reference)["keep_apart"];
   ASSERT_GT(kept.value("frames_changed", 0), 0) << kept.dump();
-  DrapeProcess cloth("cloth-server '" + scene + "' --takes 1" + roles(server), dir, "cloth");
-  const CliResult sent = runDrape("anim-server '" + scene + "' --events '" + day + "' --fast" + roles(server), dir);
+  const StudioTake take = takeThroughTheStudio(dir, server, scene, "--events '" + day + "'");
+  const CliResult& sent = take.sent;
   ASSERT_EQ(sent.code, 0) << sent.err;
   EXPECT_NE(sent.out.find("223 pose frames"), std::string::npos) << sent.out;
   EXPECT_NE(sent.err.find("each frame corrected 15 frames (0.50 s) after it comes"), std::string::npos) << sent.err;
   EXPECT_NE(sent.err.find(fmt::format("the motion corrected in {} frames", kept["frames_changed"].get<long>())),
             std::string::npos)
       << sent.err;
-  ASSERT_EQ(cloth.wait().code, 0);
-  const CliResult recorded = runDrape("player '" + scene + "' --record '" + (dir / "recorded") + "'" + roles(server), dir);
-  ASSERT_EQ(recorded.code, 0) << recorded.err;
+  ASSERT_EQ(take.served.code, 0) << take.served.err;
+  ASSERT_EQ(take.recorded.code, 0) << take.recorded.err;
   for (const char* file : {"garment.pc2", "body.pc2", "segments/LeftForeArm.pc2", "segments/RightForeArm.pc2"})
     EXPECT_TRUE(slurp(dir / ("recorded/" + std::string(file))) == slurp(reference + "/" + file)) << file;
 

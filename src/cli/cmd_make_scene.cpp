@@ -3,6 +3,7 @@
 // a MakeHuman garment on the MakeHuman body. The garment and its constraint mask are written
 // inline in metres; the collidable segments are those the garment lies near at rest; the
 // substeps per frame are the fewest that mass scaling keeps stable within --max-added-mass.
+// `--add-to SCENE` puts one more garment on a character of a scene already written.
 
 #include <algorithm>
 #include <cmath>
@@ -10,6 +11,8 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <sstream>
+#include <utility>
 
 #include <fmt/format.h>
 #include <fmt/ostream.h>
@@ -26,6 +29,7 @@
 #include "drape/scene/avatar_segment.hpp"
 #include "drape/scene/garment_fit.hpp"
 #include "run_setup.hpp"
+#include "scene_add.hpp"
 #include "scene_text.hpp"
 #include "stitch_gaps.hpp"
 
@@ -41,6 +45,11 @@ struct MakeSceneOptions {
   std::string out;
   std::string name;
   std::string title;
+  std::string addTo;      ///< --add-to: the scene the garment is added to
+  std::string character;  ///< --character: who wears it there
+  std::vector<std::string> over;  ///< --over: the garments it is worn over
+  double overGap_m = 0.004;
+  std::vector<double> colour;  ///< --colour (empty: blue, or one the scene's garments do not have)
   std::vector<std::string> collidesWith;
   std::vector<std::string> faceSamplesWith;
   std::vector<std::string> keepApart;  ///< --keep-apart: the scene's Simulation keepApart
@@ -121,6 +130,23 @@ mesh::TriMesh fitMask(const mesh::TriMesh& mask, const scene::MakeHumanGarment& 
   return fitted;
 }
 
+/// The garment's ClothSet, without its material and avatar.
+ClothSetText clothSetOf(const MakeSceneOptions& o, const mesh::TriMesh& garment, const mesh::TriMesh& mask) {
+  ClothSetText c;
+  c.name = o.name;
+  if (!o.colour.empty()) c.colour = Vec3(o.colour[0], o.colour[1], o.colour[2]);
+  c.cloth = &garment;
+  c.mask = &mask;
+  c.collidesWith = o.collidesWith;
+  c.faceSamplesWith = o.faceSamplesWith;
+  c.stitches = o.stitches;
+  c.selfCollision_m = o.selfCollision_m;
+  c.over = o.over;
+  c.overGap_m = o.overGap_m;
+  c.bindThreshold_m = o.bindThreshold_m;
+  return c;
+}
+
 void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::TriMesh& garment,
                 const mesh::TriMesh& mask) {
   std::ofstream os(path);
@@ -143,61 +169,52 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
   writeMaterial(os, o.material);
   fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n{}}}\n\n", o.avatarUrl,
              o.cutAtJoints.empty() ? "" : fmt::format("  cutAtJoints [ \"{}\" ]\n", fmt::join(o.cutAtJoints, "\", \"")));
-  fmt::print(os,
-             "DEF Garment ClothSet {{\n  name \"{}\"\n  cloth Shape {{\n"
-             "    appearance Appearance {{ material Material {{ diffuseColor 0.15 0.25 0.55 }} }}\n"
-             "    geometry IndexedFaceSet {{\n      solid FALSE\n",
-             o.name);
-  writeIndexedFaceSet(os, garment, "      ");
-  fmt::print(os, "    }}\n  }}\n  constraintMask IndexedFaceSet {{\n");
-  writeIndexedFaceSet(os, mask, "    ");
-  fmt::print(os, "  }}\n  material USE Knit\n  avatar USE Body\n");
-  fmt::print(os, "  collidesWith [ \"{}\" ]\n", fmt::join(o.collidesWith, "\", \""));
-  if (!o.faceSamplesWith.empty())
-    fmt::print(os, "  faceSamplesWith [ \"{}\" ]\n", fmt::join(o.faceSamplesWith, "\", \""));
-  if (!o.stitches.empty()) {
-    fmt::print(os, "  stitches [");
-    for (std::size_t i = 0; i < o.stitches.size(); ++i)
-      fmt::print(os, "{}{} {}{}", i % 8 == 0 ? "\n    " : " ", o.stitches[i][0], o.stitches[i][1],
-                 i + 1 < o.stitches.size() ? "," : "");
-    fmt::print(os, "\n  ]\n");
-  }
-  if (o.selfCollision_m > 0) fmt::print(os, "  selfCollision {:g}\n", o.selfCollision_m);
-  fmt::print(os, "  maskTolerance 0.0005\n  bindThreshold {:.3f}\n}}\n", o.bindThreshold_m);
+  ClothSetText c = clothSetOf(o, garment, mask);
+  c.def = "Garment";
+  c.colour = o.colour.empty() ? Vec3(0.15, 0.25, 0.55) : c.colour;
+  writeClothSet(os, c);
   if (!os) throw Error(fmt::format("{}: cannot be written", path));
+}
+
+/// The garment and its mask as modelled on the avatar file `avatarFile` at rest, in metres:
+/// a MakeHuman .mhclo refitted to the MakeHuman body that file builds.
+std::pair<mesh::TriMesh, mesh::TriMesh> readGarment(const MakeSceneOptions& o, const std::string& avatarFile) {
+  formats::ObjReadOptions read;
+  read.metresPerUnit = formats::metresPerUnit(o.units, "--units");
+  mesh::TriMesh mask = formats::readObj(o.mask, read);
+  if (std::filesystem::path(o.garment).extension() != ".mhclo") return {formats::readObj(o.garment, read), mask};
+  // A MakeHuman garment: refitted to the body this avatar is built from.
+  if (std::filesystem::path(avatarFile).extension() != ".mhskel")
+    throw Error(fmt::format("{}: a MakeHuman garment (.mhclo) fits the MakeHuman body; give a .mhskel avatar, not {}",
+                            o.garment, avatarFile.empty() ? "an H-Anim Humanoid" : avatarFile));
+  const scene::MakeHumanGarment fit = scene::fitMakeHumanGarment(o.garment, avatarFile);
+  return {fit.fitted, fitMask(mask, fit, o.mask)};
+}
+
+/// The collidable segments (the ones near the garment unless given) and those with face
+/// samples, checked against the avatar's; `whose` names the avatar in messages.
+void chooseCollidables(MakeSceneOptions& o, const scene::Avatar& avatar, const mesh::TriMesh& garment,
+                       const std::string& whose) {
+  if (o.collidesWith.empty()) o.collidesWith = segmentsNear(avatar, garment, o.reach_m);
+  for (const std::string& s : o.collidesWith)
+    if (avatar.findSegment(s) < 0) throw Error(fmt::format("--collides-with: {} has no segment '{}'", whose, s));
+  if (o.collidesWith.empty())
+    throw Error(fmt::format("{}: the garment is not within {} m of any segment of {}; is --units right?", o.garment,
+                            o.reach_m, whose));
+  for (const std::string& s : o.faceSamplesWith)
+    if (std::find(o.collidesWith.begin(), o.collidesWith.end(), s) == o.collidesWith.end())
+      throw Error(fmt::format("--face-samples-with: '{}' is not one of the collidable segments ({})", s,
+                              fmt::join(o.collidesWith, ", ")));
 }
 
 int makeScene(MakeSceneOptions& o) {
   scene::Avatar avatar = scene::loadAvatarFile(o.avatar);
   // The parts as the scene will cut them: which are within reach of the garment may change.
   if (!o.cutAtJoints.empty()) scene::segmentSkinnedAvatar(avatar, o.cutAtJoints);
-  formats::ObjReadOptions read;
-  read.metresPerUnit = formats::metresPerUnit(o.units, "--units");
-  mesh::TriMesh garment, mask = formats::readObj(o.mask, read);
-  if (std::filesystem::path(o.garment).extension() == ".mhclo") {
-    // A MakeHuman garment: refitted to the body this avatar is built from.
-    if (std::filesystem::path(o.avatar).extension() != ".mhskel")
-      throw Error(fmt::format("{}: a MakeHuman garment (.mhclo) fits the MakeHuman body; give a .mhskel avatar, "
-                              "not {}", o.garment, o.avatar));
-    const scene::MakeHumanGarment fit = scene::fitMakeHumanGarment(o.garment, o.avatar);
-    garment = fit.fitted;
-    mask = fitMask(mask, fit, o.mask);
-  } else {
-    garment = formats::readObj(o.garment, read);
-  }
+  const auto [garment, mask] = readGarment(o, o.avatar);
   if (o.name.empty()) o.name = std::filesystem::path(o.garment).stem().string();
   if (o.title.empty()) o.title = o.name;
-  if (o.collidesWith.empty()) o.collidesWith = segmentsNear(avatar, garment, o.reach_m);
-  for (const std::string& s : o.collidesWith)
-    if (avatar.findSegment(s) < 0)
-      throw Error(fmt::format("--collides-with: {} has no segment '{}'", o.avatar, s));
-  if (o.collidesWith.empty())
-    throw Error(fmt::format("{}: the garment is not within {} m of any segment of {}; is --units right?", o.garment,
-                            o.reach_m, o.avatar));
-  for (const std::string& s : o.faceSamplesWith)
-    if (std::find(o.collidesWith.begin(), o.collidesWith.end(), s) == o.collidesWith.end())
-      throw Error(fmt::format("--face-samples-with: '{}' is not one of the collidable segments ({})", s,
-                              fmt::join(o.collidesWith, ", ")));
+  chooseCollidables(o, avatar, garment, o.avatar);
   for (const std::string& s : o.keepApart)
     if (avatar.findSegment(s) < 0) throw Error(fmt::format("--keep-apart: {} has no segment '{}'", o.avatar, s));
   // The fewest substeps per frame, at least the paper's 33, that mass scaling keeps stable
@@ -244,21 +261,87 @@ int makeScene(MakeSceneOptions& o) {
   if (!o.stitches.empty())
     fmt::print("{} stitches across gaps of up to {:.1f} mm\n", o.stitches.size(), 1e3 * widestStitch_m(garment, o.stitches));
   fmt::print("wrote {}/scene.wrl, {}.obj, {}_mask.obj\n", o.out, o.name, o.name);
-  printHowToRun(o.out, avatar);
+  printHowToRun((dir / "scene.wrl").string(), avatar);
+  return 0;
+}
+
+/// --add-to: the garment put on the scene's character where the scene places it, and appended.
+int addGarment(MakeSceneOptions& o) {
+  const SceneToDress dress = openSceneToDress(o.addTo, o.character);
+  const scene::Avatar& avatar = *dress.character.avatar;
+  auto [garment, mask] = readGarment(o, dress.avatarFile);
+  // Modelled on the avatar file at rest; the scene places that file's frame.
+  for (mesh::TriMesh* m : {&garment, &mask})
+    for (Vec3& p : m->positions) p = dress.placement.apply(dress.scale * p);
+  if (o.name.empty()) o.name = std::filesystem::path(o.garment).stem().string();
+  const std::string whose = fmt::format("{} ('{}')", o.addTo, dress.character.name);
+  checkNewGarment(dress, o.name, o.over);
+  chooseCollidables(o, avatar, garment, whose);
+  const double added = checkSceneSteps(dress, garment, o.material, o.name);
+  if (o.stitchGaps_m > 0.0) o.stitches = openingsToSew(garment, mesh::Topology::build(garment), o.name, o.stitchGaps_m);
+
+  const mesh::TriMesh cloth = inFileUnits(dress, garment), clothMask = inFileUnits(dress, mask);
+  ClothSetText c = clothSetOf(o, cloth, clothMask);
+  if (o.colour.empty()) c.colour = unusedColour(dress.scene);
+  if (!o.offsets.empty()) c.offsets = std::array<double, 4>{o.offsets[0], o.offsets[1], o.offsets[2], o.offsets[3]};
+  c.material = materialNode(o.material, "  ");
+  c.avatar = dress.avatarDef;
+  std::ostringstream text;
+  fmt::print(text, "# {}: added by `drape make-scene --add-to`, worn by {}{}.\n", o.name, dress.character.name,
+             o.over.empty() ? "" : fmt::format(" over {}", fmt::join(o.over, ", ")));
+  writeClothSet(text, c);
+  appendToScene(dress, text.str());
+
+  const std::filesystem::path dir = std::filesystem::path(o.addTo).parent_path();
+  formats::writeObj((dir / (o.name + ".obj")).string(), garment.positions, garment.triangles,
+                    "drape make-scene: " + o.name + " (m, world)");
+  formats::writeObj((dir / (o.name + "_mask.obj")).string(), mask.positions, mask.triangles,
+                    "drape make-scene: constraint mask of " + o.name + " (m, world)");
+  fmt::print("{}: {} vertices, {} triangles; mask {} vertices; worn by {}{}\n", o.name, garment.vertexCount(),
+             garment.triangleCount(), mask.vertexCount(), dress.character.name,
+             o.over.empty() ? "" : fmt::format(" over {}, {:g} m above", fmt::join(o.over, ", "), o.overGap_m));
+  fmt::print("collides with {}\n", fmt::join(o.collidesWith, ", "));
+  fmt::print("the scene's {} substeps per frame keep it stable{}\n", dress.scene.simulation.stepsPerFrame,
+             added > 0.0 ? fmt::format(" (mass scaling adds {:.2f} % of its mass)", 100.0 * added) : "");
+  if (!o.stitches.empty())
+    fmt::print("{} stitches across gaps of up to {:.1f} mm\n", o.stitches.size(), 1e3 * widestStitch_m(garment, o.stitches));
+  fmt::print("added it to {}; wrote {}.obj, {}_mask.obj beside it\n", o.addTo, o.name, o.name);
+  printHowToRun(o.addTo, avatar, dress.character.motion);
   return 0;
 }
 
 RunFunction setupMakeScene(CLI::App& app) {
   static MakeSceneOptions o;
-  app.add_option("avatar", o.avatar, "Avatar file the garment was modelled on (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel)")
-      ->required();
+  app.add_option("avatar", o.avatar,
+                 "Avatar file the garment was modelled on (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel); not with "
+                 "--add-to");
   app.add_option("--garment", o.garment,
                  "Garment OBJ in the avatar's rest pose, or a MakeHuman .mhclo (refitted to the MakeHuman body)")
       ->required();
   app.add_option("--mask", o.mask,
                  "Constraint mask OBJ: the garment vertices bound to the body (for a .mhclo: on its OBJ as modelled)")
       ->required();
-  app.add_option("--out", o.out, "Directory for scene.wrl")->required();
+  app.add_option("--out", o.out, "Directory for scene.wrl (required without --add-to)");
+  app.add_option("--add-to", o.addTo,
+                 "Add the garment to this scene instead, on its character (a jacket over the shirt it wears): "
+                 "modelled on the file its Avatar node loads, placed as the node places it, and appended to the "
+                 "scene as a ClothSet once the scene with it loads; NAME.obj and NAME_mask.obj are written beside "
+                 "it. --offsets become the garment's own");
+  app.add_option("--character", o.character,
+                 "With --add-to: the character who wears it (its Avatar or Humanoid node's name; default: the "
+                 "scene's only one)");
+  app.add_option("--over", o.over,
+                 "With --add-to: the character's garments it is worn over, written as its over (kept --over-gap "
+                 "above them; docs/PHYSICS.md)")
+      ->delimiter(',');
+  app.add_option("--over-gap", o.overGap_m, "With --over: how far above them it keeps, m, written as its overGap")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--colour", o.colour,
+                 "Its colour, R,G,B from 0 to 1 (default: blue; with --add-to, a colour no garment of the scene has)")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--units", o.units, "Length unit of both OBJ files: m, dm, cm, mm, in")->capture_default_str();
   app.add_option("--name", o.name, "Garment name (default: the OBJ's file name)");
   app.add_option("--title", o.title, "Scene title (default: the garment name)");
@@ -312,13 +395,29 @@ RunFunction setupMakeScene(CLI::App& app) {
                  "this many m (a jacket's fronts) become the ClothSet's stitches, drawn together in the simulation "
                  "(0: none)")
       ->capture_default_str();
-  return [] {
+  return [&app] {
     o.material.validate("--");
     if (!(o.voxel_m > 0.0)) throw Error(fmt::format("--voxel must be > 0 m, got {}", o.voxel_m));
     if (!(o.frameRate > 0.0)) throw Error(fmt::format("--frame-rate must be > 0, got {}", o.frameRate));
     if (o.stepsPerFrame < 0) throw Error(fmt::format("--substeps must be >= 1, got {}", o.stepsPerFrame));
     if (!(o.stitchGaps_m >= 0.0)) throw Error(fmt::format("--stitch-gaps must be >= 0 m, got {}", o.stitchGaps_m));
-    return makeScene(o);
+    if (o.addTo.empty()) {
+      if (o.avatar.empty()) throw Error("make-scene: give the avatar the garment was modelled on, or --add-to SCENE");
+      if (o.out.empty()) throw Error("make-scene: --out DIR is required (or --add-to SCENE)");
+      for (const char* option : {"--character", "--over", "--over-gap"})
+        if (app.count(option) > 0) throw Error(fmt::format("{} goes with --add-to SCENE", option));
+      return makeScene(o);
+    }
+    if (!o.avatar.empty())
+      throw Error(fmt::format("make-scene --add-to {}: the garment goes on the scene's character; give no avatar ({})",
+                              o.addTo, o.avatar));
+    for (const char* option : {"--out", "--avatar-url", "--title", "--voxel", "--frame-rate", "--substeps",
+                               "--bend-every", "--collision-every", "--max-added-mass", "--keep-apart",
+                               "--cut-at-joints"})
+      if (app.count(option) > 0)
+        throw Error(fmt::format("{} does not go with --add-to: it is the scene's own setting (edit {} for it)", option,
+                                o.addTo));
+    return addGarment(o);
   };
 }
 

@@ -1,10 +1,13 @@
 // `drape make-skirt AVATAR --out DIR`: a skirt fitted to an avatar's hips at rest, with its
 // waistband constraint mask, written as a ready-to-run VRML97 scene (DIR/scene.wrl) and as
-// OBJ meshes (DIR/skirt.obj, DIR/waistband.obj).
+// OBJ meshes (DIR/skirt.obj, DIR/waistband.obj). `drape make-skirt --add-to SCENE`: one more
+// skirt for a character of that scene (over a petticoat it wears), appended to it.
 
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <utility>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -12,6 +15,7 @@
 
 #include "command.hpp"
 #include "run_setup.hpp"
+#include "scene_add.hpp"
 #include "scene_text.hpp"
 #include "drape/cloth/model.hpp"
 #include "drape/core/error.hpp"
@@ -27,6 +31,12 @@ struct MakeSkirtOptions {
   std::string avatar;
   std::string avatarUrl;
   std::string out;
+  std::string addTo;      ///< --add-to: the scene the skirt is added to
+  std::string character;  ///< --character: who wears it there
+  std::string name;       ///< --name: the ClothSet's name ("" : Skirt)
+  std::vector<std::string> over;  ///< --over: the garments it is worn over
+  double overGap_m = 0.004;
+  std::vector<double> colour;  ///< --colour: its diffuse colour (empty: red, or one the scene's garments do not have)
   scene::SkirtFit fit;
   double bindThreshold_m = 0.04;
 };
@@ -43,6 +53,21 @@ cloth::Material knit() {
   m.dynamicFriction = 0.3;
   m.compressionScale = 0.2;
   return m;
+}
+
+/// The skirt's ClothSet, without its material and avatar.
+ClothSetText clothSetOf(const MakeSkirtOptions& o, const mesh::TriMesh& cloth, const mesh::TriMesh& mask) {
+  ClothSetText c;
+  c.cloth = &cloth;
+  c.mask = &mask;
+  c.collidesWith.push_back(o.fit.waistSegment);
+  c.collidesWith.insert(c.collidesWith.end(), o.fit.hipSegments.begin(), o.fit.hipSegments.end());
+  c.collidesWith.insert(c.collidesWith.end(), o.fit.legSegments.begin(), o.fit.legSegments.end());
+  c.over = o.over;
+  c.overGap_m = o.overGap_m;
+  if (!o.colour.empty()) c.colour = Vec3(o.colour[0], o.colour[1], o.colour[2]);
+  c.bindThreshold_m = o.bindThreshold_m;
+  return c;
 }
 
 /// Writes the scene; returns its substeps per frame.
@@ -69,26 +94,21 @@ int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::S
              kFrameRate, kSubsteps, bendEvery);
   writeMaterial(os, m);
   fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n}}\n\n", o.avatarUrl);
-  fmt::print(os, "DEF Skirt ClothSet {{\n  cloth Shape {{\n    appearance Appearance {{ material Material {{ diffuseColor 0.7 0.15 0.2 }} }}\n"
-                 "    geometry DEF SkirtMesh IndexedFaceSet {{\n      solid FALSE\n");
-  writeIndexedFaceSet(os, skirt.mesh, "      ");
-  fmt::print(os, "    }}\n  }}\n  constraintMask IndexedFaceSet {{\n");
-  writeIndexedFaceSet(os, skirt.waistband, "    ");
-  fmt::print(os, "  }}\n  material USE Knit\n  avatar USE Body\n");
-  fmt::print(os, "  collidesWith [ \"{}\"", o.fit.waistSegment);
-  for (const std::string& s : o.fit.hipSegments) fmt::print(os, ", \"{}\"", s);
-  for (const std::string& s : o.fit.legSegments) fmt::print(os, ", \"{}\"", s);
-  fmt::print(os, " ]\n  maskTolerance 0.0005\n  bindThreshold {:.3f}\n}}\n", o.bindThreshold_m);
+  ClothSetText c = clothSetOf(o, skirt.mesh, skirt.waistband);
+  c.def = "Skirt";
+  c.name = o.name == "Skirt" ? "" : o.name;
+  c.meshDef = "SkirtMesh";
+  writeClothSet(os, c);
   if (!os) throw Error(fmt::format("{}: cannot be written", path));
   return kSubsteps;
 }
 
 /// Every segment the fit and the scene name must be the avatar's: the defaults are the
 /// MakeHuman CMU rig's, and another rig's avatar names its own.
-void checkSegments(const scene::Avatar& avatar, const MakeSkirtOptions& o) {
+void checkSegments(const scene::Avatar& avatar, const MakeSkirtOptions& o, const std::string& whose) {
   const auto check = [&](const std::string& name, const char* option) {
     if (avatar.findSegment(name) >= 0) return;
-    throw Error(fmt::format("{}: the avatar has no segment '{}'; name one of its own with {} (it has: {})", o.avatar,
+    throw Error(fmt::format("{}: the avatar has no segment '{}'; name one of its own with {} (it has: {})", whose,
                             name, option, fmt::join(avatar.segmentNames(), ", ")));
   };
   check(o.fit.waistSegment, "--waist-segment");
@@ -96,10 +116,100 @@ void checkSegments(const scene::Avatar& avatar, const MakeSkirtOptions& o) {
   for (const std::string& name : o.fit.legSegments) check(name, "--leg-segments");
 }
 
+/// The OBJ files' stems: skirt and waistband for the default name, else NAME and NAME_waistband.
+std::pair<std::string, std::string> objStems(const std::string& name) {
+  if (name == "Skirt") return {"skirt", "waistband"};
+  return {name, name + "_waistband"};
+}
+
+void printSkirt(const std::string& name, const mesh::Skirt& skirt) {
+  const Aabb box = skirt.mesh.bounds();
+  fmt::print("{}: {} vertices, {} triangles, waist at y = {:.3f} m, hem at y = {:.3f} m", name,
+             skirt.mesh.vertexCount(), skirt.mesh.triangleCount(), box.max.y(), box.min.y());
+}
+
+int makeSkirt(const MakeSkirtOptions& o) {
+  const scene::Avatar avatar = scene::loadAvatarFile(o.avatar);
+  checkSegments(avatar, o, o.avatar);
+  const mesh::Skirt skirt = scene::fitSkirt(avatar, o.fit);
+  MakeSkirtOptions written = o;
+  written.avatarUrl = prepareSceneDir(o.out, o.avatar, o.avatarUrl);
+  const std::filesystem::path dir(o.out);
+  const auto [stem, maskStem] = objStems(o.name);
+  formats::writeObj((dir / (stem + ".obj")).string(), skirt.mesh.positions, skirt.mesh.triangles, "drape make-skirt (m)");
+  formats::writeObj((dir / (maskStem + ".obj")).string(), skirt.waistband.positions, skirt.waistband.triangles,
+                    "drape make-skirt: constraint mask (m)");
+  const int substeps = writeScene((dir / "scene.wrl").string(), written, skirt);
+  printSkirt(o.name == "Skirt" ? "skirt" : o.name, skirt);
+  fmt::print("; {} substeps per frame\n", substeps);
+  fmt::print("wrote {}/scene.wrl, {}.obj, {}.obj\n", o.out, stem, maskStem);
+  printHowToRun((dir / "scene.wrl").string(), avatar);
+  return 0;
+}
+
+/// --add-to: the skirt fitted to the scene's character as the scene places it, and appended.
+int addSkirt(const MakeSkirtOptions& o) {
+  const SceneToDress dress = openSceneToDress(o.addTo, o.character);
+  const scene::Avatar& avatar = *dress.character.avatar;
+  checkSegments(avatar, o, fmt::format("{} ('{}')", o.addTo, dress.character.name));
+  checkNewGarment(dress, o.name, o.over);
+  const mesh::Skirt skirt = scene::fitSkirt(avatar, o.fit);
+  const double added = checkSceneSteps(dress, skirt.mesh, knit(), o.name);
+
+  const mesh::TriMesh cloth = inFileUnits(dress, skirt.mesh), mask = inFileUnits(dress, skirt.waistband);
+  ClothSetText c = clothSetOf(o, cloth, mask);
+  c.name = o.name;
+  if (o.colour.empty()) c.colour = unusedColour(dress.scene);
+  c.material = materialNode(knit(), "  ");
+  c.avatar = dress.avatarDef;
+  std::ostringstream text;
+  fmt::print(text, "# {}: added by `drape make-skirt --add-to`, worn by {}{}.\n", o.name, dress.character.name,
+             o.over.empty() ? "" : fmt::format(" over {}", fmt::join(o.over, ", ")));
+  writeClothSet(text, c);
+  appendToScene(dress, text.str());
+
+  const std::filesystem::path dir = std::filesystem::path(o.addTo).parent_path();
+  const auto [stem, maskStem] = objStems(o.name);
+  formats::writeObj((dir / (stem + ".obj")).string(), skirt.mesh.positions, skirt.mesh.triangles,
+                    "drape make-skirt: " + o.name + " (m, world)");
+  formats::writeObj((dir / (maskStem + ".obj")).string(), skirt.waistband.positions, skirt.waistband.triangles,
+                    "drape make-skirt: constraint mask of " + o.name + " (m, world)");
+  printSkirt(o.name, skirt);
+  fmt::print("; worn by {}{}\n", dress.character.name,
+             o.over.empty() ? "" : fmt::format(" over {}, {:g} m above", fmt::join(o.over, ", "), o.overGap_m));
+  fmt::print("the scene's {} substeps per frame keep it stable{}\n", dress.scene.simulation.stepsPerFrame,
+             added > 0.0 ? fmt::format(" (mass scaling adds {:.2f} % of its mass)", 100.0 * added) : "");
+  fmt::print("added it to {}; wrote {}.obj, {}.obj beside it\n", o.addTo, stem, maskStem);
+  printHowToRun(o.addTo, avatar, dress.character.motion);
+  return 0;
+}
+
 RunFunction setupMakeSkirt(CLI::App& app) {
   static MakeSkirtOptions o;
-  app.add_option("avatar", o.avatar, "Avatar file to fit the skirt to (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel)")->required();
-  app.add_option("--out", o.out, "Directory for scene.wrl, skirt.obj and waistband.obj")->required();
+  app.add_option("avatar", o.avatar, "Avatar file to fit the skirt to (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel); "
+                 "not with --add-to");
+  app.add_option("--out", o.out,
+                 "Directory for scene.wrl, skirt.obj and waistband.obj (with --name, NAME.obj and NAME_waistband.obj; "
+                 "required without --add-to)");
+  app.add_option("--add-to", o.addTo,
+                 "Add the skirt to this scene instead, fitted to its character (a second skirt over a petticoat): "
+                 "appended to the file as a ClothSet, once the scene with it loads; its OBJs are written beside it");
+  app.add_option("--character", o.character,
+                 "With --add-to: the character who wears it (its Avatar or Humanoid node's name; default: the "
+                 "scene's only one)");
+  app.add_option("--name", o.name, "The skirt's name (the ClothSet's; default Skirt)");
+  app.add_option("--over", o.over,
+                 "With --add-to: the character's garments the skirt is worn over, written as its over (kept "
+                 "--over-gap above them; docs/PHYSICS.md)")
+      ->delimiter(',');
+  app.add_option("--over-gap", o.overGap_m, "With --over: how far above them it keeps, m, written as its overGap")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--colour", o.colour,
+                 "Its colour, R,G,B from 0 to 1 (default: red; with --add-to, a colour no garment of the scene has)")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--avatar-url", o.avatarUrl, "The Avatar url written into scene.wrl (default: the avatar's path relative to --out)");
   app.add_option("--length", o.fit.length_m, "Waist to hem, m (default: a little above the knees)");
   app.add_option("--clearance", o.fit.clearance_m, "Gap between body and skirt at rest, m")->capture_default_str();
@@ -116,22 +226,24 @@ RunFunction setupMakeSkirt(CLI::App& app) {
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--bind-threshold", o.bindThreshold_m, "Written into the ClothSet, m")->capture_default_str();
-  return [] {
-    const scene::Avatar avatar = scene::loadAvatarFile(o.avatar);
-    checkSegments(avatar, o);
-    const mesh::Skirt skirt = scene::fitSkirt(avatar, o.fit);
-    o.avatarUrl = prepareSceneDir(o.out, o.avatar, o.avatarUrl);
-    const std::filesystem::path dir(o.out);
-    formats::writeObj((dir / "skirt.obj").string(), skirt.mesh.positions, skirt.mesh.triangles, "drape make-skirt (m)");
-    formats::writeObj((dir / "waistband.obj").string(), skirt.waistband.positions, skirt.waistband.triangles,
-                      "drape make-skirt: constraint mask (m)");
-    const int substeps = writeScene((dir / "scene.wrl").string(), o, skirt);
-    const Aabb box = skirt.mesh.bounds();
-    fmt::print("skirt: {} vertices, {} triangles, waist at y = {:.3f} m, hem at y = {:.3f} m; {} substeps per frame\n",
-               skirt.mesh.vertexCount(), skirt.mesh.triangleCount(), box.max.y(), box.min.y(), substeps);
-    fmt::print("wrote {}/scene.wrl, skirt.obj, waistband.obj\n", o.out);
-    printHowToRun(o.out, avatar);
-    return 0;
+  return [&app] {
+    if (o.name.empty()) o.name = "Skirt";
+    if (o.addTo.empty()) {
+      if (o.avatar.empty()) throw Error("make-skirt: give the avatar to fit the skirt to, or --add-to SCENE");
+      if (o.out.empty()) throw Error("make-skirt: --out DIR is required (or --add-to SCENE)");
+      for (const char* option : {"--character", "--over", "--over-gap"})
+        if (app.count(option) > 0) throw Error(fmt::format("{} goes with --add-to SCENE", option));
+      return makeSkirt(o);
+    }
+    if (!o.avatar.empty())
+      throw Error(fmt::format("make-skirt --add-to {}: the skirt is fitted to the scene's character; give no avatar "
+                              "({})",
+                              o.addTo, o.avatar));
+    for (const char* option : {"--out", "--avatar-url"})
+      if (app.count(option) > 0)
+        throw Error(fmt::format("{} does not go with --add-to: the skirt is added to {} and its OBJs written beside it",
+                                option, o.addTo));
+    return addSkirt(o);
   };
 }
 

@@ -509,9 +509,8 @@ std::string ownMotionText(const scene::Avatar& avatar) {
   return "";
 }
 
-void printHowToRun(const std::string& out, const scene::Avatar& avatar) {
-  const std::string scene = (std::filesystem::path(out) / "scene.wrl").string();
-  const std::string own = ownMotionText(avatar);
+void printHowToRun(const std::string& scene, const scene::Avatar& avatar, const std::string& nodeMotion) {
+  const std::string own = nodeMotion.empty() ? ownMotionText(avatar) : nodeMotion;
   if (own.empty())
     fmt::print("run it: drape run {} --motion FILE (a BVH or AMC capture, or an animated avatar file; without it "
                "the avatar stands at rest)\n",

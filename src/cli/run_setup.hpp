@@ -210,9 +210,10 @@ inline constexpr const char* kMotionPerCharacterHelp =
 /// What `avatar` plays without --motion, as the end of "the avatar plays ..." ("its own
 /// file's animation 'walk'"), or "" when it stands at rest.
 [[nodiscard]] std::string ownMotionText(const scene::Avatar& avatar);
-/// The line `drape make-skirt` and `make-scene` end with: how to run the scene they wrote in
-/// `out`, and what moves `avatar` there without --motion (what sceneMotion would play).
-void printHowToRun(const std::string& out, const scene::Avatar& avatar);
+/// The line `drape make-skirt` and `make-scene` end with: how to run the scene they wrote,
+/// and what moves `avatar` there without --motion (what sceneMotion would play): its Avatar
+/// node's `motion` file when there is one, else its own file's animation, else nothing.
+void printHowToRun(const std::string& scene, const scene::Avatar& avatar, const std::string& nodeMotion = "");
 
 /// The world settings of one of the setup's characters (the step, its voxel size, field
 /// method, lead-in and keep-apart).

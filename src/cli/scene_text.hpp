@@ -1,16 +1,21 @@
 #pragma once
 // Pieces of the VRML97 scene files that `drape make-skirt` and `drape make-scene` write.
 
+#include <array>
 #include <filesystem>
+#include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 #include <fmt/ostream.h>
+#include <fmt/ranges.h>
 
 #include "drape/cloth/material.hpp"
 #include "drape/core/error.hpp"
 #include "drape/mesh/trimesh.hpp"
+#include "stitch_gaps.hpp"
 
 namespace drape::cli {
 
@@ -23,14 +28,70 @@ inline void writeIndexedFaceSet(std::ostream& os, const mesh::TriMesh& m, const 
   fmt::print(os, "{}]\n", indent);
 }
 
+/// A ClothMaterial node with the material's values, its fields indented by `indent` and
+/// two spaces, its closing brace by `indent` (no newline after it).
+inline std::string materialNode(const cloth::Material& m, const std::string& indent) {
+  return fmt::format("ClothMaterial {{\n{0}  density {1:g}\n{0}  thickness {2:g}\n{0}  youngsModulus {3:g}\n"
+                     "{0}  poissonRatio {4:g}\n{0}  damping {5:g}\n{0}  staticFriction {6:g}\n{0}  dynamicFriction {7:g}\n"
+                     "{0}  compressionScale {8:g}\n{0}}}",
+                     indent, m.density_kg_m3, m.thickness_m, m.youngsModulus_Pa, m.poissonRatio, m.damping_s,
+                     m.staticFriction, m.dynamicFriction, m.compressionScale);
+}
+
 /// A ClothMaterial node named Knit with the material's values.
 inline void writeMaterial(std::ostream& os, const cloth::Material& m) {
+  fmt::print(os, "DEF Knit {}\n\n", materialNode(m, ""));
+}
+
+/// What a ClothSet node says: the garment, its mask and its fields as `drape make-skirt` and
+/// `drape make-scene` write them.
+struct ClothSetText {
+  std::string def;                       ///< its DEF name, or "" for none
+  std::string name;                      ///< its name field, or "" (its DEF name names it)
+  Vec3 colour{0.7, 0.15, 0.2};           ///< its Shape's diffuse colour
+  std::string meshDef;                   ///< the DEF name of its IndexedFaceSet, or ""
+  const mesh::TriMesh* cloth = nullptr;  ///< in the scene's file units
+  const mesh::TriMesh* mask = nullptr;   ///< in the scene's file units
+  std::string material = "USE Knit";     ///< the material field's value
+  std::string avatar = "Body";           ///< the DEF name of the avatar that wears it
+  std::vector<std::string> collidesWith;
+  std::vector<std::string> faceSamplesWith;
+  StitchPairs stitches;
+  double selfCollision_m = 0.0;  ///< 0: not written
+  std::vector<std::string> over;  ///< the garments it is worn over; none: not written
+  double overGap_m = 0.004;       ///< written with `over`
+  std::optional<std::array<double, 4>> offsets;  ///< its own T0..T3, m; none: not written
+  double bindThreshold_m = 0.04;
+};
+
+inline void writeClothSet(std::ostream& os, const ClothSetText& c) {
+  fmt::print(os, "{}ClothSet {{\n", c.def.empty() ? "" : "DEF " + c.def + " ");
+  if (!c.name.empty()) fmt::print(os, "  name \"{}\"\n", c.name);
   fmt::print(os,
-             "DEF Knit ClothMaterial {{\n  density {:g}\n  thickness {:g}\n  youngsModulus {:g}\n"
-             "  poissonRatio {:g}\n  damping {:g}\n  staticFriction {:g}\n  dynamicFriction {:g}\n"
-             "  compressionScale {:g}\n}}\n\n",
-             m.density_kg_m3, m.thickness_m, m.youngsModulus_Pa, m.poissonRatio, m.damping_s, m.staticFriction,
-             m.dynamicFriction, m.compressionScale);
+             "  cloth Shape {{\n    appearance Appearance {{ material Material {{ diffuseColor {:g} {:g} {:g} }} }}\n"
+             "    geometry {}IndexedFaceSet {{\n      solid FALSE\n",
+             c.colour.x(), c.colour.y(), c.colour.z(), c.meshDef.empty() ? "" : "DEF " + c.meshDef + " ");
+  writeIndexedFaceSet(os, *c.cloth, "      ");
+  fmt::print(os, "    }}\n  }}\n  constraintMask IndexedFaceSet {{\n");
+  writeIndexedFaceSet(os, *c.mask, "    ");
+  fmt::print(os, "  }}\n  material {}\n  avatar USE {}\n", c.material, c.avatar);
+  fmt::print(os, "  collidesWith [ \"{}\" ]\n", fmt::join(c.collidesWith, "\", \""));
+  if (!c.faceSamplesWith.empty())
+    fmt::print(os, "  faceSamplesWith [ \"{}\" ]\n", fmt::join(c.faceSamplesWith, "\", \""));
+  if (!c.stitches.empty()) {
+    fmt::print(os, "  stitches [");
+    for (std::size_t i = 0; i < c.stitches.size(); ++i)
+      fmt::print(os, "{}{} {}{}", i % 8 == 0 ? "\n    " : " ", c.stitches[i][0], c.stitches[i][1],
+                 i + 1 < c.stitches.size() ? "," : "");
+    fmt::print(os, "\n  ]\n");
+  }
+  if (c.selfCollision_m > 0) fmt::print(os, "  selfCollision {:g}\n", c.selfCollision_m);
+  if (!c.over.empty()) fmt::print(os, "  over [ \"{}\" ]\n  overGap {:g}\n", fmt::join(c.over, "\", \""), c.overGap_m);
+  if (c.offsets) {
+    const auto& t = *c.offsets;
+    fmt::print(os, "  offsets [ {:g} {:g} {:g} {:g} ]\n", t[0], t[1], t[2], t[3]);
+  }
+  fmt::print(os, "  maskTolerance 0.0005\n  bindThreshold {:.3f}\n}}\n", c.bindThreshold_m);
 }
 
 /// Creates the scene's directory (`--out`) and returns the Avatar url to write: `avatarUrl`

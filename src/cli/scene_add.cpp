@@ -1,0 +1,202 @@
+#include "scene_add.hpp"
+
+#include <algorithm>
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "drape/cloth/model.hpp"
+#include "drape/cloth/solver.hpp"
+#include "drape/core/error.hpp"
+#include "drape/formats/vrml_read.hpp"
+#include "drape/mesh/topology.hpp"
+#include "drape/scene/scene_build.hpp"
+
+namespace drape::cli {
+namespace {
+
+std::string readWhole(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(fmt::format("--add-to {}: cannot be read", path));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::vector<std::string> characterNames(const std::vector<sim::SceneCharacter>& characters) {
+  std::vector<std::string> names;
+  for (const sim::SceneCharacter& c : characters) names.push_back(c.name);
+  return names;
+}
+
+/// The character called `name`, or the only one when `name` is "".
+sim::SceneCharacter takeCharacter(std::vector<sim::SceneCharacter> characters, const std::string& name,
+                                  const std::string& path) {
+  if (characters.empty())
+    throw Error(fmt::format("--add-to {}: no character of the scene wears a garment yet; dress one first (drape "
+                            "make-skirt AVATAR --out DIR, or drape make-scene)",
+                            path));
+  if (name.empty()) {
+    if (characters.size() > 1)
+      throw Error(fmt::format("--add-to {}: the scene has {} characters ({}); say which wears the garment with "
+                              "--character NAME",
+                              path, characters.size(), fmt::join(characterNames(characters), ", ")));
+    return std::move(characters.front());
+  }
+  for (sim::SceneCharacter& c : characters)
+    if (c.name == name) return std::move(c);
+  throw Error(fmt::format("--character {}: {} has no character of that name wearing a garment (it has: {})", name,
+                          path, fmt::join(characterNames(characters), ", ")));
+}
+
+/// The DEF name of the character's node in the scene's own file, which a ClothSet appended
+/// to the file can USE. An Avatar node is found by the line it was read from (a nameless one
+/// is called by its file's avatar name), a Humanoid by its name.
+std::string avatarDefOf(const formats::vrml::Document& document, const sim::SceneCharacter& character, int line,
+                        const std::string& path) {
+  const std::string type = character.external ? "Avatar" : "Humanoid";
+  const auto isCharacter = [&](const formats::vrml::Node& n) {
+    return n.type == type && (character.external ? n.line == line : n.nameOrDef() == character.name);
+  };
+  const auto node = std::find_if(document.nodes.begin(), document.nodes.end(), isCharacter);
+  const std::string at = line > 0 ? fmt::format(" (line {})", line) : "";
+  if (node == document.nodes.end() || node->def.empty())
+    throw Error(fmt::format("--add-to {}: the {} node of '{}'{} has no DEF name for the new ClothSet to USE; write "
+                            "DEF NAME before it",
+                            path, type, character.name, at));
+  if (std::filesystem::path(node->file) != std::filesystem::path(document.file))
+    throw Error(fmt::format("--add-to {}: the {} node of '{}' is written in {}, which the scene inlines; a ClothSet "
+                            "added to the scene cannot USE it",
+                            path, type, character.name, node->file));
+  const auto sameDef = [&](const formats::vrml::Node& other) { return other.def == node->def; };
+  if (std::count_if(document.nodes.begin(), document.nodes.end(), sameDef) > 1)
+    throw Error(fmt::format("--add-to {}: DEF {} names more than one node; give the {} node of '{}' a name of its own",
+                            path, node->def, type, character.name));
+  return node->def;
+}
+
+/// An Avatar node's first url that is a file, from the scene's directory.
+std::string firstExistingFile(const scene::ExternalAvatar& ext, const std::string& scenePath) {
+  for (const std::string& url : ext.urls) {
+    const std::filesystem::path p(url);
+    const std::filesystem::path file =
+        p.is_absolute() ? p : (std::filesystem::path(scenePath).parent_path() / p).lexically_normal();
+    if (std::filesystem::is_regular_file(file)) return file.string();
+  }
+  return "";
+}
+
+}  // namespace
+
+SceneToDress openSceneToDress(const std::string& path, const std::string& character) {
+  SceneToDress d;
+  d.path = path;
+  d.text = readWhole(path);
+  const formats::vrml::Document document = formats::vrml::readFile(path);
+  d.scene = scene::buildScene(document);
+  d.character = takeCharacter(sim::sceneCharacters(d.scene), character, path);
+  int line = 0;
+  if (d.character.external) {
+    for (const scene::ExternalAvatar& ext : d.scene.externalAvatars) {
+      if ((ext.name.empty() ? d.character.avatar->name : ext.name) != d.character.name) continue;
+      d.avatarFile = firstExistingFile(ext, path);
+      d.placement = ext.placement;
+      d.scale = ext.scale;
+      line = ext.source.line;
+    }
+  }
+  d.avatarDef = avatarDefOf(document, d.character, line, path);
+  return d;
+}
+
+void checkNewGarment(const SceneToDress& dress, const std::string& name, const std::vector<std::string>& over) {
+  for (const scene::Garment& g : dress.scene.garments)
+    if (g.name == name)
+      throw Error(fmt::format("--add-to {}: the scene has a garment called '{}' already; call this one something else "
+                              "with --name",
+                              dress.path, name));
+  std::vector<std::string> own;
+  for (const std::size_t g : dress.character.garments) own.push_back(dress.scene.garments[g].name);
+  for (const std::string& below : over)
+    if (std::find(own.begin(), own.end(), below) == own.end())
+      throw Error(fmt::format("--over {}: not a garment of '{}' in {} (it wears: {})", below, dress.character.name,
+                              dress.path, fmt::join(own, ", ")));
+}
+
+double checkSceneSteps(const SceneToDress& dress, const mesh::TriMesh& garment, const cloth::Material& material,
+                       const std::string& name) {
+  const scene::SimulationSettings& s = dress.scene.simulation;
+  const mesh::Topology topology = mesh::Topology::build(garment);
+  const double added = cloth::addedMassFractionAt(garment, topology, material, s.frameRate, s.stepsPerFrame);
+  if (added > s.maxAddedMass) {
+    const int needed =
+        cloth::fewestStableSubsteps(garment, topology, material, s.frameRate, s.maxAddedMass, s.stepsPerFrame)
+            .substepsPerFrame;
+    throw Error(fmt::format("--add-to {}: the scene steps {} substeps per frame, and '{}' needs {} to be stable (mass "
+                            "scaling within the scene's maxAddedMass {:g}); set stepsPerFrame {} in its Simulation "
+                            "node first",
+                            dress.path, s.stepsPerFrame, name, needed, s.maxAddedMass, needed));
+  }
+  // Unscaled masses, as drape make-scene checks its own rhythm: scaling only slows bending.
+  mesh::TriMesh named = garment;
+  named.name = name;
+  const auto model = cloth::ClothModel::build(named, topology, material);
+  try {
+    cloth::checkBendingStep(*model, sim::toStepSettings(s));
+  } catch (const Error& e) {
+    throw Error(fmt::format("--add-to {}: the scene's bendEvery {} is too long for the new garment: {}", dress.path,
+                            s.bendEvery, e.what()));
+  }
+  return added;
+}
+
+Vec3 unusedColour(const scene::Scene& scene) {
+  // The two make-* commands' own colours first, then others that read apart from them.
+  static const std::array<Vec3, 6> kColours{Vec3{0.7, 0.15, 0.2},  Vec3{0.15, 0.25, 0.55}, Vec3{0.92, 0.9, 0.84},
+                                            Vec3{0.2, 0.5, 0.3},   Vec3{0.85, 0.6, 0.15},  Vec3{0.45, 0.25, 0.55}};
+  for (const Vec3& c : kColours) {
+    const auto taken = [&](const scene::Garment& g) { return g.colour && (*g.colour - c).norm() < 0.05; };
+    if (std::none_of(scene.garments.begin(), scene.garments.end(), taken)) return c;
+  }
+  return kColours[scene.garments.size() % kColours.size()];
+}
+
+mesh::TriMesh inFileUnits(const SceneToDress& dress, mesh::TriMesh world) {
+  world.scale(1.0 / dress.scene.simulation.unitScale);
+  return world;
+}
+
+void appendToScene(const SceneToDress& dress, const std::string& clothSet) {
+  std::string text = dress.text;
+  if (!text.empty() && text.back() != '\n') text += '\n';
+  text += "\n" + clothSet;
+  const std::string dir = std::filesystem::path(dress.path).parent_path().string();
+  try {
+    const scene::Scene added = scene::buildScene(formats::vrml::readText(text, dress.path, dir.empty() ? "." : dir));
+    if (added.garments.size() != dress.scene.garments.size() + 1)
+      throw Error(fmt::format("{} garments read back where {} were written", added.garments.size(),
+                              dress.scene.garments.size() + 1));
+  } catch (const Error& e) {
+    throw Error(fmt::format("--add-to {}: the scene with the garment added would not load, so it is left as it was: {}",
+                            dress.path, e.what()));
+  }
+  // Written beside it and renamed over it: the scene is never left half written.
+  const std::string temporary = dress.path + ".adding";
+  {
+    std::ofstream os(temporary, std::ios::binary);
+    os << text;
+    if (!os.flush()) throw Error(fmt::format("{}: cannot be written", temporary));
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, dress.path, ec);
+  if (ec) {
+    std::filesystem::remove(temporary, ec);
+    throw Error(fmt::format("--add-to {}: cannot be replaced ({})", dress.path, ec.message()));
+  }
+}
+
+}  // namespace drape::cli

@@ -1,0 +1,60 @@
+#pragma once
+// `--add-to SCENE` of `drape make-skirt` and `drape make-scene`: one more garment for a
+// character of a scene already written (a skirt over the petticoat it wears), appended to the
+// scene file as a ClothSet, after the scene with it has been read as `drape run` reads it.
+
+#include <string>
+#include <vector>
+
+#include "drape/cloth/material.hpp"
+#include "drape/core/math.hpp"
+#include "drape/mesh/trimesh.hpp"
+#include "drape/scene/scene.hpp"
+#include "drape/sim/scene_setup.hpp"
+
+namespace drape::cli {
+
+/// A scene a garment is being added to, and the character who will wear it.
+struct SceneToDress {
+  std::string path;   ///< the scene file
+  std::string text;   ///< its text as it is
+  scene::Scene scene;
+  sim::SceneCharacter character;  ///< who will wear the garment: loaded and placed as the scene says
+  std::string avatarDef;          ///< the DEF name of its Avatar or Humanoid node, for `avatar USE`
+  /// The file its Avatar node loads (the first of its urls that exists); "" for a Humanoid
+  /// written in the scene.
+  std::string avatarFile;
+  /// Where that file's frame lies in the scene: a point p of it is at placement(scale p).
+  RigidTransform placement;
+  double scale = 1.0;
+};
+
+/// Reads the scene and finds its character `character` (its Avatar or Humanoid node's name),
+/// or its only one when `character` is "". Throws drape::Error naming the scene when it does
+/// not load, dresses no character yet, has several and none is named, has no such
+/// character, or the character's node has no DEF name of the scene's own file to USE.
+[[nodiscard]] SceneToDress openSceneToDress(const std::string& path, const std::string& character);
+
+/// Throws drape::Error when `name` is taken by a garment of the scene or `over` names
+/// anything but the character's own garments.
+void checkNewGarment(const SceneToDress& dress, const std::string& name, const std::vector<std::string>& over);
+
+/// Checks that the scene's substeps per frame (its Simulation node's stepsPerFrame, mass
+/// scaling within its maxAddedMass, bending every bendEvery) keep the new garment stable, and
+/// returns the fraction of its mass that scaling adds. Throws drape::Error naming the scene,
+/// the garment and the substeps per frame it needs.
+double checkSceneSteps(const SceneToDress& dress, const mesh::TriMesh& garment, const cloth::Material& material,
+                       const std::string& name);
+
+/// The first of a few garment colours that no garment of the scene has.
+[[nodiscard]] Vec3 unusedColour(const scene::Scene& scene);
+
+/// A mesh in world metres, in the scene file's units (its unitScale).
+[[nodiscard]] mesh::TriMesh inFileUnits(const SceneToDress& dress, mesh::TriMesh world);
+
+/// Appends `clothSet` (a ClothSet node's text) to the scene and rewrites the file, once the
+/// new text has been read and built as `drape run` reads it: a scene that would not load is
+/// left as it was, and the error says so.
+void appendToScene(const SceneToDress& dress, const std::string& clothSet);
+
+}  // namespace drape::cli

@@ -1,0 +1,202 @@
+// `drape make-skirt --add-to` and `drape make-scene --add-to`: one more garment for a
+// character of a scene already written. Two commands make the bundled layered skirts, to the
+// byte of their caches; a garment added to one of two characters lies where the scene stands
+// that character and leaves the garments it is worn over as they were; a garment the scene
+// cannot take is refused with the scene left as it was.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.hpp"
+#include "drape/scene/scene.hpp"
+
+namespace drape::add_garment {
+
+using testing::CliResult;
+using testing::runDrape;
+using testing::runInto;
+using testing::ScratchDir;
+using testing::slurp;
+using testing::statsOf;
+
+const std::string kSource = DRAPE_SOURCE_DIR;
+const std::string kBody = "'" + std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_rig_cmu_mb.mhskel'";
+const std::string kWalk = "'" + kSource + "/examples/walking_skirt/walk.bvh'";
+
+const scene::Garment& garmentNamed(const scene::Scene& sc, const std::string& name) {
+  for (const scene::Garment& g : sc.garments)
+    if (g.name == name) return g;
+  ADD_FAILURE() << "no garment " << name;
+  return sc.garments.front();
+}
+
+/// The largest distance between two meshes' vertices, vertex by vertex (infinite when their
+/// vertex or triangle counts differ).
+double largestDistance(const mesh::TriMesh& a, const mesh::TriMesh& b) {
+  if (a.positions.size() != b.positions.size() || a.triangles != b.triangles)
+    return std::numeric_limits<double>::infinity();
+  double largest = 0.0;
+  for (std::size_t i = 0; i < a.positions.size(); ++i)
+    largest = std::max(largest, (a.positions[i] - b.positions[i]).norm());
+  return largest;
+}
+
+TEST(AddGarment, TwoCommandsMakeTheBundledLayeredSkirts) {
+  // examples/layered_skirts/README: the petticoat and the skirt, made by make-skirt and put in
+  // one scene. Made by the two commands, the scene runs to the same bytes as the bundled one.
+  ScratchDir dir("add-garment-layered");
+  const std::string scene = dir / "layered/scene.wrl";
+  const CliResult petticoat = runDrape("make-skirt " + kBody + " --clearance 0.02 --flare 0.12 --length 0.38 " +
+                                           "--name Petticoat --colour 0.92,0.9,0.84 --out '" + (dir / "layered") + "'",
+                                       dir);
+  ASSERT_EQ(petticoat.code, 0) << petticoat.err;
+  EXPECT_NE(petticoat.out.find("wrote " + (dir / "layered") + "/scene.wrl, Petticoat.obj, Petticoat_waistband.obj"),
+            std::string::npos)
+      << petticoat.out;
+  const CliResult skirt =
+      runDrape("make-skirt --add-to '" + scene + "' --clearance 0.035 --flare 0.25 --over Petticoat", dir);
+  ASSERT_EQ(skirt.code, 0) << skirt.err;
+  EXPECT_NE(skirt.out.find("Skirt: 264 vertices, 480 triangles"), std::string::npos) << skirt.out;
+  EXPECT_NE(skirt.out.find("worn by Body over Petticoat, 0.004 m above"), std::string::npos) << skirt.out;
+  EXPECT_NE(skirt.out.find("added it to " + scene + "; wrote skirt.obj, waistband.obj beside it"), std::string::npos)
+      << skirt.out;
+  EXPECT_TRUE(std::filesystem::exists(dir / "layered/skirt.obj"));
+
+  const scene::Scene made = scene::loadScene(scene);
+  const scene::Scene bundled = scene::loadScene(kSource + "/examples/layered_skirts/scene.wrl");
+  ASSERT_EQ(made.garments.size(), 2u);
+  for (const char* name : {"Petticoat", "Skirt"}) {
+    const scene::Garment& a = garmentNamed(made, name);
+    const scene::Garment& b = garmentNamed(bundled, name);
+    EXPECT_EQ(largestDistance(a.mesh, b.mesh), 0.0) << name;
+    EXPECT_EQ(a.maskVertices, b.maskVertices) << name;
+    EXPECT_EQ(a.over, b.over) << name;
+    EXPECT_EQ(a.collidesWith, b.collidesWith) << name;
+  }
+  // The added skirt takes a colour neither garment had (the petticoat's was given).
+  ASSERT_TRUE(garmentNamed(made, "Skirt").colour.has_value());
+  EXPECT_NEAR(garmentNamed(made, "Skirt").colour->x(), 0.7, 1e-6);
+
+  const std::string options = " --motion " + kWalk + " --frames 12";
+  const std::string ours = runInto(dir, "ours", "'" + scene + "'" + options);
+  const std::string theirs =
+      runInto(dir, "bundled", "'" + kSource + "/examples/layered_skirts/scene.wrl'" + options);
+  for (const char* cache : {"garment-Petticoat.pc2", "garment-Skirt.pc2"})
+    EXPECT_EQ(slurp(ours + "/" + cache), slurp(theirs + "/" + cache)) << cache;
+  EXPECT_GT(statsOf(ours)["garments"][1]["worn_over"]["contacts"].get<long>(), 0);
+}
+
+TEST(AddGarment, OnOneOfTwoCharactersWhereTheSceneStandsThem) {
+  // Bea stands 1.2 m to Ada's side. A skirt fitted to her there by make-skirt, and the same
+  // skirt modelled on the avatar's own file and put on her by make-scene, lie on her and
+  // match; worn over her skirt, they leave both characters' skirts as they were (one way).
+  ScratchDir dir("add-garment-two");
+  const std::string scene = testing::twoCharactersWithBeaAt(dir, "1.2 0 0");
+  const std::string before = runInto(dir, "before", "'" + scene + "' --frames 8");
+
+  const CliResult which = runDrape("make-skirt --add-to '" + scene + "' --clearance 0.035 --flare 0.25", dir);
+  EXPECT_EQ(which.code, 2);
+  EXPECT_NE(which.err.find("the scene has 2 characters (Ada, Bea); say which wears the garment with --character NAME"),
+            std::string::npos)
+      << which.err;
+  const CliResult fitted = runDrape("make-skirt --add-to '" + scene + "' --character Bea --clearance 0.035 " +
+                                        "--flare 0.25 --over 'Bea skirt' --name 'Bea overskirt'",
+                                    dir);
+  ASSERT_EQ(fitted.code, 0) << fitted.err;
+  EXPECT_NE(fitted.out.find("(the avatar plays " + std::string(DRAPE_DATA_DIR) + "/mocap/cmu_walk_delfem2.bvh;"),
+            std::string::npos)
+      << fitted.out;
+
+  // The same skirt made on the avatar alone, where its file stands it, in centimetres.
+  const CliResult alone = runDrape("make-skirt " + kBody + " --clearance 0.035 --flare 0.25 --out '" +
+                                       (dir / "alone") + "'",
+                                   dir);
+  ASSERT_EQ(alone.code, 0) << alone.err;
+  const CliResult put = runDrape("make-scene --add-to '" + scene + "' --character Bea --garment '" +
+                                     (dir / "alone/skirt.obj") + "' --mask '" + (dir / "alone/waistband.obj") +
+                                     "' --name 'Bea second' --over 'Bea overskirt' --offsets 0.004,0.008,0.012,0.024",
+                                 dir);
+  ASSERT_EQ(put.code, 0) << put.err;
+  EXPECT_NE(put.out.find("worn by Bea over Bea overskirt"), std::string::npos) << put.out;
+
+  const scene::Scene sc = scene::loadScene(scene);
+  ASSERT_EQ(sc.garments.size(), 4u);
+  const scene::Garment& over = garmentNamed(sc, "Bea overskirt");
+  const scene::Garment& second = garmentNamed(sc, "Bea second");
+  EXPECT_EQ(over.over, std::vector<std::string>{"Bea skirt"});
+  EXPECT_EQ(second.over, std::vector<std::string>{"Bea overskirt"});
+  ASSERT_TRUE(second.offsets.has_value());
+  EXPECT_NEAR((*second.offsets)[3], 0.024, 1e-7);  // SFFloat
+  EXPECT_NEAR(over.mesh.bounds().center().x(), 1.2, 0.03);
+  // Both written to 10 micrometres.
+  EXPECT_LT(largestDistance(over.mesh, second.mesh), 2e-5);
+  EXPECT_FALSE(over.colour && second.colour && (*over.colour - *second.colour).norm() < 0.05);
+
+  // The second one is the first one again, 4 mm over it: the run takes one of the two out.
+  std::string text = slurp(scene);
+  text = text.substr(0, text.find("# Bea second: added by"));
+  std::ofstream(scene, std::ios::trunc) << text;
+  const std::string after = runInto(dir, "after", "'" + scene + "' --frames 8");
+  for (const char* cache : {"garment-Ada skirt.pc2", "garment-Bea skirt.pc2"})
+    EXPECT_EQ(slurp(before + "/" + cache), slurp(after + "/" + cache)) << cache;
+  const nlohmann::json stats = statsOf(after);
+  EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
+  EXPECT_EQ(stats["garments"][2]["name"], "Bea overskirt");
+  EXPECT_GT(stats["garments"][2]["worn_over"]["contacts"].get<long>(), 0);
+  EXPECT_EQ(stats["garments"][2]["worn_over"]["crossings"], 0);
+}
+
+TEST(AddGarment, AGarmentTheSceneCannotTakeLeavesItAsItWas) {
+  ScratchDir dir("add-garment-refused");
+  const std::string scene = dir / "scene.wrl";
+  std::ofstream(scene) << testing::exampleSceneWithDataFound(kSource + "/examples/walking_skirt/scene.wrl");
+  const std::string original = slurp(scene);
+  const auto refused = [&](const std::string& args, const std::string& says) {
+    const std::string before = slurp(scene);
+    const CliResult r = runDrape(args, dir);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.out;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << "\n" << r.err;
+    EXPECT_TRUE(slurp(scene) == before) << args << ": the scene changed";
+  };
+  const std::string add = "make-skirt --add-to '" + scene + "' ";
+  refused(add + "--over Skirt", "the scene has a garment called 'Skirt' already; call this one something else with --name");
+  refused(add + "--name Outer --over Petticoat", "--over Petticoat: not a garment of 'Body' in " + scene + " (it wears: Skirt)");
+  refused(add + "--name Outer --out '" + (dir / "x") + "'", "--out does not go with --add-to");
+  refused(add + "--name Outer " + kBody, "the skirt is fitted to the scene's character; give no avatar");
+  refused(add + "--name Outer --character Ada", "--character Ada: " + scene + " has no character of that name");
+  refused(add + "--name Outer --waist-segment Waist", "the avatar has no segment 'Waist'");
+  refused("make-skirt " + kBody + " --out '" + (dir / "x") + "' --over Skirt", "--over goes with --add-to SCENE");
+  refused("make-skirt --clearance 0.03", "give the avatar to fit the skirt to, or --add-to SCENE");
+
+  // The MakeHuman dress needs far more substeps than the skirt's scene steps.
+  const std::string dress = "make-scene --add-to '" + scene + "' --garment '" + kSource +
+                            "/data/garments/makehuman_female_elegantsuit01_dress.mhclo' --units dm --mask '" + kSource +
+                            "/examples/walking_dress/mask.obj' --name dress ";
+  refused(dress + "--substeps 155", "--substeps does not go with --add-to: it is the scene's own setting");
+  refused(dress, "the scene steps 33 substeps per frame, and 'dress' needs ");
+  refused(dress, "set stepsPerFrame ");
+
+  // A character's node without a DEF name cannot be named by a ClothSet appended to the file.
+  std::string undefined = original;
+  testing::replaceOnce(undefined, "DEF Body Avatar {", "Avatar {");
+  testing::replaceOnce(undefined, "  avatar USE Body\n", "");
+  std::ofstream(scene, std::ios::trunc) << undefined;
+  refused(add + "--name Outer", "(line 32) has no DEF name for the new ClothSet to USE; write DEF NAME before it");
+
+  // One called by its name field uses its DEF name.
+  std::string named = original;
+  testing::replaceOnce(named, "DEF Body Avatar {", "DEF Body Avatar {\n  name \"Ada\"");
+  std::ofstream(scene, std::ios::trunc) << named;
+  const CliResult r = runDrape(add + "--name Outer --clearance 0.035 --flare 0.25 --over Skirt", dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("worn by Ada over Skirt"), std::string::npos) << r.out;
+  const std::string added = slurp(scene);
+  EXPECT_TRUE(added.substr(0, named.size()) == named) << "the scene's own text changed";
+  EXPECT_NE(added.find("  avatar USE Body\n  collidesWith", named.size()), std::string::npos);
+}
+
+}  // namespace drape::add_garment

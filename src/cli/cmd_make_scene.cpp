@@ -417,6 +417,7 @@ RunFunction setupMakeScene(CLI::App& app) {
       if (app.count(option) > 0)
         throw Error(fmt::format("{} does not go with --add-to: it is the scene's own setting (edit {} for it)", option,
                                 o.addTo));
+    if (app.count("--over-gap") > 0 && o.over.empty()) throw Error("--over-gap goes with --over NAME,...");
     return addGarment(o);
   };
 }

@@ -243,6 +243,7 @@ RunFunction setupMakeSkirt(CLI::App& app) {
       if (app.count(option) > 0)
         throw Error(fmt::format("{} does not go with --add-to: the skirt is added to {} and its OBJs written beside it",
                                 option, o.addTo));
+    if (app.count("--over-gap") > 0 && o.over.empty()) throw Error("--over-gap goes with --over NAME,...");
     return addSkirt(o);
   };
 }

@@ -165,6 +165,7 @@ TEST(AddGarment, AGarmentTheSceneCannotTakeLeavesItAsItWas) {
   const std::string add = "make-skirt --add-to '" + scene + "' ";
   refused(add + "--over Skirt", "the scene has a garment called 'Skirt' already; call this one something else with --name");
   refused(add + "--name Outer --over Petticoat", "--over Petticoat: not a garment of 'Body' in " + scene + " (it wears: Skirt)");
+  refused(add + "--name Outer --over-gap 0.01", "--over-gap goes with --over");
   refused(add + "--name Outer --out '" + (dir / "x") + "'", "--out does not go with --add-to");
   refused(add + "--name Outer " + kBody, "the skirt is fitted to the scene's character; give no avatar");
   refused(add + "--name Outer --character Ada", "--character Ada: " + scene + " has no character of that name");

@@ -85,6 +85,34 @@ namespace fs = std::filesystem;
 /// Triangles smaller than this (m^2) are degenerate for the membrane model.
 constexpr double kMinTriangleArea_m2 = 1e-12;
 
+/// What of a garment was modelled under the garments it is worn over, and what the set-up
+/// did with it (cloth::LayerCollider::liftOver).
+void logStartUnder(const std::string& name, const cloth::LayerCollider& layers) {
+  const cloth::StartUnder& under = layers.startUnder();
+  const cloth::LiftedOver& lifted = layers.liftedOver();
+  const std::string below = fmt::format("{}", fmt::join(layers.garmentsBelow(), ", "));
+  const char* them = layers.garmentsBelow().size() == 1 ? "it" : "them";
+  if (lifted.vertices == 0 && !layers.sidesFromBody() && !layers.belowWoundOneWay()) {
+    spdlog::warn("{}: {} of its {} vertices over {} start under {}, on the other side from the rest (the deepest, "
+                 "vertex {}, {:.1f} mm), and the faces of {} are not all wound one way, so which side is over cannot "
+                 "be told: they were left where they are, and the layers keep the side each starts on. Wind the faces "
+                 "of {} one way, or model {} over {}",
+                 name, under.vertices, under.over, below, them, under.deepestVertex, 1e3 * under.deepest_m, below,
+                 below, name, them);
+    return;
+  }
+  const std::string side = layers.sidesFromBody() ? ", on the body's side" : "";
+  spdlog::info("{}: {} of its {} vertices near {} were modelled under {}{} (the deepest, vertex {}, {:.1f} mm): {} "
+               "moved out over {}, {:.4g} mm above",
+               name, under.vertices, under.over, below, them, side, under.deepestVertex, 1e3 * under.deepest_m,
+               lifted.vertices, them, 1e3 * layers.gap_m());
+  if (lifted.leftUnder > 0)
+    spdlog::warn("{}: {} of its vertices lie too far under {} to be moved out (more than {:.4g} mm, the deepest {:.1f} "
+                 "mm): they were left there, and the layers keep each vertex on the side it starts on, so {} goes "
+                 "through {} there. Model {} over {} (wider, or further out from the body)",
+                 name, lifted.leftUnder, below, 1e3 * cloth::LayerCollider::kLiftDepthGaps * layers.gap_m(), 1e3 * under.deepest_m, name, below, name, below);
+}
+
 /// One garment being simulated: its model and solver (and its collider, on a character).
 struct GarmentRun {
   std::string name;
@@ -944,23 +972,7 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
       spdlog::info("{}: kept {:.4g} mm over {} (stepped after {}, tested every {} substeps)", g.name,
                    1e3 * r.layers->gap_m(), fmt::join(r.layers->garmentsBelow(), ", "),
                    r.layers->garmentsBelow().size() == 1 ? "it" : "them", r.layers->every());
-    if (r.layers && r.layers->startUnder().vertices > 0) {
-      const cloth::StartUnder& under = r.layers->startUnder();
-      const std::string below = fmt::format("{}", fmt::join(r.layers->garmentsBelow(), ", "));
-      const char* them = r.layers->garmentsBelow().size() == 1 ? "it" : "them";
-      if (r.layers->liftedOver().vertices > 0)
-        spdlog::info("{}: {} of its {} vertices over {} were modelled under {} (the deepest, vertex {}, {:.1f} mm): "
-                     "moved out over {}, {:.4g} mm above",
-                     g.name, under.vertices, under.over, below, them, under.deepestVertex, 1e3 * under.deepest_m, them,
-                     1e3 * r.layers->gap_m());
-      else
-        spdlog::warn("{}: {} of its {} vertices over {} start under {}, on the other side from the rest (the deepest, "
-                     "vertex {}, {:.1f} mm), and the faces of {} are not all wound one way, so which side is over "
-                     "cannot be told: they were left where they are, and the layers keep the side each starts on. Wind "
-                     "the faces of {} one way, or model {} over {}",
-                     g.name, under.vertices, under.over, below, them, under.deepestVertex, 1e3 * under.deepest_m, below,
-                     below, g.name, them);
-    }
+    if (r.layers && r.layers->startUnder().vertices > 0) logStartUnder(g.name, *r.layers);
     r.model = &r.solver->model();
     // Each garment its own spheres: garments step in parallel, and a collider keeps counts.
     r.spheres.reserve(setup.spheres.size());  // the solver keeps references
@@ -1173,6 +1185,7 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
                               {"candidate_lists_mended", s.mends},
                               {"vertices_starting_under", layers->startUnder().vertices},
                               {"vertices_lifted_over", layers->liftedOver().vertices},
+                              {"vertices_left_under", layers->liftedOver().leftUnder},
                               {"contacts", s.contactsBelow},
                               {"crossings", s.crossingsBelow}};
     }

@@ -4,6 +4,8 @@
 #include <array>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <utility>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -15,6 +17,7 @@
 #include "drape/formats/vrml_read.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/scene/scene_build.hpp"
+#include "drape/sim/garment_layers.hpp"
 
 namespace drape::cli {
 namespace {
@@ -170,13 +173,41 @@ mesh::TriMesh inFileUnits(const SceneToDress& dress, mesh::TriMesh world) {
   return world;
 }
 
+namespace {
+
+/// What of garment g of `scene` (worn by `avatar`) starts under the garments it is worn over,
+/// and what the set-up of a run moves out over them: the layer collider `drape run` makes for
+/// it, on solvers at rest.
+std::pair<cloth::StartUnder, cloth::LiftedOver> underAtStart(const scene::Scene& scene, const scene::Avatar& avatar,
+                                                             std::size_t g) {
+  const std::vector<sim::GarmentSpec> specs = sim::garmentSpecs(scene, &avatar);
+  const std::vector<std::vector<std::size_t>> below = sim::garmentsBelow(specs);
+  if (below[g].empty()) return {};
+  const cloth::StepSettings settings = sim::toStepSettings(scene.simulation);
+  std::vector<std::unique_ptr<cloth::ClothSolver>> solvers(specs.size());
+  const auto solver = [&](std::size_t i) -> cloth::ClothSolver& {
+    if (!solvers[i]) {
+      const mesh::Topology topology = mesh::Topology::build(specs[i].mesh);
+      solvers[i] = std::make_unique<cloth::ClothSolver>(
+          cloth::ClothModel::build(specs[i].mesh, topology, specs[i].material, settings.massScaling()), settings);
+    }
+    return *solvers[i];
+  };
+  const auto layers = sim::makeLayerCollider(specs, g, below[g], specs[g].bound, solver, 1.0 / settings.frameRate_hz,
+                                             sim::restBodyPoints(avatar, specs[g].collidesWith));
+  return {layers->startUnder(), layers->liftedOver()};
+}
+
+}  // namespace
+
 void appendToScene(const SceneToDress& dress, const std::string& clothSet) {
   std::string text = dress.text;
   if (!text.empty() && text.back() != '\n') text += '\n';
   text += "\n" + clothSet;
   const std::string dir = std::filesystem::path(dress.path).parent_path().string();
+  scene::Scene added;
   try {
-    const scene::Scene added = scene::buildScene(formats::vrml::readText(text, dress.path, dir.empty() ? "." : dir));
+    added = scene::buildScene(formats::vrml::readText(text, dress.path, dir.empty() ? "." : dir));
     if (added.garments.size() != dress.scene.garments.size() + 1)
       throw Error(fmt::format("{} garments read back where {} were written", added.garments.size(),
                               dress.scene.garments.size() + 1));
@@ -184,6 +215,20 @@ void appendToScene(const SceneToDress& dress, const std::string& clothSet) {
     throw Error(fmt::format("--add-to {}: the scene with the garment added would not load, so it is left as it was: {}",
                             dress.path, e.what()));
   }
+  const scene::Garment& garment = added.garments.back();
+  const auto [under, lifted] = underAtStart(added, *dress.character.avatar, added.garments.size() - 1);
+  const std::string below = fmt::format("{}", fmt::join(garment.over, ", "));
+  if (lifted.leftUnder > 0)
+    throw Error(fmt::format("--add-to {}: {} of the vertices of '{}' lie under {} by more than {:.4g} mm (the deepest, "
+                            "vertex {}, {:.1f} mm), too deep for drape run to move them out over {}: it would go "
+                            "through {}. Make it wider or further out from the body (for a skirt, a larger "
+                            "--clearance or --flare); the scene is left as it was",
+                            dress.path, lifted.leftUnder, garment.name, below,
+                            1e3 * cloth::LayerCollider::kLiftDepthGaps * garment.overGap, under.deepestVertex,
+                            1e3 * under.deepest_m, garment.over.size() == 1 ? "it" : "them", below));
+  if (lifted.vertices > 0)
+    fmt::print("{} of its vertices lie under {} by up to {:.1f} mm: drape run moves them out over {}\n",
+               lifted.vertices, below, 1e3 * under.deepest_m, garment.over.size() == 1 ? "it" : "them");
   // Written beside it and renamed over it: the scene is never left half written.
   const std::string temporary = dress.path + ".adding";
   {

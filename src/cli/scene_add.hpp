@@ -52,9 +52,12 @@ double checkSceneSteps(const SceneToDress& dress, const mesh::TriMesh& garment, 
 /// A mesh in world metres, in the scene file's units (its unitScale).
 [[nodiscard]] mesh::TriMesh inFileUnits(const SceneToDress& dress, mesh::TriMesh world);
 
-/// Appends `clothSet` (a ClothSet node's text) to the scene and rewrites the file, once the
-/// new text has been read and built as `drape run` reads it: a scene that would not load is
-/// left as it was, and the error says so.
+/// Appends `clothSet` (a ClothSet node's text, of a garment worn by the character) to the
+/// scene and rewrites the file, once the new text has been read and built as `drape run`
+/// reads it and what of the garment starts under the garments it is worn over has been
+/// found as `drape run` finds it (sim::makeLayerCollider): a scene that would not load, or a
+/// garment lying under them too deep for the run to move out, is refused with the file left
+/// as it was. Prints how many of its vertices the run will move out over them.
 void appendToScene(const SceneToDress& dress, const std::string& clothSet);
 
 }  // namespace drape::cli

@@ -33,9 +33,10 @@ constexpr std::size_t kMostMended = 8;
 /// How far outside a triangle (in barycentric weight) a projection may fall and still count:
 /// a vertex over the edge between two faces belongs to both.
 constexpr double kEdgeTolerance = 1e-9;
-/// How far from the garments below, in gaps, a vertex of its own is looked at for the side it
-/// starts on (LayerCollider::startUnder): a garment modelled over another lies within a few.
-constexpr double kUnderDepthGaps = 4.0;
+/// A box touching more grid cells than this is not looked up cell by cell: it is paired by
+/// its box alone. (A point flung a metre by an unstable substep would otherwise be listed in
+/// millions of cells, and fill the memory.)
+constexpr double kMostCellsPerBox = 512.0;
 /// The candidate list's order: by triangle, then vertex (the narrow test reads each
 /// triangle's plane once for all its vertices).
 constexpr auto kByTriangle = [](const std::pair<std::uint32_t, std::uint32_t>& a,
@@ -329,18 +330,37 @@ std::uint32_t LayerCollider::componentBelow(std::uint32_t vertex) const {
   return vertex;
 }
 
+void LayerCollider::setBody(std::vector<Vec3> points) { body_ = std::move(points); }
+
+namespace {
+
+Vec3 nearestOf(const std::vector<Vec3>& points, const Vec3& p) {
+  Vec3 nearest = points.front();
+  double best = (p - nearest).squaredNorm();
+  for (const Vec3& q : points)
+    if (const double d = (p - q).squaredNorm(); d < best) {
+      best = d;
+      nearest = q;
+    }
+  return nearest;
+}
+
+}  // namespace
+
 void LayerCollider::findStartUnder() {
   // Each free vertex of its own near the garments below takes the side of the nearest of
   // their triangles, along its normal, where it lies over or under it (more along the normal
-  // than beside it: not past a hem); the side most take over a connected piece of them is
-  // the one it is worn on there.
+  // than beside it: not past a hem). The side it is worn on is the one away from the body
+  // at that point, when the body is known; else the side most take over a connected piece
+  // of them.
   startUnder_ = {};
   under_.clear();
   if (below_.empty()) return;
-  const double depth = kUnderDepthGaps * gap_;
+  const double depth = body_.empty() ? kLiftDepthGaps * gap_ : std::max(kLiftDepthGaps * gap_, kBodyUnderDepth_m);
   struct Side {
     std::uint32_t vertex, triangle;
     double along;
+    Vec3 closest;
   };
   std::vector<Side> sides;  // once, at set-up
   for (std::uint32_t v = 0; v < ownVertices_; ++v) {
@@ -348,6 +368,7 @@ void LayerCollider::findStartUnder() {
     const Vec3 p = at(lastX_, lastY_, lastZ_, v);
     double nearest = depth, along = 0.0;
     std::uint32_t under = 0;
+    Vec3 closest = Vec3::Zero();
     for (std::uint32_t t = ownTriangles_; t < triangles_.size(); ++t) {
       const auto& c = triangles_[t];
       const std::array<Vec3, 3> corners{at(lastX_, lastY_, lastZ_, c[0]), at(lastX_, lastY_, lastZ_, c[1]),
@@ -355,13 +376,15 @@ void LayerCollider::findStartUnder() {
       const Vec3 n = unitNormal(corners);
       const double off = (p - corners[0]).dot(n);  // no farther from the triangle than from its plane
       if (n.isZero() || std::abs(off) > nearest) continue;
-      const double distance = (p - mesh::closestOnTriangle(p, corners[0], corners[1], corners[2])).norm();
+      const Vec3 q = mesh::closestOnTriangle(p, corners[0], corners[1], corners[2]);
+      const double distance = (p - q).norm();
       if (distance > nearest) continue;
       nearest = distance;
       along = off;
       under = t;
+      closest = q;
     }
-    if (along != 0.0 && std::abs(along) >= 0.5 * nearest) sides.push_back({v, under, along});
+    if (along != 0.0 && std::abs(along) >= 0.5 * nearest) sides.push_back({v, under, along, closest});
   }
   // Per connected piece below (root vertex): how many take each side.
   std::vector<std::uint32_t> above(vertexCount(), 0u), total(vertexCount(), 0u);
@@ -372,8 +395,16 @@ void LayerCollider::findStartUnder() {
   }
   startUnder_.over = sides.size();
   for (const Side& side : sides) {
-    const std::uint32_t piece = componentBelow(triangles_[side.triangle][0]);
-    const double wornSide = 2 * above[piece] >= total[piece] ? 1.0 : -1.0;
+    double wornSide = 0.0;
+    if (body_.empty()) {
+      const std::uint32_t piece = componentBelow(triangles_[side.triangle][0]);
+      wornSide = 2 * above[piece] >= total[piece] ? 1.0 : -1.0;
+    } else {
+      const auto& c = triangles_[side.triangle];
+      const Vec3 n = unitNormal({at(lastX_, lastY_, lastZ_, c[0]), at(lastX_, lastY_, lastZ_, c[1]),
+                                 at(lastX_, lastY_, lastZ_, c[2])});
+      wornSide = n.dot(side.closest - nearestOf(body_, side.closest)) >= 0.0 ? 1.0 : -1.0;
+    }
     if (side.along * wornSide >= 0) continue;
     under_.push_back({side.vertex, side.triangle, side.along, wornSide});
     ++startUnder_.vertices;
@@ -397,8 +428,15 @@ bool LayerCollider::belowWoundOneWay() const {
 
 std::size_t LayerCollider::liftOver(ClothState& state) {
   lifted_ = {};
-  if (under_.empty() || !belowWoundOneWay()) return 0;
+  if (under_.empty()) return 0;
+  if (body_.empty() && !belowWoundOneWay()) {
+    lifted_.leftUnder = under_.size();
+    return 0;
+  }
+  const double depth = kLiftDepthGaps * gap_;
   for (const Under& u : under_) {
+    // Deeper, the move would tear the garment's triangles across the one below: left there.
+    if (std::abs(u.along) > depth) continue;
     const auto& c = triangles_[u.triangle];
     const Vec3 n = unitNormal({at(lastX_, lastY_, lastZ_, c[0]), at(lastX_, lastY_, lastZ_, c[1]),
                                at(lastX_, lastY_, lastZ_, c[2])});
@@ -406,8 +444,9 @@ std::size_t LayerCollider::liftOver(ClothState& state) {
     state.setPosition(u.vertex, state.position(u.vertex) + move * n);
     state.setVelocity(u.vertex, Vec3::Zero());
     lifted_.largest_m = std::max(lifted_.largest_m, std::abs(move));
+    ++lifted_.vertices;
   }
-  lifted_.vertices = under_.size();
+  lifted_.leftUnder = under_.size() - lifted_.vertices;
   under_.clear();      // over them now; startUnder_ keeps what was modelled, for the log and stats
   remember(state);     // its own points start where they were moved to
   return lifted_.vertices;
@@ -544,25 +583,62 @@ void LayerCollider::buildGrid(const ClothState& after) {
   // in neither.
   for (const std::uint8_t kind : {kOwnPoint, kPointBelow}) {
     PointGrid& grid = grids_[kind == kOwnPoint ? 0 : 1];
+    std::vector<std::uint32_t>& offGrid = offGrid_[kind == kOwnPoint ? 0 : 1];
+    offGrid.clear();
     std::fill(grid.start.begin(), grid.start.end(), 0u);
-    for (std::size_t v = 0; v < n; ++v)
-      if (tested_[v] & kind) forBucketsOnce(v, [&](std::uint32_t b) { ++grid.start[b + 1]; });
+    for (std::size_t v = 0; v < n; ++v) {
+      if (!(tested_[v] & kind)) continue;
+      const double lo[3] = {pointLo_[0][v], pointLo_[1][v], pointLo_[2][v]},
+                   hi[3] = {pointHi_[0][v], pointHi_[1][v], pointHi_[2][v]};
+      if (fitsGrid(lo, hi))
+        forBucketsOnce(v, [&](std::uint32_t b) { ++grid.start[b + 1]; });
+      else
+        offGrid.push_back(static_cast<std::uint32_t>(v));
+    }
     for (std::size_t b = 1; b < grid.start.size(); ++b) grid.start[b] += grid.start[b - 1];
     if (grid.start.back() > grid.point.size()) {
       grid.point.resize(grid.start.back() + grid.start.back() / 4);
       grid.box.resize(6 * grid.point.size());
     }
     std::copy(grid.start.begin(), grid.start.end() - 1, grid.fill.begin());
-    for (std::size_t v = 0; v < n; ++v)
-      if (tested_[v] & kind)
-        forBucketsOnce(v, [&](std::uint32_t b) {
+    std::size_t nextOff = 0;
+    for (std::size_t v = 0; v < n; ++v) {
+      if (!(tested_[v] & kind)) continue;
+      if (nextOff < offGrid.size() && offGrid[nextOff] == v) {
+        ++nextOff;
+        continue;
+      }
+      forBucketsOnce(v, [&](std::uint32_t b) {
           const std::uint32_t e = grid.fill[b]++;
-          grid.point[e] = static_cast<std::uint32_t>(v);
-          for (int a = 0; a < 3; ++a) {
-            grid.box[6 * e + a] = pointLo_[a][v];
-            grid.box[6 * e + 3 + a] = pointHi_[a][v];
-          }
-        });
+        grid.point[e] = static_cast<std::uint32_t>(v);
+        for (int a = 0; a < 3; ++a) {
+          grid.box[6 * e + a] = pointLo_[a][v];
+          grid.box[6 * e + 3 + a] = pointHi_[a][v];
+        }
+      });
+    }
+  }
+}
+
+bool LayerCollider::fitsGrid(const double* lo, const double* hi) const {
+  // At most span / cell + 2 cells along an axis.
+  double cells = 1.0;
+  for (int a = 0; a < 3; ++a) cells *= (hi[a] - lo[a]) * inverseCell_ + 2.0;
+  return cells <= kMostCellsPerBox;  // false for NaN
+}
+
+void LayerCollider::pairWithPointsOffGrid(std::uint32_t t, const double* lo, const double* hi, std::uint8_t kinds,
+                                          const std::vector<std::uint32_t>* points) {
+  const auto consider = [&](std::uint32_t v) {
+    if (!(tested_[v] & kinds)) return;
+    const bool meets = (pointLo_[0][v] <= hi[0]) & (pointHi_[0][v] >= lo[0]) & (pointLo_[1][v] <= hi[1]) &
+                       (pointHi_[1][v] >= lo[1]) & (pointLo_[2][v] <= hi[2]) & (pointHi_[2][v] >= lo[2]);
+    if (meets && pairThickness(v, t) > 0) pairs_.push_back({v, t});
+  };
+  if (points != nullptr) {
+    for (const std::uint32_t v : *points) consider(v);
+  } else {
+    for (std::uint32_t v = 0; v < tested_.size(); ++v) consider(v);
   }
 }
 
@@ -595,6 +671,13 @@ void LayerCollider::gatherPairs() {
     const std::uint8_t accept = pointsAccepted(t);
     const bool scan[2] = {(accept & kOwnPoint) != 0, (accept & kPointBelow) != 0};
     const std::size_t its = pairs_.size();
+    if (!fitsGrid(lo, hi)) {  // a triangle stretched across the scene: every point, by its box
+      pairWithPointsOffGrid(t, lo, hi, accept, nullptr);
+      std::sort(pairs_.begin() + static_cast<std::ptrdiff_t>(its), pairs_.end());
+      continue;
+    }
+    for (int g = 0; g < 2; ++g)
+      if (scan[g]) pairWithPointsOffGrid(t, lo, hi, g == 0 ? kOwnPoint : kPointBelow, &offGrid_[g]);
     forCells(lo, hi, [&](std::int64_t ix, std::int64_t iy, std::int64_t iz) {
       const std::uint32_t b = bucketOf(ix, iy, iz);
       for (int g = 0; g < 2; ++g) {

@@ -185,9 +185,10 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
   // the body: where the two disagree, the body wins.
   for (std::size_t g = 0; g < garments.size(); ++g) {
     GarmentRun& run = garments_[g];
-    run.layers = makeLayerCollider(garments, g, below[g], run.fixed, [&](std::size_t i) -> cloth::ClothSolver& {
-      return *garments_[i].solver;
-    }, 1.0 / settings_.step.frameRate_hz);
+    run.layers = makeLayerCollider(
+        garments, g, below[g], run.fixed, [&](std::size_t i) -> cloth::ClothSolver& { return *garments_[i].solver; },
+        1.0 / settings_.step.frameRate_hz,
+        below[g].empty() ? std::vector<Vec3>{} : restBodyPoints(avatar, garments[g].collidesWith));
     if (run.layers) run.solver->addCollider(*run.layers);
     run.solver->addCollider(*run.collider);
   }

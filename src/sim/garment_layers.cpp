@@ -34,10 +34,20 @@ std::vector<std::vector<std::size_t>> garmentsBelow(const std::vector<GarmentSpe
   return below;
 }
 
+std::vector<Vec3> restBodyPoints(const scene::Avatar& avatar, const std::vector<std::string>& segments) {
+  std::vector<Vec3> points;
+  for (const scene::Segment& s : avatar.segments) {
+    if (std::find(segments.begin(), segments.end(), s.name) == segments.end()) continue;
+    const RigidTransform rest = avatar.joints[static_cast<std::size_t>(s.joint)].restWorld();
+    for (const Vec3& p : s.mesh.positions) points.push_back(rest.apply(p));
+  }
+  return points;
+}
+
 std::unique_ptr<cloth::LayerCollider> makeLayerCollider(
     const std::vector<GarmentSpec>& garments, std::size_t g, std::span<const std::size_t> below,
     const std::vector<std::uint32_t>& fixed, const std::function<cloth::ClothSolver&(std::size_t)>& solver,
-    double frame_s) {
+    double frame_s, std::vector<Vec3> body) {
   const GarmentSpec& spec = garments[g];
   if (!(spec.selfCollision_m > 0) && below.empty()) return nullptr;
   cloth::ClothSolver& own = solver(g);
@@ -46,6 +56,7 @@ std::unique_ptr<cloth::LayerCollider> makeLayerCollider(
   layers->setStitches(spec.stitches);
   for (const std::size_t b : below)
     layers->addGarmentBelow(solver(b).model(), garments[b].name, solver(b).state(), spec.overGap_m, frame_s);
+  if (!below.empty()) layers->setBody(std::move(body));
   layers->initialise(own.state());
   layers->liftOver(own.mutableState());  // what was modelled under the garments below, out over them
   return layers;

@@ -172,6 +172,10 @@ TEST(AddGarment, AGarmentTheSceneCannotTakeLeavesItAsItWas) {
   refused(add + "--name Outer --waist-segment Waist", "the avatar has no segment 'Waist'");
   refused("make-skirt " + kBody + " --out '" + (dir / "x") + "' --over Skirt", "--over goes with --add-to SCENE");
   refused("make-skirt --clearance 0.03", "give the avatar to fit the skirt to, or --add-to SCENE");
+  // A skirt narrower than the one it is worn over lies under it, most of it deeper than drape
+  // run moves out: refused.
+  refused(add + "--name Inner --clearance 0.01 --flare 0.05 --over Skirt",
+          "of the vertices of 'Inner' lie under Skirt by more than 16 mm (the deepest, vertex ");
 
   // The MakeHuman dress needs far more substeps than the skirt's scene steps.
   const std::string dress = "make-scene --add-to '" + scene + "' --garment '" + kSource +
@@ -192,9 +196,16 @@ TEST(AddGarment, AGarmentTheSceneCannotTakeLeavesItAsItWas) {
   std::string named = original;
   testing::replaceOnce(named, "DEF Body Avatar {", "DEF Body Avatar {\n  name \"Ada\"");
   std::ofstream(scene, std::ios::trunc) << named;
-  const CliResult r = runDrape(add + "--name Outer --clearance 0.035 --flare 0.25 --over Skirt", dir);
+  // A little narrower than the skirt low down: the run moves those vertices out over it.
+  const CliResult r = runDrape(add + "--name Outer --clearance 0.022 --flare 0.11 --over Skirt", dir);
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("worn by Ada over Skirt"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("144 of its vertices lie under Skirt by up to 2.7 mm: drape run moves them out over it"),
+            std::string::npos)
+      << r.out;
+  const nlohmann::json over = statsOf(runInto(dir, "run", "'" + scene + "' --frames 3"))["garments"][1]["worn_over"];
+  EXPECT_EQ(over["vertices_lifted_over"], 144);
+  EXPECT_EQ(over["vertices_left_under"], 0);
   const std::string added = slurp(scene);
   EXPECT_TRUE(added.substr(0, named.size()) == named) << "the scene's own text changed";
   EXPECT_NE(added.find("  avatar USE Body\n  collidesWith", named.size()), std::string::npos);

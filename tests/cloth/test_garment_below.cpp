@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <random>
 #include <set>
@@ -96,6 +97,13 @@ TEST(GarmentBelow, TheGridFindsWhatBruteForceFinds) {
     std::vector<Vec3> after = both.positions;
     std::uniform_real_distribution<double> move(-0.6 * gap, 0.6 * gap);
     for (Vec3& p : after) p += Vec3(move(random), move(random), move(random));
+    if (trial % 4 == 3) {
+      // An unstable substep flings a point of each a kilometre: their boxes, and their
+      // triangles', touch too many cells to be listed cell by cell.
+      after[static_cast<std::size_t>(unit(random) * over.positions.size())] += Vec3(1000.0, -300.0, 20.0);
+      after[over.positions.size() + static_cast<std::size_t>(unit(random) * below.positions.size())] +=
+          Vec3(-5.0, 800.0, 1000.0);
+    }
     const ClothState belowState = stateAt(below.positions);
     LayerCollider collider(*overModel, "over", self);
     std::vector<std::uint32_t> held;
@@ -350,6 +358,68 @@ TEST(GarmentBelow, VerticesThatStartUnderItAreMovedOutOneGapOverIt) {
   EXPECT_FALSE(unsure.belowWoundOneWay());
   EXPECT_EQ(unsure.liftOver(untouched), 0u);
   for (std::uint32_t v = 0; v < over.positions.size(); ++v) EXPECT_EQ(untouched.position(v), over.positions[v]);
+}
+
+TEST(GarmentBelow, WithTheBodyTheSideAwayFromItIsOver) {
+  // A sheet modelled under another, a gap below it, but for three vertices poking out over
+  // it; four more sunk six gaps deep. The body lies under both.
+  std::mt19937 random(23);
+  const double gap = 0.004;
+  const mesh::TriMesh below = wavySheet(12, 0.0, 0.02, 0.0, 7, random);
+  mesh::TriMesh over = below;
+  for (Vec3& p : over.positions) p.y() -= gap;
+  const std::vector<std::uint32_t> poking{15, 40, 77}, deep{50, 51, 90, 130};
+  for (const std::uint32_t v : poking) over.positions[v].y() += 2 * gap;
+  for (const std::uint32_t v : deep) over.positions[v].y() -= 5 * gap;
+  std::vector<Vec3> body;
+  for (int i = 0; i <= 20; ++i)
+    for (int k = 0; k <= 20; ++k) body.emplace_back(0.05 * i, -0.15, 0.05 * k);
+  const auto overModel = makeModel(over, knit()), belowModel = makeModel(below, knit());
+  const ClothState belowState = stateAt(below.positions);
+  const auto collider = [&](const std::shared_ptr<const ClothModel>& model, bool withBody) {
+    auto c = std::make_unique<LayerCollider>(*overModel, "over", 0.0);
+    c->addGarmentBelow(*model, "below", belowState, gap, kFrame_s);
+    if (withBody) c->setBody(body);
+    return c;
+  };
+  const std::size_t sunk = over.positions.size() - poking.size();
+
+  // Without the body, the side most vertices start on is over: the three poking out are under.
+  auto most = collider(belowModel, false);
+  most->initialise(stateAt(over.positions));
+  EXPECT_FALSE(most->sidesFromBody());
+  EXPECT_EQ(most->startUnder().vertices, poking.size());
+
+  // With it, all but those three are under; all but the deep four are moved out one gap over it.
+  for (const bool wound : {true, false}) {
+    SCOPED_TRACE(wound ? "faces below wound one way" : "a face below wound the other way");
+    mesh::TriMesh faces = below;
+    if (!wound) std::swap(faces.triangles[30][0], faces.triangles[30][1]);
+    auto byBody = collider(makeModel(faces, knit()), true);
+    ClothState state = stateAt(over.positions);
+    byBody->initialise(state);
+    EXPECT_TRUE(byBody->sidesFromBody());
+    EXPECT_EQ(byBody->startUnder().vertices, sunk);
+    EXPECT_TRUE(std::find(deep.begin(), deep.end(), byBody->startUnder().deepestVertex) != deep.end());
+    EXPECT_NEAR(byBody->startUnder().deepest_m, 6 * gap, 1.5 * gap);
+    EXPECT_EQ(byBody->liftOver(state), sunk - deep.size());
+    EXPECT_EQ(byBody->liftedOver().leftUnder, deep.size());
+    const SurfaceHeight height(below);
+    std::size_t measured = 0;
+    for (std::uint32_t v = 0; v < over.positions.size(); ++v) {
+      const bool stays = std::find(deep.begin(), deep.end(), v) != deep.end() ||
+                         std::find(poking.begin(), poking.end(), v) != poking.end();
+      if (stays) {
+        EXPECT_EQ(state.position(v), over.positions[v]) << "vertex " << v;
+        continue;
+      }
+      const double h = height.above(state.position(v));
+      if (std::isnan(h)) continue;  // moved along the tilted normal past the sheet's edge
+      EXPECT_NEAR(h, gap, 0.1 * gap) << "vertex " << v;
+      ++measured;
+    }
+    EXPECT_GT(measured, sunk - 48);  // all but a few on the edge
+  }
 }
 
 TEST(GarmentBelow, AGapMustBeAPositiveLength) {

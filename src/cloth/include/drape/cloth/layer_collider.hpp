@@ -99,7 +99,9 @@ struct LayerCounters {
 /// The vertices of a garment that start on the other side of the garments it is worn over
 /// than the rest of it (modelled partly under them): the layers keep the side they start on.
 struct StartUnder {
-  std::size_t over = 0;      ///< free vertices over the garments below (within a few gaps of a triangle, projecting into it)
+  /// Free vertices near the garments below (within 4 gaps of a triangle, 10 cm when the
+  /// body is known, more along its normal than beside it).
+  std::size_t over = 0;
   std::size_t vertices = 0;  ///< of those, on the side fewer are on
   std::uint32_t deepestVertex = 0;
   double deepest_m = 0.0;  ///< its distance from the triangle it is under
@@ -109,6 +111,7 @@ struct StartUnder {
 struct LiftedOver {
   std::size_t vertices = 0;
   double largest_m = 0.0;  ///< the largest move
+  std::size_t leftUnder = 0;   ///< of those starting under, too deep to move (all, when none could be)
 };
 
 class LayerCollider final : public Collider {
@@ -131,6 +134,17 @@ class LayerCollider final : public Collider {
   /// Stitched vertices are one point of the cloth: neither is tested against the triangles
   /// around the other (which a stitch holds it among).
   void setStitches(const std::vector<Stitch>& stitches);
+  /// The body the garment is worn on, as points at rest (its collidable parts; before
+  /// initialise): which side of the garments below a vertex near them is over is then the
+  /// side away from the body there, found up to kBodyUnderDepth_m from them, however their
+  /// faces are wound. Without it, the side most of its vertices within 4 gaps of them take
+  /// on each connected piece of them.
+  void setBody(std::vector<Vec3> points);
+  /// How far from the garments below a vertex is looked at by the body's side (setBody).
+  static constexpr double kBodyUnderDepth_m = 0.1;
+  /// How deep under them, in gaps, a vertex is moved out over them (liftOver); without the
+  /// body, also how far from them the sides are looked at.
+  static constexpr double kLiftDepthGaps = 4.0;
   /// Where the garment starts (the sides of its first test): its rest shape unless given;
   /// the garments below where their states are now.
   void initialise(const ClothState& state);
@@ -145,12 +159,16 @@ class LayerCollider final : public Collider {
   /// Its vertices that start under the garments below, as initialise() found them.
   [[nodiscard]] const StartUnder& startUnder() const { return startUnder_; }
   /// Moves the vertices that start under the garments below (startUnder) out over them,
-  /// `gap` above the triangle each is under, with no velocity, and starts them there; but
-  /// not when the faces of the garments below are not all wound one way (their sides could
-  /// not be told). How many it moved. After initialise(); startUnder() keeps what was
+  /// `gap` above the triangle each is under, with no velocity, and starts them there: those
+  /// within 4 gaps of it (deeper, the move would stretch its triangles across the garment
+  /// below; they stay under it). Without a body (setBody), none when the faces of the
+  /// garments below are not all wound one way (their sides could not be told). How many it
+  /// moved. After initialise(); startUnder() keeps what was
   /// modelled.
   std::size_t liftOver(ClothState& state);
   [[nodiscard]] const LiftedOver& liftedOver() const { return lifted_; }
+  /// Whether the sides over the garments below are told by the body (setBody).
+  [[nodiscard]] bool sidesFromBody() const { return !body_.empty(); }
   /// Whether the garments below go along each edge two of their faces share once each way.
   [[nodiscard]] bool belowWoundOneWay() const;
   /// Its own layers' thickness (0: not kept apart).
@@ -273,6 +291,13 @@ class LayerCollider final : public Collider {
   /// Calls visit(bucket) once for every bucket a cell of point v's box lies in.
   template <typename Visit>
   void forBucketsOnce(std::size_t v, Visit&& visit);
+  /// Whether the box [lo, hi] touches few enough cells to be looked up cell by cell (false
+  /// for a box with a coordinate that is not finite).
+  [[nodiscard]] bool fitsGrid(const double* lo, const double* hi) const;
+  /// Appends the pairs of triangle t (box [lo, hi]) with points listed in no grid: the
+  /// points of `kinds` that are among `points`, or every point of `kinds` when `points` is null.
+  void pairWithPointsOffGrid(std::uint32_t t, const double* lo, const double* hi, std::uint8_t kinds,
+                             const std::vector<std::uint32_t>* points);
 
   std::string garment_;
   double thickness_;
@@ -303,6 +328,9 @@ class LayerCollider final : public Collider {
   std::array<std::vector<double>, 3> pointLo_, pointHi_;        ///< per axis, per point: its box in the list
   std::array<std::vector<double>, 3> triangleLo_, triangleHi_;  ///< per axis, per triangle: its box in the list
   std::array<PointGrid, 2> grids_;           ///< [0]: its own points; [1]: the points below
+  /// Per grid, the points whose boxes touch too many cells to be listed in it (a point
+  /// flung far by an unstable substep): every triangle that can pair with them looks at them.
+  std::array<std::vector<std::uint32_t>, 2> offGrid_;
   std::uint32_t bucketMask_ = 0;
   double inverseCell_ = 1.0;
   std::vector<std::uint32_t> bucketsOfPoint_;  ///< forBucketsOnce's
@@ -334,6 +362,7 @@ class LayerCollider final : public Collider {
   std::vector<Under> under_;
   LiftedOver lifted_;
   std::vector<std::uint32_t> componentBelow_;  ///< per point: its parent in the pieces below
+  std::vector<Vec3> body_;  ///< the body at rest (setBody); empty: sides by the most vertices
 };
 
 }  // namespace drape::cloth

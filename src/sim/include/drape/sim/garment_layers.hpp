@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "drape/cloth/layer_collider.hpp"
@@ -25,15 +26,21 @@ namespace drape::sim {
 /// Per garment, its layer (garmentsBelow's lists, which do not go round): the scene's.
 using scene::layersOf;
 
+/// The avatar's segments named in `segments` at rest, as points in the world: the body a
+/// garment colliding with them is worn on (cloth::LayerCollider::setBody).
+[[nodiscard]] std::vector<Vec3> restBodyPoints(const scene::Avatar& avatar, const std::vector<std::string>& segments);
+
 /// The layer collider garment `g` of `garments` needs: its own layers kept apart
 /// (selfCollision_m) and the garments it is worn over (`below`, garmentsBelow's list for
 /// it) kept overGap_m under it; null when it needs neither. `fixed`: its vertices a fixture
 /// moves; `solver(i)`: garment i's solver, whose state the collider reads each frame (it
-/// must outlive the collider); frame_s: the frames' length. Initialised at the solvers'
-/// states now; the caller adds it to g's solver before the body's collider.
+/// must outlive the collider); frame_s: the frames' length; `body`: the body it is worn on
+/// at rest (restBodyPoints; empty: none), which tells which side of the garments below is
+/// over. Initialised at the solvers' states now, with what was modelled under the garments
+/// below moved out over them; the caller adds it to g's solver before the body's collider.
 [[nodiscard]] std::unique_ptr<cloth::LayerCollider> makeLayerCollider(
     const std::vector<GarmentSpec>& garments, std::size_t g, std::span<const std::size_t> below,
     const std::vector<std::uint32_t>& fixed, const std::function<cloth::ClothSolver&(std::size_t)>& solver,
-    double frame_s);
+    double frame_s, std::vector<Vec3> body = {});
 
 }  // namespace drape::sim

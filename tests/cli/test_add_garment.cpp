@@ -206,6 +206,20 @@ TEST(AddGarment, AGarmentTheSceneCannotTakeLeavesItAsItWas) {
   const nlohmann::json over = statsOf(runInto(dir, "run", "'" + scene + "' --frames 3"))["garments"][1]["worn_over"];
   EXPECT_EQ(over["vertices_lifted_over"], 144);
   EXPECT_EQ(over["vertices_left_under"], 0);
+
+  // Written by hand over the skirt, the narrow one is run: the run says what it leaves under.
+  std::ofstream(scene, std::ios::trunc) << named;
+  ASSERT_EQ(runDrape(add + "--name Inner --clearance 0.01 --flare 0.05", dir).code, 0);
+  std::string inner = slurp(scene);
+  const std::size_t last = inner.rfind("  maskTolerance 0.0005");
+  inner.insert(last, "  over [ \"Skirt\" ]\n");
+  std::ofstream(scene, std::ios::trunc) << inner;
+  const CliResult ran = runDrape("run '" + scene + "' --frames 2 --out '" + (dir / "inner") + "'", dir);
+  EXPECT_EQ(ran.code, 0) << ran.err;
+  EXPECT_NE(ran.err.find("Inner: 192 of its vertices lie too far under Skirt to be moved out (more than 16 mm"),
+            std::string::npos)
+      << ran.err;
+  EXPECT_EQ(statsOf(dir / "inner")["garments"][1]["worn_over"]["vertices_left_under"], 192);
   const std::string added = slurp(scene);
   EXPECT_TRUE(added.substr(0, named.size()) == named) << "the scene's own text changed";
   EXPECT_NE(added.find("  avatar USE Body\n  collidesWith", named.size()), std::string::npos);

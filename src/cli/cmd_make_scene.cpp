@@ -45,11 +45,7 @@ struct MakeSceneOptions {
   std::string out;
   std::string name;
   std::string title;
-  std::string addTo;      ///< --add-to: the scene the garment is added to
-  std::string character;  ///< --character: who wears it there
-  std::vector<std::string> over;  ///< --over: the garments it is worn over
-  double overGap_m = 0.004;
-  std::vector<double> colour;  ///< --colour (empty: blue, or one the scene's garments do not have)
+  AddToOptions add;  ///< --add-to, --character, --over, --over-gap, --colour
   std::vector<std::string> collidesWith;
   std::vector<std::string> faceSamplesWith;
   std::vector<std::string> keepApart;  ///< --keep-apart: the scene's Simulation keepApart
@@ -134,15 +130,13 @@ mesh::TriMesh fitMask(const mesh::TriMesh& mask, const scene::MakeHumanGarment& 
 ClothSetText clothSetOf(const MakeSceneOptions& o, const mesh::TriMesh& garment, const mesh::TriMesh& mask) {
   ClothSetText c;
   c.name = o.name;
-  if (!o.colour.empty()) c.colour = Vec3(o.colour[0], o.colour[1], o.colour[2]);
+  if (!o.add.colour.empty()) c.colour = Vec3(o.add.colour[0], o.add.colour[1], o.add.colour[2]);
   c.cloth = &garment;
   c.mask = &mask;
   c.collidesWith = o.collidesWith;
   c.faceSamplesWith = o.faceSamplesWith;
   c.stitches = o.stitches;
   c.selfCollision_m = o.selfCollision_m;
-  c.over = o.over;
-  c.overGap_m = o.overGap_m;
   c.bindThreshold_m = o.bindThreshold_m;
   return c;
 }
@@ -171,7 +165,7 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
              o.cutAtJoints.empty() ? "" : fmt::format("  cutAtJoints [ \"{}\" ]\n", fmt::join(o.cutAtJoints, "\", \"")));
   ClothSetText c = clothSetOf(o, garment, mask);
   c.def = "Garment";
-  c.colour = o.colour.empty() ? Vec3(0.15, 0.25, 0.55) : c.colour;
+  c.colour = o.add.colour.empty() ? Vec3(0.15, 0.25, 0.55) : c.colour;
   writeClothSet(os, c);
   if (!os) throw Error(fmt::format("{}: cannot be written", path));
 }
@@ -267,46 +261,40 @@ int makeScene(MakeSceneOptions& o) {
 
 /// --add-to: the garment put on the scene's character where the scene places it, and appended.
 int addGarment(MakeSceneOptions& o) {
-  const SceneToDress dress = openSceneToDress(o.addTo, o.character);
+  const SceneToDress dress = openSceneToDress(o.add.scene, o.add.character);
   const scene::Avatar& avatar = *dress.character.avatar;
   auto [garment, mask] = readGarment(o, dress.avatarFile);
   // Modelled on the avatar file at rest; the scene places that file's frame.
   for (mesh::TriMesh* m : {&garment, &mask})
     for (Vec3& p : m->positions) p = dress.placement.apply(dress.scale * p);
   if (o.name.empty()) o.name = std::filesystem::path(o.garment).stem().string();
-  const std::string whose = fmt::format("{} ('{}')", o.addTo, dress.character.name);
-  checkNewGarment(dress, o.name, o.over);
-  chooseCollidables(o, avatar, garment, whose);
+  checkNewGarment(dress, o.name, o.add.over);
+  chooseCollidables(o, avatar, garment, fmt::format("{} ('{}')", o.add.scene, dress.character.name));
   const double added = checkSceneSteps(dress, garment, o.material, o.name);
   if (o.stitchGaps_m > 0.0) o.stitches = openingsToSew(garment, mesh::Topology::build(garment), o.name, o.stitchGaps_m);
 
   const mesh::TriMesh cloth = inFileUnits(dress, garment), clothMask = inFileUnits(dress, mask);
   ClothSetText c = clothSetOf(o, cloth, clothMask);
-  if (o.colour.empty()) c.colour = unusedColour(dress.scene);
   if (!o.offsets.empty()) c.offsets = std::array<double, 4>{o.offsets[0], o.offsets[1], o.offsets[2], o.offsets[3]};
-  c.material = materialNode(o.material, "  ");
-  c.avatar = dress.avatarDef;
+  dressFor(c, dress, o.add, materialNode(o.material, "  "));
   std::ostringstream text;
-  fmt::print(text, "# {}: added by `drape make-scene --add-to`, worn by {}{}.\n", o.name, dress.character.name,
-             o.over.empty() ? "" : fmt::format(" over {}", fmt::join(o.over, ", ")));
+  text << addedComment("make-scene", o.name, dress, o.add);
   writeClothSet(text, c);
   appendToScene(dress, text.str());
 
-  const std::filesystem::path dir = std::filesystem::path(o.addTo).parent_path();
+  const std::filesystem::path dir = std::filesystem::path(o.add.scene).parent_path();
   formats::writeObj((dir / (o.name + ".obj")).string(), garment.positions, garment.triangles,
                     "drape make-scene: " + o.name + " (m, world)");
   formats::writeObj((dir / (o.name + "_mask.obj")).string(), mask.positions, mask.triangles,
                     "drape make-scene: constraint mask of " + o.name + " (m, world)");
-  fmt::print("{}: {} vertices, {} triangles; mask {} vertices; worn by {}{}\n", o.name, garment.vertexCount(),
-             garment.triangleCount(), mask.vertexCount(), dress.character.name,
-             o.over.empty() ? "" : fmt::format(" over {}, {:g} m above", fmt::join(o.over, ", "), o.overGap_m));
+  fmt::print("{}: {} vertices, {} triangles; mask {} vertices; {}\n", o.name, garment.vertexCount(),
+             garment.triangleCount(), mask.vertexCount(), wornText(dress, o.add));
   fmt::print("collides with {}\n", fmt::join(o.collidesWith, ", "));
-  fmt::print("the scene's {} substeps per frame keep it stable{}\n", dress.scene.simulation.stepsPerFrame,
-             added > 0.0 ? fmt::format(" (mass scaling adds {:.2f} % of its mass)", 100.0 * added) : "");
+  printSceneSteps(dress, added);
   if (!o.stitches.empty())
     fmt::print("{} stitches across gaps of up to {:.1f} mm\n", o.stitches.size(), 1e3 * widestStitch_m(garment, o.stitches));
-  fmt::print("added it to {}; wrote {}.obj, {}_mask.obj beside it\n", o.addTo, o.name, o.name);
-  printHowToRun(o.addTo, avatar, dress.character.motion);
+  fmt::print("added it to {}; wrote {}.obj, {}_mask.obj beside it\n", o.add.scene, o.name, o.name);
+  printHowToRun(o.add.scene, avatar, dress.character.motion);
   return 0;
 }
 
@@ -322,26 +310,12 @@ RunFunction setupMakeScene(CLI::App& app) {
                  "Constraint mask OBJ: the garment vertices bound to the body (for a .mhclo: on its OBJ as modelled)")
       ->required();
   app.add_option("--out", o.out, "Directory for scene.wrl (required without --add-to)");
-  app.add_option("--add-to", o.addTo,
-                 "Add the garment to this scene instead, on its character (a jacket over the shirt it wears): "
-                 "modelled on the file its Avatar node loads, placed as the node places it, and appended to the "
-                 "scene as a ClothSet once the scene with it loads; NAME.obj and NAME_mask.obj are written beside "
-                 "it. --offsets become the garment's own");
-  app.add_option("--character", o.character,
-                 "With --add-to: the character who wears it (its Avatar or Humanoid node's name; default: the "
-                 "scene's only one)");
-  app.add_option("--over", o.over,
-                 "With --add-to: the character's garments it is worn over, written as its over (kept --over-gap "
-                 "above them; docs/PHYSICS.md)")
-      ->delimiter(',');
-  app.add_option("--over-gap", o.overGap_m, "With --over: how far above them it keeps, m, written as its overGap")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  app.add_option("--colour", o.colour,
-                 "Its colour, R,G,B from 0 to 1 (default: blue; with --add-to, a colour no garment of the scene has)")
-      ->delimiter(',')
-      ->expected(3)
-      ->check(CLI::Range(0.0, 1.0));
+  addAddToOptions(app, o.add,
+                  "Add the garment to this scene instead, on its character (a jacket over the shirt it wears): "
+                  "modelled on the file its Avatar node loads, placed as the node places it, and appended to the "
+                  "scene as a ClothSet once the scene with it loads; NAME.obj and NAME_mask.obj are written beside "
+                  "it. --offsets become the garment's own",
+                  "blue");
   app.add_option("--units", o.units, "Length unit of both OBJ files: m, dm, cm, mm, in")->capture_default_str();
   app.add_option("--name", o.name, "Garment name (default: the OBJ's file name)");
   app.add_option("--title", o.title, "Scene title (default: the garment name)");
@@ -401,23 +375,10 @@ RunFunction setupMakeScene(CLI::App& app) {
     if (!(o.frameRate > 0.0)) throw Error(fmt::format("--frame-rate must be > 0, got {}", o.frameRate));
     if (o.stepsPerFrame < 0) throw Error(fmt::format("--substeps must be >= 1, got {}", o.stepsPerFrame));
     if (!(o.stitchGaps_m >= 0.0)) throw Error(fmt::format("--stitch-gaps must be >= 0 m, got {}", o.stitchGaps_m));
-    if (o.addTo.empty()) {
-      if (o.avatar.empty()) throw Error("make-scene: give the avatar the garment was modelled on, or --add-to SCENE");
-      if (o.out.empty()) throw Error("make-scene: --out DIR is required (or --add-to SCENE)");
-      for (const char* option : {"--character", "--over", "--over-gap"})
-        if (app.count(option) > 0) throw Error(fmt::format("{} goes with --add-to SCENE", option));
+    if (!addingToScene(app, o.add, "make-scene", o.avatar, o.out,
+                       {"--out", "--avatar-url", "--title", "--voxel", "--frame-rate", "--substeps", "--bend-every",
+                        "--collision-every", "--max-added-mass", "--keep-apart", "--cut-at-joints"}))
       return makeScene(o);
-    }
-    if (!o.avatar.empty())
-      throw Error(fmt::format("make-scene --add-to {}: the garment goes on the scene's character; give no avatar ({})",
-                              o.addTo, o.avatar));
-    for (const char* option : {"--out", "--avatar-url", "--title", "--voxel", "--frame-rate", "--substeps",
-                               "--bend-every", "--collision-every", "--max-added-mass", "--keep-apart",
-                               "--cut-at-joints"})
-      if (app.count(option) > 0)
-        throw Error(fmt::format("{} does not go with --add-to: it is the scene's own setting (edit {} for it)", option,
-                                o.addTo));
-    if (app.count("--over-gap") > 0 && o.over.empty()) throw Error("--over-gap goes with --over NAME,...");
     return addGarment(o);
   };
 }

@@ -31,12 +31,8 @@ struct MakeSkirtOptions {
   std::string avatar;
   std::string avatarUrl;
   std::string out;
-  std::string addTo;      ///< --add-to: the scene the skirt is added to
-  std::string character;  ///< --character: who wears it there
-  std::string name;       ///< --name: the ClothSet's name ("" : Skirt)
-  std::vector<std::string> over;  ///< --over: the garments it is worn over
-  double overGap_m = 0.004;
-  std::vector<double> colour;  ///< --colour: its diffuse colour (empty: red, or one the scene's garments do not have)
+  std::string name;  ///< --name: the ClothSet's name ("" : Skirt)
+  AddToOptions add;  ///< --add-to, --character, --over, --over-gap, --colour
   scene::SkirtFit fit;
   double bindThreshold_m = 0.04;
 };
@@ -63,9 +59,7 @@ ClothSetText clothSetOf(const MakeSkirtOptions& o, const mesh::TriMesh& cloth, c
   c.collidesWith.push_back(o.fit.waistSegment);
   c.collidesWith.insert(c.collidesWith.end(), o.fit.hipSegments.begin(), o.fit.hipSegments.end());
   c.collidesWith.insert(c.collidesWith.end(), o.fit.legSegments.begin(), o.fit.legSegments.end());
-  c.over = o.over;
-  c.overGap_m = o.overGap_m;
-  if (!o.colour.empty()) c.colour = Vec3(o.colour[0], o.colour[1], o.colour[2]);
+  if (!o.add.colour.empty()) c.colour = Vec3(o.add.colour[0], o.add.colour[1], o.add.colour[2]);
   c.bindThreshold_m = o.bindThreshold_m;
   return c;
 }
@@ -149,38 +143,33 @@ int makeSkirt(const MakeSkirtOptions& o) {
 
 /// --add-to: the skirt fitted to the scene's character as the scene places it, and appended.
 int addSkirt(const MakeSkirtOptions& o) {
-  const SceneToDress dress = openSceneToDress(o.addTo, o.character);
+  const SceneToDress dress = openSceneToDress(o.add.scene, o.add.character);
   const scene::Avatar& avatar = *dress.character.avatar;
-  checkSegments(avatar, o, fmt::format("{} ('{}')", o.addTo, dress.character.name));
-  checkNewGarment(dress, o.name, o.over);
+  checkSegments(avatar, o, fmt::format("{} ('{}')", o.add.scene, dress.character.name));
+  checkNewGarment(dress, o.name, o.add.over);
   const mesh::Skirt skirt = scene::fitSkirt(avatar, o.fit);
   const double added = checkSceneSteps(dress, skirt.mesh, knit(), o.name);
 
   const mesh::TriMesh cloth = inFileUnits(dress, skirt.mesh), mask = inFileUnits(dress, skirt.waistband);
   ClothSetText c = clothSetOf(o, cloth, mask);
   c.name = o.name;
-  if (o.colour.empty()) c.colour = unusedColour(dress.scene);
-  c.material = materialNode(knit(), "  ");
-  c.avatar = dress.avatarDef;
+  dressFor(c, dress, o.add, materialNode(knit(), "  "));
   std::ostringstream text;
-  fmt::print(text, "# {}: added by `drape make-skirt --add-to`, worn by {}{}.\n", o.name, dress.character.name,
-             o.over.empty() ? "" : fmt::format(" over {}", fmt::join(o.over, ", ")));
+  text << addedComment("make-skirt", o.name, dress, o.add);
   writeClothSet(text, c);
   appendToScene(dress, text.str());
 
-  const std::filesystem::path dir = std::filesystem::path(o.addTo).parent_path();
+  const std::filesystem::path dir = std::filesystem::path(o.add.scene).parent_path();
   const auto [stem, maskStem] = objStems(o.name);
   formats::writeObj((dir / (stem + ".obj")).string(), skirt.mesh.positions, skirt.mesh.triangles,
                     "drape make-skirt: " + o.name + " (m, world)");
   formats::writeObj((dir / (maskStem + ".obj")).string(), skirt.waistband.positions, skirt.waistband.triangles,
                     "drape make-skirt: constraint mask of " + o.name + " (m, world)");
   printSkirt(o.name, skirt);
-  fmt::print("; worn by {}{}\n", dress.character.name,
-             o.over.empty() ? "" : fmt::format(" over {}, {:g} m above", fmt::join(o.over, ", "), o.overGap_m));
-  fmt::print("the scene's {} substeps per frame keep it stable{}\n", dress.scene.simulation.stepsPerFrame,
-             added > 0.0 ? fmt::format(" (mass scaling adds {:.2f} % of its mass)", 100.0 * added) : "");
-  fmt::print("added it to {}; wrote {}.obj, {}.obj beside it\n", o.addTo, stem, maskStem);
-  printHowToRun(o.addTo, avatar, dress.character.motion);
+  fmt::print("; {}\n", wornText(dress, o.add));
+  printSceneSteps(dress, added);
+  fmt::print("added it to {}; wrote {}.obj, {}.obj beside it\n", o.add.scene, stem, maskStem);
+  printHowToRun(o.add.scene, avatar, dress.character.motion);
   return 0;
 }
 
@@ -191,25 +180,11 @@ RunFunction setupMakeSkirt(CLI::App& app) {
   app.add_option("--out", o.out,
                  "Directory for scene.wrl, skirt.obj and waistband.obj (with --name, NAME.obj and NAME_waistband.obj; "
                  "required without --add-to)");
-  app.add_option("--add-to", o.addTo,
-                 "Add the skirt to this scene instead, fitted to its character (a second skirt over a petticoat): "
-                 "appended to the file as a ClothSet, once the scene with it loads; its OBJs are written beside it");
-  app.add_option("--character", o.character,
-                 "With --add-to: the character who wears it (its Avatar or Humanoid node's name; default: the "
-                 "scene's only one)");
+  addAddToOptions(app, o.add,
+                  "Add the skirt to this scene instead, fitted to its character (a second skirt over a petticoat): "
+                  "appended to the file as a ClothSet, once the scene with it loads; its OBJs are written beside it",
+                  "red");
   app.add_option("--name", o.name, "The skirt's name (the ClothSet's; default Skirt)");
-  app.add_option("--over", o.over,
-                 "With --add-to: the character's garments the skirt is worn over, written as its over (kept "
-                 "--over-gap above them; docs/PHYSICS.md)")
-      ->delimiter(',');
-  app.add_option("--over-gap", o.overGap_m, "With --over: how far above them it keeps, m, written as its overGap")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  app.add_option("--colour", o.colour,
-                 "Its colour, R,G,B from 0 to 1 (default: red; with --add-to, a colour no garment of the scene has)")
-      ->delimiter(',')
-      ->expected(3)
-      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--avatar-url", o.avatarUrl, "The Avatar url written into scene.wrl (default: the avatar's path relative to --out)");
   app.add_option("--length", o.fit.length_m, "Waist to hem, m (default: a little above the knees)");
   app.add_option("--clearance", o.fit.clearance_m, "Gap between body and skirt at rest, m")->capture_default_str();
@@ -228,22 +203,7 @@ RunFunction setupMakeSkirt(CLI::App& app) {
   app.add_option("--bind-threshold", o.bindThreshold_m, "Written into the ClothSet, m")->capture_default_str();
   return [&app] {
     if (o.name.empty()) o.name = "Skirt";
-    if (o.addTo.empty()) {
-      if (o.avatar.empty()) throw Error("make-skirt: give the avatar to fit the skirt to, or --add-to SCENE");
-      if (o.out.empty()) throw Error("make-skirt: --out DIR is required (or --add-to SCENE)");
-      for (const char* option : {"--character", "--over", "--over-gap"})
-        if (app.count(option) > 0) throw Error(fmt::format("{} goes with --add-to SCENE", option));
-      return makeSkirt(o);
-    }
-    if (!o.avatar.empty())
-      throw Error(fmt::format("make-skirt --add-to {}: the skirt is fitted to the scene's character; give no avatar "
-                              "({})",
-                              o.addTo, o.avatar));
-    for (const char* option : {"--out", "--avatar-url"})
-      if (app.count(option) > 0)
-        throw Error(fmt::format("{} does not go with --add-to: the skirt is added to {} and its OBJs written beside it",
-                                option, o.addTo));
-    if (app.count("--over-gap") > 0 && o.over.empty()) throw Error("--over-gap goes with --over NAME,...");
+    if (!addingToScene(app, o.add, "make-skirt", o.avatar, o.out, {"--out", "--avatar-url"})) return makeSkirt(o);
     return addSkirt(o);
   };
 }

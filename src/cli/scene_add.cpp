@@ -95,6 +95,73 @@ std::string firstExistingFile(const scene::ExternalAvatar& ext, const std::strin
 
 }  // namespace
 
+void addAddToOptions(CLI::App& app, AddToOptions& o, const std::string& addToHelp, const std::string& ownColour) {
+  app.add_option("--add-to", o.scene, addToHelp);
+  app.add_option("--character", o.character,
+                 "With --add-to: the character who wears it (its Avatar or Humanoid node's name; default: the "
+                 "scene's only one)");
+  app.add_option("--over", o.over,
+                 "With --add-to: the character's garments it is worn over, written as its over (kept --over-gap "
+                 "above them; docs/PHYSICS.md)")
+      ->delimiter(',');
+  app.add_option("--over-gap", o.overGap_m, "With --over: how far above them it keeps, m, written as its overGap")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--colour", o.colour,
+                 fmt::format("Its colour, R,G,B from 0 to 1 (default: {}; with --add-to, a colour no garment of the "
+                             "scene has)",
+                             ownColour))
+      ->delimiter(',')
+      ->expected(3)
+      ->check(CLI::Range(0.0, 1.0));
+}
+
+bool addingToScene(const CLI::App& app, const AddToOptions& o, const std::string& command, const std::string& avatar,
+                   const std::string& out, const std::vector<std::string>& sceneOptions) {
+  if (o.scene.empty()) {
+    if (avatar.empty()) throw Error(fmt::format("{}: give the avatar to fit it to, or --add-to SCENE", command));
+    if (out.empty()) throw Error(fmt::format("{}: --out DIR is required (or --add-to SCENE)", command));
+    for (const char* option : {"--character", "--over", "--over-gap"})
+      if (app.count(option) > 0) throw Error(fmt::format("{} goes with --add-to SCENE", option));
+    return false;
+  }
+  if (!avatar.empty())
+    throw Error(fmt::format("{} --add-to {}: the garment goes on the scene's character; give no avatar ({})", command,
+                            o.scene, avatar));
+  for (const std::string& option : sceneOptions)
+    if (app.count(option) > 0)
+      throw Error(fmt::format("{} does not go with --add-to: {} is added to the scene as it is, its OBJs written "
+                              "beside it (edit {} for the scene's own settings)",
+                              option, command == "make-skirt" ? "the skirt" : "the garment", o.scene));
+  if (app.count("--over-gap") > 0 && o.over.empty()) throw Error("--over-gap goes with --over NAME,...");
+  return true;
+}
+
+void dressFor(ClothSetText& c, const SceneToDress& dress, const AddToOptions& o, const std::string& material) {
+  c.over = o.over;
+  c.overGap_m = o.overGap_m;
+  c.colour = o.colour.empty() ? unusedColour(dress.scene) : Vec3(o.colour[0], o.colour[1], o.colour[2]);
+  c.material = material;
+  c.avatar = dress.avatarDef;
+}
+
+std::string addedComment(const std::string& command, const std::string& name, const SceneToDress& dress,
+                         const AddToOptions& o) {
+  return fmt::format("# {}: added by `drape {} --add-to`, worn by {}{}.\n", name, command, dress.character.name,
+                     o.over.empty() ? "" : fmt::format(" over {}", fmt::join(o.over, ", ")));
+}
+
+std::string wornText(const SceneToDress& dress, const AddToOptions& o) {
+  return fmt::format("worn by {}{}", dress.character.name,
+                     o.over.empty() ? "" : fmt::format(" over {}, {:g} m above", fmt::join(o.over, ", "), o.overGap_m));
+}
+
+void printSceneSteps(const SceneToDress& dress, double addedMassFraction) {
+  fmt::print("the scene's {} substeps per frame keep it stable{}\n", dress.scene.simulation.stepsPerFrame,
+             addedMassFraction > 0.0 ? fmt::format(" (mass scaling adds {:.2f} % of its mass)", 100.0 * addedMassFraction)
+                                     : "");
+}
+
 SceneToDress openSceneToDress(const std::string& path, const std::string& character) {
   SceneToDress d;
   d.path = path;

@@ -6,13 +6,38 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
 #include "drape/cloth/material.hpp"
 #include "drape/core/math.hpp"
 #include "drape/mesh/trimesh.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/scene_setup.hpp"
+#include "scene_text.hpp"
 
 namespace drape::cli {
+
+/// The options `drape make-skirt` and `drape make-scene` share for adding a garment.
+struct AddToOptions {
+  std::string scene;              ///< --add-to: the scene the garment is added to ("": a new scene)
+  std::string character;          ///< --character: who wears it there
+  std::vector<std::string> over;  ///< --over: the garments it is worn over
+  double overGap_m = 0.004;       ///< --over-gap
+  /// --colour: R, G, B from 0 to 1; empty: the command's own colour, or with --add-to one
+  /// that no garment of the scene has.
+  std::vector<double> colour;
+};
+
+/// Adds --add-to (`addToHelp`), --character, --over, --over-gap and --colour (whose help
+/// names `ownColour`, the command's default) to the command.
+void addAddToOptions(CLI::App& app, AddToOptions& o, const std::string& addToHelp, const std::string& ownColour);
+
+/// Whether the command adds to a scene; throws drape::Error for what does not go together:
+/// the avatar positional, --out and the scene's own settings `sceneOptions` with --add-to;
+/// no avatar, no --out, or --character, --over, --over-gap without it; --over-gap without
+/// --over.
+bool addingToScene(const CLI::App& app, const AddToOptions& o, const std::string& command, const std::string& avatar,
+                   const std::string& out, const std::vector<std::string>& sceneOptions);
 
 /// A scene a garment is being added to, and the character who will wear it.
 struct SceneToDress {
@@ -51,6 +76,19 @@ double checkSceneSteps(const SceneToDress& dress, const mesh::TriMesh& garment, 
 
 /// A mesh in world metres, in the scene file's units (its unitScale).
 [[nodiscard]] mesh::TriMesh inFileUnits(const SceneToDress& dress, mesh::TriMesh world);
+
+/// Where the new garment goes and what it looks like: the options' over, gap and colour (a
+/// colour of the scene's garments' own when none is given), the character's DEF as its
+/// avatar, `material` (a node's text) as its material.
+void dressFor(ClothSetText& c, const SceneToDress& dress, const AddToOptions& o, const std::string& material);
+
+/// The comment written above the new ClothSet: who added it and who wears it over what.
+[[nodiscard]] std::string addedComment(const std::string& command, const std::string& name, const SceneToDress& dress,
+                                       const AddToOptions& o);
+/// "worn by Bea over Petticoat, 0.004 m above".
+[[nodiscard]] std::string wornText(const SceneToDress& dress, const AddToOptions& o);
+/// The line that says the scene's substeps keep it stable, with the mass scaling adds.
+void printSceneSteps(const SceneToDress& dress, double addedMassFraction);
 
 /// Appends `clothSet` (a ClothSet node's text, of a garment worn by the character) to the
 /// scene and rewrites the file, once the new text has been read and built as `drape run`

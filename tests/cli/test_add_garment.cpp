@@ -167,11 +167,11 @@ TEST(AddGarment, AGarmentTheSceneCannotTakeLeavesItAsItWas) {
   refused(add + "--name Outer --over Petticoat", "--over Petticoat: not a garment of 'Body' in " + scene + " (it wears: Skirt)");
   refused(add + "--name Outer --over-gap 0.01", "--over-gap goes with --over");
   refused(add + "--name Outer --out '" + (dir / "x") + "'", "--out does not go with --add-to");
-  refused(add + "--name Outer " + kBody, "the skirt is fitted to the scene's character; give no avatar");
+  refused(add + "--name Outer " + kBody, "the garment goes on the scene's character; give no avatar");
   refused(add + "--name Outer --character Ada", "--character Ada: " + scene + " has no character of that name");
   refused(add + "--name Outer --waist-segment Waist", "the avatar has no segment 'Waist'");
   refused("make-skirt " + kBody + " --out '" + (dir / "x") + "' --over Skirt", "--over goes with --add-to SCENE");
-  refused("make-skirt --clearance 0.03", "give the avatar to fit the skirt to, or --add-to SCENE");
+  refused("make-skirt --clearance 0.03", "make-skirt: give the avatar to fit it to, or --add-to SCENE");
   // A skirt narrower than the one it is worn over lies under it, most of it deeper than drape
   // run moves out: refused.
   refused(add + "--name Inner --clearance 0.01 --flare 0.05 --over Skirt",
@@ -181,7 +181,7 @@ TEST(AddGarment, AGarmentTheSceneCannotTakeLeavesItAsItWas) {
   const std::string dress = "make-scene --add-to '" + scene + "' --garment '" + kSource +
                             "/data/garments/makehuman_female_elegantsuit01_dress.mhclo' --units dm --mask '" + kSource +
                             "/examples/walking_dress/mask.obj' --name dress ";
-  refused(dress + "--substeps 155", "--substeps does not go with --add-to: it is the scene's own setting");
+  refused(dress + "--substeps 155", "--substeps does not go with --add-to: the garment is added to the scene as it is");
   refused(dress, "the scene steps 33 substeps per frame, and 'dress' needs ");
   refused(dress, "set stepsPerFrame ");
 

@@ -276,7 +276,7 @@ int addGarment(MakeSceneOptions& o) {
   const mesh::TriMesh cloth = inFileUnits(dress, garment), clothMask = inFileUnits(dress, mask);
   ClothSetText c = clothSetOf(o, cloth, clothMask);
   if (!o.offsets.empty()) c.offsets = std::array<double, 4>{o.offsets[0], o.offsets[1], o.offsets[2], o.offsets[3]};
-  dressFor(c, dress, o.add, materialNode(o.material, "  "));
+  dressFor(c, dress, o.add, materialNode(o.material, "  ", o.name + " knit"));
   std::ostringstream text;
   text << addedComment("make-scene", o.name, dress, o.add);
   writeClothSet(text, c);

@@ -153,7 +153,7 @@ int addSkirt(const MakeSkirtOptions& o) {
   const mesh::TriMesh cloth = inFileUnits(dress, skirt.mesh), mask = inFileUnits(dress, skirt.waistband);
   ClothSetText c = clothSetOf(o, cloth, mask);
   c.name = o.name;
-  dressFor(c, dress, o.add, materialNode(knit(), "  "));
+  dressFor(c, dress, o.add, materialNode(knit(), "  ", o.name + " knit"));
   std::ostringstream text;
   text << addedComment("make-skirt", o.name, dress, o.add);
   writeClothSet(text, c);

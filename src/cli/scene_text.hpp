@@ -28,14 +28,15 @@ inline void writeIndexedFaceSet(std::ostream& os, const mesh::TriMesh& m, const 
   fmt::print(os, "{}]\n", indent);
 }
 
-/// A ClothMaterial node with the material's values, its fields indented by `indent` and
-/// two spaces, its closing brace by `indent` (no newline after it).
-inline std::string materialNode(const cloth::Material& m, const std::string& indent) {
-  return fmt::format("ClothMaterial {{\n{0}  density {1:g}\n{0}  thickness {2:g}\n{0}  youngsModulus {3:g}\n"
+/// A ClothMaterial node with the material's values (and `name`, unless ""), its fields
+/// indented by `indent` and two spaces, its closing brace by `indent` (no newline after it).
+inline std::string materialNode(const cloth::Material& m, const std::string& indent, const std::string& name = "") {
+  return fmt::format("ClothMaterial {{\n{9}{0}  density {1:g}\n{0}  thickness {2:g}\n{0}  youngsModulus {3:g}\n"
                      "{0}  poissonRatio {4:g}\n{0}  damping {5:g}\n{0}  staticFriction {6:g}\n{0}  dynamicFriction {7:g}\n"
                      "{0}  compressionScale {8:g}\n{0}}}",
                      indent, m.density_kg_m3, m.thickness_m, m.youngsModulus_Pa, m.poissonRatio, m.damping_s,
-                     m.staticFriction, m.dynamicFriction, m.compressionScale);
+                     m.staticFriction, m.dynamicFriction, m.compressionScale,
+                     name.empty() ? "" : fmt::format("{}  name \"{}\"\n", indent, name));
 }
 
 /// A ClothMaterial node named Knit with the material's values.

@@ -77,7 +77,9 @@ TEST(AddGarment, TwoCommandsMakeTheBundledLayeredSkirts) {
     EXPECT_EQ(a.over, b.over) << name;
     EXPECT_EQ(a.collidesWith, b.collidesWith) << name;
   }
-  // The added skirt takes a colour neither garment had (the petticoat's was given).
+  // Its own knit, named after it; a colour neither garment had (the petticoat's was given).
+  ASSERT_EQ(made.materials.size(), 2u);
+  EXPECT_EQ(made.materials[static_cast<std::size_t>(garmentNamed(made, "Skirt").material)].name, "Skirt knit");
   ASSERT_TRUE(garmentNamed(made, "Skirt").colour.has_value());
   EXPECT_NEAR(garmentNamed(made, "Skirt").colour->x(), 0.7, 1e-6);
 

@@ -95,10 +95,10 @@ void logStartUnder(const std::string& name, const cloth::LayerCollider& layers) 
   if (lifted.vertices == 0 && !layers.sidesFromBody() && !layers.belowWoundOneWay()) {
     spdlog::warn("{}: {} of its {} vertices over {} start under {}, on the other side from the rest (the deepest, "
                  "vertex {}, {:.1f} mm), and the faces of {} are not all wound one way, so which side is over cannot "
-                 "be told: they were left where they are, and the layers keep the side each starts on. Wind the faces "
-                 "of {} one way, or model {} over {}",
+                 "be told: they were left where they are, passing through {} with their triangles. Wind the faces of "
+                 "{} one way, or model {} over {}",
                  name, under.vertices, under.over, below, them, under.deepestVertex, 1e3 * under.deepest_m, below,
-                 below, name, them);
+                 below, below, name, them);
     return;
   }
   const std::string side = layers.sidesFromBody() ? ", on the body's side" : "";
@@ -108,9 +108,10 @@ void logStartUnder(const std::string& name, const cloth::LayerCollider& layers) 
                lifted.vertices, them, 1e3 * layers.gap_m());
   if (lifted.leftUnder > 0)
     spdlog::warn("{}: {} of its vertices lie too far under {} to be moved out (more than {:.4g} mm, the deepest {:.1f} "
-                 "mm): they were left there, and the layers keep each vertex on the side it starts on, so {} goes "
-                 "through {} there. Model {} over {} (wider, or further out from the body)",
-                 name, lifted.leftUnder, below, 1e3 * cloth::LayerCollider::kLiftDepthGaps * layers.gap_m(), 1e3 * under.deepest_m, name, below, name, below);
+                 "mm): they were left there, and {} passes through {} there, those vertices and their triangles. "
+                 "Model {} over {} (wider, or further out from the body)",
+                 name, lifted.leftUnder, below, 1e3 * cloth::LayerCollider::kLiftDepthGaps * layers.gap_m(),
+                 1e3 * under.deepest_m, name, below, name, below);
 }
 
 /// One garment being simulated: its model and solver (and its collider, on a character).

@@ -139,6 +139,7 @@ LayerCollider::LayerCollider(const ClothModel& model, std::string garment, doubl
   setNeighbours(around);
   addEdgeLengths(model);
   inverseMass_ = model.inverseMass();
+  passesBelow_.assign(ownVertices_, 0);
   lastX_ = model.restX();
   lastY_ = model.restY();
   lastZ_ = model.restZ();
@@ -265,6 +266,11 @@ void LayerCollider::sizeForPoints() {
     tested_[v] = v < ownVertices_ ? (inverseMass_[v] > 0 && (thickness_ > 0 || !below_.empty()) ? kOwnPoint : 0)
                                   : (anyTriangleMoves ? kPointBelow : 0);
   pairsBuilt_ = false;
+}
+
+bool LayerCollider::passesBelow(std::uint32_t triangle) const {
+  const auto& c = triangles_[triangle];
+  return passesBelow_[c[0]] | passesBelow_[c[1]] | passesBelow_[c[2]];
 }
 
 bool LayerCollider::triangleMoves(std::uint32_t triangle) const {
@@ -415,6 +421,15 @@ void LayerCollider::findStartUnder() {
   }
 }
 
+void LayerCollider::leaveThrough() {
+  // Kept under where they start while the rest is kept over, the triangles between them would
+  // be held on both sides of the garment below at once: they pass through it instead.
+  const double depth = kLiftDepthGaps * gap_;
+  for (const Under& u : under_)
+    if (std::abs(u.along) > depth || lifted_.vertices == 0) passesBelow_[u.vertex] = 1;
+  pairsBuilt_ = false;
+}
+
 bool LayerCollider::belowWoundOneWay() const {
   // Faces wound one way go along each edge they share in opposite directions: no directed
   // edge twice.
@@ -431,6 +446,7 @@ std::size_t LayerCollider::liftOver(ClothState& state) {
   if (under_.empty()) return 0;
   if (body_.empty() && !belowWoundOneWay()) {
     lifted_.leftUnder = under_.size();
+    leaveThrough();
     return 0;
   }
   const double depth = kLiftDepthGaps * gap_;
@@ -447,6 +463,7 @@ std::size_t LayerCollider::liftOver(ClothState& state) {
     ++lifted_.vertices;
   }
   lifted_.leftUnder = under_.size() - lifted_.vertices;
+  leaveThrough();
   under_.clear();      // over them now; startUnder_ keeps what was modelled, for the log and stats
   remember(state);     // its own points start where they were moved to
   return lifted_.vertices;
@@ -464,8 +481,8 @@ double LayerCollider::pairThickness(std::uint32_t vertex, std::uint32_t triangle
   const bool ownVertex = vertex < ownVertices_, ownTriangle = triangle < ownTriangles_;
   if (ownVertex && ownTriangle)
     return thickness_ > 0 && inverseMass_[vertex] > 0 && !excluded(vertex, triangle) ? thickness_ : 0.0;
-  if (ownVertex) return inverseMass_[vertex] > 0 ? gap_ : 0.0;  // against a garment below
-  if (ownTriangle) return triangleMoves(triangle) ? gap_ : 0.0;  // a point below against its own
+  if (ownVertex) return inverseMass_[vertex] > 0 && !passesBelow_[vertex] ? gap_ : 0.0;  // against a garment below
+  if (ownTriangle) return triangleMoves(triangle) && !passesBelow(triangle) ? gap_ : 0.0;  // a point below against its own
   return 0.0;                                                    // below against below: not here
 }
 

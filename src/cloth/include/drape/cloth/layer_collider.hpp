@@ -162,8 +162,9 @@ class LayerCollider final : public Collider {
   /// `gap` above the triangle each is under, with no velocity, and starts them there: those
   /// within 4 gaps of it (deeper, the move would stretch its triangles across the garment
   /// below; they stay under it). Without a body (setBody), none when the faces of the
-  /// garments below are not all wound one way (their sides could not be told). How many it
-  /// moved. After initialise(); startUnder() keeps what was
+  /// garments below are not all wound one way (their sides could not be told). Those it
+  /// leaves under them, and their triangles, then pass through them: kept on both sides at
+  /// once, the triangles between them and the rest would be torn. How many it moved. After initialise(); startUnder() keeps what was
   /// modelled.
   std::size_t liftOver(ClothState& state);
   [[nodiscard]] const LiftedOver& liftedOver() const { return lifted_; }
@@ -231,6 +232,11 @@ class LayerCollider final : public Collider {
   }
   /// Whether a corner of the triangle can move (a vertex below is kept off it).
   [[nodiscard]] bool triangleMoves(std::uint32_t triangle) const;
+  /// Whether a corner of its own triangle passes through the garments below (leaveThrough).
+  [[nodiscard]] bool passesBelow(std::uint32_t triangle) const;
+  /// The vertices that start under the garments below and stay there (liftOver left them)
+  /// pass through them, and so do their triangles.
+  void leaveThrough();
   /// The neighbour lists (sorted and made unique here) as the CSR arrays.
   void setNeighbours(std::vector<std::vector<std::uint32_t>>& around);
   void buildGrid(const ClothState& after);
@@ -363,6 +369,7 @@ class LayerCollider final : public Collider {
   LiftedOver lifted_;
   std::vector<std::uint32_t> componentBelow_;  ///< per point: its parent in the pieces below
   std::vector<Vec3> body_;  ///< the body at rest (setBody); empty: sides by the most vertices
+  std::vector<std::uint8_t> passesBelow_;  ///< per own vertex: left under the garments below, passing through them
 };
 
 }  // namespace drape::cloth

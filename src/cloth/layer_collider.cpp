@@ -369,6 +369,14 @@ void LayerCollider::findStartUnder() {
     Vec3 closest;
   };
   std::vector<Side> sides;  // once, at set-up
+  // Their triangles' corners and unit normals, once for all vertices.
+  std::vector<std::array<Vec3, 3>> corners;
+  std::vector<Vec3> normals;
+  for (std::uint32_t t = ownTriangles_; t < triangles_.size(); ++t) {
+    const auto& c = triangles_[t];
+    corners.push_back({at(lastX_, lastY_, lastZ_, c[0]), at(lastX_, lastY_, lastZ_, c[1]), at(lastX_, lastY_, lastZ_, c[2])});
+    normals.push_back(unitNormal(corners.back()));
+  }
   for (std::uint32_t v = 0; v < ownVertices_; ++v) {
     if (!(inverseMass_[v] > 0)) continue;
     const Vec3 p = at(lastX_, lastY_, lastZ_, v);
@@ -376,13 +384,11 @@ void LayerCollider::findStartUnder() {
     std::uint32_t under = 0;
     Vec3 closest = Vec3::Zero();
     for (std::uint32_t t = ownTriangles_; t < triangles_.size(); ++t) {
-      const auto& c = triangles_[t];
-      const std::array<Vec3, 3> corners{at(lastX_, lastY_, lastZ_, c[0]), at(lastX_, lastY_, lastZ_, c[1]),
-                                        at(lastX_, lastY_, lastZ_, c[2])};
-      const Vec3 n = unitNormal(corners);
-      const double off = (p - corners[0]).dot(n);  // no farther from the triangle than from its plane
+      const std::array<Vec3, 3>& k = corners[t - ownTriangles_];
+      const Vec3& n = normals[t - ownTriangles_];
+      const double off = (p - k[0]).dot(n);  // no farther from the triangle than from its plane
       if (n.isZero() || std::abs(off) > nearest) continue;
-      const Vec3 q = mesh::closestOnTriangle(p, corners[0], corners[1], corners[2]);
+      const Vec3 q = mesh::closestOnTriangle(p, k[0], k[1], k[2]);
       const double distance = (p - q).norm();
       if (distance > nearest) continue;
       nearest = distance;
@@ -406,9 +412,7 @@ void LayerCollider::findStartUnder() {
       const std::uint32_t piece = componentBelow(triangles_[side.triangle][0]);
       wornSide = 2 * above[piece] >= total[piece] ? 1.0 : -1.0;
     } else {
-      const auto& c = triangles_[side.triangle];
-      const Vec3 n = unitNormal({at(lastX_, lastY_, lastZ_, c[0]), at(lastX_, lastY_, lastZ_, c[1]),
-                                 at(lastX_, lastY_, lastZ_, c[2])});
+      const Vec3& n = normals[side.triangle - ownTriangles_];
       wornSide = n.dot(side.closest - nearestOf(body_, side.closest)) >= 0.0 ? 1.0 : -1.0;
     }
     if (side.along * wornSide >= 0) continue;
@@ -427,6 +431,7 @@ void LayerCollider::leaveThrough() {
   const double depth = kLiftDepthGaps * gap_;
   for (const Under& u : under_)
     if (std::abs(u.along) > depth || lifted_.vertices == 0) passesBelow_[u.vertex] = 1;
+  anyPassBelow_ = std::find(passesBelow_.begin(), passesBelow_.end(), 1) != passesBelow_.end();
   pairsBuilt_ = false;
 }
 
@@ -481,8 +486,9 @@ double LayerCollider::pairThickness(std::uint32_t vertex, std::uint32_t triangle
   const bool ownVertex = vertex < ownVertices_, ownTriangle = triangle < ownTriangles_;
   if (ownVertex && ownTriangle)
     return thickness_ > 0 && inverseMass_[vertex] > 0 && !excluded(vertex, triangle) ? thickness_ : 0.0;
-  if (ownVertex) return inverseMass_[vertex] > 0 && !passesBelow_[vertex] ? gap_ : 0.0;  // against a garment below
-  if (ownTriangle) return triangleMoves(triangle) && !passesBelow(triangle) ? gap_ : 0.0;  // a point below against its own
+  // Against a garment below; a point below against its own triangle. (Rarely any pass through.)
+  if (ownVertex) return inverseMass_[vertex] > 0 && !(anyPassBelow_ && passesBelow_[vertex]) ? gap_ : 0.0;
+  if (ownTriangle) return triangleMoves(triangle) && !(anyPassBelow_ && passesBelow(triangle)) ? gap_ : 0.0;
   return 0.0;                                                    // below against below: not here
 }
 
@@ -626,7 +632,7 @@ void LayerCollider::buildGrid(const ClothState& after) {
         continue;
       }
       forBucketsOnce(v, [&](std::uint32_t b) {
-          const std::uint32_t e = grid.fill[b]++;
+        const std::uint32_t e = grid.fill[b]++;
         grid.point[e] = static_cast<std::uint32_t>(v);
         for (int a = 0; a < 3; ++a) {
           grid.box[6 * e + a] = pointLo_[a][v];
@@ -694,7 +700,7 @@ void LayerCollider::gatherPairs() {
       continue;
     }
     for (int g = 0; g < 2; ++g)
-      if (scan[g]) pairWithPointsOffGrid(t, lo, hi, g == 0 ? kOwnPoint : kPointBelow, &offGrid_[g]);
+      if (scan[g] && !offGrid_[g].empty()) pairWithPointsOffGrid(t, lo, hi, g == 0 ? kOwnPoint : kPointBelow, &offGrid_[g]);
     forCells(lo, hi, [&](std::int64_t ix, std::int64_t iy, std::int64_t iz) {
       const std::uint32_t b = bucketOf(ix, iy, iz);
       for (int g = 0; g < 2; ++g) {

@@ -370,6 +370,7 @@ class LayerCollider final : public Collider {
   std::vector<std::uint32_t> componentBelow_;  ///< per point: its parent in the pieces below
   std::vector<Vec3> body_;  ///< the body at rest (setBody); empty: sides by the most vertices
   std::vector<std::uint8_t> passesBelow_;  ///< per own vertex: left under the garments below, passing through them
+  bool anyPassBelow_ = false;              ///< whether any does
 };
 
 }  // namespace drape::cloth

@@ -5,7 +5,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
+#include <cmath>
 #include <iostream>
+#include <limits>
 #include <utility>
 #include <sstream>
 
@@ -23,6 +26,7 @@
 #include "drape/mesh/topology.hpp"
 #include "drape/scene/avatar_gltf.hpp"
 #include "drape/scene/garment_fit.hpp"
+#include "drape/sim/garment_layers.hpp"
 
 namespace drape::cli {
 namespace {
@@ -35,6 +39,7 @@ struct MakeSkirtOptions {
   AddToOptions add;  ///< --add-to, --character, --over, --over-gap, --colour
   scene::SkirtFit fit;
   double bindThreshold_m = 0.04;
+  bool bindThresholdGiven = false;  ///< --bind-threshold given (else: as far as the waistband needs, at least 0.04 m)
 };
 
 /// The knit the scene gives the skirt (written below as the Knit material).
@@ -116,6 +121,24 @@ std::pair<std::string, std::string> objStems(const std::string& name) {
   return {name, name + "_waistband"};
 }
 
+/// The bindThreshold the skirt's waistband needs on `avatar`: the default 0.04 m, or a little
+/// more than the farthest waistband vertex lies from its collidable parts' vertices (which is
+/// no nearer than their surfaces, where drape run measures it) when a wide --clearance sets
+/// the band farther out.
+double waistbandReach(const scene::Avatar& avatar, const MakeSkirtOptions& o, const mesh::Skirt& skirt) {
+  std::vector<std::string> parts{o.fit.waistSegment};
+  parts.insert(parts.end(), o.fit.hipSegments.begin(), o.fit.hipSegments.end());
+  parts.insert(parts.end(), o.fit.legSegments.begin(), o.fit.legSegments.end());
+  const std::vector<Vec3> body = sim::restBodyPoints(avatar, parts);
+  double farthest = 0.0;
+  for (const Vec3& p : skirt.waistband.positions) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Vec3& q : body) nearest = std::min(nearest, (p - q).norm());
+    farthest = std::max(farthest, nearest);
+  }
+  return std::max(0.04, std::ceil((farthest + 0.005) * 1e3) / 1e3);
+}
+
 void printSkirt(const std::string& name, const mesh::Skirt& skirt) {
   const Aabb box = skirt.mesh.bounds();
   fmt::print("{}: {} vertices, {} triangles, waist at y = {:.3f} m, hem at y = {:.3f} m", name,
@@ -127,6 +150,7 @@ int makeSkirt(const MakeSkirtOptions& o) {
   checkSegments(avatar, o, o.avatar);
   const mesh::Skirt skirt = scene::fitSkirt(avatar, o.fit);
   MakeSkirtOptions written = o;
+  if (!o.bindThresholdGiven) written.bindThreshold_m = waistbandReach(avatar, o, skirt);
   written.avatarUrl = prepareSceneDir(o.out, o.avatar, o.avatarUrl);
   const std::filesystem::path dir(o.out);
   const auto [stem, maskStem] = objStems(o.name);
@@ -152,6 +176,7 @@ int addSkirt(const MakeSkirtOptions& o) {
 
   const mesh::TriMesh cloth = inFileUnits(dress, skirt.mesh), mask = inFileUnits(dress, skirt.waistband);
   ClothSetText c = clothSetOf(o, cloth, mask);
+  if (!o.bindThresholdGiven) c.bindThreshold_m = waistbandReach(avatar, o, skirt);
   c.name = o.name;
   dressFor(c, dress, o.add, materialNode(knit(), "  ", o.name + " knit"));
   std::ostringstream text;
@@ -200,9 +225,12 @@ RunFunction setupMakeSkirt(CLI::App& app) {
                  "knees")
       ->delimiter(',')
       ->capture_default_str();
-  app.add_option("--bind-threshold", o.bindThreshold_m, "Written into the ClothSet, m")->capture_default_str();
+  app.add_option("--bind-threshold", o.bindThreshold_m,
+                 "Written into the ClothSet, m (default: 0.04, or as far as a wide --clearance sets the waistband "
+                 "from the body)");
   return [&app] {
     if (o.name.empty()) o.name = "Skirt";
+    o.bindThresholdGiven = app.count("--bind-threshold") > 0;
     if (!addingToScene(app, o.add, "make-skirt", o.avatar, o.out, {"--out", "--avatar-url"})) return makeSkirt(o);
     return addSkirt(o);
   };

@@ -64,6 +64,28 @@ TEST(MakeSkirt, FitsTheMakeHumanBodyWithItsDefaultSegments) {
   runsClean(dir, out);
 }
 
+TEST(MakeSkirt, AWideSkirtsWaistbandIsBoundWhereItSits) {
+  // A wide clearance sets the waistband farther from the body than the usual 4 cm bind
+  // threshold: the scene's threshold reaches it, and the skirt binds and runs.
+  ScratchDir dir("make-skirt-wide");
+  const std::string out = dir / "skirt";
+  const CliResult r = runDrape("make-skirt '" + kAvatars + "/makehuman_rig_cmu_mb.mhskel' --clearance 0.05 --flare 0.3 " +
+                                   "--out '" + out + "'",
+                               dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const scene::Scene sc = scene::loadScene(out + "/scene.wrl");
+  ASSERT_EQ(sc.garments.size(), 1u);
+  EXPECT_GT(sc.garments[0].bindThreshold, 0.045);
+  EXPECT_LT(sc.garments[0].bindThreshold, 0.07);
+  runsClean(dir, out);
+  // Given, it is written as given.
+  const CliResult given = runDrape("make-skirt '" + kAvatars + "/makehuman_rig_cmu_mb.mhskel' --clearance 0.05 " +
+                                       "--flare 0.3 --bind-threshold 0.04 --out '" + (dir / "given") + "'",
+                                   dir);
+  ASSERT_EQ(given.code, 0) << given.err;
+  EXPECT_NEAR(scene::loadScene(dir / "given/scene.wrl").garments[0].bindThreshold, 0.04, 1e-7);  // SFFloat
+}
+
 TEST(MakeSkirt, AnotherRigNamesItsOwnSegments) {
   // MakeHuman's game-engine rig names its segments as game engines do: the defaults (the
   // CMU rig's) are refused with the avatar's own names, which then fit the skirt.

@@ -166,7 +166,9 @@ SceneToDress openSceneToDress(const std::string& path, const std::string& charac
   SceneToDress d;
   d.path = path;
   d.text = readWhole(path);
-  const formats::vrml::Document document = formats::vrml::readFile(path);
+  // The text read once: what is parsed is what the garment is appended to.
+  const std::string dir = std::filesystem::path(path).parent_path().string();
+  const formats::vrml::Document document = formats::vrml::readText(d.text, path, dir.empty() ? "." : dir);
   d.scene = scene::buildScene(document);
   d.character = takeCharacter(sim::sceneCharacters(d.scene), character, path);
   int line = 0;

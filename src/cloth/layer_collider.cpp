@@ -398,12 +398,16 @@ void LayerCollider::findStartUnder() {
     }
     if (along != 0.0 && std::abs(along) >= 0.5 * nearest) sides.push_back({v, under, along, closest});
   }
-  // Per connected piece below (root vertex): how many take each side.
-  std::vector<std::uint32_t> above(vertexCount(), 0u), total(vertexCount(), 0u);
-  for (const Side& side : sides) {
-    const std::uint32_t piece = componentBelow(triangles_[side.triangle][0]);
-    above[piece] += side.along > 0 ? 1u : 0u;
-    ++total[piece];
+  // Without the body: per connected piece below (root vertex), how many take each side.
+  std::vector<std::uint32_t> above, total;
+  if (body_.empty()) {
+    above.assign(vertexCount(), 0u);
+    total.assign(vertexCount(), 0u);
+    for (const Side& side : sides) {
+      const std::uint32_t piece = componentBelow(triangles_[side.triangle][0]);
+      above[piece] += side.along > 0 ? 1u : 0u;
+      ++total[piece];
+    }
   }
   startUnder_.over = sides.size();
   for (const Side& side : sides) {
@@ -425,12 +429,11 @@ void LayerCollider::findStartUnder() {
   }
 }
 
-void LayerCollider::leaveThrough() {
+void LayerCollider::leaveThrough(double deeperThan) {
   // Kept under where they start while the rest is kept over, the triangles between them would
   // be held on both sides of the garment below at once: they pass through it instead.
-  const double depth = kLiftDepthGaps * gap_;
   for (const Under& u : under_)
-    if (std::abs(u.along) > depth || lifted_.vertices == 0) passesBelow_[u.vertex] = 1;
+    if (std::abs(u.along) > deeperThan) passesBelow_[u.vertex] = 1;
   anyPassBelow_ = std::find(passesBelow_.begin(), passesBelow_.end(), 1) != passesBelow_.end();
   pairsBuilt_ = false;
 }
@@ -451,7 +454,7 @@ std::size_t LayerCollider::liftOver(ClothState& state) {
   if (under_.empty()) return 0;
   if (body_.empty() && !belowWoundOneWay()) {
     lifted_.leftUnder = under_.size();
-    leaveThrough();
+    leaveThrough(-1.0);  // every one
     return 0;
   }
   const double depth = kLiftDepthGaps * gap_;
@@ -468,7 +471,7 @@ std::size_t LayerCollider::liftOver(ClothState& state) {
     ++lifted_.vertices;
   }
   lifted_.leftUnder = under_.size() - lifted_.vertices;
-  leaveThrough();
+  leaveThrough(depth);
   under_.clear();      // over them now; startUnder_ keeps what was modelled, for the log and stats
   remember(state);     // its own points start where they were moved to
   return lifted_.vertices;

@@ -113,7 +113,7 @@ TEST(AddGarment, OnOneOfTwoCharactersWhereTheSceneStandsThem) {
             std::string::npos)
       << fitted.out;
 
-  // The same skirt made on the avatar alone, where its file stands it, in centimetres.
+  // The same skirt made on the avatar alone, where its own file stands it (at the origin).
   const CliResult alone = runDrape("make-skirt " + kBody + " --clearance 0.035 --flare 0.25 --out '" +
                                        (dir / "alone") + "'",
                                    dir);

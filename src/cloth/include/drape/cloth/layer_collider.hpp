@@ -234,9 +234,9 @@ class LayerCollider final : public Collider {
   [[nodiscard]] bool triangleMoves(std::uint32_t triangle) const;
   /// Whether a corner of its own triangle passes through the garments below (leaveThrough).
   [[nodiscard]] bool passesBelow(std::uint32_t triangle) const;
-  /// The vertices that start under the garments below and stay there (liftOver left them)
-  /// pass through them, and so do their triangles.
-  void leaveThrough();
+  /// The vertices that start under the garments below deeper than `deeperThan` (m), which
+  /// liftOver leaves there, pass through them, and so do their triangles.
+  void leaveThrough(double deeperThan);
   /// The neighbour lists (sorted and made unique here) as the CSR arrays.
   void setNeighbours(std::vector<std::vector<std::uint32_t>>& around);
   void buildGrid(const ClothState& after);

@@ -26,6 +26,7 @@
 #include "drape/mesh/topology.hpp"
 #include "drape/scene/avatar_gltf.hpp"
 #include "drape/scene/garment_fit.hpp"
+#include "drape/scene/humanoid.hpp"
 #include "drape/sim/garment_layers.hpp"
 
 namespace drape::cli {
@@ -39,7 +40,8 @@ struct MakeSkirtOptions {
   AddToOptions add;  ///< --add-to, --character, --over, --over-gap, --colour
   scene::SkirtFit fit;
   double bindThreshold_m = 0.04;
-  bool bindThresholdGiven = false;  ///< --bind-threshold given (else: as far as the waistband needs, at least 0.04 m)
+  bool bindThresholdGiven = false;
+  bool waistGiven = false, hipsGiven = false, legsGiven = false;  ///< --waist-segment, --hip-segments, --leg-segments  ///< --bind-threshold given (else: as far as the waistband needs, at least 0.04 m)
 };
 
 /// The knit the scene gives the skirt (written below as the Knit material).
@@ -115,6 +117,32 @@ void checkSegments(const scene::Avatar& avatar, const MakeSkirtOptions& o, const
   for (const std::string& name : o.fit.legSegments) check(name, "--leg-segments");
 }
 
+/// The segments the command line leaves to make-skirt: the defaults (the MakeHuman CMU rig's
+/// names) where the avatar has them all, else those its skeleton's shape shows
+/// (scene::findLowerBody), said on standard output.
+void chooseSegments(const scene::Avatar& avatar, MakeSkirtOptions& o, const std::string& whose) {
+  const scene::SkirtFit defaults;
+  const auto has = [&](const std::string& name) { return avatar.findSegment(name) >= 0; };
+  const bool namedAsDefaults = has(defaults.waistSegment) && std::all_of(defaults.hipSegments.begin(), defaults.hipSegments.end(), has) &&
+                               std::all_of(defaults.legSegments.begin(), defaults.legSegments.end(), has);
+  if (namedAsDefaults || (o.waistGiven && o.hipsGiven && o.legsGiven)) return;
+  std::string whyNot;
+  if (!scene::findHumanoid(scene::jointsAt(avatar), &whyNot)) {
+    if (o.waistGiven || o.hipsGiven || o.legsGiven) return;  // checkSegments names what is missing
+    throw Error(fmt::format("{} has none of the MakeHuman CMU rig's segment names make-skirt knows ({}, {}, {}), and its "
+                            "lower body cannot be found by the skeleton's shape: {}; name its own with --waist-segment, "
+                            "--hip-segments and --leg-segments (it has: {})",
+                            whose, defaults.waistSegment, fmt::join(defaults.hipSegments, ", "),
+                            fmt::join(defaults.legSegments, ", "), whyNot, fmt::join(avatar.segmentNames(), ", ")));
+  }
+  const scene::LowerBody found = scene::findLowerBody(avatar);
+  if (!o.waistGiven) o.fit.waistSegment = found.waist;
+  if (!o.hipsGiven) o.fit.hipSegments = found.hips;
+  if (!o.legsGiven) o.fit.legSegments = found.legs;
+  fmt::print("found by the skeleton's shape: waist {}; hips {}; legs {}\n", o.fit.waistSegment,
+             fmt::join(o.fit.hipSegments, ", "), fmt::join(o.fit.legSegments, ", "));
+}
+
 /// The OBJ files' stems: skirt and waistband for the default name, else NAME and NAME_waistband.
 std::pair<std::string, std::string> objStems(const std::string& name) {
   if (name == "Skirt") return {"skirt", "waistband"};
@@ -145,8 +173,9 @@ void printSkirt(const std::string& name, const mesh::Skirt& skirt) {
              skirt.mesh.vertexCount(), skirt.mesh.triangleCount(), box.max.y(), box.min.y());
 }
 
-int makeSkirt(const MakeSkirtOptions& o) {
+int makeSkirt(MakeSkirtOptions o) {
   const scene::Avatar avatar = scene::loadAvatarFile(o.avatar);
+  chooseSegments(avatar, o, o.avatar);
   checkSegments(avatar, o, o.avatar);
   const mesh::Skirt skirt = scene::fitSkirt(avatar, o.fit);
   MakeSkirtOptions written = o;
@@ -166,10 +195,12 @@ int makeSkirt(const MakeSkirtOptions& o) {
 }
 
 /// --add-to: the skirt fitted to the scene's character as the scene places it, and appended.
-int addSkirt(const MakeSkirtOptions& o) {
+int addSkirt(MakeSkirtOptions o) {
   const SceneToDress dress = openSceneToDress(o.add.scene, o.add.character);
   const scene::Avatar& avatar = *dress.character.avatar;
-  checkSegments(avatar, o, fmt::format("{} ('{}')", o.add.scene, dress.character.name));
+  const std::string whose = fmt::format("{} ('{}')", o.add.scene, dress.character.name);
+  chooseSegments(avatar, o, whose);
+  checkSegments(avatar, o, whose);
   checkNewGarment(dress, o.name, o.add.over);
   const mesh::Skirt skirt = scene::fitSkirt(avatar, o.fit);
   const double added = checkSceneSteps(dress, skirt.mesh, knit(), o.name);
@@ -216,13 +247,17 @@ RunFunction setupMakeSkirt(CLI::App& app) {
   app.add_option("--flare", o.fit.flare, "Extra hem radius per metre of length")->capture_default_str();
   app.add_option("--around", o.fit.segments, "Vertices around")->capture_default_str()->check(CLI::Range(6, 1000));
   app.add_option("--rings", o.fit.rings, "Bands from waist to hem")->capture_default_str()->check(CLI::Range(2, 1000));
-  app.add_option("--waist-segment", o.fit.waistSegment, "Segment at whose joint the waist sits")->capture_default_str();
-  app.add_option("--hip-segments", o.fit.hipSegments, "Segments below the waist the skirt clears and collides with")
+  app.add_option("--waist-segment", o.fit.waistSegment,
+                 "Segment at whose joint the waist sits (default: LowerBack, or where an avatar without the "
+                 "MakeHuman CMU rig's names has its waist by its skeleton's shape)")
+      ->capture_default_str();
+  app.add_option("--hip-segments", o.fit.hipSegments,
+                 "Segments below the waist the skirt clears and collides with (default: Hips, or found as the waist is)")
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--leg-segments", o.fit.legSegments,
-                 "Leg segments the skirt clears and collides with; its default length reaches a little above the "
-                 "knees")
+                 "Leg segments the skirt clears and collides with (default: the thighs and shins, by the CMU rig's names "
+                 "or found as the waist is); its default length reaches a little above the knees")
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--bind-threshold", o.bindThreshold_m,
@@ -231,6 +266,9 @@ RunFunction setupMakeSkirt(CLI::App& app) {
   return [&app] {
     if (o.name.empty()) o.name = "Skirt";
     o.bindThresholdGiven = app.count("--bind-threshold") > 0;
+    o.waistGiven = app.count("--waist-segment") > 0;
+    o.hipsGiven = app.count("--hip-segments") > 0;
+    o.legsGiven = app.count("--leg-segments") > 0;
     if (!addingToScene(app, o.add, "make-skirt", o.avatar, o.out, {"--out", "--avatar-url"})) return makeSkirt(o);
     return addSkirt(o);
   };

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
@@ -32,14 +34,17 @@ void runsClean(const ScratchDir& scratch, const std::string& dir) {
   EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
 }
 
-/// CesiumMan's skirt (his glTF names his segments joint0, joint1, ...), in `dir`/skirt; ""
+/// CesiumMan's skirt (his glTF names his segments joint0, joint1, ..., and make-skirt finds
+/// his lower body by his skeleton's shape), in `dir`/skirt; ""
 /// (with the failure recorded) if make-skirt fails.
 std::string makeCesiumSkirt(const ScratchDir& dir) {
   const std::string out = dir / "skirt";
-  const CliResult r = runDrape("make-skirt '" + kAvatars + "/CesiumMan.glb' --waist-segment joint1 --hip-segments joint0 " +
-                                   "--leg-segments joint11,joint12,joint13,joint14 --out '" + out + "'",
-                               dir);
+  const CliResult r = runDrape("make-skirt '" + kAvatars + "/CesiumMan.glb' --out '" + out + "'", dir);
   EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("found by the skeleton's shape: waist joint1; hips joint0; legs joint11, joint12, joint13, "
+                       "joint14\n"),
+            std::string::npos)
+      << r.out;
   EXPECT_NE(r.out.find("run it: drape run " + out + "/scene.wrl (the avatar plays its own file's animation 'animation "
                        "0'; --motion FILE plays another)\n"),
             std::string::npos)
@@ -86,37 +91,56 @@ TEST(MakeSkirt, AWideSkirtsWaistbandIsBoundWhereItSits) {
   EXPECT_NEAR(scene::loadScene(dir / "given/scene.wrl").garments[0].bindThreshold, 0.04, 1e-7);  // SFFloat
 }
 
-TEST(MakeSkirt, AnotherRigNamesItsOwnSegments) {
-  // MakeHuman's game-engine rig names its segments as game engines do: the defaults (the
-  // CMU rig's) are refused with the avatar's own names, which then fit the skirt.
+TEST(MakeSkirt, AnotherRigsLowerBodyIsFoundByItsShape) {
+  // MakeHuman's game-engine rig names its segments as game engines do: without the CMU
+  // rig's names, make-skirt finds the waist, hips and legs by the skeleton's shape, and
+  // fits the same skirt to the same body (within the 1.5 cm its other segments' outlines
+  // make). Segments named on the command line win, and a wrong name is refused.
   ScratchDir dir("make-skirt-game-engine");
   const std::string avatar = "'" + kAvatars + "/makehuman_rig_game_engine.mhskel'";
-  const CliResult refused = runDrape("make-skirt " + avatar + " --out '" + (dir / "refused") + "'", dir);
-  EXPECT_EQ(refused.code, 2);
-  EXPECT_NE(refused.err.find("no segment 'LowerBack'"), std::string::npos) << refused.err;
-  EXPECT_NE(refused.err.find("--waist-segment"), std::string::npos) << refused.err;
-  EXPECT_NE(refused.err.find("spine_01"), std::string::npos) << refused.err;
-
-  const CliResult wrongLeg = runDrape("make-skirt " + avatar + " --waist-segment spine_01 --hip-segments pelvis " +
-                                          "--leg-segments thigh_l,knee_l --out '" + (dir / "wrong") + "'",
-                                      dir);
-  EXPECT_EQ(wrongLeg.code, 2);
-  EXPECT_NE(wrongLeg.err.find("no segment 'knee_l'; name one of its own with --leg-segments"), std::string::npos)
-      << wrongLeg.err;
-
   const std::string out = dir / "skirt";
-  const CliResult made = runDrape("make-skirt " + avatar + " --waist-segment spine_01 --hip-segments pelvis " +
-                                      "--leg-segments thigh_l,thigh_r,calf_l,calf_r --out '" + out + "'",
-                                  dir);
-  ASSERT_EQ(made.code, 0) << made.err;
+  const CliResult found = runDrape("make-skirt " + avatar + " --out '" + out + "'", dir);
+  ASSERT_EQ(found.code, 0) << found.err;
+  EXPECT_NE(found.out.find("found by the skeleton's shape: waist spine_01; hips pelvis; legs thigh_l, thigh_r, calf_l, "
+                           "calf_r\n"),
+            std::string::npos)
+      << found.out;
   const scene::Scene sc = scene::loadScene(out + "/scene.wrl");
   ASSERT_EQ(sc.garments.size(), 1u);
   EXPECT_EQ(sc.garments[0].collidesWith,
             (std::vector<std::string>{"spine_01", "pelvis", "thigh_l", "thigh_r", "calf_l", "calf_r"}));
-  // Down to a little above the knees, as on the CMU rig: well below the hips.
-  const Aabb box = sc.garments[0].mesh.bounds();
-  EXPECT_GT(box.max.y() - box.min.y(), 0.3);
+  const CliResult cmu = runDrape("make-skirt '" + kAvatars + "/makehuman_rig_cmu_mb.mhskel' --out '" + (dir / "cmu") + "'", dir);
+  ASSERT_EQ(cmu.code, 0) << cmu.err;
+  EXPECT_EQ(cmu.out.find("found by the skeleton's shape"), std::string::npos) << cmu.out;
+  const mesh::TriMesh& onCmu = scene::loadScene(dir / "cmu/scene.wrl").garments[0].mesh;
+  ASSERT_EQ(onCmu.vertexCount(), sc.garments[0].mesh.vertexCount());
+  double farthest = 0;
+  for (std::size_t v = 0; v < onCmu.vertexCount(); ++v)
+    farthest = std::max(farthest, (onCmu.positions[v] - sc.garments[0].mesh.positions[v]).norm());
+  EXPECT_LT(farthest, 0.025);
   runsClean(dir, out);
+
+  const CliResult wrongLeg = runDrape("make-skirt " + avatar + " --leg-segments thigh_l,knee_l --out '" +
+                                          (dir / "wrong") + "'",
+                                      dir);
+  EXPECT_EQ(wrongLeg.code, 2);
+  EXPECT_NE(wrongLeg.err.find("no segment 'knee_l'; name one of its own with --leg-segments"), std::string::npos)
+      << wrongLeg.err;
+  const CliResult given = runDrape("make-skirt " + avatar + " --hip-segments pelvis,thigh_l,thigh_r --leg-segments " +
+                                       "calf_l,calf_r --out '" + (dir / "given") + "'",
+                                   dir);
+  ASSERT_EQ(given.code, 0) << given.err;
+  EXPECT_EQ(scene::loadScene(dir / "given/scene.wrl").garments[0].collidesWith,
+            (std::vector<std::string>{"spine_01", "pelvis", "thigh_l", "thigh_r", "calf_l", "calf_r"}));
+
+  // A skeleton with no legs to find: refused, naming what to give.
+  const CliResult simple = runDrape("make-skirt '" + kAvatars + "/RiggedSimple.glb' --out '" + (dir / "simple") + "'", dir);
+  EXPECT_EQ(simple.code, 2);
+  EXPECT_NE(simple.err.find("its lower body cannot be found by the skeleton's shape: 2 joints are too few for legs, a "
+                            "spine and arms; name its own with --waist-segment, --hip-segments and --leg-segments (it "
+                            "has: joint0, joint1)"),
+            std::string::npos)
+      << simple.err;
 }
 
 TEST(MakeSkirt, ASmallCharactersSkirtGetsTheSubstepsItNeeds) {

@@ -1,0 +1,314 @@
+#include "drape/scene/humanoid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "drape/core/error.hpp"
+
+namespace drape::scene {
+namespace {
+
+// The proportions the rules read, as fractions of the skeleton's height (its highest joint
+// above its lowest) or of a limb's length; the human body's own are far from each edge.
+constexpr double kFloorReach = 0.15;   // a leg's lowest joint lies this near the lowest of all
+constexpr double kHipOut = 0.25;       // the hip: this far out of the middle, of the foot's distance
+constexpr double kAnkleUp = 0.25;      // the ankle: this near the floor, of the hip's height over it
+constexpr double kArmReach = 0.15;     // an arm reaches this far to the side
+constexpr double kWristOut = 0.6;      // the wrist lies at least this far along the arm's reach
+constexpr double kElbowBack = 0.45;    // the elbow: this far back from the wrist, of the arm's span
+constexpr double kShoulderBack = 0.85; // the shoulder: at least this far from the elbow, of the forearm
+constexpr double kWaistAboveHips = 0.03;  // the waist: this far above the hip joints
+
+struct Tree {
+  std::span<const JointAt> joints;
+  std::vector<std::vector<int>> children;
+  std::vector<double> lowest;   // the lowest y of each joint's subtree
+  std::vector<double> highest;  // the highest y of each joint's subtree
+
+  explicit Tree(std::span<const JointAt> j) : joints(j), children(j.size()), lowest(j.size()), highest(j.size()) {
+    for (std::size_t i = 0; i < j.size(); ++i) {
+      lowest[i] = highest[i] = j[i].rest.y();
+      if (j[i].parent >= 0) children[static_cast<std::size_t>(j[i].parent)].push_back(static_cast<int>(i));
+    }
+    for (std::size_t i = j.size(); i-- > 0;) {
+      const int p = j[i].parent;
+      if (p < 0) continue;
+      lowest[static_cast<std::size_t>(p)] = std::min(lowest[static_cast<std::size_t>(p)], lowest[i]);
+      highest[static_cast<std::size_t>(p)] = std::max(highest[static_cast<std::size_t>(p)], highest[i]);
+    }
+  }
+  [[nodiscard]] const Vec3& at(int j) const { return joints[static_cast<std::size_t>(j)].rest; }
+  [[nodiscard]] const std::vector<int>& kids(int j) const { return children[static_cast<std::size_t>(j)]; }
+  [[nodiscard]] double low(int j) const { return lowest[static_cast<std::size_t>(j)]; }
+  [[nodiscard]] double high(int j) const { return highest[static_cast<std::size_t>(j)]; }
+};
+
+Vec3 horizontal(const Vec3& v) { return {v.x(), 0.0, v.z()}; }
+
+/// From `from`, down to the lowest joint below it, through the child whose subtree reaches lowest.
+JointChain pathDown(const Tree& t, int from) {
+  JointChain path{from};
+  while (!t.kids(path.back()).empty()) {
+    const std::vector<int>& k = t.kids(path.back());
+    path.push_back(*std::min_element(k.begin(), k.end(), [&](int a, int b) { return t.low(a) < t.low(b); }));
+  }
+  return path;
+}
+
+/// From `from`, up to the highest joint above it, through the child whose subtree reaches highest.
+JointChain pathUp(const Tree& t, int from) {
+  JointChain path{from};
+  while (!t.kids(path.back()).empty()) {
+    const std::vector<int>& k = t.kids(path.back());
+    path.push_back(*std::max_element(k.begin(), k.end(), [&](int a, int b) { return t.high(a) < t.high(b); }));
+  }
+  return path;
+}
+
+JointChain slice(const JointChain& path, std::size_t first, std::size_t last) {
+  return {path.begin() + static_cast<std::ptrdiff_t>(first), path.begin() + static_cast<std::ptrdiff_t>(last)};
+}
+
+/// The leg down `path` (the pelvis's child first), or nullopt.
+std::optional<HumanoidLimb> legOf(const Tree& t, const JointChain& path, int pelvis, const Vec3& side) {
+  const double footOut = std::abs(side.dot(t.at(path.back()) - t.at(pelvis)));
+  std::size_t hip = 0;
+  while (hip < path.size() && std::abs(side.dot(t.at(path[hip]) - t.at(pelvis))) < kHipOut * footOut) ++hip;
+  const double floorY = t.at(path.back()).y();
+  if (hip >= path.size()) return std::nullopt;
+  const double hipUp = t.at(path[hip]).y() - floorY;
+  std::size_t ankle = hip + 1;
+  while (ankle < path.size() && t.at(path[ankle]).y() - floorY >= kAnkleUp * hipUp) ++ankle;
+  if (ankle >= path.size() || ankle < hip + 2) return std::nullopt;
+  const double midY = 0.5 * (t.at(path[hip]).y() + t.at(path[ankle]).y());
+  std::size_t knee = hip + 1;
+  for (std::size_t i = hip + 1; i < ankle; ++i)
+    if (std::abs(t.at(path[i]).y() - midY) < std::abs(t.at(path[knee]).y() - midY)) knee = i;
+  HumanoidLimb leg;
+  leg.base = slice(path, 0, hip);
+  leg.upper = slice(path, hip, knee);
+  leg.lower = slice(path, knee, ankle);
+  leg.end = {path[ankle]};
+  if (ankle + 1 < path.size()) leg.tip = {path[ankle + 1]};
+  return leg;
+}
+
+/// The farthest any joint of `from`'s subtree lies along `side` from `origin`.
+double sideReach(const Tree& t, int from, const Vec3& origin, const Vec3& side) {
+  double reach = std::abs(side.dot(t.at(from) - origin));
+  for (int k : t.kids(from)) reach = std::max(reach, sideReach(t, k, origin, side));
+  return reach;
+}
+
+/// The farthest joint of `from`'s subtree from `from`, and the path to it.
+JointChain pathOut(const Tree& t, int from) {
+  JointChain best{from};
+  double bestDistance = 0.0;
+  const auto visit = [&](const auto& self, JointChain& path) -> void {
+    const double d = (t.at(path.back()) - t.at(from)).norm();
+    if (d > bestDistance) {
+      bestDistance = d;
+      best = path;
+    }
+    for (int k : t.kids(path.back())) {
+      path.push_back(k);
+      self(self, path);
+      path.pop_back();
+    }
+  };
+  JointChain path{from};
+  visit(visit, path);
+  return best;
+}
+
+/// The arm that leaves the spine at `from`, or nullopt.
+std::optional<HumanoidLimb> armOf(const Tree& t, int from) {
+  const JointChain path = pathOut(t, from);
+  const double reach = (t.at(path.back()) - t.at(from)).norm();
+  std::size_t wrist = 1;
+  while (wrist + 1 < path.size() &&
+         (t.kids(path[wrist]).size() == 1 || (t.at(path[wrist]) - t.at(from)).norm() < kWristOut * reach))
+    ++wrist;
+  if (wrist >= path.size() || wrist < 1) return std::nullopt;
+  const double span = (t.at(path[wrist]) - t.at(from)).norm();
+  std::size_t elbow = 0;
+  double elbowMiss = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 1; i < wrist; ++i) {
+    const double miss = std::abs((t.at(path[wrist]) - t.at(path[i])).norm() - kElbowBack * span);
+    if (miss < elbowMiss) {
+      elbowMiss = miss;
+      elbow = i;
+    }
+  }
+  if (elbow == 0) return std::nullopt;
+  const double forearm = (t.at(path[wrist]) - t.at(path[elbow])).norm();
+  std::size_t shoulder = 0;
+  for (std::size_t i = 0; i < elbow; ++i)
+    if ((t.at(path[elbow]) - t.at(path[i])).norm() >= kShoulderBack * forearm) shoulder = i;
+  HumanoidLimb arm;
+  arm.base = slice(path, 0, shoulder);
+  arm.upper = slice(path, shoulder, elbow);
+  arm.lower = slice(path, elbow, wrist);
+  arm.end = {path[wrist]};
+  return arm;
+}
+
+std::optional<Humanoid> fail(std::string* whyNot, std::string why) {
+  if (whyNot != nullptr) *whyNot = std::move(why);
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<Humanoid> findHumanoid(std::span<const JointAt> joints, std::string* whyNot) {
+  if (joints.size() < 8) return fail(whyNot, fmt::format("{} joints are too few for legs, a spine and arms", joints.size()));
+  const Tree t(joints);
+  double lowestY = std::numeric_limits<double>::infinity(), highestY = -lowestY;
+  for (const JointAt& j : joints) {
+    lowestY = std::min(lowestY, j.rest.y());
+    highestY = std::max(highestY, j.rest.y());
+  }
+  const double height = highestY - lowestY;
+  if (!(height > 0)) return fail(whyNot, "its joints stand no higher than each other");
+
+  // The pelvis: the shallowest joint (parents come first) with two children reaching the floor.
+  Humanoid h;
+  std::vector<int> legChildren;
+  for (std::size_t i = 0; i < joints.size() && h.pelvis < 0; ++i) {
+    std::vector<int> reaching;
+    for (int k : t.kids(static_cast<int>(i)))
+      if (t.low(k) < lowestY + kFloorReach * height) reaching.push_back(k);
+    if (reaching.size() == 2) {
+      h.pelvis = static_cast<int>(i);
+      legChildren = reaching;
+    }
+  }
+  if (h.pelvis < 0) return fail(whyNot, "no joint has two children reaching the floor (the legs)");
+  for (int a = joints[static_cast<std::size_t>(h.pelvis)].parent; a >= 0; a = joints[static_cast<std::size_t>(a)].parent)
+    h.abovePelvis.insert(h.abovePelvis.begin(), a);
+  int spineChild = -1;
+  for (int k : t.kids(h.pelvis))
+    if (k != legChildren[0] && k != legChildren[1] && (spineChild < 0 || t.high(k) > t.high(spineChild))) spineChild = k;
+  if (spineChild < 0 || t.high(spineChild) < t.at(h.pelvis).y() + 0.25 * height)
+    return fail(whyNot, "no joint above the legs' parting reaches up (the spine)");
+
+  // Forward from the toes where the legs have joints past the ankle, else +z (glTF's and
+  // BVH's facing); left is up x forward.
+  const std::array<JointChain, 2> legPaths{pathDown(t, legChildren[0]), pathDown(t, legChildren[1])};
+  const Vec3 across = horizontal(t.at(legPaths[0].back()) - t.at(legPaths[1].back()));
+  if (across.norm() < 1e-6) return fail(whyNot, "the two legs end in the same place");
+  std::array<std::optional<HumanoidLimb>, 2> legs{legOf(t, legPaths[0], h.pelvis, across.normalized()),
+                                                   legOf(t, legPaths[1], h.pelvis, across.normalized())};
+  if (!legs[0] || !legs[1]) return fail(whyNot, "a leg has no hip, knee and ankle one above the other");
+  Vec3 toes = Vec3::Zero();
+  for (const auto& leg : legs)
+    if (!leg->tip.empty()) toes += horizontal(t.at(leg->tip[0]) - t.at(leg->end[0]));
+  const Vec3 side0 = horizontal(t.at(legs[0]->upper[0]) - t.at(h.pelvis));
+  if (toes.norm() > 0.01 * height) {
+    // The toes' direction, made square to the legs' parting: feet turn out.
+    const Vec3 a = across.normalized();
+    h.forward = (toes - a * a.dot(toes)).normalized();
+  } else {
+    // No toes: square to the legs' parting, towards +z (or +x), as glTF and BVH characters face.
+    h.forward = Vec3(-across.z(), 0.0, across.x()).normalized();
+    if (h.forward.z() < -1e-9 || (std::abs(h.forward.z()) <= 1e-9 && h.forward.x() < 0)) h.forward = -h.forward;
+  }
+  const Vec3 left = Vec3::UnitY().cross(h.forward);
+  const bool firstIsLeft = left.dot(side0) > 0;
+  h.legs[0] = *legs[firstIsLeft ? 0 : 1];
+  h.legs[1] = *legs[firstIsLeft ? 1 : 0];
+
+  // The spine up to the chest: where the two branches reaching farthest to the sides leave it.
+  const JointChain up = pathUp(t, spineChild);
+  std::array<int, 2> arms{-1, -1};            // the branches' first joints, left and right
+  std::array<std::size_t, 2> armAt{0, 0};     // where on the way up they leave it
+  std::array<double, 2> reach{0.0, 0.0};
+  for (std::size_t i = 0; i + 1 < up.size(); ++i)
+    for (int k : t.kids(up[i])) {
+      if (k == up[i + 1]) continue;
+      const double r = sideReach(t, k, t.at(up[i]), left);
+      const std::size_t s = left.dot(t.at(pathOut(t, k).back()) - t.at(up[i])) > 0 ? 0 : 1;
+      if (r > reach[s] && r > kArmReach * height) {
+        reach[s] = r;
+        arms[s] = k;
+        armAt[s] = i;
+      }
+    }
+  if (arms[0] < 0 || arms[1] < 0) return fail(whyNot, "the spine has no two branches reaching out to the sides (the arms)");
+  const std::size_t chestAt = std::min(armAt[0], armAt[1]);
+  h.spine = slice(up, 0, chestAt + 1);
+  // The neck up to the head: the first joint past the chest where the way up branches or ends.
+  std::size_t headAt = chestAt + 1;
+  while (headAt + 1 < up.size() && t.kids(up[headAt]).size() == 1) ++headAt;
+  if (headAt >= up.size()) return fail(whyNot, "nothing rises above the arms (the neck and head)");
+  h.neck = slice(up, chestAt + 1, headAt + 1);
+  for (std::size_t s = 0; s < 2; ++s) {
+    const std::optional<HumanoidLimb> arm = armOf(t, arms[s]);
+    if (!arm) return fail(whyNot, "an arm has no shoulder, elbow and wrist along it");
+    h.arms[s] = *arm;
+  }
+  return h;
+}
+
+std::vector<JointAt> jointsAt(const Avatar& avatar) {
+  std::vector<JointAt> out;
+  out.reserve(avatar.joints.size());
+  for (const Joint& j : avatar.joints) out.push_back({j.parent, j.restCenter});
+  return out;
+}
+
+namespace {
+
+/// The names of the avatar's segments that move with `joint`.
+std::vector<std::string> segmentsOf(const Avatar& avatar, int joint) {
+  std::vector<std::string> names;
+  for (const Segment& s : avatar.segments)
+    if (s.joint == joint && !s.mesh.triangles.empty()) names.push_back(s.name);
+  return names;
+}
+
+void addSegments(const Avatar& avatar, const JointChain& chain, std::vector<std::string>& into) {
+  for (int j : chain)
+    for (std::string& name : segmentsOf(avatar, j)) into.push_back(std::move(name));
+}
+
+}  // namespace
+
+LowerBody findLowerBody(const Avatar& avatar) {
+  std::string whyNot;
+  const std::vector<JointAt> joints = jointsAt(avatar);
+  const std::optional<Humanoid> h = findHumanoid(joints, &whyNot);
+  const std::string whose = avatar.source.empty() ? avatar.name : avatar.source;
+  if (!h) throw Error(fmt::format("{}: its lower body cannot be found by the skeleton's shape: {}", whose, whyNot));
+  double height = -std::numeric_limits<double>::infinity(), lowest = std::numeric_limits<double>::infinity();
+  for (const Joint& j : avatar.joints) {
+    height = std::max(height, j.restCenter.y());
+    lowest = std::min(lowest, j.restCenter.y());
+  }
+  height -= lowest;
+  const double hipsY = 0.5 * (avatar.joints[static_cast<std::size_t>(h->legs[0].upper[0])].restCenter.y() +
+                              avatar.joints[static_cast<std::size_t>(h->legs[1].upper[0])].restCenter.y());
+  LowerBody body;
+  addSegments(avatar, {h->pelvis}, body.hips);
+  for (int j : h->spine) {
+    std::vector<std::string> names = segmentsOf(avatar, j);
+    if (avatar.joints[static_cast<std::size_t>(j)].restCenter.y() >= hipsY + kWaistAboveHips * height && !names.empty()) {
+      body.waist = names.front();
+      break;
+    }
+    body.hips.insert(body.hips.end(), names.begin(), names.end());
+  }
+  if (body.waist.empty())
+    throw Error(fmt::format("{}: no spine joint above the hips has a segment to fit a waist to; name one with "
+                            "--waist-segment",
+                            whose));
+  for (const HumanoidLimb& leg : h->legs) addSegments(avatar, leg.base, body.hips);
+  for (const HumanoidLimb& leg : h->legs) addSegments(avatar, leg.upper, body.legs);
+  for (const HumanoidLimb& leg : h->legs) addSegments(avatar, leg.lower, body.legs);
+  return body;
+}
+
+}  // namespace drape::scene

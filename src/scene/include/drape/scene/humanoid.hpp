@@ -1,0 +1,85 @@
+#pragma once
+// A humanoid skeleton's parts found by its shape alone: which joints are the pelvis, the
+// spine, the neck and head, and each leg's and arm's bones, from the joint tree and the
+// joints' rest positions (y up), whatever the joints are called. CesiumMan's glTF names
+// its joints joint0 .. joint18; a capture or a rig in another language names them in
+// words no shipped map knows. `drape make-skirt` finds the lower body it fits a skirt to
+// this way, and motion's `shapeJointMap` pairs two skeletons' joints bone for bone.
+//
+// The rules, for a standing rest pose (T or A), in docs/MOTION.md ("Joint maps by shape"):
+// the pelvis is the shallowest joint with two children reaching the floor; the leg is the
+// path from such a child down to its lowest joint, the hip its first joint away from the
+// body's middle, the ankle its first joint near the floor, the knee the joint between
+// nearest their mid-height; the spine runs from the pelvis towards the highest joint, the
+// chest where the two branches reaching farthest to the sides leave it; an arm's wrist is
+// where its path branches (the fingers) or ends, the elbow the joint nearest 45 % of the
+// way from the wrist back to the arm's start, the shoulder the last joint before it at
+// least as far from the elbow as the wrist nearly is.
+
+#include <array>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "drape/core/math.hpp"
+#include "drape/scene/avatar.hpp"
+
+namespace drape::scene {
+
+/// A joint of a tree, as the shape sees it.
+struct JointAt {
+  int parent = -1;           ///< parents come first
+  Vec3 rest = Vec3::Zero();  ///< world position at rest, y up
+};
+
+/// Joints in order from parent to child; empty where the skeleton has no such bone.
+using JointChain = std::vector<int>;
+
+/// A limb's bones, each the chain of joints that moves as one bone (a twist joint after
+/// its bone's first joint).
+struct HumanoidLimb {
+  JointChain base;   ///< between the trunk and the limb: a hip bone (LHipJoint), a clavicle
+  JointChain upper;  ///< thigh, upper arm: from the hip or shoulder joint
+  JointChain lower;  ///< shin, forearm: from the knee or elbow
+  JointChain end;    ///< foot, hand: from the ankle or wrist
+  JointChain tip;    ///< the toe (the joint after the ankle on the way down); empty for an arm
+};
+
+struct Humanoid {
+  int pelvis = -1;               ///< where the legs and the spine part
+  JointChain abovePelvis;        ///< the pelvis's ancestors (a floor root), root first
+  JointChain spine;              ///< the pelvis's child up to the chest, which the arms leave
+  JointChain neck;               ///< the chest's child up to the head (its last joint)
+  std::array<HumanoidLimb, 2> legs;  ///< [0] left, [1] right
+  std::array<HumanoidLimb, 2> arms;  ///< [0] left, [1] right
+  Vec3 forward = Vec3::UnitZ();  ///< the way the toes point, horizontal, unit
+
+  /// The joint the head's last bone starts at.
+  [[nodiscard]] int head() const { return neck.empty() ? -1 : neck.back(); }
+  /// The chest: the spine's last joint.
+  [[nodiscard]] int chest() const { return spine.empty() ? -1 : spine.back(); }
+};
+
+/// The humanoid in `joints`, or nullopt with `whyNot` (when given) saying what was not
+/// found ("no joint has two children reaching the floor (the legs)", ...).
+[[nodiscard]] std::optional<Humanoid> findHumanoid(std::span<const JointAt> joints, std::string* whyNot = nullptr);
+
+/// The avatar's joints at rest, as findHumanoid reads them.
+[[nodiscard]] std::vector<JointAt> jointsAt(const Avatar& avatar);
+
+/// The segments a skirt is fitted to and collides with, found by the avatar's shape: the
+/// waist at the first spine joint a little above the hips, the segments below it (the
+/// pelvis's, the spine's below the waist, the hip bones') as hips, the thighs and shins as
+/// legs; each only where the avatar has a segment of that joint.
+struct LowerBody {
+  std::string waist;
+  std::vector<std::string> hips;
+  std::vector<std::string> legs;
+};
+
+/// Throws drape::Error naming the avatar and what was not found when it is not humanoid
+/// or has no segment at its waist.
+[[nodiscard]] LowerBody findLowerBody(const Avatar& avatar);
+
+}  // namespace drape::scene

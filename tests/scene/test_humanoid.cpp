@@ -1,0 +1,221 @@
+// A humanoid found by its skeleton's shape (scene::findHumanoid): on four real rigs, whose
+// joints' names say what each is (and the shipped joint maps pair them), the shape alone
+// must find the same bones; turned to face any way and moved, the same again; and what is
+// not a humanoid is refused with a reason.
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "drape/core/error.hpp"
+#include "drape/scene/avatar_gltf.hpp"
+#include "drape/scene/humanoid.hpp"
+
+namespace drape::scene {
+namespace {
+
+const std::string kHumanoidAvatars = std::string(DRAPE_DATA_DIR) + "/avatars/";
+
+/// What a rig's names say each bone is: joint names per chain, left side then right.
+struct Expected {
+  std::string pelvis;
+  std::vector<std::string> spine, neck;
+  std::array<std::vector<std::vector<std::string>>, 2> legs;  ///< base, upper, lower, end, tip
+  std::array<std::vector<std::vector<std::string>>, 2> arms;  ///< base, upper, lower, end
+};
+
+std::vector<std::string> namesOf(const Avatar& avatar, const JointChain& chain) {
+  std::vector<std::string> names;
+  for (int j : chain) names.push_back(avatar.joints[static_cast<std::size_t>(j)].name);
+  return names;
+}
+
+void expectHumanoid(const Avatar& avatar, const Humanoid& h, const Expected& e) {
+  EXPECT_EQ(avatar.joints[static_cast<std::size_t>(h.pelvis)].name, e.pelvis);
+  EXPECT_EQ(namesOf(avatar, h.spine), e.spine);
+  EXPECT_EQ(namesOf(avatar, h.neck), e.neck);
+  for (std::size_t s = 0; s < 2; ++s) {
+    const HumanoidLimb& leg = h.legs[s];
+    const std::vector<JointChain> legChains{leg.base, leg.upper, leg.lower, leg.end, leg.tip};
+    for (std::size_t b = 0; b < e.legs[s].size(); ++b)
+      EXPECT_EQ(namesOf(avatar, legChains[b]), e.legs[s][b]) << (s == 0 ? "left" : "right") << " leg, bone " << b;
+    const HumanoidLimb& arm = h.arms[s];
+    const std::vector<JointChain> armChains{arm.base, arm.upper, arm.lower, arm.end, arm.tip};
+    for (std::size_t b = 0; b < e.arms[s].size(); ++b)
+      EXPECT_EQ(namesOf(avatar, armChains[b]), e.arms[s][b]) << (s == 0 ? "left" : "right") << " arm, bone " << b;
+    EXPECT_TRUE(arm.tip.empty());
+  }
+}
+
+Humanoid humanoidOf(const Avatar& avatar) {
+  std::string why;
+  const std::optional<Humanoid> h = findHumanoid(jointsAt(avatar), &why);
+  if (!h) ADD_FAILURE() << avatar.source << ": " << why;
+  return h.value_or(Humanoid{});
+}
+
+Expected cmuRig() {
+  return {"Hips",
+          {"LowerBack", "Spine", "Spine1"},
+          {"Neck", "Neck1", "Head"},
+          {{{{"LHipJoint"}, {"LeftUpLeg"}, {"LeftLeg"}, {"LeftFoot"}, {"LeftToeBase"}},
+            {{"RHipJoint"}, {"RightUpLeg"}, {"RightLeg"}, {"RightFoot"}, {"RightToeBase"}}}},
+          {{{{"LeftShoulder"}, {"LeftArm"}, {"LeftForeArm"}, {"LeftHand"}},
+            {{"RightShoulder"}, {"RightArm"}, {"RightForeArm"}, {"RightHand"}}}}};
+}
+
+TEST(Humanoid, TheMakeHumanCmuRigsBonesAreWhereItsNamesSay) {
+  const Avatar avatar = loadAvatarFile(kHumanoidAvatars + "makehuman_rig_cmu_mb.mhskel");
+  const Humanoid h = humanoidOf(avatar);
+  expectHumanoid(avatar, h, cmuRig());
+  EXPECT_TRUE(h.abovePelvis.empty());
+  EXPECT_GT(h.forward.z(), 0.99);  // the body faces +z
+}
+
+TEST(Humanoid, TheDefaultRigsTwistBonesGoWithTheirBonesAsItsShippedMapChainsThem) {
+  // share/drape/jointmaps/makehuman_default.json chains upperleg01.L and upperleg02.L into
+  // one thigh, clavicle.L and shoulder01.L into one shoulder, and so on: the shape finds the
+  // same chains (its spine and neck it keeps whole, where the map pairs them with CMU's).
+  const Avatar avatar = loadAvatarFile(kHumanoidAvatars + "makehuman_rig_default.mhskel");
+  const Humanoid h = humanoidOf(avatar);
+  Expected e{"root",
+             {"spine05", "spine04", "spine03", "spine02", "spine01"},
+             {"neck01", "neck02", "neck03", "head"},
+             {},
+             {}};
+  for (const char* side : {"L", "R"}) {
+    const std::size_t s = side[0] == 'L' ? 0 : 1;
+    const auto n = [&](const char* bone) { return std::string(bone) + "." + side; };
+    e.legs[s] = {{n("pelvis")}, {n("upperleg01"), n("upperleg02")}, {n("lowerleg01"), n("lowerleg02")}, {n("foot")}};
+    e.arms[s] = {{n("clavicle"), n("shoulder01")},
+                 {n("upperarm01"), n("upperarm02")},
+                 {n("lowerarm01"), n("lowerarm02")},
+                 {n("wrist")}};
+  }
+  expectHumanoid(avatar, h, e);
+  for (const HumanoidLimb& leg : h.legs) {
+    ASSERT_EQ(leg.tip.size(), 1u);
+    EXPECT_EQ(avatar.joints[static_cast<std::size_t>(leg.tip[0])].name.substr(0, 3), "toe");
+  }
+}
+
+TEST(Humanoid, TheGameEngineRigsFloorRootIsAboveThePelvis) {
+  const Avatar avatar = loadAvatarFile(kHumanoidAvatars + "makehuman_rig_game_engine.mhskel");
+  const Humanoid h = humanoidOf(avatar);
+  Expected e{"pelvis", {"spine_01", "spine_02", "spine_03"}, {"neck_01", "head"}, {}, {}};
+  for (const char* side : {"l", "r"}) {
+    const std::size_t s = side[0] == 'l' ? 0 : 1;
+    const auto n = [&](const char* bone) { return std::string(bone) + "_" + side; };
+    e.legs[s] = {{}, {n("thigh")}, {n("calf")}, {n("foot")}, {n("ball")}};
+    e.arms[s] = {{n("clavicle")}, {n("upperarm")}, {n("lowerarm")}, {n("hand")}};
+  }
+  expectHumanoid(avatar, h, e);
+  EXPECT_EQ(namesOf(avatar, h.abovePelvis), std::vector<std::string>{"Root"});
+}
+
+TEST(Humanoid, CesiumMansNumberedJointsFacingX) {
+  // joint0 .. joint18: nothing in the names. He faces +x (his toes say so), so his left is -z.
+  const Avatar avatar = loadAvatarFile(kHumanoidAvatars + "CesiumMan.glb");
+  const Humanoid h = humanoidOf(avatar);
+  expectHumanoid(avatar, h,
+                 {"joint0",
+                  {"joint1", "joint2"},
+                  {"joint3", "joint4"},
+                  {{{{}, {"joint11"}, {"joint13"}, {"joint15"}, {"joint17"}},
+                    {{}, {"joint12"}, {"joint14"}, {"joint16"}, {"joint18"}}}},
+                  {{{{}, {"joint5"}, {"joint7"}, {"joint9"}}, {{}, {"joint6"}, {"joint8"}, {"joint10"}}}}});
+  EXPECT_GT(h.forward.x(), 0.95);
+  EXPECT_LT(avatar.joints[static_cast<std::size_t>(h.legs[0].upper[0])].restCenter.z(), 0.0);
+}
+
+TEST(Humanoid, TurnedAndMovedItIsTheSameHumanoid) {
+  // Every rig turned about the vertical by random angles and moved: the same joints in
+  // every bone, and forward turned with the body.
+  std::mt19937 rng(20261205);
+  std::uniform_real_distribution<double> angle(-3.14159, 3.14159), shift(-5.0, 5.0);
+  for (const char* file : {"makehuman_rig_cmu_mb.mhskel", "makehuman_rig_default.mhskel",
+                           "makehuman_rig_game_engine.mhskel", "CesiumMan.glb"}) {
+    const Avatar avatar = loadAvatarFile(kHumanoidAvatars + file);
+    const std::vector<JointAt> joints = jointsAt(avatar);
+    const std::optional<Humanoid> upright = findHumanoid(joints);
+    ASSERT_TRUE(upright.has_value()) << file;
+    for (int trial = 0; trial < 12; ++trial) {
+      const Quat turn(Eigen::AngleAxisd(angle(rng), Vec3::UnitY()));
+      const Vec3 move(shift(rng), shift(rng), shift(rng));
+      std::vector<JointAt> turned = joints;
+      for (JointAt& j : turned) j.rest = turn * j.rest + move;
+      const std::optional<Humanoid> h = findHumanoid(turned);
+      ASSERT_TRUE(h.has_value()) << file << ", trial " << trial;
+      EXPECT_EQ(h->pelvis, upright->pelvis) << file;
+      EXPECT_EQ(h->spine, upright->spine) << file;
+      EXPECT_EQ(h->neck, upright->neck) << file;
+      for (std::size_t s = 0; s < 2; ++s) {
+        for (const auto& [a, b] : {std::pair{&h->legs[s], &upright->legs[s]}, std::pair{&h->arms[s], &upright->arms[s]}}) {
+          EXPECT_EQ(a->base, b->base) << file << ", side " << s;
+          EXPECT_EQ(a->upper, b->upper) << file << ", side " << s;
+          EXPECT_EQ(a->lower, b->lower) << file << ", side " << s;
+          EXPECT_EQ(a->end, b->end) << file << ", side " << s;
+          EXPECT_EQ(a->tip, b->tip) << file << ", side " << s;
+        }
+      }
+      EXPECT_LT((h->forward - turn * upright->forward).norm(), 1e-9) << file;
+    }
+  }
+}
+
+TEST(Humanoid, WhatIsNotAHumanoidIsRefusedWithAReason) {
+  std::string why;
+  EXPECT_FALSE(findHumanoid(jointsAt(loadAvatarFile(kHumanoidAvatars + "RiggedSimple.glb")), &why));
+  EXPECT_EQ(why, "2 joints are too few for legs, a spine and arms");
+
+  // A CMU body without its arms: legs and a spine, no arms.
+  const Avatar cmu = loadAvatarFile(kHumanoidAvatars + "makehuman_rig_cmu_mb.mhskel");
+  std::vector<JointAt> noArms;
+  std::vector<int> index(cmu.joints.size(), -1);
+  for (std::size_t i = 0; i < cmu.joints.size(); ++i) {
+    const Joint& j = cmu.joints[i];
+    const bool arm = j.name.find("Shoulder") != std::string::npos ||
+                     (j.parent >= 0 && index[static_cast<std::size_t>(j.parent)] < 0 && i > 0);
+    if (arm) continue;
+    index[i] = static_cast<int>(noArms.size());
+    noArms.push_back({j.parent < 0 ? -1 : index[static_cast<std::size_t>(j.parent)], j.restCenter});
+  }
+  EXPECT_FALSE(findHumanoid(noArms, &why));
+  EXPECT_EQ(why, "the spine has no two branches reaching out to the sides (the arms)");
+
+  // Lying down: the legs reach the floor (the back lies on it), but nothing rises.
+  std::vector<JointAt> lying = jointsAt(cmu);
+  const Quat down(Eigen::AngleAxisd(1.5707963, Vec3::UnitX()));
+  for (JointAt& j : lying) j.rest = down * j.rest;
+  EXPECT_FALSE(findHumanoid(lying, &why));
+  EXPECT_EQ(why, "no joint above the legs' parting reaches up (the spine)");
+}
+
+TEST(Humanoid, TheLowerBodyASkirtIsFittedToOnEachRig) {
+  const LowerBody cmu = findLowerBody(loadAvatarFile(kHumanoidAvatars + "makehuman_rig_cmu_mb.mhskel"));
+  EXPECT_EQ(cmu.waist, "LowerBack");
+  EXPECT_EQ(cmu.hips, (std::vector<std::string>{"Hips", "LHipJoint", "RHipJoint"}));
+  EXPECT_EQ(cmu.legs, (std::vector<std::string>{"LeftUpLeg", "RightUpLeg", "LeftLeg", "RightLeg"}));
+  // The default rig's first spine joint sits at the CMU rig's Hips, 2 cm above its root: the
+  // waist is the next, at LowerBack's place.
+  const LowerBody mh = findLowerBody(loadAvatarFile(kHumanoidAvatars + "makehuman_rig_default.mhskel"));
+  EXPECT_EQ(mh.waist, "spine04");
+  EXPECT_EQ(mh.hips, (std::vector<std::string>{"spine05", "pelvis.L", "pelvis.R"}));
+  EXPECT_EQ(mh.legs.size(), 8u);
+  const LowerBody cesium = findLowerBody(loadAvatarFile(kHumanoidAvatars + "CesiumMan.glb"));
+  EXPECT_EQ(cesium.waist, "joint1");
+  EXPECT_EQ(cesium.hips, std::vector<std::string>{"joint0"});
+  EXPECT_EQ(cesium.legs, (std::vector<std::string>{"joint11", "joint12", "joint13", "joint14"}));
+  try {
+    (void)findLowerBody(loadAvatarFile(kHumanoidAvatars + "RiggedSimple.glb"));
+    ADD_FAILURE() << "RiggedSimple has no lower body";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("RiggedSimple.glb: its lower body cannot be found by the skeleton's shape: 2 "
+                                         "joints are too few"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace drape::scene

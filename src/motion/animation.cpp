@@ -678,8 +678,19 @@ Clip clipOfJointMotion(const formats::SkinnedJointMotion& m, const std::string& 
 
 /// The user's joint map (checked strictly), or the shipped map that pairs the most joints.
 JointMap jointMapFor(const Clip& clip, const scene::Avatar& avatar, const MotionOptions& options) {
-  if (options.jointMapPath.empty())
-    return chooseJointMap(readJointMapDirectory(options.jointMapDirectory), clip.skeleton, avatar);
+  if (options.jointMapPath.empty()) {
+    JointMap named = chooseJointMap(readJointMapDirectory(options.jointMapDirectory), clip.skeleton, avatar);
+    if (drivesTheTrunk(named, clip.skeleton, avatar)) return named;
+    // No shipped map knows both skeletons' names (CesiumMan's joint0 .. joint18): paired by
+    // their shapes, or refused with what the shape lacks.
+    std::string whyNot;
+    if (std::optional<JointMap> byShape = shapeJointMap(clip.skeleton, avatar, &whyNot)) return std::move(*byShape);
+    throw Error(fmt::format("{}: no shipped joint map pairs the joints of the motion {} with the avatar's (the best, '{}', "
+                            "pairs {} and misses its root), and they cannot be paired by shape: {}; give a joint map "
+                            "naming the motion's joints (--joint-map FILE, docs/MOTION.md)",
+                            avatar.source.empty() ? avatar.name : avatar.source, clip.source, named.name,
+                            matchedJointCount(named, clip.skeleton, avatar), whyNot));
+  }
   JointMap map = readJointMap(options.jointMapPath);
   checkJointMap(map, clip.skeleton, avatar);
   return map;

@@ -12,6 +12,7 @@
 
 #include "drape/core/error.hpp"
 #include "drape/formats/json_text.hpp"
+#include "drape/scene/humanoid.hpp"
 
 namespace drape::motion {
 namespace {
@@ -210,6 +211,103 @@ void checkJointMap(const JointMap& map, const Skeleton& skeleton, const scene::A
     if (avatar.findJoint(e.avatarJoint) < 0)
       throw Error::at({map.source, e.avatarAt.line, e.avatarAt.column}, fmt::format("unknown avatar joint '{}' (not in avatar '{}')", e.avatarJoint, avatar.name));
   }
+}
+
+namespace {
+
+/// The motion's skeleton at rest, as scene::findHumanoid reads joints.
+std::vector<scene::JointAt> jointsAt(const Skeleton& skeleton) {
+  const std::vector<Vec3> rest = skeleton.restPositions();
+  std::vector<scene::JointAt> out;
+  out.reserve(skeleton.size());
+  for (std::size_t i = 0; i < skeleton.size(); ++i) out.push_back({skeleton.joints[i].parent, rest[i]});
+  return out;
+}
+
+/// Pairs two skeletons' shapes into a map's entries.
+struct ShapePairing {
+  const Skeleton& skeleton;
+  const scene::Avatar& avatar;
+  const std::vector<scene::JointAt>& motionAt;
+  JointMap map;
+
+  void pair(int motionJoint, int avatarJoint) {
+    map.entries.push_back({skeleton.joints[static_cast<std::size_t>(motionJoint)].name,
+                           avatar.joints[static_cast<std::size_t>(avatarJoint)].name,
+                           {},
+                           {}});
+  }
+  /// A bone: the motion's first joint of it drives the avatar's whole chain.
+  void bone(const scene::JointChain& motion, const scene::JointChain& avatarChain) {
+    if (motion.empty()) return;
+    for (int a : avatarChain) pair(motion.front(), a);
+  }
+  /// A run of joints between two fixed ones (the spine between the pelvis and the chest):
+  /// each avatar joint driven by the motion's joint nearest its fraction of the run's height,
+  /// `motion` and `avatarRun` ending at the run's top, `motionBase` and `avatarBase` below it.
+  void run(const scene::JointChain& motion, int motionBase, const scene::JointChain& avatarRun, int avatarBase) {
+    if (motion.empty() || avatarRun.empty()) return;
+    const auto fractions = [](const scene::JointChain& chain, int base, const auto& yOf) {
+      const double y0 = yOf(base), height = yOf(chain.back()) - y0;
+      std::vector<double> f;
+      for (int j : chain) f.push_back(height > 0 ? (yOf(j) - y0) / height : 1.0);
+      return f;
+    };
+    const auto motionY = [&](int j) { return motionAt[static_cast<std::size_t>(j)].rest.y(); };
+    const auto avatarY = [&](int j) { return avatar.joints[static_cast<std::size_t>(j)].restCenter.y(); };
+    const std::vector<double> fm = fractions(motion, motionBase, motionY);
+    const std::vector<double> fa = fractions(avatarRun, avatarBase, avatarY);
+    for (std::size_t a = 0; a < avatarRun.size(); ++a) {
+      std::size_t nearest = 0;
+      for (std::size_t m = 1; m < motion.size(); ++m)
+        if (std::abs(fm[m] - fa[a]) < std::abs(fm[nearest] - fa[a])) nearest = m;
+      if (a + 1 == avatarRun.size()) nearest = motion.size() - 1;  // the top drives the top
+      pair(motion[nearest], avatarRun[a]);
+    }
+  }
+  void limb(const scene::HumanoidLimb& motion, const scene::HumanoidLimb& avatarLimb) {
+    if (!motion.base.empty() && !avatarLimb.base.empty()) bone(motion.base, avatarLimb.base);
+    bone(motion.upper, avatarLimb.upper);
+    bone(motion.lower, avatarLimb.lower);
+    bone(motion.end, avatarLimb.end);
+    if (!motion.tip.empty() && !avatarLimb.tip.empty()) bone(motion.tip, avatarLimb.tip);
+  }
+};
+
+}  // namespace
+
+std::optional<JointMap> shapeJointMap(const Skeleton& skeleton, const scene::Avatar& avatar, std::string* whyNot) {
+  const std::vector<scene::JointAt> motionAt = jointsAt(skeleton);
+  std::string why;
+  const std::optional<scene::Humanoid> m = scene::findHumanoid(motionAt, &why);
+  if (!m) {
+    if (whyNot) *whyNot = "the motion's skeleton: " + why;
+    return std::nullopt;
+  }
+  const std::optional<scene::Humanoid> a = scene::findHumanoid(scene::jointsAt(avatar), &why);
+  if (!a) {
+    if (whyNot) *whyNot = "the avatar's skeleton: " + why;
+    return std::nullopt;
+  }
+  ShapePairing p{skeleton, avatar, motionAt, {}};
+  p.map.name = "by shape";
+  if (!m->abovePelvis.empty() && !a->abovePelvis.empty()) p.pair(m->abovePelvis.front(), a->abovePelvis.front());
+  p.pair(m->pelvis, a->pelvis);
+  p.run(m->spine, m->pelvis, a->spine, a->pelvis);
+  p.run(m->neck, m->chest(), a->neck, a->chest());
+  for (std::size_t s = 0; s < 2; ++s) p.limb(m->legs[s], a->legs[s]);
+  for (std::size_t s = 0; s < 2; ++s) p.limb(m->arms[s], a->arms[s]);
+  return std::move(p.map);
+}
+
+bool drivesTheTrunk(const JointMap& map, const Skeleton& skeleton, const scene::Avatar& avatar) {
+  std::set<std::string_view> driven;
+  for (const JointMapEntry& e : map.entries)
+    if (skeleton.find(e.motionJoint) >= 0) driven.insert(e.avatarJoint);
+  for (const scene::Joint& j : avatar.joints)
+    if (j.parent < 0 && driven.count(j.name) != 0) return true;
+  const std::optional<scene::Humanoid> h = scene::findHumanoid(scene::jointsAt(avatar));
+  return h && driven.count(avatar.joints[static_cast<std::size_t>(h->pelvis)].name) != 0;
 }
 
 }  // namespace drape::motion

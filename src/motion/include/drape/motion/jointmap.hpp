@@ -76,6 +76,24 @@ struct JointMap {
 [[nodiscard]] JointMap chooseJointMap(const std::vector<JointMap>& candidates, const Skeleton& skeleton,
                                       const scene::Avatar& avatar);
 
+/// The motion's joints paired with the avatar's by both skeletons' humanoid shape
+/// (scene::findHumanoid), whatever either calls its joints; named "by shape". The pelvis
+/// drives the pelvis; each limb's bone (hip bone or clavicle, thigh or upper arm, shin or
+/// forearm, foot or hand, toe) drives the same bone, a chain where the avatar splits it
+/// (twist joints); each of the avatar's spine and neck joints is driven by the motion's
+/// joint nearest its height between the pelvis and the chest, or between the chest and the
+/// head, so chest drives chest and head drives head. The motion's joints left over (its
+/// own twist joints, fingers) drive nothing: their turns reach the avatar through the
+/// joints below them, which are paired by their world rotation. nullopt, with `whyNot`
+/// saying which skeleton is no humanoid and why, where either is not.
+[[nodiscard]] std::optional<JointMap> shapeJointMap(const Skeleton& skeleton, const scene::Avatar& avatar,
+                                                    std::string* whyNot = nullptr);
+
+/// Whether `map` drives the avatar's root, or the joint where its legs and spine part (the
+/// pelvis under a floor root, which the retargeter carries): where no named map does, the
+/// joints are paired by shape instead.
+[[nodiscard]] bool drivesTheTrunk(const JointMap& map, const Skeleton& skeleton, const scene::Avatar& avatar);
+
 /// A user's map must name only joints that exist: throws "file:line:column: unknown motion
 /// joint 'X' ..." (at its key) or "... unknown avatar joint 'Y' ..." (at that joint's name).
 void checkJointMap(const JointMap& map, const Skeleton& skeleton, const scene::Avatar& avatar);

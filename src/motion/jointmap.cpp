@@ -237,16 +237,25 @@ struct ShapePairing {
                            {},
                            {}});
   }
-  /// A bone: the motion's first joint of it drives the avatar's whole chain.
+  /// A bone: the motion's last joint of it, whose child ends the bone and whose world
+  /// rotation therefore points it (a Daz thigh's lThigh after lButtock, a twist joint after
+  /// its bone's first), drives the avatar's whole chain.
   void bone(const scene::JointChain& motion, const scene::JointChain& avatarChain) {
     if (motion.empty()) return;
-    for (int a : avatarChain) pair(motion.front(), a);
+    for (int a : avatarChain) pair(motion.back(), a);
   }
-  /// A run of joints between two fixed ones (the spine between the pelvis and the chest):
-  /// each avatar joint driven by the motion's joint nearest its fraction of the run's height,
-  /// `motion` and `avatarRun` ending at the run's top, `motionBase` and `avatarBase` below it.
+  /// A run of joints between two fixed ones (the spine between the pelvis and the chest,
+  /// `motion` and `avatarRun` ending at the chest, `motionBase` and `avatarBase` below
+  /// them): joint for joint where the two runs are as long, else each avatar joint driven by
+  /// the motion's joint (the base among them) nearest its fraction of the run's height, and
+  /// the top by the top. The runs' joints seldom stand where each other's do (a Daz spine
+  /// has two joints where MakeHuman's default rig has five), so the pairing is by height.
   void run(const scene::JointChain& motion, int motionBase, const scene::JointChain& avatarRun, int avatarBase) {
     if (motion.empty() || avatarRun.empty()) return;
+    if (motion.size() == avatarRun.size()) {
+      for (std::size_t i = 0; i < motion.size(); ++i) pair(motion[i], avatarRun[i]);
+      return;
+    }
     const auto fractions = [](const scene::JointChain& chain, int base, const auto& yOf) {
       const double y0 = yOf(base), height = yOf(chain.back()) - y0;
       std::vector<double> f;
@@ -258,11 +267,15 @@ struct ShapePairing {
     const std::vector<double> fm = fractions(motion, motionBase, motionY);
     const std::vector<double> fa = fractions(avatarRun, avatarBase, avatarY);
     for (std::size_t a = 0; a < avatarRun.size(); ++a) {
-      std::size_t nearest = 0;
-      for (std::size_t m = 1; m < motion.size(); ++m)
-        if (std::abs(fm[m] - fa[a]) < std::abs(fm[nearest] - fa[a])) nearest = m;
-      if (a + 1 == avatarRun.size()) nearest = motion.size() - 1;  // the top drives the top
-      pair(motion[nearest], avatarRun[a]);
+      int driver = motionBase;
+      double miss = std::abs(fa[a]);  // the base's own fraction is 0
+      for (std::size_t m = 0; m < motion.size(); ++m)
+        if (std::abs(fm[m] - fa[a]) < miss) {
+          miss = std::abs(fm[m] - fa[a]);
+          driver = motion[m];
+        }
+      if (a + 1 == avatarRun.size()) driver = motion.back();
+      pair(driver, avatarRun[a]);
     }
   }
   void limb(const scene::HumanoidLimb& motion, const scene::HumanoidLimb& avatarLimb) {

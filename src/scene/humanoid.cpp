@@ -14,8 +14,8 @@ namespace {
 // The proportions the rules read, as fractions of the skeleton's height (its highest joint
 // above its lowest) or of a limb's length; the human body's own are far from each edge.
 constexpr double kFloorReach = 0.15;   // a leg's lowest joint lies this near the lowest of all
-constexpr double kHipOut = 0.25;       // the hip: this far out of the middle, of the foot's distance
-constexpr double kAnkleUp = 0.25;      // the ankle: this near the floor, of the hip's height over it
+constexpr double kHipOut = 0.25;       // the hip: this far out of the middle, of the knee's distance
+constexpr double kAnkleUp = 0.2;       // the ankle: this near the floor, of the pelvis's height over it
 constexpr double kArmReach = 0.15;     // an arm reaches this far to the side
 constexpr double kWristOut = 0.6;      // the wrist lies at least this far along the arm's reach
 constexpr double kElbowBack = 0.45;    // the elbow: this far back from the wrist, of the arm's span
@@ -72,21 +72,24 @@ JointChain slice(const JointChain& path, std::size_t first, std::size_t last) {
   return {path.begin() + static_cast<std::ptrdiff_t>(first), path.begin() + static_cast<std::ptrdiff_t>(last)};
 }
 
-/// The leg down `path` (the pelvis's child first), or nullopt.
+/// The leg down `path` (the pelvis's child first), or nullopt. The ankle and the knee are
+/// found by height alone, then the hip by how far out it is of the knee's way out: legs
+/// standing apart (the Acclaim skeletons' do by 0.39 m at the feet) put the hip joint less
+/// far out than the feet.
 std::optional<HumanoidLimb> legOf(const Tree& t, const JointChain& path, int pelvis, const Vec3& side) {
-  const double footOut = std::abs(side.dot(t.at(path.back()) - t.at(pelvis)));
-  std::size_t hip = 0;
-  while (hip < path.size() && std::abs(side.dot(t.at(path[hip]) - t.at(pelvis))) < kHipOut * footOut) ++hip;
-  const double floorY = t.at(path.back()).y();
-  if (hip >= path.size()) return std::nullopt;
-  const double hipUp = t.at(path[hip]).y() - floorY;
-  std::size_t ankle = hip + 1;
-  while (ankle < path.size() && t.at(path[ankle]).y() - floorY >= kAnkleUp * hipUp) ++ankle;
-  if (ankle >= path.size() || ankle < hip + 2) return std::nullopt;
-  const double midY = 0.5 * (t.at(path[hip]).y() + t.at(path[ankle]).y());
-  std::size_t knee = hip + 1;
-  for (std::size_t i = hip + 1; i < ankle; ++i)
+  const double floorY = t.at(path.back()).y(), pelvisUp = t.at(pelvis).y() - floorY;
+  std::size_t ankle = 1;
+  while (ankle < path.size() && t.at(path[ankle]).y() - floorY >= kAnkleUp * pelvisUp) ++ankle;
+  if (ankle >= path.size() || ankle < 2) return std::nullopt;
+  const double midY = 0.5 * (t.at(pelvis).y() + t.at(path[ankle]).y());
+  std::size_t knee = 1;
+  for (std::size_t i = 1; i < ankle; ++i)
     if (std::abs(t.at(path[i]).y() - midY) < std::abs(t.at(path[knee]).y() - midY)) knee = i;
+  const auto out = [&](std::size_t i) { return std::abs(side.dot(t.at(path[i]) - t.at(pelvis))); };
+  if (out(knee) < 1e-3 * pelvisUp) return std::nullopt;
+  std::size_t hip = 0;
+  while (hip < knee && out(hip) < kHipOut * out(knee)) ++hip;
+  if (hip >= knee) return std::nullopt;
   HumanoidLimb leg;
   leg.base = slice(path, 0, hip);
   leg.upper = slice(path, hip, knee);

@@ -8,13 +8,14 @@
 //
 // The rules, for a standing rest pose (T or A), in docs/MOTION.md ("Joint maps by shape"):
 // the pelvis is the shallowest joint with two children reaching the floor; the leg is the
-// path from such a child down to its lowest joint, the hip its first joint away from the
-// body's middle, the ankle its first joint near the floor, the knee the joint between
-// nearest their mid-height; the spine runs from the pelvis towards the highest joint, the
-// chest where the two branches reaching farthest to the sides leave it; an arm's wrist is
-// where its path branches (the fingers) or ends, the elbow the joint nearest 45 % of the
-// way from the wrist back to the arm's start, the shoulder the last joint before it at
-// least as far from the elbow as the wrist nearly is.
+// path from such a child down to its lowest joint, the ankle its first joint near the
+// floor, the knee the joint before it nearest the mid-height of the pelvis and the ankle,
+// the hip the first joint a quarter as far out of the body's middle as the knee is; the
+// spine runs from the pelvis towards the highest joint, the chest where the two branches
+// reaching farthest to the sides leave it, the head where the way up past the chest
+// branches or ends; an arm's wrist is where its path branches (the fingers) or ends, the
+// elbow the joint nearest 45 % of the way from the wrist back to the arm's start, the
+// shoulder the last joint before it at least 0.85 forearms from the elbow.
 
 #include <array>
 #include <optional>

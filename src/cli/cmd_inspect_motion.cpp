@@ -1,5 +1,6 @@
 // `drape inspect FILE.bvh|.amc|.asf|.glb|.gltf|.dae|.fbx|.mhskel`: skeleton, frame count, rate,
-// duration and the units guess of motion files; joints and segments of avatars.
+// duration and the units guess of motion files; joints and segments of avatars; the humanoid
+// each skeleton's shape shows.
 
 #include <algorithm>
 #include <cctype>
@@ -17,6 +18,7 @@
 #include "drape/mesh/topology.hpp"
 #include "drape/motion/clip_io.hpp"
 #include "drape/scene/avatar_gltf.hpp"
+#include "drape/scene/humanoid.hpp"
 
 namespace drape::cli {
 namespace {
@@ -43,6 +45,47 @@ std::vector<std::pair<std::size_t, int>> depthFirst(const std::vector<int>& pare
   return order;
 }
 
+/// The way a horizontal unit vector points, for a person: +x, -z, or [x z] between.
+std::string facingText(const Vec3& f) {
+  for (int axis : {0, 2})
+    if (std::abs(f[axis]) > 0.995) return fmt::format("{}{}", f[axis] > 0 ? '+' : '-', axis == 0 ? 'x' : 'z');
+  return fmt::format("[{:.2f} {:.2f}] in x and z", f.x(), f.z());
+}
+
+/// What scene::findHumanoid sees in the joints: the bones joint maps by shape pair, and
+/// make-skirt fits to (docs/MOTION.md, "Joint maps by shape").
+void printHumanoid(std::ostream& out, const std::vector<std::string>& names, const std::vector<scene::JointAt>& joints) {
+  std::string whyNot;
+  const std::optional<scene::Humanoid> h = scene::findHumanoid(joints, &whyNot);
+  if (!h) {
+    fmt::print(out, "  humanoid   none by the skeleton's shape: {}\n", whyNot);
+    return;
+  }
+  const auto chain = [&](const scene::JointChain& c) {
+    if (c.empty()) return std::string("-");
+    std::vector<std::string> n;
+    for (int j : c) n.push_back(names[static_cast<std::size_t>(j)]);
+    return fmt::format("{}", fmt::join(n, " + "));
+  };
+  fmt::print(out, "  humanoid   by the skeleton's shape, facing {}\n", facingText(h->forward));
+  fmt::print(out, "    pelvis     {}{}\n", names[static_cast<std::size_t>(h->pelvis)],
+             h->abovePelvis.empty() ? "" : fmt::format(" (under {})", chain(h->abovePelvis)));
+  fmt::print(out, "    spine      {} (chest {})\n", chain(h->spine), names[static_cast<std::size_t>(h->chest())]);
+  fmt::print(out, "    neck       {} (head {})\n", chain(h->neck), names[static_cast<std::size_t>(h->head())]);
+  for (std::size_t s = 0; s < 2; ++s) {
+    const char* side = s == 0 ? "left " : "right";
+    const scene::HumanoidLimb& leg = h->legs[s];
+    fmt::print(out, "    {} leg  hip bone {}, thigh {}, shin {}, foot {}, toe {}\n", side, chain(leg.base), chain(leg.upper),
+               chain(leg.lower), chain(leg.end), chain(leg.tip));
+  }
+  for (std::size_t s = 0; s < 2; ++s) {
+    const char* side = s == 0 ? "left " : "right";
+    const scene::HumanoidLimb& arm = h->arms[s];
+    fmt::print(out, "    {} arm  clavicle {}, upper arm {}, forearm {}, hand {}\n", side, chain(arm.base), chain(arm.upper),
+               chain(arm.lower), chain(arm.end));
+  }
+}
+
 void printSkeleton(std::ostream& out, const motion::Skeleton& s) {
   fmt::print(out, "  skeleton   {} joints\n", s.size());
   std::vector<int> parents;
@@ -64,6 +107,14 @@ void printClip(std::ostream& out, const std::string& path, const char* kind, con
              clip.start.smpte());
   fmt::print(out, "  units      {} guessed from a rest extent of {:.4g} units ({:.3f} m each)\n", r.units.name,
              r.units.extentInUnits, r.units.metresPerUnit);
+  std::vector<std::string> names;
+  std::vector<scene::JointAt> joints;
+  const std::vector<Vec3> rest = clip.skeleton.restPositions();
+  for (std::size_t j = 0; j < clip.skeleton.size(); ++j) {
+    names.push_back(clip.skeleton.joints[j].name);
+    joints.push_back({clip.skeleton.joints[j].parent, rest[j]});
+  }
+  printHumanoid(out, names, joints);
   if (clip.frameCount() > 0) {
     const Vec3 a = clip.rootTranslations.front(), b = clip.rootTranslations.back();
     fmt::print(out, "  root path  [{:.3f} {:.3f} {:.3f}] -> [{:.3f} {:.3f} {:.3f}] m\n", a.x(), a.y(), a.z(), b.x(), b.y(), b.z());
@@ -136,6 +187,9 @@ void inspectAvatar(const std::string& path, std::ostream& out) {
   fmt::print(out, "  segments   {} (closed, by dominant skin weight)\n", a.segments.size());
   for (const scene::Segment& s : a.segments)
     fmt::print(out, "    {:<18} {:>6} triangles\n", s.name, s.mesh.triangleCount());
+  std::vector<std::string> names;
+  for (const scene::Joint& j : a.joints) names.push_back(j.name);
+  printHumanoid(out, names, scene::jointsAt(a));
   if (formats::isAvatarMotionPath(path)) inspectAvatarMotion(path, out);
 }
 

@@ -64,6 +64,30 @@ TEST(CliMotion, InspectAmcAndAvatars) {
   EXPECT_NE(r.out.find("segments   19"), std::string::npos) << r.out;
 }
 
+TEST(CliMotion, InspectShowsTheHumanoidTheShapeFinds) {
+  // What joint maps by shape pair: CesiumMan's numbered joints, bone by bone, facing +x;
+  // the Acclaim kick's bones; and the refusal for a skeleton that is no humanoid.
+  Result r = run("inspect " + data("avatars/CesiumMan.glb"));
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("  humanoid   by the skeleton's shape, facing +x\n    pelvis     joint0\n    spine      joint1 + "
+                       "joint2 (chest joint2)\n    neck       joint3 + joint4 (head joint4)\n    left  leg  hip bone -, "
+                       "thigh joint11, shin joint13, foot joint15, toe joint17\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("    left  arm  clavicle -, upper arm joint5, forearm joint7, hand joint9\n"), std::string::npos)
+      << r.out;
+  r = run("inspect " + data("mocap/cmu_11_01.amc"));
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("    right leg  hip bone rhipjoint, thigh rfemur, shin rtibia, foot rfoot, toe rtoes\n"),
+            std::string::npos)
+      << r.out;
+  r = run("inspect " + data("avatars/RiggedSimple.glb"));
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("  humanoid   none by the skeleton's shape: 2 joints are too few for legs, a spine and arms\n"),
+            std::string::npos)
+      << r.out;
+}
+
 TEST(CliMotion, InspectGltfAvatarsNameTheirAnimation) {
   Result r = run("inspect " + data("avatars/CesiumMan.glb"));
   EXPECT_EQ(r.code, 0) << r.out;

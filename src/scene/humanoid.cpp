@@ -99,32 +99,36 @@ std::optional<HumanoidLimb> legOf(const Tree& t, const JointChain& path, int pel
   return leg;
 }
 
+/// Every joint of `from`'s subtree, `from` first. Without recursion: a glTF skeleton may be
+/// a chain of any length.
+std::vector<int> subtree(const Tree& t, int from) {
+  std::vector<int> all{from};
+  for (std::size_t i = 0; i < all.size(); ++i)
+    for (int k : t.kids(all[i])) all.push_back(k);
+  return all;
+}
+
 /// The farthest any joint of `from`'s subtree lies along `side` from `origin`.
 double sideReach(const Tree& t, int from, const Vec3& origin, const Vec3& side) {
-  double reach = std::abs(side.dot(t.at(from) - origin));
-  for (int k : t.kids(from)) reach = std::max(reach, sideReach(t, k, origin, side));
+  double reach = 0.0;
+  for (int j : subtree(t, from)) reach = std::max(reach, std::abs(side.dot(t.at(j) - origin)));
   return reach;
 }
 
-/// The farthest joint of `from`'s subtree from `from`, and the path to it.
+/// The path from `from` to the joint of its subtree farthest from it.
 JointChain pathOut(const Tree& t, int from) {
-  JointChain best{from};
-  double bestDistance = 0.0;
-  const auto visit = [&](const auto& self, JointChain& path) -> void {
-    const double d = (t.at(path.back()) - t.at(from)).norm();
-    if (d > bestDistance) {
-      bestDistance = d;
-      best = path;
+  int farthest = from;
+  double distance = 0.0;
+  for (int j : subtree(t, from))
+    if ((t.at(j) - t.at(from)).norm() > distance) {
+      distance = (t.at(j) - t.at(from)).norm();
+      farthest = j;
     }
-    for (int k : t.kids(path.back())) {
-      path.push_back(k);
-      self(self, path);
-      path.pop_back();
-    }
-  };
-  JointChain path{from};
-  visit(visit, path);
-  return best;
+  JointChain path;
+  for (int j = farthest; j != from; j = t.joints[static_cast<std::size_t>(j)].parent) path.push_back(j);
+  path.push_back(from);
+  std::reverse(path.begin(), path.end());
+  return path;
 }
 
 /// The arm that leaves the spine at `from`, or nullopt.

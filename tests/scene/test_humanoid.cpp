@@ -183,6 +183,28 @@ TEST(Humanoid, WhatIsNotAHumanoidIsRefusedWithAReason) {
   EXPECT_FALSE(findHumanoid(noArms, &why));
   EXPECT_EQ(why, "the spine has no two branches reaching out to the sides (the arms)");
 
+  // A chain of 200,000 joints (a glTF skeleton may nest without limit): refused, without
+  // recursing down it.
+  std::vector<JointAt> chain;
+  for (int i = 0; i < 200000; ++i) chain.push_back({i - 1, Vec3(0.001 * (i % 7), -1e-5 * i, 0.0)});
+  EXPECT_FALSE(findHumanoid(chain, &why));
+  EXPECT_EQ(why, "no joint has two children reaching the floor (the legs)");
+  // The CMU body with such a chain hanging from each hand to the floor: still the humanoid,
+  // its arms ending at the wrists' chains.
+  std::vector<JointAt> braided = jointsAt(cmu);
+  for (const char* hand : {"LeftHand", "RightHand"}) {
+    int parent = cmu.findJoint(hand);
+    const Vec3 from = cmu.joints[static_cast<std::size_t>(parent)].restCenter;
+    for (int i = 0; i < 50000; ++i) {
+      braided.push_back({parent, from - Vec3(0.0, 1e-5 * (i + 1), 0.0)});
+      parent = static_cast<int>(braided.size()) - 1;
+    }
+  }
+  const std::optional<Humanoid> withBraids = findHumanoid(braided, &why);
+  ASSERT_TRUE(withBraids.has_value()) << why;
+  EXPECT_EQ(cmu.joints[static_cast<std::size_t>(withBraids->pelvis)].name, "Hips");
+  EXPECT_EQ(cmu.joints[static_cast<std::size_t>(withBraids->legs[0].upper[0])].name, "LeftUpLeg");
+
   // Lying down: the legs reach the floor (the back lies on it), but nothing rises.
   std::vector<JointAt> lying = jointsAt(cmu);
   const Quat down(Eigen::AngleAxisd(1.5707963, Vec3::UnitX()));

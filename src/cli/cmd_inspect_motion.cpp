@@ -68,8 +68,9 @@ void printHumanoid(std::ostream& out, const std::vector<std::string>& names, con
     return fmt::format("{}", fmt::join(n, " + "));
   };
   fmt::print(out, "  humanoid   by the skeleton's shape, facing {}\n", facingText(h->forward));
-  fmt::print(out, "    pelvis     {}{}\n", names[static_cast<std::size_t>(h->pelvis)],
-             h->abovePelvis.empty() ? "" : fmt::format(" (under {})", chain(h->abovePelvis)));
+  fmt::print(out, "    pelvis     {}{}{}\n", names[static_cast<std::size_t>(h->pelvis)],
+             h->abovePelvis.empty() ? "" : fmt::format(" (under {})", chain(h->abovePelvis)),
+             h->hips.empty() ? "" : fmt::format(", the legs from {}", chain(h->hips)));
   fmt::print(out, "    spine      {} (chest {})\n", chain(h->spine), names[static_cast<std::size_t>(h->chest())]);
   fmt::print(out, "    neck       {} (head {})\n", chain(h->neck), names[static_cast<std::size_t>(h->head())]);
   for (std::size_t s = 0; s < 2; ++s) {

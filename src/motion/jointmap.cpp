@@ -306,6 +306,7 @@ std::optional<JointMap> shapeJointMap(const Skeleton& skeleton, const scene::Ava
   p.map.name = "by shape";
   if (!m->abovePelvis.empty() && !a->abovePelvis.empty()) p.pair(m->abovePelvis.front(), a->abovePelvis.front());
   p.pair(m->pelvis, a->pelvis);
+  if (!m->hips.empty() && !a->hips.empty()) p.bone(m->hips, a->hips);
   p.run(m->spine, m->pelvis, a->spine, a->pelvis);
   p.run(m->neck, m->chest(), a->neck, a->chest());
   for (std::size_t s = 0; s < 2; ++s) p.limb(m->legs[s], a->legs[s]);

@@ -16,7 +16,7 @@ namespace {
 constexpr double kFloorReach = 0.15;   // a leg's lowest joint lies this near the lowest of all
 constexpr double kHipOut = 0.25;       // the hip: this far out of the middle, of the knee's distance
 constexpr double kAnkleUp = 0.2;       // the ankle: this near the floor, of the pelvis's height over it
-constexpr double kArmReach = 0.15;     // an arm reaches this far to the side
+constexpr double kArmReach = 0.08;     // an arm reaches this far to the side (hanging at the side, 0.12)
 constexpr double kWristOut = 0.6;      // the wrist lies at least this far along the arm's reach
 constexpr double kElbowBack = 0.45;    // the elbow: this far back from the wrist, of the arm's span
 constexpr double kShoulderBack = 0.85; // the shoulder: at least this far from the elbow, of the forearm
@@ -72,7 +72,7 @@ JointChain slice(const JointChain& path, std::size_t first, std::size_t last) {
   return {path.begin() + static_cast<std::ptrdiff_t>(first), path.begin() + static_cast<std::ptrdiff_t>(last)};
 }
 
-/// The leg down `path` (the pelvis's child first), or nullopt. The ankle and the knee are
+/// The leg down `path` (a child of `pelvis`, where the legs part, first), or nullopt. The ankle and the knee are
 /// found by height alone, then the hip by how far out it is of the knee's way out: legs
 /// standing apart (the Acclaim skeletons' do by 0.39 m at the feet) put the hip joint less
 /// far out than the feet.
@@ -181,39 +181,48 @@ std::optional<Humanoid> findHumanoid(std::span<const JointAt> joints, std::strin
   const double height = highestY - lowestY;
   if (!(height > 0)) return fail(whyNot, "its joints stand no higher than each other");
 
-  // The pelvis: the shallowest joint (parents come first) with two children reaching the floor.
+  // Where the legs part: the shallowest joint (parents come first) with two children
+  // reaching the floor. The pelvis: it, or the first joint above it that a spine leaves
+  // (H-Anim hangs the legs from a sacroiliac and the spine from the HumanoidRoot above it).
   Humanoid h;
+  int parting = -1;
   std::vector<int> legChildren;
-  for (std::size_t i = 0; i < joints.size() && h.pelvis < 0; ++i) {
+  for (std::size_t i = 0; i < joints.size() && parting < 0; ++i) {
     std::vector<int> reaching;
     for (int k : t.kids(static_cast<int>(i)))
       if (t.low(k) < lowestY + kFloorReach * height) reaching.push_back(k);
     if (reaching.size() == 2) {
-      h.pelvis = static_cast<int>(i);
+      parting = static_cast<int>(i);
       legChildren = reaching;
     }
   }
-  if (h.pelvis < 0) return fail(whyNot, "no joint has two children reaching the floor (the legs)");
+  if (parting < 0) return fail(whyNot, "no joint has two children reaching the floor (the legs)");
+  int spineChild = -1;
+  for (int j = parting, below = -1; j >= 0 && spineChild < 0; below = j, j = joints[static_cast<std::size_t>(j)].parent) {
+    for (int k : t.kids(j)) {
+      const bool towardLegs = k == below || (j == parting && (k == legChildren[0] || k == legChildren[1]));
+      if (!towardLegs && t.high(k) >= t.at(parting).y() + 0.25 * height && (spineChild < 0 || t.high(k) > t.high(spineChild)))
+        spineChild = k;
+    }
+    if (spineChild >= 0) h.pelvis = j;
+  }
+  if (spineChild < 0) return fail(whyNot, "no joint above the legs' parting reaches up (the spine)");
+  for (int j = parting; j != h.pelvis; j = joints[static_cast<std::size_t>(j)].parent) h.hips.insert(h.hips.begin(), j);
   for (int a = joints[static_cast<std::size_t>(h.pelvis)].parent; a >= 0; a = joints[static_cast<std::size_t>(a)].parent)
     h.abovePelvis.insert(h.abovePelvis.begin(), a);
-  int spineChild = -1;
-  for (int k : t.kids(h.pelvis))
-    if (k != legChildren[0] && k != legChildren[1] && (spineChild < 0 || t.high(k) > t.high(spineChild))) spineChild = k;
-  if (spineChild < 0 || t.high(spineChild) < t.at(h.pelvis).y() + 0.25 * height)
-    return fail(whyNot, "no joint above the legs' parting reaches up (the spine)");
 
   // Forward from the toes where the legs have joints past the ankle, else +z (glTF's and
   // BVH's facing); left is up x forward.
   const std::array<JointChain, 2> legPaths{pathDown(t, legChildren[0]), pathDown(t, legChildren[1])};
   const Vec3 across = horizontal(t.at(legPaths[0].back()) - t.at(legPaths[1].back()));
   if (across.norm() < 1e-6) return fail(whyNot, "the two legs end in the same place");
-  std::array<std::optional<HumanoidLimb>, 2> legs{legOf(t, legPaths[0], h.pelvis, across.normalized()),
-                                                   legOf(t, legPaths[1], h.pelvis, across.normalized())};
+  std::array<std::optional<HumanoidLimb>, 2> legs{legOf(t, legPaths[0], parting, across.normalized()),
+                                                   legOf(t, legPaths[1], parting, across.normalized())};
   if (!legs[0] || !legs[1]) return fail(whyNot, "a leg has no hip, knee and ankle one above the other");
   Vec3 toes = Vec3::Zero();
   for (const auto& leg : legs)
     if (!leg->tip.empty()) toes += horizontal(t.at(leg->tip[0]) - t.at(leg->end[0]));
-  const Vec3 side0 = horizontal(t.at(legs[0]->upper[0]) - t.at(h.pelvis));
+  const Vec3 side0 = horizontal(t.at(legs[0]->upper[0]) - t.at(parting));
   if (toes.norm() > 0.01 * height) {
     // The toes' direction, made square to the legs' parting: feet turn out.
     const Vec3 a = across.normalized();
@@ -300,6 +309,7 @@ LowerBody findLowerBody(const Avatar& avatar) {
                               avatar.joints[static_cast<std::size_t>(h->legs[1].upper[0])].restCenter.y());
   LowerBody body;
   addSegments(avatar, {h->pelvis}, body.hips);
+  addSegments(avatar, h->hips, body.hips);
   for (int j : h->spine) {
     std::vector<std::string> names = segmentsOf(avatar, j);
     if (avatar.joints[static_cast<std::size_t>(j)].restCenter.y() >= hipsY + kWaistAboveHips * height && !names.empty()) {

@@ -16,6 +16,7 @@
 #include "drape/motion/jointmap.hpp"
 #include "drape/scene/avatar_gltf.hpp"
 #include "drape/scene/humanoid.hpp"
+#include "hanim_loa1.hpp"
 #include "limb_angles.hpp"
 #include "makehuman.hpp"
 
@@ -208,6 +209,39 @@ TEST(ShapeMap, CesiumMansWalkMovesTheMakeHumanBodyAsItMovesHim) {
   }
   std::printf("CesiumMan's walk on the MakeHuman body: largest limb angle %.2f degrees\n", largest);
   EXPECT_LT(largest, 5.0);
+}
+
+TEST(ShapeMap, AnHanimHumanoidWithItsArmsDownAndItsLegsOnASacroiliac) {
+  // H-Anim hangs the legs from a sacroiliac below the HumanoidRoot, which the spine leaves,
+  // and its standard pose has the arms down at the sides: the shape finds its bones as
+  // H-Anim names them, and the CMU walk by shape moves its limbs as through the shipped
+  // 'hanim' map.
+  const scene::Avatar loa1 = hanimLoa1();
+  std::string why;
+  const std::optional<scene::Humanoid> h = scene::findHumanoid(scene::jointsAt(loa1), &why);
+  ASSERT_TRUE(h.has_value()) << why;
+  const auto name = [&](int j) { return loa1.joints[static_cast<std::size_t>(j)].name; };
+  EXPECT_EQ(name(h->pelvis), "HumanoidRoot");
+  ASSERT_EQ(h->hips.size(), 1u);
+  EXPECT_EQ(name(h->hips[0]), "sacroiliac");
+  EXPECT_EQ(name(h->chest()), "vt10");
+  EXPECT_EQ(name(h->head()), "skullbase");
+  for (std::size_t s = 0; s < 2; ++s) {
+    const std::string side = s == 0 ? "l_" : "r_";
+    EXPECT_EQ(name(h->legs[s].upper.at(0)), side + "hip");
+    EXPECT_EQ(name(h->legs[s].lower.at(0)), side + "knee");
+    EXPECT_EQ(name(h->legs[s].end.at(0)), side + "ankle");
+    EXPECT_EQ(name(h->arms[s].upper.at(0)), side + "shoulder");
+    EXPECT_EQ(name(h->arms[s].lower.at(0)), side + "elbow");
+    EXPECT_EQ(name(h->arms[s].end.at(0)), side + "wrist");
+  }
+  const Clip clip = loadClip(kShapeMocap + "cmu_12_03_walk.bvh");
+  const std::optional<JointMap> byShape = shapeJointMap(clip.skeleton, loa1, &why);
+  ASSERT_TRUE(byShape.has_value()) << why;
+  const double angle = largestLimbAngle_deg(loa1, clip, *byShape, AvatarAnimation::build(loa1, clip, *byShape),
+                                            captures()[0].limbs);
+  std::printf("cmu_12_03_walk.bvh on an H-Anim LOA1 humanoid by shape: largest limb angle %.2f degrees\n", angle);
+  EXPECT_LT(angle, 5.0);
 }
 
 TEST(ShapeMap, WhatIsNoHumanoidIsRefusedWithWhy) {

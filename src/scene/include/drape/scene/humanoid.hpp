@@ -7,8 +7,9 @@
 // this way, and motion's `shapeJointMap` pairs two skeletons' joints bone for bone.
 //
 // The rules, for a standing rest pose (T or A), in docs/MOTION.md ("Joint maps by shape"):
-// the pelvis is the shallowest joint with two children reaching the floor; the leg is the
-// path from such a child down to its lowest joint, the ankle its first joint near the
+// the legs part at the shallowest joint with two children reaching the floor, and the
+// pelvis is that joint or the first above it that a spine leaves; the leg is the path from
+// such a child down to its lowest joint, the ankle its first joint near the
 // floor, the knee the joint before it nearest the mid-height of the pelvis and the ankle,
 // the hip the first joint a quarter as far out of the body's middle as the knee is; the
 // spine runs from the pelvis towards the highest joint, the chest where the two branches
@@ -48,8 +49,9 @@ struct HumanoidLimb {
 };
 
 struct Humanoid {
-  int pelvis = -1;               ///< where the legs and the spine part
+  int pelvis = -1;               ///< where the spine leaves the legs' way
   JointChain abovePelvis;        ///< the pelvis's ancestors (a floor root), root first
+  JointChain hips;               ///< below the pelvis down to where the legs part (H-Anim's sacroiliac); mostly empty
   JointChain spine;              ///< the pelvis's child up to the chest, which the arms leave
   JointChain neck;               ///< the chest's child up to the head (its last joint)
   std::array<HumanoidLimb, 2> legs;  ///< [0] left, [1] right

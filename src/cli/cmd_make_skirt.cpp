@@ -72,7 +72,7 @@ ClothSetText clothSetOf(const MakeSkirtOptions& o, const mesh::TriMesh& cloth, c
 }
 
 /// Writes the scene; returns its substeps per frame.
-int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::Skirt& skirt) {
+int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::Skirt& skirt, const scene::Avatar& avatar) {
   constexpr double kFrameRate = 30.0;
   const cloth::Material m = knit();
   // The paper's 33 substeps per frame, or as many more as this skirt's smallest elements and
@@ -83,11 +83,14 @@ int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::S
       *cloth::ClothModel::build(skirt.mesh, mesh::Topology::build(skirt.mesh), m), 1.0 / (kFrameRate * kSubsteps));
   std::ofstream os(path);
   fmt::print(os, "#VRML V2.0 utf8\n");
+  const std::string own = ownMotionText(avatar);
   fmt::print(os, "# The paper's walking scenario: a skirt of {} triangles bound at the waist, on a segmented\n"
                  "# avatar whose hips, thighs and shins collide. Made by `drape make-skirt`; run it with\n"
-                 "#   drape run {} --motion walk.bvh --out out/walking_skirt\n"
+                 "#   drape run {}{}\n"
                  "# Units: metres, kilograms, seconds; y is up.\n\n",
-             skirt.mesh.triangleCount(), path);
+             skirt.mesh.triangleCount(), path,
+             own.empty() ? " --motion walk.bvh --out out/walking_skirt"
+                         : fmt::format(" --out out/skirt\n# (the avatar plays {}; --motion FILE plays another)", own));
   fmt::print(os, "WorldInfo {{ title \"drape: walking skirt\" }}\n\n");
   fmt::print(os, "DEF Simulation Simulation {{\n  gravity 0 -9.81 0\n  frameRate {:g}\n  stepsPerFrame {}\n"
                  "  airViscosity 0.5\n  offsets [ 0.005 0.010 0.015 0.030 ]\n  voxelSize 0.005\n"
@@ -186,7 +189,7 @@ int makeSkirt(MakeSkirtOptions o) {
   formats::writeObj((dir / (stem + ".obj")).string(), skirt.mesh.positions, skirt.mesh.triangles, "drape make-skirt (m)");
   formats::writeObj((dir / (maskStem + ".obj")).string(), skirt.waistband.positions, skirt.waistband.triangles,
                     "drape make-skirt: constraint mask (m)");
-  const int substeps = writeScene((dir / "scene.wrl").string(), written, skirt);
+  const int substeps = writeScene((dir / "scene.wrl").string(), written, skirt, avatar);
   printSkirt(o.name == "Skirt" ? "skirt" : o.name, skirt);
   fmt::print("; {} substeps per frame\n", substeps);
   fmt::print("wrote {}/scene.wrl, {}.obj, {}.obj\n", o.out, stem, maskStem);

@@ -40,8 +40,8 @@ std::vector<std::string> characterNames(const std::vector<sim::SceneCharacter>& 
 sim::SceneCharacter takeCharacter(std::vector<sim::SceneCharacter> characters, const std::string& name,
                                   const std::string& path) {
   if (characters.empty())
-    throw Error(fmt::format("--add-to {}: no character of the scene wears a garment yet; dress one first (drape "
-                            "make-skirt AVATAR --out DIR, or drape make-scene)",
+    throw Error(fmt::format("--add-to {}: the scene has no avatar to dress (an Avatar node or an H-Anim Humanoid); "
+                            "make a scene with one first (drape make-skirt AVATAR --out DIR, or drape make-scene)",
                             path));
   if (name.empty()) {
     if (characters.size() > 1)
@@ -52,7 +52,7 @@ sim::SceneCharacter takeCharacter(std::vector<sim::SceneCharacter> characters, c
   }
   for (sim::SceneCharacter& c : characters)
     if (c.name == name) return std::move(c);
-  throw Error(fmt::format("--character {}: {} has no character of that name wearing a garment (it has: {})", name,
+  throw Error(fmt::format("--character {}: {} has no character of that name (it has: {})", name,
                           path, fmt::join(characterNames(characters), ", ")));
 }
 
@@ -170,7 +170,8 @@ SceneToDress openSceneToDress(const std::string& path, const std::string& charac
   const std::string dir = std::filesystem::path(path).parent_path().string();
   const formats::vrml::Document document = formats::vrml::readText(d.text, path, dir.empty() ? "." : dir);
   d.scene = scene::buildScene(document);
-  d.character = takeCharacter(sim::sceneCharacters(d.scene), character, path);
+  // An avatar that wears nothing yet is dressed as well as one that does.
+  d.character = takeCharacter(sim::sceneCharacters(d.scene, sim::Undressed::included), character, path);
   int line = 0;
   if (d.character.external) {
     for (const scene::ExternalAvatar& ext : d.scene.externalAvatars) {

@@ -155,7 +155,7 @@ std::vector<GarmentSpec> garmentSpecs(const scene::Scene& scene, const std::vect
   return specs;
 }
 
-std::vector<SceneCharacter> sceneCharacters(const scene::Scene& scene) {
+std::vector<SceneCharacter> sceneCharacters(const scene::Scene& scene, Undressed undressed) {
   // Avatars numbered Humanoids first, then Avatar nodes.
   const std::size_t humanoids = scene.avatars.size(), avatars = humanoids + scene.externalAvatars.size();
   const auto nameOf = [&](std::size_t a) {
@@ -180,7 +180,7 @@ std::vector<SceneCharacter> sceneCharacters(const scene::Scene& scene) {
   }
   std::vector<SceneCharacter> out;
   for (std::size_t a = 0; a < avatars; ++a) {
-    if (worn[a].empty()) {
+    if (worn[a].empty() && undressed == Undressed::leftOut) {
       if (avatars > 1) spdlog::warn("{}: avatar '{}' wears no garment; it is left out", scene.source, nameOf(a));
       continue;
     }

@@ -1,8 +1,9 @@
 // `drape make-skirt --add-to` and `drape make-scene --add-to`: one more garment for a
 // character of a scene already written. Two commands make the bundled layered skirts, to the
 // byte of their caches; a garment added to one of two characters lies where the scene stands
-// that character and leaves the garments it is worn over as they were; a garment the scene
-// cannot take is refused with the scene left as it was.
+// that character and leaves the garments it is worn over as they were; an avatar that wears
+// nothing yet is dressed; a garment the scene cannot take is refused with the scene left as
+// it was.
 
 #include <gtest/gtest.h>
 
@@ -150,6 +151,46 @@ TEST(AddGarment, OnOneOfTwoCharactersWhereTheSceneStandsThem) {
   EXPECT_EQ(stats["garments"][2]["name"], "Bea overskirt");
   EXPECT_GT(stats["garments"][2]["worn_over"]["contacts"].get<long>(), 0);
   EXPECT_EQ(stats["garments"][2]["worn_over"]["crossings"], 0);
+}
+
+TEST(AddGarment, AnAvatarThatWearsNothingYetIsDressed) {
+  // Bea stands in the scene without her skirt: a run leaves her out (saying so), and
+  // make-skirt --add-to dresses her where she stands, then a run takes her in.
+  ScratchDir dir("add-garment-undressed");
+  std::string text = slurp(testing::twoCharactersWithBeaAt(dir, "1.2 0 0"));
+  const std::size_t from = text.find("    DEF BeaSkirt ClothSet {");
+  ASSERT_NE(from, std::string::npos);
+  text.erase(from, text.find("\n    }\n", from) + 7 - from);
+  const std::string scene = dir / "undressed.wrl";
+  std::ofstream(scene) << text;
+  const CliResult before = runDrape("run '" + scene + "' --frames 2 --out '" + (dir / "before") + "'", dir);
+  ASSERT_EQ(before.code, 0) << before.err;
+  EXPECT_NE(before.err.find("avatar 'Bea' wears no garment; it is left out"), std::string::npos) << before.err;
+
+  const CliResult dressed = runDrape("make-skirt --add-to '" + scene + "' --character Bea --name 'Bea skirt'", dir);
+  ASSERT_EQ(dressed.code, 0) << dressed.err;
+  EXPECT_NE(dressed.out.find("worn by Bea"), std::string::npos) << dressed.out;
+  const scene::Scene sc = scene::loadScene(scene);
+  ASSERT_EQ(sc.garments.size(), 2u);
+  const Aabb box = garmentNamed(sc, "Bea skirt").mesh.bounds();
+  EXPECT_NEAR(box.center().x(), 1.2, 0.02);
+  const std::string out = dir / "after";
+  const CliResult after = runDrape("run '" + scene + "' --frames 5 --out '" + out + "'", dir);
+  ASSERT_EQ(after.code, 0) << after.err;
+  EXPECT_EQ(after.err.find("wears no garment"), std::string::npos) << after.err;
+  const nlohmann::json stats = statsOf(out);
+  EXPECT_EQ(stats["garments"].size(), 2u);
+  EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
+
+  // A scene of one avatar and no garment at all is dressed without --character.
+  std::string alone = slurp(kSource + "/examples/walking_skirt/scene.wrl");
+  alone = alone.substr(0, alone.find("DEF Skirt ClothSet"));
+  alone.replace(alone.find("\"../../data/"), 12, "\"" + std::string(DRAPE_DATA_DIR) + "/");
+  const std::string lone = dir / "alone.wrl";
+  std::ofstream(lone) << alone;
+  const CliResult first = runDrape("make-skirt --add-to '" + lone + "'", dir);
+  ASSERT_EQ(first.code, 0) << first.err;
+  EXPECT_EQ(scene::loadScene(lone).garments.size(), 1u);
 }
 
 TEST(AddGarment, AGarmentTheSceneCannotTakeLeavesItAsItWas) {

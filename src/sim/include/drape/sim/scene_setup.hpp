@@ -38,12 +38,18 @@ struct SceneCharacter {
 /// where its mask is, as without an avatar).
 [[nodiscard]] std::vector<GarmentSpec> garmentSpecs(const scene::Scene& scene, const std::vector<SceneCharacter>& characters);
 
+/// Whether sceneCharacters lists avatars that wear nothing (`drape make-skirt --add-to`
+/// dresses them; a run leaves them out, saying so).
+enum class Undressed { leftOut, included };
+
 /// The scene's characters: each avatar (an H-Anim Humanoid, or the file an Avatar node names,
-/// loaded and placed) that wears a garment, with its garments, Humanoids first, each kind in
-/// file order. A garment that names no avatar is worn by the scene's only one. Empty when
-/// the scene has no avatar. Throws drape::Error naming the garment when the scene has
-/// several avatars and a garment does not say which wears it, or two characters share a name.
-[[nodiscard]] std::vector<SceneCharacter> sceneCharacters(const scene::Scene& scene);
+/// loaded and placed) that wears a garment, or every avatar with `Undressed::included`, with
+/// its garments, Humanoids first, each kind in file order. A garment that names no avatar is
+/// worn by the scene's only one. Empty when the scene has no avatar. Throws drape::Error
+/// naming the garment when the scene has several avatars and a garment does not say which
+/// wears it, or two characters share a name.
+[[nodiscard]] std::vector<SceneCharacter> sceneCharacters(const scene::Scene& scene,
+                                                          Undressed undressed = Undressed::leftOut);
 
 /// The avatar the scene's garments are worn by (sceneCharacters' only one); null when the
 /// scene has none. Throws drape::Error when its garments are worn by several characters.

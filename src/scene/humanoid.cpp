@@ -172,6 +172,9 @@ std::optional<Humanoid> fail(std::string* whyNot, std::string why) {
 
 std::optional<Humanoid> findHumanoid(std::span<const JointAt> joints, std::string* whyNot) {
   if (joints.size() < 8) return fail(whyNot, fmt::format("{} joints are too few for legs, a spine and arms", joints.size()));
+  for (std::size_t i = 0; i < joints.size(); ++i)
+    if (joints[i].parent >= static_cast<int>(i))
+      return fail(whyNot, fmt::format("joint {} comes before its parent {}", i, joints[i].parent));
   const Tree t(joints);
   double lowestY = std::numeric_limits<double>::infinity(), highestY = -lowestY;
   for (const JointAt& j : joints) {

@@ -205,6 +205,12 @@ TEST(Humanoid, WhatIsNotAHumanoidIsRefusedWithAReason) {
   EXPECT_EQ(cmu.joints[static_cast<std::size_t>(withBraids->pelvis)].name, "Hips");
   EXPECT_EQ(cmu.joints[static_cast<std::size_t>(withBraids->legs[0].upper[0])].name, "LeftUpLeg");
 
+  // Joints not listed parents first (the avatars' and motions' loaders list them so): refused.
+  std::vector<JointAt> disordered = jointsAt(cmu);
+  disordered[3].parent = 7;
+  EXPECT_FALSE(findHumanoid(disordered, &why));
+  EXPECT_EQ(why, "joint 3 comes before its parent 7");
+
   // Lying down: the legs reach the floor (the back lies on it), but nothing rises.
   std::vector<JointAt> lying = jointsAt(cmu);
   const Quat down(Eigen::AngleAxisd(1.5707963, Vec3::UnitX()));

@@ -41,7 +41,9 @@ struct MakeSkirtOptions {
   scene::SkirtFit fit;
   double bindThreshold_m = 0.04;
   bool bindThresholdGiven = false;
-  bool waistGiven = false, hipsGiven = false, legsGiven = false;  ///< --waist-segment, --hip-segments, --leg-segments  ///< --bind-threshold given (else: as far as the waistband needs, at least 0.04 m)
+  bool waistGiven = false, hipsGiven = false, legsGiven = false;  ///< --waist-segment, --hip-segments, --leg-segments
+  bool withArms = false;                  ///< --with-arms
+  std::vector<std::string> armSegments;   ///< with --with-arms: the forearms, hands and fingers, collidable too  ///< --bind-threshold given (else: as far as the waistband needs, at least 0.04 m)
 };
 
 /// The knit the scene gives the skirt (written below as the Knit material).
@@ -66,6 +68,7 @@ ClothSetText clothSetOf(const MakeSkirtOptions& o, const mesh::TriMesh& cloth, c
   c.collidesWith.push_back(o.fit.waistSegment);
   c.collidesWith.insert(c.collidesWith.end(), o.fit.hipSegments.begin(), o.fit.hipSegments.end());
   c.collidesWith.insert(c.collidesWith.end(), o.fit.legSegments.begin(), o.fit.legSegments.end());
+  c.collidesWith.insert(c.collidesWith.end(), o.armSegments.begin(), o.armSegments.end());
   if (!o.add.colour.empty()) c.colour = Vec3(o.add.colour[0], o.add.colour[1], o.add.colour[2]);
   c.bindThreshold_m = o.bindThreshold_m;
   return c;
@@ -146,6 +149,14 @@ void chooseSegments(const scene::Avatar& avatar, MakeSkirtOptions& o, const std:
              fmt::join(o.fit.hipSegments, ", "), fmt::join(o.fit.legSegments, ", "));
 }
 
+/// --with-arms: the forearms, hands and fingers the skirt collides with too, found by shape
+/// and said on standard output.
+void chooseArmSegments(const scene::Avatar& avatar, MakeSkirtOptions& o) {
+  if (!o.withArms) return;
+  o.armSegments = scene::findForearmsAndHands(avatar);
+  fmt::print("collides with the forearms and hands too: {}\n", fmt::join(o.armSegments, ", "));
+}
+
 /// The OBJ files' stems: skirt and waistband for the default name, else NAME and NAME_waistband.
 std::pair<std::string, std::string> objStems(const std::string& name) {
   if (name == "Skirt") return {"skirt", "waistband"};
@@ -180,6 +191,7 @@ int makeSkirt(MakeSkirtOptions o) {
   const scene::Avatar avatar = scene::loadAvatarFile(o.avatar);
   chooseSegments(avatar, o, o.avatar);
   checkSegments(avatar, o, o.avatar);
+  chooseArmSegments(avatar, o);
   const mesh::Skirt skirt = scene::fitSkirt(avatar, o.fit);
   MakeSkirtOptions written = o;
   if (!o.bindThresholdGiven) written.bindThreshold_m = waistbandReach(avatar, o, skirt);
@@ -204,6 +216,7 @@ int addSkirt(MakeSkirtOptions o) {
   const std::string whose = fmt::format("{} ('{}')", o.add.scene, dress.character.name);
   chooseSegments(avatar, o, whose);
   checkSegments(avatar, o, whose);
+  chooseArmSegments(avatar, o);
   checkNewGarment(dress, o.name, o.add.over);
   const mesh::Skirt skirt = scene::fitSkirt(avatar, o.fit);
   const double added = checkSceneSteps(dress, skirt.mesh, knit(), o.name);
@@ -263,6 +276,9 @@ RunFunction setupMakeSkirt(CLI::App& app) {
                  "or found as the waist is); its default length reaches a little above the knees")
       ->delimiter(',')
       ->capture_default_str();
+  app.add_flag("--with-arms", o.withArms,
+               "Collide with the forearms, hands and fingers too (found by the skeleton's shape), so that swinging "
+               "arms push the skirt instead of sinking into it; costs a collision test per part");
   app.add_option("--bind-threshold", o.bindThreshold_m,
                  "Written into the ClothSet, m (default: 0.04, or as far as a wide --clearance sets the waistband "
                  "from the body)");

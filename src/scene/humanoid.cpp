@@ -294,26 +294,53 @@ void addSegments(const Avatar& avatar, const JointChain& chain, std::vector<std:
     for (std::string& name : segmentsOf(avatar, j)) into.push_back(std::move(name));
 }
 
+
+/// The avatar's humanoid, or drape::Error saying that `what` cannot be found and why.
+Humanoid humanoidOf(const Avatar& avatar, const char* what) {
+  std::string whyNot;
+  const std::optional<Humanoid> h = findHumanoid(jointsAt(avatar), &whyNot);
+  if (!h)
+    throw Error(fmt::format("{}: {} cannot be found by the skeleton's shape: {}",
+                            avatar.source.empty() ? avatar.name : avatar.source, what, whyNot));
+  return *h;
+}
+
 }  // namespace
 
+std::vector<std::string> findForearmsAndHands(const Avatar& avatar) {
+  const Humanoid h = humanoidOf(avatar, "its forearms and hands");
+  std::vector<std::string> names;
+  for (const HumanoidLimb& arm : h.arms) {
+    addSegments(avatar, arm.lower, names);
+    // The hand and every joint below it, in order (parents come first).
+    std::vector<bool> carried(avatar.joints.size(), false);
+    carried[static_cast<std::size_t>(arm.end.front())] = true;
+    JointChain hand;
+    for (std::size_t j = 0; j < avatar.joints.size(); ++j) {
+      const int p = avatar.joints[j].parent;
+      if (p >= 0 && carried[static_cast<std::size_t>(p)]) carried[j] = true;
+      if (carried[j]) hand.push_back(static_cast<int>(j));
+    }
+    addSegments(avatar, hand, names);
+  }
+  return names;
+}
+
 LowerBody findLowerBody(const Avatar& avatar) {
-  std::string whyNot;
-  const std::vector<JointAt> joints = jointsAt(avatar);
-  const std::optional<Humanoid> h = findHumanoid(joints, &whyNot);
+  const Humanoid h = humanoidOf(avatar, "its lower body");
   const std::string whose = avatar.source.empty() ? avatar.name : avatar.source;
-  if (!h) throw Error(fmt::format("{}: its lower body cannot be found by the skeleton's shape: {}", whose, whyNot));
   double height = -std::numeric_limits<double>::infinity(), lowest = std::numeric_limits<double>::infinity();
   for (const Joint& j : avatar.joints) {
     height = std::max(height, j.restCenter.y());
     lowest = std::min(lowest, j.restCenter.y());
   }
   height -= lowest;
-  const double hipsY = 0.5 * (avatar.joints[static_cast<std::size_t>(h->legs[0].upper[0])].restCenter.y() +
-                              avatar.joints[static_cast<std::size_t>(h->legs[1].upper[0])].restCenter.y());
+  const double hipsY = 0.5 * (avatar.joints[static_cast<std::size_t>(h.legs[0].upper[0])].restCenter.y() +
+                              avatar.joints[static_cast<std::size_t>(h.legs[1].upper[0])].restCenter.y());
   LowerBody body;
-  addSegments(avatar, {h->pelvis}, body.hips);
-  addSegments(avatar, h->hips, body.hips);
-  for (int j : h->spine) {
+  addSegments(avatar, {h.pelvis}, body.hips);
+  addSegments(avatar, h.hips, body.hips);
+  for (int j : h.spine) {
     std::vector<std::string> names = segmentsOf(avatar, j);
     if (avatar.joints[static_cast<std::size_t>(j)].restCenter.y() >= hipsY + kWaistAboveHips * height && !names.empty()) {
       body.waist = names.front();
@@ -325,9 +352,9 @@ LowerBody findLowerBody(const Avatar& avatar) {
     throw Error(fmt::format("{}: no spine joint above the hips has a segment to fit a waist to; name one with "
                             "--waist-segment",
                             whose));
-  for (const HumanoidLimb& leg : h->legs) addSegments(avatar, leg.base, body.hips);
-  for (const HumanoidLimb& leg : h->legs) addSegments(avatar, leg.upper, body.legs);
-  for (const HumanoidLimb& leg : h->legs) addSegments(avatar, leg.lower, body.legs);
+  for (const HumanoidLimb& leg : h.legs) addSegments(avatar, leg.base, body.hips);
+  for (const HumanoidLimb& leg : h.legs) addSegments(avatar, leg.upper, body.legs);
+  for (const HumanoidLimb& leg : h.legs) addSegments(avatar, leg.lower, body.legs);
   return body;
 }
 

@@ -6,6 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <cstdio>
+#include <iterator>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -141,6 +145,65 @@ TEST(MakeSkirt, AnotherRigsLowerBodyIsFoundByItsShape) {
                             "has: joint0, joint1)"),
             std::string::npos)
       << simple.err;
+}
+
+/// Of `drape inspect RUN --deepest N`'s rows, those of free vertices (not bound) whose
+/// deepest point lies inside the skin of a forearm, hand or finger.
+int freeVerticesInsideTheArms(const std::string& inspected) {
+  int count = 0;
+  std::istringstream rows(inspected.substr(inspected.find("garment         vertex")));
+  std::string row;
+  std::getline(rows, row);  // the header
+  while (std::getline(rows, row) && row.rfind("Skirt", 0) == 0) {
+    std::istringstream words(row);
+    std::vector<std::string> w{std::istream_iterator<std::string>(words), std::istream_iterator<std::string>()};
+    // garment, vertex, frame, time code, the state's words, the depth in the skin, its part, ...
+    std::size_t depth = 4;
+    while (depth < w.size() && w[depth].find_first_not_of("+-.0123456789") != std::string::npos) ++depth;
+    if (depth + 1 >= w.size() || w[4] == "bound" || std::stod(w[depth]) >= 0) continue;
+    const std::string& part = w[depth + 1];
+    for (const char* arm : {"ForeArm", "Hand", "Finger", "Thumb"})
+      if (part.find(arm) != std::string::npos) {
+        ++count;
+        break;
+      }
+  }
+  return count;
+}
+
+TEST(MakeSkirt, WithArmsTheSwingingHandsPushTheSkirtInsteadOfSinkingIn) {
+  // The paper's part list (hips, thighs, shins) lets the walker's right hand and forearm
+  // sink into the skirt's flare: `drape inspect --deepest` finds free skirt vertices inside
+  // them. With --with-arms the forearms, hands and fingers (found by shape) collide too, and
+  // none is left inside them; nothing enters the body.
+  ScratchDir dir("make-skirt-arms");
+  const std::string body = "'" + kAvatars + "/makehuman_rig_cmu_mb.mhskel'";
+  const std::string walk = "'" + std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt/walk.bvh'";
+  const CliResult plain = runDrape("make-skirt " + body + " --out '" + (dir / "plain") + "'", dir);
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  const CliResult arms = runDrape("make-skirt " + body + " --with-arms --out '" + (dir / "arms") + "'", dir);
+  ASSERT_EQ(arms.code, 0) << arms.err;
+  EXPECT_NE(arms.out.find("collides with the forearms and hands too: LeftForeArm, LeftHand, LThumb, LeftFingerBase, "
+                          "LeftHandFinger1, RightForeArm, RightHand, RThumb, RightFingerBase, RightHandFinger1\n"),
+            std::string::npos)
+      << arms.out;
+  EXPECT_EQ(scene::loadScene(dir / "arms/scene.wrl").garments[0].collidesWith.size(), 16u);
+  std::array<int, 2> inside{};
+  for (std::size_t k = 0; k < 2; ++k) {
+    const std::string name = k == 0 ? "plain" : "arms";
+    const std::string run = dir / (name + "-run");
+    const CliResult r = runDrape("run '" + (dir / name) + "/scene.wrl' --motion " + walk + " --frames 110 --out '" +
+                                     run + "'",
+                                 dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(statsOf(run)["vertex_substeps_inside_body"], 0) << name;
+    const CliResult deepest = runDrape("inspect '" + run + "' --deepest 40", dir);
+    ASSERT_EQ(deepest.code, 0) << deepest.err;
+    inside[k] = freeVerticesInsideTheArms(deepest.out);
+    std::printf("%s: %d free skirt vertices deepest inside a forearm or hand\n", name.c_str(), inside[k]);
+  }
+  EXPECT_GT(inside[0], 0);
+  EXPECT_EQ(inside[1], 0);
 }
 
 TEST(MakeSkirt, ASmallCharactersSkirtGetsTheSubstepsItNeeds) {

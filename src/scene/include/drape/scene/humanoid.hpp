@@ -85,4 +85,9 @@ struct LowerBody {
 /// or has no segment at its waist.
 [[nodiscard]] LowerBody findLowerBody(const Avatar& avatar);
 
+/// The segments of the forearms, the hands and everything the hands carry (fingers), found
+/// by the avatar's shape: what swings against a skirt as the arms walk. Throws
+/// drape::Error naming the avatar when it is not humanoid.
+[[nodiscard]] std::vector<std::string> findForearmsAndHands(const Avatar& avatar);
+
 }  // namespace drape::scene

@@ -48,24 +48,26 @@ struct Tree {
 
 Vec3 horizontal(const Vec3& v) { return {v.x(), 0.0, v.z()}; }
 
-/// From `from`, down to the lowest joint below it, through the child whose subtree reaches lowest.
-JointChain pathDown(const Tree& t, int from) {
+/// From `from` to a leaf, each step through the child `better` prefers (whose subtree
+/// reaches lowest, or highest).
+template <typename Better>
+JointChain pathThrough(const Tree& t, int from, Better better) {
   JointChain path{from};
   while (!t.kids(path.back()).empty()) {
     const std::vector<int>& k = t.kids(path.back());
-    path.push_back(*std::min_element(k.begin(), k.end(), [&](int a, int b) { return t.low(a) < t.low(b); }));
+    path.push_back(*std::min_element(k.begin(), k.end(), better));
   }
   return path;
 }
 
-/// From `from`, up to the highest joint above it, through the child whose subtree reaches highest.
+/// From `from`, down to the lowest joint below it.
+JointChain pathDown(const Tree& t, int from) {
+  return pathThrough(t, from, [&](int a, int b) { return t.low(a) < t.low(b); });
+}
+
+/// From `from`, up to the highest joint above it.
 JointChain pathUp(const Tree& t, int from) {
-  JointChain path{from};
-  while (!t.kids(path.back()).empty()) {
-    const std::vector<int>& k = t.kids(path.back());
-    path.push_back(*std::max_element(k.begin(), k.end(), [&](int a, int b) { return t.high(a) < t.high(b); }));
-  }
-  return path;
+  return pathThrough(t, from, [&](int a, int b) { return t.high(a) > t.high(b); });
 }
 
 JointChain slice(const JointChain& path, std::size_t first, std::size_t last) {
@@ -139,7 +141,7 @@ std::optional<HumanoidLimb> armOf(const Tree& t, int from) {
   while (wrist + 1 < path.size() &&
          (t.kids(path[wrist]).size() == 1 || (t.at(path[wrist]) - t.at(from)).norm() < kWristOut * reach))
     ++wrist;
-  if (wrist >= path.size() || wrist < 1) return std::nullopt;
+  if (wrist >= path.size()) return std::nullopt;
   const double span = (t.at(path[wrist]) - t.at(from)).norm();
   std::size_t elbow = 0;
   double elbowMiss = std::numeric_limits<double>::infinity();

@@ -10,6 +10,7 @@
 #include <fmt/ranges.h>
 
 #include "command.hpp"
+#include "inspect_humanoid.hpp"
 #include "drape/core/error.hpp"
 #include "drape/core/files.hpp"
 #include "drape/formats/asf_amc.hpp"
@@ -43,48 +44,6 @@ std::vector<std::pair<std::size_t, int>> depthFirst(const std::vector<int>& pare
     for (auto c = children[j].rbegin(); c != children[j].rend(); ++c) stack.push_back(*c);  // the first child on top
   }
   return order;
-}
-
-/// The way a horizontal unit vector points, for a person: +x, -z, or [x z] between.
-std::string facingText(const Vec3& f) {
-  for (int axis : {0, 2})
-    if (std::abs(f[axis]) > 0.995) return fmt::format("{}{}", f[axis] > 0 ? '+' : '-', axis == 0 ? 'x' : 'z');
-  return fmt::format("[{:.2f} {:.2f}] in x and z", f.x(), f.z());
-}
-
-/// What scene::findHumanoid sees in the joints: the bones joint maps by shape pair, and
-/// make-skirt fits to (docs/MOTION.md, "Joint maps by shape").
-void printHumanoid(std::ostream& out, const std::vector<std::string>& names, const std::vector<scene::JointAt>& joints) {
-  std::string whyNot;
-  const std::optional<scene::Humanoid> h = scene::findHumanoid(joints, &whyNot);
-  if (!h) {
-    fmt::print(out, "  humanoid   none by the skeleton's shape: {}\n", whyNot);
-    return;
-  }
-  const auto chain = [&](const scene::JointChain& c) {
-    if (c.empty()) return std::string("-");
-    std::vector<std::string> n;
-    for (int j : c) n.push_back(names[static_cast<std::size_t>(j)]);
-    return fmt::format("{}", fmt::join(n, " + "));
-  };
-  fmt::print(out, "  humanoid   by the skeleton's shape, facing {}\n", facingText(h->forward));
-  fmt::print(out, "    pelvis     {}{}{}\n", names[static_cast<std::size_t>(h->pelvis)],
-             h->abovePelvis.empty() ? "" : fmt::format(" (under {})", chain(h->abovePelvis)),
-             h->hips.empty() ? "" : fmt::format(", the legs from {}", chain(h->hips)));
-  fmt::print(out, "    spine      {} (chest {})\n", chain(h->spine), names[static_cast<std::size_t>(h->chest())]);
-  fmt::print(out, "    neck       {} (head {})\n", chain(h->neck), names[static_cast<std::size_t>(h->head())]);
-  for (std::size_t s = 0; s < 2; ++s) {
-    const char* side = s == 0 ? "left " : "right";
-    const scene::HumanoidLimb& leg = h->legs[s];
-    fmt::print(out, "    {} leg  hip bone {}, thigh {}, shin {}, foot {}, toe {}\n", side, chain(leg.base), chain(leg.upper),
-               chain(leg.lower), chain(leg.end), chain(leg.tip));
-  }
-  for (std::size_t s = 0; s < 2; ++s) {
-    const char* side = s == 0 ? "left " : "right";
-    const scene::HumanoidLimb& arm = h->arms[s];
-    fmt::print(out, "    {} arm  clavicle {}, upper arm {}, forearm {}, hand {}\n", side, chain(arm.base), chain(arm.upper),
-               chain(arm.lower), chain(arm.end));
-  }
 }
 
 void printSkeleton(std::ostream& out, const motion::Skeleton& s) {

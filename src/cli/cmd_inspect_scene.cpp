@@ -7,6 +7,7 @@
 #include <fmt/ostream.h>
 
 #include "command.hpp"
+#include "inspect_humanoid.hpp"
 #include "run_setup.hpp"
 #include "stitch_gaps.hpp"
 #include "drape/formats/hanim_motion.hpp"
@@ -144,6 +145,9 @@ void inspectScene(const std::string& path, std::ostream& out) {
                triangles);
     for (std::size_t j = 0; j < a.joints.size(); ++j)
       if (a.joints[j].parent < 0) printJoint(out, a, static_cast<int>(j), 0);
+    std::vector<std::string> names;
+    for (const scene::Joint& j : a.joints) names.push_back(j.name);
+    printHumanoid(out, names, scene::jointsAt(a));
   }
   if (!s.avatars.empty()) printHumanoidMotions(path, s, out);
   for (const scene::ExternalAvatar& a : s.externalAvatars)

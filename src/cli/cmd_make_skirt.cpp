@@ -40,10 +40,11 @@ struct MakeSkirtOptions {
   AddToOptions add;  ///< --add-to, --character, --over, --over-gap, --colour
   scene::SkirtFit fit;
   double bindThreshold_m = 0.04;
-  bool bindThresholdGiven = false;
+  bool bindThresholdGiven = false;  ///< --bind-threshold given (else: as far as the waistband needs, at least 0.04 m)
   bool waistGiven = false, hipsGiven = false, legsGiven = false;  ///< --waist-segment, --hip-segments, --leg-segments
   bool withArms = false;                  ///< --with-arms
-  std::vector<std::string> armSegments;   ///< with --with-arms: the forearms, hands and fingers, collidable too  ///< --bind-threshold given (else: as far as the waistband needs, at least 0.04 m)
+  std::vector<std::string> armSegments;   ///< with --with-arms: the forearms, hands and fingers, collidable too
+  std::string avatarRotation;             ///< the Avatar node's rotation that stands a body up along +y; "" : none
 };
 
 /// The knit the scene gives the skirt (written below as the Knit material).
@@ -100,7 +101,8 @@ int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::S
                  "  integrator \"symplectic-euler\"\n  collisionEvery 1\n  bendEvery {}\n}}\n\n",
              kFrameRate, kSubsteps, bendEvery);
   writeMaterial(os, m);
-  fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n}}\n\n", o.avatarUrl);
+  fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n{}}}\n\n", o.avatarUrl,
+             o.avatarRotation.empty() ? "" : fmt::format("  rotation {}\n", o.avatarRotation));
   ClothSetText c = clothSetOf(o, skirt.mesh, skirt.waistband);
   c.def = "Skirt";
   c.name = o.name == "Skirt" ? "" : o.name;
@@ -135,6 +137,10 @@ void chooseSegments(const scene::Avatar& avatar, MakeSkirtOptions& o, const std:
   std::string whyNot;
   if (!scene::findHumanoid(scene::jointsAt(avatar), &whyNot)) {
     if (o.waistGiven || o.hipsGiven || o.legsGiven) return;  // checkSegments names what is missing
+    if (const std::optional<scene::Upright> u = scene::findUpright(scene::jointsAt(avatar)))
+      whyNot = fmt::format("it stands along {}, not along +y as drape's scenes do; give its Avatar node (or a Transform "
+                           "around its Humanoid) rotation {} to stand it up",
+                           u->axis, u->rotationText());
     throw Error(fmt::format("{} has none of the MakeHuman CMU rig's segment names make-skirt knows ({}, {}, {}), and its "
                             "lower body cannot be found by the skeleton's shape: {}; name its own with --waist-segment, "
                             "--hip-segments and --leg-segments (it has: {})",
@@ -147,6 +153,19 @@ void chooseSegments(const scene::Avatar& avatar, MakeSkirtOptions& o, const std:
   if (!o.legsGiven) o.fit.legSegments = found.legs;
   fmt::print("found by the skeleton's shape: waist {}; hips {}; legs {}\n", o.fit.waistSegment,
              fmt::join(o.fit.hipSegments, ", "), fmt::join(o.fit.legSegments, ", "));
+}
+
+/// A body that stands along another axis than +y (a robot from Choreonoid or OpenHRP stands
+/// along +z) turned to stand along +y, the scene's Avatar node given that rotation, and said
+/// on standard output.
+void standUp(scene::Avatar& avatar, MakeSkirtOptions& o) {
+  if (scene::findHumanoid(scene::jointsAt(avatar))) return;
+  const std::optional<scene::Upright> u = scene::findUpright(scene::jointsAt(avatar));
+  if (!u) return;  // chooseSegments says why it is no humanoid
+  scene::placeAvatar(avatar, RigidTransform{u->turn, Vec3::Zero()});
+  o.avatarRotation = u->rotationText();
+  fmt::print("{} stands along {}: turned to stand along +y, as drape's scenes do (its Avatar node's rotation {})\n",
+             o.avatar, u->axis, o.avatarRotation);
 }
 
 /// --with-arms: the forearms, hands and fingers the skirt collides with too, found by shape
@@ -188,7 +207,8 @@ void printSkirt(const std::string& name, const mesh::Skirt& skirt) {
 }
 
 int makeSkirt(MakeSkirtOptions o) {
-  const scene::Avatar avatar = scene::loadAvatarFile(o.avatar);
+  scene::Avatar avatar = scene::loadAvatarFile(o.avatar);
+  standUp(avatar, o);
   chooseSegments(avatar, o, o.avatar);
   checkSegments(avatar, o, o.avatar);
   chooseArmSegments(avatar, o);

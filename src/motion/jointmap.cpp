@@ -297,8 +297,12 @@ std::optional<JointMap> shapeJointMap(const Skeleton& skeleton, const scene::Ava
     if (whyNot) *whyNot = "the motion's skeleton: " + why;
     return std::nullopt;
   }
-  const std::optional<scene::Humanoid> a = scene::findHumanoid(scene::jointsAt(avatar), &why);
+  const std::vector<scene::JointAt> avatarAt = scene::jointsAt(avatar);
+  const std::optional<scene::Humanoid> a = scene::findHumanoid(avatarAt, &why);
   if (!a) {
+    if (const std::optional<scene::Upright> u = scene::findUpright(avatarAt))
+      why = fmt::format("it stands along {}, not along +y as drape's scenes do (give its Avatar node rotation {})",
+                        u->axis, u->rotationText());
     if (whyNot) *whyNot = "the avatar's skeleton: " + why;
     return std::nullopt;
   }

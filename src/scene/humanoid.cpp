@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include <fmt/format.h>
 
@@ -157,6 +158,9 @@ std::optional<HumanoidLimb> armOf(const Tree& t, int from) {
   std::size_t shoulder = 0;
   for (std::size_t i = 0; i < elbow; ++i)
     if ((t.at(path[elbow]) - t.at(path[i])).norm() >= kShoulderBack * forearm) shoulder = i;
+  // Joints in one place are one joint turning about several axes (a robot's shoulder pitch,
+  // roll and yaw): the bone starts at the first of them.
+  while (shoulder > 0 && (t.at(path[shoulder - 1]) - t.at(path[shoulder])).norm() < 1e-3 * forearm) --shoulder;
   HumanoidLimb arm;
   arm.base = slice(path, 0, shoulder);
   arm.upper = slice(path, shoulder, elbow);
@@ -165,7 +169,8 @@ std::optional<HumanoidLimb> armOf(const Tree& t, int from) {
   return arm;
 }
 
-std::optional<Humanoid> fail(std::string* whyNot, std::string why) {
+template <typename T = Humanoid>
+std::optional<T> fail(std::string* whyNot, std::string why) {
   if (whyNot != nullptr) *whyNot = std::move(why);
   return std::nullopt;
 }
@@ -243,13 +248,17 @@ std::optional<Humanoid> findHumanoid(std::span<const JointAt> joints, std::strin
   h.legs[1] = *legs[firstIsLeft ? 1 : 0];
 
   // The spine up to the chest: where the two branches reaching farthest to the sides leave it.
-  const JointChain up = pathUp(t, spineChild);
+  // The way up ends where it turns to a side: a body without a head (a robot's) has its
+  // highest joints in an arm, and the spine must not run out along it.
+  JointChain up = pathUp(t, spineChild);
+  const auto sideways = [&](int j) { return std::abs(left.dot(t.at(j) - t.at(h.pelvis))) > kArmReach * height; };
+  up.erase(std::find_if(up.begin() + 1, up.end(), sideways), up.end());
   std::array<int, 2> arms{-1, -1};            // the branches' first joints, left and right
   std::array<std::size_t, 2> armAt{0, 0};     // where on the way up they leave it
   std::array<double, 2> reach{0.0, 0.0};
-  for (std::size_t i = 0; i + 1 < up.size(); ++i)
+  for (std::size_t i = 0; i < up.size(); ++i)
     for (int k : t.kids(up[i])) {
-      if (k == up[i + 1]) continue;
+      if (i + 1 < up.size() && k == up[i + 1]) continue;
       const double r = sideReach(t, k, t.at(up[i]), left);
       const std::size_t s = left.dot(t.at(pathOut(t, k).back()) - t.at(up[i])) > 0 ? 0 : 1;
       if (r > reach[s] && r > kArmReach * height) {
@@ -261,17 +270,60 @@ std::optional<Humanoid> findHumanoid(std::span<const JointAt> joints, std::strin
   if (arms[0] < 0 || arms[1] < 0) return fail(whyNot, "the spine has no two branches reaching out to the sides (the arms)");
   const std::size_t chestAt = std::min(armAt[0], armAt[1]);
   h.spine = slice(up, 0, chestAt + 1);
-  // The neck up to the head: the first joint past the chest where the way up branches or ends.
-  std::size_t headAt = chestAt + 1;
-  while (headAt + 1 < up.size() && t.kids(up[headAt]).size() == 1) ++headAt;
-  if (headAt >= up.size()) return fail(whyNot, "nothing rises above the arms (the neck and head)");
-  h.neck = slice(up, chestAt + 1, headAt + 1);
+  // The neck up to the head: from the chest's highest child that is no arm, to the first
+  // joint where the way up branches or ends. None: a body without a head.
+  int neckChild = -1;
+  for (int k : t.kids(h.chest()))
+    if (k != arms[0] && k != arms[1] && (neckChild < 0 || t.high(k) > t.high(neckChild))) neckChild = k;
+  if (neckChild >= 0) {
+    const JointChain neckUp = pathUp(t, neckChild);
+    std::size_t headAt = 0;
+    while (headAt + 1 < neckUp.size() && t.kids(neckUp[headAt]).size() == 1) ++headAt;
+    h.neck = slice(neckUp, 0, headAt + 1);
+  }
   for (std::size_t s = 0; s < 2; ++s) {
     const std::optional<HumanoidLimb> arm = armOf(t, arms[s]);
     if (!arm) return fail(whyNot, "an arm has no shoulder, elbow and wrist along it");
     h.arms[s] = *arm;
   }
   return h;
+}
+
+std::optional<Upright> findUpright(std::span<const JointAt> joints, std::string* whyNot) {
+  // +y first, so that a body standing as drape's scenes do is never turned; then the other
+  // axes files stand their bodies along (robotics' and CAD's +z first).
+  const double quarter = 0.5 * std::numbers::pi;
+  const std::array<std::pair<const char*, Quat>, 6> axes{{
+      {"+y", Quat::Identity()},
+      {"+z", Quat(Eigen::AngleAxisd(-quarter, Vec3::UnitX()))},
+      {"-z", Quat(Eigen::AngleAxisd(quarter, Vec3::UnitX()))},
+      {"+x", Quat(Eigen::AngleAxisd(quarter, Vec3::UnitZ()))},
+      {"-x", Quat(Eigen::AngleAxisd(-quarter, Vec3::UnitZ()))},
+      {"-y", Quat(Eigen::AngleAxisd(2.0 * quarter, Vec3::UnitX()))},
+  }};
+  std::string whyNotUp;
+  bool sameEverywhere = true;  // too few joints, or out of order: nothing to do with the axis
+  std::vector<JointAt> turned(joints.begin(), joints.end());
+  for (const auto& [axis, turn] : axes) {
+    for (std::size_t i = 0; i < joints.size(); ++i) turned[i].rest = turn * joints[i].rest;
+    std::string why;
+    if (std::optional<Humanoid> h = findHumanoid(turned, &why)) return Upright{axis, turn, std::move(*h)};
+    if (whyNotUp.empty()) whyNotUp = why;
+    sameEverywhere = sameEverywhere && why == whyNotUp;
+  }
+  return fail<Upright>(whyNot, sameEverywhere ? whyNotUp
+                                              : whyNotUp + " (and turned to stand along x or z, it is no humanoid either)");
+}
+
+std::string Upright::rotationText() const {
+  const Eigen::AngleAxisd a(turn);
+  // About a positive axis, as people write them: 1 0 0 -1.5708 rather than -1 0 0 1.5708.
+  Eigen::Index major = 0;
+  a.axis().cwiseAbs().maxCoeff(&major);
+  const double sign = a.axis()[major] < 0 ? -1.0 : 1.0;
+  const auto round = [](double v) { return std::abs(v) < 1e-9 ? 0.0 : v; };
+  return fmt::format("{:g} {:g} {:g} {:.4f}", round(sign * a.axis().x()), round(sign * a.axis().y()),
+                     round(sign * a.axis().z()), sign * a.angle());
 }
 
 std::vector<JointAt> jointsAt(const Avatar& avatar) {

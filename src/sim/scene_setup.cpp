@@ -13,19 +13,6 @@
 namespace drape::sim {
 namespace {
 
-/// Places an avatar loaded in its own frame where the scene's Avatar node puts it.
-void place(scene::Avatar& avatar, const RigidTransform& placement, double scale) {
-  for (scene::Joint& j : avatar.joints) {
-    j.restCenter = placement.apply(scale * j.restCenter);
-    j.restOrientation = (placement.rotation * j.restOrientation).normalized();
-  }
-  for (scene::Segment& s : avatar.segments) s.mesh.scale(scale);
-  if (avatar.skin) {
-    avatar.skin->mesh.scale(scale);
-    avatar.skin->mesh.transform(placement);
-  }
-}
-
 /// Cuts the parts of the joints the Avatar node's cutAtJoints names across their joints
 /// (scene::segmentSkinnedAvatar), after placing: the cut runs through the placed skin.
 void cutAtJoints(scene::Avatar& avatar, const scene::ExternalAvatar& ext) {
@@ -119,7 +106,7 @@ std::unique_ptr<scene::Avatar> loadExternal(const scene::Scene& scene, const sce
     const std::string path = resolved(scene, url);
     try {
       auto avatar = std::make_unique<scene::Avatar>(scene::loadAvatarFile(path));
-      place(*avatar, ext.placement, ext.scale);
+      scene::placeAvatar(*avatar, ext.placement, ext.scale);
       if (!ext.cutAtJoints.empty()) cutAtJoints(*avatar, ext);
       return avatar;
     } catch (const Error& e) {

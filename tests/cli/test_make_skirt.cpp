@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <fstream>
 #include <iterator>
 #include <sstream>
 
@@ -145,6 +146,65 @@ TEST(MakeSkirt, AnotherRigsLowerBodyIsFoundByItsShape) {
                             "has: joint0, joint1)"),
             std::string::npos)
       << simple.err;
+}
+
+TEST(MakeSkirt, ARobotStandingAlongZIsStoodUpDressedAndWalked) {
+  // Choreonoid's SR1 robot stands along +z, as robotics tools stand everything, and has no
+  // head. make-skirt stands it up (the scene's Avatar node turns it), finds its lower body
+  // by its shape, and the CMU walk moves it through a joint map by shape, the skirt hanging
+  // down along -y and out of the body.
+  ScratchDir dir("make-skirt-robot");
+  const std::string robot = "'" + std::string(DRAPE_DATA_DIR) + "/vrml/choreonoid_SR1.wrl'";
+  const std::string out = dir / "robot";
+  const CliResult r = runDrape("make-skirt " + robot + " --out '" + out + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("stands along +z: turned to stand along +y, as drape's scenes do (its Avatar node's rotation 1 0 "
+                       "0 -1.5708)\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("found by the skeleton's shape: waist WAIST_LINK1; hips WAIST_LINK0; legs LLEG_LINK1, LLEG_LINK2, "
+                       "RLEG_LINK1, RLEG_LINK2, LLEG_LINK3, LLEG_LINK4, RLEG_LINK3, RLEG_LINK4\n"),
+            std::string::npos)
+      << r.out;
+  const scene::Scene sc = scene::loadScene(out + "/scene.wrl");
+  ASSERT_EQ(sc.externalAvatars.size(), 1u);
+  EXPECT_LT((sc.externalAvatars[0].placement.rotation * Vec3::UnitZ() - Vec3::UnitY()).norm(), 1e-4);
+  ASSERT_EQ(sc.garments.size(), 1u);
+  const Aabb rest = sc.garments[0].mesh.bounds();
+  EXPECT_NEAR(rest.max.y(), 0.89, 0.005);  // at the waist joint, 0.89 m up the robot's z
+
+  const std::string run = dir / "walk";
+  const CliResult walked = runDrape("run '" + out + "/scene.wrl' --motion '" + std::string(DRAPE_SOURCE_DIR) +
+                                        "/examples/walking_skirt/walk.bvh' --frames 40 --out '" + run + "'",
+                                    dir);
+  ASSERT_EQ(walked.code, 0) << walked.err;
+  EXPECT_NE(walked.err.find("joint map 'by shape' drives 26 of the avatar's 30 joints"), std::string::npos) << walked.err;
+  const nlohmann::json stats = statsOf(run);
+  EXPECT_EQ(stats["frames"], 40);
+  EXPECT_EQ(stats["nan_detected"], false);
+  EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
+  // The skirt hangs from the waist: in the last frame no vertex has risen above it or
+  // fallen below the hem by more than the walk's bounce and sway.
+  const formats::Pc2Cache cache = formats::readPc2(run + "/garment.pc2");
+  ASSERT_EQ(cache.frames.size(), 41u);
+  for (const Vec3& p : cache.frames.back()) {
+    EXPECT_LT(p.y(), rest.max.y() + 0.1);
+    EXPECT_GT(p.y(), rest.min.y() - 0.1);
+  }
+
+  // Placed lying in a scene, as its file stands it: --add-to says how to stand it up.
+  const std::string lying = dir / "lying.wrl";
+  {
+    std::ofstream f(lying);
+    f << "#VRML V2.0 utf8\nDEF Robot Avatar { url \"" << DRAPE_DATA_DIR
+      << "/vrml/choreonoid_SR1.wrl\" }\n";
+  }
+  const CliResult added = runDrape("make-skirt --add-to '" + lying + "'", dir);
+  EXPECT_EQ(added.code, 2);
+  EXPECT_NE(added.err.find("it stands along +z, not along +y as drape's scenes do; give its Avatar node (or a Transform "
+                           "around its Humanoid) rotation 1 0 0 -1.5708 to stand it up"),
+            std::string::npos)
+      << added.err;
 }
 
 /// Of `drape inspect RUN --deepest N`'s rows, those of free vertices (not bound) whose

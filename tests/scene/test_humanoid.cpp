@@ -1,7 +1,8 @@
 // A humanoid found by its skeleton's shape (scene::findHumanoid): on four real rigs, whose
 // joints' names say what each is (and the shipped joint maps pair them), the shape alone
-// must find the same bones; turned to face any way and moved, the same again; and what is
-// not a humanoid is refused with a reason.
+// must find the same bones; turned to face any way and moved, the same again; laid along
+// any axis, stood up again by scene::findUpright (two real robots stand along +z); and what
+// is not a humanoid is refused with a reason.
 
 #include <gtest/gtest.h>
 
@@ -217,6 +218,98 @@ TEST(Humanoid, WhatIsNotAHumanoidIsRefusedWithAReason) {
   for (JointAt& j : lying) j.rest = down * j.rest;
   EXPECT_FALSE(findHumanoid(lying, &why));
   EXPECT_EQ(why, "no joint above the legs' parting reaches up (the spine)");
+}
+
+TEST(Humanoid, RobotsStandingAlongZAreFoundStoodUp) {
+  // Choreonoid's robots stand along +z, as robotics tools stand everything, and face +x;
+  // SR1 has no head (its chest carries the arms and nothing above them), and each of its
+  // joints is one axis of a shoulder, hip or wrist, so several share a place.
+  const Avatar sr1 = loadAvatarFile(std::string(DRAPE_DATA_DIR) + "/vrml/choreonoid_SR1.wrl");
+  std::string why;
+  EXPECT_FALSE(findHumanoid(jointsAt(sr1), &why));
+  EXPECT_EQ(why, "no joint has two children reaching the floor (the legs)");
+  std::optional<Upright> u = findUpright(jointsAt(sr1), &why);
+  ASSERT_TRUE(u.has_value()) << why;
+  EXPECT_EQ(u->axis, "+z");
+  EXPECT_EQ(u->rotationText(), "1 0 0 -1.5708");
+  EXPECT_LT((u->turn * Vec3::UnitZ() - Vec3::UnitY()).norm(), 1e-12);
+  expectHumanoid(sr1, u->humanoid,
+                 {"WAIST",
+                  {"WAIST_P", "WAIST_R", "CHEST"},
+                  {},
+                  {{{{}, {"LLEG_HIP_R", "LLEG_HIP_P"}, {"LLEG_HIP_Y", "LLEG_KNEE"}, {"LLEG_ANKLE_P"}, {"LLEG_ANKLE_R"}},
+                    {{}, {"RLEG_HIP_R", "RLEG_HIP_P"}, {"RLEG_HIP_Y", "RLEG_KNEE"}, {"RLEG_ANKLE_P"}, {"RLEG_ANKLE_R"}}}},
+                  {{{{}, {"LARM_SHOULDER_P", "LARM_SHOULDER_R"}, {"LARM_SHOULDER_Y", "LARM_ELBOW"}, {"LARM_WRIST_Y"}},
+                    {{}, {"RARM_SHOULDER_P", "RARM_SHOULDER_R"}, {"RARM_SHOULDER_Y", "RARM_ELBOW"}, {"RARM_WRIST_Y"}}}}});
+  EXPECT_EQ(u->humanoid.head(), -1);
+  EXPECT_GT(u->humanoid.forward.x(), 0.99);
+  // Stood up by the turn, it is the same humanoid along +y.
+  Avatar stood = sr1;
+  placeAvatar(stood, RigidTransform{u->turn, Vec3::Zero()});
+  const std::optional<Humanoid> along = findHumanoid(jointsAt(stood), &why);
+  ASSERT_TRUE(along.has_value()) << why;
+  EXPECT_EQ(along->spine, u->humanoid.spine);
+  EXPECT_EQ(along->legs[0].upper, u->humanoid.legs[0].upper);
+
+  const Avatar gr001 = loadAvatarFile(std::string(DRAPE_DATA_DIR) + "/vrml/choreonoid_GR001/GR001.wrl");
+  u = findUpright(jointsAt(gr001), &why);
+  ASSERT_TRUE(u.has_value()) << why;
+  EXPECT_EQ(u->axis, "+z");
+  EXPECT_EQ(namesOf(gr001, u->humanoid.spine), std::vector<std::string>{"CHEST_P"});
+  EXPECT_EQ(namesOf(gr001, u->humanoid.neck), std::vector<std::string>{"NECK_Y"});
+  EXPECT_EQ(namesOf(gr001, u->humanoid.legs[0].upper), (std::vector<std::string>{"L_HIP_Y", "L_HIP_R", "L_HIP_P"}));
+  EXPECT_EQ(namesOf(gr001, u->humanoid.legs[1].lower), std::vector<std::string>{"R_KNEE_P"});
+}
+
+TEST(Humanoid, ABodyStandingAlongAnyAxisIsStoodUpWithTheSameBones) {
+  // Each rig laid along each axis, and turned about it at random: findUpright names the
+  // axis, its turn takes the axis onto +y, and the bones are those of the rig standing.
+  std::mt19937 rng(20261206);
+  std::uniform_real_distribution<double> angle(-3.14159, 3.14159);
+  const std::array<std::pair<const char*, Vec3>, 6> axes{{{"+y", Vec3::UnitY()},
+                                                          {"+z", Vec3::UnitZ()},
+                                                          {"-z", -Vec3::UnitZ()},
+                                                          {"+x", Vec3::UnitX()},
+                                                          {"-x", -Vec3::UnitX()},
+                                                          {"-y", -Vec3::UnitY()}}};
+  for (const char* file : {"makehuman_rig_cmu_mb.mhskel", "makehuman_rig_default.mhskel", "CesiumMan.glb"}) {
+    const Avatar avatar = loadAvatarFile(kHumanoidAvatars + file);
+    const std::vector<JointAt> joints = jointsAt(avatar);
+    const std::optional<Humanoid> standing = findHumanoid(joints);
+    ASSERT_TRUE(standing.has_value()) << file;
+    for (const auto& [name, axis] : axes) {
+      // A quarter or half turn about a horizontal axis that takes +y onto `axis`.
+      const Quat lay = axis.y() < -0.5 ? Quat(Eigen::AngleAxisd(3.14159265358979, Vec3::UnitZ()))
+                                       : Quat::FromTwoVectors(Vec3::UnitY(), axis);
+      const Quat about(Eigen::AngleAxisd(angle(rng), axis));
+      std::vector<JointAt> laid = joints;
+      for (JointAt& j : laid) j.rest = about * lay * j.rest;
+      std::string why;
+      const std::optional<Upright> u = findUpright(laid, &why);
+      ASSERT_TRUE(u.has_value()) << file << " along " << name << ": " << why;
+      EXPECT_EQ(u->axis, name) << file;
+      EXPECT_LT((u->turn * axis - Vec3::UnitY()).norm(), 1e-12) << file << " along " << name;
+      EXPECT_EQ(u->humanoid.pelvis, standing->pelvis) << file << " along " << name;
+      EXPECT_EQ(u->humanoid.spine, standing->spine) << file << " along " << name;
+      EXPECT_EQ(u->humanoid.neck, standing->neck) << file << " along " << name;
+      for (std::size_t s = 0; s < 2; ++s) {
+        EXPECT_EQ(u->humanoid.legs[s].upper, standing->legs[s].upper) << file << " along " << name;
+        EXPECT_EQ(u->humanoid.arms[s].lower, standing->arms[s].lower) << file << " along " << name;
+      }
+    }
+  }
+  // What stands along no axis is refused with the reason along +y, and that the other axes
+  // were tried where the reason depends on the axis.
+  std::string why;
+  EXPECT_FALSE(findUpright(jointsAt(loadAvatarFile(kHumanoidAvatars + "RiggedSimple.glb")), &why));
+  EXPECT_EQ(why, "2 joints are too few for legs, a spine and arms");
+  // Legs and a spine without arms: along +y the arms are missing, along the others the legs.
+  const std::vector<JointAt> armless{{-1, {0.0, 1.0, 0.0}},   {0, {0.1, 0.95, 0.0}},  {1, {0.1, 0.5, 0.0}},
+                                     {2, {0.1, 0.05, 0.0}},   {0, {-0.1, 0.95, 0.0}}, {4, {-0.1, 0.5, 0.0}},
+                                     {5, {-0.1, 0.05, 0.0}},  {0, {0.0, 1.4, 0.0}},   {7, {0.0, 1.8, 0.0}}};
+  EXPECT_FALSE(findUpright(armless, &why));
+  EXPECT_EQ(why, "the spine has no two branches reaching out to the sides (the arms) (and turned to stand along x or z, "
+                 "it is no humanoid either)");
 }
 
 TEST(Humanoid, TheLowerBodyASkirtIsFittedToOnEachRig) {

@@ -67,4 +67,8 @@ struct Avatar {
   }
 };
 
+/// Places an avatar loaded in its own frame: scaled about its origin, then moved rigidly (an
+/// Avatar node's scale, rotation and translation; a quarter turn that stands a Z-up body up).
+void placeAvatar(Avatar& avatar, const RigidTransform& placement, double scale = 1.0);
+
 }  // namespace drape::scene

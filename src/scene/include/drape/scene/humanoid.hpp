@@ -12,9 +12,9 @@
 // such a child down to its lowest joint, the ankle its first joint near the
 // floor, the knee the joint before it nearest the mid-height of the pelvis and the ankle,
 // the hip the first joint a quarter as far out of the body's middle as the knee is; the
-// spine runs from the pelvis towards the highest joint, the chest where the two branches
-// reaching farthest to the sides leave it, the head where the way up past the chest
-// branches or ends; an arm's wrist is where its path branches (the fingers) or ends, the
+// spine runs from the pelvis towards the highest joint until it turns to a side, the chest
+// where the two branches reaching farthest to the sides leave it, the head where the way up
+// from the chest's other child branches or ends (a robot may have none); an arm's wrist is where its path branches (the fingers) or ends, the
 // elbow the joint nearest 45 % of the way from the wrist back to the arm's start, the
 // shoulder the last joint before it at least 0.85 forearms from the elbow.
 
@@ -53,7 +53,7 @@ struct Humanoid {
   JointChain abovePelvis;        ///< the pelvis's ancestors (a floor root), root first
   JointChain hips;               ///< below the pelvis down to where the legs part (H-Anim's sacroiliac); mostly empty
   JointChain spine;              ///< the pelvis's child up to the chest, which the arms leave
-  JointChain neck;               ///< the chest's child up to the head (its last joint)
+  JointChain neck;               ///< the chest's child up to the head (its last joint); empty without a head
   std::array<HumanoidLimb, 2> legs;  ///< [0] left, [1] right
   std::array<HumanoidLimb, 2> arms;  ///< [0] left, [1] right
   Vec3 forward = Vec3::UnitZ();  ///< the way the toes point, horizontal, unit
@@ -67,6 +67,23 @@ struct Humanoid {
 /// The humanoid in `joints`, or nullopt with `whyNot` (when given) saying what was not
 /// found ("no joint has two children reaching the floor (the legs)", ...).
 [[nodiscard]] std::optional<Humanoid> findHumanoid(std::span<const JointAt> joints, std::string* whyNot = nullptr);
+
+/// How a skeleton stands at rest: its head's axis in its own frame, and the quarter turn
+/// that stands it up along +y as drape's scenes are. Robots from Choreonoid and OpenHRP,
+/// and files from CAD and robotics tools, stand their bodies along +z.
+struct Upright {
+  std::string axis = "+y";       ///< "+y", "+z", "-z", "+x", "-x" or "-y"
+  Quat turn = Quat::Identity();  ///< takes `axis` onto +y (a quarter or half turn)
+  Humanoid humanoid;             ///< found in the turned frame
+
+  /// The turn as a VRML97 SFRotation ("1 0 0 -1.5708"): the rotation of an Avatar node or
+  /// Transform that stands the body up.
+  [[nodiscard]] std::string rotationText() const;
+};
+
+/// The humanoid standing along +y, or along the first other axis that shows one; nullopt
+/// with `whyNot` saying what is missing standing along +y.
+[[nodiscard]] std::optional<Upright> findUpright(std::span<const JointAt> joints, std::string* whyNot = nullptr);
 
 /// The avatar's joints at rest, as findHumanoid reads them.
 [[nodiscard]] std::vector<JointAt> jointsAt(const Avatar& avatar);

@@ -60,6 +60,7 @@ void printClip(std::ostream& out, const std::string& path, const char* kind, con
   printSkeleton(out, clip.skeleton);
   const double sourceDuration = r.sourceFrames > 1 ? static_cast<double>(r.sourceFrames - 1) / r.sourceRate : 0.0;
   fmt::print(out, "  frames     {} at {:.4g} Hz in the file ({:.3f} s)\n", r.sourceFrames, r.sourceRate, sourceDuration);
+  fmt::print(out, "  standing   {}\n", r.standingAxis == "+y" ? std::string("along +y") : r.stoodUp());
   fmt::print(out, "  T-pose     {}\n", r.referenceTPoseSkipped ? r.referenceTPose() : "no reference frame");
   const std::string unfolding = r.restUnfoldSkipped();
   fmt::print(out, "  unfolding  {}\n", unfolding.empty() ? "none from the rest pose" : unfolding);

@@ -369,6 +369,7 @@ void addMotion(const RunSetup& setup, CharacterSetup& character, const std::stri
                map.name, driven, setup.characters.size() > 1 ? character.name : std::string("the avatar"),
                driving.size());
   // Frames the motion file holds but drape does not play: say so, the timing shifts.
+  if (report.standingAxis != "+y") spdlog::info("{}: {}", motionPath, report.stoodUp());
   if (report.referenceTPoseSkipped) spdlog::info("{}: {}", motionPath, report.referenceTPose());
   if (report.restUnfoldFramesSkipped > 0) spdlog::info("{}: {}", motionPath, report.restUnfoldSkipped());
 }

@@ -10,6 +10,7 @@
 #include "drape/core/files.hpp"
 #include "drape/formats/asf_amc.hpp"
 #include "drape/motion/interpolate.hpp"
+#include "drape/motion/standing.hpp"
 
 namespace drape::motion {
 namespace {
@@ -78,6 +79,11 @@ void finishClip(Clip& clip, double metresPerUnitValue, const ClipLoadOptions& op
   r.unitsOverridden = options.metresPerUnit.has_value();
   r.sourceRate = clip.rate;
   r.sourceFrames = clip.frameCount();
+  // Stood up first: the reference T-pose test, the retargeting and the grounding read +y as up.
+  const Standing standing = standingOf(clip.skeleton);
+  r.standingAxis = standing.axis;
+  r.standingTurn = standing.turn;
+  if (standing.axis != "+y") turnClip(clip, standing.turn);
   if (options.skipReferenceTPose && firstFrameIsReferenceTPose(clip)) {
     dropLeadingFrames(clip, 1);
     r.referenceTPoseSkipped = true;
@@ -137,6 +143,11 @@ bool firstFrameIsReferenceTPose(const Clip& clip) {
 
 std::string ClipLoadReport::referenceTPose() const {
   return referenceTPoseSkipped ? "frame 1 is a reference T-pose, not played" : "";
+}
+
+std::string ClipLoadReport::stoodUp() const {
+  if (standingAxis == "+y") return {};
+  return fmt::format("it stands along {}: turned to stand along +y, as drape's scenes do", standingAxis);
 }
 
 std::string ClipLoadReport::restUnfoldSkipped() const {

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drape/core/error.hpp"
+#include "drape/motion/standing.hpp"
 #include "drape/formats/json_text.hpp"
 #include "drape/scene/humanoid.hpp"
 
@@ -214,15 +215,6 @@ void checkJointMap(const JointMap& map, const Skeleton& skeleton, const scene::A
 }
 
 namespace {
-
-/// The motion's skeleton at rest, as scene::findHumanoid reads joints.
-std::vector<scene::JointAt> jointsAt(const Skeleton& skeleton) {
-  const std::vector<Vec3> rest = skeleton.restPositions();
-  std::vector<scene::JointAt> out;
-  out.reserve(skeleton.size());
-  for (std::size_t i = 0; i < skeleton.size(); ++i) out.push_back({skeleton.joints[i].parent, rest[i]});
-  return out;
-}
 
 /// Pairs two skeletons' shapes into a map's entries.
 struct ShapePairing {

@@ -7,6 +7,7 @@
 
 #include "drape/core/error.hpp"
 #include "drape/motion/interpolate.hpp"
+#include "drape/motion/standing.hpp"
 
 namespace drape::motion {
 namespace {
@@ -51,6 +52,8 @@ void LiveMotion::push(std::span<const double> values) {
                 ExitCode::Internal);
   ++pushed_;
   bvhFramePose(header_, values.data(), converted_.local, converted_.root);
+  // Stood up as the header's skeleton was (a capture standing along +z).
+  if (report_.standingAxis != "+y") turnPose(converted_.local, converted_.root, report_.standingTurn);
   converted_.root *= scale_;
   if (opened_) {
     accept(converted_);

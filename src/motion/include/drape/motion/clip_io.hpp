@@ -46,6 +46,11 @@ struct ClipLoadReport {
   std::size_t sourceFrames = 0;            ///< frames in the file
   bool referenceTPoseSkipped = false;
   std::size_t restUnfoldFramesSkipped = 0;  ///< file frames of an unfolding from the rest pose, not played
+  std::string standingAxis = "+y";         ///< the axis the file stands the capture along (standing.hpp)
+  Quat standingTurn = Quat::Identity();    ///< the turn that stood it up along +y
+
+  /// "it stands along +z: turned to stand along +y, as drape's scenes do"; empty for +y.
+  [[nodiscard]] std::string stoodUp() const;
 
   /// "frame 1 is a reference T-pose, not played"; empty without one.
   [[nodiscard]] std::string referenceTPose() const;

@@ -1,0 +1,43 @@
+#include "drape/motion/standing.hpp"
+
+#include <optional>
+
+namespace drape::motion {
+
+std::vector<scene::JointAt> jointsAt(const Skeleton& skeleton) {
+  const std::vector<Vec3> rest = skeleton.restPositions();
+  std::vector<scene::JointAt> out;
+  out.reserve(skeleton.size());
+  for (std::size_t i = 0; i < skeleton.size(); ++i) out.push_back({skeleton.joints[i].parent, rest[i]});
+  return out;
+}
+
+Standing standingOf(const Skeleton& skeleton) {
+  const std::vector<scene::JointAt> joints = jointsAt(skeleton);
+  if (scene::findHumanoid(joints)) return {};
+  const std::optional<scene::Upright> u = scene::findUpright(joints);
+  if (!u) return {};
+  return {u->axis, u->turn};
+}
+
+void turnPose(std::span<Quat> local, Vec3& root, const Quat& turn) {
+  const Quat back = turn.conjugate();
+  for (Quat& q : local) q = (turn * q * back).normalized();
+  root = turn * root;
+}
+
+void turnSkeleton(Skeleton& skeleton, const Quat& turn) {
+  for (SkeletonJoint& j : skeleton.joints) {
+    j.offset = turn * j.offset;
+    if (j.endSite) *j.endSite = turn * *j.endSite;
+  }
+}
+
+void turnClip(Clip& clip, const Quat& turn) {
+  turnSkeleton(clip.skeleton, turn);
+  const std::size_t n = clip.skeleton.size();
+  for (std::size_t f = 0; f < clip.frameCount(); ++f)
+    turnPose({clip.rotations.data() + f * n, n}, clip.rootTranslations[f], turn);
+}
+
+}  // namespace drape::motion

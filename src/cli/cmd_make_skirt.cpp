@@ -93,8 +93,11 @@ int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::S
                  "#   drape run {}{}\n"
                  "# Units: metres, kilograms, seconds; y is up.\n\n",
              skirt.mesh.triangleCount(), path,
-             own.empty() ? " --motion walk.bvh --out out/walking_skirt"
-                         : fmt::format(" --out out/skirt\n# (the avatar plays {}; --motion FILE plays another)", own));
+             !own.empty() ? fmt::format(" --out out/skirt\n# (the avatar plays {}; --motion FILE plays another)", own)
+             // The bundled walking skirt keeps its walk beside its scene; elsewhere any capture.
+             : std::filesystem::exists(std::filesystem::path(path).parent_path() / "walk.bvh")
+                 ? " --motion walk.bvh --out out/walking_skirt"
+                 : " --motion CAPTURE.bvh --out out/skirt");
   fmt::print(os, "WorldInfo {{ title \"drape: walking skirt\" }}\n\n");
   fmt::print(os, "DEF Simulation Simulation {{\n  gravity 0 -9.81 0\n  frameRate {:g}\n  stepsPerFrame {}\n"
                  "  airViscosity 0.5\n  offsets [ 0.005 0.010 0.015 0.030 ]\n  voxelSize 0.005\n"

@@ -166,6 +166,8 @@ TEST(MakeSkirt, ARobotStandingAlongZIsStoodUpDressedAndWalked) {
                        "RLEG_LINK1, RLEG_LINK2, LLEG_LINK3, LLEG_LINK4, RLEG_LINK3, RLEG_LINK4\n"),
             std::string::npos)
       << r.out;
+  // Its header's run hint names no walk.bvh it does not have beside it.
+  EXPECT_NE(testing::slurp(out + "/scene.wrl").find("--motion CAPTURE.bvh --out out/skirt\n"), std::string::npos);
   const scene::Scene sc = scene::loadScene(out + "/scene.wrl");
   ASSERT_EQ(sc.externalAvatars.size(), 1u);
   EXPECT_LT((sc.externalAvatars[0].placement.rotation * Vec3::UnitZ() - Vec3::UnitY()).norm(), 1e-4);

@@ -19,6 +19,7 @@
 #include <fmt/ranges.h>
 
 #include "command.hpp"
+#include "stand_up.hpp"
 #include "drape/cloth/model.hpp"
 #include "drape/cloth/solver.hpp"
 #include "drape/core/error.hpp"
@@ -50,6 +51,7 @@ struct MakeSceneOptions {
   std::vector<std::string> faceSamplesWith;
   std::vector<std::string> keepApart;  ///< --keep-apart: the scene's Simulation keepApart
   std::vector<std::string> cutAtJoints;  ///< --cut-at-joints: the Avatar node's cutAtJoints
+  std::string avatarRotation;            ///< the Avatar node's rotation that stands a body up along +y; "" : none
   double reach_m = 0.03;
   double voxel_m = 0.005;
   std::vector<double> offsets;  ///< T0..T3, m; empty: 1, 2, 3 and 6 voxels
@@ -161,7 +163,8 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
              o.frameRate, o.stepsPerFrame, o.maxAddedMass, t[0], t[1], t[2], t[3], v, o.collisionEvery, o.bendEvery,
              o.keepApart.empty() ? "" : fmt::format("  keepApart [ \"{}\" ]\n", fmt::join(o.keepApart, "\", \"")));
   writeMaterial(os, o.material);
-  fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n{}}}\n\n", o.avatarUrl,
+  fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n{}{}}}\n\n", o.avatarUrl,
+             o.avatarRotation.empty() ? "" : fmt::format("  rotation {}\n", o.avatarRotation),
              o.cutAtJoints.empty() ? "" : fmt::format("  cutAtJoints [ \"{}\" ]\n", fmt::join(o.cutAtJoints, "\", \"")));
   ClothSetText c = clothSetOf(o, garment, mask);
   c.def = "Garment";
@@ -203,9 +206,16 @@ void chooseCollidables(MakeSceneOptions& o, const scene::Avatar& avatar, const m
 
 int makeScene(MakeSceneOptions& o) {
   scene::Avatar avatar = scene::loadAvatarFile(o.avatar);
+  // A body standing along +z stood up, and the garment modelled on it with it.
+  const std::optional<scene::Upright> upright = standUp(avatar, o.avatar);
+  if (upright) o.avatarRotation = upright->rotationText();
   // The parts as the scene will cut them: which are within reach of the garment may change.
   if (!o.cutAtJoints.empty()) scene::segmentSkinnedAvatar(avatar, o.cutAtJoints);
-  const auto [garment, mask] = readGarment(o, o.avatar);
+  auto [garment, mask] = readGarment(o, o.avatar);
+  if (upright) {
+    garment.transform(RigidTransform{upright->turn, Vec3::Zero()});
+    mask.transform(RigidTransform{upright->turn, Vec3::Zero()});
+  }
   if (o.name.empty()) o.name = std::filesystem::path(o.garment).stem().string();
   if (o.title.empty()) o.title = o.name;
   chooseCollidables(o, avatar, garment, o.avatar);

@@ -20,6 +20,7 @@
 #include "run_setup.hpp"
 #include "scene_add.hpp"
 #include "scene_text.hpp"
+#include "stand_up.hpp"
 #include "drape/cloth/model.hpp"
 #include "drape/core/error.hpp"
 #include "drape/formats/obj.hpp"
@@ -158,19 +159,6 @@ void chooseSegments(const scene::Avatar& avatar, MakeSkirtOptions& o, const std:
              fmt::join(o.fit.hipSegments, ", "), fmt::join(o.fit.legSegments, ", "));
 }
 
-/// A body that stands along another axis than +y (a robot from Choreonoid or OpenHRP stands
-/// along +z) turned to stand along +y, the scene's Avatar node given that rotation, and said
-/// on standard output.
-void standUp(scene::Avatar& avatar, MakeSkirtOptions& o) {
-  if (scene::findHumanoid(scene::jointsAt(avatar))) return;
-  const std::optional<scene::Upright> u = scene::findUpright(scene::jointsAt(avatar));
-  if (!u) return;  // chooseSegments says why it is no humanoid
-  scene::placeAvatar(avatar, RigidTransform{u->turn, Vec3::Zero()});
-  o.avatarRotation = u->rotationText();
-  fmt::print("{} stands along {}: turned to stand along +y, as drape's scenes do (its Avatar node's rotation {})\n",
-             o.avatar, u->axis, o.avatarRotation);
-}
-
 /// --with-arms: the forearms, hands and fingers the skirt collides with too, found by shape
 /// and said on standard output.
 void chooseArmSegments(const scene::Avatar& avatar, MakeSkirtOptions& o) {
@@ -211,7 +199,7 @@ void printSkirt(const std::string& name, const mesh::Skirt& skirt) {
 
 int makeSkirt(MakeSkirtOptions o) {
   scene::Avatar avatar = scene::loadAvatarFile(o.avatar);
-  standUp(avatar, o);
+  if (const std::optional<scene::Upright> u = standUp(avatar, o.avatar)) o.avatarRotation = u->rotationText();
   chooseSegments(avatar, o, o.avatar);
   checkSegments(avatar, o, o.avatar);
   chooseArmSegments(avatar, o);

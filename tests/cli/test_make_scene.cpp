@@ -6,6 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
 
 #include <nlohmann/json.hpp>
 
@@ -49,6 +53,59 @@ TEST(MakeScene, WritesWhereTheAvatarsPartsAreCut) {
   EXPECT_EQ(bad.code, 2) << bad.err;
   EXPECT_NE(bad.err.find("cutAtJoints names 'Tail', which is not a joint of avatar"), std::string::npos) << bad.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "bad/scene.wrl"));
+}
+
+TEST(MakeScene, AGarmentModelledOnARobotStandingAlongZIsStoodUpWithIt) {
+  // A skirt modelled on Choreonoid's SR1 as its file stands it, along +z: make-scene stands
+  // the robot up and the skirt with it, so the scene's skirt is make-skirt's (which fits it
+  // to the robot standing) and runs out of the body.
+  ScratchDir dir("make-scene-robot");
+  const std::string robot = kSource + "/data/vrml/choreonoid_SR1.wrl";
+  const CliResult skirt = runDrape("make-skirt '" + robot + "' --out '" + (dir / "skirt") + "'", dir);
+  ASSERT_EQ(skirt.code, 0) << skirt.err;
+  const scene::Scene fitted = scene::loadScene(dir / "skirt/scene.wrl");
+  ASSERT_EQ(fitted.garments.size(), 1u);
+  // Laid back along +z, as a tool that stands the robot so would have modelled it.
+  const auto writeLaid = [&](const std::string& from, const std::string& to) {
+    std::ifstream in(from);
+    std::ofstream out(to);
+    std::string line;
+    while (std::getline(in, line)) {
+      if (line.rfind("v ", 0) == 0) {
+        double x = 0, y = 0, z = 0;
+        std::istringstream(line.substr(2)) >> x >> y >> z;
+        out << fmt::format("v {:.9g} {:.9g} {:.9g}\n", x, -z, y);
+      } else {
+        out << line << "\n";
+      }
+    }
+  };
+  writeLaid(dir / "skirt/skirt.obj", dir / "laid_skirt.obj");
+  writeLaid(dir / "skirt/waistband.obj", dir / "laid_waistband.obj");
+  const std::string out = dir / "scene";
+  const CliResult made = runDrape("make-scene '" + robot + "' --garment '" + (dir / "laid_skirt.obj") + "' --mask '" +
+                                      (dir / "laid_waistband.obj") + "' --name skirt --out '" + out + "'",
+                                  dir);
+  ASSERT_EQ(made.code, 0) << made.err;
+  EXPECT_NE(made.out.find("stands along +z: turned to stand along +y, as drape's scenes do (its Avatar node's rotation "
+                          "1 0 0 -1.5708)\n"),
+            std::string::npos)
+      << made.out;
+  const scene::Scene sc = scene::loadScene(out + "/scene.wrl");
+  ASSERT_EQ(sc.externalAvatars.size(), 1u);
+  EXPECT_LT((sc.externalAvatars[0].placement.rotation * Vec3::UnitZ() - Vec3::UnitY()).norm(), 1e-4);
+  ASSERT_EQ(sc.garments.size(), 1u);
+  const mesh::TriMesh& a = sc.garments[0].mesh;
+  const mesh::TriMesh& b = fitted.garments[0].mesh;
+  ASSERT_EQ(a.vertexCount(), b.vertexCount());
+  double farthest = 0.0;
+  for (std::size_t v = 0; v < a.vertexCount(); ++v) farthest = std::max(farthest, (a.positions[v] - b.positions[v]).norm());
+  EXPECT_LT(farthest, 1e-4) << "m, from make-skirt's skirt on the robot standing";
+  const CliResult run = runDrape("run '" + out + "/scene.wrl' --motion none --frames 5 --out '" + (dir / "run") + "'", dir);
+  ASSERT_EQ(run.code, 0) << run.err;
+  const nlohmann::json stats = statsOf(dir / "run");
+  EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
+  EXPECT_EQ(stats["nan_detected"], false);
 }
 
 TEST(MakeScene, DressOnTheWalkingBody) {

@@ -66,18 +66,25 @@ RunFunction setupInspect(CLI::App& app) {
                  "With a run directory: list the N garment vertices that go deepest into the body (its skin, as "
                  "players draw it), each in its deepest frame, with its state and the collidable parts it is nearest")
       ->check(CLI::PositiveNumber);
+  app.add_option("--stretched", query.stretched,
+                 "With a run directory: list the N garment edges stretched most beyond their length at rest, each in "
+                 "the frame it is longest, with its vertices' states and the collidable parts nearest its middle (a "
+                 "pinch between two parts shows there)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--vertex", query.vertex,
                  "With a run directory: follow this garment vertex frame by frame: its state, its distance to the "
                  "skin and to the two nearest collidable parts (what it rests on)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--range", query.range,
-                 "With --deepest or --vertex: only the run's frames FIRST:LAST (0-based, inclusive; FIRST: to the "
+                 "With --deepest, --stretched or --vertex: only the run's frames FIRST:LAST (0-based, inclusive; FIRST: to the "
                  "end; one FRAME)");
-  app.add_option("--garment", query.garment, "With --deepest or --vertex: only this garment (by its name in the run)");
+  app.add_option("--garment", query.garment,
+                 "With --deepest, --stretched or --vertex: only this garment (by its name in the run)");
   app.footer([] {
     std::string text = "Understands:";
     text += fmt::format("\n  {:<18} {}", "DIR", "a run directory (manifest.json): its meshes, figures and, with "
-                                                "--deepest or --vertex, where its garments lie against the body");
+                                                "--deepest, --stretched or --vertex, where its garments lie against "
+                                                "the body");
     text += fmt::format("\n  {:<18} {}", "nats://HOST:PORT",
                         "a studio's NATS server: each drape stream, its take, what it carries, how far it has come");
     for (const InspectorEntry& e : registeredInspectors()) text += fmt::format("\n  {:<18} {}", fmt::join(e.extensions, " "), e.what);
@@ -94,7 +101,8 @@ RunFunction setupInspect(CLI::App& app) {
       inspectRun(path, query, std::cout);
       return 0;
     }
-    if (query.any()) throw Error(fmt::format("--deepest, --vertex, --range and --garment go with a run directory, not with {}", path));
+    if (query.any()) throw Error(fmt::format("--deepest, --stretched, --vertex, --range and --garment go with a run directory, not with {}",
+                              path));
     const std::string ext = lowerExtension(path);
     for (const InspectorEntry& e : registeredInspectors()) {
       if (std::find(e.extensions.begin(), e.extensions.end(), ext) != e.extensions.end()) {

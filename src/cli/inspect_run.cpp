@@ -1,6 +1,7 @@
 #include "inspect_run.hpp"
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <limits>
 #include <optional>
@@ -16,6 +17,8 @@
 #include "drape/core/progress.hpp"
 #include "drape/core/timecode.hpp"
 #include "drape/formats/json_text.hpp"
+#include "drape/formats/obj.hpp"
+#include "drape/formats/run_manifest.hpp"
 #include "drape/mesh/surface_distance.hpp"
 #include "drape/render/run_replay.hpp"
 #include "frame_range.hpp"
@@ -375,6 +378,84 @@ void printDeepest(const render::RunReplay& run, const RunQuery& query, const Fra
                garments.size() > 1 ? " --garment NAME" : "");
 }
 
+struct Stretched {
+  std::size_t garment = 0;
+  std::array<std::uint32_t, 2> vertices{};
+  double rest_m = 0.0;
+  std::int64_t frame = 0;
+  double ratio = 0.0;  ///< its longest over its rest length
+};
+
+/// The garment's positions at rest: its OBJ in the run directory, as the scene models it.
+std::vector<Vec3> restPositions(const std::string& directory, const render::RunReplay& run, std::size_t g) {
+  const render::MeshInfo& info = run.meshes()[g];
+  for (const formats::RunMesh& m : formats::readRunManifest(directory).meshes) {
+    if (m.role != "garment" || m.name != info.name || m.character != info.character) continue;
+    const std::string path = (std::filesystem::path(directory) / m.topology).string();
+    std::vector<Vec3> rest = formats::readObj(path).positions;
+    if (rest.size() != info.vertexCount)
+      throw Error(fmt::format("{}: {} vertices, where the run's cache has {}", path, rest.size(), info.vertexCount));
+    return rest;
+  }
+  throw Error(fmt::format("{}: the manifest lists no garment {}", directory, info.name));
+}
+
+/// Every edge of the selected garments, each in the frame where it is longest against its
+/// length at rest, longest first.
+std::vector<Stretched> stretchedEdges(const std::string& directory, const render::RunReplay& run,
+                                      const std::vector<std::size_t>& garments, const Frames& frames) {
+  std::vector<Stretched> edges;
+  for (const std::size_t g : garments) {
+    const std::vector<Vec3> rest = restPositions(directory, run, g);
+    std::vector<std::array<std::uint32_t, 2>> pairs;
+    for (const mesh::Triangle& t : run.meshes()[g].triangles)
+      for (int k = 0; k < 3; ++k) pairs.push_back({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    for (const auto& e : pairs) {
+      const double length = (rest[e[0]] - rest[e[1]]).norm();
+      if (length > 0.0) edges.push_back({g, e, length, frames.first, 0.0});
+    }
+  }
+  for (std::int64_t f = frames.first; f <= frames.last; ++f)
+    for (Stretched& e : edges) {
+      const std::vector<Vec3>& p = run.positions(e.garment, f);
+      const double ratio = (p[e.vertices[0]] - p[e.vertices[1]]).norm() / e.rest_m;
+      if (ratio > e.ratio) {
+        e.ratio = ratio;
+        e.frame = f;
+      }
+    }
+  std::stable_sort(edges.begin(), edges.end(), [](const Stretched& a, const Stretched& b) { return a.ratio > b.ratio; });
+  return edges;
+}
+
+void printStretched(const std::string& directory, const render::RunReplay& run, const RunQuery& query,
+                    const Frames& frames, const std::vector<std::size_t>& collidable, std::ostream& out) {
+  const std::vector<std::size_t> garments = selectedGarments(run, query.garment);
+  const std::vector<Stretched> edges = stretchedEdges(directory, run, garments, frames);
+  constexpr double kNoted = 1.1;  // a knit stretches a few per cent as it hangs; a tenth more is a pull
+  const auto over = std::count_if(edges.begin(), edges.end(), [](const Stretched& e) { return e.ratio > kNoted; });
+  fmt::print(out, "\ngarment edges stretched most over frames {} to {}: {} of {} are more than {:.0f} % longer than at "
+                  "rest in some frame\n",
+             frames.first, frames.last, over, edges.size(), 100.0 * (kNoted - 1.0));
+  fmt::print(out, "{:<14}  {:>11}  {:>6}  {:<11}  {:>8}  {:<32}  {:<24}  {}\n", "garment", "vertices", "frame", "time code",
+             "stretch", "states", "nearest collidable part", "next");
+  const std::size_t shown = std::min(edges.size(), static_cast<std::size_t>(query.stretched));
+  for (std::size_t i = 0; i < shown; ++i) {
+    const Stretched& e = edges[i];
+    const std::vector<Vec3>& p = run.positions(e.garment, e.frame);
+    const Vec3 middle = 0.5 * (p[e.vertices[0]] + p[e.vertices[1]]);
+    const std::vector<PartDistance> parts = nearestParts(bodyAt(run, e.frame, bodyOf(run, e.garment, collidable)), middle);
+    const std::span<const std::uint8_t> states = run.states(e.garment, e.frame);
+    fmt::print(out, "{:<14}  {:>11}  {:>6}  {:<11}  {:>8}  {:<32}  {:<24}  {}\n", run.meshes()[e.garment].name,
+               fmt::format("{} {}", e.vertices[0], e.vertices[1]), e.frame, timeCode(run, e.frame),
+               fmt::format("{:+.1f} %", 100.0 * (e.ratio - 1.0)),
+               fmt::format("{}, {}", stateText(states, e.vertices[0]), stateText(states, e.vertices[1])),
+               partText(run, parts, 0), partText(run, parts, 1));
+  }
+}
+
 }  // namespace
 
 void inspectRun(const std::string& directory, const RunQuery& query, std::ostream& out) {
@@ -383,14 +464,15 @@ void inspectRun(const std::string& directory, const RunQuery& query, std::ostrea
   const std::vector<std::size_t> collidable = collidableSegments(run, stats);
   const bool skin = !meshesWithRole(run, MeshRole::Skin).empty();
   printSummary(directory, run, stats, collidable, out);
-  if (query.vertex < 0 && query.deepest <= 0) {
-    if (query.any()) throw Error("--range and --garment go with --vertex V or --deepest N");
-    fmt::print(out, "look closer: --deepest N (the garment vertices deepest in the body), --vertex V --range FIRST:LAST "
-                    "(one vertex frame by frame)\n");
+  if (query.vertex < 0 && query.deepest <= 0 && query.stretched <= 0) {
+    if (query.any()) throw Error("--range and --garment go with --vertex V, --deepest N or --stretched N");
+    fmt::print(out, "look closer: --deepest N (the garment vertices deepest in the body), --stretched N (the edges "
+                    "stretched most), --vertex V --range FIRST:LAST (one vertex frame by frame)\n");
     return;
   }
   const Frames frames = framesOf(run, query.range);
   if (query.deepest > 0) printDeepest(run, query, frames, skin, collidable, out);
+  if (query.stretched > 0) printStretched(directory, run, query, frames, collidable, out);
   if (query.vertex >= 0) printVertexTrack(run, query, frames, collidable, out);
 }
 

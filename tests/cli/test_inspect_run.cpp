@@ -194,6 +194,71 @@ TEST_F(InspectRun, AVertexFollowedFrameByFrameAgreesWithTheDeepestList) {
   EXPECT_DOUBLE_EQ(single.begin()->second, rows[0].skin_mm);
 }
 
+/// The rows of `--stretched`: "Skirt  A B  FRAME  TIMECODE  +S.S %  ...".
+struct EdgeRow {
+  long a = 0, b = 0, frame = 0;
+  double stretch_percent = 0;
+};
+
+std::vector<EdgeRow> stretchedRows(const std::string& out) {
+  std::vector<EdgeRow> rows;
+  std::istringstream lines(out);
+  for (std::string line; std::getline(lines, line);) {
+    const std::vector<std::string> w = wordsOf(line);
+    if (line.rfind("Skirt ", 0) != 0 || w.size() < 7 || !allDigits(w[1]) || !allDigits(w[2]) || !allDigits(w[3]) ||
+        !isTimeCode(w[4]) || w[6] != "%")
+      continue;
+    rows.push_back({std::stol(w[1]), std::stol(w[2]), std::stol(w[3]), std::stod(w[5])});
+  }
+  return rows;
+}
+
+TEST_F(InspectRun, TheStretchedEdgesAreTheLongestAgainstRestAsTheRunsFilesSay) {
+  const CliResult r = inspect("--stretched 5");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::vector<EdgeRow> rows = stretchedRows(r.out);
+  ASSERT_EQ(rows.size(), 5u) << r.out;
+  // Measured here by brute force from the run's files: every edge of the rest mesh, in every
+  // frame of the cache.
+  const mesh::TriMesh rest = formats::readObj(run_ + "/garment.obj");
+  const formats::Pc2Cache cache = formats::readPc2(run_ + "/garment.pc2");
+  std::map<std::pair<long, long>, std::pair<double, long>> longest;  // edge -> (ratio, frame)
+  for (const mesh::Triangle& t : rest.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const long a = std::min(t[k], t[(k + 1) % 3]), b = std::max(t[k], t[(k + 1) % 3]);
+      auto& [ratio, frame] = longest[{a, b}];
+      const double length = (rest.positions[a] - rest.positions[b]).norm();
+      for (std::size_t f = 0; f < cache.frames.size(); ++f) {
+        const double r2 = (cache.frames[f][a] - cache.frames[f][b]).norm() / length;
+        if (r2 > ratio) {
+          ratio = r2;
+          frame = static_cast<long>(f);
+        }
+      }
+    }
+  std::vector<std::pair<double, std::pair<long, long>>> order;
+  for (const auto& [edge, found] : longest) order.push_back({found.first, edge});
+  std::sort(order.rbegin(), order.rend());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& [ratio, frame] = longest.at({rows[i].a, rows[i].b});
+    EXPECT_EQ(rows[i].frame, frame) << "edge " << rows[i].a << "-" << rows[i].b;
+    EXPECT_NEAR(rows[i].stretch_percent, 100.0 * (ratio - 1.0), 0.051) << "edge " << rows[i].a << "-" << rows[i].b;
+    EXPECT_NEAR(rows[i].stretch_percent, 100.0 * (order[i].first - 1.0), 0.051) << "the " << i << "th longest";
+  }
+  EXPECT_GT(rows.front().stretch_percent, 0.0);
+  const auto over = std::count_if(order.begin(), order.end(), [](const auto& o) { return o.first > 1.1; });
+  EXPECT_NE(r.out.find(fmt::format(": {} of {} are more than 10 % longer than at rest in some frame", over, order.size())),
+            std::string::npos)
+      << r.out;
+  // Within a range, each edge's longest frame lies in it.
+  const CliResult late = inspect("--stretched 3 --range 40:50");
+  ASSERT_EQ(late.code, 0) << late.err;
+  for (const EdgeRow& row : stretchedRows(late.out)) {
+    EXPECT_GE(row.frame, 40);
+    EXPECT_LE(row.frame, 50);
+  }
+}
+
 TEST_F(InspectRun, WhatTheRunDoesNotHaveIsAnErrorThatSaysSo) {
   const struct {
     std::string args, says;
@@ -203,7 +268,7 @@ TEST_F(InspectRun, WhatTheRunDoesNotHaveIsAnErrorThatSaysSo) {
       {"--vertex 3 --range 9:4", "--range 9:4: the run has frames 0 to 60"},
       {"--vertex 3 --range x", "--range x is not a range"},
       {"--deepest 2 --garment Cape", "--garment Cape: the run's garments are Skirt"},
-      {"--range 3", "--range and --garment go with --vertex V or --deepest N"},
+      {"--range 3", "--range and --garment go with --vertex V, --deepest N or --stretched N"},
       {"--deepest 0", "--deepest"},
       {"--motion '" + kSkirtDir + "/walk.bvh'", "--motion and --keep-apart go with a scene, not a run"},
   };

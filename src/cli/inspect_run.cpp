@@ -255,9 +255,10 @@ void printSummary(const std::string& directory, const render::RunReplay& run, co
   const bool unstable = stats.contains("unstable") && stats["unstable"].is_boolean() && stats["unstable"].get<bool>();
   fmt::print(out,
              "  stats.json: {:.0f} frames simulated, {:.3f} ms per frame; vertex-substeps inside the body {:.0f} of {:.0f} "
-             "(deepest {:.1f} mm), below T1 {:.0f}; {}\n",
+             "(deepest {:.1f} mm), below T1 {:.0f}; largest edge strain {:.1f} % (stretched or compressed, at the end of a frame); "
+             "{}\n",
              number("frames"), number("ms_per_frame"), number("vertex_substeps_inside_body"), number("vertex_substeps"),
-             number("max_penetration_m") * 1000.0, number("vertex_substeps_below_T1"),
+             number("max_penetration_m") * 1000.0, number("vertex_substeps_below_T1"), 100.0 * number("max_strain"),
              unstable ? "went unstable (see its \"instability\")" : "stable");
   printLayers(stats, out);
   printSlowestFrame(run, stats, out);

@@ -246,6 +246,22 @@ TEST_F(InspectRun, TheStretchedEdgesAreTheLongestAgainstRestAsTheRunsFilesSay) {
     EXPECT_NEAR(rows[i].stretch_percent, 100.0 * (order[i].first - 1.0), 0.051) << "the " << i << "th longest";
   }
   EXPECT_GT(rows.front().stretch_percent, 0.0);
+  // The simulation's own figure (stats.json's max_strain, measured on its rest lengths at the
+  // end of each frame, stretched or compressed) is the larger of the longest stretch and the
+  // deepest compression found here, and the summary says it.
+  double compressed = 0.0;
+  for (const mesh::Triangle& t : rest.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t a = t[k], b = t[(k + 1) % 3];
+      const double length = (rest.positions[a] - rest.positions[b]).norm();
+      for (std::size_t f = 1; f < cache.frames.size(); ++f)
+        compressed = std::max(compressed, 1.0 - (cache.frames[f][a] - cache.frames[f][b]).norm() / length);
+    }
+  const double maxStrain = testing::statsOf(run_)["max_strain"].get<double>();
+  EXPECT_NEAR(100.0 * std::max(compressed, order.front().first - 1.0), 100.0 * maxStrain, 0.051);
+  EXPECT_NE(r.out.find(fmt::format("largest edge strain {:.1f} % (stretched or compressed", 100.0 * maxStrain)),
+            std::string::npos)
+      << r.out;
   const auto over = std::count_if(order.begin(), order.end(), [](const auto& o) { return o.first > 1.1; });
   EXPECT_NE(r.out.find(fmt::format(": {} of {} are more than 10 % longer than at rest in some frame", over, order.size())),
             std::string::npos)

@@ -82,12 +82,14 @@ RunFunction setupInspect(CLI::App& app) {
                  "With --deepest, --stretched or --vertex: only this garment (by its name in the run)");
   app.footer([] {
     std::string text = "Understands:";
-    text += fmt::format("\n  {:<18} {}", "DIR", "a run directory (manifest.json): its meshes, figures and, with "
+    text += fmt::format("\n  {:<29} {}", "DIR", "a run directory (manifest.json): its meshes, figures and, with "
                                                 "--deepest, --stretched or --vertex, where its garments lie against "
                                                 "the body");
-    text += fmt::format("\n  {:<18} {}", "nats://HOST:PORT",
+    text += fmt::format("\n  {:<29} {}", "nats://HOST:PORT",
                         "a studio's NATS server: each drape stream, its take, what it carries, how far it has come");
-    for (const InspectorEntry& e : registeredInspectors()) text += fmt::format("\n  {:<18} {}", fmt::join(e.extensions, " "), e.what);
+    // Joined first: a width given with fmt::join pads each extension, not the list.
+    for (const InspectorEntry& e : registeredInspectors())
+      text += fmt::format("\n  {:<29} {}", fmt::format("{}", fmt::join(e.extensions, " ")), e.what);
     return text;
   });
   return [] {

@@ -9,6 +9,7 @@
 #include "drape/core/error.hpp"
 #include "drape/scene/avatar_gltf.hpp"
 #include "drape/scene/avatar_segment.hpp"
+#include "drape/scene/humanoid.hpp"
 
 namespace drape::sim {
 namespace {
@@ -20,6 +21,21 @@ void cutAtJoints(scene::Avatar& avatar, const scene::ExternalAvatar& ext) {
   scene::segmentSkinnedAvatar(avatar, ext.cutAtJoints, &moved);
   spdlog::info("avatar '{}': the parts of {} cut across their joints, {} triangles behind them given to their parents",
                ext.name.empty() ? avatar.name : ext.name, fmt::join(ext.cutAtJoints, ", "), moved);
+}
+
+/// A character its scene stands along another axis than +y, where gravity pulls along -y (a
+/// robot from Choreonoid placed as its file stands it, along +z), is said so: its garments
+/// would fall across it, and its captures would lay it down.
+void sayWhereItLies(const scene::Scene& scene, const SceneCharacter& c) {
+  const Vec3 g = scene.simulation.gravity;
+  if (!(g.norm() > 0.0) || g.normalized().dot(-Vec3::UnitY()) < 0.999) return;  // the scene's own up: its choice
+  const std::vector<scene::JointAt> joints = scene::jointsAt(*c.avatar);
+  if (scene::findHumanoid(joints)) return;
+  const std::optional<scene::Upright> u = scene::findUpright(joints);
+  if (!u) return;
+  spdlog::warn("{}: character '{}' stands along {}, where gravity pulls along -y: its garments would fall across it; "
+               "give its Avatar node (or a Transform around its Humanoid) rotation {} to stand it up",
+               scene.source, c.name, u->axis, u->rotationText());
 }
 
 }  // namespace
@@ -178,6 +194,7 @@ std::vector<SceneCharacter> sceneCharacters(const scene::Scene& scene, Undressed
     c.external = a >= humanoids;
     if (c.external) c.motion = motionFile(scene, scene.externalAvatars[a - humanoids]);
     c.garments = std::move(worn[a]);
+    sayWhereItLies(scene, c);
     for (const SceneCharacter& other : out)
       if (other.name == c.name)
         throw Error(fmt::format("{}: two characters are called '{}'; give their Avatar or Humanoid nodes different "

@@ -194,6 +194,21 @@ TEST(MakeSkirt, ARobotStandingAlongZIsStoodUpDressedAndWalked) {
     EXPECT_GT(p.y(), rest.min.y() - 0.1);
   }
 
+  // The same scene without the Avatar node's rotation: the run warns that the robot lies
+  // across gravity, with the rotation that stands it up.
+  std::string text = testing::slurp(out + "/scene.wrl");
+  testing::replaceOnce(text, "  rotation 1 0 0 -1.5708\n", "");
+  std::ofstream(out + "/lying.wrl") << text;
+  const CliResult across =
+      runDrape("run '" + out + "/lying.wrl' --motion none --frames 1 --out '" + (dir / "across") + "'", dir);
+  // (The skirt, fitted to the robot standing, then cannot bind to it: the warning comes first.)
+  EXPECT_NE(across.err.find("character 'Body' stands along +z, where gravity pulls along -y: its garments would fall "
+                            "across it; give its Avatar node (or a Transform around its Humanoid) rotation 1 0 0 -1.5708 "
+                            "to stand it up"),
+            std::string::npos)
+      << across.err;
+  EXPECT_EQ(walked.err.find("where gravity pulls along -y"), std::string::npos) << walked.err;
+
   // Placed lying in a scene, as its file stands it: --add-to says how to stand it up.
   const std::string lying = dir / "lying.wrl";
   {

@@ -47,7 +47,8 @@ enum class Undressed { leftOut, included };
 /// its garments, Humanoids first, each kind in file order. A garment that names no avatar is
 /// worn by the scene's only one. Empty when the scene has no avatar. Throws drape::Error
 /// naming the garment when the scene has several avatars and a garment does not say which
-/// wears it, or two characters share a name.
+/// wears it, or two characters share a name. Warns of a character that stands along another
+/// axis than +y in a scene whose gravity pulls along -y, with the rotation that stands it up.
 [[nodiscard]] std::vector<SceneCharacter> sceneCharacters(const scene::Scene& scene,
                                                           Undressed undressed = Undressed::leftOut);
 

@@ -311,8 +311,8 @@ int addGarment(MakeSceneOptions& o) {
 RunFunction setupMakeScene(CLI::App& app) {
   static MakeSceneOptions o;
   app.add_option("avatar", o.avatar,
-                 "Avatar file the garment was modelled on (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel); not with "
-                 "--add-to");
+                 "Avatar file the garment was modelled on (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel, or a VRML97 "
+                 "H-Anim humanoid .wrl; one standing along +z is stood up with the garment); not with --add-to");
   app.add_option("--garment", o.garment,
                  "Garment OBJ in the avatar's rest pose, or a MakeHuman .mhclo (refitted to the MakeHuman body)")
       ->required();

@@ -141,10 +141,12 @@ void chooseSegments(const scene::Avatar& avatar, MakeSkirtOptions& o, const std:
   std::string whyNot;
   if (!scene::findHumanoid(scene::jointsAt(avatar), &whyNot)) {
     if (o.waistGiven || o.hipsGiven || o.legsGiven) return;  // checkSegments names what is missing
-    if (const std::optional<scene::Upright> u = scene::findUpright(scene::jointsAt(avatar)))
-      whyNot = fmt::format("it stands along {}, not along +y as drape's scenes do; give its Avatar node (or a Transform "
-                           "around its Humanoid) rotation {} to stand it up",
-                           u->axis, u->rotationText());
+    // Lying in its scene, it needs turning, not naming its segments.
+    if (const std::optional<scene::Upright> u = scene::uprightAlongAnotherAxis(scene::jointsAt(avatar)))
+      throw Error(fmt::format("{}: it stands along {}, not along +y as drape's scenes do; give its Avatar node (or a "
+                              "Transform around its Humanoid) rotation {} to stand it up, and the skirt is fitted to "
+                              "it standing",
+                              whose, u->axis, u->rotationText()));
     throw Error(fmt::format("{} has none of the MakeHuman CMU rig's segment names make-skirt knows ({}, {}, {}), and its "
                             "lower body cannot be found by the skeleton's shape: {}; name its own with --waist-segment, "
                             "--hip-segments and --leg-segments (it has: {})",
@@ -258,8 +260,8 @@ int addSkirt(MakeSkirtOptions o) {
 
 RunFunction setupMakeSkirt(CLI::App& app) {
   static MakeSkirtOptions o;
-  app.add_option("avatar", o.avatar, "Avatar file to fit the skirt to (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel); "
-                 "not with --add-to");
+  app.add_option("avatar", o.avatar, "Avatar file to fit the skirt to (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel, or a VRML97 "
+                 "H-Anim humanoid .wrl; one standing along +z is stood up); not with --add-to");
   app.add_option("--out", o.out,
                  "Directory for scene.wrl, skirt.obj and waistband.obj (with --name, NAME.obj and NAME_waistband.obj; "
                  "required without --add-to)");

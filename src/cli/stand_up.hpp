@@ -17,8 +17,7 @@ namespace drape::cli {
 /// output; the turn, or nullopt where it stands along +y or is no humanoid at all (the
 /// caller's own checks say why).
 inline std::optional<scene::Upright> standUp(scene::Avatar& avatar, const std::string& whose) {
-  if (scene::findHumanoid(scene::jointsAt(avatar))) return std::nullopt;
-  std::optional<scene::Upright> u = scene::findUpright(scene::jointsAt(avatar));
+  std::optional<scene::Upright> u = scene::uprightAlongAnotherAxis(scene::jointsAt(avatar));
   if (!u) return std::nullopt;
   scene::placeAvatar(avatar, RigidTransform{u->turn, Vec3::Zero()});
   fmt::print("{} stands along {}: turned to stand along +y, as drape's scenes do (its Avatar node's rotation {})\n",

@@ -703,11 +703,12 @@ AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& mo
     const formats::SkinnedJointMotion motion =
         options.sampled != nullptr ? *options.sampled : formats::readAvatarMotion(motionPath, rate, options.animation);
     if (report) {
-      *report = {};
-      report->units.metresPerUnit = 1.0;
-      report->units.name = fmt::format("m ({})", formatLabel(motionPath));
-      report->sourceFrames = motion.frameCount();
-      report->sourceRate = rate;
+      ClipLoadReport r;
+      r.units.metresPerUnit = 1.0;
+      r.units.name = fmt::format("m ({})", formatLabel(motionPath));
+      r.sourceFrames = motion.frameCount();
+      r.sourceRate = rate;
+      *report = std::move(r);
     }
     // The avatar of the file itself (every joint of it named in the skin, resting where the
     // skin's does): its own motion, no retargeting. Any other avatar, a skeleton of the same

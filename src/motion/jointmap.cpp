@@ -292,7 +292,7 @@ std::optional<JointMap> shapeJointMap(const Skeleton& skeleton, const scene::Ava
   const std::vector<scene::JointAt> avatarAt = scene::jointsAt(avatar);
   const std::optional<scene::Humanoid> a = scene::findHumanoid(avatarAt, &why);
   if (!a) {
-    if (const std::optional<scene::Upright> u = scene::findUpright(avatarAt))
+    if (const std::optional<scene::Upright> u = scene::uprightAlongAnotherAxis(avatarAt))
       why = fmt::format("it stands along {}, not along +y as drape's scenes do (give its Avatar node, or a Transform "
                         "around its Humanoid, rotation {})",
                         u->axis, u->rotationText());

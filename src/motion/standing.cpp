@@ -13,9 +13,7 @@ std::vector<scene::JointAt> jointsAt(const Skeleton& skeleton) {
 }
 
 Standing standingOf(const Skeleton& skeleton) {
-  const std::vector<scene::JointAt> joints = jointsAt(skeleton);
-  if (scene::findHumanoid(joints)) return {};
-  const std::optional<scene::Upright> u = scene::findUpright(joints);
+  const std::optional<scene::Upright> u = scene::uprightAlongAnotherAxis(jointsAt(skeleton));
   if (!u) return {};
   return {u->axis, u->turn};
 }

@@ -315,6 +315,12 @@ std::optional<Upright> findUpright(std::span<const JointAt> joints, std::string*
                                               : whyNotUp + " (and turned to stand along x or z, it is no humanoid either)");
 }
 
+std::optional<Upright> uprightAlongAnotherAxis(std::span<const JointAt> joints) {
+  std::optional<Upright> u = findUpright(joints);
+  if (u && u->axis == "+y") return std::nullopt;
+  return u;
+}
+
 std::string Upright::rotationText() const {
   const Eigen::AngleAxisd a(turn);
   // About a positive axis, as people write them: 1 0 0 -1.5708 rather than -1 0 0 1.5708.

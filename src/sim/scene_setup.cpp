@@ -29,9 +29,7 @@ void cutAtJoints(scene::Avatar& avatar, const scene::ExternalAvatar& ext) {
 void sayWhereItLies(const scene::Scene& scene, const SceneCharacter& c) {
   const Vec3 g = scene.simulation.gravity;
   if (!(g.norm() > 0.0) || g.normalized().dot(-Vec3::UnitY()) < 0.999) return;  // the scene's own up: its choice
-  const std::vector<scene::JointAt> joints = scene::jointsAt(*c.avatar);
-  if (scene::findHumanoid(joints)) return;
-  const std::optional<scene::Upright> u = scene::findUpright(joints);
+  const std::optional<scene::Upright> u = scene::uprightAlongAnotherAxis(scene::jointsAt(*c.avatar));
   if (!u) return;
   spdlog::warn("{}: character '{}' stands along {}, where gravity pulls along -y: its garments would fall across it; "
                "give its Avatar node (or a Transform around its Humanoid) rotation {} to stand it up",

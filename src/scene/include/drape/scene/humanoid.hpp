@@ -85,6 +85,10 @@ struct Upright {
 /// with `whyNot` saying what is missing standing along +y.
 [[nodiscard]] std::optional<Upright> findUpright(std::span<const JointAt> joints, std::string* whyNot = nullptr);
 
+/// findUpright's answer for a body that stands along another axis than +y (what a scene
+/// must turn to stand it up); nullopt where it stands along +y or is no humanoid at all.
+[[nodiscard]] std::optional<Upright> uprightAlongAnotherAxis(std::span<const JointAt> joints);
+
 /// The avatar's joints at rest, as findHumanoid reads them.
 [[nodiscard]] std::vector<JointAt> jointsAt(const Avatar& avatar);
 

@@ -7,6 +7,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <fstream>
+#include <iterator>
 #include <thread>
 #include <vector>
 
@@ -25,15 +27,19 @@ sockaddr_in loopback(int port) {
   return addr;
 }
 
-int freePort() {
-  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr = loopback(0);
-  socklen_t length = sizeof addr;
-  const bool ok = s >= 0 && ::bind(s, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0 &&
-                  ::getsockname(s, reinterpret_cast<sockaddr*>(&addr), &length) == 0;
-  if (s >= 0) ::close(s);
-  if (!ok) throw Error("no free port on 127.0.0.1 for a nats-server", ExitCode::Unavailable);
-  return ntohs(addr.sin_port);
+/// The client port nats-server `pid` wrote to its ports file in `dir` once it listened (0
+/// while it has written none). The file names the process, so a server of another process
+/// on the same port is never taken for ours.
+int portFileSays(const std::filesystem::path& dir, pid_t pid) {
+  std::ifstream in(dir / fmt::format("nats-server_{}.ports", pid));
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string marker = "nats://127.0.0.1:";
+  const std::size_t at = text.find(marker);
+  if (at == std::string::npos) return 0;
+  int port = 0;
+  for (std::size_t i = at + marker.size(); i < text.size() && text[i] >= '0' && text[i] <= '9'; ++i)
+    port = port * 10 + (text[i] - '0');
+  return port;
 }
 
 bool listening(int port) {
@@ -56,7 +62,7 @@ std::string natsServerExecutable() {
 }
 
 LocalServer::LocalServer(std::filesystem::path store, bool jetStream)
-    : store_(std::move(store)), jetStream_(jetStream), port_(freePort()) {
+    : store_(std::move(store)), jetStream_(jetStream) {
   std::filesystem::create_directories(store_);
   start();
 }
@@ -69,8 +75,12 @@ void LocalServer::start() {
   if (exe.empty())
     throw Error("nats-server is not installed (Debian's nats-server package; scripts/install-deps installs it)",
                 ExitCode::Unavailable);
-  const std::string port = std::to_string(port_), store = store_.string(), log = (store_ / "server.log").string();
-  std::vector<std::string> args{exe, "-a", "127.0.0.1", "-p", port, "-l", log};
+  // The first start lets nats-server choose a free port itself (-p -1) rather than taking
+  // one found free a moment before, which another process may take in between; a restart
+  // asks for the same port again.
+  const std::string port = port_ > 0 ? std::to_string(port_) : "-1", store = store_.string(),
+                    log = (store_ / "server.log").string(), portsDir = store_.string();
+  std::vector<std::string> args{exe, "-a", "127.0.0.1", "-p", port, "-l", log, "--ports_file_dir", portsDir};
   if (jetStream_) args.insert(args.end(), {"-js", "-sd", store});
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
@@ -82,7 +92,12 @@ void LocalServer::start() {
   }
   if (pid_ < 0) throw Error("cannot start nats-server (fork failed)", ExitCode::Unavailable);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-  while (!listening(port_)) {
+  for (;;) {
+    const int said = portFileSays(store_, pid_);
+    if (said > 0 && listening(said)) {
+      port_ = said;
+      return;
+    }
     int status = 0;
     if (::waitpid(pid_, &status, WNOHANG) == pid_) {
       pid_ = -1;
@@ -90,7 +105,8 @@ void LocalServer::start() {
     }
     if (std::chrono::steady_clock::now() > deadline) {
       stop();
-      throw Error(fmt::format("nats-server does not listen on 127.0.0.1:{} after 20 s (its log: {})", port_, log),
+      throw Error(fmt::format("nats-server does not listen on 127.0.0.1{} after 20 s (its log: {})",
+                              port_ > 0 ? ":" + port : "", log),
                   ExitCode::Unavailable);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));

@@ -915,11 +915,8 @@ TEST(Studio, ALiveSourceOfFrameLinesTakesItsSkeletonFromABvhFile) {
 
 TEST(Studio, ErrorsSayWhatToDo) {
   ScratchDir dir("studio-errors");
-  std::string nowhere;
-  {
-    const NatsServer gone;
-    nowhere = gone.url();
-  }
+  const RefusingPort refusing;
+  const std::string nowhere = refusing.url();
   CliResult r = runDrape("player '" + kScene + "' --record '" + (dir / "rec") + "' --server " + nowhere, dir);
   EXPECT_EQ(r.code, 4) << r.err;
   EXPECT_NE(r.err.find(nowhere + ": no NATS server answers (start one with nats-server -js"), std::string::npos) << r.err;

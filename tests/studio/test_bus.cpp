@@ -106,8 +106,8 @@ TEST(StudioBus, ErrorsSayWhatToDo) {
               std::string::npos)
         << e.what();
   }
-  const std::string nowhere = "nats://127.0.0.1:" + std::to_string(plain.port());
-  plain.stop();
+  const testing::RefusingPort refusing;
+  const std::string nowhere = refusing.url();
   try {
     (void)Bus::connect(nowhere, "test", std::chrono::milliseconds(500));
     FAIL() << "connected to no server";

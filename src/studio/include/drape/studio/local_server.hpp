@@ -1,8 +1,8 @@
 #pragma once
-// A nats-server of our own on this machine: started on 127.0.0.1 at a free port with
-// JetStream and a store in a directory given, stopped when the object goes. For what needs
-// a real server without one running (drape bench studio, the tests); a studio runs its own
-// server as a service.
+// A nats-server of our own on this machine: started on 127.0.0.1 at a free port of its own
+// choosing, with JetStream and a store in a directory given, stopped when the object goes.
+// For what needs a real server without one running (drape bench studio, the tests); a studio
+// runs its own server as a service.
 
 #include <sys/types.h>
 

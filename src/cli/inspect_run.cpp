@@ -253,12 +253,17 @@ void printSummary(const std::string& directory, const render::RunReplay& run, co
     return stats.contains(key) && stats[key].is_number() ? stats[key].get<double>() : 0.0;
   };
   const bool unstable = stats.contains("unstable") && stats["unstable"].is_boolean() && stats["unstable"].get<bool>();
+  // Runs written before stats.json told stretch from compression have max_strain alone.
+  const std::string strain =
+      stats.contains("max_stretch")
+          ? fmt::format("edges at most {:.1f} % longer and {:.1f} % shorter than at rest", 100.0 * number("max_stretch"),
+                        100.0 * number("max_compression"))
+          : fmt::format("largest edge strain {:.1f} % (stretched or compressed)", 100.0 * number("max_strain"));
   fmt::print(out,
              "  stats.json: {:.0f} frames simulated, {:.3f} ms per frame; vertex-substeps inside the body {:.0f} of {:.0f} "
-             "(deepest {:.1f} mm), below T1 {:.0f}; largest edge strain {:.1f} % (stretched or compressed, at the end of a frame); "
-             "{}\n",
+             "(deepest {:.1f} mm), below T1 {:.0f}; {} (at the end of a frame); {}\n",
              number("frames"), number("ms_per_frame"), number("vertex_substeps_inside_body"), number("vertex_substeps"),
-             number("max_penetration_m") * 1000.0, number("vertex_substeps_below_T1"), 100.0 * number("max_strain"),
+             number("max_penetration_m") * 1000.0, number("vertex_substeps_below_T1"), strain,
              unstable ? "went unstable (see its \"instability\")" : "stable");
   printLayers(stats, out);
   printSlowestFrame(run, stats, out);

@@ -1011,7 +1011,8 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
     for (const GarmentRun& r : runs) sum += stageTotalsMs(r.solver->stageTimes());
     return sum;
   };
-  double maxStrain = 0.0, outputSeconds = 0.0;
+  cloth::EdgeStrain maxStrain;
+  double outputSeconds = 0.0;
   std::string unstable;
   bool unstableNan = false;
 
@@ -1033,7 +1034,9 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
       solver.state().copyPositions(taken.positions[g]);
       garmentVertexStates(solver, runs[g].collider, taken.states[g]);
       e += solver.totalEnergy();
-      maxStrain = std::max(maxStrain, cloth::maxEdgeStrain(*runs[g].model, solver.state()));
+      const cloth::EdgeStrain strain = cloth::edgeStrain(*runs[g].model, solver.state());
+      maxStrain.stretch = std::max(maxStrain.stretch, strain.stretch);
+      maxStrain.compression = std::max(maxStrain.compression, strain.compression);
     }
     energy.push_back(e);
     worlds.evaluateJoints(frame, taken.joints);
@@ -1138,7 +1141,9 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
   byFrame["output"] = frameOutputMs;
   stats["frame_ms_per_stage"] = std::move(byFrame);
   stats["energy"] = energy;
-  stats["max_strain"] = maxStrain;
+  stats["max_strain"] = maxStrain.largest();
+  stats["max_stretch"] = maxStrain.stretch;
+  stats["max_compression"] = maxStrain.compression;
   stats["nan_detected"] = unstableNan;
   stats["unstable"] = !unstable.empty();
   stats["instability"] = unstable.empty() ? nlohmann::json(nullptr) : nlohmann::json(unstable);

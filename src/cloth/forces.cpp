@@ -495,16 +495,21 @@ double gravityEnergy(const ClothModel& model, const ClothState& s, const Vec3& g
   return energy;
 }
 
-double maxEdgeStrain(const ClothModel& model, const ClothState& s) {
-  double worst = 0.0;
+EdgeStrain edgeStrain(const ClothModel& model, const ClothState& s) {
+  EdgeStrain worst;
   const auto& a = model.edgeV0();
   const auto& b = model.edgeV1();
   const auto& rest = model.edgeRestLength();
   for (std::size_t e = 0; e < rest.size(); ++e) {
     if (!(rest[e] > 0.0)) continue;
     const double dx = s.x[b[e]] - s.x[a[e]], dy = s.y[b[e]] - s.y[a[e]], dz = s.z[b[e]] - s.z[a[e]];
-    const double strain = std::abs(std::sqrt(dx * dx + dy * dy + dz * dz) - rest[e]) / rest[e];
-    if (!(strain <= worst)) worst = strain;  // also propagates NaN
+    const double strain = (std::sqrt(dx * dx + dy * dy + dz * dz) - rest[e]) / rest[e];
+    if (std::isnan(strain)) {
+      worst.stretch = worst.compression = strain;
+      return worst;
+    }
+    if (strain > worst.stretch) worst.stretch = strain;
+    if (-strain > worst.compression) worst.compression = -strain;
   }
   return worst;
 }

@@ -82,7 +82,7 @@ TEST(Run, BundledExampleWritesEverything) {
 
   const nlohmann::json stats = statsOf(out);
   for (const char* key : {"frames", "substeps_per_frame", "ms_per_frame", "loop_wall_ms_per_frame", "ms_per_stage",
-                          "energy", "max_strain", "nan_detected"})
+                          "energy", "max_strain", "max_stretch", "max_compression", "nan_detected"})
     EXPECT_TRUE(stats.contains(key)) << key;
   for (const char* stage : {"forces", "integrate", "collide", "fixtures", "output"})
     EXPECT_TRUE(stats["ms_per_stage"].contains(stage)) << stage;

@@ -51,7 +51,20 @@ void accumulateDragForces(const ClothModel& model, const StepSettings& settings,
 /// Gravitational potential -sum m g . x, J (zero at the origin).
 [[nodiscard]] double gravityEnergy(const ClothModel& model, const ClothState& state, const Vec3& gravity_m_s2);
 
+/// The model's edges' extremes against their rest lengths l0: the longest stretch
+/// max (l - l0) / l0 and the deepest compression max (l0 - l) / l0, each 0 when no edge is
+/// so. A NaN position makes both NaN.
+struct EdgeStrain {
+  double stretch = 0.0;
+  double compression = 0.0;
+  /// Largest |l - l0| / l0: the larger of the two.
+  [[nodiscard]] double largest() const { return stretch >= compression ? stretch : compression; }
+};
+[[nodiscard]] EdgeStrain edgeStrain(const ClothModel& model, const ClothState& state);
+
 /// Largest |l - l0| / l0 over the model's edges.
-[[nodiscard]] double maxEdgeStrain(const ClothModel& model, const ClothState& state);
+[[nodiscard]] inline double maxEdgeStrain(const ClothModel& model, const ClothState& state) {
+  return edgeStrain(model, state).largest();
+}
 
 }  // namespace drape::cloth

@@ -1,7 +1,9 @@
 // libFuzzer target: BVH text through the reader and the clip conversion (units guess,
-// T-pose test, resampling), and as a live source sends it (anim-server --live): the header
-// up to its "Frame Time:" line, then a frame a line. Any drape::Error is a correct answer; a
-// crash is a bug.
+// standing up a body lying along another axis, T-pose test, resampling); a clip whose
+// skeleton is humanoid by its shape then retargeted onto the bundled MakeHuman body through
+// the joint map found by shape; and the text as a live source sends it (anim-server --live):
+// the header up to its "Frame Time:" line, then a frame a line. Any drape::Error is a
+// correct answer; a crash is a bug.
 
 #include <algorithm>
 #include <cstddef>
@@ -11,7 +13,10 @@
 
 #include "drape/core/error.hpp"
 #include "drape/formats/bvh.hpp"
+#include "drape/motion/animation.hpp"
 #include "drape/motion/clip_io.hpp"
+#include "drape/motion/jointmap.hpp"
+#include "drape/scene/avatar_gltf.hpp"
 
 namespace {
 
@@ -37,13 +42,25 @@ void readAsStream(std::string_view text) {
   }
 }
 
+/// The body a capture drives, loaded once (the MakeHuman rig the examples walk).
+const drape::scene::Avatar& body() {
+  static const drape::scene::Avatar avatar =
+      drape::scene::loadAvatarFile(DRAPE_SOURCE_DIR "/data/avatars/makehuman_rig_cmu_mb.mhskel");
+  return avatar;
+}
+
+void retargetByShape(const drape::motion::Clip& clip) {
+  const std::optional<drape::motion::JointMap> map = drape::motion::shapeJointMap(clip.skeleton, body());
+  if (map) (void)drape::motion::AvatarAnimation::build(body(), clip, *map);
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   try {
     const drape::formats::BvhFile bvh = drape::formats::parseBvh(text, "fuzz.bvh");
-    (void)drape::motion::clipFromBvh(bvh);
+    retargetByShape(drape::motion::clipFromBvh(bvh));
   } catch (const drape::Error&) {
   }
   try {

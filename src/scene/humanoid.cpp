@@ -279,6 +279,11 @@ std::optional<Humanoid> findHumanoid(std::span<const JointAt> joints, std::strin
     const JointChain neckUp = pathUp(t, neckChild);
     std::size_t headAt = 0;
     while (headAt + 1 < neckUp.size() && t.kids(neckUp[headAt]).size() == 1) ++headAt;
+    // A rig's marker at the top of the head (Mixamo's HeadTop_End) ends the way up, but the
+    // head's bone starts below it, at the joint the head moves with.
+    const auto carries = [&](int j) { return t.joints[static_cast<std::size_t>(j)].carries; };
+    if (headAt > 0 && t.kids(neckUp[headAt]).empty() && !carries(neckUp[headAt]) && carries(neckUp[headAt - 1]))
+      --headAt;
     h.neck = slice(neckUp, 0, headAt + 1);
   }
   for (std::size_t s = 0; s < 2; ++s) {
@@ -336,6 +341,12 @@ std::vector<JointAt> jointsAt(const Avatar& avatar) {
   std::vector<JointAt> out;
   out.reserve(avatar.joints.size());
   for (const Joint& j : avatar.joints) out.push_back({j.parent, j.restCenter});
+  // Joints without a segment carry nothing, where the avatar has segments at all.
+  if (avatar.segments.empty()) return out;
+  for (JointAt& j : out) j.carries = false;
+  for (const Segment& s : avatar.segments)
+    if (s.joint >= 0 && static_cast<std::size_t>(s.joint) < out.size() && !s.mesh.triangles.empty())
+      out[static_cast<std::size_t>(s.joint)].carries = true;
   return out;
 }
 

@@ -138,6 +138,41 @@ TEST(ShapeMap, PairsTheBonesTheShippedMapsPairByName) {
   }
 }
 
+TEST(ShapeMap, TheCapturesHeadDrivesTheHeadUnderATopOfHeadMarker) {
+  // A rig that ends its head with a marker joint (Mixamo's HeadTop_End, no segment on it):
+  // the capture's head drives the avatar's head, not the marker, and the marker follows it.
+  scene::Avatar avatar = makeHuman();
+  const int head = avatar.findJoint("Head");
+  scene::Joint marker = avatar.joints[static_cast<std::size_t>(head)];
+  marker.name = "HeadTop_End";
+  marker.parent = head;
+  marker.restCenter += Vec3(0.0, 0.2, 0.0);
+  avatar.joints.push_back(marker);
+  const Clip clip = loadClip(kShapeMocap + "cmu_12_03_walk.bvh");
+  std::string why;
+  const std::optional<JointMap> map = shapeJointMap(clip.skeleton, avatar, &why);
+  ASSERT_TRUE(map.has_value()) << why;
+  const auto pairs = pairsOf(*map);
+  ASSERT_TRUE(pairs.count("Head"));
+  EXPECT_EQ(pairs.at("Head"), std::set<std::string>{"Head"});
+  for (const JointMapEntry& e : map->entries) EXPECT_NE(e.avatarJoint, "HeadTop_End") << e.motionJoint;
+  // The marker follows the head: 0.2 m from it in every frame.
+  const AvatarAnimation anim = AvatarAnimation::build(avatar, clip, *map);
+  const std::size_t top = avatar.joints.size() - 1;
+  for (std::size_t f = 0; f < anim.frameCount(); f += 10) {
+    const auto world = anim.frame(f);
+    EXPECT_NEAR((world[top].translation - world[static_cast<std::size_t>(head)].translation).norm(), 0.2, 1e-9) << f;
+  }
+  // And the body moves as it does without the marker: the same trunk, the same head.
+  const std::optional<JointMap> unmarked = shapeJointMap(clip.skeleton, makeHuman());
+  ASSERT_TRUE(unmarked.has_value());
+  const AvatarAnimation plain = AvatarAnimation::build(makeHuman(), clip, *unmarked);
+  for (std::size_t f = 0; f < anim.frameCount(); f += 10)
+    for (std::size_t j = 0; j < top; ++j)
+      EXPECT_LT((anim.frame(f)[j].translation - plain.frame(f)[j].translation).norm(), 1e-9)
+          << "frame " << f << " joint " << avatar.joints[j].name;
+}
+
 TEST(ShapeMap, TheCapturesMoveCesiumMansNumberedJointsLimbForLimb) {
   // No shipped map names joint0 .. joint18: loadAnimation pairs them by shape, and each
   // limb on CesiumMan points where the capture's does on every frame. He faces +x, the

@@ -73,6 +73,40 @@ TEST(Humanoid, TheMakeHumanCmuRigsBonesAreWhereItsNamesSay) {
   EXPECT_GT(h.forward.z(), 0.99);  // the body faces +z
 }
 
+/// The MakeHuman body with a marker joint 0.2 m above its head, as Mixamo's rigs and many
+/// exporters end a chain (HeadTop_End): no segment moves with it.
+Avatar withTopOfHeadMarker(Avatar avatar) {
+  const int head = avatar.findJoint("Head");
+  Joint marker = avatar.joints[static_cast<std::size_t>(head)];
+  marker.name = "HeadTop_End";
+  marker.parent = head;
+  marker.restCenter += Vec3(0.0, 0.2, 0.0);
+  avatar.joints.push_back(marker);
+  return avatar;
+}
+
+TEST(Humanoid, AMarkerAtTheTopOfTheHeadIsNoHead) {
+  // The way up the neck ends at the marker, but the head is the joint it hangs from: the one
+  // the head's segment moves with.
+  const Avatar marked = withTopOfHeadMarker(loadAvatarFile(kHumanoidAvatars + "makehuman_rig_cmu_mb.mhskel"));
+  Humanoid h = humanoidOf(marked);
+  expectHumanoid(marked, h, cmuRig());
+  EXPECT_EQ(marked.joints[static_cast<std::size_t>(h.head())].name, "Head");
+  // A joint at the top that carries a segment is a bone of its own: the head's last.
+  Avatar carrying = marked;
+  Segment top = carrying.segments.front();
+  top.name = "HeadTop";
+  top.joint = carrying.findJoint("HeadTop_End");
+  carrying.segments.push_back(top);
+  h = humanoidOf(carrying);
+  EXPECT_EQ(namesOf(carrying, h.neck), (std::vector<std::string>{"Neck", "Neck1", "Head", "HeadTop_End"}));
+  // A skeleton alone (no segments) does not say which joints carry the body: every one does.
+  Avatar bare = marked;
+  bare.segments.clear();
+  h = humanoidOf(bare);
+  EXPECT_EQ(namesOf(bare, h.neck), (std::vector<std::string>{"Neck", "Neck1", "Head", "HeadTop_End"}));
+}
+
 TEST(Humanoid, TheDefaultRigsTwistBonesGoWithTheirBonesAsItsShippedMapChainsThem) {
   // share/drape/jointmaps/makehuman_default.json chains upperleg01.L and upperleg02.L into
   // one thigh, clavicle.L and shoulder01.L into one shoulder, and so on: the shape finds the

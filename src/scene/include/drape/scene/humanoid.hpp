@@ -33,6 +33,9 @@ namespace drape::scene {
 struct JointAt {
   int parent = -1;           ///< parents come first
   Vec3 rest = Vec3::Zero();  ///< world position at rest, y up
+  /// Whether any of the body moves with it. False for an avatar's joint without a segment:
+  /// the end markers rigs carry at their tips (Mixamo's HeadTop_End), which no bone starts.
+  bool carries = true;
 };
 
 /// Joints in order from parent to child; empty where the skeleton has no such bone.

@@ -1,6 +1,7 @@
 // libFuzzer target: glTF/GLB bytes through the skinned-avatar reader (in process, so the
-// fuzzer sees crashes the isolation child would hide) and the segmentation that follows,
-// and through the animation sampler (at 1 Hz: the fuzzer's animations may be a day long).
+// fuzzer sees crashes the isolation child would hide), the segmentation that follows and the
+// humanoid found by the skeleton's shape (along any axis), and through the animation
+// sampler (at 1 Hz: the fuzzer's animations may be a day long).
 // No folder is given: only data: URIs may load.
 
 #include <cstddef>
@@ -10,6 +11,7 @@
 #include "drape/core/error.hpp"
 #include "drape/formats/gltf_avatar.hpp"
 #include "drape/scene/avatar_gltf.hpp"
+#include "drape/scene/humanoid.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);
@@ -21,7 +23,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     const drape::formats::GltfSkinnedModel model =
         drape::formats::parseGltfSkinnedModel(bytes, "fuzz.glb", "");
-    (void)drape::scene::buildAvatarFromSkinnedModel(model);
+    const drape::scene::Avatar avatar = drape::scene::buildAvatarFromSkinnedModel(model);
+    (void)drape::scene::findUpright(drape::scene::jointsAt(avatar));
     (void)drape::formats::deserialiseSkinnedModel(drape::formats::serialise(model), "fuzz.glb");
   } catch (const drape::Error&) {
   }

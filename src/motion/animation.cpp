@@ -14,6 +14,7 @@
 #include "drape/core/files.hpp"
 #include "drape/formats/hanim_motion.hpp"
 #include "drape/motion/interpolate.hpp"
+#include "drape/motion/standing.hpp"
 
 namespace drape::motion {
 namespace {
@@ -721,7 +722,15 @@ AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& mo
       }
       return AvatarAnimation::fromJointMotion(avatar, motion, motionPath);
     }
-    const Clip clip = clipOfJointMotion(motion, motionPath);
+    // Retargeted like a capture, stood up like one: a file that stands its skeleton along +z
+    // (an FBX from a Z-up tool, a robot's H-Anim) would lay the avatar down.
+    Clip clip = clipOfJointMotion(motion, motionPath);
+    const Standing standing = standingOf(clip.skeleton);
+    if (standing.axis != "+y") turnClip(clip, standing.turn);
+    if (report) {
+      report->standingAxis = standing.axis;
+      report->standingTurn = standing.turn;
+    }
     const JointMap map = jointMapFor(clip, avatar, options);
     if (chosenMap) *chosenMap = map;
     return AvatarAnimation::build(avatar, clip, map, options.retarget);

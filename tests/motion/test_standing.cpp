@@ -8,11 +8,13 @@
 #include <array>
 #include <cstdio>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 #include <sys/wait.h>
 
 #include <fmt/format.h>
 
+#include "drape/formats/avatar_motion.hpp"
 #include "drape/formats/bvh.hpp"
 #include "drape/motion/animation.hpp"
 #include "drape/motion/clip_io.hpp"
@@ -162,6 +164,42 @@ TEST(Standing, TheStoodUpCaptureMovesTheBodyAsTheCaptureStandingDoes) {
     EXPECT_EQ(frames, whole.frameCount());
     EXPECT_LT(liveFarthest, 1e-6) << "m";
   }
+}
+
+TEST(Standing, AnAvatarFilesAnimationStandingAlongZIsStoodUpAsItIsRetargeted) {
+  // CesiumMan's own walk with his skeleton laid along +z, as a file from a Z-up tool holds
+  // it, retargeted onto the MakeHuman body: the body moves as the walk standing moves it.
+  const std::string file = std::string(DRAPE_DATA_DIR) + "/avatars/CesiumMan.glb";
+  const formats::SkinnedJointMotion walk = formats::readAvatarMotion(file, 30.0);
+  formats::SkinnedJointMotion laid = walk;
+  const Quat lay(Eigen::AngleAxisd(0.5 * std::numbers::pi, Vec3::UnitX()));  // +y onto +z
+  for (Vec3& c : laid.restCenters) c = lay * c;
+  for (RigidTransform& f : laid.frames) {
+    f.rotation = (lay * f.rotation * lay.conjugate()).normalized();
+    f.translation = lay * f.translation;
+  }
+  MotionOptions options;
+  options.jointMapDirectory = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";
+  options.sampled = &walk;
+  ClipLoadReport standingReport, laidReport;
+  const AvatarAnimation standing = loadAnimation(makeHuman(), file, options, &standingReport);
+  options.sampled = &laid;
+  const AvatarAnimation stoodUp = loadAnimation(makeHuman(), file, options, &laidReport);
+  EXPECT_EQ(standingReport.standingAxis, "+y");
+  EXPECT_EQ(laidReport.standingAxis, "+z");
+  EXPECT_EQ(laidReport.stoodUp(), "it stands along +z: turned to stand along +y, as drape's scenes do");
+  ASSERT_EQ(standing.frameCount(), stoodUp.frameCount());
+  ASSERT_GT(standing.frameCount(), 10u);
+  double worst = 0.0, worstTurn = 0.0;
+  for (std::size_t f = 0; f < standing.frameCount(); ++f) {
+    const auto a = standing.frame(f), b = stoodUp.frame(f);
+    for (std::size_t j = 0; j < a.size(); ++j) {
+      worst = std::max(worst, (a[j].translation - b[j].translation).norm());
+      worstTurn = std::max(worstTurn, a[j].rotation.angularDistance(b[j].rotation));
+    }
+  }
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_LT(worstTurn, 1e-6);
 }
 
 TEST(Standing, InspectSaysHowTheFileStands) {

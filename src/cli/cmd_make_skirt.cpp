@@ -143,10 +143,9 @@ void chooseSegments(const scene::Avatar& avatar, MakeSkirtOptions& o, const std:
     if (o.waistGiven || o.hipsGiven || o.legsGiven) return;  // checkSegments names what is missing
     // Lying in its scene, it needs turning, not naming its segments.
     if (const std::optional<scene::Upright> u = scene::uprightAlongAnotherAxis(scene::jointsAt(avatar)))
-      throw Error(fmt::format("{}: it stands along {}, not along +y as drape's scenes do; give its Avatar node (or a "
-                              "Transform around its Humanoid) rotation {} to stand it up, and the skirt is fitted to "
+      throw Error(fmt::format("{}: it stands along {}, not along +y as drape's scenes do; {}, and the skirt is fitted to "
                               "it standing",
-                              whose, u->axis, u->rotationText()));
+                              whose, u->axis, u->standUpAdvice()));
     throw Error(fmt::format("{} has none of the MakeHuman CMU rig's segment names make-skirt knows ({}, {}, {}), and its "
                             "lower body cannot be found by the skeleton's shape: {}; name its own with --waist-segment, "
                             "--hip-segments and --leg-segments (it has: {})",

@@ -20,6 +20,7 @@
 #include "drape/formats/obj.hpp"
 #include "drape/formats/run_manifest.hpp"
 #include "drape/mesh/surface_distance.hpp"
+#include "drape/mesh/topology.hpp"
 #include "drape/render/run_replay.hpp"
 #include "frame_range.hpp"
 
@@ -392,15 +393,15 @@ struct Stretched {
   double ratio = 0.0;  ///< its longest over its rest length
 };
 
-/// The garment's positions at rest: its OBJ in the run directory, as the scene models it.
-std::vector<Vec3> restPositions(const std::string& directory, const render::RunReplay& run, std::size_t g) {
+/// The garment at rest: its OBJ in the run directory, as the scene models it.
+mesh::TriMesh restMesh(const std::string& directory, const render::RunReplay& run, std::size_t g) {
   const render::MeshInfo& info = run.meshes()[g];
   for (const formats::RunMesh& m : formats::readRunManifest(directory).meshes) {
     if (m.role != "garment" || m.name != info.name || m.character != info.character) continue;
     const std::string path = (std::filesystem::path(directory) / m.topology).string();
-    std::vector<Vec3> rest = formats::readObj(path).positions;
-    if (rest.size() != info.vertexCount)
-      throw Error(fmt::format("{}: {} vertices, where the run's cache has {}", path, rest.size(), info.vertexCount));
+    mesh::TriMesh rest = formats::readObj(path);
+    if (rest.vertexCount() != info.vertexCount)
+      throw Error(fmt::format("{}: {} vertices, where the run's cache has {}", path, rest.vertexCount(), info.vertexCount));
     return rest;
   }
   throw Error(fmt::format("{}: the manifest lists no garment {}", directory, info.name));
@@ -412,15 +413,10 @@ std::vector<Stretched> stretchedEdges(const std::string& directory, const render
                                       const std::vector<std::size_t>& garments, const Frames& frames) {
   std::vector<Stretched> edges;
   for (const std::size_t g : garments) {
-    const std::vector<Vec3> rest = restPositions(directory, run, g);
-    std::vector<std::array<std::uint32_t, 2>> pairs;
-    for (const mesh::Triangle& t : run.meshes()[g].triangles)
-      for (int k = 0; k < 3; ++k) pairs.push_back({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
-    std::sort(pairs.begin(), pairs.end());
-    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-    for (const auto& e : pairs) {
-      const double length = (rest[e[0]] - rest[e[1]]).norm();
-      if (length > 0.0) edges.push_back({g, e, length, frames.first, 0.0});
+    const mesh::TriMesh rest = restMesh(directory, run, g);
+    for (const mesh::Edge& e : mesh::Topology::build(rest).edges) {
+      const double length = (rest.positions[e.v0] - rest.positions[e.v1]).norm();
+      if (length > 0.0) edges.push_back({g, {e.v0, e.v1}, length, frames.first, 0.0});
     }
   }
   for (std::int64_t f = frames.first; f <= frames.last; ++f)

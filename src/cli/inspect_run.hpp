@@ -2,8 +2,9 @@
 // `drape inspect RUN_DIR`: what a finished run holds, and where its garments lie against
 // the body in the frames it recorded: the garment vertices deepest in the skinned body
 // (--deepest N), the edges stretched most (--stretched N), or one vertex frame by frame
-// (--vertex V) with the collidable parts it is nearest to, which is what it rests on. Everything is measured on the meshes the run wrote
-// (the skin as players draw it, the rigid segments the cloth collided with), exactly.
+// (--vertex V) with the collidable parts it is nearest to, which is what it rests on.
+// Everything is measured on the meshes the run wrote (the skin as players draw it, the
+// rigid segments the cloth collided with), exactly.
 
 #include <ostream>
 #include <string>

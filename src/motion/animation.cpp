@@ -725,8 +725,7 @@ AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& mo
     // Retargeted like a capture, stood up like one: a file that stands its skeleton along +z
     // (an FBX from a Z-up tool, a robot's H-Anim) would lay the avatar down.
     Clip clip = clipOfJointMotion(motion, motionPath);
-    const Standing standing = standingOf(clip.skeleton);
-    if (standing.axis != "+y") turnClip(clip, standing.turn);
+    const Standing standing = standUp(clip);
     if (report) {
       report->standingAxis = standing.axis;
       report->standingTurn = standing.turn;

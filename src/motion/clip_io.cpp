@@ -80,10 +80,9 @@ void finishClip(Clip& clip, double metresPerUnitValue, const ClipLoadOptions& op
   r.sourceRate = clip.rate;
   r.sourceFrames = clip.frameCount();
   // Stood up first: the reference T-pose test, the retargeting and the grounding read +y as up.
-  const Standing standing = standingOf(clip.skeleton);
+  const Standing standing = standUp(clip);
   r.standingAxis = standing.axis;
   r.standingTurn = standing.turn;
-  if (standing.axis != "+y") turnClip(clip, standing.turn);
   if (options.skipReferenceTPose && firstFrameIsReferenceTPose(clip)) {
     dropLeadingFrames(clip, 1);
     r.referenceTPoseSkipped = true;

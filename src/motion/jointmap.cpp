@@ -293,9 +293,7 @@ std::optional<JointMap> shapeJointMap(const Skeleton& skeleton, const scene::Ava
   const std::optional<scene::Humanoid> a = scene::findHumanoid(avatarAt, &why);
   if (!a) {
     if (const std::optional<scene::Upright> u = scene::uprightAlongAnotherAxis(avatarAt))
-      why = fmt::format("it stands along {}, not along +y as drape's scenes do (give its Avatar node, or a Transform "
-                        "around its Humanoid, rotation {})",
-                        u->axis, u->rotationText());
+      why = fmt::format("it stands along {}, not along +y as drape's scenes do; {}", u->axis, u->standUpAdvice());
     if (whyNot) *whyNot = "the avatar's skeleton: " + why;
     return std::nullopt;
   }

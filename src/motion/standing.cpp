@@ -12,30 +12,23 @@ std::vector<scene::JointAt> jointsAt(const Skeleton& skeleton) {
   return out;
 }
 
-Standing standingOf(const Skeleton& skeleton) {
-  const std::optional<scene::Upright> u = scene::uprightAlongAnotherAxis(jointsAt(skeleton));
-  if (!u) return {};
-  return {u->axis, u->turn};
-}
-
 void turnPose(std::span<Quat> local, Vec3& root, const Quat& turn) {
   const Quat back = turn.conjugate();
   for (Quat& q : local) q = (turn * q * back).normalized();
   root = turn * root;
 }
 
-void turnSkeleton(Skeleton& skeleton, const Quat& turn) {
-  for (SkeletonJoint& j : skeleton.joints) {
-    j.offset = turn * j.offset;
-    if (j.endSite) *j.endSite = turn * *j.endSite;
+Standing standUp(Clip& clip) {
+  const std::optional<scene::Upright> u = scene::uprightAlongAnotherAxis(jointsAt(clip.skeleton));
+  if (!u) return {};
+  for (SkeletonJoint& j : clip.skeleton.joints) {
+    j.offset = u->turn * j.offset;
+    if (j.endSite) *j.endSite = u->turn * *j.endSite;
   }
-}
-
-void turnClip(Clip& clip, const Quat& turn) {
-  turnSkeleton(clip.skeleton, turn);
   const std::size_t n = clip.skeleton.size();
   for (std::size_t f = 0; f < clip.frameCount(); ++f)
-    turnPose({clip.rotations.data() + f * n, n}, clip.rootTranslations[f], turn);
+    turnPose({clip.rotations.data() + f * n, n}, clip.rootTranslations[f], u->turn);
+  return {u->axis, u->turn};
 }
 
 }  // namespace drape::motion

@@ -337,6 +337,11 @@ std::string Upright::rotationText() const {
                      round(sign * a.axis().z()), sign * a.angle());
 }
 
+std::string Upright::standUpAdvice() const {
+  return fmt::format("give its Avatar node (or a Transform around its Humanoid) rotation {} to stand it up",
+                     rotationText());
+}
+
 std::vector<JointAt> jointsAt(const Avatar& avatar) {
   std::vector<JointAt> out;
   out.reserve(avatar.joints.size());

@@ -31,9 +31,8 @@ void sayWhereItLies(const scene::Scene& scene, const SceneCharacter& c) {
   if (!(g.norm() > 0.0) || g.normalized().dot(-Vec3::UnitY()) < 0.999) return;  // the scene's own up: its choice
   const std::optional<scene::Upright> u = scene::uprightAlongAnotherAxis(scene::jointsAt(*c.avatar));
   if (!u) return;
-  spdlog::warn("{}: character '{}' stands along {}, where gravity pulls along -y: its garments would fall across it; "
-               "give its Avatar node (or a Transform around its Humanoid) rotation {} to stand it up",
-               scene.source, c.name, u->axis, u->rotationText());
+  spdlog::warn("{}: character '{}' stands along {}, where gravity pulls along -y: its garments would fall across it; {}",
+               scene.source, c.name, u->axis, u->standUpAdvice());
 }
 
 }  // namespace

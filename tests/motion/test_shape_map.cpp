@@ -294,6 +294,13 @@ TEST(ShapeMap, WhatIsNoHumanoidIsRefusedWithWhy) {
               std::string::npos)
         << e.what();
   }
+  // An avatar lying in its scene as its file stands it (Choreonoid's SR1, along +z) is no
+  // humanoid along +y: the shape says how to stand it up.
+  const scene::Avatar robot = scene::loadAvatarFile(std::string(DRAPE_DATA_DIR) + "/vrml/choreonoid_SR1.wrl");
+  std::string why;
+  EXPECT_FALSE(shapeJointMap(loadClip(kShapeMocap + "cmu_12_03_walk.bvh").skeleton, robot, &why));
+  EXPECT_EQ(why, "the avatar's skeleton: it stands along +z, not along +y as drape's scenes do; give its Avatar node (or "
+                 "a Transform around its Humanoid) rotation 1 0 0 -1.5708 to stand it up");
   // Where a shipped map drives the trunk, it is used as before.
   JointMap chosen;
   (void)loadAnimation(makeHuman(), kShapeMocap + "cmu_12_03_walk.bvh", options, nullptr, &chosen);

@@ -18,23 +18,20 @@ namespace drape::motion {
 /// The skeleton's joints at rest (every rotation zero), as scene::findHumanoid reads them.
 [[nodiscard]] std::vector<scene::JointAt> jointsAt(const Skeleton& skeleton);
 
-/// How a capture's skeleton stands: "+y" with no turn where it is a humanoid standing so or
+/// How a capture's skeleton stood: "+y" with no turn where it is a humanoid standing so or
 /// no humanoid along any axis, else the axis scene::findUpright finds and its turn.
 struct Standing {
   std::string axis = "+y";
   Quat turn = Quat::Identity();
 };
-[[nodiscard]] Standing standingOf(const Skeleton& skeleton);
+
+/// Stands the clip up along +y where its skeleton is a humanoid along another axis: its
+/// offsets, end sites and every frame turned (turnPose); how it stood.
+Standing standUp(Clip& clip);
 
 /// Turns one frame: the root translation by `turn`, each local rotation q to turn q turn^-1,
-/// which with the skeleton turned (turnSkeleton) turns every joint's world position and
+/// which with the skeleton's offsets turned too turns every joint's world position and
 /// conjugates its world rotation. Allocates nothing.
 void turnPose(std::span<Quat> local, Vec3& root, const Quat& turn);
-
-/// Turns every offset and end site of the skeleton by `turn`.
-void turnSkeleton(Skeleton& skeleton, const Quat& turn);
-
-/// Turns the whole clip: its skeleton and every frame.
-void turnClip(Clip& clip, const Quat& turn);
 
 }  // namespace drape::motion

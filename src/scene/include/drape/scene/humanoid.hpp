@@ -82,6 +82,9 @@ struct Upright {
   /// The turn as a VRML97 SFRotation ("1 0 0 -1.5708"): the rotation of an Avatar node or
   /// Transform that stands the body up.
   [[nodiscard]] std::string rotationText() const;
+  /// What a scene that leaves the body lying is to do: "give its Avatar node (or a Transform
+  /// around its Humanoid) rotation 1 0 0 -1.5708 to stand it up".
+  [[nodiscard]] std::string standUpAdvice() const;
 };
 
 /// The humanoid standing along +y, or along the first other axis that shows one; nullopt

@@ -23,6 +23,8 @@
 #include "drape/cloth/model.hpp"
 #include "drape/cloth/solver.hpp"
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
+#include "drape/formats/mesh_file.hpp"
 #include "drape/formats/obj.hpp"
 #include "drape/formats/units.hpp"
 #include "drape/mesh/topology.hpp"
@@ -41,6 +43,7 @@ struct MakeSceneOptions {
   std::string avatar;
   std::string avatarUrl;
   std::string garment;
+  std::vector<std::string> garmentParts;  ///< --garment-parts: the meshes (OBJ groups) that are the garment
   std::string mask;
   std::string units = "m";
   std::string out;
@@ -173,14 +176,24 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
   if (!os) throw Error(fmt::format("{}: cannot be written", path));
 }
 
+/// A garment or mask file in metres: an OBJ in --units, the other formats in their own.
+/// Says what was read from a file that holds several meshes or was welded.
+mesh::TriMesh readMeshOf(const MakeSceneOptions& o, const std::string& path, const std::vector<std::string>& parts) {
+  formats::MeshFileOptions read;
+  read.metresPerUnit = formats::metresPerUnit(o.units, "--units");
+  read.parts = parts;
+  formats::MeshFile file = formats::readMeshFile(path, read);
+  if (const std::string what = formats::describeRead(file); !what.empty()) fmt::print("{}: {}\n", path, what);
+  return std::move(file.mesh);
+}
+
 /// The garment and its mask as modelled on the avatar file `avatarFile` at rest, in metres:
 /// a MakeHuman .mhclo refitted to the MakeHuman body that file builds.
 std::pair<mesh::TriMesh, mesh::TriMesh> readGarment(const MakeSceneOptions& o, const std::string& avatarFile) {
-  formats::ObjReadOptions read;
-  read.metresPerUnit = formats::metresPerUnit(o.units, "--units");
-  mesh::TriMesh mask = formats::readObj(o.mask, read);
-  if (std::filesystem::path(o.garment).extension() != ".mhclo") return {formats::readObj(o.garment, read), mask};
+  mesh::TriMesh mask = readMeshOf(o, o.mask, {});
+  if (std::filesystem::path(o.garment).extension() != ".mhclo") return {readMeshOf(o, o.garment, o.garmentParts), mask};
   // A MakeHuman garment: refitted to the body this avatar is built from.
+  if (!o.garmentParts.empty()) throw Error(fmt::format("--garment-parts: {} is one mesh, not a file of parts", o.garment));
   if (std::filesystem::path(avatarFile).extension() != ".mhskel")
     throw Error(fmt::format("{}: a MakeHuman garment (.mhclo) fits the MakeHuman body; give a .mhskel avatar, not {}",
                             o.garment, avatarFile.empty() ? "an H-Anim Humanoid" : avatarFile));
@@ -314,10 +327,16 @@ RunFunction setupMakeScene(CLI::App& app) {
                  "Avatar file the garment was modelled on (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel, or a VRML97 "
                  "H-Anim humanoid .wrl; one standing along +z is stood up with the garment); not with --add-to");
   app.add_option("--garment", o.garment,
-                 "Garment OBJ in the avatar's rest pose, or a MakeHuman .mhclo (refitted to the MakeHuman body)")
+                 "Garment in the avatar's rest pose: OBJ, glTF (.glb, .gltf), Collada (.dae) or FBX (.fbx), its "
+                 "vertices welded where those files split them; or a MakeHuman .mhclo (refitted to the MakeHuman body)")
       ->required();
+  app.add_option("--garment-parts", o.garmentParts,
+                 "The meshes of the garment file that are the garment, by node or mesh name (OBJ: g/o groups); "
+                 "default: all")
+      ->delimiter(',');
   app.add_option("--mask", o.mask,
-                 "Constraint mask OBJ: the garment vertices bound to the body (for a .mhclo: on its OBJ as modelled)")
+                 "Constraint mask (OBJ, glTF, Collada or FBX): the garment vertices bound to the body (for a .mhclo: "
+                 "on its OBJ as modelled)")
       ->required();
   app.add_option("--out", o.out, "Directory for scene.wrl (required without --add-to)");
   addAddToOptions(app, o.add,
@@ -326,7 +345,10 @@ RunFunction setupMakeScene(CLI::App& app) {
                   "scene as a ClothSet once the scene with it loads; NAME.obj and NAME_mask.obj are written beside "
                   "it. --offsets become the garment's own",
                   "blue");
-  app.add_option("--units", o.units, "Length unit of both OBJ files: m, dm, cm, mm, in")->capture_default_str();
+  app.add_option("--units", o.units,
+                 "Length unit of the garment and mask where they are OBJ files: m, dm, cm, mm, in (glTF, Collada and "
+                 "FBX state their own)")
+      ->capture_default_str();
   app.add_option("--name", o.name, "Garment name (default: the OBJ's file name)");
   app.add_option("--title", o.title, "Scene title (default: the garment name)");
   app.add_option("--avatar-url", o.avatarUrl, "The Avatar url written into scene.wrl (default: the avatar's path relative to --out)");
@@ -385,6 +407,9 @@ RunFunction setupMakeScene(CLI::App& app) {
     if (!(o.frameRate > 0.0)) throw Error(fmt::format("--frame-rate must be > 0, got {}", o.frameRate));
     if (o.stepsPerFrame < 0) throw Error(fmt::format("--substeps must be >= 1, got {}", o.stepsPerFrame));
     if (!(o.stitchGaps_m >= 0.0)) throw Error(fmt::format("--stitch-gaps must be >= 0 m, got {}", o.stitchGaps_m));
+    const auto isObj = [](const std::string& path) { return lowerExtension(path) == ".obj"; };
+    if (app.count("--units") > 0 && !isObj(o.garment) && !isObj(o.mask))
+      throw Error(fmt::format("--units {}: applies to OBJ files; {} and {} state their own unit", o.units, o.garment, o.mask));
     if (!addingToScene(app, o.add, "make-scene", o.avatar, o.out,
                        {"--out", "--avatar-url", "--title", "--voxel", "--frame-rate", "--substeps", "--bend-every",
                         "--collision-every", "--max-added-mass", "--keep-apart", "--cut-at-joints"}))

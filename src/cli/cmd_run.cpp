@@ -21,7 +21,7 @@
 #include "command.hpp"
 #include "drape/cloth/field_collider.hpp"
 #include "drape/core/error.hpp"
-#include "drape/formats/obj.hpp"
+#include "drape/formats/mesh_file.hpp"
 #include "drape/formats/units.hpp"
 #include "drape/motion/animation.hpp"
 #include "drape/scene/avatar_gltf.hpp"
@@ -211,19 +211,20 @@ void applyOverrides(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   }
 }
 
-/// A garment from --garment (OBJ) with its pins or mask.
+/// A garment from --garment (OBJ, glTF, Collada or FBX) with its pins or mask.
 void setupFromGarment(const RunOptions& o, RunSetup& setup, bool onAvatar) {
-  const double scale = formats::metresPerUnit(o.units, "--units");
-  formats::ObjReadOptions read;
-  read.metresPerUnit = scale;
+  formats::MeshFileOptions read;
+  read.metresPerUnit = formats::metresPerUnit(o.units, "--units");
   GarmentSetup garment;
-  garment.mesh = formats::readObj(o.garment, read);
+  formats::MeshFile file = formats::readMeshFile(o.garment, read);
+  if (const std::string what = formats::describeRead(file); !what.empty()) spdlog::info("{}: {}", o.garment, what);
+  garment.mesh = std::move(file.mesh);
   garment.name = std::filesystem::path(o.garment).stem().string();
   garment.material = o.material;
   if (!o.pinVertices.empty()) garment.pinned = parseIndexList(o.pinVertices);
   if (!o.pinMask.empty()) {
     if (!(o.pinTolerance_m > 0.0)) throw Error(fmt::format("--pin-tolerance must be > 0 m, got {}", o.pinTolerance_m));
-    garment.pinned = matchMask(garment.mesh, formats::readObj(o.pinMask, read), o.pinTolerance_m);
+    garment.pinned = matchMask(garment.mesh, formats::readMeshFile(o.pinMask, read).mesh, o.pinTolerance_m);
   }
   if (onAvatar) std::swap(garment.bound, garment.pinned);  // a mask on a body binds to it
   setup.settings = o.settings;
@@ -402,7 +403,9 @@ RunFunction setupRun(CLI::App& app) {
       "them for every garment. The defaults shown are those of --garment runs.\n"
       "Exit codes: 0 done, 2 bad input, 3 the simulation became unstable (files so far are kept).");
   app.add_option("scene", o->scene, "VRML97 scene with ClothSet garments (and an avatar)");
-  app.add_option("--garment", o->garment, "Garment mesh (OBJ), instead of a scene");
+  app.add_option("--garment", o->garment,
+                 "Garment mesh (OBJ, or glTF, Collada or FBX: every mesh of the file, welded where it splits "
+                 "vertices), instead of a scene");
   app.add_option("--avatar", o->avatar, "Avatar to wear --garment (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel)");
   app.add_option("--motion", o->motions, std::string("Motion for the avatar ") + kMotionHelp + kMotionPerCharacterHelp)
       ->type_name("FILE|NAME=FILE");
@@ -487,9 +490,10 @@ RunFunction setupRun(CLI::App& app) {
                  "other across a gap of at most this many m (a jacket's fronts) are drawn together (as drape "
                  "make-scene --stitch-gaps finds them)")
       ->excludes(unsewn);
-  app.add_option("--units", o->units, "Length unit of the OBJ files: m, dm, cm, mm, in")->capture_default_str();
+  app.add_option("--units", o->units, "Length unit of the OBJ files: m, dm, cm, mm, in (glTF, Collada and FBX state their own)")
+      ->capture_default_str();
   auto* pins = app.add_option("--pin-vertices", o->pinVertices, "Vertices pinned in place, 0-based, e.g. 0,12,40");
-  auto* mask = app.add_option("--pin-mask", o->pinMask, "OBJ whose vertices mark the pinned garment vertices");
+  auto* mask = app.add_option("--pin-mask", o->pinMask, "Mesh (OBJ, glTF, Collada or FBX) whose vertices mark the pinned garment vertices");
   pins->excludes(mask);
   mask->excludes(pins);
   app.add_option("--pin-tolerance", o->pinTolerance_m, "Distance within which a mask vertex matches, m")

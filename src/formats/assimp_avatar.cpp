@@ -20,9 +20,11 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "drape/core/error.hpp"
 #include "drape/core/files.hpp"
+#include "drape/formats/mesh_file.hpp"
 #include "text_scan.hpp"
 
 namespace drape::formats {
@@ -199,7 +201,7 @@ constexpr unsigned kPostProcess = aiProcess_Triangulate | aiProcess_JoinIdentica
 
 std::string refusalNote(const OwnBytesOnly& io) {
   if (io.refused().empty()) return "";
-  return fmt::format(" (it asked for '{}', which drape does not open: only the avatar file itself is read)", io.refused().front());
+  return fmt::format(" (it asked for '{}', which drape does not open: only the file itself is read)", io.refused().front());
 }
 
 // ---- the scene as drape's plain data --------------------------------------------------
@@ -914,6 +916,87 @@ const aiScene& importScene(Assimp::Importer& importer, std::string_view bytes, c
   return *scene;
 }
 
+// ---- static meshes (a garment, a mask) -------------------------------------------------
+
+// A mesh's positions at rest: placed by its node, or where it has bones skinned with the
+// rest-pose nodes (every influence, normalised; a vertex no bone weighs stays where its
+// node puts it).
+std::vector<Vec3> restPositions(const SceneReader& r, const aiMesh& mesh, const aiNode& node) {
+  const std::size_t count = mesh.mNumVertices;
+  const Eigen::Matrix4d nodeWorld = r.world.at(&node);
+  std::vector<Eigen::Matrix4d> sum(mesh.HasBones() ? count : 0, Eigen::Matrix4d::Zero());
+  std::vector<double> total(sum.size(), 0.0);
+  for (unsigned b = 0; b < mesh.mNumBones; ++b) {
+    const aiBone& bone = *mesh.mBones[b];
+    const Eigen::Matrix4d skin = r.world.at(r.boneNode(bone)) * toEigen(bone.mOffsetMatrix);
+    for (unsigned k = 0; k < bone.mNumWeights; ++k) {
+      const aiVertexWeight& w = bone.mWeights[k];
+      if (w.mVertexId >= count) r.fail(fmt::format("bone '{}' weighs vertex {}, but the mesh has {}", bone.mName.C_Str(), w.mVertexId, count));
+      if (!std::isfinite(w.mWeight) || w.mWeight < 0.0f) r.fail(fmt::format("bone '{}' has a bad weight {}", bone.mName.C_Str(), w.mWeight));
+      sum[w.mVertexId] += w.mWeight * skin;
+      total[w.mVertexId] += w.mWeight;
+    }
+  }
+  std::vector<Vec3> out;
+  out.reserve(count);
+  for (std::size_t v = 0; v < count; ++v) {
+    const Eigen::Matrix4d m = !sum.empty() && total[v] > 1e-9 ? Eigen::Matrix4d(sum[v] / total[v]) : nodeWorld;
+    const aiVector3D& p = mesh.mVertices[v];
+    const Eigen::Vector4d h = m * Eigen::Vector4d(p.x, p.y, p.z, 1.0);
+    if (!h.allFinite()) r.fail(fmt::format("vertex {} of mesh '{}' is not finite at rest", v, mesh.mName.C_Str()));
+    out.emplace_back(h.x(), h.y(), h.z());
+  }
+  return out;
+}
+
+MeshParts extractMesh(const aiScene& scene, Format format, const std::string& name, const std::vector<std::string>& parts) {
+  const SceneReader r = readerFor(scene, format, name);
+  MeshParts out;
+  out.mesh.name = name;
+  std::vector<bool> matched(parts.size(), false);
+  std::vector<const aiNode*> stack{scene.mRootNode};
+  while (!stack.empty()) {
+    const aiNode* node = stack.back();
+    stack.pop_back();
+    for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+      const unsigned m = node->mMeshes[i];
+      if (m >= scene.mNumMeshes || scene.mMeshes[m] == nullptr) r.fail(fmt::format("node '{}' names mesh {}, which does not exist", node->mName.C_Str(), m));
+      const aiMesh& mesh = *scene.mMeshes[m];
+      const std::string nodeName = node->mName.C_Str(), meshName = mesh.mName.C_Str();
+      const std::string part = !nodeName.empty() ? nodeName : !meshName.empty() ? meshName : fmt::format("mesh {}", m);
+      if (std::find(out.all.begin(), out.all.end(), part) == out.all.end()) out.all.push_back(part);
+      bool keep = parts.empty();
+      for (std::size_t k = 0; k < parts.size(); ++k)
+        if (parts[k] == part || (!meshName.empty() && parts[k] == meshName)) keep = matched[k] = true;
+      if (!keep || (mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) continue;
+      const std::vector<Vec3> positions = restPositions(r, mesh, *node);
+      if (out.mesh.positions.size() + positions.size() > kMaxVertices) r.fail(fmt::format("it has more than {} vertices", kMaxVertices));
+      const auto base = static_cast<std::uint32_t>(out.mesh.positions.size());
+      out.mesh.positions.insert(out.mesh.positions.end(), positions.begin(), positions.end());
+      const std::size_t before = out.mesh.triangles.size();
+      for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+        const aiFace& face = mesh.mFaces[f];
+        if (face.mNumIndices != 3) continue;  // points and lines left by triangulation
+        mesh::Triangle tri;
+        for (unsigned c = 0; c < 3; ++c) {
+          if (face.mIndices[c] >= positions.size()) r.fail(fmt::format("face {} names vertex {}, but the mesh has {}", f, face.mIndices[c], positions.size()));
+          tri[c] = base + face.mIndices[c];
+        }
+        if (tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2]) out.mesh.triangles.push_back(tri);
+      }
+      if (out.mesh.triangles.size() > before && std::find(out.read.begin(), out.read.end(), part) == out.read.end())
+        out.read.push_back(part);
+    }
+    for (unsigned i = node->mNumChildren; i-- > 0;) stack.push_back(node->mChildren[i]);
+  }
+  for (std::size_t k = 0; k < parts.size(); ++k)
+    if (!matched[k])
+      r.fail(fmt::format("has no node or mesh named '{}' (its meshes: {})", parts[k],
+                         out.all.empty() ? std::string("none") : fmt::format("{}", fmt::join(out.all, ", "))));
+  if (out.mesh.triangles.empty()) r.fail(parts.empty() ? "has no triangle mesh" : "the parts asked for have no triangles");
+  return out;
+}
+
 }  // namespace
 
 SkinnedModel parseAssimpSkinnedModel(std::string_view bytes, const std::string& name) {
@@ -954,6 +1037,11 @@ std::vector<SkinnedJointMotion> readAssimpJointMotions(const std::string& path, 
   const std::string reader = fmt::format("{} reader (Assimp)", formatName(formatOf(path)));
   const std::string result = runIsolated(path, reader, [&] { return serialise(parseAssimpJointMotions(bytes, path, rate)); }, limits);
   return deserialiseJointMotions(result, path);
+}
+
+MeshParts parseAssimpMesh(std::string_view bytes, const std::string& name, const std::vector<std::string>& parts) {
+  Assimp::Importer importer;
+  return extractMesh(importScene(importer, bytes, name, false), formatOf(name), name, parts);
 }
 
 SkinnedModel readAssimpSkinnedModel(const std::string& path, const IsolationLimits& limits) {

@@ -13,6 +13,7 @@
 
 #include "drape/core/error.hpp"
 #include "drape/formats/json_text.hpp"
+#include "drape/formats/mesh_file.hpp"
 #include "plain_data.hpp"
 #include "text_scan.hpp"
 
@@ -74,6 +75,7 @@ struct GModel {
   std::vector<GNode> nodes;
   std::vector<GSkin> skins;
   std::vector<std::vector<GPrimitive>> meshes;
+  std::vector<std::string> meshNames;  ///< "" where a mesh has none
 };
 
 bool insideFolder(const std::string& baseDir, const std::string& path) {
@@ -317,6 +319,7 @@ GModel parseDocument(std::string_view bytes, const std::string& name, const std:
         prims.push_back(std::move(prim));
       }
       m.meshes.push_back(std::move(prims));
+      m.meshNames.push_back(mesh.contains("name") && mesh["name"].is_string() ? mesh["name"].get<std::string>() : "");
     }
   } catch (const json::exception& e) {
     throw Error(fmt::format("{}: bad glTF JSON ({})", name, e.what()));
@@ -511,6 +514,29 @@ std::vector<std::string> animationNames(const GModel& model) {
   return names;
 }
 
+// Skin `index`'s joint matrices at rest: each joint's world matrix times its inverse bind
+// matrix (identity when the skin gives none, as the glTF spec says).
+std::vector<Eigen::Matrix4d> skinMatrices(const GModel& model, std::size_t index, const std::vector<Eigen::Matrix4d>& world,
+                                          const GltfReader& r) {
+  if (index >= model.skins.size()) r.fail(fmt::format("skin {} does not exist", index));
+  const GSkin& skin = model.skins[index];
+  const std::size_t jn = skin.joints.size();
+  std::vector<Eigen::Matrix4d> inverseBind(jn, Eigen::Matrix4d::Identity());
+  if (skin.inverseBindMatrices >= 0) {
+    const std::vector<double> m = r.read(skin.inverseBindMatrices, 16, "inverseBindMatrices");
+    if (m.size() / 16 < jn) r.fail("inverseBindMatrices has fewer matrices than the skin has joints");
+    for (std::size_t j = 0; j < jn; ++j)
+      for (int i = 0; i < 16; ++i) inverseBind[j](i % 4, i / 4) = m[j * 16 + static_cast<std::size_t>(i)];
+  }
+  std::vector<Eigen::Matrix4d> out(jn);
+  for (std::size_t j = 0; j < jn; ++j) {
+    const int node = skin.joints[j];
+    if (node < 0 || static_cast<std::size_t>(node) >= world.size()) r.fail(fmt::format("skin {} names joint node {}, which does not exist", index, node));
+    out[j] = world[static_cast<std::size_t>(node)] * inverseBind[j];
+  }
+  return out;
+}
+
 SkinnedModel extract(const GModel& model, const std::string& name) {
   const GltfReader r{model, name};
   std::vector<int> nodeParent;
@@ -530,16 +556,7 @@ SkinnedModel extract(const GModel& model, const std::string& name) {
     joint.restWorld = world[static_cast<std::size_t>(sj.node[k])];
     out.joints.push_back(joint);
   }
-  // Inverse bind matrices; identity when absent, as the glTF spec says.
-  std::vector<Eigen::Matrix4d> inverseBind(jn, Eigen::Matrix4d::Identity());
-  if (skin.inverseBindMatrices >= 0) {
-    const std::vector<double> m = r.read(skin.inverseBindMatrices, 16, "inverseBindMatrices");
-    if (m.size() / 16 < jn) r.fail("inverseBindMatrices has fewer matrices than the skin has joints");
-    for (std::size_t j = 0; j < jn; ++j)
-      for (int i = 0; i < 16; ++i) inverseBind[j](i % 4, i / 4) = m[j * 16 + static_cast<std::size_t>(i)];
-  }
-  std::vector<Eigen::Matrix4d> skinMatrix(jn);
-  for (std::size_t j = 0; j < jn; ++j) skinMatrix[j] = world[static_cast<std::size_t>(skin.joints[j])] * inverseBind[j];
+  const std::vector<Eigen::Matrix4d> skinMatrix = skinMatrices(model, 0, world, r);
 
   for (std::size_t ni = 0; ni < model.nodes.size(); ++ni) {
     const GNode& node = model.nodes[ni];
@@ -602,6 +619,125 @@ SkinnedModel extract(const GModel& model, const std::string& name) {
     }
   }
   if (out.triangles.empty()) r.fail("no skinned triangle mesh uses its first skin");
+  return out;
+}
+
+// ---- static meshes (a garment, a mask) -------------------------------------------------
+
+constexpr int kModeTriangleStrip = 5, kModeTriangleFan = 6;
+
+// The triangles a primitive's index list draws in its mode (lists, strips, fans), with
+// degenerate ones left out; `base` offsets the indices.
+void appendTriangles(const std::vector<double>& idx, int mode, std::size_t count, std::uint32_t base,
+                     std::vector<mesh::Triangle>& out, const GltfReader& r) {
+  auto corner = [&](std::size_t k) {
+    const double i = idx[k];
+    if (!(i >= 0.0) || i >= static_cast<double>(count)) r.fail(fmt::format("index {} is out of range ({} vertices)", i, count));
+    return base + static_cast<std::uint32_t>(i);
+  };
+  auto add = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    if (a != b && b != c && a != c) out.push_back({a, b, c});
+  };
+  if (mode == kModeTriangles)
+    for (std::size_t t = 0; t + 2 < idx.size(); t += 3) add(corner(t), corner(t + 1), corner(t + 2));
+  else if (mode == kModeTriangleStrip)
+    for (std::size_t t = 0; t + 2 < idx.size(); ++t)
+      t % 2 == 0 ? add(corner(t), corner(t + 1), corner(t + 2)) : add(corner(t + 1), corner(t), corner(t + 2));
+  else if (mode == kModeTriangleFan)
+    for (std::size_t t = 1; t + 1 < idx.size(); ++t) add(corner(0), corner(t), corner(t + 1));
+}
+
+// One primitive's positions at rest: placed by its node, or skinned where the node has a
+// skin and the primitive its joints and weights (the node's own transform then does not
+// apply, as the glTF spec says).
+std::vector<Vec3> restPositions(const GPrimitive& prim, const Eigen::Matrix4d& nodeWorld,
+                                const std::vector<Eigen::Matrix4d>& skinning, const GltfReader& r) {
+  const std::vector<double> p = r.read(prim.attributes.at("POSITION"), 3, "POSITION");
+  const std::size_t count = p.size() / 3;
+  const auto jts = prim.attributes.find("JOINTS_0");
+  const auto wts = prim.attributes.find("WEIGHTS_0");
+  const bool skinned = !skinning.empty() && jts != prim.attributes.end() && wts != prim.attributes.end();
+  std::vector<double> ji, w;
+  if (skinned) {
+    ji = r.read(jts->second, 4, "JOINTS_0");
+    w = r.read(wts->second, 4, "WEIGHTS_0");
+    if (ji.size() / 4 != count || w.size() / 4 != count) r.fail("JOINTS_0/WEIGHTS_0 and POSITION have different counts");
+  }
+  std::vector<Vec3> out;
+  out.reserve(count);
+  for (std::size_t v = 0; v < count; ++v) {
+    Eigen::Matrix4d m = nodeWorld;
+    if (skinned) {
+      Eigen::Matrix4d sum = Eigen::Matrix4d::Zero();
+      double total = 0.0;
+      for (std::size_t k = 0; k < 4; ++k) {
+        const double jk = ji[v * 4 + k], wk = w[v * 4 + k];
+        if (!(jk >= 0.0) || jk >= static_cast<double>(skinning.size())) r.fail(fmt::format("vertex {} names joint {}, but the skin has {}", v, jk, skinning.size()));
+        if (!(wk >= 0.0) || !std::isfinite(wk)) r.fail(fmt::format("vertex {} has a bad weight {}", v, wk));
+        sum += wk * skinning[static_cast<std::size_t>(jk)];
+        total += wk;
+      }
+      if (total > 1e-9) m = sum / total;
+    }
+    const Eigen::Vector4d h = m * Eigen::Vector4d(p[3 * v], p[3 * v + 1], p[3 * v + 2], 1.0);
+    if (!h.allFinite()) r.fail(fmt::format("vertex {} is not finite at rest", v));
+    out.emplace_back(h.x(), h.y(), h.z());
+  }
+  return out;
+}
+
+// Whether node `ni` is one of the parts asked for (every one when none are), marking which
+// names matched.
+bool wanted(const std::vector<std::string>& parts, std::vector<bool>& matched, const std::string& nodeName,
+            const std::string& meshName) {
+  if (parts.empty()) return true;
+  bool keep = false;
+  for (std::size_t k = 0; k < parts.size(); ++k)
+    if (parts[k] == nodeName || (!meshName.empty() && parts[k] == meshName)) keep = matched[k] = true;
+  return keep;
+}
+
+MeshParts extractMesh(const GModel& model, const std::string& name, const std::vector<std::string>& parts) {
+  const GltfReader r{model, name};
+  std::vector<int> nodeParent;
+  const std::vector<Eigen::Matrix4d> world = nodeWorlds(model, nodeParent, r);
+  MeshParts out;
+  out.mesh.name = name;
+  std::vector<bool> matched(parts.size(), false);
+  for (std::size_t ni = 0; ni < model.nodes.size(); ++ni) {
+    const GNode& node = model.nodes[ni];
+    if (node.mesh < 0) continue;
+    if (static_cast<std::size_t>(node.mesh) >= model.meshes.size()) r.fail(fmt::format("node {} names mesh {}, which does not exist", ni, node.mesh));
+    const std::string& meshName = model.meshNames[static_cast<std::size_t>(node.mesh)];
+    const std::string part = !node.name.empty() ? node.name : !meshName.empty() ? meshName : fmt::format("node {}", ni);
+    out.all.push_back(part);
+    if (!wanted(parts, matched, part, meshName)) continue;
+    const std::vector<Eigen::Matrix4d> skinning =
+        node.skin >= 0 ? skinMatrices(model, static_cast<std::size_t>(node.skin), world, r) : std::vector<Eigen::Matrix4d>{};
+    const std::size_t before = out.mesh.triangles.size();
+    for (const GPrimitive& prim : model.meshes[static_cast<std::size_t>(node.mesh)]) {
+      if (prim.mode != kModeTriangles && prim.mode != kModeTriangleStrip && prim.mode != kModeTriangleFan) continue;
+      if (prim.attributes.count("POSITION") == 0) continue;
+      const std::vector<Vec3> positions = restPositions(prim, world[ni], skinning, r);
+      if (out.mesh.positions.size() + positions.size() > kMaxElements) r.fail("too many vertices");
+      const auto base = static_cast<std::uint32_t>(out.mesh.positions.size());
+      out.mesh.positions.insert(out.mesh.positions.end(), positions.begin(), positions.end());
+      std::vector<double> idx;
+      if (prim.indices >= 0) {
+        idx = r.read(prim.indices, 1, "indices");
+      } else {
+        idx.resize(positions.size());
+        for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = static_cast<double>(i);
+      }
+      appendTriangles(idx, prim.mode, positions.size(), base, out.mesh.triangles, r);
+    }
+    if (out.mesh.triangles.size() > before) out.read.push_back(part);
+  }
+  for (std::size_t k = 0; k < parts.size(); ++k)
+    if (!matched[k])
+      r.fail(fmt::format("has no node or mesh named '{}' (its meshes: {})", parts[k],
+                         out.all.empty() ? std::string("none") : fmt::format("{}", fmt::join(out.all, ", "))));
+  if (out.mesh.triangles.empty()) r.fail(parts.empty() ? "has no triangle mesh" : "the parts asked for have no triangles");
   return out;
 }
 
@@ -815,6 +951,11 @@ GltfJointMotion readGltfJointMotion(const std::string& path, double rate, const 
   const std::string result = runIsolated(
       path, "glTF reader", [&] { return serialise(parseGltfJointMotion(bytes, path, baseDir, rate, animation)); }, limits);
   return deserialiseJointMotion(result, path);
+}
+
+MeshParts parseGltfMesh(std::string_view bytes, const std::string& name, const std::string& baseDir,
+                        const std::vector<std::string>& parts) {
+  return extractMesh(parseDocument(bytes, name, baseDir), name, parts);
 }
 
 SkinnedModel readGltfSkinnedModel(const std::string& path, const IsolationLimits& limits) {

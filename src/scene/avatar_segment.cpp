@@ -10,6 +10,7 @@
 
 #include "drape/core/error.hpp"
 #include "drape/mesh/edge_key.hpp"
+#include "drape/mesh/weld.hpp"
 
 namespace drape::scene {
 namespace {
@@ -45,29 +46,6 @@ std::vector<int> dominantJointPerTriangle(const SkinnedMesh& skin, std::size_t j
         if (skin.joints[v][k] < jointCount) sum[skin.joints[v][k]] = 0.0;
   }
   return label;
-}
-
-std::vector<std::uint32_t> weldByPosition(const mesh::TriMesh& mesh, double tolerance) {
-  const std::size_t n = mesh.positions.size();
-  std::vector<std::uint32_t> order(n);
-  std::iota(order.begin(), order.end(), 0u);
-  auto cell = [&](std::uint32_t v) {
-    const Vec3& p = mesh.positions[v];
-    return std::array<long long, 3>{std::llround(p.x() / tolerance), std::llround(p.y() / tolerance),
-                                    std::llround(p.z() / tolerance)};
-  };
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    const auto ca = cell(a), cb = cell(b);
-    return ca != cb ? ca < cb : a < b;
-  });
-  std::vector<std::uint32_t> map(n);
-  for (std::size_t i = 0; i < n;) {
-    std::size_t j = i;
-    const auto c = cell(order[i]);
-    while (j < n && cell(order[j]) == c) map[order[j++]] = order[i];
-    i = j;
-  }
-  return map;
 }
 
 std::size_t countBoundaryEdges(const mesh::TriMesh& mesh) {
@@ -172,7 +150,7 @@ std::vector<int> segmentSkinnedAvatar(Avatar& avatar, const std::vector<std::str
       if (cutTriangles != nullptr) ++*cutTriangles;
     }
   }
-  const std::vector<std::uint32_t> weld = weldByPosition(skin.mesh);
+  const std::vector<std::uint32_t> weld = mesh::weldByPosition(skin.mesh);
   segmentOfTriangle.assign(label.size(), -1);
   std::vector<std::uint32_t> local(skin.mesh.positions.size(), mesh::kNoVertex);
   for (std::size_t j = 0; j < avatar.joints.size(); ++j) {

@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -14,7 +16,9 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
+#include "drape/formats/obj.hpp"
 #include "drape/scene/scene.hpp"
+#include "drape/testing/assimp_export.hpp"
 #include "drape/testing/long_scenario.hpp"
 
 namespace drape {
@@ -216,6 +220,92 @@ TEST(MakeScene, AMakeHumanGarmentIsRefittedWithItsMask) {
                             "'makehuman_female_elegantsuit01_dress' face each other within 0.001 m"),
             std::string::npos)
       << narrow.err;
+}
+
+TEST(MakeScene, AGarmentExportedAsGltfOrColladaMakesTheSceneItsObjMakes) {
+  // The dress and its mask as Assimp's exporters write them (in metres, split at the dress's
+  // texture seams, the glTF not indexed at all) give the scene the dress's OBJ gives: the
+  // same vertices and triangles, the same mask, collidable parts and substeps.
+  ScratchDir dir("make-scene-exported");
+  const std::string mask = kSource + "/examples/hanging_dress/shoulders_mask.obj";
+  const std::string dressObj = std::string(DRAPE_DATA_DIR) + "/garments/makehuman_female_elegantsuit01_dress.obj";
+  (void)testing::exportThroughAssimp(dressObj, 0.1, "glb2", dir / "dress.glb");
+  (void)testing::exportThroughAssimp(dressObj, 0.1, "collada", dir / "dress.dae");
+  (void)testing::exportThroughAssimp(mask, 0.1, "glb2", dir / "mask.glb");
+  const std::string avatar = kSource + "/data/avatars/makehuman_rig_cmu_mb.mhskel";
+  auto make = [&](const std::string& garment, const std::string& options, const std::string& out) {
+    return runDrape("make-scene '" + avatar + "' --garment '" + garment + "' --name dress --offsets "
+                    "0.002,0.004,0.006,0.016 " + options + " --out '" + out + "'", dir);
+  };
+  const CliResult fromObj = make(dressObj, "--units dm --mask '" + mask + "'", dir / "obj");
+  ASSERT_EQ(fromObj.code, 0) << fromObj.err;
+  const scene::Scene reference = scene::loadScene(dir / "obj/scene.wrl");
+  const mesh::TriMesh maskObj = formats::readObj(mask);
+  std::vector<bool> used(maskObj.vertexCount(), false);
+  for (const mesh::Triangle& t : maskObj.triangles)
+    for (std::uint32_t v : t) used[v] = true;
+  const auto maskVerticesNoFaceUses = static_cast<std::size_t>(std::count(used.begin(), used.end(), false));
+  ASSERT_GT(maskVerticesNoFaceUses, 0u);
+  const mesh::TriMesh& want = reference.garments.at(0).mesh;
+  for (const std::string& options : {"--garment-parts defaultobject --units dm --mask '" + mask + "'",
+                                     "--mask '" + dir / "mask.glb" + "'"})
+    for (const char* file : {"dress.glb", "dress.dae"}) {
+      SCOPED_TRACE(std::string(file) + " " + options);
+      const std::string out = dir / (std::string(file) + std::to_string(options.size()));
+      const CliResult made = make(dir / file, options, out);
+      ASSERT_EQ(made.code, 0) << made.err;
+      EXPECT_NE(made.out.find(dir / file + ": mesh defaultobject (2205 vertices, 4192 triangles; "), std::string::npos)
+          << made.out;
+      EXPECT_NE(made.out.find("split vertices welded"), std::string::npos) << made.out;
+      const scene::Scene sc = scene::loadScene(out + "/scene.wrl");
+      const mesh::TriMesh& got = sc.garments.at(0).mesh;
+      ASSERT_EQ(got.vertexCount(), want.vertexCount());
+      ASSERT_EQ(got.triangleCount(), want.triangleCount());
+      std::vector<std::uint32_t> same(got.vertexCount());
+      for (std::size_t v = 0; v < got.vertexCount(); ++v) {
+        std::size_t best = 0;
+        for (std::size_t w = 1; w < want.vertexCount(); ++w)
+          if ((want.positions[w] - got.positions[v]).squaredNorm() < (want.positions[best] - got.positions[v]).squaredNorm())
+            best = w;
+        ASSERT_LT((want.positions[best] - got.positions[v]).norm(), 1e-6) << "vertex " << v;
+        same[v] = static_cast<std::uint32_t>(best);
+      }
+      std::set<std::array<std::uint32_t, 3>> wantTriangles;
+      auto rotated = [](std::array<std::uint32_t, 3> t) {
+        std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+        return t;
+      };
+      for (const mesh::Triangle& t : want.triangles) wantTriangles.insert(rotated(t));
+      std::size_t matched = 0;
+      for (const mesh::Triangle& t : got.triangles) matched += wantTriangles.count(rotated({same[t[0]], same[t[1]], same[t[2]]}));
+      EXPECT_EQ(matched, want.triangleCount());
+      std::vector<std::uint32_t> maskVertices;
+      for (std::uint32_t v : sc.garments[0].maskVertices) maskVertices.push_back(same[v]);
+      std::sort(maskVertices.begin(), maskVertices.end());
+      if (options.find("mask.glb") == std::string::npos) {
+        EXPECT_EQ(maskVertices, reference.garments[0].maskVertices);
+      } else {
+        // Assimp's OBJ importer leaves out the mask's vertices that no face uses: the
+        // exported mask lacks them, and binds all the others.
+        EXPECT_TRUE(std::includes(reference.garments[0].maskVertices.begin(), reference.garments[0].maskVertices.end(),
+                                  maskVertices.begin(), maskVertices.end()));
+        EXPECT_EQ(maskVertices.size() + maskVerticesNoFaceUses, reference.garments[0].maskVertices.size());
+      }
+      EXPECT_EQ(sc.garments[0].collidesWith, reference.garments[0].collidesWith);
+      EXPECT_EQ(sc.simulation.stepsPerFrame, reference.simulation.stepsPerFrame);
+    }
+  // A part the file does not have, and --units where no file is an OBJ, are refused.
+  const CliResult sleeve = make(dir / "dress.glb", "--garment-parts Sleeve --mask '" + dir / "mask.glb" + "'", dir / "sleeve");
+  EXPECT_EQ(sleeve.code, 2);
+  EXPECT_NE(sleeve.err.find(dir / "dress.glb" + ": has no node or mesh named 'Sleeve' (its meshes: defaultobject)"),
+            std::string::npos)
+      << sleeve.err;
+  const CliResult units = make(dir / "dress.glb", "--units dm --mask '" + dir / "mask.glb" + "'", dir / "units");
+  EXPECT_EQ(units.code, 2);
+  EXPECT_NE(units.err.find("--units dm: applies to OBJ files; " + dir / "dress.glb" + " and " + dir / "mask.glb" +
+                           " state their own unit"),
+            std::string::npos)
+      << units.err;
 }
 
 TEST(MakeScene, TooFewSubstepsForTheAddedMassIsAClearError) {

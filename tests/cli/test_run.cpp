@@ -2,6 +2,7 @@
 // unstable run.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -14,6 +15,7 @@
 #include "drape/formats/obj.hpp"
 #include "drape/formats/pc2.hpp"
 #include "drape/formats/run_manifest.hpp"
+#include "drape/testing/assimp_export.hpp"
 #include "drape/testing/long_scenario.hpp"
 
 namespace drape {
@@ -47,6 +49,37 @@ TEST(Run, AutoSubstepsTakeTheMassScalingAllowance) {
   EXPECT_LE(g["added_mass_kg"].get<double>(), 0.02 * (g["mass_kg"].get<double>() - g["added_mass_kg"].get<double>()));
   EXPECT_EQ(plain["garments"][0]["added_mass_kg"].get<double>(), 0.0);
   EXPECT_FALSE(scaled["unstable"].get<bool>());
+}
+
+TEST(Run, AGarmentFromAGlbHangsAsItsObjDoes) {
+  // The hanging dress as Assimp's glTF exporter writes it (in metres, not indexed: a vertex
+  // per triangle corner) is welded back into the dress, and hangs from the same pinned
+  // vertices to the same shape as its OBJ, vertex for vertex.
+  ScratchDir dir("run-glb");
+  (void)testing::exportThroughAssimp(kDress, 0.1, "glb2", dir / "dress.glb");
+  const std::string common = " --units dm --pin-mask '" + kMask + "' --substeps auto --frames 3";
+  const std::string fromObj = testing::runInto(dir, "obj", "--garment '" + kDress + "'" + common);
+  const CliResult r = runDrape("run --garment '" + dir / "dress.glb" + "'" + common + " --out '" + dir / "glb" + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("dress.glb: mesh defaultobject (2205 vertices, 4192 triangles; 10371 split vertices welded)"),
+            std::string::npos)
+      << r.err;
+  const mesh::TriMesh objRest = formats::readObj(fromObj + "/garment.obj"), glbRest = formats::readObj(dir / "glb/garment.obj");
+  const formats::Pc2Cache objCache = formats::readPc2(fromObj + "/garment.pc2"), glbCache = formats::readPc2(dir / "glb/garment.pc2");
+  ASSERT_EQ(glbCache.pointCount, objCache.pointCount);
+  ASSERT_EQ(glbCache.frames.size(), 4u);
+  double farthest = 0.0, fallen = 0.0;
+  for (std::size_t v = 0; v < glbRest.vertexCount(); ++v) {
+    std::size_t same = 0;
+    for (std::size_t w = 1; w < objRest.vertexCount(); ++w)
+      if ((objRest.positions[w] - glbRest.positions[v]).squaredNorm() < (objRest.positions[same] - glbRest.positions[v]).squaredNorm())
+        same = w;
+    ASSERT_LT((objRest.positions[same] - glbRest.positions[v]).norm(), 1e-6) << "vertex " << v;
+    farthest = std::max(farthest, (glbCache.frames.back()[v] - objCache.frames.back()[same]).norm());
+    fallen = std::max(fallen, objCache.frames.front()[same].y() - objCache.frames.back()[same].y());
+  }
+  EXPECT_GT(fallen, 0.01) << "the free hem falls";
+  EXPECT_LT(farthest, 1e-5) << "the same dress, summed in another vertex order";
 }
 
 TEST(Run, BundledExampleWritesEverything) {

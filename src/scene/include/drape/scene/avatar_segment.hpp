@@ -17,10 +17,6 @@ namespace drape::scene {
 /// (ties go to the lower joint index).
 [[nodiscard]] std::vector<int> dominantJointPerTriangle(const SkinnedMesh& skin, std::size_t jointCount);
 
-/// Vertex index map that merges vertices at the same position (within `tolerance` m):
-/// UV and normal seams split vertices that are one point of the surface.
-[[nodiscard]] std::vector<std::uint32_t> weldByPosition(const mesh::TriMesh& mesh, double tolerance = 1e-7);
-
 /// Closes every opening of `mesh`: each connected run of boundary edges gets a centre
 /// vertex (the mean of its vertices) and one triangle per boundary edge, wound against
 /// the edge's face. Returns the number of caps added.

@@ -1,0 +1,67 @@
+#pragma once
+// Static triangle meshes (a garment, its constraint mask) from the files modelling tools
+// export: Wavefront OBJ, glTF 2.0 (.gltf, .glb), Collada (.dae) and FBX (.fbx).
+//
+// glTF goes through drape's own glTF reader, Collada and FBX through Assimp, each in a
+// limited child process and under the safety rules of gltf_avatar.hpp and
+// assimp_avatar.hpp. Every triangle of every mesh the file's node tree places is read, at
+// the nodes' rest transforms (a skinned mesh skinned with its skeleton at rest), in metres
+// with y up (glTF is in metres; Collada's <unit> and <up_axis>, FBX's UnitScaleFactor and
+// axes are applied). Those files split a vertex wherever its texture coordinates or
+// normals change, and may hold a garment's pieces as separate meshes whose seams
+// coincide: the vertices are welded by position (mesh/weld.hpp) into the one surface the
+// cloth simulates. An OBJ is read as it is (its vertices are already shared).
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "drape/core/isolate.hpp"
+#include "drape/mesh/trimesh.hpp"
+
+namespace drape::formats {
+
+struct MeshFileOptions {
+  double metresPerUnit = 1.0;      ///< OBJ only: the other formats state their own unit
+  /// Keep only these parts (empty: all): OBJ g/o groups; glTF, Collada and FBX nodes or
+  /// meshes by name. A name that matches nothing is an error that lists the file's parts.
+  std::vector<std::string> parts;
+  double weldTolerance_m = 1e-6;   ///< positions this close are one vertex (not for OBJ)
+};
+
+struct MeshFile {
+  mesh::TriMesh mesh;                   ///< metres, y up; named after the file
+  std::vector<std::string> partsRead;   ///< the nodes whose meshes were read, in the file's order
+  std::size_t welded = 0;               ///< vertices merged into another at the same position
+  std::size_t droppedTriangles = 0;     ///< triangles welding collapsed or repeated (a two-sided copy)
+};
+
+/// What was read, for a log line after the file's name: "mesh Dress (2205 vertices, 4192
+/// triangles; 10371 split vertices welded)", or "" for a file of one part read as it is
+/// (an OBJ, nothing welded or dropped).
+[[nodiscard]] std::string describeRead(const MeshFile& file);
+
+/// True for the extensions readMeshFile takes (".obj", ".gltf", ".glb", ".dae", ".fbx"; any case).
+[[nodiscard]] bool isMeshFilePath(const std::string& path);
+
+/// Reads a mesh file of any of those formats. Throws drape::Error naming the file: an
+/// unknown extension, a file without triangles, parts that match nothing.
+[[nodiscard]] MeshFile readMeshFile(const std::string& path, const MeshFileOptions& options = {},
+                                    const IsolationLimits& limits = {});
+
+/// What a reader hands back before welding: every triangle of the parts asked for, and the
+/// names of every part the file has (for messages).
+struct MeshParts {
+  mesh::TriMesh mesh;
+  std::vector<std::string> read, all;
+};
+
+/// glTF/GLB bytes in this process (for the fuzz target and the child); `baseDir` as in
+/// parseGltfSkinnedModel.
+[[nodiscard]] MeshParts parseGltfMesh(std::string_view bytes, const std::string& name, const std::string& baseDir,
+                                      const std::vector<std::string>& parts = {});
+/// Collada or FBX bytes in this process (the extension of `name` picks the format).
+[[nodiscard]] MeshParts parseAssimpMesh(std::string_view bytes, const std::string& name,
+                                        const std::vector<std::string>& parts = {});
+
+}  // namespace drape::formats

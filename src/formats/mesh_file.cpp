@@ -1,0 +1,119 @@
+#include "drape/formats/mesh_file.hpp"
+
+#include <cmath>
+#include <filesystem>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
+#include "drape/formats/obj.hpp"
+#include "drape/mesh/weld.hpp"
+#include "plain_data.hpp"
+#include "text_scan.hpp"
+
+namespace drape::formats {
+namespace {
+
+using detail::Cursor;
+using detail::put;
+using detail::putVector;
+
+std::string serialise(const MeshParts& parts) {
+  std::string s;
+  std::vector<double> xyz;
+  xyz.reserve(3 * parts.mesh.positions.size());
+  for (const Vec3& p : parts.mesh.positions) xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
+  putVector(s, xyz);
+  putVector(s, parts.mesh.triangles);
+  for (const std::vector<std::string>* names : {&parts.read, &parts.all}) {
+    put<std::uint64_t>(s, names->size());
+    for (const std::string& n : *names) putVector(s, std::vector<char>(n.begin(), n.end()));
+  }
+  return s;
+}
+
+MeshParts deserialiseMeshParts(std::string_view bytes, const std::string& name) {
+  Cursor c{bytes, 0, name};
+  MeshParts parts;
+  parts.mesh.name = name;
+  const std::vector<double> xyz = c.getVector<double>();
+  if (xyz.size() % 3 != 0) throw Error(fmt::format("{}: the reader returned bad data", name));
+  for (std::size_t i = 0; i < xyz.size(); i += 3) parts.mesh.positions.emplace_back(xyz[i], xyz[i + 1], xyz[i + 2]);
+  parts.mesh.triangles = c.getVector<mesh::Triangle>();
+  for (const mesh::Triangle& t : parts.mesh.triangles)
+    for (std::uint32_t v : t)
+      if (v >= parts.mesh.positions.size()) throw Error(fmt::format("{}: the reader returned bad data", name));
+  for (std::vector<std::string>* names : {&parts.read, &parts.all}) {
+    const auto n = c.get<std::uint64_t>();
+    if (n > bytes.size()) throw Error(fmt::format("{}: the reader returned bad data", name));
+    for (std::uint64_t k = 0; k < n; ++k) {
+      const std::vector<char> chars = c.getVector<char>();
+      names->emplace_back(chars.begin(), chars.end());
+    }
+  }
+  if (c.at != bytes.size()) throw Error(fmt::format("{}: the reader returned bad data", name));
+  return parts;
+}
+
+constexpr std::size_t kMaxMeshFileBytes = std::size_t{1} << 30;
+
+MeshParts readIsolated(const std::string& path, const std::string& ext, const std::vector<std::string>& parts,
+                       const IsolationLimits& limits) {
+  const std::string bytes = detail::readWholeFile(path, kMaxMeshFileBytes);
+  if (ext == ".gltf" || ext == ".glb") {
+    const std::string baseDir = std::filesystem::absolute(path).parent_path().string();
+    return deserialiseMeshParts(
+        runIsolated(path, "glTF reader", [&] { return serialise(parseGltfMesh(bytes, path, baseDir, parts)); }, limits), path);
+  }
+  const std::string reader = fmt::format("{} reader (Assimp)", ext == ".dae" ? "Collada" : "FBX");
+  return deserialiseMeshParts(runIsolated(path, reader, [&] { return serialise(parseAssimpMesh(bytes, path, parts)); }, limits),
+                              path);
+}
+
+}  // namespace
+
+std::string describeRead(const MeshFile& file) {
+  if (file.partsRead.size() <= 1 && file.welded == 0 && file.droppedTriangles == 0) return "";
+  return fmt::format("{} ({} vertices, {} triangles{}{})",
+                     file.partsRead.size() == 1 ? fmt::format("mesh {}", file.partsRead.front())
+                                                : fmt::format("{} meshes: {}", file.partsRead.size(), fmt::join(file.partsRead, ", ")),
+                     file.mesh.vertexCount(), file.mesh.triangleCount(),
+                     file.welded > 0 ? fmt::format("; {} split vertices welded", file.welded) : "",
+                     file.droppedTriangles > 0 ? fmt::format("; {} repeated or collapsed triangles dropped", file.droppedTriangles)
+                                               : "");
+}
+
+bool isMeshFilePath(const std::string& path) {
+  const std::string ext = lowerExtension(path);
+  return ext == ".obj" || ext == ".gltf" || ext == ".glb" || ext == ".dae" || ext == ".fbx";
+}
+
+MeshFile readMeshFile(const std::string& path, const MeshFileOptions& options, const IsolationLimits& limits) {
+  const std::string ext = lowerExtension(path);
+  MeshFile out;
+  if (ext == ".obj") {
+    ObjReadOptions read;
+    read.metresPerUnit = options.metresPerUnit;
+    read.groups = options.parts;
+    out.mesh = readObj(path, read);
+    out.partsRead = options.parts;
+    return out;
+  }
+  if (!isMeshFilePath(path))
+    throw Error(fmt::format("{}: drape reads meshes from OBJ, glTF (.gltf, .glb), Collada (.dae) and FBX (.fbx), not '{}'",
+                            path, ext));
+  if (!(options.weldTolerance_m > 0.0) || !std::isfinite(options.weldTolerance_m))
+    throw Error(fmt::format("{}: the weld tolerance must be > 0 m, got {}", path, options.weldTolerance_m));
+  const MeshParts parts = readIsolated(path, ext, options.parts, limits);
+  mesh::Welded welded = mesh::weld(parts.mesh, options.weldTolerance_m);
+  out.mesh = std::move(welded.mesh);
+  out.mesh.name = path;
+  out.partsRead = parts.read;
+  out.welded = welded.merged;
+  out.droppedTriangles = welded.collapsed + welded.duplicates;
+  return out;
+}
+
+}  // namespace drape::formats

@@ -10,12 +10,19 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <set>
 
+#include <nlohmann/json.hpp>
+
+#include "drape/core/files.hpp"
+#include "drape/formats/assimp_avatar.hpp"
+#include "drape/formats/gltf_avatar.hpp"
 #include "drape/formats/mesh_file.hpp"
 #include "drape/formats/obj.hpp"
 #include "drape/formats/units.hpp"
+#include "drape/mesh/weld.hpp"
 #include "drape/testing/assimp_export.hpp"
 #include "drape/testing/errors.hpp"
 #include "drape/testing/temp_dir.hpp"
@@ -83,6 +90,69 @@ INSTANTIATE_TEST_SUITE_P(Formats, MeshFileExported,
                          ::testing::Values(Exporter{".glb", "glb2", 1.0}, Exporter{".gltf", "gltf2", 1.0},
                                            Exporter{".dae", "collada", 1.0}, Exporter{".fbx", "fbxa", 0.01}),
                          [](const auto& info) { return std::string(info.param.extension + 1); });
+
+// A skinned mesh is read where its skeleton at rest puts it, as the avatar readers skin it
+// (CesiumMan's skin turns his Z-up mesh upright; the robot arm and the tube bend at rest).
+TEST(MeshFile, ASkinnedMeshIsReadWhereTheAvatarReadersSkinItAtRest) {
+  for (const std::string& path : {std::string(DRAPE_DATA_DIR) + "/avatars/CesiumMan.glb",
+                                 std::string(DRAPE_DATA_DIR) + "/avatars/RiggedSimple.glb",
+                                 std::string(DRAPE_TEST_DATA_DIR) + "/avatars/rigged_simple_animated.dae",
+                                 std::string(DRAPE_TEST_DATA_DIR) + "/avatars/rigged_simple_animated.fbx",
+                                 std::string(DRAPE_TEST_DATA_DIR) + "/avatars/tube_two_joints.fbx"}) {
+    SCOPED_TRACE(path);
+    const SkinnedModel avatar = lowerExtension(path) == ".glb" ? readGltfSkinnedModel(path) : readAssimpSkinnedModel(path);
+    mesh::TriMesh skin;
+    skin.positions = avatar.positions;
+    skin.triangles = avatar.triangles;
+    const mesh::TriMesh want = mesh::weld(skin, 1e-6).mesh;
+    const MeshFile got = readMeshFile(path);
+    ASSERT_EQ(got.mesh.vertexCount(), want.vertexCount());
+    ASSERT_EQ(got.mesh.triangleCount(), want.triangleCount());
+    for (std::size_t v = 0; v < want.vertexCount(); ++v) {
+      double best = std::numeric_limits<double>::infinity();
+      for (const Vec3& p : got.mesh.positions) best = std::min(best, (p - want.positions[v]).norm());
+      ASSERT_LT(best, 1e-9) << "vertex " << v;
+    }
+  }
+}
+
+/// RiggedSimple (a tube of two bones) as a .gltf whose second joint is turned 90 degrees
+/// about x at rest: its skin is bound straight, so at rest it bends.
+std::string bentRiggedSimple() {
+  std::ifstream in(std::string(DRAPE_DATA_DIR) + "/avatars/RiggedSimple.glb", std::ios::binary);
+  const std::string glb((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::uint32_t jsonLength = 0, binLength = 0;
+  std::memcpy(&jsonLength, glb.data() + 12, 4);
+  std::memcpy(&binLength, glb.data() + 20 + jsonLength, 4);
+  nlohmann::json doc = nlohmann::json::parse(glb.substr(20, jsonLength));
+  doc["nodes"][3]["rotation"] = {0.70710678, 0.0, 0.0, 0.70710678};
+  doc["buffers"][0]["uri"] = "bent.bin";
+  const std::filesystem::path dir = drape::testing::processTempDir("mesh-file-bent");
+  std::ofstream(dir / "bent.bin", std::ios::binary) << glb.substr(28 + jsonLength, binLength);
+  std::ofstream(dir / "bent.gltf") << doc.dump();
+  return (dir / "bent.gltf").string();
+}
+
+TEST(MeshFile, ASkinnedMeshBentAtRestIsReadBentAsTheAvatarReaderSkinsIt) {
+  const std::string path = bentRiggedSimple();
+  const SkinnedModel avatar = readGltfSkinnedModel(path);
+  const MeshFile got = readMeshFile(path);
+  const MeshFile straight = readMeshFile(std::string(DRAPE_DATA_DIR) + "/avatars/RiggedSimple.glb");
+  mesh::TriMesh skin;
+  skin.positions = avatar.positions;
+  skin.triangles = avatar.triangles;
+  const mesh::TriMesh want = mesh::weld(skin, 1e-6).mesh;
+  ASSERT_EQ(got.mesh.vertexCount(), want.vertexCount());
+  ASSERT_EQ(got.mesh.triangleCount(), want.triangleCount());
+  double moved = 0.0;
+  for (std::size_t v = 0; v < want.vertexCount(); ++v) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const Vec3& p : got.mesh.positions) best = std::min(best, (p - want.positions[v]).norm());
+    ASSERT_LT(best, 1e-9) << "vertex " << v;
+    moved = std::max(moved, (got.mesh.positions[v] - straight.mesh.positions[v]).norm());
+  }
+  EXPECT_GT(moved, 1.0) << "the bent tube's end is metres from the straight one's";
+}
 
 // ---- a glTF written by hand ---------------------------------------------------------------
 

@@ -176,10 +176,13 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
   if (!os) throw Error(fmt::format("{}: cannot be written", path));
 }
 
-/// A garment or mask file in metres: an OBJ in --units, the other formats in their own.
+/// A garment or mask file in metres: an OBJ in --units, the other formats in their own (a
+/// mask with its loose points).
 /// Says what was read from a file that holds several meshes or was welded.
-mesh::TriMesh readMeshOf(const MakeSceneOptions& o, const std::string& path, const std::vector<std::string>& parts) {
+mesh::TriMesh readMeshOf(const MakeSceneOptions& o, const std::string& path, const std::vector<std::string>& parts,
+                         bool isMask) {
   formats::MeshFileOptions read;
+  read.looseVertices = isMask;
   read.metresPerUnit = formats::metresPerUnit(o.units, "--units");
   read.parts = parts;
   formats::MeshFile file = formats::readMeshFile(path, read);
@@ -190,8 +193,8 @@ mesh::TriMesh readMeshOf(const MakeSceneOptions& o, const std::string& path, con
 /// The garment and its mask as modelled on the avatar file `avatarFile` at rest, in metres:
 /// a MakeHuman .mhclo refitted to the MakeHuman body that file builds.
 std::pair<mesh::TriMesh, mesh::TriMesh> readGarment(const MakeSceneOptions& o, const std::string& avatarFile) {
-  mesh::TriMesh mask = readMeshOf(o, o.mask, {});
-  if (std::filesystem::path(o.garment).extension() != ".mhclo") return {readMeshOf(o, o.garment, o.garmentParts), mask};
+  mesh::TriMesh mask = readMeshOf(o, o.mask, {}, true);
+  if (std::filesystem::path(o.garment).extension() != ".mhclo") return {readMeshOf(o, o.garment, o.garmentParts, false), mask};
   // A MakeHuman garment: refitted to the body this avatar is built from.
   if (!o.garmentParts.empty()) throw Error(fmt::format("--garment-parts: {} is one mesh, not a file of parts", o.garment));
   if (std::filesystem::path(avatarFile).extension() != ".mhskel")

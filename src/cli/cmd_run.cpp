@@ -224,6 +224,7 @@ void setupFromGarment(const RunOptions& o, RunSetup& setup, bool onAvatar) {
   if (!o.pinVertices.empty()) garment.pinned = parseIndexList(o.pinVertices);
   if (!o.pinMask.empty()) {
     if (!(o.pinTolerance_m > 0.0)) throw Error(fmt::format("--pin-tolerance must be > 0 m, got {}", o.pinTolerance_m));
+    read.looseVertices = true;  // a mask's points count, whatever uses them
     garment.pinned = matchMask(garment.mesh, formats::readMeshFile(o.pinMask, read).mesh, o.pinTolerance_m);
   }
   if (onAvatar) std::swap(garment.bound, garment.pinned);  // a mask on a body binds to it

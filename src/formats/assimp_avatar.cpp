@@ -949,7 +949,8 @@ std::vector<Vec3> restPositions(const SceneReader& r, const aiMesh& mesh, const 
   return out;
 }
 
-MeshParts extractMesh(const aiScene& scene, Format format, const std::string& name, const std::vector<std::string>& parts) {
+MeshParts extractMesh(const aiScene& scene, Format format, const std::string& name, const std::vector<std::string>& parts,
+                      bool loose) {
   const SceneReader r = readerFor(scene, format, name);
   MeshParts out;
   out.mesh.name = name;
@@ -968,7 +969,8 @@ MeshParts extractMesh(const aiScene& scene, Format format, const std::string& na
       bool keep = parts.empty();
       for (std::size_t k = 0; k < parts.size(); ++k)
         if (parts[k] == part || (!meshName.empty() && parts[k] == meshName)) keep = matched[k] = true;
-      if (!keep || (mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) continue;
+      // A mesh of points or lines only: loose vertices, which only a mask keeps.
+      if (!keep || ((mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0 && !loose)) continue;
       const std::vector<Vec3> positions = restPositions(r, mesh, *node);
       if (out.mesh.positions.size() + positions.size() > kMaxVertices) r.fail(fmt::format("it has more than {} vertices", kMaxVertices));
       const auto base = static_cast<std::uint32_t>(out.mesh.positions.size());
@@ -984,7 +986,8 @@ MeshParts extractMesh(const aiScene& scene, Format format, const std::string& na
         }
         if (tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2]) out.mesh.triangles.push_back(tri);
       }
-      if (out.mesh.triangles.size() > before && std::find(out.read.begin(), out.read.end(), part) == out.read.end())
+      if ((out.mesh.triangles.size() > before || (loose && !positions.empty())) &&
+          std::find(out.read.begin(), out.read.end(), part) == out.read.end())
         out.read.push_back(part);
     }
     for (unsigned i = node->mNumChildren; i-- > 0;) stack.push_back(node->mChildren[i]);
@@ -993,7 +996,9 @@ MeshParts extractMesh(const aiScene& scene, Format format, const std::string& na
     if (!matched[k])
       r.fail(fmt::format("has no node or mesh named '{}' (its meshes: {})", parts[k],
                          out.all.empty() ? std::string("none") : fmt::format("{}", fmt::join(out.all, ", "))));
-  if (out.mesh.triangles.empty()) r.fail(parts.empty() ? "has no triangle mesh" : "the parts asked for have no triangles");
+  if (out.mesh.triangles.empty() && (!loose || out.mesh.positions.empty()))
+    r.fail(loose ? (parts.empty() ? "has no mesh" : "the parts asked for have no vertices")
+                 : (parts.empty() ? "has no triangle mesh" : "the parts asked for have no triangles"));
   return out;
 }
 
@@ -1039,9 +1044,10 @@ std::vector<SkinnedJointMotion> readAssimpJointMotions(const std::string& path, 
   return deserialiseJointMotions(result, path);
 }
 
-MeshParts parseAssimpMesh(std::string_view bytes, const std::string& name, const std::vector<std::string>& parts) {
+MeshParts parseAssimpMesh(std::string_view bytes, const std::string& name, const std::vector<std::string>& parts,
+                          bool loose) {
   Assimp::Importer importer;
-  return extractMesh(importScene(importer, bytes, name, false), formatOf(name), name, parts);
+  return extractMesh(importScene(importer, bytes, name, false), formatOf(name), name, parts, loose);
 }
 
 SkinnedModel readAssimpSkinnedModel(const std::string& path, const IsolationLimits& limits) {

@@ -697,7 +697,7 @@ bool wanted(const std::vector<std::string>& parts, std::vector<bool>& matched, c
   return keep;
 }
 
-MeshParts extractMesh(const GModel& model, const std::string& name, const std::vector<std::string>& parts) {
+MeshParts extractMesh(const GModel& model, const std::string& name, const std::vector<std::string>& parts, bool loose) {
   const GltfReader r{model, name};
   std::vector<int> nodeParent;
   const std::vector<Eigen::Matrix4d> world = nodeWorlds(model, nodeParent, r);
@@ -714,9 +714,11 @@ MeshParts extractMesh(const GModel& model, const std::string& name, const std::v
     if (!wanted(parts, matched, part, meshName)) continue;
     const std::vector<Eigen::Matrix4d> skinning =
         node.skin >= 0 ? skinMatrices(model, static_cast<std::size_t>(node.skin), world, r) : std::vector<Eigen::Matrix4d>{};
-    const std::size_t before = out.mesh.triangles.size();
+    const std::size_t before = out.mesh.triangles.size(), beforeVertices = out.mesh.positions.size();
     for (const GPrimitive& prim : model.meshes[static_cast<std::size_t>(node.mesh)]) {
-      if (prim.mode != kModeTriangles && prim.mode != kModeTriangleStrip && prim.mode != kModeTriangleFan) continue;
+      const bool triangles = prim.mode == kModeTriangles || prim.mode == kModeTriangleStrip || prim.mode == kModeTriangleFan;
+      // Points and lines (modes 0 to 3): loose vertices, which only a mask keeps.
+      if (!(triangles || (loose && prim.mode >= 0 && prim.mode < kModeTriangles))) continue;
       if (prim.attributes.count("POSITION") == 0) continue;
       const std::vector<Vec3> positions = restPositions(prim, world[ni], skinning, r);
       if (out.mesh.positions.size() + positions.size() > kMaxElements) r.fail("too many vertices");
@@ -729,15 +731,17 @@ MeshParts extractMesh(const GModel& model, const std::string& name, const std::v
         idx.resize(positions.size());
         for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = static_cast<double>(i);
       }
-      appendTriangles(idx, prim.mode, positions.size(), base, out.mesh.triangles, r);
+      if (triangles) appendTriangles(idx, prim.mode, positions.size(), base, out.mesh.triangles, r);
     }
-    if (out.mesh.triangles.size() > before) out.read.push_back(part);
+    if (out.mesh.triangles.size() > before || (loose && out.mesh.positions.size() > beforeVertices)) out.read.push_back(part);
   }
   for (std::size_t k = 0; k < parts.size(); ++k)
     if (!matched[k])
       r.fail(fmt::format("has no node or mesh named '{}' (its meshes: {})", parts[k],
                          out.all.empty() ? std::string("none") : fmt::format("{}", fmt::join(out.all, ", "))));
-  if (out.mesh.triangles.empty()) r.fail(parts.empty() ? "has no triangle mesh" : "the parts asked for have no triangles");
+  if (out.mesh.triangles.empty() && (!loose || out.mesh.positions.empty()))
+    r.fail(loose ? (parts.empty() ? "has no mesh" : "the parts asked for have no vertices")
+                 : (parts.empty() ? "has no triangle mesh" : "the parts asked for have no triangles"));
   return out;
 }
 
@@ -954,8 +958,8 @@ GltfJointMotion readGltfJointMotion(const std::string& path, double rate, const 
 }
 
 MeshParts parseGltfMesh(std::string_view bytes, const std::string& name, const std::string& baseDir,
-                        const std::vector<std::string>& parts) {
-  return extractMesh(parseDocument(bytes, name, baseDir), name, parts);
+                        const std::vector<std::string>& parts, bool loose) {
+  return extractMesh(parseDocument(bytes, name, baseDir), name, parts, loose);
 }
 
 SkinnedModel readGltfSkinnedModel(const std::string& path, const IsolationLimits& limits) {

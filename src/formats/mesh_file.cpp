@@ -59,16 +59,16 @@ MeshParts deserialiseMeshParts(std::string_view bytes, const std::string& name) 
 
 constexpr std::size_t kMaxMeshFileBytes = std::size_t{1} << 30;
 
-MeshParts readIsolated(const std::string& path, const std::string& ext, const std::vector<std::string>& parts,
+MeshParts readIsolated(const std::string& path, const std::string& ext, const std::vector<std::string>& parts, bool loose,
                        const IsolationLimits& limits) {
   const std::string bytes = detail::readWholeFile(path, kMaxMeshFileBytes);
   if (ext == ".gltf" || ext == ".glb") {
     const std::string baseDir = std::filesystem::absolute(path).parent_path().string();
     return deserialiseMeshParts(
-        runIsolated(path, "glTF reader", [&] { return serialise(parseGltfMesh(bytes, path, baseDir, parts)); }, limits), path);
+        runIsolated(path, "glTF reader", [&] { return serialise(parseGltfMesh(bytes, path, baseDir, parts, loose)); }, limits), path);
   }
   const std::string reader = fmt::format("{} reader (Assimp)", ext == ".dae" ? "Collada" : "FBX");
-  return deserialiseMeshParts(runIsolated(path, reader, [&] { return serialise(parseAssimpMesh(bytes, path, parts)); }, limits),
+  return deserialiseMeshParts(runIsolated(path, reader, [&] { return serialise(parseAssimpMesh(bytes, path, parts, loose)); }, limits),
                               path);
 }
 
@@ -106,8 +106,8 @@ MeshFile readMeshFile(const std::string& path, const MeshFileOptions& options, c
                             path, ext));
   if (!(options.weldTolerance_m > 0.0) || !std::isfinite(options.weldTolerance_m))
     throw Error(fmt::format("{}: the weld tolerance must be > 0 m, got {}", path, options.weldTolerance_m));
-  const MeshParts parts = readIsolated(path, ext, options.parts, limits);
-  mesh::Welded welded = mesh::weld(parts.mesh, options.weldTolerance_m);
+  const MeshParts parts = readIsolated(path, ext, options.parts, options.looseVertices, limits);
+  mesh::Welded welded = mesh::weld(parts.mesh, options.weldTolerance_m, options.looseVertices);
   out.mesh = std::move(welded.mesh);
   out.mesh.name = path;
   out.partsRead = parts.read;

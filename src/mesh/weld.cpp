@@ -49,7 +49,7 @@ struct TriangleHash {
 
 }  // namespace
 
-Welded weld(const TriMesh& mesh, double tolerance) {
+Welded weld(const TriMesh& mesh, double tolerance, bool keepLoose) {
   const std::vector<std::uint32_t> map = weldByPosition(mesh, tolerance);
   Welded out;
   out.mesh.name = mesh.name;
@@ -83,8 +83,14 @@ Welded weld(const TriMesh& mesh, double tolerance) {
     out.mesh.triangles.push_back(tri);
   }
   std::size_t used = 0;
-  for (std::size_t v = 0; v < map.size(); ++v)
-    if (map[v] == v) ++used;
+  for (std::size_t v = 0; v < map.size(); ++v) {
+    if (map[v] != v) continue;
+    ++used;
+    if (keepLoose && renumbered[v] == kNoVertex) {
+      renumbered[v] = static_cast<std::uint32_t>(out.mesh.positions.size());
+      out.mesh.positions.push_back(mesh.positions[v]);
+    }
+  }
   out.unused = used - out.mesh.positions.size();
   return out;
 }

@@ -163,7 +163,8 @@ void append(std::string& bin, std::initializer_list<T> values) {
 
 /// Three nodes: "Front", a quad as two unindexed triangles plus a copy of the first wound the
 /// other way (a two-sided face); "Back", a strip of two triangles, moved to z = -1 and scaled
-/// by 2; "Fan" (mesh "FanMesh"), a fan of two triangles moved to x = 5.
+/// by 2; "Fan" (mesh "FanMesh"), a fan of two triangles moved to x = 5; "Pins", the fan's
+/// four vertices as points, moved to y = 10.
 std::string handWrittenGltf() {
   const std::filesystem::path dir = drape::testing::processTempDir("mesh-file-hand");
   std::string bin;
@@ -174,16 +175,18 @@ std::string handWrittenGltf() {
   std::ofstream(dir / "hand.bin", std::ios::binary) << bin;
   const std::string json = R"({
   "asset": {"version": "2.0"},
-  "scene": 0, "scenes": [{"nodes": [0, 1, 2]}],
+  "scene": 0, "scenes": [{"nodes": [0, 1, 2, 3]}],
   "nodes": [
     {"name": "Front", "mesh": 0},
     {"name": "Back", "mesh": 1, "translation": [0, 0, -1], "scale": [2, 2, 2]},
-    {"name": "Fan", "mesh": 2, "translation": [5, 0, 0]}
+    {"name": "Fan", "mesh": 2, "translation": [5, 0, 0]},
+    {"name": "Pins", "mesh": 3, "translation": [0, 10, 0]}
   ],
   "meshes": [
     {"name": "FrontMesh", "primitives": [{"attributes": {"POSITION": 0}}]},
     {"name": "BackMesh", "primitives": [{"attributes": {"POSITION": 1}, "indices": 3, "mode": 5}]},
-    {"name": "FanMesh", "primitives": [{"attributes": {"POSITION": 2}, "mode": 6}]}
+    {"name": "FanMesh", "primitives": [{"attributes": {"POSITION": 2}, "mode": 6}]},
+    {"name": "PinsMesh", "primitives": [{"attributes": {"POSITION": 2}, "mode": 0}]}
   ],
   "buffers": [{"uri": "hand.bin", "byteLength": 212}],
   "bufferViews": [
@@ -225,6 +228,25 @@ TEST(MeshFile, AHandWrittenGltfIsReadNodeByNode) {
   EXPECT_DOUBLE_EQ(fanArea, 1.0);
 }
 
+TEST(MeshFile, AMaskKeepsItsLoosePoints) {
+  // A garment leaves the points out; a mask keeps them, after the triangles' vertices.
+  MeshFileOptions mask;
+  mask.looseVertices = true;
+  const MeshFile m = readMeshFile(handWrittenGltf(), mask);
+  EXPECT_EQ(m.partsRead, (std::vector<std::string>{"Front", "Back", "Fan", "Pins"}));
+  ASSERT_EQ(m.mesh.vertexCount(), 16u);
+  EXPECT_EQ(m.mesh.triangleCount(), 6u);
+  for (std::size_t v = 12; v < 16; ++v) EXPECT_EQ(m.mesh.positions[v].y(), v == 14 ? 11.0 : 10.0) << v;
+  mask.parts = {"PinsMesh"};
+  const MeshFile pins = readMeshFile(handWrittenGltf(), mask);
+  EXPECT_EQ(pins.mesh.vertexCount(), 4u);
+  EXPECT_EQ(pins.mesh.triangleCount(), 0u);
+  MeshFileOptions garment;
+  garment.parts = {"Pins"};
+  EXPECT_EQ(drape::testing::errorOf([&] { (void)readMeshFile(handWrittenGltf(), garment); }),
+            handWrittenGltf() + ": the parts asked for have no triangles");
+}
+
 TEST(MeshFile, PartsAreChosenByNodeOrMeshName) {
   const std::string path = handWrittenGltf();
   MeshFileOptions back;
@@ -241,7 +263,7 @@ TEST(MeshFile, PartsAreChosenByNodeOrMeshName) {
   MeshFileOptions none;
   none.parts = {"Sleeve"};
   EXPECT_EQ(drape::testing::errorOf([&] { (void)readMeshFile(path, none); }),
-            path + ": has no node or mesh named 'Sleeve' (its meshes: Front, Back, Fan)");
+            path + ": has no node or mesh named 'Sleeve' (its meshes: Front, Back, Fan, Pins)");
 }
 
 TEST(MeshFile, ErrorsNameTheFile) {

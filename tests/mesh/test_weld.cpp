@@ -79,6 +79,13 @@ TEST(Weld, MergesExactlyTheVerticesAtOnePositionOnRandomMeshes) {
       for (std::uint32_t v : t) used[v] = true;
     EXPECT_TRUE(std::all_of(used.begin(), used.end(), [](bool u) { return u; }));
     EXPECT_EQ(w.unused, distinct.size() - w.mesh.positions.size());
+    // Keeping the loose vertices: the same triangles, then every other position once.
+    const Welded all = weld(in, 1e-7, true);
+    EXPECT_EQ(all.mesh.triangles, w.mesh.triangles);
+    ASSERT_EQ(all.mesh.positions.size(), distinct.size());
+    EXPECT_TRUE(std::equal(w.mesh.positions.begin(), w.mesh.positions.end(), all.mesh.positions.begin()));
+    for (const Vec3& p : distinct) EXPECT_NE(std::find(all.mesh.positions.begin(), all.mesh.positions.end(), p), all.mesh.positions.end());
+    EXPECT_EQ(all.unused, 0u);
   }
 }
 

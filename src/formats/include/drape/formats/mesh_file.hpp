@@ -27,6 +27,9 @@ struct MeshFileOptions {
   /// meshes by name. A name that matches nothing is an error that lists the file's parts.
   std::vector<std::string> parts;
   double weldTolerance_m = 1e-6;   ///< positions this close are one vertex (not for OBJ)
+  /// Keep the vertices no triangle uses (a mask: a vertex selection may be loose points, or
+  /// lines); a garment leaves them out. An OBJ keeps every vertex it lists either way.
+  bool looseVertices = false;
 };
 
 struct MeshFile {
@@ -49,8 +52,9 @@ struct MeshFile {
 [[nodiscard]] MeshFile readMeshFile(const std::string& path, const MeshFileOptions& options = {},
                                     const IsolationLimits& limits = {});
 
-/// What a reader hands back before welding: every triangle of the parts asked for, and the
-/// names of every part the file has (for messages).
+/// What a reader hands back before welding: every triangle of the parts asked for (with
+/// `loose`, the vertices of their points and lines too), and the names of every part the
+/// file has (for messages).
 struct MeshParts {
   mesh::TriMesh mesh;
   std::vector<std::string> read, all;
@@ -59,9 +63,9 @@ struct MeshParts {
 /// glTF/GLB bytes in this process (for the fuzz target and the child); `baseDir` as in
 /// parseGltfSkinnedModel.
 [[nodiscard]] MeshParts parseGltfMesh(std::string_view bytes, const std::string& name, const std::string& baseDir,
-                                      const std::vector<std::string>& parts = {});
+                                      const std::vector<std::string>& parts = {}, bool loose = false);
 /// Collada or FBX bytes in this process (the extension of `name` picks the format).
 [[nodiscard]] MeshParts parseAssimpMesh(std::string_view bytes, const std::string& name,
-                                        const std::vector<std::string>& parts = {});
+                                        const std::vector<std::string>& parts = {}, bool loose = false);
 
 }  // namespace drape::formats

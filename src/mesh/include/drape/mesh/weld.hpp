@@ -21,12 +21,13 @@ struct Welded {
   std::size_t merged = 0;        ///< vertices that became another vertex
   std::size_t collapsed = 0;     ///< triangles dropped: two corners became one vertex
   std::size_t duplicates = 0;    ///< triangles dropped: the same three vertices as an earlier one
-  std::size_t unused = 0;        ///< vertices no triangle uses, dropped
+  std::size_t unused = 0;        ///< vertices no triangle uses, dropped (0 with keepLoose)
 };
 
 /// `mesh` with its vertices welded by position (weldByPosition), the triangles that welding
 /// collapses or repeats (a two-sided copy, a piece modelled twice) dropped, and only the
-/// vertices the triangles use kept.
-[[nodiscard]] Welded weld(const TriMesh& mesh, double tolerance = 1e-7);
+/// vertices the triangles use kept; with `keepLoose`, the others too (after them, in the
+/// order of the mesh's vertices: a mask's loose points).
+[[nodiscard]] Welded weld(const TriMesh& mesh, double tolerance = 1e-7, bool keepLoose = false);
 
 }  // namespace drape::mesh

@@ -11,6 +11,7 @@
 
 #include "command.hpp"
 #include "inspect_humanoid.hpp"
+#include "inspect_mesh.hpp"
 #include "drape/core/error.hpp"
 #include "drape/core/files.hpp"
 #include "drape/formats/asf_amc.hpp"
@@ -130,7 +131,20 @@ void inspectAvatarMotion(const std::string& path, std::ostream& out) {
 }
 
 void inspectAvatar(const std::string& path, std::ostream& out) {
-  const scene::Avatar a = scene::loadAvatarFile(path);
+  scene::Avatar a;
+  try {
+    a = scene::loadAvatarFile(path);
+  } catch (const Error& e) {
+    // A glTF, Collada or FBX file without a skin may be a garment: say what it holds as one.
+    if (lowerExtension(path) == ".mhskel") throw;
+    try {
+      inspectMeshFile(path, out);
+    } catch (const Error&) {
+      throw e;
+    }
+    fmt::print(out, "  as an avatar: {}\n", e.what());
+    return;
+  }
   fmt::print(out, "{}: skinned avatar '{}'\n", path, a.name);
   fmt::print(out, "  joints     {}\n", a.joints.size());
   std::vector<int> parents;
@@ -156,7 +170,7 @@ void inspectAvatar(const std::string& path, std::ostream& out) {
 
 const bool bvh = registerInspector({".bvh"}, "BVH motion: skeleton, frames, rate, duration, units guess", &inspectBvh);
 const bool acclaim = registerInspector({".amc", ".asf"}, "Acclaim (CMU) ASF skeletons and AMC motion", &inspectAcclaim);
-const bool avatars = registerInspector({".glb", ".gltf", ".dae", ".fbx", ".mhskel"}, "skinned avatars: joints, skin, segments", &inspectAvatar);
+const bool avatars = registerInspector({".glb", ".gltf", ".dae", ".fbx", ".mhskel"}, "skinned avatars: joints, skin, segments (a file without a skin: its meshes, as a garment)", &inspectAvatar);
 
 }  // namespace
 }  // namespace drape::cli

@@ -1,18 +1,30 @@
-// `drape inspect MESH.obj`: vertex, triangle, edge and boundary counts of an OBJ mesh.
+// `drape inspect MESH.obj`: vertex, triangle, edge and boundary counts of a mesh; and the
+// same for the static meshes of a glTF, Collada or FBX file (cmd_inspect_motion.cpp sends a
+// file without a skin here).
 
 #include <fmt/ostream.h>
+#include <fmt/ranges.h>
 
 #include "command.hpp"
-#include "drape/formats/obj.hpp"
+#include "drape/core/files.hpp"
+#include "drape/formats/mesh_file.hpp"
 #include "drape/mesh/topology.hpp"
+#include "inspect_mesh.hpp"
 
 namespace drape::cli {
-namespace {
 
-void inspectObj(const std::string& path, std::ostream& out) {
-  const mesh::TriMesh m = formats::readObj(path);
+void inspectMeshFile(const std::string& path, std::ostream& out) {
+  const formats::MeshFile file = formats::readMeshFile(path);
+  const mesh::TriMesh& m = file.mesh;
   const Aabb box = m.bounds();
-  fmt::print(out, "{}: OBJ mesh (file units)\n", path);
+  if (lowerExtension(path) == ".obj") {
+    fmt::print(out, "{}: OBJ mesh (file units)\n", path);
+  } else {
+    fmt::print(out, "{}: static mesh, as drape make-scene --garment reads it (m)\n", path);
+    fmt::print(out, "  meshes     {} ({})\n", file.partsRead.size(), fmt::join(file.partsRead, ", "));
+    fmt::print(out, "  welded     {} split vertices into others at the same position; {} triangles dropped as repeated "
+                    "or collapsed\n", file.welded, file.droppedTriangles);
+  }
   fmt::print(out, "  vertices   {}\n  triangles  {}\n", m.vertexCount(), m.triangleCount());
   fmt::print(out, "  bounds     [{:.4g} {:.4g} {:.4g}] .. [{:.4g} {:.4g} {:.4g}]\n", box.min.x(), box.min.y(),
              box.min.z(), box.max.x(), box.max.y(), box.max.z());
@@ -27,7 +39,10 @@ void inspectObj(const std::string& path, std::ostream& out) {
   for (const auto& loop : t.boundaryLoops) fmt::print(out, "    {} vertices\n", loop.size());
 }
 
-const bool registered_cmd_inspect_obj = registerInspector({".obj"}, "OBJ meshes: counts, bounds, boundary loops", &inspectObj);
+namespace {
+
+const bool registered_cmd_inspect_obj =
+    registerInspector({".obj"}, "OBJ meshes: counts, bounds, boundary loops", &inspectMeshFile);
 
 }  // namespace
 }  // namespace drape::cli

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -306,6 +307,29 @@ TEST(MakeScene, AGarmentExportedAsGltfOrColladaMakesTheSceneItsObjMakes) {
                            " state their own unit"),
             std::string::npos)
       << units.err;
+}
+
+TEST(MakeScene, InspectSaysWhatAGarmentFileHoldsAsMakeSceneReadsIt) {
+  // `drape inspect` of a glTF or Collada file without a skin lists its meshes, the welding
+  // and the dress's five openings (hem, waist seam, neckline, two sleeves), in metres.
+  ScratchDir dir("inspect-garment-file");
+  const std::string dressObj = std::string(DRAPE_DATA_DIR) + "/garments/makehuman_female_elegantsuit01_dress.obj";
+  for (const auto& [format, file] : {std::pair{"glb2", "dress.glb"}, std::pair{"collada", "dress.dae"}}) {
+    (void)testing::exportThroughAssimp(dressObj, 0.1, format, dir / file);
+    const CliResult r = runDrape("inspect '" + dir / file + "'", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (const std::string& line :
+         {dir / file + ": static mesh, as drape make-scene --garment reads it (m)\n", std::string("  meshes     1 (defaultobject)\n"),
+          std::string("  vertices   2205\n  triangles  4192\n"),
+          std::string("  bounds     [-0.4467 -0.2992 -0.0967] .. [0.4452 0.5621 0.1902]\n"),
+          std::string("  boundary loops 5\n"), "  as an avatar: " + dir / file + ": "})
+      EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
+  }
+  // A file that is neither: the avatar reader's error.
+  std::ofstream(dir / "bad.glb") << "not a model";
+  const CliResult bad = runDrape("inspect '" + dir / "bad.glb" + "'", dir);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find(dir / "bad.glb" + ": not a glTF 2.0 file"), std::string::npos) << bad.err;
 }
 
 TEST(MakeScene, TooFewSubstepsForTheAddedMassIsAClearError) {

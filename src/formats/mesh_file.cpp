@@ -97,6 +97,8 @@ MeshFile readMeshFile(const std::string& path, const MeshFileOptions& options, c
     ObjReadOptions read;
     read.metresPerUnit = options.metresPerUnit;
     read.groups = options.parts;
+    // The other groups' vertices are no part of a garment chosen by group.
+    read.keepUnusedVertices = options.parts.empty() || options.looseVertices;
     out.mesh = readObj(path, read);
     out.partsRead = options.parts;
     return out;

@@ -266,6 +266,23 @@ TEST(MeshFile, PartsAreChosenByNodeOrMeshName) {
             path + ": has no node or mesh named 'Sleeve' (its meshes: Front, Back, Fan, Pins)");
 }
 
+TEST(MeshFile, AnObjsGroupsAreItsParts) {
+  // The MakeHuman base mesh's body group alone: its vertices, not the helpers' (tights,
+  // skirt, hair) that share the file; as a mask, every vertex the file lists.
+  const std::string path = std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_base_hm08.obj";
+  MeshFileOptions body;
+  body.parts = {"body"};
+  const MeshFile m = readMeshFile(path, body);
+  EXPECT_EQ(m.mesh.triangleCount(), 13378u * 2);
+  std::vector<bool> used(m.mesh.vertexCount(), false);
+  for (const mesh::Triangle& t : m.mesh.triangles)
+    for (std::uint32_t v : t) used[v] = true;
+  EXPECT_EQ(std::count(used.begin(), used.end(), false), 0);
+  EXPECT_EQ(m.partsRead, (std::vector<std::string>{"body"}));
+  body.looseVertices = true;
+  EXPECT_EQ(readMeshFile(path, body).mesh.vertexCount(), 19158u);
+}
+
 TEST(MeshFile, ErrorsNameTheFile) {
   using drape::testing::errorOf;
   EXPECT_EQ(errorOf([] { (void)readMeshFile("skirt.stl"); }),

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -76,6 +77,9 @@ struct GModel {
   std::vector<GSkin> skins;
   std::vector<std::vector<GPrimitive>> meshes;
   std::vector<std::string> meshNames;  ///< "" where a mesh has none
+  /// The root nodes of the scene the file shows (its "scene", else its first); nullopt for
+  /// a file without scenes, which shows every node.
+  std::optional<std::vector<int>> sceneRoots;
 };
 
 bool insideFolder(const std::string& baseDir, const std::string& path) {
@@ -287,6 +291,13 @@ GModel parseDocument(std::string_view bytes, const std::string& name, const std:
       m.nodes.push_back(std::move(node));
     }
     for (const json& s : arrayOf(doc, "skins")) m.skins.push_back({indices(s, "joints"), intOr(s, "inverseBindMatrices", -1)});
+    const json& scenes = arrayOf(doc, "scenes");
+    if (!scenes.empty()) {
+      const int shown = intOr(doc, "scene", 0);
+      if (shown < 0 || static_cast<std::size_t>(shown) >= scenes.size())
+        throw Error(fmt::format("\"scene\" {} names no scene (the file has {})", shown, scenes.size()));
+      m.sceneRoots = indices(scenes[static_cast<std::size_t>(shown)], "nodes");
+    }
     for (const json& a : arrayOf(doc, "animations")) {
       GAnimation anim;
       anim.name = a.contains("name") && a["name"].is_string() ? a["name"].get<std::string>() : "";
@@ -697,16 +708,35 @@ bool wanted(const std::vector<std::string>& parts, std::vector<bool>& matched, c
   return keep;
 }
 
+// Which nodes the file's scene shows: those under its root nodes (every node when the file
+// has no scenes). A node outside it (a collision proxy, another scene's) is not read.
+std::vector<bool> shownNodes(const GModel& model, const std::vector<int>& nodeParent, const GltfReader& r) {
+  const std::size_t n = model.nodes.size();
+  if (!model.sceneRoots) return std::vector<bool>(n, true);
+  std::vector<bool> root(n, false), shown(n, false);
+  for (int k : *model.sceneRoots) {
+    if (k < 0 || static_cast<std::size_t>(k) >= n) r.fail(fmt::format("the scene names node {}, which does not exist", k));
+    root[static_cast<std::size_t>(k)] = true;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t top = i;  // the hierarchy has no cycles: nodeWorlds checked it
+    while (nodeParent[top] >= 0 && !root[top]) top = static_cast<std::size_t>(nodeParent[top]);
+    shown[i] = root[top];
+  }
+  return shown;
+}
+
 MeshParts extractMesh(const GModel& model, const std::string& name, const std::vector<std::string>& parts, bool loose) {
   const GltfReader r{model, name};
   std::vector<int> nodeParent;
   const std::vector<Eigen::Matrix4d> world = nodeWorlds(model, nodeParent, r);
+  const std::vector<bool> shown = shownNodes(model, nodeParent, r);
   MeshParts out;
   out.mesh.name = name;
   std::vector<bool> matched(parts.size(), false);
   for (std::size_t ni = 0; ni < model.nodes.size(); ++ni) {
     const GNode& node = model.nodes[ni];
-    if (node.mesh < 0) continue;
+    if (node.mesh < 0 || !shown[ni]) continue;
     if (static_cast<std::size_t>(node.mesh) >= model.meshes.size()) r.fail(fmt::format("node {} names mesh {}, which does not exist", ni, node.mesh));
     const std::string& meshName = model.meshNames[static_cast<std::size_t>(node.mesh)];
     const std::string part = !node.name.empty() ? node.name : !meshName.empty() ? meshName : fmt::format("node {}", ni);

@@ -164,7 +164,8 @@ void append(std::string& bin, std::initializer_list<T> values) {
 /// Three nodes: "Front", a quad as two unindexed triangles plus a copy of the first wound the
 /// other way (a two-sided face); "Back", a strip of two triangles, moved to z = -1 and scaled
 /// by 2; "Fan" (mesh "FanMesh"), a fan of two triangles moved to x = 5; "Pins", the fan's
-/// four vertices as points, moved to y = 10.
+/// four vertices as points, moved to y = 10; and "Proxy", the front again, in no scene:
+/// nothing shows it, and nothing reads it.
 std::string handWrittenGltf() {
   const std::filesystem::path dir = drape::testing::processTempDir("mesh-file-hand");
   std::string bin;
@@ -180,7 +181,8 @@ std::string handWrittenGltf() {
     {"name": "Front", "mesh": 0},
     {"name": "Back", "mesh": 1, "translation": [0, 0, -1], "scale": [2, 2, 2]},
     {"name": "Fan", "mesh": 2, "translation": [5, 0, 0]},
-    {"name": "Pins", "mesh": 3, "translation": [0, 10, 0]}
+    {"name": "Pins", "mesh": 3, "translation": [0, 10, 0]},
+    {"name": "Proxy", "mesh": 0, "translation": [0, 0, 7]}
   ],
   "meshes": [
     {"name": "FrontMesh", "primitives": [{"attributes": {"POSITION": 0}}]},

@@ -4,7 +4,7 @@
 //
 // glTF goes through drape's own glTF reader, Collada and FBX through Assimp, each in a
 // limited child process and under the safety rules of gltf_avatar.hpp and
-// assimp_avatar.hpp. Every triangle of every mesh the file's node tree places is read, at
+// assimp_avatar.hpp. Every triangle of every mesh the file's scene shows is read, at
 // the nodes' rest transforms (a skinned mesh skinned with its skeleton at rest), in metres
 // with y up (glTF is in metres; Collada's <unit> and <up_axis>, FBX's UnitScaleFactor and
 // axes are applied). Those files split a vertex wherever its texture coordinates or

@@ -177,8 +177,7 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
 }
 
 /// A garment or mask file in metres: an OBJ in --units, the other formats in their own (a
-/// mask with its loose points).
-/// Says what was read from a file that holds several meshes or was welded.
+/// mask with its loose points). Says what was read from a file of several meshes, or welded.
 mesh::TriMesh readMeshOf(const MakeSceneOptions& o, const std::string& path, const std::vector<std::string>& parts,
                          bool isMask) {
   formats::MeshFileOptions read;
@@ -352,7 +351,7 @@ RunFunction setupMakeScene(CLI::App& app) {
                  "Length unit of the garment and mask where they are OBJ files: m, dm, cm, mm, in (glTF, Collada and "
                  "FBX state their own)")
       ->capture_default_str();
-  app.add_option("--name", o.name, "Garment name (default: the OBJ's file name)");
+  app.add_option("--name", o.name, "Garment name (default: the garment file's name)");
   app.add_option("--title", o.title, "Scene title (default: the garment name)");
   app.add_option("--avatar-url", o.avatarUrl, "The Avatar url written into scene.wrl (default: the avatar's path relative to --out)");
   app.add_option("--collides-with", o.collidesWith,

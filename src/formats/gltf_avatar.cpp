@@ -236,6 +236,16 @@ void splitGlb(std::string_view bytes, const std::string& name, std::string_view&
   if (!sawJson) throw Error(fmt::format("{}: the GLB file has no JSON chunk", name));
 }
 
+// The extensions a file may require that change nothing drape reads: appearance (materials,
+// textures, lights, metadata), and KHR_mesh_quantization, whose integer positions the
+// accessor reader takes as it takes floats. Any other (Draco or meshopt compression, GPU
+// instancing) changes where the geometry is, and a file that requires it is refused.
+bool harmlessExtension(const std::string& ext) {
+  for (const char* prefix : {"KHR_materials_", "KHR_texture_", "EXT_texture_", "KHR_lights_", "KHR_xmp"})
+    if (ext.rfind(prefix, 0) == 0) return true;
+  return ext == "KHR_mesh_quantization";
+}
+
 GModel parseDocument(std::string_view bytes, const std::string& name, const std::string& baseDir) {
   std::string_view jsonText = bytes;
   std::vector<unsigned char> bin;
@@ -253,6 +263,12 @@ GModel parseDocument(std::string_view bytes, const std::string& name, const std:
   if (version.rfind("2.", 0) != 0) throw Error(fmt::format("{}: glTF version '{}' (drape reads 2.x)", name, version));
   GModel m;
   try {
+    for (const json& e : arrayOf(doc, "extensionsRequired")) {
+      if (!e.is_string()) throw Error("\"extensionsRequired\" must be a list of names");
+      if (!harmlessExtension(e.get<std::string>()))
+        throw Error(fmt::format("needs the glTF extension {}, which drape does not read (export it without compression "
+                                "or instancing)", e.get<std::string>()));
+    }
     for (const json& b : arrayOf(doc, "buffers")) {
       const std::size_t length = sizeOr(b, "byteLength", 0);
       std::vector<unsigned char> data;

@@ -110,6 +110,9 @@ MeshFile readMeshFile(const std::string& path, const MeshFileOptions& options, c
     throw Error(fmt::format("{}: the weld tolerance must be > 0 m, got {}", path, options.weldTolerance_m));
   const MeshParts parts = readIsolated(path, ext, options.parts, options.looseVertices, limits);
   mesh::Welded welded = mesh::weld(parts.mesh, options.weldTolerance_m, options.looseVertices);
+  if (welded.mesh.triangles.empty() && !options.looseVertices)
+    throw Error(fmt::format("{}: its triangles ({}) all collapse when the vertices within {:g} m of each other are welded: "
+                            "no surface is left", path, parts.mesh.triangleCount(), options.weldTolerance_m));
   out.mesh = std::move(welded.mesh);
   out.mesh.name = path;
   out.partsRead = parts.read;

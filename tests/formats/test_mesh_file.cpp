@@ -296,6 +296,20 @@ TEST(MeshFile, ErrorsNameTheFile) {
   std::ofstream(dir / "bad.fbx") << "; FBX 7.5.0 project file\nnothing else";
   EXPECT_NE(errorOf([&] { (void)readMeshFile((dir / "bad.fbx").string()); }).find((dir / "bad.fbx").string() + ": "),
             std::string::npos);
+  // Geometry compressed by an extension drape does not read; a mesh of one point.
+  std::ofstream(dir / "draco.gltf") << R"({"asset": {"version": "2.0"}, "extensionsRequired": ["KHR_materials_unlit", )"
+                                       R"("KHR_draco_mesh_compression"], "nodes": [{"name": "Dress"}]})";
+  EXPECT_EQ(errorOf([&] { (void)readMeshFile((dir / "draco.gltf").string()); }),
+            (dir / "draco.gltf").string() + ": needs the glTF extension KHR_draco_mesh_compression, which drape does not "
+                                            "read (export it without compression or instancing)");
+  std::ofstream(dir / "point.bin", std::ios::binary) << std::string(36, '\0');
+  std::ofstream(dir / "point.gltf") << R"({"asset": {"version": "2.0"}, "nodes": [{"mesh": 0}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}], "buffers": [{"uri": "point.bin", "byteLength": 36}],
+    "bufferViews": [{"buffer": 0, "byteLength": 36}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"}]})";
+  EXPECT_EQ(errorOf([&] { (void)readMeshFile((dir / "point.gltf").string()); }),
+            (dir / "point.gltf").string() + ": its triangles (1) all collapse when the vertices within 1e-06 m of each other "
+                                            "are welded: no surface is left");
   // A file of cameras and empty nodes: nothing to simulate.
   std::ofstream(dir / "empty.gltf") << R"({"asset": {"version": "2.0"}, "nodes": [{"name": "Camera"}]})";
   EXPECT_EQ(errorOf([&] { (void)readMeshFile((dir / "empty.gltf").string()); }), (dir / "empty.gltf").string() + ": has no triangle mesh");

@@ -22,7 +22,7 @@ void put(std::string& s, const T& v) {
 template <typename T>
 void putVector(std::string& s, const std::vector<T>& v) {
   put<std::uint64_t>(s, v.size());
-  s.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  if (!v.empty()) s.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
 }
 
 struct Cursor {
@@ -42,7 +42,7 @@ struct Cursor {
     const auto n = get<std::uint64_t>();
     if (n > (bytes.size() - at) / std::max<std::size_t>(sizeof(T), 1)) throw Error(fmt::format("{}: the reader returned truncated data", name));
     std::vector<T> v(n);
-    std::memcpy(v.data(), bytes.data() + at, n * sizeof(T));
+    if (n > 0) std::memcpy(v.data(), bytes.data() + at, n * sizeof(T));  // an empty vector's data() may be null
     at += n * sizeof(T);
     return v;
   }

@@ -781,13 +781,7 @@ MeshParts extractMesh(const GModel& model, const std::string& name, const std::v
     }
     if (out.mesh.triangles.size() > before || (loose && out.mesh.positions.size() > beforeVertices)) out.read.push_back(part);
   }
-  for (std::size_t k = 0; k < parts.size(); ++k)
-    if (!matched[k])
-      r.fail(fmt::format("has no node or mesh named '{}' (its meshes: {})", parts[k],
-                         out.all.empty() ? std::string("none") : fmt::format("{}", fmt::join(out.all, ", "))));
-  if (out.mesh.triangles.empty() && (!loose || out.mesh.positions.empty()))
-    r.fail(loose ? (parts.empty() ? "has no mesh" : "the parts asked for have no vertices")
-                 : (parts.empty() ? "has no triangle mesh" : "the parts asked for have no triangles"));
+  checkMeshParts(out, parts, matched, loose, name);
   return out;
 }
 

@@ -74,6 +74,18 @@ MeshParts readIsolated(const std::string& path, const std::string& ext, const st
 
 }  // namespace
 
+void checkMeshParts(const MeshParts& read, const std::vector<std::string>& parts, const std::vector<bool>& matched,
+                    bool loose, const std::string& name) {
+  for (std::size_t k = 0; k < parts.size(); ++k)
+    if (!matched[k])
+      throw Error(fmt::format("{}: has no node or mesh named '{}' (its meshes: {})", name, parts[k],
+                              read.all.empty() ? std::string("none") : fmt::format("{}", fmt::join(read.all, ", "))));
+  if (read.mesh.triangles.empty() && (!loose || read.mesh.positions.empty()))
+    throw Error(fmt::format("{}: {}", name,
+                            loose ? (parts.empty() ? "has no mesh" : "the parts asked for have no vertices")
+                                  : (parts.empty() ? "has no triangle mesh" : "the parts asked for have no triangles")));
+}
+
 std::string describeRead(const MeshFile& file) {
   if (file.partsRead.size() <= 1 && file.welded == 0 && file.droppedTriangles == 0) return "";
   return fmt::format("{} ({} vertices, {} triangles{}{})",

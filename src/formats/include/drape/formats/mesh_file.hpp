@@ -60,6 +60,11 @@ struct MeshParts {
   std::vector<std::string> read, all;
 };
 
+/// A reader's last check: every name in `parts` matched (`matched`, in the same order) and
+/// something was read. Throws drape::Error naming the file `name` and listing its meshes.
+void checkMeshParts(const MeshParts& read, const std::vector<std::string>& parts, const std::vector<bool>& matched,
+                    bool loose, const std::string& name);
+
 /// glTF/GLB bytes in this process (for the fuzz target and the child); `baseDir` as in
 /// parseGltfSkinnedModel.
 [[nodiscard]] MeshParts parseGltfMesh(std::string_view bytes, const std::string& name, const std::string& baseDir,

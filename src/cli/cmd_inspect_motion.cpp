@@ -154,6 +154,9 @@ void inspectAvatar(const std::string& path, std::ostream& out) {
     fmt::print(out, "    {}{} at [{:.3f} {:.3f} {:.3f}] m\n", std::string(static_cast<std::size_t>(depth) * 2, ' '),
                a.joints[j].name, c.x(), c.y(), c.z());
   }
+  if (a.fileMeshes.size() > 1)
+    fmt::print(out, "  meshes     {} skinned: {} (make-scene --avatar-meshes chooses those that make the body)\n",
+               a.fileMeshes.size(), fmt::join(a.fileMeshes, ", "));
   if (a.skin) {
     const Aabb box = a.skin->mesh.bounds();
     fmt::print(out, "  skin       {} vertices, {} triangles, height {:.3f} m\n", a.skin->mesh.vertexCount(),

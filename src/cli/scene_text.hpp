@@ -19,6 +19,24 @@
 
 namespace drape::cli {
 
+/// A VRML97 string: quoted, with its quotes and backslashes escaped.
+inline std::string vrmlString(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+/// An MFString field's line of an Avatar node (`  NAME [ "A", "B" ]`), or "" for none.
+inline std::string stringsField(const std::string& name, const std::vector<std::string>& values) {
+  if (values.empty()) return "";
+  std::vector<std::string> quoted;
+  for (const std::string& v : values) quoted.push_back(vrmlString(v));
+  return fmt::format("  {} [ {} ]\n", name, fmt::join(quoted, ", "));
+}
+
 /// The coord and coordIndex fields of an IndexedFaceSet, one vertex or triangle per line.
 inline void writeIndexedFaceSet(std::ostream& os, const mesh::TriMesh& m, const std::string& indent) {
   fmt::print(os, "{}coord Coordinate {{ point [\n", indent);

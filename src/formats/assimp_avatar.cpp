@@ -451,7 +451,15 @@ std::vector<std::string> animationNames(const aiScene& scene) {
   return names;
 }
 
-SkinnedModel extract(const aiScene& scene, Format format, const std::string& name) {
+// What a mesh placed by `node` is called: the node's name, else the mesh's, else "mesh <m>".
+std::string partName(const aiNode& node, const aiMesh& mesh, unsigned m) {
+  const std::string nodeName = node.mName.C_Str(), meshName = mesh.mName.C_Str();
+  return !nodeName.empty() ? nodeName : !meshName.empty() ? meshName : fmt::format("mesh {}", m);
+}
+
+// The skin's rest model. Its skeleton comes from every skinned mesh, as the motion readers'
+// does; its triangles from those of `parts` only when some are named (by node or mesh name).
+SkinnedModel extract(const aiScene& scene, Format format, const std::string& name, const std::vector<std::string>& parts) {
   const SceneReader r = readerFor(scene, format, name);
   std::vector<std::pair<const aiMesh*, const aiNode*>> meshes;
   const std::vector<const aiNode*> skeleton = skinSkeleton(r, meshes);
@@ -469,8 +477,19 @@ SkinnedModel extract(const aiScene& scene, Format format, const std::string& nam
     joint.restWorld = r.world.at(node);
     out.joints.push_back(std::move(joint));
   }
-  for (const auto& [mesh, node] : meshes) appendMesh(r, *mesh, *node, jointOf, out);
-  if (out.triangles.empty()) r.fail("its skinned meshes have no triangles");
+  std::vector<bool> matched(parts.size(), false);
+  for (const auto& [mesh, node] : meshes) {
+    const auto m = static_cast<unsigned>(std::find(scene.mMeshes, scene.mMeshes + scene.mNumMeshes, mesh) - scene.mMeshes);
+    const std::string part = partName(*node, *mesh, m);
+    if (std::find(out.meshes.begin(), out.meshes.end(), part) == out.meshes.end()) out.meshes.push_back(part);
+    if (!partWanted(parts, matched, part, mesh->mName.C_Str())) continue;
+    const std::size_t before = out.triangles.size();
+    appendMesh(r, *mesh, *node, jointOf, out);
+    if (out.triangles.size() > before && std::find(out.meshesRead.begin(), out.meshesRead.end(), part) == out.meshesRead.end())
+      out.meshesRead.push_back(part);
+  }
+  checkPartsMatched(parts, matched, out.meshes, name, "skinned meshes");
+  if (out.triangles.empty()) r.fail(parts.empty() ? "its skinned meshes have no triangles" : "the meshes asked for have no triangles");
   return out;
 }
 
@@ -642,7 +661,7 @@ struct MotionRig {
       : skin(readerFor(skinScene, format, name)),
         animated(animatedScene),
         toMetres(format == Format::Fbx ? fbxToMetresYUp(animatedScene, name) : Eigen::Matrix4d::Identity()),
-        floor_m(detail::lowestOf(extract(skinScene, format, name).positions, {})) {
+        floor_m(detail::lowestOf(extract(skinScene, format, name, {}).positions, {})) {
     const std::vector<const aiNode*> skeleton = skeletonOf(skin);
     nodes = MotionNodes(animatedScene, findJoints(animatedScene, skeleton, skin));
     for (std::size_t k = 0; k < skeleton.size(); ++k) {
@@ -963,12 +982,10 @@ MeshParts extractMesh(const aiScene& scene, Format format, const std::string& na
       const unsigned m = node->mMeshes[i];
       if (m >= scene.mNumMeshes || scene.mMeshes[m] == nullptr) r.fail(fmt::format("node '{}' names mesh {}, which does not exist", node->mName.C_Str(), m));
       const aiMesh& mesh = *scene.mMeshes[m];
-      const std::string nodeName = node->mName.C_Str(), meshName = mesh.mName.C_Str();
-      const std::string part = !nodeName.empty() ? nodeName : !meshName.empty() ? meshName : fmt::format("mesh {}", m);
+      const std::string meshName = mesh.mName.C_Str();
+      const std::string part = partName(*node, mesh, m);
       if (std::find(out.all.begin(), out.all.end(), part) == out.all.end()) out.all.push_back(part);
-      bool keep = parts.empty();
-      for (std::size_t k = 0; k < parts.size(); ++k)
-        if (parts[k] == part || (!meshName.empty() && parts[k] == meshName)) keep = matched[k] = true;
+      const bool keep = partWanted(parts, matched, part, meshName);
       // A mesh of points or lines only: loose vertices, which only a mask keeps.
       if (!keep || ((mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0 && !loose)) continue;
       const std::vector<Vec3> positions = restPositions(r, mesh, *node);
@@ -998,9 +1015,9 @@ MeshParts extractMesh(const aiScene& scene, Format format, const std::string& na
 
 }  // namespace
 
-SkinnedModel parseAssimpSkinnedModel(std::string_view bytes, const std::string& name) {
+SkinnedModel parseAssimpSkinnedModel(std::string_view bytes, const std::string& name, const std::vector<std::string>& parts) {
   Assimp::Importer importer;
-  return extract(importScene(importer, bytes, name, false), formatOf(name), name);
+  return extract(importScene(importer, bytes, name, false), formatOf(name), name, parts);
 }
 
 SkinnedJointMotion parseAssimpJointMotion(std::string_view bytes, const std::string& name, double rate,
@@ -1044,11 +1061,12 @@ MeshParts parseAssimpMesh(std::string_view bytes, const std::string& name, const
   return extractMesh(importScene(importer, bytes, name, false), formatOf(name), name, parts, loose);
 }
 
-SkinnedModel readAssimpSkinnedModel(const std::string& path, const IsolationLimits& limits) {
+SkinnedModel readAssimpSkinnedModel(const std::string& path, const std::vector<std::string>& parts, const IsolationLimits& limits) {
   const Format format = formatOf(path);
   const std::string bytes = detail::readWholeFile(path, kMaxFileBytes);
   const std::string reader = fmt::format("{} reader (Assimp)", formatName(format));
-  const std::string result = runIsolated(path, reader, [&] { return serialise(parseAssimpSkinnedModel(bytes, path)); }, limits);
+  const std::string result =
+      runIsolated(path, reader, [&] { return serialise(parseAssimpSkinnedModel(bytes, path, parts)); }, limits);
   return deserialiseSkinnedModel(result, path);
 }
 

@@ -564,7 +564,16 @@ std::vector<Eigen::Matrix4d> skinMatrices(const GModel& model, std::size_t index
   return out;
 }
 
-SkinnedModel extract(const GModel& model, const std::string& name) {
+// What a mesh placed by node `ni` is called: its node's name, else its mesh's, else "node <ni>".
+std::string partName(const GModel& model, std::size_t ni) {
+  const GNode& node = model.nodes[ni];
+  const std::string& meshName = model.meshNames[static_cast<std::size_t>(node.mesh)];
+  return !node.name.empty() ? node.name : !meshName.empty() ? meshName : fmt::format("node {}", ni);
+}
+
+// The skin's rest model from the triangle meshes its first skin moves, those of `parts`
+// only when some are named (by node or mesh name).
+SkinnedModel extract(const GModel& model, const std::string& name, const std::vector<std::string>& parts = {}) {
   const GltfReader r{model, name};
   std::vector<int> nodeParent;
   const std::vector<Eigen::Matrix4d> world = nodeWorlds(model, nodeParent, r);
@@ -585,10 +594,24 @@ SkinnedModel extract(const GModel& model, const std::string& name) {
   }
   const std::vector<Eigen::Matrix4d> skinMatrix = skinMatrices(model, 0, world, r);
 
+  std::vector<bool> matched(parts.size(), false);
   for (std::size_t ni = 0; ni < model.nodes.size(); ++ni) {
     const GNode& node = model.nodes[ni];
-    if (node.skin != 0 || node.mesh < 0) continue;
+    if (node.skin < 0 || node.mesh < 0) continue;
     if (static_cast<std::size_t>(node.mesh) >= model.meshes.size()) r.fail(fmt::format("node {} names mesh {}, which does not exist", ni, node.mesh));
+    const std::string part = partName(model, ni);
+    const std::string& meshName = model.meshNames[static_cast<std::size_t>(node.mesh)];
+    if (node.skin != 0) {
+      // Another skeleton's mesh: drape reads one skin, the file's first.
+      std::vector<bool> other(parts.size(), false);
+      if (partWanted(parts, other, part, meshName) && !parts.empty())
+        r.fail(fmt::format("its mesh '{}' is moved by skin {}; drape reads the meshes of the file's first skin, skin 0",
+                           part, node.skin));
+      continue;
+    }
+    out.meshes.push_back(part);
+    if (!partWanted(parts, matched, part, meshName)) continue;
+    const std::size_t trianglesBefore = out.triangles.size();
     for (const GPrimitive& prim : model.meshes[static_cast<std::size_t>(node.mesh)]) {
       if (prim.mode != kModeTriangles) continue;
       const auto pos = prim.attributes.find("POSITION");
@@ -644,8 +667,11 @@ SkinnedModel extract(const GModel& model, const std::string& name) {
         if (tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2]) out.triangles.push_back(tri);
       }
     }
+    if (out.triangles.size() > trianglesBefore) out.meshesRead.push_back(part);
   }
-  if (out.triangles.empty()) r.fail("no skinned triangle mesh uses its first skin");
+  checkPartsMatched(parts, matched, out.meshes, name, "skinned meshes");
+  if (out.triangles.empty())
+    r.fail(parts.empty() ? "no skinned triangle mesh uses its first skin" : "the meshes asked for have no skinned triangles");
   return out;
 }
 
@@ -713,17 +739,6 @@ std::vector<Vec3> restPositions(const GPrimitive& prim, const Eigen::Matrix4d& n
   return out;
 }
 
-// Whether node `ni` is one of the parts asked for (every one when none are), marking which
-// names matched.
-bool wanted(const std::vector<std::string>& parts, std::vector<bool>& matched, const std::string& nodeName,
-            const std::string& meshName) {
-  if (parts.empty()) return true;
-  bool keep = false;
-  for (std::size_t k = 0; k < parts.size(); ++k)
-    if (parts[k] == nodeName || (!meshName.empty() && parts[k] == meshName)) keep = matched[k] = true;
-  return keep;
-}
-
 // Which nodes the file's scene shows: those under its root nodes (every node when the file
 // has no scenes). A node outside it (a collision proxy, another scene's) is not read.
 std::vector<bool> shownNodes(const GModel& model, const std::vector<int>& nodeParent, const GltfReader& r) {
@@ -755,9 +770,9 @@ MeshParts extractMesh(const GModel& model, const std::string& name, const std::v
     if (node.mesh < 0 || !shown[ni]) continue;
     if (static_cast<std::size_t>(node.mesh) >= model.meshes.size()) r.fail(fmt::format("node {} names mesh {}, which does not exist", ni, node.mesh));
     const std::string& meshName = model.meshNames[static_cast<std::size_t>(node.mesh)];
-    const std::string part = !node.name.empty() ? node.name : !meshName.empty() ? meshName : fmt::format("node {}", ni);
+    const std::string part = partName(model, ni);
     out.all.push_back(part);
-    if (!wanted(parts, matched, part, meshName)) continue;
+    if (!partWanted(parts, matched, part, meshName)) continue;
     const std::vector<Eigen::Matrix4d> skinning =
         node.skin >= 0 ? skinMatrices(model, static_cast<std::size_t>(node.skin), world, r) : std::vector<Eigen::Matrix4d>{};
     const std::size_t before = out.mesh.triangles.size(), beforeVertices = out.mesh.positions.size();
@@ -962,8 +977,9 @@ GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, 
 
 }  // namespace
 
-SkinnedModel parseGltfSkinnedModel(std::string_view bytes, const std::string& name, const std::string& baseDir) {
-  return extract(parseDocument(bytes, name, baseDir), name);
+SkinnedModel parseGltfSkinnedModel(std::string_view bytes, const std::string& name, const std::string& baseDir,
+                                   const std::vector<std::string>& parts) {
+  return extract(parseDocument(bytes, name, baseDir), name, parts);
 }
 
 GltfJointMotion parseGltfJointMotion(std::string_view bytes, const std::string& name, const std::string& baseDir,
@@ -1002,10 +1018,11 @@ MeshParts parseGltfMesh(std::string_view bytes, const std::string& name, const s
   return extractMesh(parseDocument(bytes, name, baseDir), name, parts, loose);
 }
 
-SkinnedModel readGltfSkinnedModel(const std::string& path, const IsolationLimits& limits) {
+SkinnedModel readGltfSkinnedModel(const std::string& path, const std::vector<std::string>& parts, const IsolationLimits& limits) {
   const std::string bytes = detail::readWholeFile(path, std::size_t{1} << 30);
   const std::string baseDir = std::filesystem::absolute(path).parent_path().string();
-  const std::string result = runIsolated(path, "glTF reader", [&] { return serialise(parseGltfSkinnedModel(bytes, path, baseDir)); }, limits);
+  const std::string result =
+      runIsolated(path, "glTF reader", [&] { return serialise(parseGltfSkinnedModel(bytes, path, baseDir, parts)); }, limits);
   return deserialiseSkinnedModel(result, path);
 }
 

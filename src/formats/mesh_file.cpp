@@ -27,10 +27,8 @@ std::string serialise(const MeshParts& parts) {
   for (const Vec3& p : parts.mesh.positions) xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
   putVector(s, xyz);
   putVector(s, parts.mesh.triangles);
-  for (const std::vector<std::string>* names : {&parts.read, &parts.all}) {
-    put<std::uint64_t>(s, names->size());
-    for (const std::string& n : *names) putVector(s, std::vector<char>(n.begin(), n.end()));
-  }
+  detail::putStrings(s, parts.read);
+  detail::putStrings(s, parts.all);
   return s;
 }
 
@@ -45,14 +43,8 @@ MeshParts deserialiseMeshParts(std::string_view bytes, const std::string& name) 
   for (const mesh::Triangle& t : parts.mesh.triangles)
     for (std::uint32_t v : t)
       if (v >= parts.mesh.positions.size()) throw Error(fmt::format("{}: the reader returned bad data", name));
-  for (std::vector<std::string>* names : {&parts.read, &parts.all}) {
-    const auto n = c.get<std::uint64_t>();
-    if (n > bytes.size()) throw Error(fmt::format("{}: the reader returned bad data", name));
-    for (std::uint64_t k = 0; k < n; ++k) {
-      const std::vector<char> chars = c.getVector<char>();
-      names->emplace_back(chars.begin(), chars.end());
-    }
-  }
+  parts.read = c.getStrings();
+  parts.all = c.getStrings();
   if (c.at != bytes.size()) throw Error(fmt::format("{}: the reader returned bad data", name));
   return parts;
 }
@@ -74,12 +66,26 @@ MeshParts readIsolated(const std::string& path, const std::string& ext, const st
 
 }  // namespace
 
-void checkMeshParts(const MeshParts& read, const std::vector<std::string>& parts, const std::vector<bool>& matched,
-                    bool loose, const std::string& name) {
+bool partWanted(const std::vector<std::string>& parts, std::vector<bool>& matched, const std::string& part,
+                const std::string& meshName) {
+  if (parts.empty()) return true;
+  bool keep = false;
+  for (std::size_t k = 0; k < parts.size(); ++k)
+    if (parts[k] == part || (!meshName.empty() && parts[k] == meshName)) keep = matched[k] = true;
+  return keep;
+}
+
+void checkPartsMatched(const std::vector<std::string>& parts, const std::vector<bool>& matched,
+                       const std::vector<std::string>& all, const std::string& name, const std::string& what) {
   for (std::size_t k = 0; k < parts.size(); ++k)
     if (!matched[k])
-      throw Error(fmt::format("{}: has no node or mesh named '{}' (its meshes: {})", name, parts[k],
-                              read.all.empty() ? std::string("none") : fmt::format("{}", fmt::join(read.all, ", "))));
+      throw Error(fmt::format("{}: has no node or mesh named '{}' (its {}: {})", name, parts[k], what,
+                              all.empty() ? std::string("none") : fmt::format("{}", fmt::join(all, ", "))));
+}
+
+void checkMeshParts(const MeshParts& read, const std::vector<std::string>& parts, const std::vector<bool>& matched,
+                    bool loose, const std::string& name) {
+  checkPartsMatched(parts, matched, read.all, name);
   if (read.mesh.triangles.empty() && (!loose || read.mesh.positions.empty()))
     throw Error(fmt::format("{}: {}", name,
                             loose ? (parts.empty() ? "has no mesh" : "the parts asked for have no vertices")

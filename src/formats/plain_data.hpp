@@ -25,6 +25,11 @@ void putVector(std::string& s, const std::vector<T>& v) {
   if (!v.empty()) s.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
 }
 
+inline void putStrings(std::string& s, const std::vector<std::string>& strings) {
+  put<std::uint64_t>(s, strings.size());
+  for (const std::string& x : strings) putVector(s, std::vector<char>(x.begin(), x.end()));
+}
+
 struct Cursor {
   std::string_view bytes;
   std::size_t at = 0;
@@ -45,6 +50,18 @@ struct Cursor {
     if (n > 0) std::memcpy(v.data(), bytes.data() + at, n * sizeof(T));  // an empty vector's data() may be null
     at += n * sizeof(T);
     return v;
+  }
+  /// A list putStrings wrote; `most` bounds its length (bad data otherwise).
+  std::vector<std::string> getStrings(std::size_t most = 1'000'000) {
+    const auto n = get<std::uint64_t>();
+    if (n > most || n > bytes.size() - at) throw Error(fmt::format("{}: the reader returned bad data", name));
+    std::vector<std::string> out;
+    out.reserve(n);
+    for (std::uint64_t k = 0; k < n; ++k) {
+      const std::vector<char> chars = getVector<char>();
+      out.emplace_back(chars.begin(), chars.end());
+    }
+    return out;
   }
 };
 

@@ -31,8 +31,9 @@ std::string serialise(const SkinnedModel& model) {
   putVector(s, model.triangles);
   putVector(s, model.vertexJoints);
   putVector(s, model.vertexWeights);
-  put<std::uint64_t>(s, model.animations.size());
-  for (const std::string& a : model.animations) putVector(s, std::vector<char>(a.begin(), a.end()));
+  detail::putStrings(s, model.animations);
+  detail::putStrings(s, model.meshes);
+  detail::putStrings(s, model.meshesRead);
   return s;
 }
 
@@ -55,12 +56,9 @@ SkinnedModel deserialiseSkinnedModel(std::string_view bytes, const std::string& 
   model.triangles = c.getVector<mesh::Triangle>();
   model.vertexJoints = c.getVector<std::array<std::uint16_t, 4>>();
   model.vertexWeights = c.getVector<std::array<float, 4>>();
-  const auto animations = c.get<std::uint64_t>();
-  if (animations > 1'000'000) throw Error(fmt::format("{}: the reader returned bad data", name));
-  for (std::uint64_t k = 0; k < animations; ++k) {
-    const std::vector<char> chars = c.getVector<char>();
-    model.animations.emplace_back(chars.begin(), chars.end());
-  }
+  model.animations = c.getStrings();
+  model.meshes = c.getStrings();
+  model.meshesRead = c.getStrings();
   return model;
 }
 

@@ -38,14 +38,18 @@ Avatar buildAvatarFromSkinnedModel(const formats::SkinnedModel& model) {
   skin.weights = model.vertexWeights;
   avatar.skin = std::move(skin);
   avatar.animations = model.animations;
+  avatar.fileMeshes = model.meshes;
+  avatar.meshesRead = model.meshesRead;
   segmentSkinnedAvatar(avatar);
   return avatar;
 }
 
-Avatar loadGltfAvatar(const std::string& path) { return buildAvatarFromSkinnedModel(formats::readGltfSkinnedModel(path)); }
+Avatar loadGltfAvatar(const std::string& path, const std::vector<std::string>& meshes) {
+  return buildAvatarFromSkinnedModel(formats::readGltfSkinnedModel(path, meshes));
+}
 
-Avatar loadAssimpAvatar(const std::string& path) {
-  return buildAvatarFromSkinnedModel(formats::readAssimpSkinnedModel(path));
+Avatar loadAssimpAvatar(const std::string& path, const std::vector<std::string>& meshes) {
+  return buildAvatarFromSkinnedModel(formats::readAssimpSkinnedModel(path, meshes));
 }
 
 formats::SkinnedModel skinnedModelOf(const Avatar& avatar) {
@@ -78,10 +82,14 @@ Avatar loadHumanoidFile(const std::string& path) {
                           fmt::join(names, ", ")));
 }
 
-Avatar loadAvatarFile(const std::string& path) {
+Avatar loadAvatarFile(const std::string& path, const std::vector<std::string>& meshes) {
   const std::string ext = lowerExtension(path);
-  if (ext == ".glb" || ext == ".gltf") return loadGltfAvatar(path);
-  if (ext == ".dae" || ext == ".fbx") return loadAssimpAvatar(path);
+  if (ext == ".glb" || ext == ".gltf") return loadGltfAvatar(path, meshes);
+  if (ext == ".dae" || ext == ".fbx") return loadAssimpAvatar(path, meshes);
+  if (!meshes.empty())
+    throw Error(fmt::format("{}: meshes ({}) choose among the skinned meshes of a glTF, Collada or FBX avatar; "
+                            "a {} avatar is one body",
+                            path, fmt::join(meshes, ", "), ext == ".mhskel" ? "MakeHuman" : "VRML97 H-Anim"));
   if (ext == ".mhskel") return loadMakeHumanAvatar(path);
   if (formats::isVrmlPath(path)) return loadHumanoidFile(path);
   throw Error(fmt::format("{}: drape reads avatars from .glb, .gltf, .dae, .fbx, MakeHuman .mhskel and VRML97 H-Anim "

@@ -310,6 +310,7 @@ class Builder {
     a.urls = strings(n, "url");
     a.jointMap = strings(n, "jointMap");
     a.cutAtJoints = strings(n, "cutAtJoints");
+    a.meshes = strings(n, "meshes");
     a.motion = strings(n, "motion");
     a.source = where(n);
     if (a.urls.empty())

@@ -33,10 +33,14 @@ namespace drape::formats {
 
 /// Parses Collada or FBX bytes in this process (for the fuzz target and the child). The
 /// extension of `name` picks the format; `name` is also what messages call the file.
-[[nodiscard]] SkinnedModel parseAssimpSkinnedModel(std::string_view bytes, const std::string& name);
+/// `parts`, when given, names the skinned meshes to read by node or mesh name (the
+/// skeleton is still every skinned mesh's); a name that matches none is an error listing them.
+[[nodiscard]] SkinnedModel parseAssimpSkinnedModel(std::string_view bytes, const std::string& name,
+                                                   const std::vector<std::string>& parts = {});
 
 /// Reads a .dae/.fbx file in a limited child process. Throws drape::Error naming the file.
-[[nodiscard]] SkinnedModel readAssimpSkinnedModel(const std::string& path, const IsolationLimits& limits = {});
+[[nodiscard]] SkinnedModel readAssimpSkinnedModel(const std::string& path, const std::vector<std::string>& parts = {},
+                                                  const IsolationLimits& limits = {});
 
 /// One animation of Collada or FBX bytes as the motion of the skin's joints (the skeleton
 /// parseAssimpSkinnedModel reads), sampled at `rate` from its first key time to its last:

@@ -26,12 +26,16 @@ using GltfJoint = SkinnedJoint;
 using GltfSkinnedModel = SkinnedModel;
 
 /// Parses glTF/GLB bytes in this process (for the fuzz target and the child). `baseDir` is
-/// the folder external URIs must stay inside ("" allows data: URIs only).
+/// the folder external URIs must stay inside ("" allows data: URIs only). `parts`, when
+/// given, names the skinned meshes to read by node or mesh name (the body of a character
+/// whose file holds its clothes too); a name that matches none, or a mesh of another
+/// skin, is an error listing the skin's meshes.
 [[nodiscard]] GltfSkinnedModel parseGltfSkinnedModel(std::string_view bytes, const std::string& name,
-                                                     const std::string& baseDir);
+                                                     const std::string& baseDir, const std::vector<std::string>& parts = {});
 
 /// Reads a .gltf/.glb file in a limited child process. Throws drape::Error naming the file.
-[[nodiscard]] GltfSkinnedModel readGltfSkinnedModel(const std::string& path, const IsolationLimits& limits = {});
+[[nodiscard]] GltfSkinnedModel readGltfSkinnedModel(const std::string& path, const std::vector<std::string>& parts = {},
+                                                    const IsolationLimits& limits = {});
 
 /// One of a glTF file's animations: channels follow the glTF 2.0 rules (translation,
 /// rotation and scale of nodes, LINEAR with rotations by SLERP, STEP and CUBICSPLINE

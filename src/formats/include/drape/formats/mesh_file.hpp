@@ -60,6 +60,17 @@ struct MeshParts {
   std::vector<std::string> read, all;
 };
 
+/// Whether a mesh placed by a node called `part` (its node's name, or its mesh's where the
+/// node has none) is one of `parts`, by that name or its mesh's `meshName`; every mesh is
+/// when `parts` is empty. Marks in `matched` (as long as `parts`) the names it answers.
+[[nodiscard]] bool partWanted(const std::vector<std::string>& parts, std::vector<bool>& matched, const std::string& part,
+                              const std::string& meshName);
+
+/// Throws drape::Error naming the file `name` when a name in `parts` matched no mesh
+/// (`matched`, in the same order), listing the file's meshes `all` (`what` says which kind).
+void checkPartsMatched(const std::vector<std::string>& parts, const std::vector<bool>& matched,
+                       const std::vector<std::string>& all, const std::string& name, const std::string& what = "meshes");
+
 /// A reader's last check: every name in `parts` matched (`matched`, in the same order) and
 /// something was read. Throws drape::Error naming the file `name` and listing its meshes.
 void checkMeshParts(const MeshParts& read, const std::vector<std::string>& parts, const std::vector<bool>& matched,

@@ -31,6 +31,11 @@ struct SkinnedModel {
   /// The file's animations by name ("animation <index>" if one has none), in the file's
   /// order: what the avatar could play as its own motion (a reader of the motion samples them).
   std::vector<std::string> animations;
+  /// The meshes its skin moves, each by its node's name (its mesh's name, or "node <i>" /
+  /// "mesh <i>", where the node has none), in the file's order; and those read, which are
+  /// all of them unless the reader was asked for some by name (an avatar file that holds
+  /// the character's clothes or hair as well as its body).
+  std::vector<std::string> meshes, meshesRead;
 };
 
 /// One of an avatar file's animations as the motion of its skin's joints, sampled at a

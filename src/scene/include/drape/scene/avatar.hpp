@@ -46,6 +46,9 @@ struct Avatar {
   /// in its order): the motion it plays when no other is given. Empty for the other
   /// sources (an H-Anim humanoid's interpolators are found where its file has ROUTEs).
   std::vector<std::string> animations;
+  /// A glTF, Collada or FBX file's skinned meshes (by node or mesh name), and those its
+  /// skin was built from: all of them, or those the Avatar node's `meshes` chose.
+  std::vector<std::string> fileMeshes, meshesRead;
 
   /// Index of the joint named `name`, or -1.
   [[nodiscard]] int findJoint(const std::string& name) const {

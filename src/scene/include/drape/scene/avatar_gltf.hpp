@@ -7,6 +7,7 @@
 // (formats/gltf_avatar.hpp, formats/assimp_avatar.hpp).
 
 #include <string>
+#include <vector>
 
 #include "drape/formats/gltf_avatar.hpp"
 #include "drape/formats/skinned_model.hpp"
@@ -17,12 +18,14 @@ namespace drape::scene {
 /// Builds the avatar from an already-read skinned model (positions in metres, Y up).
 [[nodiscard]] Avatar buildAvatarFromSkinnedModel(const formats::SkinnedModel& model);
 
-/// Reads and builds; throws drape::Error naming the file.
-[[nodiscard]] Avatar loadGltfAvatar(const std::string& path);
+/// Reads and builds; throws drape::Error naming the file. `meshes`, when given, names the
+/// skinned meshes that make the body (by node or mesh name): a file that also holds the
+/// character's clothes or hair leaves those out of the body the cloth collides with.
+[[nodiscard]] Avatar loadGltfAvatar(const std::string& path, const std::vector<std::string>& meshes = {});
 
 /// Reads a Collada (.dae) or FBX (.fbx) skinned character through Assimp and builds it;
-/// throws drape::Error naming the file.
-[[nodiscard]] Avatar loadAssimpAvatar(const std::string& path);
+/// throws drape::Error naming the file. `meshes` as for loadGltfAvatar.
+[[nodiscard]] Avatar loadAssimpAvatar(const std::string& path, const std::vector<std::string>& meshes = {});
 
 /// The avatar's skinned mesh and skeleton as plain data, for the skinned-model writers
 /// (joint frames are the avatar's: rest centre, root-aligned axes). Throws drape::Error if
@@ -36,7 +39,7 @@ namespace drape::scene {
 
 /// Any avatar file drape reads: .glb/.gltf, .dae/.fbx, a MakeHuman .mhskel (the mesh and
 /// weights beside it), or a VRML97 H-Anim humanoid (.wrl). Throws drape::Error for other
-/// extensions.
-[[nodiscard]] Avatar loadAvatarFile(const std::string& path);
+/// extensions, and for `meshes` (as for loadGltfAvatar) given with a file of one body.
+[[nodiscard]] Avatar loadAvatarFile(const std::string& path, const std::vector<std::string>& meshes = {});
 
 }  // namespace drape::scene

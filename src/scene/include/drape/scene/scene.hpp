@@ -107,6 +107,9 @@ struct ExternalAvatar {
   /// Joints whose rigid parts are cut across the joint, what lies behind it going to the
   /// parent's part (scene::segmentSkinnedAvatar); empty: parts by dominant weight alone.
   std::vector<std::string> cutAtJoints;
+  /// The file's skinned meshes that make the body, by node or mesh name (a character file
+  /// that also holds its clothes or hair); empty: every mesh of its skin.
+  std::vector<std::string> meshes;
   /// URL(s) of the motion it plays when a command gives it none (a BVH, AMC, or animated
   /// avatar file), relative to the scene; the first that exists is played. Empty: none.
   std::vector<std::string> motion;

@@ -39,4 +39,16 @@ inline Exported exportThroughAssimp(const std::string& objPath, double scale, co
   return out;
 }
 
+/// Writes the file at `inPath`, imported by Assimp as it is (no processing), to `outPath`
+/// with Assimp's exporter `formatId`: a skinned character as another tool converts it.
+/// Throws on failure.
+inline void convertThroughAssimp(const std::string& inPath, const std::string& formatId, const std::string& outPath) {
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(inPath, 0);
+  if (scene == nullptr) throw std::runtime_error(inPath + ": Assimp cannot import it: " + importer.GetErrorString());
+  Assimp::Exporter exporter;
+  if (exporter.Export(scene, formatId, outPath) != AI_SUCCESS)
+    throw std::runtime_error(outPath + ": Assimp's " + formatId + " exporter failed: " + exporter.GetErrorString());
+}
+
 }  // namespace drape::testing

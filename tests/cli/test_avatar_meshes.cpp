@@ -1,0 +1,126 @@
+// A character file that holds its clothes as well as its body (games and character tools
+// ship them so): the Avatar node's meshes choose the body the cloth collides with, and the
+// garment comes from the same file by its own mesh's name.
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.hpp"
+#include "drape/formats/mesh_file.hpp"
+#include "drape/formats/obj.hpp"
+#include "drape/testing/clothed_avatar.hpp"
+
+namespace drape {
+namespace {
+
+using testing::CliResult;
+using testing::runDrape;
+using testing::ScratchDir;
+using testing::statsOf;
+
+/// The cape's triangles from the shoulders up, as an OBJ: the constraint mask.
+std::string shouldersMask(const std::string& clothed, const ScratchDir& dir) {
+  formats::MeshFileOptions options;
+  options.parts = {"Cape"};
+  const mesh::TriMesh cape = formats::readMeshFile(clothed, options).mesh;
+  std::vector<Vec3> positions;
+  std::vector<mesh::Triangle> top;
+  std::vector<std::uint32_t> index(cape.vertexCount(), UINT32_MAX);
+  for (const mesh::Triangle& t : cape.triangles) {
+    if (cape.positions[t[0]].y() < 1.2 || cape.positions[t[1]].y() < 1.2 || cape.positions[t[2]].y() < 1.2) continue;
+    mesh::Triangle kept;
+    for (std::size_t c = 0; c < 3; ++c) {
+      if (index[t[c]] == UINT32_MAX) {
+        index[t[c]] = static_cast<std::uint32_t>(positions.size());
+        positions.push_back(cape.positions[t[c]]);
+      }
+      kept[c] = index[t[c]];
+    }
+    top.push_back(kept);
+  }
+  const std::string path = dir / "shoulders.obj";
+  formats::writeObj(path, positions, top, "the cape from the shoulders up (m)");
+  return path;
+}
+
+TEST(AvatarMeshes, ACharacterFileWithItsClothesCollidesTheClothWithTheBodyAlone) {
+  // CesiumMan with a cape, his skin 1 cm out, in the same file and skin. Worn as a garment
+  // from that file, the cape collides with the body its meshes field names and starts
+  // outside its offset surfaces (T2 = 6 mm); with every mesh of the skin taken for the body,
+  // the cape collides with itself as a body and starts inside them everywhere.
+  ScratchDir dir("avatar-meshes");
+  const std::string clothed = testing::clothedCesiumMan(dir / "clothed", {.offset_m = 0.01});
+  const std::string mask = shouldersMask(clothed, dir);
+  auto make = [&](const std::string& options, const std::string& out) {
+    return runDrape("make-scene '" + clothed + "' --garment '" + clothed + "' --garment-parts Cape --mask '" + mask +
+                        "' --name cape --offsets 0.002,0.004,0.006,0.012 " + options + " --out '" + (dir / out) + "'",
+                    dir);
+  };
+  auto run = [&](const std::string& out) {
+    const CliResult ran = runDrape("run '" + (dir / out) + "/scene.wrl' --motion '" + clothed + "' --frames 3 --out '" +
+                                       (dir / out) + "/run'",
+                                   dir);
+    EXPECT_EQ(ran.code, 0) << ran.err;
+    return statsOf(dir / out + "/run");
+  };
+  const CliResult body = make("--avatar-meshes Body", "body");
+  ASSERT_EQ(body.code, 0) << body.err;
+  EXPECT_NE(testing::slurp(dir / "body/scene.wrl").find("  meshes [ \"Body\" ]\n"), std::string::npos);
+  EXPECT_NE(body.out.find(clothed + ": the body is Body of its meshes Body, Cape\n"), std::string::npos) << body.out;
+  const nlohmann::json alone = run("body");
+  EXPECT_LT(alone.at("pairs_embedded_at_start").get<int>(), 20);
+  EXPECT_EQ(alone.at("vertex_substeps_below_T1").get<long>(), 0);
+  EXPECT_EQ(alone.at("vertex_substeps_inside_body").get<long>(), 0);
+
+  const CliResult all = make("", "all");
+  ASSERT_EQ(all.code, 0) << all.err;
+  EXPECT_EQ(testing::slurp(dir / "all/scene.wrl").find("  meshes ["), std::string::npos);
+  EXPECT_NE(all.out.find(clothed + ": the body is every mesh of its skin (Body, Cape); --avatar-meshes chooses"),
+            std::string::npos)
+      << all.out;
+  EXPECT_GT(run("all").at("pairs_embedded_at_start").get<int>(), 1000);
+}
+
+TEST(AvatarMeshes, InspectListsTheMeshesAndAWrongNameIsRefusedWithThem) {
+  ScratchDir dir("avatar-meshes-errors");
+  const std::string clothed = testing::clothedCesiumMan(dir / "clothed");
+  const CliResult inspected = runDrape("inspect '" + clothed + "'", dir);
+  ASSERT_EQ(inspected.code, 0) << inspected.err;
+  EXPECT_NE(inspected.out.find("  meshes     2 skinned: Body, Cape (make-scene --avatar-meshes chooses those that make "
+                               "the body)\n"),
+            std::string::npos)
+      << inspected.out;
+
+  const std::string garment = std::string(DRAPE_DATA_DIR) + "/garments/makehuman_female_elegantsuit01_dress.obj";
+  const std::string mask = std::string(DRAPE_SOURCE_DIR) + "/examples/hanging_dress/shoulders_mask.obj";
+  const CliResult hair = runDrape("make-scene '" + clothed + "' --avatar-meshes Body,Hair --garment '" + clothed +
+                                      "' --garment-parts Cape --mask '" + clothed + "' --out '" + (dir / "hair") + "'",
+                                  dir);
+  EXPECT_EQ(hair.code, 2);
+  EXPECT_NE(hair.err.find(clothed + ": has no node or mesh named 'Hair' (its skinned meshes: Body, Cape)"), std::string::npos)
+      << hair.err;
+  const std::string makehuman = std::string(DRAPE_SOURCE_DIR) + "/data/avatars/makehuman_rig_cmu_mb.mhskel";
+  const CliResult one = runDrape("make-scene '" + makehuman + "' --avatar-meshes Body --garment '" + garment +
+                                     "' --units dm --mask '" + mask + "' --out '" + (dir / "one") + "'",
+                                 dir);
+  EXPECT_EQ(one.code, 2);
+  EXPECT_NE(one.err.find("makehuman_rig_cmu_mb.mhskel: meshes (Body) choose among the skinned meshes of a glTF, Collada "
+                         "or FBX avatar; a MakeHuman avatar is one body"),
+            std::string::npos)
+      << one.err;
+  const CliResult ran = runDrape("run '" + std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt/scene.wrl' "
+                                 "--avatar-meshes Body --frames 1 --out '" + (dir / "run") + "'",
+                                 dir);
+  EXPECT_EQ(ran.code, 2);
+  EXPECT_NE(ran.err.find("--avatar-meshes chooses the meshes of --avatar FILE; in a scene the Avatar node's meshes field "
+                         "does"),
+            std::string::npos)
+      << ran.err;
+}
+
+}  // namespace
+}  // namespace drape

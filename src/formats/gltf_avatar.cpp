@@ -483,55 +483,94 @@ std::vector<Eigen::Matrix4d> nodeWorlds(const GModel& model, std::vector<int>& p
   return worldsOf(parent, local, r);
 }
 
-// The first skin's joints in parent-first order (by depth in the node tree), named and
-// parented as SkinnedModel has them.
+// The skeleton: the joints of the first skin and of every skin that shares a joint with it
+// (exporters from Unity and three.js write one skin per skinned mesh, each listing the
+// joints its mesh uses, all of one skeleton), in parent-first order (by depth in the node
+// tree), named and parented as SkinnedModel has them. A skin of joints apart from these
+// (another character's) is not the avatar's.
 struct SkinJoints {
   std::vector<int> node;          ///< k -> the joint's node
-  std::vector<int> skinIndex;     ///< k -> its index in the skin's list
-  std::vector<int> newIndex;      ///< index in the skin's list -> k
   std::vector<std::string> name;  ///< k -> its name
   std::vector<int> parent;        ///< k -> the nearest ancestor that is a joint, or -1
+  /// Per skin of the file: index in its joint list -> k; empty for a skin not of the skeleton.
+  std::vector<std::vector<int>> newIndex;
 };
+
+// Which skins share joints with the first, directly or through each other.
+std::vector<bool> skinsOfTheSkeleton(const GModel& model, const GltfReader& r) {
+  const std::size_t nodes = model.nodes.size(), skins = model.skins.size();
+  for (std::size_t s = 0; s < skins; ++s) {
+    if (model.skins[s].joints.empty()) r.fail(fmt::format("skin {} has no joints", s));
+    if (model.skins[s].joints.size() > 65535) r.fail(fmt::format("skin {} has too many joints", s));
+    for (const int node : model.skins[s].joints)
+      if (node < 0 || static_cast<std::size_t>(node) >= nodes) r.fail(fmt::format("skin joint {} is not a node", node));
+  }
+  std::vector<bool> inSkeleton(skins, false), jointNode(nodes, false);
+  inSkeleton[0] = true;
+  for (const int node : model.skins[0].joints) jointNode[static_cast<std::size_t>(node)] = true;
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (std::size_t s = 1; s < skins; ++s) {
+      if (inSkeleton[s]) continue;
+      const std::vector<int>& joints = model.skins[s].joints;
+      if (std::none_of(joints.begin(), joints.end(), [&](int n) { return jointNode[static_cast<std::size_t>(n)]; })) continue;
+      inSkeleton[s] = grew = true;
+      for (const int node : joints) jointNode[static_cast<std::size_t>(node)] = true;
+    }
+  }
+  return inSkeleton;
+}
 
 SkinJoints skinJoints(const GModel& model, const std::vector<int>& nodeParent, const GltfReader& r) {
   if (model.skins.empty()) r.fail("has no skin (a skinned character is needed)");
-  const GSkin& skin = model.skins.front();
-  if (skin.joints.empty()) r.fail("its skin has no joints");
-  if (skin.joints.size() > 65535) r.fail("its skin has too many joints");
-  const std::size_t jn = skin.joints.size();
-  std::vector<int> jointOfNode(model.nodes.size(), -1);
-  for (std::size_t j = 0; j < jn; ++j) {
-    const int node = skin.joints[j];
-    if (node < 0 || static_cast<std::size_t>(node) >= model.nodes.size()) r.fail(fmt::format("skin joint {} is not a node", node));
-    if (jointOfNode[static_cast<std::size_t>(node)] >= 0) r.fail(fmt::format("node {} is listed twice in the skin", node));
-    jointOfNode[static_cast<std::size_t>(node)] = static_cast<int>(j);
+  const std::vector<bool> inSkeleton = skinsOfTheSkeleton(model, r);
+  // The skeleton's joint nodes: the first skin's in its order (an unnamed one is called by
+  // its index there), then those the other skins add.
+  std::vector<int> nodes, jointOfNode(model.nodes.size(), -1);
+  for (std::size_t s = 0; s < model.skins.size(); ++s) {
+    if (!inSkeleton[s]) continue;
+    for (const int node : model.skins[s].joints) {
+      int& j = jointOfNode[static_cast<std::size_t>(node)];
+      if (j >= 0) {
+        if (s == 0) r.fail(fmt::format("node {} is listed twice in the skin", node));
+        continue;
+      }
+      j = static_cast<int>(nodes.size());
+      nodes.push_back(node);
+    }
   }
+  if (nodes.size() > 65535) r.fail("its skins have too many joints");
   auto depth = [&](int node) {
     int d = 0;
     for (int k = nodeParent[static_cast<std::size_t>(node)]; k >= 0; k = nodeParent[static_cast<std::size_t>(k)]) ++d;
     return d;
   };
+  const std::size_t jn = nodes.size();
   std::vector<std::size_t> order(jn);
   for (std::size_t j = 0; j < jn; ++j) order[j] = j;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return depth(skin.joints[a]) < depth(skin.joints[b]); });
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return depth(nodes[a]) < depth(nodes[b]); });
+  std::vector<int> kOf(jn);
+  for (std::size_t k = 0; k < jn; ++k) kOf[order[k]] = static_cast<int>(k);
   SkinJoints out;
-  out.newIndex.resize(jn);
-  for (std::size_t k = 0; k < jn; ++k) out.newIndex[order[k]] = static_cast<int>(k);
   for (std::size_t k = 0; k < jn; ++k) {
-    const int node = skin.joints[order[k]];
+    const int node = nodes[order[k]];
     out.node.push_back(node);
-    out.skinIndex.push_back(static_cast<int>(order[k]));
     out.name.push_back(model.nodes[static_cast<std::size_t>(node)].name.empty()
                            ? fmt::format("joint{}", order[k])
                            : model.nodes[static_cast<std::size_t>(node)].name);
     int parent = -1;
     for (int a = nodeParent[static_cast<std::size_t>(node)]; a >= 0; a = nodeParent[static_cast<std::size_t>(a)])
       if (jointOfNode[static_cast<std::size_t>(a)] >= 0) {
-        parent = out.newIndex[static_cast<std::size_t>(jointOfNode[static_cast<std::size_t>(a)])];
+        parent = kOf[static_cast<std::size_t>(jointOfNode[static_cast<std::size_t>(a)])];
         break;
       }
     out.parent.push_back(parent);
   }
+  out.newIndex.resize(model.skins.size());
+  for (std::size_t s = 0; s < model.skins.size(); ++s)
+    if (inSkeleton[s])
+      for (const int node : model.skins[s].joints)
+        out.newIndex[s].push_back(kOf[static_cast<std::size_t>(jointOfNode[static_cast<std::size_t>(node)])]);
   return out;
 }
 
@@ -578,37 +617,38 @@ SkinnedModel extract(const GModel& model, const std::string& name, const std::ve
   std::vector<int> nodeParent;
   const std::vector<Eigen::Matrix4d> world = nodeWorlds(model, nodeParent, r);
   const SkinJoints sj = skinJoints(model, nodeParent, r);
-  const GSkin& skin = model.skins.front();
-  const std::size_t jn = skin.joints.size();
-  const std::vector<int>& newIndex = sj.newIndex;
 
   SkinnedModel out;
   out.source = name;
   out.animations = animationNames(model);
-  for (std::size_t k = 0; k < jn; ++k) {
+  for (std::size_t k = 0; k < sj.node.size(); ++k) {
     SkinnedJoint joint;
     joint.name = sj.name[k];
     joint.parent = sj.parent[k];
     joint.restWorld = world[static_cast<std::size_t>(sj.node[k])];
     out.joints.push_back(joint);
   }
-  const std::vector<Eigen::Matrix4d> skinMatrix = skinMatrices(model, 0, world, r);
 
   std::vector<bool> matched(parts.size(), false);
   for (std::size_t ni = 0; ni < model.nodes.size(); ++ni) {
     const GNode& node = model.nodes[ni];
     if (node.skin < 0 || node.mesh < 0) continue;
     if (static_cast<std::size_t>(node.mesh) >= model.meshes.size()) r.fail(fmt::format("node {} names mesh {}, which does not exist", ni, node.mesh));
+    if (static_cast<std::size_t>(node.skin) >= model.skins.size()) r.fail(fmt::format("node {} names skin {}, which does not exist", ni, node.skin));
     const std::string part = partName(model, ni);
     const std::string& meshName = model.meshNames[static_cast<std::size_t>(node.mesh)];
-    if (node.skin != 0) {
-      // Another skeleton's mesh: drape reads one skin, the file's first.
+    const std::vector<int>& newIndex = sj.newIndex[static_cast<std::size_t>(node.skin)];
+    if (newIndex.empty()) {
+      // Another skeleton's mesh (a second character): not the avatar's.
       std::vector<bool> other(parts.size(), false);
       if (partWanted(parts, other, part, meshName) && !parts.empty())
-        r.fail(fmt::format("its mesh '{}' is moved by skin {}; drape reads the meshes of the file's first skin, skin 0",
+        r.fail(fmt::format("its mesh '{}' is moved by skin {}, whose joints are apart from the first skin's skeleton; "
+                           "drape reads the character of the file's first skin",
                            part, node.skin));
       continue;
     }
+    const std::size_t jn = newIndex.size();
+    const std::vector<Eigen::Matrix4d> skinMatrix = skinMatrices(model, static_cast<std::size_t>(node.skin), world, r);
     out.meshes.push_back(part);
     if (!partWanted(parts, matched, part, meshName)) continue;
     const std::size_t trianglesBefore = out.triangles.size();

@@ -73,13 +73,41 @@ TEST(AvatarMeshes, EveryMeshOfTheSkinIsReadUnlessSomeAreNamed) {
 TEST(AvatarMeshes, ANameThatIsNoMeshOfTheSkinListsThem) {
   EXPECT_EQ(errorOf([] { (void)readGltfSkinnedModel(clothed(), {"Body", "Hair"}); }),
             clothed() + ": has no node or mesh named 'Hair' (its skinned meshes: Body, Cape)");
-  // A mesh of a second skin: drape reads the first skin's meshes, and says so.
-  const std::string twoSkins = drape::testing::clothedCesiumMan(drape::testing::processTempDir("avatar-meshes-two-skins"),
-                                                                {.offset_m = 0.01, .capeSkinOfItsOwn = true});
-  EXPECT_EQ(readGltfSkinnedModel(twoSkins).meshes, (Names{"Body"}));
-  EXPECT_NE(errorOf([&] { (void)readGltfSkinnedModel(twoSkins, {"Cape"}); })
-                .find("its mesh 'Cape' is moved by skin 1; drape reads the meshes of the file's first skin, skin 0"),
+  // A mesh of a skin whose joints are apart from the body's (a second character): not read,
+  // and an error when named.
+  const std::string apart = drape::testing::clothedCesiumMan(drape::testing::processTempDir("avatar-meshes-apart"),
+                                                             {.capeSkin = drape::testing::CapeSkin::Apart});
+  EXPECT_EQ(readGltfSkinnedModel(apart).meshes, (Names{"Body"}));
+  EXPECT_NE(errorOf([&] { (void)readGltfSkinnedModel(apart, {"Cape"}); })
+                .find("its mesh 'Cape' is moved by skin 1, whose joints are apart from the first skin's skeleton"),
             std::string::npos);
+}
+
+TEST(AvatarMeshes, MeshesWithSkinsOfTheirOwnOverOneSkeletonAreOneAvatar) {
+  // Unity's and three.js's exporters write a skin per skinned mesh, each listing the joints
+  // in its own order: the cape's skin lists the body's joints reversed, its JOINTS_0
+  // renumbered to match. The avatar is the same as with one skin, joint for joint and vertex
+  // for vertex.
+  const SkinnedModel one = readGltfSkinnedModel(clothed());
+  for (const auto skin : {drape::testing::CapeSkin::Copy, drape::testing::CapeSkin::Reversed}) {
+    SCOPED_TRACE(static_cast<int>(skin));
+    const std::string path = drape::testing::clothedCesiumMan(
+        drape::testing::processTempDir("avatar-meshes-skin-" + std::to_string(static_cast<int>(skin))), {.capeSkin = skin});
+    const SkinnedModel two = readGltfSkinnedModel(path);
+    EXPECT_EQ(two.meshes, (Names{"Body", "Cape"}));
+    ASSERT_EQ(two.joints.size(), one.joints.size());
+    for (std::size_t j = 0; j < one.joints.size(); ++j) {
+      EXPECT_EQ(two.joints[j].name, one.joints[j].name);
+      EXPECT_EQ(two.joints[j].parent, one.joints[j].parent);
+    }
+    ASSERT_EQ(two.positions.size(), one.positions.size());
+    EXPECT_EQ(two.triangles, one.triangles);
+    EXPECT_EQ(two.vertexJoints, one.vertexJoints);
+    EXPECT_LT(largestMove(two.positions, one.positions), 1e-9);
+    // The file's animation drives every joint of the one skeleton.
+    const SkinnedJointMotion motion = readGltfJointMotion(path, 30.0, "");
+    EXPECT_EQ(motion.joints.size(), one.joints.size());
+  }
 }
 
 TEST(AvatarMeshes, ColladaAndFbxChooseTheirMeshesAsGltfDoes) {

@@ -1,8 +1,10 @@
 #pragma once
 // Skinned characters from glTF 2.0 (.gltf, .glb), read by drape's own reader (GLB chunks,
 // then the JSON through nlohmann_json) inside a limited child process (core/isolate.hpp),
-// handed back as plain data. Only the first skin and the triangle primitives of the nodes
-// that use it are read, and on request one animation as the motion of that skin's joints.
+// handed back as plain data. The skeleton is the first skin's joints and those of every
+// skin that shares joints with it (exporters that write one skin per mesh list one
+// skeleton's joints several times over); the triangle primitives of the nodes those skins
+// move are read, and on request one animation as the motion of the skeleton's joints.
 // (Debian's compiled tinygltf did not match its own header's struct layout in our build:
 // AddressSanitizer caught a bad free in Model's destructor.)
 //

@@ -6,6 +6,7 @@
 // `offset_m` (in the mesh's own space, before skinning). Test modules that include this
 // link nlohmann_json.
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -13,16 +14,23 @@
 #include <iterator>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 namespace drape::testing {
 
+/// Which skin moves the cape.
+enum class CapeSkin {
+  Body,      ///< the body's
+  Copy,      ///< a skin of its own listing the same joints (exporters that write one skin per mesh)
+  Reversed,  ///< a skin of its own listing the same joints in reverse order, its JOINTS_0 renumbered to match
+  Apart,     ///< a skin of one joint of its own, a node outside the body's skeleton (a second character)
+};
+
 struct ClothedAvatarOptions {
   double offset_m = 0.01;
-  /// Give the cape a skin of its own (a copy of the body's), as some exporters write one
-  /// skin per mesh: drape reads the file's first skin only.
-  bool capeSkinOfItsOwn = false;
+  CapeSkin capeSkin = CapeSkin::Body;
 };
 
 /// Writes DIR/clothed.gltf and DIR/clothed.bin; returns the .gltf's path.
@@ -52,6 +60,44 @@ inline std::string clothedCesiumMan(const std::filesystem::path& dir, const Clot
       }
     return out;
   };
+  // An accessor's components as numbers (floats, or unsigned bytes or shorts), `n` per element.
+  auto numbers = [&](int accessor, std::size_t n) {
+    const nlohmann::json& a = doc["accessors"][accessor];
+    const nlohmann::json& view = doc["bufferViews"][a["bufferView"].get<int>()];
+    const int type = a["componentType"].get<int>();
+    const std::size_t size = type == 5126 ? 4 : type == 5123 ? 2 : 1;
+    const std::size_t at = view.value("byteOffset", std::size_t{0}) + a.value("byteOffset", std::size_t{0});
+    const std::size_t stride = view.value("byteStride", n * size);
+    std::vector<double> out;
+    for (std::size_t e = 0; e < a["count"].get<std::size_t>(); ++e)
+      for (std::size_t c = 0; c < n; ++c) {
+        const char* q = bin.data() + at + e * stride + c * size;
+        float f = 0;
+        std::uint16_t u = 0;
+        if (size == 4) std::memcpy(&f, q, 4);
+        if (size == 2) std::memcpy(&u, q, 2);
+        out.push_back(size == 4 ? f : size == 2 ? u : static_cast<unsigned char>(*q));
+      }
+    return out;
+  };
+  // Appends `values` as a new accessor of `type` (floats, or unsigned shorts for 5123).
+  auto appendAccessor = [&](const std::vector<double>& values, int componentType, const char* type, std::size_t count) {
+    while (bin.size() % 4 != 0) bin.push_back('\0');
+    const std::size_t at = bin.size();
+    for (double v : values) {
+      if (componentType == 5126) {
+        const auto f = static_cast<float>(v);
+        bin.append(reinterpret_cast<const char*>(&f), 4);
+      } else {
+        const auto u = static_cast<std::uint16_t>(v);
+        bin.append(reinterpret_cast<const char*>(&u), 2);
+      }
+    }
+    doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", at}, {"byteLength", bin.size() - at}});
+    doc["accessors"].push_back(
+        {{"bufferView", doc["bufferViews"].size() - 1}, {"componentType", componentType}, {"count", count}, {"type", type}});
+    return static_cast<int>(doc["accessors"].size()) - 1;
+  };
   const std::vector<float> p = floats(body["attributes"]["POSITION"].get<int>());
   const std::vector<float> n = floats(body["attributes"]["NORMAL"].get<int>());
   while (bin.size() % 4 != 0) bin.push_back('\0');
@@ -72,12 +118,35 @@ inline std::string clothedCesiumMan(const std::filesystem::path& dir, const Clot
   cape["attributes"]["POSITION"] = doc["accessors"].size() - 1;
   doc["meshes"].push_back({{"name", "CapeMesh"}, {"primitives", {cape}}});
 
-  // Node 1 places the body; the cape goes beside it under the same parent.
+  // The cape's skin.
   int skin = 0;
-  if (options.capeSkinOfItsOwn) {
+  const std::size_t vertices = p.size() / 3;
+  if (options.capeSkin == CapeSkin::Copy) {
     doc["skins"].push_back(doc["skins"][0]);
-    skin = static_cast<int>(doc["skins"].size()) - 1;
+    skin = 1;
+  } else if (options.capeSkin == CapeSkin::Reversed) {
+    nlohmann::json reversed = doc["skins"][0];
+    const std::size_t n = reversed["joints"].size();
+    std::reverse(reversed["joints"].begin(), reversed["joints"].end());
+    const std::vector<double> bind = numbers(reversed["inverseBindMatrices"].get<int>(), 16);
+    std::vector<double> bindReversed;
+    for (std::size_t j = n; j-- > 0;) bindReversed.insert(bindReversed.end(), bind.begin() + 16 * j, bind.begin() + 16 * (j + 1));
+    reversed["inverseBindMatrices"] = appendAccessor(bindReversed, 5126, "MAT4", n);
+    std::vector<double> joints = numbers(body["attributes"]["JOINTS_0"].get<int>(), 4);
+    for (double& j : joints) j = static_cast<double>(n - 1) - j;
+    doc["skins"].push_back(reversed);
+    skin = 1;
+    cape["attributes"]["JOINTS_0"] = appendAccessor(joints, 5123, "VEC4", vertices);
+  } else if (options.capeSkin == CapeSkin::Apart) {
+    doc["nodes"].push_back({{"name", "Prop"}});
+    doc["nodes"][0]["children"].push_back(doc["nodes"].size() - 1);
+    doc["skins"].push_back({{"joints", {doc["nodes"].size() - 1}}});
+    skin = 1;
+    cape["attributes"]["JOINTS_0"] = appendAccessor(std::vector<double>(4 * vertices, 0.0), 5123, "VEC4", vertices);
   }
+  doc["meshes"].back()["primitives"][0] = cape;
+
+  // Node 1 places the body; the cape goes beside it under the same parent.
   doc["nodes"][1]["name"] = "Body";
   doc["nodes"].push_back({{"name", "Cape"}, {"mesh", doc["meshes"].size() - 1}, {"skin", skin}});
   const std::size_t capeNode = doc["nodes"].size() - 1;

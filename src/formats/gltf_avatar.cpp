@@ -603,6 +603,24 @@ std::vector<Eigen::Matrix4d> skinMatrices(const GModel& model, std::size_t index
   return out;
 }
 
+// Which nodes the file's scene shows: those under its root nodes (every node when the file
+// has no scenes). A node outside it (a collision proxy, another scene's) is not read.
+std::vector<bool> shownNodes(const GModel& model, const std::vector<int>& nodeParent, const GltfReader& r) {
+  const std::size_t n = model.nodes.size();
+  if (!model.sceneRoots) return std::vector<bool>(n, true);
+  std::vector<bool> root(n, false), shown(n, false);
+  for (int k : *model.sceneRoots) {
+    if (k < 0 || static_cast<std::size_t>(k) >= n) r.fail(fmt::format("the scene names node {}, which does not exist", k));
+    root[static_cast<std::size_t>(k)] = true;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t top = i;  // the hierarchy has no cycles: nodeWorlds checked it
+    while (nodeParent[top] >= 0 && !root[top]) top = static_cast<std::size_t>(nodeParent[top]);
+    shown[i] = root[top];
+  }
+  return shown;
+}
+
 // What a mesh placed by node `ni` is called: its node's name, else its mesh's, else "node <ni>".
 std::string partName(const GModel& model, std::size_t ni) {
   const GNode& node = model.nodes[ni];
@@ -617,6 +635,7 @@ SkinnedModel extract(const GModel& model, const std::string& name, const std::ve
   std::vector<int> nodeParent;
   const std::vector<Eigen::Matrix4d> world = nodeWorlds(model, nodeParent, r);
   const SkinJoints sj = skinJoints(model, nodeParent, r);
+  const std::vector<bool> shown = shownNodes(model, nodeParent, r);
 
   SkinnedModel out;
   out.source = name;
@@ -632,7 +651,8 @@ SkinnedModel extract(const GModel& model, const std::string& name, const std::ve
   std::vector<bool> matched(parts.size(), false);
   for (std::size_t ni = 0; ni < model.nodes.size(); ++ni) {
     const GNode& node = model.nodes[ni];
-    if (node.skin < 0 || node.mesh < 0) continue;
+    // A node no scene shows (a collision proxy, another level of detail) is not the body's.
+    if (node.skin < 0 || node.mesh < 0 || !shown[ni]) continue;
     if (static_cast<std::size_t>(node.mesh) >= model.meshes.size()) r.fail(fmt::format("node {} names mesh {}, which does not exist", ni, node.mesh));
     if (static_cast<std::size_t>(node.skin) >= model.skins.size()) r.fail(fmt::format("node {} names skin {}, which does not exist", ni, node.skin));
     const std::string part = partName(model, ni);
@@ -777,24 +797,6 @@ std::vector<Vec3> restPositions(const GPrimitive& prim, const Eigen::Matrix4d& n
     out.emplace_back(h.x(), h.y(), h.z());
   }
   return out;
-}
-
-// Which nodes the file's scene shows: those under its root nodes (every node when the file
-// has no scenes). A node outside it (a collision proxy, another scene's) is not read.
-std::vector<bool> shownNodes(const GModel& model, const std::vector<int>& nodeParent, const GltfReader& r) {
-  const std::size_t n = model.nodes.size();
-  if (!model.sceneRoots) return std::vector<bool>(n, true);
-  std::vector<bool> root(n, false), shown(n, false);
-  for (int k : *model.sceneRoots) {
-    if (k < 0 || static_cast<std::size_t>(k) >= n) r.fail(fmt::format("the scene names node {}, which does not exist", k));
-    root[static_cast<std::size_t>(k)] = true;
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    std::size_t top = i;  // the hierarchy has no cycles: nodeWorlds checked it
-    while (nodeParent[top] >= 0 && !root[top]) top = static_cast<std::size_t>(nodeParent[top]);
-    shown[i] = root[top];
-  }
-  return shown;
 }
 
 MeshParts extractMesh(const GModel& model, const std::string& name, const std::vector<std::string>& parts, bool loose) {

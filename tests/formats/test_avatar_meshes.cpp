@@ -4,8 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "drape/formats/assimp_avatar.hpp"
 #include "drape/formats/gltf_avatar.hpp"
@@ -55,7 +60,7 @@ TEST(AvatarMeshes, EveryMeshOfTheSkinIsReadUnlessSomeAreNamed) {
   EXPECT_LT(largestMove(body.positions, plain.positions), 1e-12);
 
   // The cape by its node's name and by its mesh's: the body pushed out by about a centimetre.
-  for (const std::string& name : {"Cape", "CapeMesh"}) {
+  for (const char* name : {"Cape", "CapeMesh"}) {
     SCOPED_TRACE(name);
     const SkinnedModel cape = readGltfSkinnedModel(clothed(), {name});
     EXPECT_EQ(cape.meshesRead, (Names{"Cape"}));
@@ -81,6 +86,22 @@ TEST(AvatarMeshes, ANameThatIsNoMeshOfTheSkinListsThem) {
   EXPECT_NE(errorOf([&] { (void)readGltfSkinnedModel(apart, {"Cape"}); })
                 .find("its mesh 'Cape' is moved by skin 1, whose joints are apart from the first skin's skeleton"),
             std::string::npos);
+}
+
+TEST(AvatarMeshes, AMeshNoSceneShowsIsNotTheBodys) {
+  // The cape's node taken out of the node tree the scene shows: a proxy nothing draws.
+  std::ifstream in(clothed());
+  nlohmann::json doc = nlohmann::json::parse(in);
+  const std::size_t cape = doc["nodes"].size() - 1;
+  ASSERT_EQ(doc["nodes"][cape]["name"], "Cape");
+  for (nlohmann::json& node : doc["nodes"])
+    if (node.contains("children"))
+      node["children"].erase(std::remove(node["children"].begin(), node["children"].end(), cape), node["children"].end());
+  const std::string path = (std::filesystem::path(clothed()).parent_path() / "proxy.gltf").string();
+  std::ofstream(path) << doc.dump();
+  const SkinnedModel read = readGltfSkinnedModel(path);
+  EXPECT_EQ(read.meshes, (Names{"Body"}));
+  EXPECT_EQ(read.triangles, cesiumMan().triangles);
 }
 
 TEST(AvatarMeshes, MeshesWithSkinsOfTheirOwnOverOneSkeletonAreOneAvatar) {

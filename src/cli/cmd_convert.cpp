@@ -95,7 +95,7 @@ motion::AvatarAnimation retargeted(const scene::Avatar& avatar) {
 std::vector<formats::SkinnedJointMotion> ownAnimations() {
   if (!formats::isAvatarMotionPath(input)) {
     if (!animationName.empty())
-      throw Error(fmt::format("--animation {}: {} carries no animations (.glb, .gltf, .dae, .fbx and H-Anim .wrl files can)",
+      throw Error(fmt::format("--animation {}: {} carries no animations (.glb, .gltf, .vrm, .dae, .fbx and H-Anim .wrl files can)",
                               animationName, input));
     return {};
   }
@@ -136,7 +136,7 @@ void writeHanimWithMotion(const scene::Avatar& avatar) {
 
 RunFunction setupConvert(CLI::App& app) {
   app.add_option("avatar", input,
-                 "The avatar to convert: .glb, .gltf, .dae, .fbx, MakeHuman .mhskel (mesh and weights beside it), or "
+                 "The avatar to convert: .glb, .gltf, .vrm, .dae, .fbx, MakeHuman .mhskel (mesh and weights beside it), or "
                  "an H-Anim VRML97 humanoid (.wrl; segmented, so to .wrl only)")
       ->required();
   app.add_option("--to", output,

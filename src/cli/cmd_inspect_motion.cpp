@@ -1,4 +1,4 @@
-// `drape inspect FILE.bvh|.amc|.asf|.glb|.gltf|.dae|.fbx|.mhskel`: skeleton, frame count, rate,
+// `drape inspect FILE.bvh|.amc|.asf|.glb|.gltf|.vrm|.dae|.fbx|.mhskel`: skeleton, frame count, rate,
 // duration and the units guess of motion files; joints and segments of avatars; the humanoid
 // each skeleton's shape shows.
 
@@ -173,7 +173,7 @@ void inspectAvatar(const std::string& path, std::ostream& out) {
 
 const bool bvh = registerInspector({".bvh"}, "BVH motion: skeleton, frames, rate, duration, units guess", &inspectBvh);
 const bool acclaim = registerInspector({".amc", ".asf"}, "Acclaim (CMU) ASF skeletons and AMC motion", &inspectAcclaim);
-const bool avatars = registerInspector({".glb", ".gltf", ".dae", ".fbx", ".mhskel"}, "skinned avatars: joints, skin, segments (a file without a skin: its meshes, as a garment)", &inspectAvatar);
+const bool avatars = registerInspector({".glb", ".gltf", ".vrm", ".dae", ".fbx", ".mhskel"}, "skinned avatars: joints, skin, segments (a file without a skin: its meshes, as a garment)", &inspectAvatar);
 
 }  // namespace
 }  // namespace drape::cli

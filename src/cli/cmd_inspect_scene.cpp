@@ -104,6 +104,11 @@ void printHumanoidMotions(const std::string& path, const scene::Scene& s, std::o
 void printAvatarFile(const std::string& path, const scene::Avatar& avatar, std::ostream& out) {
   fmt::print(out, "    {}: {} joints, {} segments{}\n", avatar.source, avatar.joints.size(), avatar.segments.size(),
              avatar.skin ? fmt::format(", a skin of {} triangles", avatar.skin->mesh.triangleCount()) : "");
+  if (avatar.fileMeshes.size() > 1)
+    fmt::print(out, "    its skin moves {} meshes ({}); the body is {}\n", avatar.fileMeshes.size(),
+               fmt::join(avatar.fileMeshes, ", "),
+               avatar.meshesRead.size() == avatar.fileMeshes.size() ? std::string("every one")
+                                                                   : fmt::format("{}", fmt::join(avatar.meshesRead, ", ")));
   if (!avatar.animations.empty())
     fmt::print(out, "    its file carries {} animation{} ('{}')\n", avatar.animations.size(),
                avatar.animations.size() == 1 ? "" : "s", fmt::join(avatar.animations, "', '"));
@@ -151,7 +156,8 @@ void inspectScene(const std::string& path, std::ostream& out) {
   }
   if (!s.avatars.empty()) printHumanoidMotions(path, s, out);
   for (const scene::ExternalAvatar& a : s.externalAvatars)
-    fmt::print(out, "  {} (from {}){}{}\n", a.name, fmt::join(a.urls, ", "),
+    fmt::print(out, "  {} (from {}){}{}{}\n", a.name, fmt::join(a.urls, ", "),
+               a.meshes.empty() ? "" : fmt::format(", its body the meshes {}", fmt::join(a.meshes, ", ")),
                a.jointMap.empty() ? "" : fmt::format(", joint map {}", fmt::join(a.jointMap, ", ")),
                a.cutAtJoints.empty() ? "" : fmt::format(", parts cut across joints {}", fmt::join(a.cutAtJoints, ", ")));
   if (!s.externalAvatars.empty() || s.avatars.size() > 1) printCharacters(path, s, out);

@@ -328,10 +328,10 @@ int addGarment(MakeSceneOptions& o) {
 RunFunction setupMakeScene(CLI::App& app) {
   static MakeSceneOptions o;
   app.add_option("avatar", o.avatar,
-                 "Avatar file the garment was modelled on (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel, or a VRML97 "
+                 "Avatar file the garment was modelled on (.glb, .gltf, .vrm, .dae, .fbx, MakeHuman .mhskel, or a VRML97 "
                  "H-Anim humanoid .wrl; one standing along +z is stood up with the garment); not with --add-to");
   app.add_option("--garment", o.garment,
-                 "Garment in the avatar's rest pose: OBJ, glTF (.glb, .gltf), Collada (.dae) or FBX (.fbx), its "
+                 "Garment in the avatar's rest pose: OBJ, glTF (.glb, .gltf, .vrm), Collada (.dae) or FBX (.fbx), its "
                  "vertices welded where those files split them; or a MakeHuman .mhclo (refitted to the MakeHuman body)")
       ->required();
   app.add_option("--garment-parts", o.garmentParts,

@@ -262,7 +262,7 @@ int addSkirt(MakeSkirtOptions o) {
 
 RunFunction setupMakeSkirt(CLI::App& app) {
   static MakeSkirtOptions o;
-  app.add_option("avatar", o.avatar, "Avatar file to fit the skirt to (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel, or a VRML97 "
+  app.add_option("avatar", o.avatar, "Avatar file to fit the skirt to (.glb, .gltf, .vrm, .dae, .fbx, MakeHuman .mhskel, or a VRML97 "
                  "H-Anim humanoid .wrl; one standing along +z is stood up); not with --add-to");
   app.add_option("--out", o.out,
                  "Directory for scene.wrl, skirt.obj and waistband.obj (with --name, NAME.obj and NAME_waistband.obj; "

@@ -412,7 +412,7 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--garment", o->garment,
                  "Garment mesh (OBJ, or glTF, Collada or FBX: every mesh of the file, welded where it splits "
                  "vertices), instead of a scene");
-  app.add_option("--avatar", o->avatar, "Avatar to wear --garment (.glb, .gltf, .dae, .fbx, MakeHuman .mhskel)");
+  app.add_option("--avatar", o->avatar, "Avatar to wear --garment (.glb, .gltf, .vrm, .dae, .fbx, MakeHuman .mhskel)");
   app.add_option("--avatar-meshes", o->avatarMeshes,
                  "With --avatar: its file's skinned meshes that make the body, by node or mesh name (a character file "
                  "that holds its clothes or hair too); default: every mesh of its skin")

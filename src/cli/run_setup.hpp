@@ -173,7 +173,7 @@ void addEvents(RunSetup& setup, const std::string& graphPath, const std::vector<
 
 /// --motion's help after "Motion for the avatar ", and --animation's, for run, play and render.
 inline constexpr const char* kMotionHelp =
-    "(.bvh, .amc; an avatar file's animation, .glb, .gltf, .dae, .fbx; or an H-Anim humanoid's interpolators, .wrl), "
+    "(.bvh, .amc; an avatar file's animation, .glb, .gltf, .vrm, .dae, .fbx; or an H-Anim humanoid's interpolators, .wrl), "
     "retargeted unless the avatar is that file's; none: at rest. Without it, the avatar plays its own file's "
     "animation if the file carries one (a glTF, Collada or FBX animation, or interpolators ROUTEd into a VRML97 "
     "Humanoid)";

@@ -11,14 +11,9 @@
 namespace drape::formats {
 namespace {
 
-bool isGltfPath(const std::string& path) {
-  const std::string ext = lowerExtension(path);
-  return ext == ".glb" || ext == ".gltf";
-}
-
 void checkPath(const std::string& path) {
   if (!isAvatarMotionPath(path))
-    throw Error(fmt::format("{}: drape reads an avatar's own animations from .glb, .gltf, .dae, .fbx and VRML97 (.wrl) "
+    throw Error(fmt::format("{}: drape reads an avatar's own animations from .glb, .gltf, .vrm, .dae, .fbx and VRML97 (.wrl) "
                             "files, not '{}'",
                             path, lowerExtension(path)));
 }

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drape/core/error.hpp"
+#include "drape/core/files.hpp"
 #include "drape/formats/json_text.hpp"
 #include "drape/formats/mesh_file.hpp"
 #include "plain_data.hpp"
@@ -1018,6 +1019,11 @@ GltfJointMotion sampleJointMotion(const GModel& model, const std::string& name, 
 }
 
 }  // namespace
+
+bool isGltfPath(const std::string& path) {
+  const std::string ext = lowerExtension(path);
+  return ext == ".glb" || ext == ".gltf" || ext == ".vrm";
+}
 
 SkinnedModel parseGltfSkinnedModel(std::string_view bytes, const std::string& name, const std::string& baseDir,
                                    const std::vector<std::string>& parts) {

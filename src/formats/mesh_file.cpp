@@ -8,6 +8,7 @@
 
 #include "drape/core/error.hpp"
 #include "drape/core/files.hpp"
+#include "drape/formats/gltf_avatar.hpp"
 #include "drape/formats/obj.hpp"
 #include "drape/mesh/weld.hpp"
 #include "plain_data.hpp"
@@ -54,7 +55,7 @@ constexpr std::size_t kMaxMeshFileBytes = std::size_t{1} << 30;
 MeshParts readIsolated(const std::string& path, const std::string& ext, const std::vector<std::string>& parts, bool loose,
                        const IsolationLimits& limits) {
   const std::string bytes = detail::readWholeFile(path, kMaxMeshFileBytes);
-  if (ext == ".gltf" || ext == ".glb") {
+  if (isGltfPath(path)) {
     const std::string baseDir = std::filesystem::absolute(path).parent_path().string();
     return deserialiseMeshParts(
         runIsolated(path, "glTF reader", [&] { return serialise(parseGltfMesh(bytes, path, baseDir, parts, loose)); }, limits), path);
@@ -105,7 +106,7 @@ std::string describeRead(const MeshFile& file) {
 
 bool isMeshFilePath(const std::string& path) {
   const std::string ext = lowerExtension(path);
-  return ext == ".obj" || ext == ".gltf" || ext == ".glb" || ext == ".dae" || ext == ".fbx";
+  return ext == ".obj" || isGltfPath(path) || ext == ".dae" || ext == ".fbx";
 }
 
 MeshFile readMeshFile(const std::string& path, const MeshFileOptions& options, const IsolationLimits& limits) {
@@ -122,7 +123,7 @@ MeshFile readMeshFile(const std::string& path, const MeshFileOptions& options, c
     return out;
   }
   if (!isMeshFilePath(path))
-    throw Error(fmt::format("{}: drape reads meshes from OBJ, glTF (.gltf, .glb), Collada (.dae) and FBX (.fbx), not '{}'",
+    throw Error(fmt::format("{}: drape reads meshes from OBJ, glTF (.gltf, .glb, .vrm), Collada (.dae) and FBX (.fbx), not '{}'",
                             path, ext));
   if (!(options.weldTolerance_m > 0.0) || !std::isfinite(options.weldTolerance_m))
     throw Error(fmt::format("{}: the weld tolerance must be > 0 m, got {}", path, options.weldTolerance_m));

@@ -735,7 +735,7 @@ AvatarAnimation loadAnimation(const scene::Avatar& avatar, const std::string& mo
     return AvatarAnimation::build(avatar, clip, map, options.retarget);
   }
   if (!options.animation.empty())
-    throw Error(fmt::format("--animation: {} is not an avatar file (.glb, .gltf, .dae, .fbx, .wrl); animations are chosen "
+    throw Error(fmt::format("--animation: {} is not an avatar file (.glb, .gltf, .vrm, .dae, .fbx, .wrl); animations are chosen "
                             "from an avatar's own file",
                             motionPath));
   const Clip clip = loadClip(motionPath, options.clip, report);

@@ -84,7 +84,7 @@ Avatar loadHumanoidFile(const std::string& path) {
 
 Avatar loadAvatarFile(const std::string& path, const std::vector<std::string>& meshes) {
   const std::string ext = lowerExtension(path);
-  if (ext == ".glb" || ext == ".gltf") return loadGltfAvatar(path, meshes);
+  if (formats::isGltfPath(path)) return loadGltfAvatar(path, meshes);
   if (ext == ".dae" || ext == ".fbx") return loadAssimpAvatar(path, meshes);
   if (!meshes.empty())
     throw Error(fmt::format("{}: meshes ({}) choose among the skinned meshes of a glTF, Collada or FBX avatar; "
@@ -92,7 +92,7 @@ Avatar loadAvatarFile(const std::string& path, const std::vector<std::string>& m
                             path, fmt::join(meshes, ", "), ext == ".mhskel" ? "MakeHuman" : "VRML97 H-Anim"));
   if (ext == ".mhskel") return loadMakeHumanAvatar(path);
   if (formats::isVrmlPath(path)) return loadHumanoidFile(path);
-  throw Error(fmt::format("{}: drape reads avatars from .glb, .gltf, .dae, .fbx, MakeHuman .mhskel and VRML97 H-Anim "
+  throw Error(fmt::format("{}: drape reads avatars from .glb, .gltf, .vrm, .dae, .fbx, MakeHuman .mhskel and VRML97 H-Anim "
                           "(.wrl) files, not '{}'",
                           path, ext));
 }

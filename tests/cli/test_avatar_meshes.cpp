@@ -71,6 +71,10 @@ TEST(AvatarMeshes, ACharacterFileWithItsClothesCollidesTheClothWithTheBodyAlone)
   ASSERT_EQ(body.code, 0) << body.err;
   EXPECT_NE(testing::slurp(dir / "body/scene.wrl").find("  meshes [ \"Body\" ]\n"), std::string::npos);
   EXPECT_NE(body.out.find(clothed + ": the body is Body of its meshes Body, Cape\n"), std::string::npos) << body.out;
+  const CliResult inspected = runDrape("inspect '" + (dir / "body/scene.wrl") + "'", dir);
+  EXPECT_NE(inspected.out.find(", its body the meshes Body"), std::string::npos) << inspected.out;
+  EXPECT_NE(inspected.out.find("its skin moves 2 meshes (Body, Cape); the body is Body\n"), std::string::npos)
+      << inspected.out;
   const nlohmann::json alone = run("body");
   EXPECT_LT(alone.at("pairs_embedded_at_start").get<int>(), 20);
   EXPECT_EQ(alone.at("vertex_substeps_below_T1").get<long>(), 0);

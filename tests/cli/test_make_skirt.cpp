@@ -367,7 +367,7 @@ TEST(MakeSkirt, CesiumMansSkirtWalksOnItsOwnAnimation) {
                                  dir);
   EXPECT_EQ(bvh.code, 2);
   EXPECT_NE(bvh.err.find("--animation: " + testing::kSkirtDir +
-                         "/walk.bvh is not an avatar file (.glb, .gltf, .dae, .fbx, .wrl); animations are chosen from an avatar's own file"),
+                         "/walk.bvh is not an avatar file (.glb, .gltf, .vrm, .dae, .fbx, .wrl); animations are chosen from an avatar's own file"),
             std::string::npos)
       << bvh.err;
 

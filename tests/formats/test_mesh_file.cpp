@@ -288,7 +288,7 @@ TEST(MeshFile, AnObjsGroupsAreItsParts) {
 TEST(MeshFile, ErrorsNameTheFile) {
   using drape::testing::errorOf;
   EXPECT_EQ(errorOf([] { (void)readMeshFile("skirt.stl"); }),
-            "skirt.stl: drape reads meshes from OBJ, glTF (.gltf, .glb), Collada (.dae) and FBX (.fbx), not '.stl'");
+            "skirt.stl: drape reads meshes from OBJ, glTF (.gltf, .glb, .vrm), Collada (.dae) and FBX (.fbx), not '.stl'");
   const std::filesystem::path dir = drape::testing::processTempDir("mesh-file-bad");
   std::ofstream(dir / "bad.glb") << "glTF but not really";
   EXPECT_NE(errorOf([&] { (void)readMeshFile((dir / "bad.glb").string()); }).find((dir / "bad.glb").string() + ": "),

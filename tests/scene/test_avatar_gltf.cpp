@@ -3,8 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+
+#include <nlohmann/json.hpp>
 
 #include "drape/core/error.hpp"
 #include "drape/scene/avatar_gltf.hpp"
@@ -127,9 +132,42 @@ TEST(HumanoidFile, OneHumanoidIsAnAvatarNoneOrSeveralAreErrors) {
             two + ": holds 2 H-Anim Humanoids ('a', 'b'); an avatar file holds one");
 }
 
+/// CesiumMan as VRoid Studio and UniVRM save their characters: a binary glTF named .vrm,
+/// using VRM's extension (its humanoid bone map, which drape finds by shape instead).
+std::string cesiumManAsVrm() {
+  std::ifstream in(avatarData("CesiumMan.glb"), std::ios::binary);
+  const std::string glb((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::uint32_t jsonLength = 0;
+  std::memcpy(&jsonLength, glb.data() + 12, 4);
+  nlohmann::json doc = nlohmann::json::parse(glb.substr(20, jsonLength));
+  doc["extensionsUsed"] = {"VRM"};
+  doc["extensions"]["VRM"] = {{"specVersion", "0.0"}, {"humanoid", {{"humanBones", {{{"bone", "hips"}, {"node", 2}}}}}}};
+  std::string json = doc.dump();
+  while (json.size() % 4 != 0) json += ' ';
+  const std::string binChunk = glb.substr(20 + jsonLength);  // its length, type and bytes
+  const auto u32 = [](std::uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+  const std::string vrm = "glTF" + u32(2) + u32(static_cast<std::uint32_t>(12 + 8 + json.size() + binChunk.size())) +
+                          u32(static_cast<std::uint32_t>(json.size())) + "JSON" + json + binChunk;
+  const std::string path = (drape::testing::processTempDir("vrm") / "CesiumMan.vrm").string();
+  std::ofstream(path, std::ios::binary) << vrm;
+  return path;
+}
+
+TEST(GltfAvatar, AVrmIsReadAsTheGlbItIs) {
+  const Avatar glb = loadAvatarFile(avatarData("CesiumMan.glb"));
+  const Avatar vrm = loadAvatarFile(cesiumManAsVrm());
+  ASSERT_TRUE(vrm.skin.has_value());
+  EXPECT_EQ(vrm.skin->mesh.positions, glb.skin->mesh.positions);
+  EXPECT_EQ(vrm.skin->mesh.triangles, glb.skin->mesh.triangles);
+  ASSERT_EQ(vrm.joints.size(), glb.joints.size());
+  for (std::size_t j = 0; j < glb.joints.size(); ++j) EXPECT_EQ(vrm.joints[j].name, glb.joints[j].name);
+  EXPECT_EQ(vrm.segments.size(), glb.segments.size());
+  EXPECT_EQ(vrm.animations, glb.animations);
+}
+
 TEST(GltfAvatar, UnknownAvatarExtension) {
   EXPECT_EQ(errorOf([] { (void)loadAvatarFile("x.obj"); }),
-            "x.obj: drape reads avatars from .glb, .gltf, .dae, .fbx, MakeHuman .mhskel and VRML97 H-Anim (.wrl) files, not '.obj'");
+            "x.obj: drape reads avatars from .glb, .gltf, .vrm, .dae, .fbx, MakeHuman .mhskel and VRML97 H-Anim (.wrl) files, not '.obj'");
 }
 
 }  // namespace

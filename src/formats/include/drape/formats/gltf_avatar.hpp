@@ -23,6 +23,10 @@
 
 namespace drape::formats {
 
+/// True for the extensions of glTF files (".gltf", ".glb", and ".vrm": VRoid Studio's and
+/// UniVRM's avatars, binary glTF with VRM's extensions, which drape does not need; any case).
+[[nodiscard]] bool isGltfPath(const std::string& path);
+
 // The glTF reader's result is the neutral plain data every skinned reader returns.
 using GltfJoint = SkinnedJoint;
 using GltfSkinnedModel = SkinnedModel;

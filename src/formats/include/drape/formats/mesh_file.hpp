@@ -44,7 +44,7 @@ struct MeshFile {
 /// (an OBJ, nothing welded or dropped).
 [[nodiscard]] std::string describeRead(const MeshFile& file);
 
-/// True for the extensions readMeshFile takes (".obj", ".gltf", ".glb", ".dae", ".fbx"; any case).
+/// True for the extensions readMeshFile takes (".obj", ".gltf", ".glb", ".vrm", ".dae", ".fbx"; any case).
 [[nodiscard]] bool isMeshFilePath(const std::string& path);
 
 /// Reads a mesh file of any of those formats. Throws drape::Error naming the file: an

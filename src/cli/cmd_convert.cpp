@@ -71,6 +71,7 @@ formats::HanimMotion hanimMotion(const scene::Avatar& a, const motion::AvatarAni
 
 // The command line (CLI11 binds options to variables that outlive setupConvert).
 std::string input, output, motionPath, jointMap, animationName;
+std::vector<std::string> avatarMeshes;  ///< --avatar-meshes: the skinned meshes to convert
 double rate = 30.0, motionScale = 0.0;
 
 // --motion: the motion as `drape run --motion` plays it on this avatar (retargeted,
@@ -139,6 +140,10 @@ RunFunction setupConvert(CLI::App& app) {
                  "The avatar to convert: .glb, .gltf, .vrm, .dae, .fbx, MakeHuman .mhskel (mesh and weights beside it), or "
                  "an H-Anim VRML97 humanoid (.wrl; segmented, so to .wrl only)")
       ->required();
+  app.add_option("--avatar-meshes", avatarMeshes,
+                 "Of an avatar file whose skin moves several meshes (drape inspect FILE lists them), those to convert, "
+                 "by node or mesh name (the body without the clothes the file holds too)")
+      ->delimiter(',');
   app.add_option("--to", output,
                  "Output file: a segmented H-Anim 1.1 VRML97 humanoid (.wrl) with one motion as its joints' "
                  "interpolators, or the skinned mesh and skeleton as Collada (.dae, metres) or ASCII FBX (.fbx, "
@@ -166,7 +171,7 @@ RunFunction setupConvert(CLI::App& app) {
     const bool skinned = formats::isAssimpAvatarPath(output);
     if (ext != ".wrl" && !skinned)
       throw Error(fmt::format("--to {}: drape converts avatars to H-Anim VRML97 (.wrl), Collada (.dae) or FBX (.fbx)", output));
-    const scene::Avatar avatar = scene::loadAvatarFile(input);
+    const scene::Avatar avatar = scene::loadAvatarFile(input, avatarMeshes);
     if (skinned && !avatar.skin)
       throw Error(fmt::format("--to {}: {} is a segmented avatar (rigid parts, no skin and weights), which Collada and "
                               "FBX skinned models cannot carry; convert it --to .wrl",

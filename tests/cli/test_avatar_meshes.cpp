@@ -89,6 +89,17 @@ TEST(AvatarMeshes, ACharacterFileWithItsClothesCollidesTheClothWithTheBodyAlone)
   EXPECT_GT(run("all").at("pairs_embedded_at_start").get<int>(), 1000);
 }
 
+TEST(AvatarMeshes, ConvertWritesTheMeshesChosen) {
+  ScratchDir dir("avatar-meshes-convert");
+  const std::string clothed = testing::clothedCesiumMan(dir / "clothed");
+  const CliResult body = runDrape("convert '" + clothed + "' --avatar-meshes Body --to '" + (dir / "body.dae") + "'", dir);
+  ASSERT_EQ(body.code, 0) << body.err;
+  const CliResult inspected = runDrape("inspect '" + (dir / "body.dae") + "'", dir);
+  ASSERT_EQ(inspected.code, 0) << inspected.err;
+  EXPECT_NE(inspected.out.find(" vertices, 4672 triangles, height 1.507 m\n"), std::string::npos) << inspected.out;
+  EXPECT_EQ(inspected.out.find("  meshes "), std::string::npos) << inspected.out;
+}
+
 TEST(AvatarMeshes, InspectListsTheMeshesAndAWrongNameIsRefusedWithThem) {
   ScratchDir dir("avatar-meshes-errors");
   const std::string clothed = testing::clothedCesiumMan(dir / "clothed");

@@ -14,26 +14,17 @@
 
 #include "drape/cloth/material.hpp"
 #include "drape/core/error.hpp"
+#include "drape/formats/vrml_write.hpp"
 #include "drape/mesh/trimesh.hpp"
 #include "stitch_gaps.hpp"
 
 namespace drape::cli {
 
-/// A VRML97 string: quoted, with its quotes and backslashes escaped.
-inline std::string vrmlString(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
 /// An MFString field's line of an Avatar node (`  NAME [ "A", "B" ]`), or "" for none.
 inline std::string stringsField(const std::string& name, const std::vector<std::string>& values) {
   if (values.empty()) return "";
   std::vector<std::string> quoted;
-  for (const std::string& v : values) quoted.push_back(vrmlString(v));
+  for (const std::string& v : values) quoted.push_back(formats::vrml::quotedString(v));
   return fmt::format("  {} [ {} ]\n", name, fmt::join(quoted, ", "));
 }
 

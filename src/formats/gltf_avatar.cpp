@@ -662,7 +662,7 @@ SkinnedModel extract(const GModel& model, const std::string& name, const std::ve
     if (newIndex.empty()) {
       // Another skeleton's mesh (a second character): not the avatar's.
       std::vector<bool> other(parts.size(), false);
-      if (partWanted(parts, other, part, meshName) && !parts.empty())
+      if (!parts.empty() && partWanted(parts, other, part, meshName))
         r.fail(fmt::format("its mesh '{}' is moved by skin {}, whose joints are apart from the first skin's skeleton; "
                            "drape reads the character of the file's first skin",
                            part, node.skin));

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "drape/core/error.hpp"
+#include "drape/formats/vrml_write.hpp"
 
 namespace drape::formats {
 namespace {
@@ -91,17 +92,8 @@ PROTO Humanoid [
 }
 )";
 
-std::string quote(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
 void writeSegment(std::string& out, const HanimSegmentData& s, const std::string& def, const std::string& indent) {
-  out += fmt::format("{}DEF {} Segment {{\n{}  name {}\n{}  children [\n", indent, def, indent, quote(s.name), indent);
+  out += fmt::format("{}DEF {} Segment {{\n{}  name {}\n{}  children [\n", indent, def, indent, vrml::quotedString(s.name), indent);
   out += fmt::format("{}    Shape {{\n{}      appearance Appearance {{ material Material {{ diffuseColor 0.8 0.7 0.6 }} }}\n", indent, indent);
   out += fmt::format("{}      geometry IndexedFaceSet {{\n{}        solid TRUE\n{}        coord Coordinate {{\n{}          point [\n",
                      indent, indent, indent, indent);
@@ -131,7 +123,7 @@ std::string motionText(const HanimMotion& m, const std::vector<std::string>& joi
   keys += " ]\n";
   const std::string clock = unique("hanim_clock");
   std::string out = fmt::format("\n# motion {}: {} frames at {:g} frames/s\nDEF {} TimeSensor {{ cycleInterval {:.9g} loop TRUE }}\n",
-                                quote(m.name), frames, m.frameRate, clock, cycle);
+                                vrml::quotedString(m.name), frames, m.frameRate, clock, cycle);
   std::string routes;
   for (std::size_t j = 0; j < jointDefs.size(); ++j) {
     const std::string& def = jointDefs[j];
@@ -225,7 +217,7 @@ std::string hanimText(const HanimHumanoidData& h) {
     const HanimJointData& j = h.joints[item.joint];
     jointUses.push_back(jointDef(item.joint));
     body += fmt::format("{}DEF {} Joint {{\n{}  name {}\n{}  center {:.7g} {:.7g} {:.7g}\n{}  children [\n", indent,
-                        jointDef(item.joint), indent, quote(j.name), indent, j.center.x(), j.center.y(), j.center.z(), indent);
+                        jointDef(item.joint), indent, vrml::quotedString(j.name), indent, j.center.x(), j.center.y(), j.center.z(), indent);
     for (std::size_t s = 0; s < j.segments.size(); ++s) {
       segmentUses.push_back(segmentDef(item.joint, s));
       writeSegment(body, j.segments[s], segmentDef(item.joint, s), indent + "    ");
@@ -233,8 +225,8 @@ std::string hanimText(const HanimHumanoidData& h) {
     stack.push_back({item.joint, true, item.depth});
     for (auto c = children[item.joint].rbegin(); c != children[item.joint].rend(); ++c) stack.push_back({*c, false, item.depth + 2});
   }
-  out += fmt::format("\nDEF {} Humanoid {{\n  name {}\n  version \"1.1\"\n  info [", humanoidDef, quote(h.name));
-  for (std::size_t i = 0; i < h.info.size(); ++i) out += (i ? ", " : " ") + quote(h.info[i]);
+  out += fmt::format("\nDEF {} Humanoid {{\n  name {}\n  version \"1.1\"\n  info [", humanoidDef, vrml::quotedString(h.name));
+  for (std::size_t i = 0; i < h.info.size(); ++i) out += (i ? ", " : " ") + vrml::quotedString(h.info[i]);
   out += " ]\n  humanoidBody [\n" + body + "  ]\n  joints [\n";
   for (const std::string& u : jointUses) out += "    USE " + u + "\n";
   out += "  ]\n  segments [\n";

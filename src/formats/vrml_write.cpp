@@ -109,6 +109,15 @@ void joint(File& out, const JointTrack& j, const std::string& def) {
 
 }  // namespace
 
+std::string quotedString(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
 void writeAnimation(const std::string& path, const Animation& animation) {
   std::size_t frames = 0;
   for (const GarmentTrack& g : animation.garments) frames = std::max(frames, g.frames.size());

@@ -86,15 +86,16 @@ Avatar loadAvatarFile(const std::string& path, const std::vector<std::string>& m
   const std::string ext = lowerExtension(path);
   if (formats::isGltfPath(path)) return loadGltfAvatar(path, meshes);
   if (ext == ".dae" || ext == ".fbx") return loadAssimpAvatar(path, meshes);
+  const bool makeHuman = ext == ".mhskel";
+  if (!makeHuman && !formats::isVrmlPath(path))
+    throw Error(fmt::format("{}: drape reads avatars from .glb, .gltf, .vrm, .dae, .fbx, MakeHuman .mhskel and VRML97 "
+                            "H-Anim (.wrl) files, not '{}'",
+                            path, ext));
   if (!meshes.empty())
     throw Error(fmt::format("{}: meshes ({}) choose among the skinned meshes of a glTF, Collada or FBX avatar; "
                             "a {} avatar is one body",
-                            path, fmt::join(meshes, ", "), ext == ".mhskel" ? "MakeHuman" : "VRML97 H-Anim"));
-  if (ext == ".mhskel") return loadMakeHumanAvatar(path);
-  if (formats::isVrmlPath(path)) return loadHumanoidFile(path);
-  throw Error(fmt::format("{}: drape reads avatars from .glb, .gltf, .vrm, .dae, .fbx, MakeHuman .mhskel and VRML97 H-Anim "
-                          "(.wrl) files, not '{}'",
-                          path, ext));
+                            path, fmt::join(meshes, ", "), makeHuman ? "MakeHuman" : "VRML97 H-Anim"));
+  return makeHuman ? loadMakeHumanAvatar(path) : loadHumanoidFile(path);
 }
 
 }  // namespace drape::scene

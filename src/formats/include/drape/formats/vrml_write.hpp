@@ -32,6 +32,9 @@ struct Animation {
   std::vector<JointTrack> joints;  ///< optional: the avatar
 };
 
+/// `text` as a VRML97 string: in double quotes, its quotes and backslashes escaped.
+[[nodiscard]] std::string quotedString(const std::string& text);
+
 /// Writes `animation` to `path`. Throws drape::Error on inconsistent tracks (frame counts
 /// differ, a frame with the wrong number of vertices) or when the file cannot be written.
 void writeAnimation(const std::string& path, const Animation& animation);

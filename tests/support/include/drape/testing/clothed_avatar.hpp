@@ -44,22 +44,7 @@ inline std::string clothedCesiumMan(const std::filesystem::path& dir, const Clot
   nlohmann::json doc = nlohmann::json::parse(glb.substr(20, jsonLength));
   std::string bin = glb.substr(28 + jsonLength, binLength);
 
-  // The cape's positions: each skin vertex moved along its normal (tightly packed floats).
   const nlohmann::json body = doc["meshes"][0]["primitives"][0];
-  auto floats = [&](int accessor) {
-    const nlohmann::json& a = doc["accessors"][accessor];
-    const nlohmann::json& view = doc["bufferViews"][a["bufferView"].get<int>()];
-    const std::size_t at = view.value("byteOffset", std::size_t{0}) + a.value("byteOffset", std::size_t{0});
-    const std::size_t stride = view.value("byteStride", std::size_t{12});
-    std::vector<float> out;
-    for (std::size_t v = 0; v < a["count"].get<std::size_t>(); ++v)
-      for (std::size_t c = 0; c < 3; ++c) {
-        float x = 0;
-        std::memcpy(&x, bin.data() + at + v * stride + c * 4, 4);
-        out.push_back(x);
-      }
-    return out;
-  };
   // An accessor's components as numbers (floats, or unsigned bytes or shorts), `n` per element.
   auto numbers = [&](int accessor, std::size_t n) {
     const nlohmann::json& a = doc["accessors"][accessor];
@@ -98,24 +83,18 @@ inline std::string clothedCesiumMan(const std::filesystem::path& dir, const Clot
         {{"bufferView", doc["bufferViews"].size() - 1}, {"componentType", componentType}, {"count", count}, {"type", type}});
     return static_cast<int>(doc["accessors"].size()) - 1;
   };
-  const std::vector<float> p = floats(body["attributes"]["POSITION"].get<int>());
-  const std::vector<float> n = floats(body["attributes"]["NORMAL"].get<int>());
-  while (bin.size() % 4 != 0) bin.push_back('\0');
-  const std::size_t capeAt = bin.size();
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const float x = p[i] + static_cast<float>(options.offset_m) * n[i];
-    bin.append(reinterpret_cast<const char*>(&x), 4);
-  }
-  doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", capeAt}, {"byteLength", 4 * p.size()}});
-  doc["accessors"].push_back({{"bufferView", doc["bufferViews"].size() - 1},
-                              {"componentType", 5126},
-                              {"count", p.size() / 3},
-                              {"type", "VEC3"}});
+  // The cape's positions: each skin vertex moved along its normal.
+  const std::vector<double> p = numbers(body["attributes"]["POSITION"].get<int>(), 3);
+  const std::vector<double> n = numbers(body["attributes"]["NORMAL"].get<int>(), 3);
+  std::vector<double> capePositions(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i)  // in floats, as the file stores them
+    capePositions[i] = static_cast<float>(p[i]) + static_cast<float>(options.offset_m) * static_cast<float>(n[i]);
+  const int capeAccessor = appendAccessor(capePositions, 5126, "VEC3", p.size() / 3);
   nlohmann::json cape = body;
   cape.erase("material");
   cape["attributes"].erase("NORMAL");
   cape["attributes"].erase("TEXCOORD_0");
-  cape["attributes"]["POSITION"] = doc["accessors"].size() - 1;
+  cape["attributes"]["POSITION"] = capeAccessor;
   doc["meshes"].push_back({{"name", "CapeMesh"}, {"primitives", {cape}}});
 
   // The cape's skin.

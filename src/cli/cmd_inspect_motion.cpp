@@ -155,7 +155,9 @@ void inspectAvatar(const std::string& path, std::ostream& out) {
                a.joints[j].name, c.x(), c.y(), c.z());
   }
   if (a.fileMeshes.size() > 1)
-    fmt::print(out, "  meshes     {} skinned: {} (make-scene --avatar-meshes chooses those that make the body)\n",
+    fmt::print(out,
+               "  meshes     {} skinned: {} (make-scene --avatar-meshes chooses those that make the body, "
+               "--avatar-drawn-meshes those drawn with it)\n",
                a.fileMeshes.size(), fmt::join(a.fileMeshes, ", "));
   if (a.skin) {
     const Aabb box = a.skin->mesh.bounds();

@@ -109,6 +109,9 @@ void printAvatarFile(const std::string& path, const scene::Avatar& avatar, std::
                fmt::join(avatar.fileMeshes, ", "),
                avatar.meshesRead.size() == avatar.fileMeshes.size() ? std::string("every one")
                                                                    : fmt::format("{}", fmt::join(avatar.meshesRead, ", ")));
+  if (avatar.drawnSkin)
+    fmt::print(out, "    drawn with it, not collided with: {} ({} triangles)\n", fmt::join(avatar.drawnMeshesRead, ", "),
+               avatar.drawnSkin->mesh.triangleCount());
   if (!avatar.animations.empty())
     fmt::print(out, "    its file carries {} animation{} ('{}')\n", avatar.animations.size(),
                avatar.animations.size() == 1 ? "" : "s", fmt::join(avatar.animations, "', '"));
@@ -156,8 +159,9 @@ void inspectScene(const std::string& path, std::ostream& out) {
   }
   if (!s.avatars.empty()) printHumanoidMotions(path, s, out);
   for (const scene::ExternalAvatar& a : s.externalAvatars)
-    fmt::print(out, "  {} (from {}){}{}{}\n", a.name, fmt::join(a.urls, ", "),
+    fmt::print(out, "  {} (from {}){}{}{}{}\n", a.name, fmt::join(a.urls, ", "),
                a.meshes.empty() ? "" : fmt::format(", its body the meshes {}", fmt::join(a.meshes, ", ")),
+               a.drawnMeshes.empty() ? "" : fmt::format(", drawn with it {}", fmt::join(a.drawnMeshes, ", ")),
                a.jointMap.empty() ? "" : fmt::format(", joint map {}", fmt::join(a.jointMap, ", ")),
                a.cutAtJoints.empty() ? "" : fmt::format(", parts cut across joints {}", fmt::join(a.cutAtJoints, ", ")));
   if (!s.externalAvatars.empty() || s.avatars.size() > 1) printCharacters(path, s, out);

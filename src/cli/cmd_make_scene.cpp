@@ -55,6 +55,7 @@ struct MakeSceneOptions {
   std::vector<std::string> keepApart;  ///< --keep-apart: the scene's Simulation keepApart
   std::vector<std::string> cutAtJoints;  ///< --cut-at-joints: the Avatar node's cutAtJoints
   std::vector<std::string> avatarMeshes;  ///< --avatar-meshes: the Avatar node's meshes
+  std::vector<std::string> drawnMeshes;   ///< --avatar-drawn-meshes: the Avatar node's drawnMeshes
   std::string avatarRotation;            ///< the Avatar node's rotation that stands a body up along +y; "" : none
   double reach_m = 0.03;
   double voxel_m = 0.005;
@@ -167,9 +168,10 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
              o.frameRate, o.stepsPerFrame, o.maxAddedMass, t[0], t[1], t[2], t[3], v, o.collisionEvery, o.bendEvery,
              o.keepApart.empty() ? "" : fmt::format("  keepApart [ \"{}\" ]\n", fmt::join(o.keepApart, "\", \"")));
   writeMaterial(os, o.material);
-  fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n{}{}{}}}\n\n", o.avatarUrl,
+  fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n{}{}{}{}}}\n\n", o.avatarUrl,
              o.avatarRotation.empty() ? "" : fmt::format("  rotation {}\n", o.avatarRotation),
-             stringsField("meshes", o.avatarMeshes), stringsField("cutAtJoints", o.cutAtJoints));
+             stringsField("meshes", o.avatarMeshes), stringsField("drawnMeshes", o.drawnMeshes),
+             stringsField("cutAtJoints", o.cutAtJoints));
   ClothSetText c = clothSetOf(o, garment, mask);
   c.def = "Garment";
   c.colour = o.add.colour.empty() ? Vec3(0.15, 0.25, 0.55) : c.colour;
@@ -221,7 +223,7 @@ void chooseCollidables(MakeSceneOptions& o, const scene::Avatar& avatar, const m
 }
 
 int makeScene(MakeSceneOptions& o) {
-  scene::Avatar avatar = scene::loadAvatarFile(o.avatar, o.avatarMeshes);
+  scene::Avatar avatar = scene::loadAvatarFile(o.avatar, o.avatarMeshes, o.drawnMeshes);
   sayWhichMeshesMakeTheBody(avatar, o.avatar);
   // A body standing along +z stood up, and the garment modelled on it with it.
   const std::optional<scene::Upright> upright = standUp(avatar, o.avatar);
@@ -377,6 +379,10 @@ RunFunction setupMakeScene(CLI::App& app) {
                  "holds its clothes or hair too: e.g. Body,Shoes), written as the Avatar node's meshes; default: "
                  "every mesh of its skin (drape inspect FILE lists them)")
       ->delimiter(',');
+  app.add_option("--avatar-drawn-meshes", o.drawnMeshes,
+                 "Of the avatar file's skinned meshes, those drawn with the body but not collided with (hair, eyes, "
+                 "accessories), by node or mesh name, written as the Avatar node's drawnMeshes; default: none")
+      ->delimiter(',');
   app.add_option("--cut-at-joints", o.cutAtJoints,
                  "Joints whose rigid parts are cut across the joint, what lies behind it going to the parent's part, "
                  "written as the Avatar node's cutAtJoints (e.g. LeftArm,RightArm; see drape run --help)")
@@ -421,7 +427,8 @@ RunFunction setupMakeScene(CLI::App& app) {
       throw Error(fmt::format("--units {}: applies to OBJ files; {} and {} state their own unit", o.units, o.garment, o.mask));
     if (!addingToScene(app, o.add, "make-scene", o.avatar, o.out,
                        {"--out", "--avatar-url", "--title", "--voxel", "--frame-rate", "--substeps", "--bend-every",
-                        "--collision-every", "--max-added-mass", "--keep-apart", "--cut-at-joints", "--avatar-meshes"}))
+                        "--collision-every", "--max-added-mass", "--keep-apart", "--cut-at-joints", "--avatar-meshes",
+                        "--avatar-drawn-meshes"}))
       return makeScene(o);
     return addGarment(o);
   };

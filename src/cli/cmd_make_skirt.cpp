@@ -47,6 +47,7 @@ struct MakeSkirtOptions {
   std::vector<std::string> armSegments;   ///< with --with-arms: the forearms, hands and fingers, collidable too
   std::string avatarRotation;             ///< the Avatar node's rotation that stands a body up along +y; "" : none
   std::vector<std::string> avatarMeshes;  ///< --avatar-meshes: the Avatar node's meshes
+  std::vector<std::string> drawnMeshes;   ///< --avatar-drawn-meshes: the Avatar node's drawnMeshes
 };
 
 /// The knit the scene gives the skirt (written below as the Knit material).
@@ -106,9 +107,9 @@ int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::S
                  "  integrator \"symplectic-euler\"\n  collisionEvery 1\n  bendEvery {}\n}}\n\n",
              kFrameRate, kSubsteps, bendEvery);
   writeMaterial(os, m);
-  fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n{}{}}}\n\n", o.avatarUrl,
+  fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n{}{}{}}}\n\n", o.avatarUrl,
              o.avatarRotation.empty() ? "" : fmt::format("  rotation {}\n", o.avatarRotation),
-             stringsField("meshes", o.avatarMeshes));
+             stringsField("meshes", o.avatarMeshes), stringsField("drawnMeshes", o.drawnMeshes));
   ClothSetText c = clothSetOf(o, skirt.mesh, skirt.waistband);
   c.def = "Skirt";
   c.name = o.name == "Skirt" ? "" : o.name;
@@ -201,7 +202,7 @@ void printSkirt(const std::string& name, const mesh::Skirt& skirt) {
 }
 
 int makeSkirt(MakeSkirtOptions o) {
-  scene::Avatar avatar = scene::loadAvatarFile(o.avatar, o.avatarMeshes);
+  scene::Avatar avatar = scene::loadAvatarFile(o.avatar, o.avatarMeshes, o.drawnMeshes);
   sayWhichMeshesMakeTheBody(avatar, o.avatar);
   if (const std::optional<scene::Upright> u = standUp(avatar, o.avatar)) o.avatarRotation = u->rotationText();
   chooseSegments(avatar, o, o.avatar);
@@ -277,6 +278,10 @@ RunFunction setupMakeSkirt(CLI::App& app) {
                  "The avatar file's skinned meshes that make the body, by node or mesh name (a character file that "
                  "holds its clothes or hair too), written as the Avatar node's meshes; default: every mesh of its skin")
       ->delimiter(',');
+  app.add_option("--avatar-drawn-meshes", o.drawnMeshes,
+                 "Of the avatar file's skinned meshes, those drawn with the body but not collided with (hair, eyes, "
+                 "accessories), by node or mesh name, written as the Avatar node's drawnMeshes; default: none")
+      ->delimiter(',');
   app.add_option("--length", o.fit.length_m, "Waist to hem, m (default: a little above the knees)");
   app.add_option("--clearance", o.fit.clearance_m, "Gap between body and skirt at rest, m")->capture_default_str();
   app.add_option("--flare", o.fit.flare, "Extra hem radius per metre of length")->capture_default_str();
@@ -307,7 +312,7 @@ RunFunction setupMakeSkirt(CLI::App& app) {
     o.waistGiven = app.count("--waist-segment") > 0;
     o.hipsGiven = app.count("--hip-segments") > 0;
     o.legsGiven = app.count("--leg-segments") > 0;
-    if (!addingToScene(app, o.add, "make-skirt", o.avatar, o.out, {"--out", "--avatar-url", "--avatar-meshes"})) return makeSkirt(o);
+    if (!addingToScene(app, o.add, "make-skirt", o.avatar, o.out, {"--out", "--avatar-url", "--avatar-meshes", "--avatar-drawn-meshes"})) return makeSkirt(o);
     return addSkirt(o);
   };
 }

@@ -47,6 +47,7 @@ struct RunOptions {
   double selfCollision_m = 0.0;  ///< --self-collision
   std::vector<std::string> faceSamplesWith, keepApart, cutAtJoints;
   std::vector<std::string> avatarMeshes;  ///< --avatar-meshes: the meshes of --avatar FILE that make the body
+  std::vector<std::string> drawnMeshes;   ///< --avatar-drawn-meshes: those drawn with it, not collided with
   std::string events;                       ///< --events: an EGML event graph instead of --motion
   std::vector<std::string> lives;           ///< --live SOURCE, or NAME=SOURCE per character: captures as they come
   std::string liveHeader;                   ///< --live-header FILE.bvh: the sources' skeleton
@@ -239,8 +240,9 @@ void setupFromGarment(const RunOptions& o, RunSetup& setup, bool onAvatar) {
 
 /// The avatar file's, its parts cut across the joints named (none: as segmented on load).
 std::shared_ptr<const scene::Avatar> loadAvatarCut(const std::string& path, const std::vector<std::string>& meshes,
+                                                   const std::vector<std::string>& drawnMeshes,
                                                    const std::vector<std::string>& cutAtJoints) {
-  scene::Avatar avatar = scene::loadAvatarFile(path, meshes);
+  scene::Avatar avatar = scene::loadAvatarFile(path, meshes, drawnMeshes);
   if (!cutAtJoints.empty()) {
     std::size_t moved = 0;
     scene::segmentSkinnedAvatar(avatar, cutAtJoints, &moved);
@@ -289,6 +291,9 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   if (!o.scene.empty()) {
     if (!o.avatarMeshes.empty())
       throw Error("--avatar-meshes chooses the meshes of --avatar FILE; in a scene the Avatar node's meshes field does");
+    if (!o.drawnMeshes.empty())
+      throw Error("--avatar-drawn-meshes chooses the drawn meshes of --avatar FILE; in a scene the Avatar node's "
+                  "drawnMeshes field does");
     setup = runSetupFromScene(o.scene, app.count("--cut-at-joints")
                                            ? std::optional<std::vector<std::string>>(keepApartParts(o.cutAtJoints))
                                            : std::nullopt);
@@ -297,9 +302,12 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     applyCollisionOptions(app, o, setup);
   } else {
     std::shared_ptr<const scene::Avatar> avatar;
-    if (!o.avatar.empty()) avatar = loadAvatarCut(o.avatar, o.avatarMeshes, keepApartParts(o.cutAtJoints));
+    if (!o.avatar.empty())
+      avatar = loadAvatarCut(o.avatar, o.avatarMeshes, o.drawnMeshes, keepApartParts(o.cutAtJoints));
     else if (app.count("--cut-at-joints")) throw Error("--cut-at-joints cuts an avatar's parts: give a scene or --avatar FILE");
     else if (!o.avatarMeshes.empty()) throw Error("--avatar-meshes chooses the meshes of --avatar FILE: give --avatar");
+    else if (!o.drawnMeshes.empty())
+      throw Error("--avatar-drawn-meshes chooses the drawn meshes of --avatar FILE: give --avatar");
     setupFromGarment(o, setup, avatar != nullptr);
     if (avatar) {
       CharacterSetup& character = setup.characters.emplace_back();
@@ -416,6 +424,10 @@ RunFunction setupRun(CLI::App& app) {
   app.add_option("--avatar-meshes", o->avatarMeshes,
                  "With --avatar: its file's skinned meshes that make the body, by node or mesh name (a character file "
                  "that holds its clothes or hair too); default: every mesh of its skin")
+      ->delimiter(',');
+  app.add_option("--avatar-drawn-meshes", o->drawnMeshes,
+                 "With --avatar: its file's skinned meshes drawn with the body but not collided with (hair, eyes, "
+                 "accessories), by node or mesh name; default: none")
       ->delimiter(',');
   app.add_option("--motion", o->motions, std::string("Motion for the avatar ") + kMotionHelp + kMotionPerCharacterHelp)
       ->type_name("FILE|NAME=FILE");

@@ -239,10 +239,12 @@ void printSummary(const std::string& directory, const render::RunReplay& run, co
                info.triangles.size(), run.states(m, 0).empty() ? "" : ", collision states recorded",
                info.character.empty() ? "" : ", worn by " + info.character);
   }
-  for (const std::size_t m : meshesWithRole(run, MeshRole::Skin))
-    fmt::print(out, "  skin     {:<14} {} vertices, {} triangles{}\n", run.meshes()[m].name, run.meshes()[m].vertexCount,
-               run.meshes()[m].triangles.size(),
-               run.meshes()[m].character.empty() ? "" : ", " + run.meshes()[m].character + "'s");
+  for (const MeshRole role : {MeshRole::Skin, MeshRole::Drawn})
+    for (const std::size_t m : meshesWithRole(run, role))
+      fmt::print(out, "  {:<8} {:<14} {} vertices, {} triangles{}{}\n", role == MeshRole::Skin ? "skin" : "drawn",
+                 run.meshes()[m].name, run.meshes()[m].vertexCount, run.meshes()[m].triangles.size(),
+                 run.meshes()[m].character.empty() ? "" : ", " + run.meshes()[m].character + "'s",
+                 role == MeshRole::Drawn ? " (skinned with the body, not collided with)" : "");
   const std::size_t segments = meshesWithRole(run, MeshRole::Segment).size();
   if (segments > 0) {
     std::vector<std::string> names;

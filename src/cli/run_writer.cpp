@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "drape/core/error.hpp"
 #include "drape/core/log.hpp"
@@ -15,6 +16,7 @@
 #include "drape/formats/run_manifest.hpp"
 #include "drape/formats/state_cache.hpp"
 #include "drape/formats/vrml_write.hpp"
+#include "drape/motion/skinning.hpp"
 #include "drape/render/outputs.hpp"
 #include "drape/sim/body_skin.hpp"
 
@@ -51,8 +53,8 @@ struct SegmentFiles {
   std::unique_ptr<formats::Pc2Writer> cache;
 };
 
-/// One character's files: its parts, its skinned body (when the avatar has one), and its
-/// joints per frame for result.wrl.
+/// One character's files: its parts, its skinned body (when the avatar has one), its drawn
+/// meshes (when it has some), and its joints per frame for result.wrl.
 struct CharacterFiles {
   const CharacterSetup* setup = nullptr;
   std::vector<SegmentFiles> segments;
@@ -60,6 +62,8 @@ struct CharacterFiles {
   std::unique_ptr<sim::BodySkin> skin;
   std::unique_ptr<formats::Pc2Writer> skinCache;
   std::vector<Vec3> skinPositions;
+  std::unique_ptr<formats::Pc2Writer> drawnCache;
+  std::vector<Vec3> drawnPositions;
 };
 
 }  // namespace
@@ -138,6 +142,17 @@ struct RunWriter::Impl {
           std::make_unique<formats::Pc2Writer>((out / (stem + ".pc2")).string(), files.skinPositions.size(), 0.0, 1.0);
       manifest.meshes.push_back({"body", "skin", stem + ".obj", stem + ".pc2", "", who, std::nullopt});
     }
+    if (avatar.drawnSkin) {
+      // Hair, eyes: skinned as they are, neither fitted nor tucked (the cloth never meets them).
+      const std::string stem = several ? "drawn-" + fileSafe(who) : "drawn";
+      motion::poseSkin(avatar, *avatar.drawnSkin, start.joints, files.drawnPositions);
+      formats::writeObj((out / (stem + ".obj")).string(), files.drawnPositions, avatar.drawnSkin->mesh.triangles,
+                        fmt::format("drape run: {} drawn meshes ({}) (m)", several ? who + "'s" : "the avatar's",
+                                    fmt::join(avatar.drawnMeshesRead, ", ")));
+      files.drawnCache =
+          std::make_unique<formats::Pc2Writer>((out / (stem + ".pc2")).string(), files.drawnPositions.size(), 0.0, 1.0);
+      manifest.meshes.push_back({"drawn", "drawn", stem + ".obj", stem + ".pc2", "", who, std::nullopt});
+    }
     for (const scene::Segment& seg : avatar.segments) {
       SegmentFiles sf;
       sf.name = seg.name;
@@ -190,6 +205,10 @@ struct RunWriter::Impl {
       files.skin->pose(joints, surfaces, files.skinPositions);
       files.skinCache->writeFrame(files.skinPositions);
     }
+    if (files.drawnCache) {
+      motion::poseSkin(*files.setup->avatar, *files.setup->avatar->drawnSkin, joints, files.drawnPositions);
+      files.drawnCache->writeFrame(files.drawnPositions);
+    }
   }
 
   /// result.wrl (any VRML97 browser, and drape's reader) and result.glb (glTF viewers, DCC
@@ -234,6 +253,7 @@ struct RunWriter::Impl {
     for (CharacterFiles& files : characters) {
       for (SegmentFiles& sf : files.segments) sf.cache->close();
       if (files.skinCache) files.skinCache->close();
+      if (files.drawnCache) files.drawnCache->close();
     }
     manifest.frames = frames + 1;
     formats::writeRunManifest(setup.outDir, manifest);

@@ -1,5 +1,7 @@
 #include "shown_bodies.hpp"
 
+#include "drape/motion/skinning.hpp"
+
 namespace drape::cli {
 
 ShownBodies::ShownBodies(const RunSetup& setup, std::vector<render::MeshInfo>& meshes,
@@ -21,6 +23,11 @@ ShownBodies::ShownBodies(const RunSetup& setup, std::vector<render::MeshInfo>& m
       meshes.push_back({"body", render::MeshRole::Skin, avatar.skin->mesh.vertexCount(), avatar.skin->mesh.triangles, who});
       body.skin = std::make_unique<sim::BodySkin>(avatar, *fields[c], allowance_m[c]);
     }
+    if (avatar.drawnSkin) {
+      body.drawnMesh = meshes.size();
+      meshes.push_back({"drawn", render::MeshRole::Drawn, avatar.drawnSkin->mesh.vertexCount(),
+                        avatar.drawnSkin->mesh.triangles, who});
+    }
   }
 }
 
@@ -36,6 +43,7 @@ void ShownBodies::pose(const std::vector<std::vector<RigidTransform>>& joints,
       const RigidTransform& pose = joints[c][static_cast<std::size_t>(seg.joint)];
       for (const Vec3& v : seg.mesh.positions) p.push_back(pose.apply(v));
     }
+    if (body.drawnMesh) motion::poseSkin(avatar, *avatar.drawnSkin, joints[c], out[*body.drawnMesh]);
     if (!body.skin) continue;
     surfaces_.clear();
     for (const std::size_t g : body.character->garments)

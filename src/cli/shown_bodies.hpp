@@ -1,6 +1,7 @@
 #pragma once
 // The characters' bodies as a window shows them, frame by frame: each one's rigid parts
-// posed, and its skinned body fitted to its parts and tucked under the garments it wears
+// posed, its skinned body fitted to its parts and tucked under the garments it wears, and
+// its drawn meshes (hair, eyes) skinned as they are
 // (`drape play SCENE` and the studio's player; `drape run` writes the same through
 // RunWriter).
 //
@@ -20,7 +21,7 @@ namespace drape::cli {
 class ShownBodies {
  public:
   /// Appends to `meshes` (which holds the setup's garments first, in its order) each
-  /// character's segments and skinned body. `fields[c]` are the part fields character c's
+  /// character's segments, skinned body and drawn meshes. `fields[c]` are the part fields character c's
   /// skin is fitted to (null: no skin), `allowance_m[c]` how far out of them it may stand.
   ShownBodies(const RunSetup& setup, std::vector<render::MeshInfo>& meshes,
               const std::vector<const std::vector<sim::PartField>*>& fields, const std::vector<double>& allowance_m);
@@ -35,6 +36,7 @@ class ShownBodies {
     const CharacterSetup* character = nullptr;
     std::size_t firstSegment = 0;         ///< its first segment's mesh
     std::optional<std::size_t> skinMesh;  ///< its skinned body's mesh
+    std::optional<std::size_t> drawnMesh; ///< its drawn meshes' mesh
     std::unique_ptr<sim::BodySkin> skin;
   };
   const RunSetup& setup_;

@@ -39,6 +39,8 @@ inline void sayWhichMeshesMakeTheBody(const scene::Avatar& avatar, const std::st
   else
     fmt::print("{}: the body is {} of its meshes {}\n", whose, fmt::join(avatar.meshesRead, ", "),
                fmt::join(avatar.fileMeshes, ", "));
+  if (avatar.drawnSkin)
+    fmt::print("{}: {} drawn with the body, not collided with\n", whose, fmt::join(avatar.drawnMeshesRead, ", "));
 }
 
 }  // namespace drape::cli

@@ -331,9 +331,10 @@ RunExportSummary exportRunToGlb(const std::string& runDirectory, const std::stri
   RunExportSummary summary;
   summary.frames = manifest.frames;
   for (const RunMesh& rm : manifest.meshes) {
-    // The skinned body is drawn by players; the file carries the body as its segments,
-    // rigid nodes a few kilobytes each, where the skin would be a morph target per frame.
-    if (rm.role == "skin") continue;
+    // The skinned body (and its drawn meshes) are drawn by players; the file carries the
+    // body as its segments, rigid nodes a few kilobytes each, where the skin would be a
+    // morph target per frame.
+    if (rm.role == "skin" || rm.role == "drawn") continue;
     const std::string objPath = (dir / rm.topology).string();
     const std::string pc2Path = (dir / rm.cache).string();
     mesh::TriMesh topology = readObj(objPath);
@@ -350,7 +351,7 @@ RunExportSummary exportRunToGlb(const std::string& runDirectory, const std::stri
     // Among several characters, a part's node is named for its character too.
     const std::string name = rm.character.empty() ? rm.name : rm.character + "/" + rm.name;
     if (rm.role != "garment" && rm.role != "segment") {
-      throw Error(fmt::format("{}: mesh '{}' has role '{}' (expected garment, segment or skin)",
+      throw Error(fmt::format("{}: mesh '{}' has role '{}' (expected garment, segment, skin or drawn)",
                               (dir / "manifest.json").string(), rm.name, rm.role));
     }
 

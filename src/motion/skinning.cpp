@@ -8,10 +8,14 @@ namespace drape::motion {
 
 void poseSkin(const scene::Avatar& avatar, std::span<const RigidTransform> jointWorld, std::vector<Vec3>& out) {
   if (!avatar.skin) throw Error(fmt::format("{}: the avatar has no skinned mesh to pose", avatar.source));
+  poseSkin(avatar, *avatar.skin, jointWorld, out);
+}
+
+void poseSkin(const scene::Avatar& avatar, const scene::SkinnedMesh& skin, std::span<const RigidTransform> jointWorld,
+              std::vector<Vec3>& out) {
   if (jointWorld.size() != avatar.joints.size())
     throw Error(fmt::format("{}: {} joint transforms for an avatar of {} joints", avatar.source, jointWorld.size(),
                             avatar.joints.size()));
-  const scene::SkinnedMesh& skin = *avatar.skin;
   // Rest world -> posed world per joint, as a matrix and an offset: one product per weight.
   std::vector<Mat3> linear(avatar.joints.size());
   std::vector<Vec3> offset(avatar.joints.size());

@@ -12,7 +12,8 @@ MeshRole parseMeshRole(const std::string& role) {
   if (role == "garment") return MeshRole::Garment;
   if (role == "segment") return MeshRole::Segment;
   if (role == "skin") return MeshRole::Skin;
-  throw Error(fmt::format("mesh role '{}' is not one of: garment, segment, skin", role));
+  if (role == "drawn") return MeshRole::Drawn;
+  throw Error(fmt::format("mesh role '{}' is not one of: garment, segment, skin, drawn", role));
 }
 
 bool hasSkin(const std::vector<MeshInfo>& meshes, const std::string& character) {

@@ -21,6 +21,7 @@ using V3 = Eigen::Vector3f;
 // Colours are given in sRGB (as a person picks them) and lit in linear space.
 constexpr std::array<float, 3> kGarmentSrgb = {0.80f, 0.22f, 0.25f};  // a warm red cloth
 constexpr std::array<float, 3> kSegmentSrgb = {0.80f, 0.74f, 0.68f};  // clay-coloured body
+constexpr std::array<float, 3> kDrawnSrgb = {0.36f, 0.31f, 0.28f};    // its hair and eyes, a darker clay
 constexpr std::array<float, 3> kBackgroundTop = {44.f, 50.f, 62.f};   // 0-255
 constexpr std::array<float, 3> kBackgroundBottom = {120.f, 128.f, 140.f};
 
@@ -437,13 +438,14 @@ struct Renderer::Impl {
 
   /// Planar shadows: every mesh flattened onto the floor along the light, blended once per
   /// pixel (the stencil goes from 1 to 2 on the first hit) so overlaps do not darken twice.
-  /// Whether mesh m is drawn: the skinned body, or the segments when the run has no skin
-  /// or the overlay asks for them.
+  /// Whether mesh m is drawn: the skinned body and its drawn meshes, or the segments when
+  /// the run has no skin or the overlay asks for them.
   bool drawn(std::size_t m, const OverlaySettings& overlay) const {
     switch (meshes[m].role) {
       case MeshRole::Garment:
         return true;
       case MeshRole::Skin:
+      case MeshRole::Drawn:
         return !overlay.segments;
       case MeshRole::Segment:
         return overlay.segments || !skinned[m];
@@ -485,10 +487,14 @@ struct Renderer::Impl {
       if (!drawn(m, overlay)) continue;
       const bool garment = meshes[m].role == MeshRole::Garment;
       const std::optional<Vec3>& own = meshes[m].colour;
-      const V3 colour = srgbToLinear(!garment ? kSegmentSrgb
-                                     : own ? std::array<float, 3>{static_cast<float>(own->x()), static_cast<float>(own->y()),
-                                                                  static_cast<float>(own->z())}
-                                           : kGarmentSrgb);
+      const std::array<float, 3> fallback = garment                             ? kGarmentSrgb
+                                            : meshes[m].role == MeshRole::Drawn ? kDrawnSrgb
+                                                                                : kSegmentSrgb;
+      const V3 colour = srgbToLinear(own && (garment || meshes[m].role == MeshRole::Drawn)
+                                         ? std::array<float, 3>{static_cast<float>(own->x()),
+                                                                static_cast<float>(own->y()),
+                                                                static_cast<float>(own->z())}
+                                         : fallback);
       glUniform3fv(glGetUniformLocation(meshProgram, "uColour"), 1, colour.data());
       glUniform1i(glGetUniformLocation(meshProgram, "uStateColours"), garment && overlay.collisionColours ? 1 : 0);
       glBindVertexArray(gpu[m].vao);

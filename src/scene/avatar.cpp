@@ -9,9 +9,10 @@ void placeAvatar(Avatar& avatar, const RigidTransform& placement, double scale) 
   }
   // Segment vertices are in their joint's frame, which the joint's orientation turns.
   for (Segment& s : avatar.segments) s.mesh.scale(scale);
-  if (avatar.skin) {
-    avatar.skin->mesh.scale(scale);
-    avatar.skin->mesh.transform(placement);
+  for (std::optional<SkinnedMesh>* skin : {&avatar.skin, &avatar.drawnSkin}) {
+    if (!*skin) continue;
+    (*skin)->mesh.scale(scale);
+    (*skin)->mesh.transform(placement);
   }
 }
 

@@ -82,19 +82,66 @@ Avatar loadHumanoidFile(const std::string& path) {
                           fmt::join(names, ", ")));
 }
 
-Avatar loadAvatarFile(const std::string& path, const std::vector<std::string>& meshes) {
+namespace {
+
+formats::SkinnedModel readSkinnedModel(const std::string& path, const std::vector<std::string>& parts) {
+  return formats::isGltfPath(path) ? formats::readGltfSkinnedModel(path, parts)
+                                   : formats::readAssimpSkinnedModel(path, parts);
+}
+
+/// The meshes `drawn` names, read again from the avatar's file with its skeleton: the
+/// readers build a file's skeleton from its skins whatever meshes are chosen, so the joint
+/// indices are the body's. A mesh both drawn and the body's would be drawn twice.
+/// `bodyUnnamed`: no meshes named the body, which is then every mesh of the skin.
+void addDrawnMeshes(Avatar& avatar, const std::string& path, const std::vector<std::string>& drawn, bool bodyUnnamed) {
+  const formats::SkinnedModel model = readSkinnedModel(path, drawn);
+  std::vector<std::string> both;
+  for (const std::string& name : model.meshesRead)
+    if (std::find(avatar.meshesRead.begin(), avatar.meshesRead.end(), name) != avatar.meshesRead.end())
+      both.push_back(name);
+  if (!both.empty()) {
+    const std::string why = bodyUnnamed ? fmt::format(" (the body is every mesh of its skin unless meshes names those "
+                                                      "that make it; its skinned meshes: {})",
+                                                      fmt::join(avatar.fileMeshes, ", "))
+                                        : "";
+    throw Error(fmt::format("{}: drawnMeshes ({}) name {}, which {} the body's: a mesh is drawn or makes the body, "
+                            "not both{}",
+                            path, fmt::join(drawn, ", "), fmt::join(both, ", "), both.size() == 1 ? "is" : "are", why));
+  }
+  if (model.joints.size() != avatar.joints.size())
+    throw Error(fmt::format("{}: its drawn meshes were read with {} joints, its body with {}", path,
+                            model.joints.size(), avatar.joints.size()),
+                ExitCode::Internal);
+  SkinnedMesh skin;
+  skin.mesh.name = avatar.name + " (drawn)";
+  skin.mesh.positions = model.positions;
+  skin.mesh.triangles = model.triangles;
+  skin.joints = model.vertexJoints;
+  skin.weights = model.vertexWeights;
+  avatar.drawnSkin = std::move(skin);
+  avatar.drawnMeshesRead = model.meshesRead;
+}
+
+}  // namespace
+
+Avatar loadAvatarFile(const std::string& path, const std::vector<std::string>& meshes,
+                      const std::vector<std::string>& drawnMeshes) {
   const std::string ext = lowerExtension(path);
-  if (formats::isGltfPath(path)) return loadGltfAvatar(path, meshes);
-  if (ext == ".dae" || ext == ".fbx") return loadAssimpAvatar(path, meshes);
+  if (formats::isGltfPath(path) || ext == ".dae" || ext == ".fbx") {
+    Avatar avatar = buildAvatarFromSkinnedModel(readSkinnedModel(path, meshes));
+    if (!drawnMeshes.empty()) addDrawnMeshes(avatar, path, drawnMeshes, meshes.empty());
+    return avatar;
+  }
   const bool makeHuman = ext == ".mhskel";
   if (!makeHuman && !formats::isVrmlPath(path))
     throw Error(fmt::format("{}: drape reads avatars from .glb, .gltf, .vrm, .dae, .fbx, MakeHuman .mhskel and VRML97 "
                             "H-Anim (.wrl) files, not '{}'",
                             path, ext));
-  if (!meshes.empty())
-    throw Error(fmt::format("{}: meshes ({}) choose among the skinned meshes of a glTF, Collada or FBX avatar; "
-                            "a {} avatar is one body",
-                            path, fmt::join(meshes, ", "), makeHuman ? "MakeHuman" : "VRML97 H-Anim"));
+  for (const auto& [field, names] : {std::pair{"meshes", &meshes}, std::pair{"drawnMeshes", &drawnMeshes}})
+    if (!names->empty())
+      throw Error(fmt::format("{}: {} ({}) choose among the skinned meshes of a glTF, Collada or FBX avatar; "
+                              "a {} avatar is one body",
+                              path, field, fmt::join(*names, ", "), makeHuman ? "MakeHuman" : "VRML97 H-Anim"));
   return makeHuman ? loadMakeHumanAvatar(path) : loadHumanoidFile(path);
 }
 

@@ -311,6 +311,7 @@ class Builder {
     a.jointMap = strings(n, "jointMap");
     a.cutAtJoints = strings(n, "cutAtJoints");
     a.meshes = strings(n, "meshes");
+    a.drawnMeshes = strings(n, "drawnMeshes");
     a.motion = strings(n, "motion");
     a.source = where(n);
     if (a.urls.empty())

@@ -118,7 +118,7 @@ std::unique_ptr<scene::Avatar> loadExternal(const scene::Scene& scene, const sce
   for (const std::string& url : ext.urls) {
     const std::string path = resolved(scene, url);
     try {
-      auto avatar = std::make_unique<scene::Avatar>(scene::loadAvatarFile(path, ext.meshes));
+      auto avatar = std::make_unique<scene::Avatar>(scene::loadAvatarFile(path, ext.meshes, ext.drawnMeshes));
       scene::placeAvatar(*avatar, ext.placement, ext.scale);
       if (!ext.cutAtJoints.empty()) cutAtJoints(*avatar, ext);
       return avatar;

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,8 @@
 #include "cli_runner.hpp"
 #include "drape/formats/mesh_file.hpp"
 #include "drape/formats/obj.hpp"
+#include "drape/formats/pc2.hpp"
+#include "drape/formats/run_manifest.hpp"
 #include "drape/testing/clothed_avatar.hpp"
 
 namespace drape {
@@ -89,6 +92,75 @@ TEST(AvatarMeshes, ACharacterFileWithItsClothesCollidesTheClothWithTheBodyAlone)
   EXPECT_GT(run("all").at("pairs_embedded_at_start").get<int>(), 1000);
 }
 
+TEST(AvatarMeshes, DrawnMeshesMoveWithTheSkinAndTheClothNeverMeetsThem) {
+  // The cape drawn with the body, as hair or eyes would be, and worn as before: the cloth
+  // collides with the body alone, and the run writes the drawn cape skinned frame by frame,
+  // 1 cm out of the body as the file has it, without fitting it to the parts.
+  ScratchDir dir("avatar-drawn-meshes");
+  const std::string clothed = testing::clothedCesiumMan(dir / "clothed", {.offset_m = 0.01});
+  const std::string mask = shouldersMask(clothed, dir);
+  const CliResult made = runDrape("make-scene '" + clothed + "' --garment '" + clothed + "' --garment-parts Cape --mask '" +
+                                      mask + "' --name cape --offsets 0.002,0.004,0.006,0.012 --avatar-meshes Body "
+                                      "--avatar-drawn-meshes Cape --out '" + (dir / "scene") + "'",
+                                  dir);
+  ASSERT_EQ(made.code, 0) << made.err;
+  EXPECT_NE(testing::slurp(dir / "scene/scene.wrl").find("  meshes [ \"Body\" ]\n  drawnMeshes [ \"Cape\" ]\n"),
+            std::string::npos);
+  EXPECT_NE(made.out.find(clothed + ": Cape drawn with the body, not collided with\n"), std::string::npos) << made.out;
+  const CliResult inspected = runDrape("inspect '" + (dir / "scene/scene.wrl") + "'", dir);
+  EXPECT_NE(inspected.out.find(", its body the meshes Body, drawn with it Cape"), std::string::npos) << inspected.out;
+  EXPECT_NE(inspected.out.find("    drawn with it, not collided with: Cape (4672 triangles)\n"), std::string::npos)
+      << inspected.out;
+
+  const std::string run = dir / "scene/run";
+  const CliResult ran =
+      runDrape("run '" + (dir / "scene/scene.wrl") + "' --motion '" + clothed + "' --frames 6 --out '" + run + "'", dir);
+  ASSERT_EQ(ran.code, 0) << ran.err;
+  const nlohmann::json stats = statsOf(run);
+  EXPECT_LT(stats.at("pairs_embedded_at_start").get<int>(), 20);
+  EXPECT_EQ(stats.at("vertex_substeps_inside_body").get<long>(), 0);
+
+  const formats::RunManifest manifest = formats::readRunManifest(run);
+  const auto drawn = std::find_if(manifest.meshes.begin(), manifest.meshes.end(),
+                                  [](const formats::RunMesh& m) { return m.role == "drawn"; });
+  ASSERT_NE(drawn, manifest.meshes.end());
+  EXPECT_EQ(formats::readObj(run + "/" + drawn->topology).triangleCount(), 4672u);
+  const formats::Pc2Cache cape = formats::readPc2(run + "/" + drawn->cache);
+  const formats::Pc2Cache body = formats::readPc2(run + "/body.pc2");
+  ASSERT_EQ(cape.frames.size(), static_cast<std::size_t>(manifest.frames));
+  ASSERT_EQ(cape.pointCount, body.pointCount);
+  // Vertex i of the cape is vertex i of the body pushed 1 cm out at rest and skinned by the
+  // same weights, so it stays within 1 cm of it (rotations blended shorten the offset a
+  // little); the body's skin is fitted to the parts near the joints, which moves it by
+  // millimetres. And the cape walks: its last frame is not its first.
+  for (const std::size_t f : {std::size_t{0}, cape.frames.size() - 1}) {
+    std::vector<double> apart;
+    for (std::size_t i = 0; i < cape.pointCount; ++i) apart.push_back((cape.frames[f][i] - body.frames[f][i]).norm());
+    std::nth_element(apart.begin(), apart.begin() + static_cast<long>(apart.size() / 2), apart.end());
+    EXPECT_NEAR(apart[apart.size() / 2], 0.01, 0.002) << "frame " << f;
+  }
+  double moved = 0.0;
+  for (std::size_t i = 0; i < cape.pointCount; ++i)
+    moved = std::max(moved, (cape.frames.back()[i] - cape.frames.front()[i]).norm());
+  EXPECT_GT(moved, 0.02);
+  const CliResult listed = runDrape("inspect '" + run + "'", dir);
+  EXPECT_NE(listed.out.find("  drawn    drawn          3273 vertices, 4672 triangles (skinned with the body, not "
+                            "collided with)\n"),
+            std::string::npos)
+      << listed.out;
+
+  // A mesh drawn and the body's both is refused: with no meshes named, the body is all of them.
+  const CliResult twice = runDrape("run --garment '" + clothed + "' --avatar '" + clothed +
+                                       "' --avatar-drawn-meshes Cape --frames 1 --out '" + (dir / "twice") + "'",
+                                   dir);
+  EXPECT_EQ(twice.code, 2);
+  EXPECT_NE(twice.err.find(clothed + ": drawnMeshes (Cape) name Cape, which is the body's: a mesh is drawn or makes the "
+                           "body, not both (the body is every mesh of its skin unless meshes names those that make "
+                           "it; its skinned meshes: Body, Cape)"),
+            std::string::npos)
+      << twice.err;
+}
+
 TEST(AvatarMeshes, ConvertWritesTheMeshesChosen) {
   ScratchDir dir("avatar-meshes-convert");
   const std::string clothed = testing::clothedCesiumMan(dir / "clothed");
@@ -106,7 +178,7 @@ TEST(AvatarMeshes, InspectListsTheMeshesAndAWrongNameIsRefusedWithThem) {
   const CliResult inspected = runDrape("inspect '" + clothed + "'", dir);
   ASSERT_EQ(inspected.code, 0) << inspected.err;
   EXPECT_NE(inspected.out.find("  meshes     2 skinned: Body, Cape (make-scene --avatar-meshes chooses those that make "
-                               "the body)\n"),
+                               "the body, --avatar-drawn-meshes those drawn with it)\n"),
             std::string::npos)
       << inspected.out;
 

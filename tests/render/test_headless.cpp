@@ -271,6 +271,36 @@ TEST(HeadlessBody, TheSkinIsDrawnInsteadOfTheSegmentsUnlessTheyAreAskedFor) {
   EXPECT_FALSE(isBackground(bare, ox, oy));
 }
 
+TEST(HeadlessBody, DrawnMeshesShowWithTheSkinInADarkerClay) {
+  // The skin on the left, a drawn mesh (hair, eyes) on the right: both show with the skin,
+  // the drawn one darker; neither with the segments the overlay asks for.
+  const auto [skin, skinAt] = square("body", MeshRole::Skin, Vec3(-0.3, 0, 0), 0.3);
+  const auto [hair, hairAt] = square("drawn", MeshRole::Drawn, Vec3(0.3, 0, 0), 0.3);
+  HeadlessRenderer renderer({skin, hair}, kW, kH);
+  Frame f;
+  f.positions = {skinAt, hairAt};
+  f.states = {{}, {}};
+  ViewSettings view;
+  view.azimuthDeg = 0.0;
+  view.elevationDeg = 0.0;
+  OverlaySettings overlay;
+  overlay.floor = false;
+  const Image shown = renderer.render(f, view, overlay);
+  overlay.segments = true;
+  const Image segments = renderer.render(f, view, overlay);
+  const CameraMatrices cam = renderer.renderer().camera(kW, kH, view);
+  const Box left = projectedBox(cam, skinAt), right = projectedBox(cam, hairAt);
+  const int lx = (left.x0 + left.x1) / 2, ly = (left.y0 + left.y1) / 2;
+  const int rx = (right.x0 + right.x1) / 2, ry = (right.y0 + right.y1) / 2;
+  ASSERT_FALSE(isBackground(shown, lx, ly));
+  ASSERT_FALSE(isBackground(shown, rx, ry)) << "the drawn mesh is not drawn with the skin";
+  const auto brightness = [](const Image& image, int x, int y) {
+    return static_cast<int>(image.pixel(x, y)[0]) + image.pixel(x, y)[1] + image.pixel(x, y)[2];
+  };
+  EXPECT_LT(brightness(shown, rx, ry) + 100, brightness(shown, lx, ly)) << "the drawn mesh is not darker than the skin";
+  EXPECT_TRUE(isBackground(segments, rx, ry)) << "the drawn mesh is drawn with the segments";
+}
+
 /// A coarse closed UV sphere (outward winding), as a skinned body: its smoothed normals lean
 /// away from the camera on front faces near the silhouette.
 std::pair<MeshInfo, std::vector<Vec3>> coarseSphere(const Vec3& centre, double radius, int slices, int stacks) {

@@ -14,6 +14,7 @@
 #include "drape/core/error.hpp"
 #include "drape/scene/avatar_gltf.hpp"
 #include "drape/scene/avatar_segment.hpp"
+#include "drape/testing/clothed_avatar.hpp"
 #include "drape/testing/errors.hpp"
 #include "drape/testing/temp_dir.hpp"
 
@@ -163,6 +164,52 @@ TEST(GltfAvatar, AVrmIsReadAsTheGlbItIs) {
   for (std::size_t j = 0; j < glb.joints.size(); ++j) EXPECT_EQ(vrm.joints[j].name, glb.joints[j].name);
   EXPECT_EQ(vrm.segments.size(), glb.segments.size());
   EXPECT_EQ(vrm.animations, glb.animations);
+}
+
+TEST(AvatarFile, DrawnMeshesAreSkinnedOverTheBodysJointsAndPlacedWithIt) {
+  // The cape drawn, the body alone colliding: the drawn skin is exactly the cape's part of
+  // the whole skin's read (positions, joints, weights), on the same skeleton, and moves
+  // with the avatar's placement as the skin does.
+  const std::string clothed = drape::testing::clothedCesiumMan(drape::testing::processTempDir("drawn-meshes"));
+  const Avatar whole = loadAvatarFile(clothed);
+  Avatar drawn = loadAvatarFile(clothed, {"Body"}, {"Cape"});
+  ASSERT_TRUE(drawn.drawnSkin.has_value());
+  EXPECT_EQ(drawn.drawnMeshesRead, std::vector<std::string>{"Cape"});
+  ASSERT_EQ(drawn.joints.size(), whole.joints.size());
+  for (std::size_t j = 0; j < whole.joints.size(); ++j) EXPECT_EQ(drawn.joints[j].name, whole.joints[j].name);
+  const std::size_t body = drawn.skin->mesh.vertexCount(), cape = drawn.drawnSkin->mesh.vertexCount();
+  ASSERT_EQ(body + cape, whole.skin->mesh.vertexCount());
+  ASSERT_EQ(drawn.skin->mesh.triangleCount() + drawn.drawnSkin->mesh.triangleCount(), whole.skin->mesh.triangleCount());
+  for (std::size_t v = 0; v < cape; ++v) {
+    EXPECT_LT((drawn.drawnSkin->mesh.positions[v] - whole.skin->mesh.positions[body + v]).norm(), 1e-12);
+    EXPECT_EQ(drawn.drawnSkin->joints[v], whole.skin->joints[body + v]);
+    EXPECT_EQ(drawn.drawnSkin->weights[v], whole.skin->weights[body + v]);
+  }
+  EXPECT_EQ(drawn.segments.size(), loadAvatarFile(clothed, {"Body"}).segments.size()) << "the drawn meshes are not cut";
+
+  const std::vector<Vec3> before = drawn.drawnSkin->mesh.positions;
+  const RigidTransform placement{Quat(Eigen::AngleAxisd(0.7, Vec3::UnitY())), Vec3(1.0, 0.0, -2.0)};
+  placeAvatar(drawn, placement, 0.5);
+  for (std::size_t v = 0; v < cape; v += 97)
+    EXPECT_LT((drawn.drawnSkin->mesh.positions[v] - placement.apply(0.5 * before[v])).norm(), 1e-12);
+}
+
+TEST(AvatarFile, AMeshDrawnAndTheBodysIsRefused) {
+  const std::string clothed = drape::testing::clothedCesiumMan(drape::testing::processTempDir("drawn-refused"));
+  EXPECT_EQ(errorOf([&] { (void)loadAvatarFile(clothed, {}, {"Cape"}); }),
+            clothed + ": drawnMeshes (Cape) name Cape, which is the body's: a mesh is drawn or makes the body, not both "
+                      "(the body is every mesh of its skin unless meshes names those that make it; its skinned meshes: "
+                      "Body, Cape)");
+  EXPECT_EQ(errorOf([&] { (void)loadAvatarFile(clothed, {"Body", "Cape"}, {"CapeMesh", "Body"}); }),
+            clothed + ": drawnMeshes (CapeMesh, Body) name Body, Cape, which are the body's: a mesh is drawn or makes "
+                      "the body, not both");
+  EXPECT_NE(errorOf([&] { (void)loadAvatarFile(clothed, {"Body"}, {"Hair"}); })
+                .find("has no node or mesh named 'Hair' (its skinned meshes: Body, Cape)"),
+            std::string::npos);
+  const std::string makeHuman = std::string(DRAPE_SOURCE_DIR) + "/data/avatars/makehuman_rig_cmu_mb.mhskel";
+  EXPECT_EQ(errorOf([&] { (void)loadAvatarFile(makeHuman, {}, {"Hair"}); }),
+            makeHuman + ": drawnMeshes (Hair) choose among the skinned meshes of a glTF, Collada or FBX avatar; a "
+                        "MakeHuman avatar is one body");
 }
 
 TEST(GltfAvatar, UnknownAvatarExtension) {

@@ -25,7 +25,9 @@ namespace drape::formats {
 
 struct RunMesh {
   std::string name;
-  std::string role;      ///< "garment", "segment" (an avatar body part) or "skin" (the avatar's smooth body)
+  /// "garment", "segment" (an avatar body part), "skin" (the avatar's smooth body) or
+  /// "drawn" (skinned meshes drawn with it, never collided with: hair, eyes)
+  std::string role;
   std::string topology;  ///< OBJ file, relative to the run directory
   std::string cache;     ///< PC2 file, relative to the run directory
   std::string states;    ///< state cache, relative to the run directory; "": none (optional key)

@@ -18,4 +18,9 @@ namespace drape::motion {
 /// skin or the span does not hold one transform per joint.
 void poseSkin(const scene::Avatar& avatar, std::span<const RigidTransform> jointWorld, std::vector<Vec3>& out);
 
+/// The same for another skinned mesh over the avatar's joints (its drawn meshes,
+/// Avatar::drawnSkin).
+void poseSkin(const scene::Avatar& avatar, const scene::SkinnedMesh& skin, std::span<const RigidTransform> jointWorld,
+              std::vector<Vec3>& out);
+
 }  // namespace drape::motion

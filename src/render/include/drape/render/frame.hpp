@@ -20,11 +20,12 @@ namespace drape::render {
 
 /// How a mesh is drawn: garments in cloth colours with collision-state colouring and
 /// markers, segments (the avatar's rigid body parts, what the cloth collides with) in the
-/// body colour with offset surfaces, and the skin (the avatar's skinned body) in the body
-/// colour instead of the segments when a run has one.
-enum class MeshRole : std::uint8_t { Garment, Segment, Skin };
+/// body colour with offset surfaces, the skin (the avatar's skinned body) in the body
+/// colour instead of the segments when a run has one, and the avatar's drawn meshes (hair,
+/// eyes: skinned with the body, never collided with) in a darker clay beside the skin.
+enum class MeshRole : std::uint8_t { Garment, Segment, Skin, Drawn };
 
-/// Parses "garment" / "segment" / "skin" (the run manifest's role names); throws
+/// Parses "garment" / "segment" / "skin" / "drawn" (the run manifest's role names); throws
 /// drape::Error otherwise.
 [[nodiscard]] MeshRole parseMeshRole(const std::string& role);
 

@@ -49,6 +49,11 @@ struct Avatar {
   /// A glTF, Collada or FBX file's skinned meshes (by node or mesh name), and those its
   /// skin was built from: all of them, or those the Avatar node's `meshes` chose.
   std::vector<std::string> fileMeshes, meshesRead;
+  /// Skinned meshes of the same file drawn with the body and moved by its skeleton, but no
+  /// part of the body the cloth collides with (hair, eyes, accessories: the Avatar node's
+  /// drawnMeshes), and the names they were read by. Never segmented, fitted or tucked.
+  std::optional<SkinnedMesh> drawnSkin;
+  std::vector<std::string> drawnMeshesRead;
 
   /// Index of the joint named `name`, or -1.
   [[nodiscard]] int findJoint(const std::string& name) const {

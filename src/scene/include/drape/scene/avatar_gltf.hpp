@@ -40,6 +40,9 @@ namespace drape::scene {
 /// Any avatar file drape reads: .glb/.gltf, .dae/.fbx, a MakeHuman .mhskel (the mesh and
 /// weights beside it), or a VRML97 H-Anim humanoid (.wrl). Throws drape::Error for other
 /// extensions, and for `meshes` (as for loadGltfAvatar) given with a file of one body.
-[[nodiscard]] Avatar loadAvatarFile(const std::string& path, const std::vector<std::string>& meshes = {});
+/// `drawnMeshes` names skinned meshes of the same file drawn with the body but not part of
+/// it (Avatar::drawnSkin: hair, eyes); a mesh both drawn and the body's is an error.
+[[nodiscard]] Avatar loadAvatarFile(const std::string& path, const std::vector<std::string>& meshes = {},
+                                    const std::vector<std::string>& drawnMeshes = {});
 
 }  // namespace drape::scene

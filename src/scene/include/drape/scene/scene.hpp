@@ -110,6 +110,9 @@ struct ExternalAvatar {
   /// The file's skinned meshes that make the body, by node or mesh name (a character file
   /// that also holds its clothes or hair); empty: every mesh of its skin.
   std::vector<std::string> meshes;
+  /// Skinned meshes of the same file drawn with the body but not collided with (hair, eyes,
+  /// accessories), by node or mesh name; empty: none.
+  std::vector<std::string> drawnMeshes;
   /// URL(s) of the motion it plays when a command gives it none (a BVH, AMC, or animated
   /// avatar file), relative to the scene; the first that exists is played. Empty: none.
   std::vector<std::string> motion;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -260,6 +261,7 @@ void addRigid(ModelBuilder& b, const GltfRigidMesh& m, int timeAccessor, std::si
 
 constexpr std::array<float, 4> kGarmentColour = {0.60f, 0.04f, 0.05f, 1.0f};  // linear, the renderer's cloth red
 constexpr std::array<float, 4> kSegmentColour = {0.61f, 0.51f, 0.43f, 1.0f};  // linear, clay
+constexpr std::array<float, 4> kDrawnColour = {0.107f, 0.078f, 0.064f, 1.0f};  // linear, the renderer's darker clay
 
 /// A scene's sRGB colour as glTF's linear base colour (the renderer's 2.2 gamma).
 std::array<float, 4> linearColour(const Vec3& srgb) {
@@ -322,8 +324,13 @@ RigidFit fitRigid(const std::vector<Vec3>& from, const std::vector<Vec3>& to) {
   return fit;
 }
 
-RunExportSummary exportRunToGlb(const std::string& runDirectory, const std::string& glbPath, double rigidTolerance_m) {
+RunExportSummary exportRunToGlb(const std::string& runDirectory, const std::string& glbPath, ExportedBody body,
+                                double rigidTolerance_m) {
   const RunManifest manifest = readRunManifest(runDirectory);
+  std::set<std::string> skinned;  // the characters whose skinned body is in the run
+  for (const RunMesh& rm : manifest.meshes)
+    if (rm.role == "skin") skinned.insert(rm.character);
+  const bool skins = body == ExportedBody::Skin;
   const std::filesystem::path dir(runDirectory);
   if (manifest.frames <= 0) throw Error(fmt::format("{}: the run has no frames", (dir / "manifest.json").string()));
   GltfAnimation animation;
@@ -331,10 +338,10 @@ RunExportSummary exportRunToGlb(const std::string& runDirectory, const std::stri
   RunExportSummary summary;
   summary.frames = manifest.frames;
   for (const RunMesh& rm : manifest.meshes) {
-    // The skinned body (and its drawn meshes) are drawn by players; the file carries the
-    // body as its segments, rigid nodes a few kilobytes each, where the skin would be a
-    // morph target per frame.
-    if (rm.role == "skin" || rm.role == "drawn") continue;
+    // By default the file carries the body as its segments, rigid nodes a few kilobytes
+    // each, where the skinned body (and its drawn meshes) would be a morph target per frame.
+    if ((rm.role == "skin" || rm.role == "drawn") && !skins) continue;
+    if (rm.role == "segment" && skins && skinned.count(rm.character) > 0) continue;
     const std::string objPath = (dir / rm.topology).string();
     const std::string pc2Path = (dir / rm.cache).string();
     mesh::TriMesh topology = readObj(objPath);
@@ -350,7 +357,7 @@ RunExportSummary exportRunToGlb(const std::string& runDirectory, const std::stri
     cache.frames.resize(static_cast<std::size_t>(manifest.frames));
     // Among several characters, a part's node is named for its character too.
     const std::string name = rm.character.empty() ? rm.name : rm.character + "/" + rm.name;
-    if (rm.role != "garment" && rm.role != "segment") {
+    if (rm.role != "garment" && rm.role != "segment" && rm.role != "skin" && rm.role != "drawn") {
       throw Error(fmt::format("{}: mesh '{}' has role '{}' (expected garment, segment, skin or drawn)",
                               (dir / "manifest.json").string(), rm.name, rm.role));
     }
@@ -388,7 +395,10 @@ RunExportSummary exportRunToGlb(const std::string& runDirectory, const std::stri
     m.name = name;
     m.triangles = std::move(topology.triangles);
     m.frames = std::move(cache.frames);
-    m.colour = rm.role != "garment" ? kSegmentColour : rm.colour ? linearColour(*rm.colour) : kGarmentColour;
+    m.colour = rm.role == "garment" ? (rm.colour ? linearColour(*rm.colour) : kGarmentColour)
+               : rm.role == "drawn" ? kDrawnColour
+                                    : kSegmentColour;
+    if (rm.role == "skin" || rm.role == "drawn") ++summary.skins;
     m.doubleSided = rm.role == "garment";
     animation.deforming.push_back(std::move(m));
     ++summary.deforming;

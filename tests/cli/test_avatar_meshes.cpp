@@ -5,10 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <tiny_gltf.h>
 
 #include "cli_runner.hpp"
 #include "drape/formats/mesh_file.hpp"
@@ -24,6 +28,24 @@ using testing::CliResult;
 using testing::runDrape;
 using testing::ScratchDir;
 using testing::statsOf;
+
+tinygltf::Model loadGlb(const std::string& path) {
+  tinygltf::TinyGLTF loader;
+  tinygltf::Model model;
+  std::string err, warn;
+  EXPECT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, path)) << err;
+  return model;
+}
+
+/// A float accessor's components, as tightly packed as drape writes them.
+std::vector<float> floats(const tinygltf::Model& model, int accessor) {
+  const tinygltf::Accessor& a = model.accessors.at(static_cast<std::size_t>(accessor));
+  const tinygltf::BufferView& v = model.bufferViews.at(static_cast<std::size_t>(a.bufferView));
+  std::vector<float> out(a.count * static_cast<std::size_t>(tinygltf::GetNumComponentsInType(a.type)));
+  std::memcpy(out.data(), model.buffers.at(static_cast<std::size_t>(v.buffer)).data.data() + v.byteOffset + a.byteOffset,
+              out.size() * sizeof(float));
+  return out;
+}
 
 /// The cape's triangles from the shoulders up, as an OBJ: the constraint mask.
 std::string shouldersMask(const std::string& clothed, const ScratchDir& dir) {
@@ -143,6 +165,34 @@ TEST(AvatarMeshes, DrawnMeshesMoveWithTheSkinAndTheClothNeverMeetsThem) {
   for (std::size_t i = 0; i < cape.pointCount; ++i)
     moved = std::max(moved, (cape.frames.back()[i] - cape.frames.front()[i]).norm());
   EXPECT_GT(moved, 0.02);
+  // Exported with --body skin, the file carries the body and the drawn cape as the players
+  // draw them, frame by frame, and no part; by default, the parts and neither of them.
+  const CliResult exported = runDrape("export '" + run + "' --body skin --glb '" + (dir / "skin.glb") + "'", dir);
+  ASSERT_EQ(exported.code, 0) << exported.err;
+  ASSERT_EQ(runDrape("export '" + run + "' --glb '" + (dir / "parts.glb") + "'", dir).code, 0);
+  const auto nodeNames = [](const tinygltf::Model& model) {
+    std::vector<std::string> names;
+    for (const tinygltf::Node& n : model.nodes) names.push_back(n.name);
+    return names;
+  };
+  if (std::filesystem::exists(std::string(DRAPE_SOURCE_DIR) + "/tools/gltf-validator/node_modules/gltf-validator")) {
+    const std::string report = dir / "validator.json";
+    (void)std::system(("node '" + std::string(DRAPE_SOURCE_DIR) + "/tools/gltf-validator/validate.js' '" +
+                       (dir / "skin.glb") + "' >'" + report + "' 2>&1")
+                          .c_str());
+    EXPECT_NE(testing::slurp(report).find("\"errors\":0"), std::string::npos) << testing::slurp(report);
+  }
+  const tinygltf::Model skin = loadGlb(dir / "skin.glb");
+  EXPECT_EQ(nodeNames(skin), (std::vector<std::string>{"cape", "body", "drawn"}));
+  EXPECT_EQ(nodeNames(loadGlb(dir / "parts.glb")).size(), 1 + manifest.meshes.size() - 3) << "the cape and every part";
+  const tinygltf::Primitive& drawnPrimitive = skin.meshes.at(static_cast<std::size_t>(skin.nodes[2].mesh)).primitives[0];
+  ASSERT_EQ(drawnPrimitive.targets.size(), cape.frames.size() - 1);
+  std::vector<float> last = floats(skin, drawnPrimitive.attributes.at("POSITION"));
+  const std::vector<float> delta = floats(skin, drawnPrimitive.targets.back().at("POSITION"));
+  for (std::size_t i = 0; i < last.size(); ++i) last[i] += delta[i];
+  for (std::size_t v = 0; v < cape.pointCount; ++v)
+    for (std::size_t k = 0; k < 3; ++k) ASSERT_NEAR(last[3 * v + k], cape.frames.back()[v][static_cast<Eigen::Index>(k)], 1e-5);
+
   const CliResult listed = runDrape("inspect '" + run + "'", dir);
   EXPECT_NE(listed.out.find("  drawn    drawn          3273 vertices, 4672 triangles (skinned with the body, not "
                             "collided with)\n"),

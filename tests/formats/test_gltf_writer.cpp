@@ -112,6 +112,14 @@ TEST(GltfWriter, RunExportReproducesEveryFrame) {
   }
 }
 
+TEST(GltfWriter, ARunWithoutASkinnedBodyKeepsItsPartsWhenTheSkinIsAskedFor) {
+  const std::string dir = testrun::writeTestRun(testrun::freshDir("gltf_no_skin"), 5);
+  const RunExportSummary s = exportRunToGlb(dir, dir + "/skin.glb", ExportedBody::Skin);
+  EXPECT_EQ(s.rigid, 1u) << "the torso";
+  EXPECT_EQ(s.deforming, 1u) << "the flag";
+  EXPECT_EQ(s.skins, 0u);
+}
+
 TEST(GltfWriter, KhronosValidatorReportsNoErrors) {
   const std::string validator = std::string(DRAPE_SOURCE_DIR) + "/tools/gltf-validator/validate.js";
   if (std::system("node --version >/dev/null 2>&1") != 0)

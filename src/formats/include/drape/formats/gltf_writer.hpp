@@ -8,6 +8,7 @@
 // with translation/rotation (TRS) animation.
 
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -53,15 +54,27 @@ struct RigidFit {
 };
 [[nodiscard]] RigidFit fitRigid(const std::vector<Vec3>& from, const std::vector<Vec3>& to);
 
+/// Which of a run's bodies an export carries.
+enum class ExportedBody : std::uint8_t {
+  /// The rigid parts the cloth collides with: a TRS-animated node each, kilobytes a part.
+  Segments,
+  /// The skinned body and its drawn meshes, as the players draw them (fitted and tucked under
+  /// the cloth): a morph target per frame, tens of kilobytes a frame. A character without a
+  /// skinned body keeps its segments.
+  Skin,
+};
+
 /// Exports a run directory (manifest.json with OBJ + PC2 per mesh) to `glbPath`: garments
 /// as morph-target meshes; segments as TRS-animated nodes when their caches move rigidly
-/// (within `rigidTolerance_m`), else as morph-target meshes too.
+/// (within `rigidTolerance_m`), else as morph-target meshes too; or, with `body` Skin, each
+/// character's skinned body and drawn meshes instead of its segments.
 struct RunExportSummary {
   std::size_t deforming = 0;
   std::size_t rigid = 0;
+  std::size_t skins = 0;  ///< skinned bodies and drawn meshes written (ExportedBody::Skin)
   long frames = 0;
 };
 RunExportSummary exportRunToGlb(const std::string& runDirectory, const std::string& glbPath,
-                                double rigidTolerance_m = 1e-4);
+                                ExportedBody body = ExportedBody::Segments, double rigidTolerance_m = 1e-4);
 
 }  // namespace drape::formats

@@ -142,7 +142,7 @@ RunFunction setupConvert(CLI::App& app) {
       ->required();
   app.add_option("--avatar-meshes", avatarMeshes,
                  "Of an avatar file whose skin moves several meshes (drape inspect FILE lists them), those to convert, "
-                 "by node or mesh name (the body without the clothes the file holds too)")
+                 "by node or mesh name or shell pattern (the body without the clothes the file holds too)")
       ->delimiter(',');
   app.add_option("--to", output,
                  "Output file: a segmented H-Anim 1.1 VRML97 humanoid (.wrl) with one motion as its joints' "

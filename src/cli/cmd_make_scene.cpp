@@ -337,8 +337,8 @@ RunFunction setupMakeScene(CLI::App& app) {
                  "vertices welded where those files split them; or a MakeHuman .mhclo (refitted to the MakeHuman body)")
       ->required();
   app.add_option("--garment-parts", o.garmentParts,
-                 "The meshes of the garment file that are the garment, by node or mesh name (OBJ: g/o groups); "
-                 "default: all")
+                 "The meshes of the garment file that are the garment, by node or mesh name or shell pattern (OBJ: g/o "
+                 "groups); default: all")
       ->delimiter(',');
   app.add_option("--mask", o.mask,
                  "Constraint mask (OBJ, glTF, Collada or FBX): the garment vertices bound to the body (for a .mhclo: "
@@ -375,13 +375,14 @@ RunFunction setupMakeScene(CLI::App& app) {
                  "written as the scene's keepApart (e.g. LeftForeArm,RightForeArm,LeftArm,RightArm)")
       ->delimiter(',');
   app.add_option("--avatar-meshes", o.avatarMeshes,
-                 "The avatar file's skinned meshes that make the body, by node or mesh name (a character file that "
-                 "holds its clothes or hair too: e.g. Body,Shoes), written as the Avatar node's meshes; default: "
+                 "The avatar file's skinned meshes that make the body, by node or mesh name or shell pattern (a "
+                 "character file that holds its clothes or hair too: e.g. Body,Shoes), written as the Avatar node's meshes; default: "
                  "every mesh of its skin (drape inspect FILE lists them)")
       ->delimiter(',');
   app.add_option("--avatar-drawn-meshes", o.drawnMeshes,
                  "Of the avatar file's skinned meshes, those drawn with the body but not collided with (hair, eyes, "
-                 "accessories), by node or mesh name, written as the Avatar node's drawnMeshes; default: none")
+                 "accessories), by node or mesh name or shell pattern (*: every mesh the body leaves out), written as "
+                 "the Avatar node's drawnMeshes; default: none")
       ->delimiter(',');
   app.add_option("--cut-at-joints", o.cutAtJoints,
                  "Joints whose rigid parts are cut across the joint, what lies behind it going to the parent's part, "

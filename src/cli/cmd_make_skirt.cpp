@@ -275,12 +275,14 @@ RunFunction setupMakeSkirt(CLI::App& app) {
   app.add_option("--name", o.name, "The skirt's name (the ClothSet's; default Skirt)");
   app.add_option("--avatar-url", o.avatarUrl, "The Avatar url written into scene.wrl (default: the avatar's path relative to --out)");
   app.add_option("--avatar-meshes", o.avatarMeshes,
-                 "The avatar file's skinned meshes that make the body, by node or mesh name (a character file that "
-                 "holds its clothes or hair too), written as the Avatar node's meshes; default: every mesh of its skin")
+                 "The avatar file's skinned meshes that make the body, by node or mesh name or shell pattern (a "
+                 "character file that holds its clothes or hair too), written as the Avatar node's meshes; default: "
+                 "every mesh of its skin")
       ->delimiter(',');
   app.add_option("--avatar-drawn-meshes", o.drawnMeshes,
                  "Of the avatar file's skinned meshes, those drawn with the body but not collided with (hair, eyes, "
-                 "accessories), by node or mesh name, written as the Avatar node's drawnMeshes; default: none")
+                 "accessories), by node or mesh name or shell pattern (*: every mesh the body leaves out), written as "
+                 "the Avatar node's drawnMeshes; default: none")
       ->delimiter(',');
   app.add_option("--length", o.fit.length_m, "Waist to hem, m (default: a little above the knees)");
   app.add_option("--clearance", o.fit.clearance_m, "Gap between body and skirt at rest, m")->capture_default_str();

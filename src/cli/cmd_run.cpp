@@ -422,12 +422,12 @@ RunFunction setupRun(CLI::App& app) {
                  "vertices), instead of a scene");
   app.add_option("--avatar", o->avatar, "Avatar to wear --garment (.glb, .gltf, .vrm, .dae, .fbx, MakeHuman .mhskel)");
   app.add_option("--avatar-meshes", o->avatarMeshes,
-                 "With --avatar: its file's skinned meshes that make the body, by node or mesh name (a character file "
-                 "that holds its clothes or hair too); default: every mesh of its skin")
+                 "With --avatar: its file's skinned meshes that make the body, by node or mesh name or shell pattern "
+                 "(a character file that holds its clothes or hair too); default: every mesh of its skin")
       ->delimiter(',');
   app.add_option("--avatar-drawn-meshes", o->drawnMeshes,
                  "With --avatar: its file's skinned meshes drawn with the body but not collided with (hair, eyes, "
-                 "accessories), by node or mesh name; default: none")
+                 "accessories), by node or mesh name or shell pattern; default: none")
       ->delimiter(',');
   app.add_option("--motion", o->motions, std::string("Motion for the avatar ") + kMotionHelp + kMotionPerCharacterHelp)
       ->type_name("FILE|NAME=FILE");

@@ -16,6 +16,7 @@
 #include "drape/core/files.hpp"
 #include "drape/formats/json_text.hpp"
 #include "drape/formats/mesh_file.hpp"
+#include "drape/formats/part_names.hpp"
 #include "plain_data.hpp"
 #include "text_scan.hpp"
 
@@ -660,9 +661,10 @@ SkinnedModel extract(const GModel& model, const std::string& name, const std::ve
     const std::string& meshName = model.meshNames[static_cast<std::size_t>(node.mesh)];
     const std::vector<int>& newIndex = sj.newIndex[static_cast<std::size_t>(node.skin)];
     if (newIndex.empty()) {
-      // Another skeleton's mesh (a second character): not the avatar's.
-      std::vector<bool> other(parts.size(), false);
-      if (!parts.empty() && partWanted(parts, other, part, meshName))
+      // Another skeleton's mesh (a second character): not the avatar's. Named (not only
+      // matched by a pattern), it is an error.
+      const auto named = [&](const std::string& p) { return !isNamePattern(p) && (p == part || p == meshName); };
+      if (std::any_of(parts.begin(), parts.end(), named))
         r.fail(fmt::format("its mesh '{}' is moved by skin {}, whose joints are apart from the first skin's skeleton; "
                            "drape reads the character of the file's first skin",
                            part, node.skin));

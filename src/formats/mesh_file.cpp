@@ -10,6 +10,7 @@
 #include "drape/core/files.hpp"
 #include "drape/formats/gltf_avatar.hpp"
 #include "drape/formats/obj.hpp"
+#include "drape/formats/part_names.hpp"
 #include "drape/mesh/weld.hpp"
 #include "plain_data.hpp"
 #include "text_scan.hpp"
@@ -72,7 +73,7 @@ bool partWanted(const std::vector<std::string>& parts, std::vector<bool>& matche
   if (parts.empty()) return true;
   bool keep = false;
   for (std::size_t k = 0; k < parts.size(); ++k)
-    if (parts[k] == part || (!meshName.empty() && parts[k] == meshName)) keep = matched[k] = true;
+    if (nameMatches(parts[k], part) || (!meshName.empty() && nameMatches(parts[k], meshName))) keep = matched[k] = true;
   return keep;
 }
 
@@ -80,7 +81,8 @@ void checkPartsMatched(const std::vector<std::string>& parts, const std::vector<
                        const std::vector<std::string>& all, const std::string& name, const std::string& what) {
   for (std::size_t k = 0; k < parts.size(); ++k)
     if (!matched[k])
-      throw Error(fmt::format("{}: has no node or mesh named '{}' (its {}: {})", name, parts[k], what,
+      throw Error(fmt::format("{}: has no node or mesh {} '{}' (its {}: {})", name,
+                              isNamePattern(parts[k]) ? "matching" : "named", parts[k], what,
                               all.empty() ? std::string("none") : fmt::format("{}", fmt::join(all, ", "))));
 }
 

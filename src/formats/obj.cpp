@@ -9,8 +9,10 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "drape/core/error.hpp"
+#include "drape/formats/part_names.hpp"
 #include "text_scan.hpp"
 
 namespace drape::formats {
@@ -30,8 +32,13 @@ void requireReadableFile(const std::string& path) {
   if (!probe) throw Error(fmt::format("{}: cannot be read", path));
 }
 
-bool wanted(const std::string& shapeName, const std::vector<std::string>& groups) {
-  return groups.empty() || std::find(groups.begin(), groups.end(), shapeName) != groups.end();
+/// Whether group `shapeName` is one of `groups` (names or shell patterns; every group when
+/// there are none), marking in `matched` those that answer.
+bool wanted(const std::string& shapeName, const std::vector<std::string>& groups, std::vector<bool>& matched) {
+  bool keep = groups.empty();
+  for (std::size_t k = 0; k < groups.size(); ++k)
+    if (nameMatches(groups[k], shapeName)) keep = matched[k] = true;
+  return keep;
 }
 
 // tinyobjloader reads a coordinate it cannot parse ("nan", "abc") as 0 and one too large
@@ -101,8 +108,9 @@ mesh::TriMesh buildMesh(const TinyObj& obj, const std::string& name, const ObjRe
   }
 
   std::vector<std::uint32_t> polygon;
+  std::vector<bool> matched(options.groups.size(), false);
   for (const auto& shape : obj.shapes) {
-    if (!wanted(shape.name, options.groups)) continue;
+    if (!wanted(shape.name, options.groups, matched)) continue;
     std::size_t offset = 0;
     for (const auto faceSize : shape.mesh.num_face_vertices) {
       polygon.clear();
@@ -118,6 +126,21 @@ mesh::TriMesh buildMesh(const TinyObj& obj, const std::string& name, const ObjRe
       if (polygon.size() < 3) throw Error(fmt::format("{}: a face in group '{}' has fewer than 3 vertices", name, shape.name));
       mesh::triangulatePolygon(polygon, out.triangles);
     }
+  }
+  for (std::size_t k = 0; k < options.groups.size(); ++k) {
+    if (matched[k]) continue;
+    std::vector<std::string> groups;
+    for (const auto& shape : obj.shapes)
+      if (std::find(groups.begin(), groups.end(), shape.name) == groups.end()) groups.push_back(shape.name);
+    // A body's file can hold hundreds of helper groups: the first few say what they are.
+    constexpr std::size_t kListed = 12;
+    const std::size_t listed = std::min(groups.size(), kListed);
+    throw Error(fmt::format(
+        "{}: has no g/o group {} '{}' (its groups: {}{})", name,
+        isNamePattern(options.groups[k]) ? "matching" : "named", options.groups[k],
+        groups.empty() ? std::string("none")
+                       : fmt::format("{}", fmt::join(groups.begin(), groups.begin() + static_cast<long>(listed), ", ")),
+        groups.size() > listed ? fmt::format(", ... {} in all", groups.size()) : ""));
   }
   if (out.triangles.empty()) {
     throw Error(options.groups.empty()

@@ -10,6 +10,7 @@
 #include "drape/core/files.hpp"
 #include "drape/formats/assimp_avatar.hpp"
 #include "drape/formats/hanim_motion.hpp"
+#include "drape/formats/part_names.hpp"
 #include "drape/scene/avatar_makehuman.hpp"
 #include "drape/scene/avatar_segment.hpp"
 #include "drape/scene/scene.hpp"
@@ -89,16 +90,47 @@ formats::SkinnedModel readSkinnedModel(const std::string& path, const std::vecto
                                    : formats::readAssimpSkinnedModel(path, parts);
 }
 
+bool contains(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+/// `drawn` with each shell pattern (formats/part_names.hpp) replaced by the skinned meshes
+/// of the file it matches that the body leaves out: `*` draws every one of them. A pattern
+/// matching none of them is an error listing them.
+std::vector<std::string> drawnNames(const Avatar& avatar, const std::string& path,
+                                    const std::vector<std::string>& drawn) {
+  std::vector<std::string> names, leftOut;
+  for (const std::string& mesh : avatar.fileMeshes)
+    if (!contains(avatar.meshesRead, mesh)) leftOut.push_back(mesh);
+  for (const std::string& d : drawn) {
+    if (!formats::isNamePattern(d)) {
+      if (!contains(names, d)) names.push_back(d);
+      continue;
+    }
+    bool any = false;
+    for (const std::string& mesh : leftOut)
+      if (formats::nameMatches(d, mesh)) {
+        any = true;
+        if (!contains(names, mesh)) names.push_back(mesh);
+      }
+    if (!any)
+      throw Error(fmt::format("{}: drawnMeshes '{}' matches none of the skinned meshes the body leaves out ({})", path,
+                              d,
+                              leftOut.empty() ? std::string("none: the body is every mesh of its skin")
+                                              : fmt::format("{}", fmt::join(leftOut, ", "))));
+  }
+  return names;
+}
+
 /// The meshes `drawn` names, read again from the avatar's file with its skeleton: the
 /// readers build a file's skeleton from its skins whatever meshes are chosen, so the joint
 /// indices are the body's. A mesh both drawn and the body's would be drawn twice.
 /// `bodyUnnamed`: no meshes named the body, which is then every mesh of the skin.
 void addDrawnMeshes(Avatar& avatar, const std::string& path, const std::vector<std::string>& drawn, bool bodyUnnamed) {
-  const formats::SkinnedModel model = readSkinnedModel(path, drawn);
+  const formats::SkinnedModel model = readSkinnedModel(path, drawnNames(avatar, path, drawn));
   std::vector<std::string> both;
   for (const std::string& name : model.meshesRead)
-    if (std::find(avatar.meshesRead.begin(), avatar.meshesRead.end(), name) != avatar.meshesRead.end())
-      both.push_back(name);
+    if (contains(avatar.meshesRead, name)) both.push_back(name);
   if (!both.empty()) {
     const std::string why = bodyUnnamed ? fmt::format(" (the body is every mesh of its skin unless meshes names those "
                                                       "that make it; its skinned meshes: {})",

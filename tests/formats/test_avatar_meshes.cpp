@@ -88,6 +88,18 @@ TEST(AvatarMeshes, ANameThatIsNoMeshOfTheSkinListsThem) {
             std::string::npos);
 }
 
+TEST(AvatarMeshes, ShellPatternsChooseMeshesByNodeOrMeshName) {
+  EXPECT_EQ(readGltfSkinnedModel(clothed(), {"B*"}).meshesRead, (Names{"Body"}));
+  EXPECT_EQ(readGltfSkinnedModel(clothed(), {"*Mesh"}).meshesRead, (Names{"Cape"})) << "by the mesh's name";
+  EXPECT_EQ(readGltfSkinnedModel(clothed(), {"[BC]?[dp]?"}).meshesRead, (Names{"Body", "Cape"}));
+  EXPECT_EQ(errorOf([] { (void)readGltfSkinnedModel(clothed(), {"Body", "Hair*"}); }),
+            clothed() + ": has no node or mesh matching 'Hair*' (its skinned meshes: Body, Cape)");
+  // A pattern that matches a second character's mesh does not ask for it: it is left out.
+  const std::string apart = drape::testing::clothedCesiumMan(
+      drape::testing::processTempDir("avatar-meshes-apart-pattern"), {.capeSkin = drape::testing::CapeSkin::Apart});
+  EXPECT_EQ(readGltfSkinnedModel(apart, {"*"}).meshesRead, (Names{"Body"}));
+}
+
 TEST(AvatarMeshes, AMeshNoSceneShowsIsNotTheBodys) {
   // The cape's node taken out of the node tree the scene shows: a proxy nothing draws.
   std::ifstream in(clothed());

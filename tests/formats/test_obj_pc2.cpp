@@ -42,6 +42,32 @@ TEST(Obj, KeepsOnlyRequestedGroups) {
   EXPECT_LE(m.positions.size(), 13380u);
 }
 
+TEST(Obj, GroupsAreChosenByNameOrShellPatternAndOneThatIsNotThereIsAnError) {
+  const std::string path = std::string(DRAPE_DATA_DIR) + "/avatars/makehuman_base_hm08.obj";
+  auto triangles = [&](const std::vector<std::string>& groups) {
+    ObjReadOptions options;
+    options.groups = groups;
+    options.keepUnusedVertices = false;
+    return readObj(path, options).triangles.size();
+  };
+  const std::size_t body = triangles({"body"}), tights = triangles({"helper-tights"});
+  EXPECT_EQ(triangles({"b?dy"}), body);
+  EXPECT_EQ(triangles({"helper-ti*"}), tights);
+  EXPECT_EQ(triangles({"helper-t*"}), tights + triangles({"helper-tongue"}));
+  EXPECT_EQ(triangles({"[bh]*", "joint-*"}) - triangles({"joint-*"}), triangles({"body", "helper-*"}));
+  const std::string missing = drape::testing::errorOf([&] { (void)triangles({"body", "bdoy"}); });
+  EXPECT_EQ(
+      missing.rfind(path + ": has no g/o group named 'bdoy' (its groups: body, helper-tights, joint-l-eye, "
+                           "joint-r-eye, joint-pelvis, joint-spine-4, joint-spine-3, joint-spine-2, joint-spine-1, "
+                           "joint-l-foot-2, joint-l-foot-1, joint-l-toe-5-3, ... ",
+                    0),
+      0u)
+      << missing;
+  EXPECT_EQ(missing.substr(missing.size() - 8), " in all)") << missing;
+  const std::string unmatched = drape::testing::errorOf([&] { (void)triangles({"hair*"}); });
+  EXPECT_NE(unmatched.find(": has no g/o group matching 'hair*' (its groups: body,"), std::string::npos) << unmatched;
+}
+
 TEST(Obj, ClearErrors) {
   EXPECT_THROW((void)readObj("/nonexistent/garment.obj"), Error);
   const std::string path = tempPath("bad.obj");

@@ -174,6 +174,9 @@ TEST(AvatarFile, DrawnMeshesAreSkinnedOverTheBodysJointsAndPlacedWithIt) {
   const Avatar whole = loadAvatarFile(clothed);
   Avatar drawn = loadAvatarFile(clothed, {"Body"}, {"Cape"});
   ASSERT_TRUE(drawn.drawnSkin.has_value());
+  const Avatar everyOther = loadAvatarFile(clothed, {"B*"}, {"*"});
+  EXPECT_EQ(everyOther.meshesRead, std::vector<std::string>{"Body"});
+  EXPECT_EQ(everyOther.drawnMeshesRead, std::vector<std::string>{"Cape"}) << "* draws every mesh the body leaves out";
   EXPECT_EQ(drawn.drawnMeshesRead, std::vector<std::string>{"Cape"});
   ASSERT_EQ(drawn.joints.size(), whole.joints.size());
   for (std::size_t j = 0; j < whole.joints.size(); ++j) EXPECT_EQ(drawn.joints[j].name, whole.joints[j].name);
@@ -206,6 +209,13 @@ TEST(AvatarFile, AMeshDrawnAndTheBodysIsRefused) {
   EXPECT_NE(errorOf([&] { (void)loadAvatarFile(clothed, {"Body"}, {"Hair"}); })
                 .find("has no node or mesh named 'Hair' (its skinned meshes: Body, Cape)"),
             std::string::npos);
+  // A pattern draws only meshes the body leaves out: with the whole skin the body, none.
+  EXPECT_EQ(errorOf([&] { (void)loadAvatarFile(clothed, {}, {"*"}); }),
+            clothed +
+                ": drawnMeshes '*' matches none of the skinned meshes the body leaves out (none: the body is "
+                "every mesh of its skin)");
+  EXPECT_EQ(errorOf([&] { (void)loadAvatarFile(clothed, {"Body"}, {"Hair*"}); }),
+            clothed + ": drawnMeshes 'Hair*' matches none of the skinned meshes the body leaves out (Cape)");
   const std::string makeHuman = std::string(DRAPE_SOURCE_DIR) + "/data/avatars/makehuman_rig_cmu_mb.mhskel";
   EXPECT_EQ(errorOf([&] { (void)loadAvatarFile(makeHuman, {}, {"Hair"}); }),
             makeHuman + ": drawnMeshes (Hair) choose among the skinned meshes of a glTF, Collada or FBX avatar; a "

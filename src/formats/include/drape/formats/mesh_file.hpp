@@ -61,8 +61,9 @@ struct MeshParts {
 };
 
 /// Whether a mesh placed by a node called `part` (its node's name, or its mesh's where the
-/// node has none) is one of `parts`, by that name or its mesh's `meshName`; every mesh is
-/// when `parts` is empty. Marks in `matched` (as long as `parts`) the names it answers.
+/// node has none) is one of `parts`, by that name or its mesh's `meshName`, each of `parts`
+/// a name or a shell pattern (part_names.hpp); every mesh is when `parts` is empty. Marks
+/// in `matched` (as long as `parts`) the names it answers.
 [[nodiscard]] bool partWanted(const std::vector<std::string>& parts, std::vector<bool>& matched, const std::string& part,
                               const std::string& meshName);
 

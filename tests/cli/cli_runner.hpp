@@ -43,11 +43,12 @@ struct ScratchDir {
   [[nodiscard]] std::string operator/(const std::string& leaf) const { return (path / leaf).string(); }
 };
 
-/// `args` is appended to the drape path as shell words (callers quote what needs it).
-inline CliResult runDrape(const std::string& args, const ScratchDir& scratch) {
+/// `args` is appended to the drape path as shell words (callers quote what needs it);
+/// `wrapper` goes before it (e.g. "xvfb-run -a " for a window).
+inline CliResult runDrape(const std::string& args, const ScratchDir& scratch, const std::string& wrapper = "") {
   const std::string outFile = scratch / "stdout.txt", errFile = scratch / "stderr.txt";
-  const std::string cmd = std::string("ASAN_OPTIONS=detect_leaks=0 '") + DRAPE_EXE + "' " + args + " >'" + outFile +
-                          "' 2>'" + errFile + "'";
+  const std::string cmd = std::string("ASAN_OPTIONS=detect_leaks=0 ") + wrapper + "'" + DRAPE_EXE + "' " + args +
+                          " >'" + outFile + "' 2>'" + errFile + "'";
   const int status = std::system(cmd.c_str());
   CliResult r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

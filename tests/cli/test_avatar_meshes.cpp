@@ -19,6 +19,7 @@
 #include "drape/formats/obj.hpp"
 #include "drape/formats/pc2.hpp"
 #include "drape/formats/run_manifest.hpp"
+#include "drape/render/image.hpp"
 #include "drape/testing/clothed_avatar.hpp"
 
 namespace drape {
@@ -209,6 +210,39 @@ TEST(AvatarMeshes, DrawnMeshesMoveWithTheSkinAndTheClothNeverMeetsThem) {
                            "it; its skinned meshes: Body, Cape)"),
             std::string::npos)
       << twice.err;
+}
+
+TEST(AvatarMeshes, TheLivePlayerDrawsTheDrawnMeshesOverTheSkin) {
+  // drape play simulates and draws through its own path (cli::ShownBodies): a skirt on the
+  // body, and the cape drawn over it darkens the character's pixels against the same scene
+  // without it.
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps installs xvfb)";
+  ScratchDir dir("avatar-drawn-play");
+  const std::string clothed = testing::clothedCesiumMan(dir / "clothed", {.offset_m = 0.01});
+  auto shot = [&](const std::string& drawn, const std::string& name) {
+    const CliResult made =
+        runDrape("make-skirt '" + clothed + "' --avatar-meshes Body " + drawn + " --out '" + (dir / name) + "'", dir);
+    EXPECT_EQ(made.code, 0) << made.err;
+    const std::string png = dir / (name + ".png");
+    const CliResult played = runDrape("play '" + (dir / name) + "/scene.wrl' --frames 3 --fast --size 320x240 "
+                                      "--screenshot '" + png + "'",
+                                      dir, "xvfb-run -a ");
+    EXPECT_EQ(played.code, 0) << played.out << played.err;
+    return render::readPng(png);
+  };
+  const render::Image with = shot("--avatar-drawn-meshes Cape", "with"), without = shot("", "without");
+  ASSERT_EQ(with.rgb.size(), without.rgb.size());
+  long darker = 0, brighter = 0;
+  for (int y = 0; y < with.height; ++y)
+    for (int x = 0; x < with.width; ++x) {
+      const int a = with.pixel(x, y)[0] + with.pixel(x, y)[1] + with.pixel(x, y)[2];
+      const int b = without.pixel(x, y)[0] + without.pixel(x, y)[1] + without.pixel(x, y)[2];
+      darker += a + 60 < b;
+      brighter += a > b + 60;
+    }
+  EXPECT_GT(darker, 1500) << "the drawn cape does not show";  // 4,710 measured
+  EXPECT_LT(brighter, darker / 5);
 }
 
 TEST(AvatarMeshes, ConvertWritesTheMeshesChosen) {

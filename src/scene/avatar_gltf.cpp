@@ -16,6 +16,20 @@
 #include "drape/scene/scene.hpp"
 
 namespace drape::scene {
+namespace {
+
+/// The model's triangles, rest positions and weights as a skinned mesh called `name`.
+SkinnedMesh skinnedMesh(const formats::SkinnedModel& model, const std::string& name) {
+  SkinnedMesh skin;
+  skin.mesh.name = name;
+  skin.mesh.positions = model.positions;
+  skin.mesh.triangles = model.triangles;
+  skin.joints = model.vertexJoints;
+  skin.weights = model.vertexWeights;
+  return skin;
+}
+
+}  // namespace
 
 Avatar buildAvatarFromSkinnedModel(const formats::SkinnedModel& model) {
   Avatar avatar;
@@ -31,13 +45,7 @@ Avatar buildAvatarFromSkinnedModel(const formats::SkinnedModel& model) {
     joint.restOrientation = Quat::Identity();
     avatar.joints.push_back(joint);
   }
-  SkinnedMesh skin;
-  skin.mesh.name = avatar.name;
-  skin.mesh.positions = model.positions;
-  skin.mesh.triangles = model.triangles;
-  skin.joints = model.vertexJoints;
-  skin.weights = model.vertexWeights;
-  avatar.skin = std::move(skin);
+  avatar.skin = skinnedMesh(model, avatar.name);
   avatar.animations = model.animations;
   avatar.fileMeshes = model.meshes;
   avatar.meshesRead = model.meshesRead;
@@ -144,13 +152,7 @@ void addDrawnMeshes(Avatar& avatar, const std::string& path, const std::vector<s
     throw Error(fmt::format("{}: its drawn meshes were read with {} joints, its body with {}", path,
                             model.joints.size(), avatar.joints.size()),
                 ExitCode::Internal);
-  SkinnedMesh skin;
-  skin.mesh.name = avatar.name + " (drawn)";
-  skin.mesh.positions = model.positions;
-  skin.mesh.triangles = model.triangles;
-  skin.joints = model.vertexJoints;
-  skin.weights = model.vertexWeights;
-  avatar.drawnSkin = std::move(skin);
+  avatar.drawnSkin = skinnedMesh(model, avatar.name + " (drawn)");
   avatar.drawnMeshesRead = model.meshesRead;
 }
 

@@ -234,71 +234,81 @@ std::pair<MeshInfo, std::vector<Vec3>> square(const std::string& name, MeshRole 
           {centre + Vec3(-h, -h, 0), centre + Vec3(h, -h, 0), centre + Vec3(h, h, 0), centre + Vec3(-h, h, 0)}};
 }
 
-TEST(HeadlessBody, TheSkinIsDrawnInsteadOfTheSegmentsUnlessTheyAreAskedFor) {
-  // A segment on the left, the skin on the right: which one shows?
-  const auto [segment, segmentAt] = square("LeftUpLeg", MeshRole::Segment, Vec3(-0.3, 0, 0), 0.3);
-  const auto [skin, skinAt] = square("body", MeshRole::Skin, Vec3(0.3, 0, 0), 0.3);
-  HeadlessRenderer renderer({segment, skin}, kW, kH);
-  Frame f;
-  f.positions = {segmentAt, skinAt};
-  f.states = {{}, {}};
+/// The view of the body tests: from the front, level, no floor.
+ViewSettings frontView() {
   ViewSettings view;
   view.azimuthDeg = 0.0;
   view.elevationDeg = 0.0;
+  return view;
+}
+
+/// The pixel at the centre of what `points` project to.
+std::pair<int, int> centreOf(HeadlessRenderer& renderer, const std::vector<Vec3>& points) {
+  const Box b = projectedBox(renderer.renderer().camera(kW, kH, frontView()), points);
+  return {(b.x0 + b.x1) / 2, (b.y0 + b.y1) / 2};
+}
+
+/// Two squares facing the camera, of roles `leftRole` and `rightRole`, drawn as a run shows
+/// its bodies and with the segments asked for; the pixels at their centres.
+struct SideBySide {
+  Image shown, segments;
+  std::pair<int, int> left, right;
+};
+
+SideBySide renderSideBySide(MeshRole leftRole, MeshRole rightRole) {
+  const auto [left, leftAt] = square("left", leftRole, Vec3(-0.3, 0, 0), 0.3);
+  const auto [right, rightAt] = square("right", rightRole, Vec3(0.3, 0, 0), 0.3);
+  HeadlessRenderer renderer({left, right}, kW, kH);
+  Frame f;
+  f.positions = {leftAt, rightAt};
+  f.states = {{}, {}};
   OverlaySettings overlay;
   overlay.floor = false;
-  const Image drawnSkin = renderer.render(f, view, overlay);
+  SideBySide out;
+  out.shown = renderer.render(f, frontView(), overlay);
   overlay.segments = true;
-  const Image drawnSegments = renderer.render(f, view, overlay);
-  const CameraMatrices cam = renderer.renderer().camera(kW, kH, view);
-  const Box left = projectedBox(cam, segmentAt), right = projectedBox(cam, skinAt);
-  const auto centre = [](const Box& b) { return std::pair{(b.x0 + b.x1) / 2, (b.y0 + b.y1) / 2}; };
-  const auto [lx, ly] = centre(left);
-  const auto [rx, ry] = centre(right);
-  EXPECT_TRUE(isBackground(drawnSkin, lx, ly)) << "the segment is drawn beside the skin";
-  EXPECT_FALSE(isBackground(drawnSkin, rx, ry)) << "the skin is not drawn";
-  EXPECT_FALSE(isBackground(drawnSegments, lx, ly)) << "asked for, the segment is not drawn";
-  EXPECT_TRUE(isBackground(drawnSegments, rx, ry)) << "the skin is drawn with the segments";
+  out.segments = renderer.render(f, frontView(), overlay);
+  out.left = centreOf(renderer, leftAt);
+  out.right = centreOf(renderer, rightAt);
+  return out;
+}
+
+TEST(HeadlessBody, TheSkinIsDrawnInsteadOfTheSegmentsUnlessTheyAreAskedFor) {
+  // A segment on the left, the skin on the right: which one shows?
+  const SideBySide r = renderSideBySide(MeshRole::Segment, MeshRole::Skin);
+  const auto [lx, ly] = r.left;
+  const auto [rx, ry] = r.right;
+  EXPECT_TRUE(isBackground(r.shown, lx, ly)) << "the segment is drawn beside the skin";
+  EXPECT_FALSE(isBackground(r.shown, rx, ry)) << "the skin is not drawn";
+  EXPECT_FALSE(isBackground(r.segments, lx, ly)) << "asked for, the segment is not drawn";
+  EXPECT_TRUE(isBackground(r.segments, rx, ry)) << "the skin is drawn with the segments";
   // Without a skin in the run the segments are the body.
+  const auto [segment, segmentAt] = square("LeftUpLeg", MeshRole::Segment, Vec3(-0.3, 0, 0), 0.3);
   HeadlessRenderer segmentsOnly({segment}, kW, kH);
   Frame g;
   g.positions = {segmentAt};
   g.states = {{}};
-  overlay.segments = false;
-  const Image bare = segmentsOnly.render(g, view, overlay);
-  const Box only = projectedBox(segmentsOnly.renderer().camera(kW, kH, view), segmentAt);
-  const auto [ox, oy] = centre(only);
+  OverlaySettings overlay;
+  overlay.floor = false;
+  const Image bare = segmentsOnly.render(g, frontView(), overlay);
+  const auto [ox, oy] = centreOf(segmentsOnly, segmentAt);
   EXPECT_FALSE(isBackground(bare, ox, oy));
 }
 
 TEST(HeadlessBody, DrawnMeshesShowWithTheSkinInADarkerClay) {
   // The skin on the left, a drawn mesh (hair, eyes) on the right: both show with the skin,
   // the drawn one darker; neither with the segments the overlay asks for.
-  const auto [skin, skinAt] = square("body", MeshRole::Skin, Vec3(-0.3, 0, 0), 0.3);
-  const auto [hair, hairAt] = square("drawn", MeshRole::Drawn, Vec3(0.3, 0, 0), 0.3);
-  HeadlessRenderer renderer({skin, hair}, kW, kH);
-  Frame f;
-  f.positions = {skinAt, hairAt};
-  f.states = {{}, {}};
-  ViewSettings view;
-  view.azimuthDeg = 0.0;
-  view.elevationDeg = 0.0;
-  OverlaySettings overlay;
-  overlay.floor = false;
-  const Image shown = renderer.render(f, view, overlay);
-  overlay.segments = true;
-  const Image segments = renderer.render(f, view, overlay);
-  const CameraMatrices cam = renderer.renderer().camera(kW, kH, view);
-  const Box left = projectedBox(cam, skinAt), right = projectedBox(cam, hairAt);
-  const int lx = (left.x0 + left.x1) / 2, ly = (left.y0 + left.y1) / 2;
-  const int rx = (right.x0 + right.x1) / 2, ry = (right.y0 + right.y1) / 2;
+  const SideBySide r = renderSideBySide(MeshRole::Skin, MeshRole::Drawn);
+  const auto [lx, ly] = r.left;
+  const auto [rx, ry] = r.right;
+  const Image& shown = r.shown;
   ASSERT_FALSE(isBackground(shown, lx, ly));
   ASSERT_FALSE(isBackground(shown, rx, ry)) << "the drawn mesh is not drawn with the skin";
   const auto brightness = [](const Image& image, int x, int y) {
     return static_cast<int>(image.pixel(x, y)[0]) + image.pixel(x, y)[1] + image.pixel(x, y)[2];
   };
   EXPECT_LT(brightness(shown, rx, ry) + 100, brightness(shown, lx, ly)) << "the drawn mesh is not darker than the skin";
-  EXPECT_TRUE(isBackground(segments, rx, ry)) << "the drawn mesh is drawn with the segments";
+  EXPECT_TRUE(isBackground(r.segments, rx, ry)) << "the drawn mesh is drawn with the segments";
 }
 
 /// A coarse closed UV sphere (outward winding), as a skinned body: its smoothed normals lean

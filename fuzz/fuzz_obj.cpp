@@ -1,6 +1,7 @@
 // libFuzzer target: Wavefront OBJ text through drape's vertex-line check, tinyobjloader
 // (not instrumented: coverage guides drape's side) and the mesh build, once keeping every
-// vertex and once keeping only group "body" with unused vertices dropped (the renumbering).
+// vertex, once keeping only group "body" with unused vertices dropped (the renumbering), and
+// once the groups two shell patterns match (an unmatched one lists the file's groups).
 
 #include <cstddef>
 #include <cstdint>
@@ -21,6 +22,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   bodyOnly.keepUnusedVertices = false;
   try {
     (void)drape::formats::parseObj(text, "fuzz.obj", bodyOnly);
+  } catch (const drape::Error&) {
+  }
+  drape::formats::ObjReadOptions byPattern;
+  byPattern.groups = {"b*", "[!b]?*"};
+  try {
+    (void)drape::formats::parseObj(text, "fuzz.obj", byPattern);
   } catch (const drape::Error&) {
   }
   return 0;

@@ -261,7 +261,7 @@ void addRigid(ModelBuilder& b, const GltfRigidMesh& m, int timeAccessor, std::si
 
 constexpr std::array<float, 4> kGarmentColour = {0.60f, 0.04f, 0.05f, 1.0f};  // linear, the renderer's cloth red
 constexpr std::array<float, 4> kSegmentColour = {0.61f, 0.51f, 0.43f, 1.0f};  // linear, clay
-constexpr std::array<float, 4> kDrawnColour = {0.107f, 0.078f, 0.064f, 1.0f};  // linear, the renderer's darker clay
+constexpr std::array<float, 4> kDrawnColour = {0.106f, 0.076f, 0.061f, 1.0f};  // linear, the renderer's darker clay
 
 /// A scene's sRGB colour as glTF's linear base colour (the renderer's 2.2 gamma).
 std::array<float, 4> linearColour(const Vec3& srgb) {

@@ -161,7 +161,7 @@ void inspectScene(const std::string& path, std::ostream& out) {
   for (const scene::ExternalAvatar& a : s.externalAvatars)
     fmt::print(out, "  {} (from {}){}{}{}{}\n", a.name, fmt::join(a.urls, ", "),
                a.meshes.empty() ? "" : fmt::format(", its body the meshes {}", fmt::join(a.meshes, ", ")),
-               a.drawnMeshes.empty() ? "" : fmt::format(", drawn with it {}", fmt::join(a.drawnMeshes, ", ")),
+               a.drawnMeshes.empty() ? "" : fmt::format(", drawn with it the meshes {}", fmt::join(a.drawnMeshes, ", ")),
                a.jointMap.empty() ? "" : fmt::format(", joint map {}", fmt::join(a.jointMap, ", ")),
                a.cutAtJoints.empty() ? "" : fmt::format(", parts cut across joints {}", fmt::join(a.cutAtJoints, ", ")));
   if (!s.externalAvatars.empty() || s.avatars.size() > 1) printCharacters(path, s, out);

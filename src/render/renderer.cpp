@@ -487,14 +487,13 @@ struct Renderer::Impl {
       if (!drawn(m, overlay)) continue;
       const bool garment = meshes[m].role == MeshRole::Garment;
       const std::optional<Vec3>& own = meshes[m].colour;
-      const std::array<float, 3> fallback = garment                             ? kGarmentSrgb
-                                            : meshes[m].role == MeshRole::Drawn ? kDrawnSrgb
-                                                                                : kSegmentSrgb;
-      const V3 colour = srgbToLinear(own && (garment || meshes[m].role == MeshRole::Drawn)
-                                         ? std::array<float, 3>{static_cast<float>(own->x()),
-                                                                static_cast<float>(own->y()),
-                                                                static_cast<float>(own->z())}
-                                         : fallback);
+      // A garment in its scene's colour; the bodies in clay, their drawn meshes darker.
+      const V3 colour = srgbToLinear(
+          garment && own ? std::array<float, 3>{static_cast<float>(own->x()), static_cast<float>(own->y()),
+                                                static_cast<float>(own->z())}
+          : garment      ? kGarmentSrgb
+          : meshes[m].role == MeshRole::Drawn ? kDrawnSrgb
+                                              : kSegmentSrgb);
       glUniform3fv(glGetUniformLocation(meshProgram, "uColour"), 1, colour.data());
       glUniform1i(glGetUniformLocation(meshProgram, "uStateColours"), garment && overlay.collisionColours ? 1 : 0);
       glBindVertexArray(gpu[m].vao);

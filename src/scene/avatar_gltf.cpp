@@ -162,7 +162,7 @@ Avatar loadAvatarFile(const std::string& path, const std::vector<std::string>& m
                       const std::vector<std::string>& drawnMeshes) {
   const std::string ext = lowerExtension(path);
   if (formats::isGltfPath(path) || ext == ".dae" || ext == ".fbx") {
-    Avatar avatar = buildAvatarFromSkinnedModel(readSkinnedModel(path, meshes));
+    Avatar avatar = formats::isGltfPath(path) ? loadGltfAvatar(path, meshes) : loadAssimpAvatar(path, meshes);
     if (!drawnMeshes.empty()) addDrawnMeshes(avatar, path, drawnMeshes, meshes.empty());
     return avatar;
   }

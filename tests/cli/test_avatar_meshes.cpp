@@ -6,13 +6,11 @@
 
 #include <algorithm>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
-#include <tiny_gltf.h>
 
 #include "cli_runner.hpp"
 #include "drape/formats/mesh_file.hpp"
@@ -21,6 +19,7 @@
 #include "drape/formats/run_manifest.hpp"
 #include "drape/render/image.hpp"
 #include "drape/testing/clothed_avatar.hpp"
+#include "drape/testing/glb_read.hpp"
 
 namespace drape {
 namespace {
@@ -30,23 +29,7 @@ using testing::runDrape;
 using testing::ScratchDir;
 using testing::statsOf;
 
-tinygltf::Model loadGlb(const std::string& path) {
-  tinygltf::TinyGLTF loader;
-  tinygltf::Model model;
-  std::string err, warn;
-  EXPECT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, path)) << err;
-  return model;
-}
-
-/// A float accessor's components, as tightly packed as drape writes them.
-std::vector<float> floats(const tinygltf::Model& model, int accessor) {
-  const tinygltf::Accessor& a = model.accessors.at(static_cast<std::size_t>(accessor));
-  const tinygltf::BufferView& v = model.bufferViews.at(static_cast<std::size_t>(a.bufferView));
-  std::vector<float> out(a.count * static_cast<std::size_t>(tinygltf::GetNumComponentsInType(a.type)));
-  std::memcpy(out.data(), model.buffers.at(static_cast<std::size_t>(v.buffer)).data.data() + v.byteOffset + a.byteOffset,
-              out.size() * sizeof(float));
-  return out;
-}
+using testing::loadGlb;
 
 /// The cape's triangles from the shoulders up, as an OBJ: the constraint mask.
 std::string shouldersMask(const std::string& clothed, const ScratchDir& dir) {
@@ -189,8 +172,8 @@ TEST(AvatarMeshes, DrawnMeshesMoveWithTheSkinAndTheClothNeverMeetsThem) {
   EXPECT_EQ(nodeNames(loadGlb(dir / "parts.glb")).size(), 1 + manifest.meshes.size() - 3) << "the cape and every part";
   const tinygltf::Primitive& drawnPrimitive = skin.meshes.at(static_cast<std::size_t>(skin.nodes[2].mesh)).primitives[0];
   ASSERT_EQ(drawnPrimitive.targets.size(), cape.frames.size() - 1);
-  std::vector<float> last = floats(skin, drawnPrimitive.attributes.at("POSITION"));
-  const std::vector<float> delta = floats(skin, drawnPrimitive.targets.back().at("POSITION"));
+  std::vector<float> last = testing::accessorData<float>(skin, drawnPrimitive.attributes.at("POSITION"));
+  const std::vector<float> delta = testing::accessorData<float>(skin, drawnPrimitive.targets.back().at("POSITION"));
   for (std::size_t i = 0; i < last.size(); ++i) last[i] += delta[i];
   for (std::size_t v = 0; v < cape.pointCount; ++v)
     for (std::size_t k = 0; k < 3; ++k) ASSERT_NEAR(last[3 * v + k], cape.frames.back()[v][static_cast<Eigen::Index>(k)], 1e-5);

@@ -13,29 +13,14 @@
 #include "drape/core/error.hpp"
 #include "drape/formats/gltf_writer.hpp"
 #include "drape/formats/pc2.hpp"
+#include "drape/testing/glb_read.hpp"
 #include "test_run_fixture.hpp"
 
 namespace drape::formats {
 namespace {
 
-template <typename T>
-std::vector<T> accessorData(const tinygltf::Model& model, int index) {
-  const tinygltf::Accessor& a = model.accessors.at(static_cast<std::size_t>(index));
-  const tinygltf::BufferView& v = model.bufferViews.at(static_cast<std::size_t>(a.bufferView));
-  const std::size_t components = a.type == TINYGLTF_TYPE_SCALAR ? 1 : a.type == TINYGLTF_TYPE_VEC3 ? 3 : 4;
-  std::vector<T> out(a.count * components);
-  std::memcpy(out.data(), model.buffers[static_cast<std::size_t>(v.buffer)].data.data() + v.byteOffset + a.byteOffset,
-              out.size() * sizeof(T));
-  return out;
-}
-
-tinygltf::Model load(const std::string& path) {
-  tinygltf::TinyGLTF loader;
-  tinygltf::Model model;
-  std::string err, warn;
-  EXPECT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, path)) << err;
-  return model;
-}
+using drape::testing::accessorData;
+using drape::testing::loadGlb;
 
 TEST(FitRigid, RecoversRandomMotionsAndRejectsDeformation) {
   std::mt19937 rng(7);
@@ -64,7 +49,7 @@ TEST(GltfWriter, RunExportReproducesEveryFrame) {
   EXPECT_EQ(s.rigid, 1u) << "the torso moves rigidly";
   EXPECT_EQ(s.deforming, 1u) << "the flag deforms";
 
-  const tinygltf::Model model = load(glb);
+  const tinygltf::Model model = loadGlb(glb);
   ASSERT_EQ(model.nodes.size(), 2u);
   ASSERT_EQ(model.animations.size(), 1u);
   EXPECT_EQ(model.animations[0].channels.size(), 3u) << "weights for the flag; translation and rotation for the torso";

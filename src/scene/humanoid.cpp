@@ -21,6 +21,7 @@ constexpr double kArmReach = 0.08;     // an arm reaches this far to the side (h
 constexpr double kWristOut = 0.6;      // the wrist lies at least this far along the arm's reach
 constexpr double kElbowBack = 0.45;    // the elbow: this far back from the wrist, of the arm's span
 constexpr double kShoulderBack = 0.85; // the shoulder: at least this far from the elbow, of the forearm
+constexpr double kForearmOfItsHand = 0.57;  // a forearm, of the forearm and the hand together (25 cm of 44)
 constexpr double kWaistAboveHips = 0.03;  // the waist: this far above the hip joints
 
 struct Tree {
@@ -134,9 +135,39 @@ JointChain pathOut(const Tree& t, int from) {
   return path;
 }
 
+/// The index on `path` of the arm's shoulder, the elbow being at `elbow`: the last joint
+/// at least kShoulderBack forearms from the elbow, or the first of the joints in that place
+/// (a robot's shoulder is a pitch, a roll and a yaw joint in one place).
+std::size_t shoulderOf(const Tree& t, const JointChain& path, std::size_t elbow, double forearm) {
+  std::size_t shoulder = 0;
+  for (std::size_t i = 0; i < elbow; ++i)
+    if ((t.at(path[elbow]) - t.at(path[i])).norm() >= kShoulderBack * forearm) shoulder = i;
+  while (shoulder > 0 && (t.at(path[shoulder - 1]) - t.at(path[shoulder])).norm() < 1e-3 * forearm) --shoulder;
+  return shoulder;
+}
+
+/// The arm along `path` if it ends at its elbow, or nullopt: a robot's arm (Choreonoid's
+/// GR001) may have no wrist, its last joint the elbow, whose segment is the forearm and the
+/// hand. The segment's far end then lies well past the joint: the joint short of
+/// kWristOut of the way to it, where a hand's segment puts its wrist farther out.
+std::optional<HumanoidLimb> armEndingAtItsElbow(const Tree& t, const JointChain& path) {
+  const int last = path.back();
+  const std::optional<Vec3>& tip = t.joints[static_cast<std::size_t>(last)].tip;
+  if (path.size() < 2 || !tip) return std::nullopt;
+  if ((t.at(last) - t.at(path.front())).norm() >= kWristOut * (*tip - t.at(path.front())).norm()) return std::nullopt;
+  const std::size_t elbow = path.size() - 1;
+  const std::size_t shoulder = shoulderOf(t, path, elbow, kForearmOfItsHand * (*tip - t.at(last)).norm());
+  HumanoidLimb arm;
+  arm.base = slice(path, 0, shoulder);
+  arm.upper = slice(path, shoulder, elbow);
+  arm.lower = {last};
+  return arm;
+}
+
 /// The arm that leaves the spine at `from`, or nullopt.
 std::optional<HumanoidLimb> armOf(const Tree& t, int from) {
   const JointChain path = pathOut(t, from);
+  if (std::optional<HumanoidLimb> arm = armEndingAtItsElbow(t, path)) return arm;
   const double reach = (t.at(path.back()) - t.at(from)).norm();
   std::size_t wrist = 1;
   while (wrist + 1 < path.size() &&
@@ -154,13 +185,7 @@ std::optional<HumanoidLimb> armOf(const Tree& t, int from) {
     }
   }
   if (elbow == 0) return std::nullopt;
-  const double forearm = (t.at(path[wrist]) - t.at(path[elbow])).norm();
-  std::size_t shoulder = 0;
-  for (std::size_t i = 0; i < elbow; ++i)
-    if ((t.at(path[elbow]) - t.at(path[i])).norm() >= kShoulderBack * forearm) shoulder = i;
-  // Joints in one place are one joint turning about several axes (a robot's shoulder pitch,
-  // roll and yaw): the bone starts at the first of them.
-  while (shoulder > 0 && (t.at(path[shoulder - 1]) - t.at(path[shoulder])).norm() < 1e-3 * forearm) --shoulder;
+  const std::size_t shoulder = shoulderOf(t, path, elbow, (t.at(path[wrist]) - t.at(path[elbow])).norm());
   HumanoidLimb arm;
   arm.base = slice(path, 0, shoulder);
   arm.upper = slice(path, shoulder, elbow);
@@ -310,7 +335,10 @@ std::optional<Upright> findUpright(std::span<const JointAt> joints, std::string*
   bool sameEverywhere = true;  // too few joints, or out of order: nothing to do with the axis
   std::vector<JointAt> turned(joints.begin(), joints.end());
   for (const auto& [axis, turn] : axes) {
-    for (std::size_t i = 0; i < joints.size(); ++i) turned[i].rest = turn * joints[i].rest;
+    for (std::size_t i = 0; i < joints.size(); ++i) {
+      turned[i].rest = turn * joints[i].rest;
+      if (joints[i].tip) turned[i].tip = turn * *joints[i].tip;
+    }
     std::string why;
     if (std::optional<Humanoid> h = findHumanoid(turned, &why)) return Upright{axis, turn, std::move(*h)};
     if (whyNotUp.empty()) whyNotUp = why;
@@ -348,10 +376,23 @@ std::vector<JointAt> jointsAt(const Avatar& avatar) {
   for (const Joint& j : avatar.joints) out.push_back({j.parent, j.restCenter});
   // Joints without a segment carry nothing, where the avatar has segments at all.
   if (avatar.segments.empty()) return out;
+  std::vector<bool> hasChildren(out.size(), false);
+  for (const JointAt& j : out)
+    if (j.parent >= 0) hasChildren[static_cast<std::size_t>(j.parent)] = true;
   for (JointAt& j : out) j.carries = false;
-  for (const Segment& s : avatar.segments)
-    if (s.joint >= 0 && static_cast<std::size_t>(s.joint) < out.size() && !s.mesh.triangles.empty())
-      out[static_cast<std::size_t>(s.joint)].carries = true;
+  for (const Segment& s : avatar.segments) {
+    if (s.joint < 0 || static_cast<std::size_t>(s.joint) >= out.size() || s.mesh.triangles.empty()) continue;
+    const auto i = static_cast<std::size_t>(s.joint);
+    out[i].carries = true;
+    if (hasChildren[i]) continue;
+    // The segment's point farthest from its joint, kept only where it reaches past what the
+    // joint's tip already is.
+    const RigidTransform rest = avatar.joints[i].restWorld();
+    for (const Vec3& v : s.mesh.positions) {
+      const Vec3 p = rest.apply(v);
+      if ((p - out[i].rest).norm() > (out[i].tip.value_or(out[i].rest) - out[i].rest).norm()) out[i].tip = p;
+    }
+  }
   return out;
 }
 
@@ -388,6 +429,7 @@ std::vector<std::string> findForearmsAndHands(const Avatar& avatar) {
   std::vector<std::string> names;
   for (const HumanoidLimb& arm : h.arms) {
     addSegments(avatar, arm.lower, names);
+    if (arm.end.empty()) continue;  // an arm ending at its elbow: the forearm's segment is the hand too
     // The hand and every joint below it, in order (parents come first).
     std::vector<bool> carried(avatar.joints.size(), false);
     carried[static_cast<std::size_t>(arm.end.front())] = true;

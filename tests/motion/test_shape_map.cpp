@@ -279,6 +279,33 @@ TEST(ShapeMap, AnHanimHumanoidWithItsArmsDownAndItsLegsOnASacroiliac) {
   EXPECT_LT(angle, 5.0);
 }
 
+TEST(ShapeMap, ARobotWhoseArmsEndAtTheElbowsHasThemDrivenAsArms) {
+  // Choreonoid's GR001, stood up: its arms end at the elbows, whose segments are the forearm
+  // and the gripper. The capture's clavicle, upper arm and forearm drive the shoulder's two
+  // joints and the elbow; its hand drives nothing; the upper arms point as the capture's.
+  scene::Avatar robot = scene::loadAvatarFile(std::string(DRAPE_DATA_DIR) + "/vrml/choreonoid_GR001/GR001.wrl");
+  const std::optional<scene::Upright> u = scene::findUpright(scene::jointsAt(robot));
+  ASSERT_TRUE(u.has_value());
+  scene::placeAvatar(robot, RigidTransform{u->turn, Vec3::Zero()});
+  const Clip clip = loadClip(kShapeMocap + "cmu_12_03_walk.bvh");
+  std::string why;
+  const std::optional<JointMap> map = shapeJointMap(clip.skeleton, robot, &why);
+  ASSERT_TRUE(map.has_value()) << why;
+  auto pairs = pairsOf(*map);
+  for (const auto& [motionSide, robotSide] : {std::pair{"Left", "L_"}, std::pair{"Right", "R_"}}) {
+    const std::string m = motionSide, r = robotSide;
+    EXPECT_EQ(pairs[m + "Shoulder"], std::set<std::string>{r + "SHOULDER_P"});
+    EXPECT_EQ(pairs[m + "Arm"], std::set<std::string>{r + "SHOULDER_R"});
+    EXPECT_EQ(pairs[m + "ForeArm"], std::set<std::string>{r + "ELBOW_P"});
+    EXPECT_TRUE(pairs[m + "Hand"].empty()) << m;
+  }
+  const double angle = largestLimbAngle_deg(robot, clip, *map, AvatarAnimation::build(robot, clip, *map),
+                                            {{"LeftArm", "LeftForeArm"}, {"RightArm", "RightForeArm"},
+                                             {"LeftUpLeg", "LeftLeg"}, {"RightUpLeg", "RightLeg"}});
+  std::printf("cmu_12_03_walk.bvh on GR001 by shape: largest upper arm or thigh angle %.2f degrees\n", angle);
+  EXPECT_LT(angle, 5.0);
+}
+
 TEST(ShapeMap, WhatIsNoHumanoidIsRefusedWithWhy) {
   MotionOptions options;
   options.jointMapDirectory = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";

@@ -48,6 +48,12 @@ void expectHumanoid(const Avatar& avatar, const Humanoid& h, const Expected& e) 
   }
 }
 
+/// A joint turned by `turn` and moved by `move`, with the tip of its segment.
+void moveJoint(JointAt& j, const Quat& turn, const Vec3& move = Vec3::Zero()) {
+  j.rest = turn * j.rest + move;
+  if (j.tip) j.tip = turn * *j.tip + move;
+}
+
 Humanoid humanoidOf(const Avatar& avatar) {
   std::string why;
   const std::optional<Humanoid> h = findHumanoid(jointsAt(avatar), &why);
@@ -178,7 +184,7 @@ TEST(Humanoid, TurnedAndMovedItIsTheSameHumanoid) {
       const Quat turn(Eigen::AngleAxisd(angle(rng), Vec3::UnitY()));
       const Vec3 move(shift(rng), shift(rng), shift(rng));
       std::vector<JointAt> turned = joints;
-      for (JointAt& j : turned) j.rest = turn * j.rest + move;
+      for (JointAt& j : turned) moveJoint(j, turn, move);
       const std::optional<Humanoid> h = findHumanoid(turned);
       ASSERT_TRUE(h.has_value()) << file << ", trial " << trial;
       EXPECT_EQ(h->pelvis, upright->pelvis) << file;
@@ -293,6 +299,71 @@ TEST(Humanoid, RobotsStandingAlongZAreFoundStoodUp) {
   EXPECT_EQ(namesOf(gr001, u->humanoid.neck), std::vector<std::string>{"NECK_Y"});
   EXPECT_EQ(namesOf(gr001, u->humanoid.legs[0].upper), (std::vector<std::string>{"L_HIP_Y", "L_HIP_R", "L_HIP_P"}));
   EXPECT_EQ(namesOf(gr001, u->humanoid.legs[1].lower), std::vector<std::string>{"R_KNEE_P"});
+  // GR001's arms end at the elbow, whose segment is the forearm and the gripper: no joint is
+  // the wrist, and the shoulder's two joints stand 2.6 cm apart, the first out to the side
+  // of the chest as a clavicle is.
+  for (std::size_t s = 0; s < 2; ++s) {
+    const std::string side = s == 0 ? "L_" : "R_";
+    const HumanoidLimb& arm = u->humanoid.arms[s];
+    EXPECT_EQ(namesOf(gr001, arm.base), std::vector<std::string>{side + "SHOULDER_P"});
+    EXPECT_EQ(namesOf(gr001, arm.upper), std::vector<std::string>{side + "SHOULDER_R"});
+    EXPECT_EQ(namesOf(gr001, arm.lower), std::vector<std::string>{side + "ELBOW_P"});
+    EXPECT_TRUE(arm.end.empty()) << side;
+  }
+  Avatar gr001Standing = gr001;
+  placeAvatar(gr001Standing, RigidTransform{u->turn, Vec3::Zero()});
+  EXPECT_EQ(findForearmsAndHands(gr001Standing), (std::vector<std::string>{"L_ELBOW_P_LINK", "R_ELBOW_P_LINK"}));
+}
+
+TEST(Humanoid, AnArmEndingAtItsElbowHasNoHand) {
+  // CMU's rig with its arms cut at the elbows, each elbow's segment reaching to where the
+  // fingertips were: the forearm is the elbow, the hand no joint. The whole rig with its
+  // hands' segments as long as hands: its own arms.
+  const Avatar avatar = loadAvatarFile(kHumanoidAvatars + "makehuman_rig_cmu_mb.mhskel");
+  const std::vector<JointAt> whole = jointsAt(avatar);
+  const std::optional<Humanoid> h = findHumanoid(whole);
+  ASSERT_TRUE(h.has_value());
+  std::vector<JointAt> cut;
+  std::vector<int> index(whole.size(), -1);
+  std::vector<bool> dropped(whole.size(), false);
+  for (std::size_t s = 0; s < 2; ++s) dropped[static_cast<std::size_t>(h->arms[s].end.front())] = true;
+  for (std::size_t j = 0; j < whole.size(); ++j) {
+    const int p = whole[j].parent;
+    if (dropped[j] || (p >= 0 && dropped[static_cast<std::size_t>(p)])) {
+      dropped[j] = true;
+      continue;
+    }
+    index[j] = static_cast<int>(cut.size());
+    cut.push_back({p < 0 ? -1 : index[static_cast<std::size_t>(p)], whole[j].rest});
+  }
+  std::array<Vec3, 2> fingertips{};
+  for (std::size_t s = 0; s < 2; ++s) {
+    const int wrist = h->arms[s].end.front();
+    const Vec3 along = whole[static_cast<std::size_t>(wrist)].rest - whole[static_cast<std::size_t>(h->arms[s].lower.front())].rest;
+    fingertips[s] = whole[static_cast<std::size_t>(wrist)].rest + 0.75 * along;  // a hand three quarters of a forearm
+  }
+  for (std::size_t s = 0; s < 2; ++s)
+    cut[static_cast<std::size_t>(index[static_cast<std::size_t>(h->arms[s].lower.front())])].tip = fingertips[s];
+  const std::optional<Humanoid> elbowed = findHumanoid(cut);
+  ASSERT_TRUE(elbowed.has_value());
+  for (std::size_t s = 0; s < 2; ++s) {
+    const HumanoidLimb& arm = elbowed->arms[s];
+    EXPECT_EQ(arm.lower, JointChain{index[static_cast<std::size_t>(h->arms[s].lower.front())]});
+    EXPECT_TRUE(arm.end.empty());
+    ASSERT_EQ(arm.upper.size(), 1U);
+    EXPECT_EQ(arm.upper.front(), index[static_cast<std::size_t>(h->arms[s].upper.front())]);
+    EXPECT_EQ(arm.base, JointChain{index[static_cast<std::size_t>(h->arms[s].base.front())]});
+  }
+  // The whole rig with a tip on each hand, a hand long: its own arms.
+  std::vector<JointAt> tipped = whole;
+  for (std::size_t s = 0; s < 2; ++s) tipped[static_cast<std::size_t>(h->arms[s].end.front())].tip = fingertips[s];
+  const std::optional<Humanoid> same = findHumanoid(tipped);
+  ASSERT_TRUE(same.has_value());
+  for (std::size_t s = 0; s < 2; ++s) {
+    EXPECT_EQ(same->arms[s].upper, h->arms[s].upper);
+    EXPECT_EQ(same->arms[s].lower, h->arms[s].lower);
+    EXPECT_EQ(same->arms[s].end, h->arms[s].end);
+  }
 }
 
 TEST(Humanoid, ABodyStandingAlongAnyAxisIsStoodUpWithTheSameBones) {
@@ -317,7 +388,7 @@ TEST(Humanoid, ABodyStandingAlongAnyAxisIsStoodUpWithTheSameBones) {
                                        : Quat::FromTwoVectors(Vec3::UnitY(), axis);
       const Quat about(Eigen::AngleAxisd(angle(rng), axis));
       std::vector<JointAt> laid = joints;
-      for (JointAt& j : laid) j.rest = about * lay * j.rest;
+      for (JointAt& j : laid) moveJoint(j, about * lay);
       std::string why;
       const std::optional<Upright> u = findUpright(laid, &why);
       ASSERT_TRUE(u.has_value()) << file << " along " << name << ": " << why;

@@ -36,6 +36,10 @@ struct JointAt {
   /// Whether any of the body moves with it. False for an avatar's joint without a segment:
   /// the end markers rigs carry at their tips (Mixamo's HeadTop_End), which no bone starts.
   bool carries = true;
+  /// For a joint without children whose segment reaches on past it: the segment's point
+  /// farthest from the joint, at rest. A robot's arm may end at its elbow, whose segment is
+  /// the forearm and the hand; the arm's shape is read to there.
+  std::optional<Vec3> tip = std::nullopt;
 };
 
 /// Joints in order from parent to child; empty where the skeleton has no such bone.

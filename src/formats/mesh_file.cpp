@@ -120,8 +120,9 @@ MeshFile readMeshFile(const std::string& path, const MeshFileOptions& options, c
     read.groups = options.parts;
     // The other groups' vertices are no part of a garment chosen by group.
     read.keepUnusedVertices = options.parts.empty() || options.looseVertices;
-    out.mesh = readObj(path, read);
-    out.partsRead = options.parts;
+    std::vector<std::string> groups;
+    out.mesh = readObj(path, read, &groups);
+    if (!options.parts.empty()) out.partsRead = std::move(groups);
     return out;
   }
   if (!isMeshFilePath(path))

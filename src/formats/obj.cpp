@@ -95,7 +95,8 @@ TinyObj loadWithTinyObj(std::string_view text, const std::string& name, tinyobj:
   return obj;
 }
 
-mesh::TriMesh buildMesh(const TinyObj& obj, const std::string& name, const ObjReadOptions& options) {
+mesh::TriMesh buildMesh(const TinyObj& obj, const std::string& name, const ObjReadOptions& options,
+                        std::vector<std::string>* groupsRead) {
   const auto& attrib = obj.attrib;
   mesh::TriMesh out;
   out.name = name;
@@ -111,6 +112,9 @@ mesh::TriMesh buildMesh(const TinyObj& obj, const std::string& name, const ObjRe
   std::vector<bool> matched(options.groups.size(), false);
   for (const auto& shape : obj.shapes) {
     if (!wanted(shape.name, options.groups, matched)) continue;
+    if (groupsRead != nullptr && !shape.mesh.num_face_vertices.empty() &&
+        std::find(groupsRead->begin(), groupsRead->end(), shape.name) == groupsRead->end())
+      groupsRead->push_back(shape.name);
     std::size_t offset = 0;
     for (const auto faceSize : shape.mesh.num_face_vertices) {
       polygon.clear();
@@ -166,18 +170,19 @@ mesh::TriMesh buildMesh(const TinyObj& obj, const std::string& name, const ObjRe
 }
 
 mesh::TriMesh parseWith(std::string_view text, const std::string& name, const ObjReadOptions& options,
-                        tinyobj::MaterialReader* materials) {
+                        tinyobj::MaterialReader* materials, std::vector<std::string>* groupsRead) {
   checkVertexLines(text, name);
-  return buildMesh(loadWithTinyObj(text, name, materials), name, options);
+  return buildMesh(loadWithTinyObj(text, name, materials), name, options, groupsRead);
 }
 
 }  // namespace
 
-mesh::TriMesh parseObj(std::string_view text, const std::string& name, const ObjReadOptions& options) {
-  return parseWith(text, name, options, nullptr);  // text has no folder to find an .mtl in
+mesh::TriMesh parseObj(std::string_view text, const std::string& name, const ObjReadOptions& options,
+                       std::vector<std::string>* groupsRead) {
+  return parseWith(text, name, options, nullptr, groupsRead);  // text has no folder to find an .mtl in
 }
 
-mesh::TriMesh readObj(const std::string& path, const ObjReadOptions& options) {
+mesh::TriMesh readObj(const std::string& path, const ObjReadOptions& options, std::vector<std::string>* groupsRead) {
   requireReadableFile(path);
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
@@ -185,7 +190,7 @@ mesh::TriMesh readObj(const std::string& path, const ObjReadOptions& options) {
   // Material files beside the OBJ, as tinyobjloader's own file reader finds them.
   const std::size_t slash = path.find_last_of('/');
   tinyobj::MaterialFileReader materials(slash == std::string::npos ? std::string() : path.substr(0, slash + 1));
-  return parseWith(text.str(), path, options, &materials);
+  return parseWith(text.str(), path, options, &materials, groupsRead);
 }
 
 void writeObj(const std::string& path, std::span<const Vec3> positions,

@@ -281,6 +281,10 @@ TEST(MeshFile, AnObjsGroupsAreItsParts) {
     for (std::uint32_t v : t) used[v] = true;
   EXPECT_EQ(std::count(used.begin(), used.end(), false), 0);
   EXPECT_EQ(m.partsRead, (std::vector<std::string>{"body"}));
+  MeshFileOptions helpers;
+  helpers.parts = {"helper-t*"};
+  EXPECT_EQ(readMeshFile(path, helpers).partsRead, (std::vector<std::string>{"helper-tights", "helper-tongue"}));
+  EXPECT_TRUE(readMeshFile(path).partsRead.empty());
   body.looseVertices = true;
   EXPECT_EQ(readMeshFile(path, body).mesh.vertexCount(), 19158u);
 }

@@ -55,6 +55,12 @@ TEST(Obj, GroupsAreChosenByNameOrShellPatternAndOneThatIsNotThereIsAnError) {
   EXPECT_EQ(triangles({"helper-ti*"}), tights);
   EXPECT_EQ(triangles({"helper-t*"}), tights + triangles({"helper-tongue"}));
   EXPECT_EQ(triangles({"[bh]*", "joint-*"}) - triangles({"joint-*"}), triangles({"body", "helper-*"}));
+  // The groups a pattern matched are what was read, in the file's order.
+  std::vector<std::string> read;
+  ObjReadOptions byPattern;
+  byPattern.groups = {"helper-t*", "b?dy"};
+  (void)readObj(path, byPattern, &read);
+  EXPECT_EQ(read, (std::vector<std::string>{"body", "helper-tights", "helper-tongue"}));
   const std::string missing = drape::testing::errorOf([&] { (void)triangles({"body", "bdoy"}); });
   EXPECT_EQ(
       missing.rfind(path + ": has no g/o group named 'bdoy' (its groups: body, helper-tights, joint-l-eye, "

@@ -34,7 +34,7 @@ struct MeshFileOptions {
 
 struct MeshFile {
   mesh::TriMesh mesh;                   ///< metres, y up; named after the file
-  std::vector<std::string> partsRead;   ///< the nodes whose meshes were read, in the file's order
+  std::vector<std::string> partsRead;   ///< the nodes (an OBJ's groups) whose meshes were read, in the file's order; an OBJ read whole names none
   std::size_t welded = 0;               ///< vertices merged into another at the same position
   std::size_t droppedTriangles = 0;     ///< triangles welding collapsed or repeated (a two-sided copy)
 };

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <sstream>
 
@@ -16,6 +17,7 @@
 #include "drape/core/error.hpp"
 #include "drape/formats/vrml_read.hpp"
 #include "drape/mesh/topology.hpp"
+#include "drape/scene/humanoid.hpp"
 #include "drape/scene/scene_build.hpp"
 #include "drape/sim/garment_layers.hpp"
 
@@ -172,6 +174,12 @@ SceneToDress openSceneToDress(const std::string& path, const std::string& charac
   d.scene = scene::buildScene(document);
   // An avatar that wears nothing yet is dressed as well as one that does.
   d.character = takeCharacter(sim::sceneCharacters(d.scene, sim::Undressed::included), character, path);
+  // A garment fitted to a character lying across gravity would fall across it, and stays
+  // where it was fitted when the character is stood up: it is stood up first.
+  if (const std::optional<scene::Upright> u = sim::lyingAcrossGravity(d.scene, *d.character.avatar))
+    throw Error(fmt::format("--add-to {}: character '{}' stands along {}, not along +y as drape's scenes do, and a "
+                            "garment would fall across it; {}, then dress it",
+                            path, d.character.name, u->axis, u->standUpAdvice()));
   int line = 0;
   if (d.character.external) {
     for (const scene::ExternalAvatar& ext : d.scene.externalAvatars) {

@@ -15,6 +15,7 @@
 #include "drape/formats/hanim_motion.hpp"
 #include "drape/motion/interpolate.hpp"
 #include "drape/motion/standing.hpp"
+#include "drape/scene/humanoid.hpp"
 
 namespace drape::motion {
 namespace {
@@ -686,6 +687,13 @@ JointMap jointMapFor(const Clip& clip, const scene::Avatar& avatar, const Motion
     // their shapes, or refused with what the shape lacks.
     std::string whyNot;
     if (std::optional<JointMap> byShape = shapeJointMap(clip.skeleton, avatar, &whyNot)) return std::move(*byShape);
+    // Lying, the avatar needs turning, not a joint map.
+    if (const std::optional<scene::Upright> u = scene::uprightAlongAnotherAxis(scene::jointsAt(avatar)))
+      throw Error(fmt::format("{}: it stands along {}, not along +y as drape's scenes do, and the motion {} is paired with "
+                              "its joints by shape only once it stands (no shipped joint map pairs them: the best, '{}', "
+                              "pairs {} and misses its root); {}",
+                              avatar.source.empty() ? avatar.name : avatar.source, u->axis, clip.source, named.name,
+                              matchedJointCount(named, clip.skeleton, avatar), u->standUpAdvice()));
     throw Error(fmt::format("{}: no shipped joint map pairs the joints of the motion {} with the avatar's (the best, '{}', "
                             "pairs {} and misses its root), and they cannot be paired by shape: {}; give a joint map "
                             "naming the motion's joints (--joint-map FILE, docs/MOTION.md)",

@@ -27,15 +27,19 @@ void cutAtJoints(scene::Avatar& avatar, const scene::ExternalAvatar& ext) {
 /// robot from Choreonoid placed as its file stands it, along +z), is said so: its garments
 /// would fall across it, and its captures would lay it down.
 void sayWhereItLies(const scene::Scene& scene, const SceneCharacter& c) {
-  const Vec3 g = scene.simulation.gravity;
-  if (!(g.norm() > 0.0) || g.normalized().dot(-Vec3::UnitY()) < 0.999) return;  // the scene's own up: its choice
-  const std::optional<scene::Upright> u = scene::uprightAlongAnotherAxis(scene::jointsAt(*c.avatar));
+  const std::optional<scene::Upright> u = lyingAcrossGravity(scene, *c.avatar);
   if (!u) return;
   spdlog::warn("{}: character '{}' stands along {}, where gravity pulls along -y: its garments would fall across it; {}",
                scene.source, c.name, u->axis, u->standUpAdvice());
 }
 
 }  // namespace
+
+std::optional<scene::Upright> lyingAcrossGravity(const scene::Scene& scene, const scene::Avatar& avatar) {
+  const Vec3 g = scene.simulation.gravity;
+  if (!(g.norm() > 0.0) || g.normalized().dot(-Vec3::UnitY()) < 0.999) return std::nullopt;  // the scene's own up: its choice
+  return scene::uprightAlongAnotherAxis(scene::jointsAt(avatar));
+}
 
 cloth::Material toClothMaterial(const scene::ClothMaterial& m) {
   cloth::Material c;

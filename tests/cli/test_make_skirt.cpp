@@ -218,10 +218,18 @@ TEST(MakeSkirt, ARobotStandingAlongZIsStoodUpDressedAndWalked) {
   }
   const CliResult added = runDrape("make-skirt --add-to '" + lying + "'", dir);
   EXPECT_EQ(added.code, 2);
-  EXPECT_NE(added.err.find("it stands along +z, not along +y as drape's scenes do; give its Avatar node (or a Transform "
-                           "around its Humanoid) rotation 1 0 0 -1.5708 to stand it up"),
+  EXPECT_NE(added.err.find("--add-to " + lying + ": character 'Robot' stands along +z, not along +y as drape's scenes "
+                           "do, and a garment would fall across it; give its Avatar node (or a Transform around its "
+                           "Humanoid) rotation 1 0 0 -1.5708 to stand it up, then dress it"),
             std::string::npos)
       << added.err;
+  // make-scene --add-to refuses it alike, before it reads the garment.
+  const CliResult addedScene = runDrape("make-scene --add-to '" + lying + "' --garment '" + out + "/skirt.obj' --mask '" +
+                                            out + "/waistband.obj'",
+                                        dir);
+  EXPECT_EQ(addedScene.code, 2);
+  EXPECT_NE(addedScene.err.find("--add-to " + lying + ": character 'Robot' stands along +z"), std::string::npos)
+      << addedScene.err;
 }
 
 /// Of `drape inspect RUN --deepest N`'s rows, those of free vertices (not bound) whose

@@ -16,6 +16,7 @@
 #include "drape/motion/jointmap.hpp"
 #include "drape/scene/avatar_gltf.hpp"
 #include "drape/scene/humanoid.hpp"
+#include "drape/testing/errors.hpp"
 #include "hanim_loa1.hpp"
 #include "limb_angles.hpp"
 #include "makehuman.hpp"
@@ -328,6 +329,20 @@ TEST(ShapeMap, WhatIsNoHumanoidIsRefusedWithWhy) {
   EXPECT_FALSE(shapeJointMap(loadClip(kShapeMocap + "cmu_12_03_walk.bvh").skeleton, robot, &why));
   EXPECT_EQ(why, "the avatar's skeleton: it stands along +z, not along +y as drape's scenes do; give its Avatar node (or "
                  "a Transform around its Humanoid) rotation 1 0 0 -1.5708 to stand it up");
+  // Retargeting onto it says so, and no joint map is what it needs.
+  const std::string lying = drape::testing::errorOf(
+      [&] { (void)loadAnimation(robot, kShapeMocap + "cmu_12_03_walk.bvh", options); });
+  EXPECT_NE(lying.find("choreonoid_SR1.wrl: it stands along +z, not along +y as drape's scenes do, and the motion "),
+            std::string::npos)
+      << lying;
+  EXPECT_NE(lying.find("cmu_12_03_walk.bvh is paired with its joints by shape only once it stands (no shipped joint map "
+                       "pairs them: the best, '"),
+            std::string::npos)
+      << lying;
+  EXPECT_EQ(lying.substr(lying.size() - 95),
+            "give its Avatar node (or a Transform around its Humanoid) rotation 1 0 0 -1.5708 to stand it up")
+      << lying;
+  EXPECT_EQ(lying.find("--joint-map"), std::string::npos) << lying;
   // Where a shipped map drives the trunk, it is used as before.
   JointMap chosen;
   (void)loadAnimation(makeHuman(), kShapeMocap + "cmu_12_03_walk.bvh", options, nullptr, &chosen);

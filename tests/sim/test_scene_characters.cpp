@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <optional>
 #include <regex>
 #include <string>
 
@@ -132,6 +133,27 @@ TEST(SceneCharacters, RefusesWhatItCannotTellApart) {
   const std::string at = fmt::format(":{}: ", std::count(text.begin(), text.begin() + ada, '\n') + 1);
   EXPECT_EQ(testing::errorOf([&] { (void)sceneCharacters(scene::loadScene(noMotion)); }),
             noMotion + at + "Avatar Ada: motion: no such file (no-such-walk.bvh)");
+}
+
+TEST(SceneCharacters, ARobotLyingAcrossGravityIsToldFromOneStandingOrUnderItsOwnUp) {
+  // Choreonoid's SR1 stands along +z, as its file does: lying where gravity pulls along -y,
+  // standing once its Avatar node turns it, or where the scene's gravity pulls along -z.
+  const std::string dir = testing::processTempDir("scene-characters").string();
+  const auto robotIn = [&](const std::string& name, const std::string& avatarFields, const std::string& more) {
+    const std::string path = dir + "/" + name;
+    std::ofstream(path) << "#VRML V2.0 utf8\nDEF Robot Avatar { url \"" << DRAPE_DATA_DIR << "/vrml/choreonoid_SR1.wrl\" "
+                        << avatarFields << " }\n" << more;
+    const scene::Scene scene = scene::loadScene(path);
+    std::vector<SceneCharacter> characters = sceneCharacters(scene, Undressed::included);
+    EXPECT_EQ(characters.size(), 1u);
+    return lyingAcrossGravity(scene, *characters.at(0).avatar);
+  };
+  const std::optional<scene::Upright> lying = robotIn("lying.wrl", "", "");
+  ASSERT_TRUE(lying.has_value());
+  EXPECT_EQ(lying->axis, "+z");
+  EXPECT_EQ(lying->rotationText(), "1 0 0 -1.5708");
+  EXPECT_FALSE(robotIn("stood.wrl", "rotation 1 0 0 -1.5708", "").has_value());
+  EXPECT_FALSE(robotIn("own-up.wrl", "", "Simulation { gravity 0 0 -9.81 }\n").has_value());
 }
 
 }  // namespace

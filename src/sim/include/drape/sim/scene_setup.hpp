@@ -5,10 +5,12 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "drape/cloth/material.hpp"
+#include "drape/scene/humanoid.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/character_world.hpp"
 
@@ -51,6 +53,13 @@ enum class Undressed { leftOut, included };
 /// axis than +y in a scene whose gravity pulls along -y, with the rotation that stands it up.
 [[nodiscard]] std::vector<SceneCharacter> sceneCharacters(const scene::Scene& scene,
                                                           Undressed undressed = Undressed::leftOut);
+
+/// How `avatar`, placed in `scene`, stands where it lies across the scene's gravity: a
+/// humanoid along another axis than +y (a robot placed as its file stands it, along +z) in a
+/// scene whose gravity pulls along -y, its garments would fall across it. nullopt where it
+/// stands along +y, is no humanoid, or the scene's gravity pulls along another axis (the
+/// scene's own up).
+[[nodiscard]] std::optional<scene::Upright> lyingAcrossGravity(const scene::Scene& scene, const scene::Avatar& avatar);
 
 /// The avatar the scene's garments are worn by (sceneCharacters' only one); null when the
 /// scene has none. Throws drape::Error when its garments are worn by several characters.

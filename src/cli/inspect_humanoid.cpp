@@ -56,7 +56,7 @@ void printHumanoid(std::ostream& out, const std::vector<std::string>& names, con
     const char* side = s == 0 ? "left " : "right";
     const scene::HumanoidLimb& arm = h.arms[s];
     fmt::print(out, "    {} arm  clavicle {}, upper arm {}, forearm {}, hand {}\n", side, chain(arm.base), chain(arm.upper),
-               chain(arm.lower), chain(arm.end));
+               chain(arm.lower), arm.end.empty() ? "- (the arm ends at its elbow, whose part is the forearm and hand)" : chain(arm.end));
   }
 }
 

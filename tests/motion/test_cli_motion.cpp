@@ -81,6 +81,13 @@ TEST(CliMotion, InspectShowsTheHumanoidTheShapeFinds) {
   EXPECT_NE(r.out.find("    right leg  hip bone rhipjoint, thigh rfemur, shin rtibia, foot rfoot, toe rtoes\n"),
             std::string::npos)
       << r.out;
+  // Choreonoid's GR001: its arms end at the elbows, whose parts carry the forearms and grippers.
+  r = run("inspect " + data("vrml/choreonoid_GR001/GR001.wrl"));
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("    left  arm  clavicle L_SHOULDER_P, upper arm L_SHOULDER_R, forearm L_ELBOW_P, hand - (the arm "
+                       "ends at its elbow, whose part is the forearm and hand)\n"),
+            std::string::npos)
+      << r.out;
   r = run("inspect " + data("avatars/RiggedSimple.glb"));
   EXPECT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("  humanoid   none by the skeleton's shape: 2 joints are too few for legs, a spine and arms\n"),

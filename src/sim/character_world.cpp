@@ -12,6 +12,7 @@
 
 #include "drape/core/error.hpp"
 #include "drape/core/log.hpp"
+#include "drape/mesh/surface_distance.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/motion/interpolate.hpp"
 #include "drape/sim/garment_layers.hpp"
@@ -418,6 +419,7 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
         nearest[i] = static_cast<int>(k);
     }
   }
+  measureBeyondTheFields(parts, local, distance, nearest);
   std::size_t unbound = 0;
   std::string firstUnbound;
   for (std::size_t i = 0; i < n; ++i) {
@@ -481,6 +483,28 @@ std::vector<cloth::PinGroup> CharacterWorld::bindMask(const GarmentSpec& spec, c
     spdlog::info("garment '{}': {} of {} constraint-mask vertices follow a blend of parts across a joint", spec.name,
                  blended, n);
   return out;
+}
+
+void CharacterWorld::measureBeyondTheFields(const std::vector<int>& parts, const std::vector<Vec3>& local,
+                                            std::vector<double>& distance, std::vector<int>& nearest) const {
+  // A field reaches T3 (and a little more) around its part, while bindThreshold is the
+  // scene's own: a mask vertex beyond every part's field is measured on the parts' surfaces
+  // themselves, exactly. Only those: a vertex some field holds binds as it always has.
+  const std::size_t np = parts.size();
+  std::vector<std::optional<mesh::SurfaceDistance>> surfaces(np);
+  for (std::size_t i = 0; i < nearest.size(); ++i) {
+    if (nearest[i] >= 0) continue;
+    for (std::size_t k = 0; k < np; ++k) {
+      if (!surfaces[k]) {
+        const std::string& name = (*fields_)[static_cast<std::size_t>(parts[k])].segment;
+        const mesh::TriMesh& m = avatar_.segments[static_cast<std::size_t>(avatar_.findSegment(name))].mesh;
+        surfaces[k].emplace(m.positions, m.triangles);
+      }
+      distance[i * np + k] = std::abs(surfaces[k]->at(local[i * np + k]).distance_m);
+      if (nearest[i] < 0 || distance[i * np + k] < distance[i * np + static_cast<std::size_t>(nearest[i])])
+        nearest[i] = static_cast<int>(k);
+    }
+  }
 }
 
 void CharacterWorld::liftOutOfTheParts(const GarmentSpec& spec, const std::vector<int>& parts,

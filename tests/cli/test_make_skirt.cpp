@@ -148,6 +148,48 @@ TEST(MakeSkirt, AnotherRigsLowerBodyIsFoundByItsShape) {
       << simple.err;
 }
 
+TEST(MakeSkirt, ASmallRobotsSkirtCollidesAtItsScaleAndWalksStable) {
+  // Choreonoid's GR001 is 0.26 m tall, its parts a few centimetres across: a person's
+  // offsets (T3 = 3 cm) overlapped each other around them, and its skirt went unstable at
+  // rest. make-skirt scales the voxel and offsets with its height; its waistband then lies
+  // beyond the parts' fields (they reach T3 = 4.5 mm) and is bound by the parts' surfaces,
+  // within the scene's 4 cm bindThreshold.
+  ScratchDir dir("make-skirt-small-robot");
+  const std::string out = dir / "robot";
+  const CliResult r = runDrape("make-skirt '" + std::string(DRAPE_DATA_DIR) + "/vrml/choreonoid_GR001/GR001.wrl' --out '" +
+                                   out + "'",
+                               dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("GR001.wrl is 0.26 m tall: distance-field voxel 0.75 mm, offsets T0..T3 0.75 to 4.50 mm (a "
+                       "person's: 5 mm, 5 to 30 mm)\n"),
+            std::string::npos)
+      << r.out;
+  const std::string text = testing::slurp(out + "/scene.wrl");
+  EXPECT_NE(text.find("  offsets [ 0.00075 0.00150 0.00225 0.00450 ]\n  voxelSize 0.00075\n"), std::string::npos);
+  const scene::Scene sc = scene::loadScene(out + "/scene.wrl");
+  ASSERT_EQ(sc.garments.size(), 1u);
+  EXPECT_NEAR(sc.garments[0].bindThreshold, 0.04, 1e-7);
+  const std::string run = dir / "walk";
+  const CliResult walked = runDrape("run '" + out + "/scene.wrl' --motion '" + std::string(DRAPE_SOURCE_DIR) +
+                                        "/examples/walking_skirt/walk.bvh' --frames 40 --out '" + run + "'",
+                                    dir);
+  ASSERT_EQ(walked.code, 0) << walked.err;
+  EXPECT_EQ(walked.err.find("warning"), std::string::npos) << walked.err;
+  const nlohmann::json stats = statsOf(run);
+  EXPECT_EQ(stats["nan_detected"], false);
+  EXPECT_EQ(stats["unstable"], false);
+  EXPECT_EQ(stats["last_resort_projections"], 0);
+  EXPECT_EQ(stats["vertex_substeps_inside_body"], 0);
+  EXPECT_LT(stats["max_stretch"].get<double>(), 0.15);  // with a person's offsets: 0.50, strain-limited
+  // A person's size keeps a person's voxel.
+  const CliResult person =
+      runDrape("make-skirt '" + kAvatars + "/makehuman_rig_cmu_mb.mhskel' --out '" + (dir / "person") + "'", dir);
+  ASSERT_EQ(person.code, 0) << person.err;
+  EXPECT_EQ(person.out.find("tall: distance-field voxel"), std::string::npos) << person.out;
+  EXPECT_NE(testing::slurp(dir / "person/scene.wrl").find("  offsets [ 0.005 0.010 0.015 0.030 ]\n  voxelSize 0.005\n"),
+            std::string::npos);
+}
+
 TEST(MakeSkirt, ARobotStandingAlongZIsStoodUpDressedAndWalked) {
   // Choreonoid's SR1 robot stands along +z, as robotics tools stand everything, and has no
   // head. make-skirt stands it up (the scene's Avatar node turns it), finds its lower body

@@ -254,6 +254,10 @@ class CharacterWorld {
   /// parts' surfaces, keeping its edges' lengths as far as it can: `local` (per mask vertex and part, as
   /// bindMask computes them) then places the mask there.
   void liftOutOfTheParts(const GarmentSpec& spec, const std::vector<int>& parts, std::vector<Vec3>& local) const;
+  /// bindMask's distances (per mask vertex and part, `local` the vertex in each part's
+  /// frame) for the vertices beyond every part's field, from the parts' surfaces.
+  void measureBeyondTheFields(const std::vector<int>& parts, const std::vector<Vec3>& local,
+                              std::vector<double>& distance, std::vector<int>& nearest) const;
 
   const scene::Avatar& avatar_;
   const motion::AvatarAnimation* animation_ = nullptr;

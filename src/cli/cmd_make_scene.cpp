@@ -18,6 +18,7 @@
 #include <fmt/ostream.h>
 #include <fmt/ranges.h>
 
+#include "avatar_scale.hpp"
 #include "command.hpp"
 #include "stand_up.hpp"
 #include "drape/cloth/model.hpp"
@@ -59,6 +60,7 @@ struct MakeSceneOptions {
   std::string avatarRotation;            ///< the Avatar node's rotation that stands a body up along +y; "" : none
   double reach_m = 0.03;
   double voxel_m = 0.005;
+  bool voxelGiven = false;  ///< else voxelFor_m: a person's 5 mm, less for a small avatar
   std::vector<double> offsets;  ///< T0..T3, m; empty: 1, 2, 3 and 6 voxels
   double frameRate = 30.0;
   int stepsPerFrame = 0;
@@ -237,6 +239,10 @@ int makeScene(MakeSceneOptions& o) {
   }
   if (o.name.empty()) o.name = std::filesystem::path(o.garment).stem().string();
   if (o.title.empty()) o.title = o.name;
+  if (!o.voxelGiven) {
+    o.voxel_m = voxelFor_m(avatar);
+    sayWhereTheVoxelIsScaled(avatar, o.avatar, o.voxel_m);
+  }
   chooseCollidables(o, avatar, garment, o.avatar);
   for (const std::string& s : o.keepApart)
     if (avatar.findSegment(s) < 0) throw Error(fmt::format("--keep-apart: {} has no segment '{}'", o.avatar, s));
@@ -389,8 +395,9 @@ RunFunction setupMakeScene(CLI::App& app) {
                  "written as the Avatar node's cutAtJoints (e.g. LeftArm,RightArm; see drape run --help)")
       ->delimiter(',');
   app.add_option("--reach", o.reach_m, "Distance from a segment's box that makes it collidable, m")->capture_default_str();
-  app.add_option("--voxel", o.voxel_m, "Distance-field voxel, m; without --offsets, T0..T3 are 1, 2, 3 and 6 voxels")
-      ->capture_default_str();
+  app.add_option("--voxel", o.voxel_m,
+                 "Distance-field voxel, m; without --offsets, T0..T3 are 1, 2, 3 and 6 voxels (default: 0.005, less for "
+                 "an avatar under 1 m tall, by its height against a person's 1.7 m)");
   app.add_option("--offsets", o.offsets, "The offset surfaces T0,T1,T2,T3 in m (a garment modelled tight on the body "
                  "needs T2 below its clearance)")
       ->delimiter(',')
@@ -420,6 +427,7 @@ RunFunction setupMakeScene(CLI::App& app) {
   return [&app] {
     o.material.validate("--");
     if (!(o.voxel_m > 0.0)) throw Error(fmt::format("--voxel must be > 0 m, got {}", o.voxel_m));
+    o.voxelGiven = app.count("--voxel") > 0;
     if (!(o.frameRate > 0.0)) throw Error(fmt::format("--frame-rate must be > 0, got {}", o.frameRate));
     if (o.stepsPerFrame < 0) throw Error(fmt::format("--substeps must be >= 1, got {}", o.stepsPerFrame));
     if (!(o.stitchGaps_m >= 0.0)) throw Error(fmt::format("--stitch-gaps must be >= 0 m, got {}", o.stitchGaps_m));

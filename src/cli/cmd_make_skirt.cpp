@@ -16,6 +16,7 @@
 #include <fmt/ranges.h>
 #include <fmt/ostream.h>
 
+#include "avatar_scale.hpp"
 #include "command.hpp"
 #include "run_setup.hpp"
 #include "scene_add.hpp"
@@ -78,33 +79,6 @@ ClothSetText clothSetOf(const MakeSkirtOptions& o, const mesh::TriMesh& cloth, c
   return c;
 }
 
-/// The avatar's height at rest: its body parts from the lowest point to the highest.
-double restHeight_m(const scene::Avatar& avatar) {
-  double low = std::numeric_limits<double>::infinity(), high = -low;
-  for (const scene::Segment& s : avatar.segments) {
-    const RigidTransform rest = avatar.joints[static_cast<std::size_t>(s.joint)].restWorld();
-    for (const Vec3& v : s.mesh.positions) {
-      const double y = rest.apply(v).y();
-      low = std::min(low, y);
-      high = std::max(high, y);
-    }
-  }
-  return high > low ? high - low : 0.0;
-}
-
-/// The distance fields' voxel for the skirt's scene: 5 mm, as the paper's offsets (T0..T3 at
-/// 1, 2, 3 and 6 voxels) suit a person; for an avatar under 1 m tall (a toy robot: GR001 is
-/// 0.26 m) the voxel shrinks with its height against a person's 1.7 m, since offsets of 3 cm
-/// around parts a few centimetres across overlap each other and the skirt goes unstable.
-constexpr double kPersonsVoxel = 0.005;
-
-double skirtVoxel_m(const scene::Avatar& avatar) {
-  constexpr double kPerson = 1.7, kSmall = 1.0;
-  const double height = restHeight_m(avatar);
-  if (!(height > 0.0) || height >= kSmall) return kPersonsVoxel;
-  return std::round(kPersonsVoxel * height / kPerson * 1e5) / 1e5;  // to 0.01 mm, as the scene writes it
-}
-
 /// Writes the scene; returns its substeps per frame.
 int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::Skirt& skirt, const scene::Avatar& avatar) {
   constexpr double kFrameRate = 30.0;
@@ -129,7 +103,7 @@ int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::S
                  ? " --motion walk.bvh --out out/walking_skirt"
                  : " --motion CAPTURE.bvh --out out/skirt");
   fmt::print(os, "WorldInfo {{ title \"drape: walking skirt\" }}\n\n");
-  const double voxel = skirtVoxel_m(avatar);
+  const double voxel = voxelFor_m(avatar);
   const int digits = voxel >= 0.001 ? 3 : 5;  // whole millimetres, or a small avatar's hundredths
   fmt::print(os, "DEF Simulation Simulation {{\n  gravity 0 -9.81 0\n  frameRate {:g}\n  stepsPerFrame {}\n"
                  "  airViscosity 0.5\n  offsets [ {:.{}f} {:.{}f} {:.{}f} {:.{}f} ]\n  voxelSize {:.{}f}\n"
@@ -250,10 +224,7 @@ int makeSkirt(MakeSkirtOptions o) {
   const int substeps = writeScene((dir / "scene.wrl").string(), written, skirt, avatar);
   printSkirt(o.name == "Skirt" ? "skirt" : o.name, skirt);
   fmt::print("; {} substeps per frame\n", substeps);
-  if (const double voxel = skirtVoxel_m(avatar); voxel != kPersonsVoxel)
-    fmt::print("{} is {:.2f} m tall: distance-field voxel {:.2f} mm, offsets T0..T3 {:.2f} to {:.2f} mm (a person's: 5 "
-               "mm, 5 to 30 mm)\n",
-               o.avatar, restHeight_m(avatar), 1e3 * voxel, 1e3 * voxel, 6e3 * voxel);
+  sayWhereTheVoxelIsScaled(avatar, o.avatar, voxelFor_m(avatar));
   fmt::print("wrote {}/scene.wrl, {}.obj, {}.obj\n", o.out, stem, maskStem);
   printHowToRun((dir / "scene.wrl").string(), avatar);
   return 0;

@@ -40,12 +40,14 @@ inline double voxelFor_m(const scene::Avatar& avatar) {
   return std::round(kPersonsVoxel_m * height / kPerson * 1e5) / 1e5;
 }
 
-/// Says on standard output that `voxel` (voxelFor_m's) is scaled from a person's, if it is.
-inline void sayWhereTheVoxelIsScaled(const scene::Avatar& avatar, const std::string& whose, double voxel) {
+/// Says on standard output that `voxel` (voxelFor_m's) is scaled from a person's, if it is;
+/// `more`: what else was scaled with it ("; clearance 3.0 mm (a person's: 20 mm)").
+inline void sayWhereTheVoxelIsScaled(const scene::Avatar& avatar, const std::string& whose, double voxel,
+                                     const std::string& more = "") {
   if (voxel == kPersonsVoxel_m) return;
   fmt::print("{} is {:.2f} m tall: distance-field voxel {:.2f} mm, offsets T0..T3 {:.2f} to {:.2f} mm (a person's: 5 "
-             "mm, 5 to 30 mm)\n",
-             whose, restHeight_m(avatar), 1e3 * voxel, 1e3 * voxel, 6e3 * voxel);
+             "mm, 5 to 30 mm){}\n",
+             whose, restHeight_m(avatar), 1e3 * voxel, 1e3 * voxel, 6e3 * voxel, more);
 }
 
 }  // namespace drape::cli

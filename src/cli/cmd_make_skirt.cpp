@@ -42,6 +42,7 @@ struct MakeSkirtOptions {
   AddToOptions add;  ///< --add-to, --character, --over, --over-gap, --colour
   scene::SkirtFit fit;
   double bindThreshold_m = 0.04;
+  bool clearanceGiven = false;      ///< --clearance given (else 2 cm, less for an avatar under 1 m tall)
   bool bindThresholdGiven = false;  ///< --bind-threshold given (else: as far as the waistband needs, at least 0.04 m)
   bool waistGiven = false, hipsGiven = false, legsGiven = false;  ///< --waist-segment, --hip-segments, --leg-segments
   bool withArms = false;                  ///< --with-arms
@@ -212,6 +213,8 @@ int makeSkirt(MakeSkirtOptions o) {
   chooseSegments(avatar, o, o.avatar);
   checkSegments(avatar, o, o.avatar);
   chooseArmSegments(avatar, o);
+  // A small avatar's skirt sits as near its body as a person's does, for its size.
+  if (!o.clearanceGiven) o.fit.clearance_m *= voxelFor_m(avatar) / kPersonsVoxel_m;
   const mesh::Skirt skirt = scene::fitSkirt(avatar, o.fit);
   MakeSkirtOptions written = o;
   if (!o.bindThresholdGiven) written.bindThreshold_m = waistbandReach(avatar, o, skirt);
@@ -224,7 +227,9 @@ int makeSkirt(MakeSkirtOptions o) {
   const int substeps = writeScene((dir / "scene.wrl").string(), written, skirt, avatar);
   printSkirt(o.name == "Skirt" ? "skirt" : o.name, skirt);
   fmt::print("; {} substeps per frame\n", substeps);
-  sayWhereTheVoxelIsScaled(avatar, o.avatar, voxelFor_m(avatar));
+  sayWhereTheVoxelIsScaled(
+      avatar, o.avatar, voxelFor_m(avatar),
+      o.clearanceGiven ? "" : fmt::format("; clearance {:.1f} mm (a person's: 20 mm)", 1e3 * o.fit.clearance_m));
   fmt::print("wrote {}/scene.wrl, {}.obj, {}.obj\n", o.out, stem, maskStem);
   printHowToRun((dir / "scene.wrl").string(), avatar);
   return 0;
@@ -290,7 +295,9 @@ RunFunction setupMakeSkirt(CLI::App& app) {
                  "the Avatar node's drawnMeshes; default: none")
       ->delimiter(',');
   app.add_option("--length", o.fit.length_m, "Waist to hem, m (default: a little above the knees)");
-  app.add_option("--clearance", o.fit.clearance_m, "Gap between body and skirt at rest, m")->capture_default_str();
+  app.add_option("--clearance", o.fit.clearance_m,
+                 "Gap between body and skirt at rest, m (default: 0.02, less for an avatar under 1 m tall, by its "
+                 "height against a person's 1.7 m)");
   app.add_option("--flare", o.fit.flare, "Extra hem radius per metre of length")->capture_default_str();
   app.add_option("--around", o.fit.segments, "Vertices around")->capture_default_str()->check(CLI::Range(6, 1000));
   app.add_option("--rings", o.fit.rings, "Bands from waist to hem")->capture_default_str()->check(CLI::Range(2, 1000));
@@ -316,6 +323,7 @@ RunFunction setupMakeSkirt(CLI::App& app) {
   return [&app] {
     if (o.name.empty()) o.name = "Skirt";
     o.bindThresholdGiven = app.count("--bind-threshold") > 0;
+    o.clearanceGiven = app.count("--clearance") > 0;
     o.waistGiven = app.count("--waist-segment") > 0;
     o.hipsGiven = app.count("--hip-segments") > 0;
     o.legsGiven = app.count("--leg-segments") > 0;

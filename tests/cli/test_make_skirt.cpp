@@ -152,7 +152,7 @@ TEST(MakeSkirt, AnotherRigsLowerBodyIsFoundByItsShape) {
 TEST(MakeSkirt, ASmallRobotsSkirtCollidesAtItsScaleAndWalksStable) {
   // Choreonoid's GR001 is 0.26 m tall, its parts a few centimetres across: a person's
   // offsets (T3 = 3 cm) overlapped each other around them, and its skirt went unstable at
-  // rest. make-skirt scales the voxel and offsets with its height; its waistband then lies
+  // rest. make-skirt scales the voxel, offsets and clearance with its height; its waistband then lies
   // beyond the parts' fields (they reach T3 = 4.5 mm) and is bound by the parts' surfaces,
   // within the scene's 4 cm bindThreshold.
   ScratchDir dir("make-skirt-small-robot");
@@ -162,7 +162,7 @@ TEST(MakeSkirt, ASmallRobotsSkirtCollidesAtItsScaleAndWalksStable) {
                                dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("GR001.wrl is 0.26 m tall: distance-field voxel 0.75 mm, offsets T0..T3 0.75 to 4.50 mm (a "
-                       "person's: 5 mm, 5 to 30 mm)\n"),
+                       "person's: 5 mm, 5 to 30 mm); clearance 3.0 mm (a person's: 20 mm)\n"),
             std::string::npos)
       << r.out;
   const std::string text = testing::slurp(out + "/scene.wrl");

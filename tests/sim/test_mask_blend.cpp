@@ -17,6 +17,7 @@
 #include <numeric>
 #include <set>
 
+#include "drape/core/error.hpp"
 #include "drape/motion/animation.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/character_world.hpp"
@@ -271,6 +272,45 @@ TEST(MaskBlend, TheMaskIsBoundOutsideTheBody) {
     EXPECT_LT(deepest, 0.1 * modelledDeepest);
     EXPECT_LT(furthest, 0.015);
     EXPECT_LT(strain, 0.1);
+  }
+}
+
+TEST(MaskBlend, AMaskBeyondThePartsFieldsIsMeasuredOnTheirSurfaces) {
+  // The walking skirt's waistband pushed 6 cm farther out from the waist's axis: beyond
+  // every part's field (they reach T3 = 3 cm around their parts). Within a bindThreshold
+  // that reaches it, it binds; within one that does not, the error says how far it is.
+  const scene::Scene sc = scene::loadScene(testing::kSkirtScene);
+  const std::unique_ptr<scene::Avatar> avatar = sceneAvatar(sc);
+  motion::MotionOptions mo;
+  mo.clip.rate = sc.simulation.frameRate;
+  mo.jointMapDirectory = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";
+  const motion::AvatarAnimation animation = motion::loadAnimation(*avatar, testing::kSkirtWalk, mo);
+  const WorldSettings settings = toWorldSettings(sc.simulation);
+  std::vector<GarmentSpec> specs = garmentSpecs(sc, avatar.get());
+  ASSERT_EQ(specs.size(), 1u);
+  GarmentSpec& skirt = specs[0];
+  Vec3 axis = Vec3::Zero();
+  for (const std::uint32_t v : skirt.bound) axis += skirt.mesh.positions[v];
+  axis /= static_cast<double>(skirt.bound.size());
+  for (const std::uint32_t v : skirt.bound) {
+    Vec3& p = skirt.mesh.positions[v];
+    const Vec3 out(p.x() - axis.x(), 0.0, p.z() - axis.z());
+    p += 0.06 * out.normalized();
+  }
+  skirt.bindThreshold_m = 0.12;
+  EXPECT_NO_THROW((void)CharacterWorld(*avatar, &animation, specs, settings));
+  skirt.bindThreshold_m = 0.05;
+  try {
+    (void)CharacterWorld(*avatar, &animation, specs, settings);
+    ADD_FAILURE() << "a waistband 6 cm beyond its place bound within 5 cm";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(" of 24 constraint-mask vertices cannot be bound within bindThreshold 0.050 "
+                        "m of a collidable part"),
+              std::string::npos)
+        << what;
+    // How far, exactly, rather than "near no collidable part" (no field holds it).
+    EXPECT_NE(what.find("; vertex 0 at (0.000, 0.119, 0.231) m is 0.086 m from 'LowerBack'"), std::string::npos) << what;
   }
 }
 

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -34,7 +35,9 @@ struct DressedWalk {
   std::unique_ptr<CharacterWorld> world;
   long frames = 0;  ///< the lead-in and the walk
 
-  explicit DressedWalk(const std::string& scenePath) {
+  /// `alter` changes the scene's garments before the world binds them.
+  explicit DressedWalk(const std::string& scenePath,
+                       const std::function<void(std::vector<GarmentSpec>&)>& alter = {}) {
     const scene::Scene sc = scene::loadScene(scenePath);
     avatar = sceneAvatar(sc);
     motion::MotionOptions mo;
@@ -43,7 +46,9 @@ struct DressedWalk {
     animation = std::make_unique<motion::AvatarAnimation>(motion::loadAnimation(*avatar, testing::kSkirtWalk, mo));
     const WorldSettings settings = toWorldSettings(sc.simulation);
     frames = static_cast<long>((settings.leadIn_s + animation->duration()) * sc.simulation.frameRate);
-    world = std::make_unique<CharacterWorld>(*avatar, animation.get(), garmentSpecs(sc, avatar.get()), settings);
+    std::vector<GarmentSpec> specs = garmentSpecs(sc, avatar.get());
+    if (alter) alter(specs);
+    world = std::make_unique<CharacterWorld>(*avatar, animation.get(), std::move(specs), settings);
   }
   [[nodiscard]] const std::vector<cloth::CollisionPart>& parts() const { return world->collider(0)->parts(); }
   [[nodiscard]] const std::vector<std::uint32_t>& bound() const { return world->garment(0).bound; }
@@ -279,34 +284,28 @@ TEST(MaskBlend, AMaskBeyondThePartsFieldsIsMeasuredOnTheirSurfaces) {
   // The walking skirt's waistband pushed 6 cm farther out from the waist's axis: beyond
   // every part's field (they reach T3 = 3 cm around their parts). Within a bindThreshold
   // that reaches it, it binds; within one that does not, the error says how far it is.
-  const scene::Scene sc = scene::loadScene(testing::kSkirtScene);
-  const std::unique_ptr<scene::Avatar> avatar = sceneAvatar(sc);
-  motion::MotionOptions mo;
-  mo.clip.rate = sc.simulation.frameRate;
-  mo.jointMapDirectory = std::string(DRAPE_SOURCE_DIR) + "/share/drape/jointmaps";
-  const motion::AvatarAnimation animation = motion::loadAnimation(*avatar, testing::kSkirtWalk, mo);
-  const WorldSettings settings = toWorldSettings(sc.simulation);
-  std::vector<GarmentSpec> specs = garmentSpecs(sc, avatar.get());
-  ASSERT_EQ(specs.size(), 1u);
-  GarmentSpec& skirt = specs[0];
-  Vec3 axis = Vec3::Zero();
-  for (const std::uint32_t v : skirt.bound) axis += skirt.mesh.positions[v];
-  axis /= static_cast<double>(skirt.bound.size());
-  for (const std::uint32_t v : skirt.bound) {
-    Vec3& p = skirt.mesh.positions[v];
-    const Vec3 out(p.x() - axis.x(), 0.0, p.z() - axis.z());
-    p += 0.06 * out.normalized();
-  }
-  skirt.bindThreshold_m = 0.12;
-  EXPECT_NO_THROW((void)CharacterWorld(*avatar, &animation, specs, settings));
-  skirt.bindThreshold_m = 0.05;
+  const auto pushedOut = [](double bindThreshold_m) {
+    return [bindThreshold_m](std::vector<GarmentSpec>& specs) {
+      ASSERT_EQ(specs.size(), 1u);
+      GarmentSpec& skirt = specs[0];
+      Vec3 axis = Vec3::Zero();
+      for (const std::uint32_t v : skirt.bound) axis += skirt.mesh.positions[v];
+      axis /= static_cast<double>(skirt.bound.size());
+      for (const std::uint32_t v : skirt.bound) {
+        Vec3& p = skirt.mesh.positions[v];
+        p += 0.06 * Vec3(p.x() - axis.x(), 0.0, p.z() - axis.z()).normalized();
+      }
+      skirt.bindThreshold_m = bindThreshold_m;
+    };
+  };
+  EXPECT_NO_THROW((void)DressedWalk(testing::kSkirtScene, pushedOut(0.12)));
   try {
-    (void)CharacterWorld(*avatar, &animation, specs, settings);
+    (void)DressedWalk(testing::kSkirtScene, pushedOut(0.05));
     ADD_FAILURE() << "a waistband 6 cm beyond its place bound within 5 cm";
   } catch (const Error& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find(" of 24 constraint-mask vertices cannot be bound within bindThreshold 0.050 "
-                        "m of a collidable part"),
+    EXPECT_NE(what.find(" of 24 constraint-mask vertices cannot be bound within bindThreshold 0.050 m of a collidable "
+                        "part"),
               std::string::npos)
         << what;
     // How far, exactly, rather than "near no collidable part" (no field holds it).

@@ -125,6 +125,7 @@ void printCharacters(const std::string& path, const scene::Scene& s, std::ostrea
   std::vector<sim::SceneCharacter> characters;
   try {
     characters = sim::sceneCharacters(s);
+    sim::warnOfLyingCharacters(s, characters);
   } catch (const Error& e) {
     fmt::print(out, "    not loaded: {}\n", e.what());
     return;

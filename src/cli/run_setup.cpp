@@ -237,6 +237,7 @@ RunSetup runSetupFromScene(const std::string& scenePath, const std::optional<std
   }
   RunSetup setup;
   std::vector<sim::SceneCharacter> characters = sim::sceneCharacters(sc);
+  sim::warnOfLyingCharacters(sc, characters);
   setup.settings = sim::toStepSettings(sc.simulation);
   setup.garments = sim::garmentSpecs(sc, characters);
   for (sim::SceneCharacter& c : characters) {

@@ -23,17 +23,15 @@ void cutAtJoints(scene::Avatar& avatar, const scene::ExternalAvatar& ext) {
                ext.name.empty() ? avatar.name : ext.name, fmt::join(ext.cutAtJoints, ", "), moved);
 }
 
-/// A character its scene stands along another axis than +y, where gravity pulls along -y (a
-/// robot from Choreonoid placed as its file stands it, along +z), is said so: its garments
-/// would fall across it, and its captures would lay it down.
-void sayWhereItLies(const scene::Scene& scene, const SceneCharacter& c) {
-  const std::optional<scene::Upright> u = lyingAcrossGravity(scene, *c.avatar);
-  if (!u) return;
-  spdlog::warn("{}: character '{}' stands along {}, where gravity pulls along -y: its garments would fall across it; {}",
-               scene.source, c.name, u->axis, u->standUpAdvice());
-}
-
 }  // namespace
+
+void warnOfLyingCharacters(const scene::Scene& scene, const std::vector<SceneCharacter>& characters) {
+  for (const SceneCharacter& c : characters)
+    if (const std::optional<scene::Upright> u = lyingAcrossGravity(scene, *c.avatar))
+      spdlog::warn("{}: character '{}' stands along {}, where gravity pulls along -y: its garments would fall across "
+                   "it; {}",
+                   scene.source, c.name, u->axis, u->standUpAdvice());
+}
 
 std::optional<scene::Upright> lyingAcrossGravity(const scene::Scene& scene, const scene::Avatar& avatar) {
   const Vec3 g = scene.simulation.gravity;
@@ -195,7 +193,6 @@ std::vector<SceneCharacter> sceneCharacters(const scene::Scene& scene, Undressed
     c.external = a >= humanoids;
     if (c.external) c.motion = motionFile(scene, scene.externalAvatars[a - humanoids]);
     c.garments = std::move(worn[a]);
-    sayWhereItLies(scene, c);
     for (const SceneCharacter& other : out)
       if (other.name == c.name)
         throw Error(fmt::format("{}: two characters are called '{}'; give their Avatar or Humanoid nodes different "

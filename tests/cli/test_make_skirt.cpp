@@ -284,6 +284,7 @@ TEST(MakeSkirt, ARobotStandingAlongZIsStoodUpDressedAndWalked) {
                            "Humanoid) rotation 1 0 0 -1.5708 to stand it up, then dress it"),
             std::string::npos)
       << added.err;
+  EXPECT_EQ(added.err.find("warning"), std::string::npos) << "said once, as the error: " << added.err;
   // make-scene --add-to refuses it alike, before it reads the garment.
   const CliResult addedScene = runDrape("make-scene --add-to '" + lying + "' --garment '" + out + "/skirt.obj' --mask '" +
                                             out + "/waistband.obj'",

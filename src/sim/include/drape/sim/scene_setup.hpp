@@ -49,8 +49,7 @@ enum class Undressed { leftOut, included };
 /// its garments, Humanoids first, each kind in file order. A garment that names no avatar is
 /// worn by the scene's only one. Empty when the scene has no avatar. Throws drape::Error
 /// naming the garment when the scene has several avatars and a garment does not say which
-/// wears it, or two characters share a name. Warns of a character that stands along another
-/// axis than +y in a scene whose gravity pulls along -y, with the rotation that stands it up.
+/// wears it, or two characters share a name.
 [[nodiscard]] std::vector<SceneCharacter> sceneCharacters(const scene::Scene& scene,
                                                           Undressed undressed = Undressed::leftOut);
 
@@ -60,6 +59,11 @@ enum class Undressed { leftOut, included };
 /// stands along +y, is no humanoid, or the scene's gravity pulls along another axis (the
 /// scene's own up).
 [[nodiscard]] std::optional<scene::Upright> lyingAcrossGravity(const scene::Scene& scene, const scene::Avatar& avatar);
+
+/// Warns of each of `characters` (sceneCharacters') lying across the scene's gravity, with
+/// the rotation that stands it up: what a run or `drape inspect` goes on with, and a command
+/// that dresses it refuses.
+void warnOfLyingCharacters(const scene::Scene& scene, const std::vector<SceneCharacter>& characters);
 
 /// The avatar the scene's garments are worn by (sceneCharacters' only one); null when the
 /// scene has none. Throws drape::Error when its garments are worn by several characters.

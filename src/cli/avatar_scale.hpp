@@ -7,47 +7,46 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
 #include "drape/scene/avatar.hpp"
+#include "drape/sim/garment_layers.hpp"
 
 namespace drape::cli {
 
 inline constexpr double kPersonsVoxel_m = 0.005;
 
-/// The avatar's height at rest: its body parts from the lowest point to the highest.
-inline double restHeight_m(const scene::Avatar& avatar) {
-  double low = std::numeric_limits<double>::infinity(), high = -low;
-  for (const scene::Segment& s : avatar.segments) {
-    const RigidTransform rest = avatar.joints[static_cast<std::size_t>(s.joint)].restWorld();
-    for (const Vec3& v : s.mesh.positions) {
-      const double y = rest.apply(v).y();
-      low = std::min(low, y);
-      high = std::max(high, y);
-    }
-  }
-  return high > low ? high - low : 0.0;
-}
+/// An avatar's size and the voxel its scene is given.
+struct SceneScale {
+  double height_m = 0.0;               ///< its body parts at rest, from the lowest point to the highest
+  double voxel_m = kPersonsVoxel_m;    ///< to 0.01 mm
+  /// What a person's lengths (a skirt's clearance) are multiplied by: 1 for a person.
+  [[nodiscard]] double factor() const { return voxel_m / kPersonsVoxel_m; }
+};
 
-/// The voxel for `avatar`'s scene, to 0.01 mm.
-inline double voxelFor_m(const scene::Avatar& avatar) {
+inline SceneScale sceneScaleOf(const scene::Avatar& avatar) {
   constexpr double kPerson = 1.7, kSmall = 1.0;
-  const double height = restHeight_m(avatar);
-  if (!(height > 0.0) || height >= kSmall) return kPersonsVoxel_m;
-  return std::round(kPersonsVoxel_m * height / kPerson * 1e5) / 1e5;
+  const std::vector<Vec3> body = sim::restBodyPoints(avatar, avatar.segmentNames());
+  SceneScale s;
+  if (body.empty()) return s;
+  const auto [low, high] =
+      std::minmax_element(body.begin(), body.end(), [](const Vec3& a, const Vec3& b) { return a.y() < b.y(); });
+  s.height_m = high->y() - low->y();
+  if (s.height_m > 0.0 && s.height_m < kSmall)
+    s.voxel_m = std::round(kPersonsVoxel_m * s.height_m / kPerson * 1e5) / 1e5;
+  return s;
 }
 
-/// Says on standard output that `voxel` (voxelFor_m's) is scaled from a person's, if it is;
-/// `more`: what else was scaled with it ("; clearance 3.0 mm (a person's: 20 mm)").
-inline void sayWhereTheVoxelIsScaled(const scene::Avatar& avatar, const std::string& whose, double voxel,
-                                     const std::string& more = "") {
-  if (voxel == kPersonsVoxel_m) return;
+/// Says on standard output that the voxel is scaled from a person's, if it is; `more`:
+/// what else was scaled with it ("; clearance 3.0 mm (a person's: 20 mm)").
+inline void sayWhereTheVoxelIsScaled(const SceneScale& s, const std::string& whose, const std::string& more = "") {
+  if (s.voxel_m == kPersonsVoxel_m) return;
   fmt::print("{} is {:.2f} m tall: distance-field voxel {:.2f} mm, offsets T0..T3 {:.2f} to {:.2f} mm (a person's: 5 "
              "mm, 5 to 30 mm){}\n",
-             whose, restHeight_m(avatar), 1e3 * voxel, 1e3 * voxel, 6e3 * voxel, more);
+             whose, s.height_m, 1e3 * s.voxel_m, 1e3 * s.voxel_m, 6e3 * s.voxel_m, more);
 }
 
 }  // namespace drape::cli

@@ -60,7 +60,7 @@ struct MakeSceneOptions {
   std::string avatarRotation;            ///< the Avatar node's rotation that stands a body up along +y; "" : none
   double reach_m = 0.03;
   double voxel_m = 0.005;
-  bool voxelGiven = false;  ///< else voxelFor_m: a person's 5 mm, less for a small avatar
+  bool voxelGiven = false;  ///< else sceneScaleOf's: a person's 5 mm, less for a small avatar
   std::vector<double> offsets;  ///< T0..T3, m; empty: 1, 2, 3 and 6 voxels
   double frameRate = 30.0;
   int stepsPerFrame = 0;
@@ -240,8 +240,9 @@ int makeScene(MakeSceneOptions& o) {
   if (o.name.empty()) o.name = std::filesystem::path(o.garment).stem().string();
   if (o.title.empty()) o.title = o.name;
   if (!o.voxelGiven) {
-    o.voxel_m = voxelFor_m(avatar);
-    sayWhereTheVoxelIsScaled(avatar, o.avatar, o.voxel_m);
+    const SceneScale scale = sceneScaleOf(avatar);
+    o.voxel_m = scale.voxel_m;
+    sayWhereTheVoxelIsScaled(scale, o.avatar);
   }
   chooseCollidables(o, avatar, garment, o.avatar);
   for (const std::string& s : o.keepApart)

@@ -43,6 +43,7 @@ struct MakeSkirtOptions {
   scene::SkirtFit fit;
   double bindThreshold_m = 0.04;
   bool clearanceGiven = false;      ///< --clearance given (else 2 cm, less for an avatar under 1 m tall)
+  double voxel_m = kPersonsVoxel_m;  ///< the scene's voxel: a person's, less for a small avatar (sceneScaleOf)
   bool bindThresholdGiven = false;  ///< --bind-threshold given (else: as far as the waistband needs, at least 0.04 m)
   bool waistGiven = false, hipsGiven = false, legsGiven = false;  ///< --waist-segment, --hip-segments, --leg-segments
   bool withArms = false;                  ///< --with-arms
@@ -104,7 +105,7 @@ int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::S
                  ? " --motion walk.bvh --out out/walking_skirt"
                  : " --motion CAPTURE.bvh --out out/skirt");
   fmt::print(os, "WorldInfo {{ title \"drape: walking skirt\" }}\n\n");
-  const double voxel = voxelFor_m(avatar);
+  const double voxel = o.voxel_m;
   const int digits = voxel >= 0.001 ? 3 : 5;  // whole millimetres, or a small avatar's hundredths
   fmt::print(os, "DEF Simulation Simulation {{\n  gravity 0 -9.81 0\n  frameRate {:g}\n  stepsPerFrame {}\n"
                  "  airViscosity 0.5\n  offsets [ {:.{}f} {:.{}f} {:.{}f} {:.{}f} ]\n  voxelSize {:.{}f}\n"
@@ -214,7 +215,9 @@ int makeSkirt(MakeSkirtOptions o) {
   checkSegments(avatar, o, o.avatar);
   chooseArmSegments(avatar, o);
   // A small avatar's skirt sits as near its body as a person's does, for its size.
-  if (!o.clearanceGiven) o.fit.clearance_m *= voxelFor_m(avatar) / kPersonsVoxel_m;
+  const SceneScale scale = sceneScaleOf(avatar);
+  o.voxel_m = scale.voxel_m;
+  if (!o.clearanceGiven) o.fit.clearance_m *= scale.factor();
   const mesh::Skirt skirt = scene::fitSkirt(avatar, o.fit);
   MakeSkirtOptions written = o;
   if (!o.bindThresholdGiven) written.bindThreshold_m = waistbandReach(avatar, o, skirt);
@@ -228,7 +231,7 @@ int makeSkirt(MakeSkirtOptions o) {
   printSkirt(o.name == "Skirt" ? "skirt" : o.name, skirt);
   fmt::print("; {} substeps per frame\n", substeps);
   sayWhereTheVoxelIsScaled(
-      avatar, o.avatar, voxelFor_m(avatar),
+      scale, o.avatar,
       o.clearanceGiven ? "" : fmt::format("; clearance {:.1f} mm (a person's: 20 mm)", 1e3 * o.fit.clearance_m));
   fmt::print("wrote {}/scene.wrl, {}.obj, {}.obj\n", o.out, stem, maskStem);
   printHowToRun((dir / "scene.wrl").string(), avatar);

@@ -385,12 +385,15 @@ std::vector<JointAt> jointsAt(const Avatar& avatar) {
     const auto i = static_cast<std::size_t>(s.joint);
     out[i].carries = true;
     if (hasChildren[i]) continue;
-    // The segment's point farthest from its joint, kept only where it reaches past what the
-    // joint's tip already is.
+    // The farthest point of the joint's segments from it (a joint may carry several).
     const RigidTransform rest = avatar.joints[i].restWorld();
+    double reach = out[i].tip ? (*out[i].tip - out[i].rest).norm() : 0.0;
     for (const Vec3& v : s.mesh.positions) {
       const Vec3 p = rest.apply(v);
-      if ((p - out[i].rest).norm() > (out[i].tip.value_or(out[i].rest) - out[i].rest).norm()) out[i].tip = p;
+      if ((p - out[i].rest).norm() > reach) {
+        reach = (p - out[i].rest).norm();
+        out[i].tip = p;
+      }
     }
   }
   return out;

@@ -305,6 +305,8 @@ int addGarment(MakeSceneOptions& o) {
     for (Vec3& p : m->positions) p = dress.placement.apply(dress.scale * p);
   if (o.name.empty()) o.name = std::filesystem::path(o.garment).stem().string();
   checkNewGarment(dress, o.name, o.add.over);
+  const SceneScale scale = sceneScaleOf(avatar);
+  const std::string scaled = fitToASmallCharacter(o.add, dress, scale);
   chooseCollidables(o, avatar, garment, fmt::format("{} ('{}')", o.add.scene, dress.character.name));
   const double added = checkSceneSteps(dress, garment, o.material, o.name);
   if (o.stitchGaps_m > 0.0) o.stitches = openingsToSew(garment, mesh::Topology::build(garment), o.name, o.stitchGaps_m);
@@ -325,6 +327,7 @@ int addGarment(MakeSceneOptions& o) {
                     "drape make-scene: constraint mask of " + o.name + " (m, world)");
   fmt::print("{}: {} vertices, {} triangles; mask {} vertices; {}\n", o.name, garment.vertexCount(),
              garment.triangleCount(), mask.vertexCount(), wornText(dress, o.add));
+  if (!scaled.empty()) fmt::print("{} is {:.2f} m tall: {}\n", dress.character.name, scale.height_m, scaled);
   fmt::print("collides with {}\n", fmt::join(o.collidesWith, ", "));
   printSceneSteps(dress, added);
   if (!o.stitches.empty())
@@ -429,6 +432,7 @@ RunFunction setupMakeScene(CLI::App& app) {
     o.material.validate("--");
     if (!(o.voxel_m > 0.0)) throw Error(fmt::format("--voxel must be > 0 m, got {}", o.voxel_m));
     o.voxelGiven = app.count("--voxel") > 0;
+    o.add.overGapGiven = app.count("--over-gap") > 0;
     if (!(o.frameRate > 0.0)) throw Error(fmt::format("--frame-rate must be > 0, got {}", o.frameRate));
     if (o.stepsPerFrame < 0) throw Error(fmt::format("--substeps must be >= 1, got {}", o.stepsPerFrame));
     if (!(o.stitchGaps_m >= 0.0)) throw Error(fmt::format("--stitch-gaps must be >= 0 m, got {}", o.stitchGaps_m));

@@ -11,6 +11,8 @@
 #include <limits>
 #include <utility>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -247,6 +249,19 @@ int addSkirt(MakeSkirtOptions o) {
   checkSegments(avatar, o, whose);
   chooseArmSegments(avatar, o);
   checkNewGarment(dress, o.name, o.add.over);
+  // A small character's skirt sits as near its body, and as near the skirt under it, as a
+  // person's does, for its size; the scene's voxel and offsets are its own.
+  const SceneScale scale = sceneScaleOf(avatar);
+  std::vector<std::string> scaled;
+  if (!o.clearanceGiven && scale.factor() != 1.0) {
+    o.fit.clearance_m *= scale.factor();
+    scaled.push_back(fmt::format("clearance {:.1f} mm (a person's: 20 mm)", 1e3 * o.fit.clearance_m));
+  }
+  if (const std::string gap = fitToASmallCharacter(o.add, dress, scale); !gap.empty()) scaled.push_back(gap);
+  for (const scene::Garment& g : dress.scene.garments)
+    if (std::find(o.add.over.begin(), o.add.over.end(), g.name) != o.add.over.end())
+      o.fit.wornOver.insert(o.fit.wornOver.end(), g.mesh.positions.begin(), g.mesh.positions.end());
+  o.fit.wornOverGap_m = o.add.overGap_m;
   const mesh::Skirt skirt = scene::fitSkirt(avatar, o.fit);
   const double added = checkSceneSteps(dress, skirt.mesh, knit(), o.name);
 
@@ -268,6 +283,8 @@ int addSkirt(MakeSkirtOptions o) {
                     "drape make-skirt: constraint mask of " + o.name + " (m, world)");
   printSkirt(o.name, skirt);
   fmt::print("; {}\n", wornText(dress, o.add));
+  if (!scaled.empty())
+    fmt::print("{} is {:.2f} m tall: {}\n", dress.character.name, scale.height_m, fmt::join(scaled, ", "));
   printSceneSteps(dress, added);
   fmt::print("added it to {}; wrote {}.obj, {}.obj beside it\n", o.add.scene, stem, maskStem);
   printHowToRun(o.add.scene, avatar, dress.character.motion);
@@ -300,7 +317,8 @@ RunFunction setupMakeSkirt(CLI::App& app) {
   app.add_option("--length", o.fit.length_m, "Waist to hem, m (default: a little above the knees)");
   app.add_option("--clearance", o.fit.clearance_m,
                  "Gap between body and skirt at rest, m (default: 0.02, less for an avatar under 1 m tall, by its "
-                 "height against a person's 1.7 m)");
+                 "height against a person's 1.7 m); with --over, the skirt also clears the garments it is worn over by "
+                 "twice --over-gap");
   app.add_option("--flare", o.fit.flare, "Extra hem radius per metre of length")->capture_default_str();
   app.add_option("--around", o.fit.segments, "Vertices around")->capture_default_str()->check(CLI::Range(6, 1000));
   app.add_option("--rings", o.fit.rings, "Bands from waist to hem")->capture_default_str()->check(CLI::Range(2, 1000));
@@ -327,6 +345,7 @@ RunFunction setupMakeSkirt(CLI::App& app) {
     if (o.name.empty()) o.name = "Skirt";
     o.bindThresholdGiven = app.count("--bind-threshold") > 0;
     o.clearanceGiven = app.count("--clearance") > 0;
+    o.add.overGapGiven = app.count("--over-gap") > 0;
     o.waistGiven = app.count("--waist-segment") > 0;
     o.hipsGiven = app.count("--hip-segments") > 0;
     o.legsGiven = app.count("--leg-segments") > 0;

@@ -8,10 +8,13 @@
 #include <optional>
 #include <utility>
 #include <sstream>
+#include <vector>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
 
+#include "drape/cloth/fixture.hpp"
 #include "drape/cloth/model.hpp"
 #include "drape/cloth/solver.hpp"
 #include "drape/core/error.hpp"
@@ -106,7 +109,9 @@ void addAddToOptions(CLI::App& app, AddToOptions& o, const std::string& addToHel
                  "With --add-to: the character's garments it is worn over, written as its over (kept --over-gap "
                  "above them; docs/PHYSICS.md)")
       ->delimiter(',');
-  app.add_option("--over-gap", o.overGap_m, "With --over: how far above them it keeps, m, written as its overGap")
+  app.add_option("--over-gap", o.overGap_m,
+                 "With --over: how far above them it keeps, m, written as its overGap (on a character under 1 m tall, "
+                 "by default less, by its height against a person's 1.7 m)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   app.add_option("--colour", o.colour,
@@ -137,6 +142,19 @@ bool addingToScene(const CLI::App& app, const AddToOptions& o, const std::string
                               option, command == "make-skirt" ? "the skirt" : "the garment", o.scene));
   if (app.count("--over-gap") > 0 && o.over.empty()) throw Error("--over-gap goes with --over NAME,...");
   return true;
+}
+
+std::string fitToASmallCharacter(AddToOptions& o, const SceneToDress& dress, const SceneScale& scale) {
+  if (scale.factor() == 1.0) return "";
+  const double voxel = dress.scene.simulation.voxelSize;
+  if (voxel > 2.0 * scale.voxel_m)
+    spdlog::warn("{}: the scene's distance-field voxel is {:.2f} mm, for a character {:.2f} m tall; {:.2f} mm (offsets "
+                 "T0..T3 {:.2f} to {:.2f} mm) keeps the offset surfaces of its small parts apart: set voxelSize and "
+                 "offsets in its Simulation node (drape make-skirt and make-scene write them so for a new scene)",
+                 dress.path, 1e3 * voxel, scale.height_m, 1e3 * scale.voxel_m, 1e3 * scale.voxel_m, 6e3 * scale.voxel_m);
+  if (o.over.empty() || o.overGapGiven) return "";
+  o.overGap_m *= scale.factor();
+  return fmt::format("{:.2f} mm above {} (a person's: 4 mm)", 1e3 * o.overGap_m, fmt::join(o.over, ", "));
 }
 
 void dressFor(ClothSetText& c, const SceneToDress& dress, const AddToOptions& o, const std::string& material) {
@@ -266,8 +284,16 @@ std::pair<cloth::StartUnder, cloth::LiftedOver> underAtStart(const scene::Scene&
   const auto solver = [&](std::size_t i) -> cloth::ClothSolver& {
     if (!solvers[i]) {
       const mesh::Topology topology = mesh::Topology::build(specs[i].mesh);
-      solvers[i] = std::make_unique<cloth::ClothSolver>(
-          cloth::ClothModel::build(specs[i].mesh, topology, specs[i].material, settings.massScaling()), settings);
+      const auto model = cloth::ClothModel::build(specs[i].mesh, topology, specs[i].material, settings.massScaling());
+      // Held where drape run holds them (pinned, and bound by the mask): the solver's
+      // damping check measures the membrane's frequency with them fixed, as the run's does.
+      std::vector<std::uint32_t> held = specs[i].pinned;
+      held.insert(held.end(), specs[i].bound.begin(), specs[i].bound.end());
+      std::sort(held.begin(), held.end());
+      held.erase(std::unique(held.begin(), held.end()), held.end());
+      std::vector<cloth::PinGroup> pins;
+      if (!held.empty()) pins.push_back(cloth::PinGroup::atRest(held, model->restX(), model->restY(), model->restZ()));
+      solvers[i] = std::make_unique<cloth::ClothSolver>(model, settings, std::move(pins));
     }
     return *solvers[i];
   };

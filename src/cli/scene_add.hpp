@@ -13,6 +13,7 @@
 #include "drape/mesh/trimesh.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/scene_setup.hpp"
+#include "avatar_scale.hpp"
 #include "scene_text.hpp"
 
 namespace drape::cli {
@@ -23,6 +24,7 @@ struct AddToOptions {
   std::string character;          ///< --character: who wears it there
   std::vector<std::string> over;  ///< --over: the garments it is worn over
   double overGap_m = 0.004;       ///< --over-gap
+  bool overGapGiven = false;      ///< --over-gap given (else 4 mm, less on a character under 1 m tall)
   /// --colour: R, G, B from 0 to 1; empty: the command's own colour, or with --add-to one
   /// that no garment of the scene has.
   std::vector<double> colour;
@@ -76,6 +78,12 @@ double checkSceneSteps(const SceneToDress& dress, const mesh::TriMesh& garment, 
 
 /// A mesh in world metres, in the scene file's units (its unitScale).
 [[nodiscard]] mesh::TriMesh inFileUnits(const SceneToDress& dress, mesh::TriMesh world);
+
+/// On a character under 1 m tall (`scale`, the scene's voxel being its own): the default
+/// --over-gap scaled from a person's 4 mm by its height, and a warning when the scene's voxel
+/// is a person's, whose offsets are too wide around small parts. Returns what was scaled,
+/// for the command's message ("0.62 mm above Skirt (a person's: 4 mm)"), or "".
+std::string fitToASmallCharacter(AddToOptions& o, const SceneToDress& dress, const SceneScale& scale);
 
 /// Where the new garment goes and what it looks like: the options' over, gap and colour (a
 /// colour of the scene's garments' own when none is given), the character's DEF as its

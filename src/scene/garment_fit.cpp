@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -61,17 +63,21 @@ mesh::Skirt fitSkirt(const Avatar& avatar, const SkirtFit& fit) {
   centre.y() = waistY;
   shape.waistCentre = centre;
 
-  // The body's half-extents in x and z within each ring's band, about the skirt's axis.
+  // The half-extents in x and z of `points` within ring r's band, about the skirt's axis.
   const double band = shape.length / shape.rings;
-  double rx = 0, rz = 0;
-  for (int r = 0; r <= shape.rings; ++r) {
+  const auto extentsAt = [&](const std::vector<Vec3>& points, int r) {
     const double y = waistY - band * r;
     double hx = 0, hz = 0;
-    for (const Vec3& p : body) {
+    for (const Vec3& p : points) {
       if (std::abs(p.y() - y) > 0.5 * band + (r == 0 ? 0.01 : 0.0)) continue;
       hx = std::max(hx, std::abs(p.x() - centre.x()));
       hz = std::max(hz, std::abs(p.z() - centre.z()));
     }
+    return std::pair{hx, hz};
+  };
+  double rx = 0, rz = 0, wx = 0, wz = 0;
+  for (int r = 0; r <= shape.rings; ++r) {
+    const auto [hx, hz] = extentsAt(body, r);
     // Radii never shrink going down.
     // The waistband sits close (it is bound there); below it, an ellipse through the box
     // corners of the outline would need sqrt(2) times the half-extents, 1.15 covers the
@@ -80,8 +86,14 @@ mesh::Skirt fitSkirt(const Avatar& avatar, const SkirtFit& fit) {
     const double clearance = r == 0 ? 0.5 * fit.clearance_m : fit.clearance_m;
     rx = std::max(rx, round * hx + clearance);
     rz = std::max(rz, round * hz + clearance);
-    shape.ringRadiusX.push_back(rx + fit.flare * band * r);
-    shape.ringRadiusZ.push_back(rz + fit.flare * band * r);
+    // A garment worn under it is cleared as it is (a skirt's rings are ellipses already),
+    // its flare included.
+    const auto [ux, uz] = extentsAt(fit.wornOver, r);
+    const double gap = r == 0 ? fit.wornOverGap_m : 2.0 * fit.wornOverGap_m;
+    if (ux > 0.0) wx = std::max(wx, ux + gap);
+    if (uz > 0.0) wz = std::max(wz, uz + gap);
+    shape.ringRadiusX.push_back(std::max(rx + fit.flare * band * r, wx));
+    shape.ringRadiusZ.push_back(std::max(rz + fit.flare * band * r, wz));
   }
   mesh::Skirt skirt = mesh::makeSkirt(shape);
   skirt.mesh.name = "skirt";

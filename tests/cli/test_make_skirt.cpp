@@ -209,6 +209,58 @@ TEST(MakeSkirt, ASmallRobotsSkirtCollidesAtItsScaleAndWalksStable) {
             std::string::npos);
 }
 
+TEST(MakeSkirt, ASecondSkirtOnASmallRobotIsScaledAsItsFirst) {
+  // make-skirt --add-to on GR001 (0.26 m) scales the new skirt's clearance and its gap over
+  // the skirt under it, as a new scene's are; the scene's voxel and offsets are its own, and
+  // a scene whose voxel is too coarse for so small a character is warned of. Both skirts then
+  // walk with no warning (before, adding failed: the check of the layers at the start measured
+  // the skirt under it with its waistband free, where a run holds it).
+  ScratchDir dir("make-skirt-small-second");
+  const std::string gr001 = "'" + std::string(DRAPE_DATA_DIR) + "/vrml/choreonoid_GR001/GR001.wrl'";
+  const CliResult first = runDrape("make-skirt " + gr001 + " --out '" + (dir / "robot") + "'", dir);
+  ASSERT_EQ(first.code, 0) << first.err;
+  const std::string scene = dir / "robot/scene.wrl";
+  const CliResult second = runDrape("make-skirt --add-to '" + scene + "' --name Over --over Skirt", dir);
+  ASSERT_EQ(second.code, 0) << second.err;
+  EXPECT_NE(second.out.find("Body is 0.26 m tall: clearance 3.0 mm (a person's: 20 mm), 0.60 mm above Skirt (a person's: "
+                            "4 mm)\n"),
+            std::string::npos)
+      << second.out;
+  EXPECT_EQ(second.err.find("warning"), std::string::npos) << second.err;
+  const scene::Scene sc = scene::loadScene(scene);
+  ASSERT_EQ(sc.garments.size(), 2u);
+  EXPECT_NEAR(sc.garments[1].overGap, 0.0006, 1e-9);
+  EXPECT_NEAR(sc.simulation.voxelSize, 0.00075, 1e-9);
+  const std::string run = dir / "walk";
+  const CliResult walked = runDrape("run '" + scene + "' --motion '" + std::string(DRAPE_SOURCE_DIR) +
+                                        "/examples/walking_skirt/walk.bvh' --frames 30 --out '" + run + "'",
+                                    dir);
+  ASSERT_EQ(walked.code, 0) << walked.err;
+  EXPECT_EQ(walked.err.find("warning"), std::string::npos) << walked.err;
+  EXPECT_EQ(statsOf(run)["vertex_substeps_inside_body"], 0);
+  // An --over-gap given is kept, and not said to be scaled.
+  const CliResult given = runDrape("make-skirt --add-to '" + scene + "' --name Third --over Over --over-gap 0.001", dir);
+  ASSERT_EQ(given.code, 0) << given.err;
+  EXPECT_NE(given.out.find("Body is 0.26 m tall: clearance 3.0 mm (a person's: 20 mm)\n"), std::string::npos)
+      << given.out;
+  EXPECT_NEAR(scene::loadScene(scene).garments[2].overGap, 0.001, 1e-9);
+
+  // A scene on the robot with a person's voxel (written by hand, or with make-scene --voxel):
+  // the new skirt is added, with a warning naming the voxel it would need.
+  std::string coarse = testing::slurp(dir / "robot/scene.wrl");
+  const std::string fine = "  offsets [ 0.00075 0.00150 0.00225 0.00450 ]\n  voxelSize 0.00075\n";
+  const std::size_t at = coarse.find(fine);
+  ASSERT_NE(at, std::string::npos);
+  coarse.replace(at, fine.size(), "  offsets [ 0.005 0.010 0.015 0.030 ]\n  voxelSize 0.005\n");
+  std::ofstream(dir / "robot/coarse.wrl") << coarse;
+  const CliResult warned = runDrape("make-skirt --add-to '" + (dir / "robot/coarse.wrl") + "' --name Fourth", dir);
+  ASSERT_EQ(warned.code, 0) << warned.err;
+  EXPECT_NE(warned.err.find("robot/coarse.wrl: the scene's distance-field voxel is 5.00 mm, for a character 0.26 m tall; "
+                            "0.75 mm (offsets T0..T3 0.75 to 4.50 mm) keeps the offset surfaces of its small parts apart"),
+            std::string::npos)
+      << warned.err;
+}
+
 TEST(MakeSkirt, ARobotStandingAlongZIsStoodUpDressedAndWalked) {
   // Choreonoid's SR1 robot stands along +z, as robotics tools stand everything, and has no
   // head. make-skirt stands it up (the scene's Avatar node turns it), finds its lower body

@@ -272,6 +272,36 @@ TEST(GarmentBelow, ASheetOnAGarmentSlidingAwayIsDraggedAtMuG) {
   }
 }
 
+TEST(GarmentBelow, ACornerOfSmallWeightIsNotFlungOut) {
+  // A triangle held at two corners (a waistband bound over another's) and a vertex below
+  // pushing up into it near its held edge: only the free corner can move, at a twentieth of
+  // the contact point's weight. The exact projection would lift it twenty times the
+  // correction (40 mm in one test, and the cloth there explodes); it moves at most
+  // LayerCollider::kMostLever times the correction per sweep, three sweeps a test.
+  const double gap = 0.004, height = 0.002, weightOfFree = 0.05;
+  mesh::TriMesh over;
+  over.positions = {Vec3(0, height, 0), Vec3(0.1, height, 0), Vec3(0.05, height, 0.1)};
+  over.triangles = {{0, 2, 1}};
+  mesh::TriMesh below;
+  below.positions = {Vec3(0.05, 0, weightOfFree * 0.1), Vec3(0.5, 0, 0.5), Vec3(0.6, 0, 0.5)};
+  below.triangles = {{0, 2, 1}};
+  const auto overModel = makeModel(over, knit()), belowModel = makeModel(below, knit());
+  const ClothState belowState = stateAt(below.positions);
+  LayerCollider collider(*overModel, "over", 0.0);
+  collider.setFixedVertices({0, 1});
+  collider.addGarmentBelow(*belowModel, "below", belowState, gap, kFrame_s);
+  ClothState state = stateAt(over.positions);
+  collider.initialise(state);
+  collider.beginFrame();
+  collider.collide(*overModel, 0.0, 1e-4, state);
+  const double correction = gap - height, lift = state.y[2] - height;
+  EXPECT_GT(lift, LayerCollider::kMostLever * correction);  // it moves out, over the sweeps
+  EXPECT_LE(lift, 3 * LayerCollider::kMostLever * correction);
+  EXPECT_EQ(state.y[0], height);  // held
+  EXPECT_EQ(state.y[1], height);
+  EXPECT_EQ(collider.layerCounters().contactsBelow, 1u);
+}
+
 TEST(GarmentBelow, SaysWhichVerticesStartUnderTheGarmentBelow) {
   // A sheet modelled one gap over another, the same waves: every vertex over it. Pushed
   // through it by half a gap, `pushed` of them start under it, which the layers would keep.

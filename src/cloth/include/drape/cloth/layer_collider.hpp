@@ -145,6 +145,9 @@ class LayerCollider final : public Collider {
   /// How deep under them, in gaps, a vertex is moved out over them (liftOver); without the
   /// body, also how far from them the sides are looked at.
   static constexpr double kLiftDepthGaps = 4.0;
+  /// The most one sweep of a contact's resolution moves any one point, in units of its
+  /// correction (where only corners of small weight can move; docs/PHYSICS.md).
+  static constexpr double kMostLever = 2.0;
   /// Where the garment starts (the sides of its first test): its rest shape unless given;
   /// the garments below where their states are now.
   void initialise(const ClothState& state);

@@ -18,6 +18,11 @@ struct SkirtFit {
   double flare = 0.12;         ///< extra hem radius per metre of length (an A-line)
   int segments = 24;           ///< vertices around
   int rings = 10;              ///< bands from waist to hem (segments x rings x 2 triangles)
+  /// The vertices of garments the skirt is worn over (m, world, at rest), and how far it
+  /// keeps outside them: twice this below the waist, this at the waist (their waistbands lie
+  /// at half their clearance too). Each ring clears them as well as the body's outline.
+  std::vector<Vec3> wornOver;
+  double wornOverGap_m = 0.0;
 };
 
 /// Fits a skirt to the avatar at rest: the waist ring wraps the waist segment at its

@@ -298,7 +298,8 @@ std::pair<cloth::StartUnder, cloth::LiftedOver> underAtStart(const scene::Scene&
     return *solvers[i];
   };
   const auto layers = sim::makeLayerCollider(specs, g, below[g], specs[g].bound, solver, 1.0 / settings.frameRate_hz,
-                                             sim::restBodyPoints(avatar, specs[g].collidesWith));
+                                             sim::restBodyPoints(avatar, specs[g].collidesWith,
+                                                                 sim::kBodySpacingGaps * specs[g].overGap_m));
   return {layers->startUnder(), layers->liftedOver()};
 }
 

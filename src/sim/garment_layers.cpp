@@ -1,6 +1,8 @@
 #include "drape/sim/garment_layers.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <vector>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -34,12 +36,34 @@ std::vector<std::vector<std::size_t>> garmentsBelow(const std::vector<GarmentSpe
   return below;
 }
 
-std::vector<Vec3> restBodyPoints(const scene::Avatar& avatar, const std::vector<std::string>& segments) {
+namespace {
+
+/// Points on triangle (a, b, c) no farther apart than `spacing`, its corners left out. The
+/// corners by value: they may be elements of `points`, which grows.
+void sampleTriangle(const Vec3 a, const Vec3 b, const Vec3 c, double spacing, std::vector<Vec3>& points) {
+  const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+  const int n = static_cast<int>(std::ceil(longest / spacing));
+  if (n < 2) return;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; i + j <= n; ++j) {
+      if ((i == 0 && j == 0) || i == n || j == n) continue;
+      points.push_back(a + (b - a) * (double(i) / n) + (c - a) * (double(j) / n));
+    }
+}
+
+}  // namespace
+
+std::vector<Vec3> restBodyPoints(const scene::Avatar& avatar, const std::vector<std::string>& segments,
+                                 double spacing_m) {
   std::vector<Vec3> points;
   for (const scene::Segment& s : avatar.segments) {
     if (std::find(segments.begin(), segments.end(), s.name) == segments.end()) continue;
     const RigidTransform rest = avatar.joints[static_cast<std::size_t>(s.joint)].restWorld();
+    const std::size_t first = points.size();
     for (const Vec3& p : s.mesh.positions) points.push_back(rest.apply(p));
+    if (!(spacing_m > 0.0)) continue;
+    for (const mesh::Triangle& t : s.mesh.triangles)
+      sampleTriangle(points[first + t[0]], points[first + t[1]], points[first + t[2]], spacing_m, points);
   }
   return points;
 }

@@ -3,7 +3,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
 #include "drape/core/error.hpp"
+#include "drape/scene/avatar_gltf.hpp"
 #include "drape/sim/garment_layers.hpp"
 #include "drape/testing/errors.hpp"
 
@@ -46,6 +53,44 @@ TEST(GarmentLayers, RefusesWhatCannotBeStepped) {
   const std::string round = errorOf([] { (void)garmentsBelow(wardrobe({{"A", {"B"}}, {"B", {"C"}}, {"C", {"A"}}, {"D", {}}})); });
   EXPECT_NE(round.find("garment 'A' is worn, through the garments it is worn over, over itself"), std::string::npos)
       << round;
+}
+
+TEST(GarmentLayers, TheBodysPointsCoverItsTrianglesAsCloseAsAsked) {
+  // GR001's hips and legs are CAD boxes of a few large triangles: their vertices alone put
+  // the body's nearest point centimetres off to the side of a skirt 3 mm out, and which side
+  // of the skirt below is over came out wrong. With a spacing, every point of their
+  // triangles has one of the body's points within it (random points, against every point).
+  const scene::Avatar avatar = scene::loadAvatarFile(std::string(DRAPE_DATA_DIR) + "/vrml/choreonoid_GR001/GR001.wrl");
+  const std::vector<std::string> parts{"WAIST_LINK", "L_HIP_P_LINK", "R_KNEE_P_LINK"};
+  const std::vector<Vec3> vertices = restBodyPoints(avatar, parts);
+  const double spacing = 0.002;
+  const std::vector<Vec3> sampled = restBodyPoints(avatar, parts, spacing);
+  ASSERT_GT(sampled.size(), 4 * vertices.size());
+  for (const Vec3& v : vertices)  // the vertices too, as they were
+    EXPECT_TRUE(std::find(sampled.begin(), sampled.end(), v) != sampled.end()) << v.transpose();
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  double farthest = 0.0, farthestByVertices = 0.0;
+  for (const scene::Segment& segment : avatar.segments) {
+    if (std::find(parts.begin(), parts.end(), segment.name) == parts.end()) continue;
+    const RigidTransform rest = avatar.joints[static_cast<std::size_t>(segment.joint)].restWorld();
+    for (int k = 0; k < 300; ++k) {
+      const mesh::Triangle& t = segment.mesh.triangles[random() % segment.mesh.triangles.size()];
+      double u = unit(random), v = unit(random);
+      if (u + v > 1.0) u = 1.0 - u, v = 1.0 - v;
+      const Vec3 a = segment.mesh.positions[t[0]], b = segment.mesh.positions[t[1]], c = segment.mesh.positions[t[2]];
+      const Vec3 p = rest.apply(a + u * (b - a) + v * (c - a));
+      const auto nearest = [&](const std::vector<Vec3>& points) {
+        double best = std::numeric_limits<double>::infinity();
+        for (const Vec3& q : points) best = std::min(best, (p - q).norm());
+        return best;
+      };
+      farthest = std::max(farthest, nearest(sampled));
+      farthestByVertices = std::max(farthestByVertices, nearest(vertices));
+    }
+  }
+  EXPECT_LE(farthest, spacing);
+  EXPECT_GT(farthestByVertices, 5 * spacing);  // what the vertices alone left
 }
 
 }  // namespace

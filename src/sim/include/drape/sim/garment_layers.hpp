@@ -26,9 +26,16 @@ namespace drape::sim {
 /// Per garment, its layer (garmentsBelow's lists, which do not go round): the scene's.
 using scene::layersOf;
 
-/// The avatar's segments named in `segments` at rest, as points in the world: the body a
-/// garment colliding with them is worn on (cloth::LayerCollider::setBody).
-[[nodiscard]] std::vector<Vec3> restBodyPoints(const scene::Avatar& avatar, const std::vector<std::string>& segments);
+/// The avatar's segments named in `segments` at rest, as points in the world: their
+/// vertices, and with `spacing_m` > 0 points on their triangles no farther apart than that
+/// too: the body a garment colliding with them is worn on (cloth::LayerCollider::setBody),
+/// whose nearest point must lie under a garment's vertex, not off to its side, where a
+/// robot's parts are boxes of a few large triangles.
+[[nodiscard]] std::vector<Vec3> restBodyPoints(const scene::Avatar& avatar, const std::vector<std::string>& segments,
+                                               double spacing_m = 0.0);
+/// The spacing of the body's points a garment worn over others is given, in its gaps
+/// (restBodyPoints): as near as it is worn over them.
+inline constexpr double kBodySpacingGaps = 2.0;
 
 /// The layer collider garment `g` of `garments` needs: its own layers kept apart
 /// (selfCollision_m) and the garments it is worn over (`below`, garmentsBelow's list for

@@ -29,6 +29,15 @@ using testing::statsOf;
 
 const std::string kAvatars = std::string(DRAPE_DATA_DIR) + "/avatars";
 
+/// `drape run SCENE` for `frames` frames of the bundled walk, into DIR/walk; the run's
+/// result (its stats.json in DIR/walk).
+CliResult walk(const ScratchDir& dir, const std::string& scene, int frames) {
+  return runDrape("run '" + scene + "' --motion '" + std::string(DRAPE_SOURCE_DIR) +
+                      "/examples/walking_skirt/walk.bvh' --frames " + std::to_string(frames) + " --out '" +
+                      (dir / "walk") + "'",
+                  dir);
+}
+
 /// Runs the scene `dir/scene.wrl` for a few frames (the avatar stands, whatever animation
 /// its file carries) and checks the skirt stayed out of the body.
 void runsClean(const ScratchDir& scratch, const std::string& dir) {
@@ -171,9 +180,7 @@ TEST(MakeSkirt, ASmallRobotsSkirtCollidesAtItsScaleAndWalksStable) {
   ASSERT_EQ(sc.garments.size(), 1u);
   EXPECT_NEAR(sc.garments[0].bindThreshold, 0.04, 1e-7);
   const std::string run = dir / "walk";
-  const CliResult walked = runDrape("run '" + out + "/scene.wrl' --motion '" + std::string(DRAPE_SOURCE_DIR) +
-                                        "/examples/walking_skirt/walk.bvh' --frames 40 --out '" + run + "'",
-                                    dir);
+  const CliResult walked = walk(dir, out + "/scene.wrl", 40);
   ASSERT_EQ(walked.code, 0) << walked.err;
   EXPECT_EQ(walked.err.find("warning"), std::string::npos) << walked.err;
   const nlohmann::json stats = statsOf(run);
@@ -232,9 +239,7 @@ TEST(MakeSkirt, ASecondSkirtOnASmallRobotIsScaledAsItsFirst) {
   EXPECT_NEAR(sc.garments[1].overGap, 0.0006, 1e-9);
   EXPECT_NEAR(sc.simulation.voxelSize, 0.00075, 1e-9);
   const std::string run = dir / "walk";
-  const CliResult walked = runDrape("run '" + scene + "' --motion '" + std::string(DRAPE_SOURCE_DIR) +
-                                        "/examples/walking_skirt/walk.bvh' --frames 30 --out '" + run + "'",
-                                    dir);
+  const CliResult walked = walk(dir, scene, 30);
   ASSERT_EQ(walked.code, 0) << walked.err;
   EXPECT_EQ(walked.err.find("warning"), std::string::npos) << walked.err;
   EXPECT_EQ(statsOf(run)["vertex_substeps_inside_body"], 0);
@@ -293,9 +298,7 @@ TEST(MakeSkirt, ARobotStandingAlongZIsStoodUpDressedAndWalked) {
   EXPECT_NEAR(rest.max.y(), 0.89, 0.005);  // at the waist joint, 0.89 m up the robot's z
 
   const std::string run = dir / "walk";
-  const CliResult walked = runDrape("run '" + out + "/scene.wrl' --motion '" + std::string(DRAPE_SOURCE_DIR) +
-                                        "/examples/walking_skirt/walk.bvh' --frames 40 --out '" + run + "'",
-                                    dir);
+  const CliResult walked = walk(dir, out + "/scene.wrl", 40);
   ASSERT_EQ(walked.code, 0) << walked.err;
   EXPECT_NE(walked.err.find("joint map 'by shape' drives 26 of the avatar's 30 joints"), std::string::npos) << walked.err;
   const nlohmann::json stats = statsOf(run);

@@ -203,6 +203,11 @@ double waistbandReach(const scene::Avatar& avatar, const MakeSkirtOptions& o, co
   return std::max(0.04, std::ceil((farthest + 0.005) * 1e3) / 1e3);
 }
 
+/// What a small avatar's default clearance was scaled to, against a person's.
+std::string scaledClearance(double clearance_m) {
+  return fmt::format("clearance {:.1f} mm (a person's: {:g} mm)", 1e3 * clearance_m, 1e3 * scene::SkirtFit{}.clearance_m);
+}
+
 void printSkirt(const std::string& name, const mesh::Skirt& skirt) {
   const Aabb box = skirt.mesh.bounds();
   fmt::print("{}: {} vertices, {} triangles, waist at y = {:.3f} m, hem at y = {:.3f} m", name,
@@ -234,7 +239,7 @@ int makeSkirt(MakeSkirtOptions o) {
   fmt::print("; {} substeps per frame\n", substeps);
   sayWhereTheVoxelIsScaled(
       scale, o.avatar,
-      o.clearanceGiven ? "" : fmt::format("; clearance {:.1f} mm (a person's: 20 mm)", 1e3 * o.fit.clearance_m));
+      o.clearanceGiven ? "" : "; " + scaledClearance(o.fit.clearance_m));
   fmt::print("wrote {}/scene.wrl, {}.obj, {}.obj\n", o.out, stem, maskStem);
   printHowToRun((dir / "scene.wrl").string(), avatar);
   return 0;
@@ -255,7 +260,7 @@ int addSkirt(MakeSkirtOptions o) {
   std::vector<std::string> scaled;
   if (!o.clearanceGiven && scale.factor() != 1.0) {
     o.fit.clearance_m *= scale.factor();
-    scaled.push_back(fmt::format("clearance {:.1f} mm (a person's: 20 mm)", 1e3 * o.fit.clearance_m));
+    scaled.push_back(scaledClearance(o.fit.clearance_m));
   }
   if (const std::string gap = fitToASmallCharacter(o.add, dress, scale); !gap.empty()) scaled.push_back(gap);
   for (const scene::Garment& g : dress.scene.garments)

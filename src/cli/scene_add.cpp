@@ -110,8 +110,8 @@ void addAddToOptions(CLI::App& app, AddToOptions& o, const std::string& addToHel
                  "above them; docs/PHYSICS.md)")
       ->delimiter(',');
   app.add_option("--over-gap", o.overGap_m,
-                 "With --over: how far above them it keeps, m, written as its overGap (on a character under 1 m tall, "
-                 "by default less, by its height against a person's 1.7 m)")
+                 "With --over: how far above them it keeps, m, written as its overGap (by default, on a character "
+                 "under 1 m tall, less by its height against a person's 1.7 m)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   app.add_option("--colour", o.colour,
@@ -154,7 +154,8 @@ std::string fitToASmallCharacter(AddToOptions& o, const SceneToDress& dress, con
                  dress.path, 1e3 * voxel, scale.height_m, 1e3 * scale.voxel_m, 1e3 * scale.voxel_m, 6e3 * scale.voxel_m);
   if (o.over.empty() || o.overGapGiven) return "";
   o.overGap_m *= scale.factor();
-  return fmt::format("{:.2f} mm above {} (a person's: 4 mm)", 1e3 * o.overGap_m, fmt::join(o.over, ", "));
+  return fmt::format("{:.2f} mm above {} (a person's: {:g} mm)", 1e3 * o.overGap_m, fmt::join(o.over, ", "),
+                     1e3 * AddToOptions{}.overGap_m);
 }
 
 void dressFor(ClothSetText& c, const SceneToDress& dress, const AddToOptions& o, const std::string& material) {
@@ -297,9 +298,8 @@ std::pair<cloth::StartUnder, cloth::LiftedOver> underAtStart(const scene::Scene&
     }
     return *solvers[i];
   };
-  const auto layers = sim::makeLayerCollider(specs, g, below[g], specs[g].bound, solver, 1.0 / settings.frameRate_hz,
-                                             sim::restBodyPoints(avatar, specs[g].collidesWith,
-                                                                 sim::kBodySpacingGaps * specs[g].overGap_m));
+  const auto layers =
+      sim::makeLayerCollider(specs, g, below[g], specs[g].bound, solver, 1.0 / settings.frameRate_hz, &avatar);
   return {layers->startUnder(), layers->liftedOver()};
 }
 

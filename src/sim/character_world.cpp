@@ -188,9 +188,7 @@ CharacterWorld::CharacterWorld(const scene::Avatar& avatar, const motion::Avatar
     GarmentRun& run = garments_[g];
     run.layers = makeLayerCollider(
         garments, g, below[g], run.fixed, [&](std::size_t i) -> cloth::ClothSolver& { return *garments_[i].solver; },
-        1.0 / settings_.step.frameRate_hz,
-        below[g].empty() ? std::vector<Vec3>{}
-                         : restBodyPoints(avatar, garments[g].collidesWith, kBodySpacingGaps * garments[g].overGap_m));
+        1.0 / settings_.step.frameRate_hz, &avatar);
     if (run.layers) run.solver->addCollider(*run.layers);
     run.solver->addCollider(*run.collider);
   }

@@ -51,6 +51,10 @@ void sampleTriangle(const Vec3 a, const Vec3 b, const Vec3 c, double spacing, st
     }
 }
 
+/// The spacing of the body's points a garment worn over others is given, in its gaps: as
+/// near as it is worn over them.
+constexpr double kBodySpacingGaps = 2.0;
+
 }  // namespace
 
 std::vector<Vec3> restBodyPoints(const scene::Avatar& avatar, const std::vector<std::string>& segments,
@@ -71,7 +75,7 @@ std::vector<Vec3> restBodyPoints(const scene::Avatar& avatar, const std::vector<
 std::unique_ptr<cloth::LayerCollider> makeLayerCollider(
     const std::vector<GarmentSpec>& garments, std::size_t g, std::span<const std::size_t> below,
     const std::vector<std::uint32_t>& fixed, const std::function<cloth::ClothSolver&(std::size_t)>& solver,
-    double frame_s, std::vector<Vec3> body) {
+    double frame_s, const scene::Avatar* avatar) {
   const GarmentSpec& spec = garments[g];
   if (!(spec.selfCollision_m > 0) && below.empty()) return nullptr;
   cloth::ClothSolver& own = solver(g);
@@ -80,7 +84,8 @@ std::unique_ptr<cloth::LayerCollider> makeLayerCollider(
   layers->setStitches(spec.stitches);
   for (const std::size_t b : below)
     layers->addGarmentBelow(solver(b).model(), garments[b].name, solver(b).state(), spec.overGap_m, frame_s);
-  if (!below.empty()) layers->setBody(std::move(body));
+  if (!below.empty() && avatar)
+    layers->setBody(restBodyPoints(*avatar, spec.collidesWith, kBodySpacingGaps * spec.overGap_m));
   layers->initialise(own.state());
   layers->liftOver(own.mutableState());  // what was modelled under the garments below, out over them
   return layers;

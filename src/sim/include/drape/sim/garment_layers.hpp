@@ -33,21 +33,19 @@ using scene::layersOf;
 /// robot's parts are boxes of a few large triangles.
 [[nodiscard]] std::vector<Vec3> restBodyPoints(const scene::Avatar& avatar, const std::vector<std::string>& segments,
                                                double spacing_m = 0.0);
-/// The spacing of the body's points a garment worn over others is given, in its gaps
-/// (restBodyPoints): as near as it is worn over them.
-inline constexpr double kBodySpacingGaps = 2.0;
 
 /// The layer collider garment `g` of `garments` needs: its own layers kept apart
 /// (selfCollision_m) and the garments it is worn over (`below`, garmentsBelow's list for
 /// it) kept overGap_m under it; null when it needs neither. `fixed`: its vertices a fixture
 /// moves; `solver(i)`: garment i's solver, whose state the collider reads each frame (it
-/// must outlive the collider); frame_s: the frames' length; `body`: the body it is worn on
-/// at rest (restBodyPoints; empty: none), which tells which side of the garments below is
-/// over. Initialised at the solvers' states now, with what was modelled under the garments
-/// below moved out over them; the caller adds it to g's solver before the body's collider.
+/// must outlive the collider); frame_s: the frames' length; `avatar`: who wears it (null:
+/// none), whose collidable parts at rest (restBodyPoints, two gaps apart: as near as it is
+/// worn over the garments below) tell which side of those is over. Initialised at the
+/// solvers' states now, with what was modelled under the garments below moved out over
+/// them; the caller adds it to g's solver before the body's collider.
 [[nodiscard]] std::unique_ptr<cloth::LayerCollider> makeLayerCollider(
     const std::vector<GarmentSpec>& garments, std::size_t g, std::span<const std::size_t> below,
     const std::vector<std::uint32_t>& fixed, const std::function<cloth::ClothSolver&(std::size_t)>& solver,
-    double frame_s, std::vector<Vec3> body = {});
+    double frame_s, const scene::Avatar* avatar = nullptr);
 
 }  // namespace drape::sim

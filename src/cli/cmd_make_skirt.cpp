@@ -50,6 +50,7 @@ struct MakeSkirtOptions {
   bool waistGiven = false, hipsGiven = false, legsGiven = false;  ///< --waist-segment, --hip-segments, --leg-segments
   bool withArms = false;                  ///< --with-arms
   std::vector<std::string> armSegments;   ///< with --with-arms: the forearms, hands and fingers, collidable too
+  std::vector<std::string> keptApart;     ///< with --with-arms: the upper arms and forearms, the scene's keepApart
   std::string avatarRotation;             ///< the Avatar node's rotation that stands a body up along +y; "" : none
   std::vector<std::string> avatarMeshes;  ///< --avatar-meshes: the Avatar node's meshes
   std::vector<std::string> drawnMeshes;   ///< --avatar-drawn-meshes: the Avatar node's drawnMeshes
@@ -111,9 +112,9 @@ int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::S
   const int digits = voxel >= 0.001 ? 3 : 5;  // whole millimetres, or a small avatar's hundredths
   fmt::print(os, "DEF Simulation Simulation {{\n  gravity 0 -9.81 0\n  frameRate {:g}\n  stepsPerFrame {}\n"
                  "  airViscosity 0.5\n  offsets [ {:.{}f} {:.{}f} {:.{}f} {:.{}f} ]\n  voxelSize {:.{}f}\n"
-                 "  integrator \"symplectic-euler\"\n  collisionEvery 1\n  bendEvery {}\n}}\n\n",
+                 "  integrator \"symplectic-euler\"\n  collisionEvery 1\n  bendEvery {}\n{}}}\n\n",
              kFrameRate, kSubsteps, voxel, digits, 2 * voxel, digits, 3 * voxel, digits, 6 * voxel, digits, voxel,
-             digits, bendEvery);
+             digits, bendEvery, stringsField("keepApart", o.keptApart));
   writeMaterial(os, m);
   fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n{}{}{}}}\n\n", o.avatarUrl,
              o.avatarRotation.empty() ? "" : fmt::format("  rotation {}\n", o.avatarRotation),
@@ -172,11 +173,15 @@ void chooseSegments(const scene::Avatar& avatar, MakeSkirtOptions& o, const std:
 }
 
 /// --with-arms: the forearms, hands and fingers the skirt collides with too, found by shape
-/// and said on standard output.
+/// and said on standard output; and the arms a new scene keeps out of the body.
 void chooseArmSegments(const scene::Avatar& avatar, MakeSkirtOptions& o) {
   if (!o.withArms) return;
   o.armSegments = scene::findForearmsAndHands(avatar);
   fmt::print("collides with the forearms and hands too: {}\n", fmt::join(o.armSegments, ", "));
+  // A walk swings the forearms into the hips, where the skirt's waistband, bound there,
+  // cannot give way (on the MakeHuman body and CMU walk, 26 mm deep): once they collide,
+  // the scene turns them out of the body as the walking dress's does.
+  o.keptApart = scene::findUpperArmsAndForearms(avatar);
 }
 
 /// The OBJ files' stems: skirt and waistband for the default name, else NAME and NAME_waistband.
@@ -221,6 +226,8 @@ int makeSkirt(MakeSkirtOptions o) {
   chooseSegments(avatar, o, o.avatar);
   checkSegments(avatar, o, o.avatar);
   chooseArmSegments(avatar, o);
+  if (!o.keptApart.empty())
+    fmt::print("keeps the arms out of the body as they swing (the scene's keepApart): {}\n", fmt::join(o.keptApart, ", "));
   // A small avatar's skirt sits as near its body as a person's does, for its size.
   const SceneScale scale = sceneScaleOf(avatar);
   o.voxel_m = scale.voxel_m;

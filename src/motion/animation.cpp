@@ -77,7 +77,7 @@ Hub findHub(const scene::Avatar& avatar, const std::vector<int>& driving, const 
 // joints one motion joint drives (twist joints) counting as one bone from its head, whose
 // index comes first. What the rest corrections turn onto each other.
 struct RestBone {
-  std::size_t head;
+  std::size_t head, tail;     ///< the avatar joints it runs from and to
   Vec3 avatarDir, motionDir;  ///< unit vectors
 };
 
@@ -101,7 +101,7 @@ std::vector<RestBone> restBones(const scene::Avatar& avatar, const std::vector<i
     const Vec3 dm = motionRest[static_cast<std::size_t>(driving[c])] -
                     motionRest[static_cast<std::size_t>(driving[static_cast<std::size_t>(a)])];
     if (da.norm() < 1e-9 || dm.norm() < 1e-9) continue;
-    bones.push_back({h, da.normalized(), dm.normalized()});
+    bones.push_back({h, c, da.normalized(), dm.normalized()});
   }
   return bones;
 }
@@ -124,21 +124,48 @@ std::optional<Quat> restFacingTurn(const std::vector<RestBone>& bones) {
   return Quat(Eigen::AngleAxisd(quarters * std::numbers::pi / 2, Vec3::UnitY()));
 }
 
+// The avatar's hip bones and clavicles (a humanoid's limb bases), which the rest
+// corrections leave as the avatar's own; none for a body that is not humanoid.
+std::vector<std::uint8_t> girdleJoints(const scene::Avatar& avatar) {
+  std::vector<std::uint8_t> girdle(avatar.joints.size(), 0);
+  const std::optional<scene::Humanoid> h = scene::findHumanoid(scene::jointsAt(avatar));
+  if (!h) return girdle;
+  for (const auto* limbs : {&h->legs, &h->arms})
+    for (const scene::HumanoidLimb& limb : *limbs)
+      for (const int j : limb.base) girdle[static_cast<std::size_t>(j)] = 1;
+  return girdle;
+}
+
 // Rest-pose correction per avatar joint: the world rotation that turns the avatar's rest
 // bone directions (towards its nearest driven descendants) onto the motion skeleton's rest
 // bone directions towards the same joints. A T-pose motion then lifts an A-pose avatar's
 // arms at its reference frame, and both skeletons agree wherever the motion goes. The
 // avatar is first turned by `facing` (restFacingTurn), and every correction ends with that
 // turn: roots take it alone (both then stand upright facing the same way); joints with no
-// usable child share their parent's correction.
+// usable child share their parent's correction. So do the hip bones and clavicles
+// (`girdle`): where they sit on the pelvis and chest is the avatar's build, not its pose, and
+// turned onto the capture's they moved the joints they carry: a Daz capture's hip bone (2.8
+// cm, pointing down and back) carried MakeHuman's thighs 15 cm on its hips; the CMU walk's
+// turned its hip bones 34 degrees and its clavicles 21 (the thighs and shoulders about 6 cm
+// off their places), so that the thighs stood 48 mm inside each other through the whole
+// walk. The Daz walk's clavicles tore a jacket's yoke from its skirt.
+// The capture's own turns of those bones still reach them, from the avatar's rest.
 std::vector<Quat> restCorrections(const scene::Avatar& avatar, const std::vector<int>& driving,
                                   const Skeleton& skeleton, const std::vector<RestBone>& bones,
-                                  const std::optional<Quat>& facing) {
+                                  const std::optional<Quat>& facing, const std::vector<std::uint8_t>& girdle) {
   const std::size_t n = avatar.joints.size();
   const std::vector<std::size_t> head = chainHeads(avatar, driving);
   const auto turn = [&](const Vec3& v) { return facing ? Vec3(*facing * v) : v; };
   std::vector<Vec3> avatarDir(n, Vec3::Zero()), motionDir(n, Vec3::Zero());
+  // The bones from the trunk to where a hip bone or clavicle starts are the avatar's
+  // anatomy as well (MakeHuman's clavicles start in front of its chest joint, a Daz
+  // capture's behind): where the trunk joint has another bone (the neck), they do not
+  // turn it.
+  std::vector<std::uint8_t> hasTrunkBone(n, 0);
+  for (const RestBone& b : bones)
+    if (!girdle[b.tail] || girdle[b.head]) hasTrunkBone[b.head] = 1;
   for (const RestBone& b : bones) {
+    if (girdle[b.tail] && !girdle[b.head] && hasTrunkBone[b.head]) continue;
     avatarDir[b.head] += turn(b.avatarDir);
     motionDir[b.head] += b.motionDir;
   }
@@ -164,6 +191,8 @@ std::vector<Quat> restCorrections(const scene::Avatar& avatar, const std::vector
     if (parent < 0) continue;
     if (head[a] != a) {
       correction[a] = correction[head[a]];  // the rest of a chain turns with its head
+    } else if (girdle[a]) {
+      correction[a] = correction[static_cast<std::size_t>(parent)];  // kept as the avatar's own
     } else if (avatarDir[a].norm() > 1e-9 && motionDir[a].norm() > 1e-9) {
       correction[a] = Quat::FromTwoVectors(avatarDir[a], motionDir[a]);
     } else {
@@ -305,7 +334,7 @@ Retargeter::Retargeter(const scene::Avatar& avatar, const Skeleton& skeleton, co
   const std::vector<Vec3> motionRest = skeleton.restPositions();
   const std::vector<RestBone> bones = restBones(avatar, driving_, motionRest);
   facing_ = restFacingTurn(bones);
-  correction_ = restCorrections(avatar, driving_, skeleton, bones, facing_);
+  correction_ = restCorrections(avatar, driving_, skeleton, bones, facing_, girdleJoints(avatar));
   rootScale_ = options.rootScale > 0.0 ? options.rootScale : legLengthRatio(avatar, driving_, motionRest, skeleton);
   floor_ = avatarFloor(avatar);
   samples_ = groundSamples(avatar);

@@ -447,6 +447,16 @@ std::vector<std::string> findForearmsAndHands(const Avatar& avatar) {
   return names;
 }
 
+std::vector<std::string> findUpperArmsAndForearms(const Avatar& avatar) {
+  const Humanoid h = humanoidOf(avatar, "its arms");
+  std::vector<std::string> names;
+  for (const HumanoidLimb& arm : h.arms) {
+    addSegments(avatar, arm.upper, names);
+    addSegments(avatar, arm.lower, names);
+  }
+  return names;
+}
+
 LowerBody findLowerBody(const Avatar& avatar) {
   const Humanoid h = humanoidOf(avatar, "its lower body");
   const std::string whose = avatar.source.empty() ? avatar.name : avatar.source;

@@ -381,7 +381,10 @@ TEST(MakeSkirt, WithArmsTheSwingingHandsPushTheSkirtInsteadOfSinkingIn) {
   // The paper's part list (hips, thighs, shins) lets the walker's right hand and forearm
   // sink into the skirt's flare: `drape inspect --deepest` finds free skirt vertices inside
   // them. With --with-arms the forearms, hands and fingers (found by shape) collide too, and
-  // none is left inside them; nothing enters the body.
+  // none is left inside them; nothing enters the body. The scene keeps the upper arms and
+  // forearms out of the body (keepApart): the walk swings the right forearm 26 mm into the
+  // hips, through the waistband, whose bound vertices cannot give way (313 vertex-substeps
+  // inside it without).
   ScratchDir dir("make-skirt-arms");
   const std::string body = "'" + kAvatars + "/makehuman_rig_cmu_mb.mhskel'";
   const std::string walk = "'" + std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt/walk.bvh'";
@@ -394,6 +397,13 @@ TEST(MakeSkirt, WithArmsTheSwingingHandsPushTheSkirtInsteadOfSinkingIn) {
             std::string::npos)
       << arms.out;
   EXPECT_EQ(scene::loadScene(dir / "arms/scene.wrl").garments[0].collidesWith.size(), 16u);
+  EXPECT_NE(arms.out.find("keeps the arms out of the body as they swing (the scene's keepApart): LeftArm, "
+                          "LeftForeArm, RightArm, RightForeArm\n"),
+            std::string::npos)
+      << arms.out;
+  EXPECT_EQ(scene::loadScene(dir / "arms/scene.wrl").simulation.keepApart,
+            (std::vector<std::string>{"LeftArm", "LeftForeArm", "RightArm", "RightForeArm"}));
+  EXPECT_TRUE(scene::loadScene(dir / "plain/scene.wrl").simulation.keepApart.empty());
   std::array<int, 2> inside{};
   for (std::size_t k = 0; k < 2; ++k) {
     const std::string name = k == 0 ? "plain" : "arms";

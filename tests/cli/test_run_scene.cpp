@@ -69,7 +69,11 @@ TEST(RunScene, AnAcclaimKickDrivesTheAvatarAndTheSkirtStaysOut) {
 
 // The walking skirt on MakeHuman's default rig (twist bones) and game-engine rig (a Root on
 // the floor) walking the CMU walk: the shipped maps compose onto each rig and the run is
-// stable. On the default rig the skirt stays out of the body; the game-engine rig's thigh
+// stable. On the default rig the skirt stays out of the body but where its waistband, bound
+// to the waist, dips into the hip bones' parts (pelvis.L, .R: every part of the body
+// collides here) as the spine bends over the hips: 0.025 % of the vertex-substeps, 8 mm at
+// most. (Until the hip bones kept their place on the pelvis, the capture's hip bone turned
+// pelvis.L up to 97 mm off it, out of the waistband's way.) The game-engine rig's thigh
 // segments carry the buttocks (it has no hip bones), so the skirt is pinched between them
 // and the pelvis and sinks into it (over the whole walk 0.071 % of vertex-substeps, up to
 // 11 mm; docs/MOTION.md).
@@ -88,7 +92,8 @@ TEST(RunScene, TheSkirtWalksOnMakeHumansOtherRigs) {
     EXPECT_EQ(stats["frames"].get<int>(), 60);
     EXPECT_FALSE(stats["unstable"].get<bool>());
     if (rig == "default") {
-      EXPECT_EQ(stats["vertex_substeps_inside_body"].get<long>(), 0);
+      EXPECT_LT(stats["vertex_substeps_inside_body"].get<double>() / stats["vertex_substeps"].get<double>(), 1e-3);
+      EXPECT_LT(stats["max_penetration_m"].get<double>(), 0.010);
     }
   }
 }
@@ -205,14 +210,15 @@ TEST(RunScene, WalkingSkirtWritesEverything) {
                           "vertex_substeps_below_T1", "vertex_substeps_below_T0", "vertex_substeps_inside_body",
                           "max_penetration_m", "distance_fields", "body_overlaps"})
     EXPECT_TRUE(stats.contains(key)) << key;
-  // Walking, the segmented thighs press into each other (docs/ARCHITECTURE.md, body overlaps).
-  bool thighs = false;
+  // Walking, the segmented thigh swung forward presses into the belly's part
+  // (docs/ARCHITECTURE.md, body overlaps).
+  bool thigh = false;
   for (const auto& o : stats["body_overlaps"]) {
     for (const char* key : {"part", "into", "depth_m", "deepest_frame", "first_frame", "last_frame", "frames"})
       EXPECT_TRUE(o.contains(key)) << key;
-    thighs |= o["part"] == "RightUpLeg" && o["into"] == "LeftUpLeg" && o["depth_m"].get<double>() > 0.02;
+    thigh |= o["part"] == "LeftUpLeg" && o["into"] == "LowerBack" && o["depth_m"].get<double>() > 0.02;
   }
-  EXPECT_TRUE(thighs) << stats["body_overlaps"].dump();
+  EXPECT_TRUE(thigh) << stats["body_overlaps"].dump();
   EXPECT_EQ(stats["vertex_substeps_inside_body"].get<long>(), 0);
   const double share = stats["collision_time_share"].get<double>();
   EXPECT_GT(share, 0.0);

@@ -127,6 +127,38 @@ TEST(Retarget, CmuWalkDelfem2OnMakeHuman) { checkWalk("cmu_walk_delfem2.bvh"); }
 TEST(Retarget, CmuWalk12_03OnMakeHuman) { checkWalk("cmu_12_03_walk.bvh"); }
 TEST(Retarget, DazStyleWalkOnMakeHuman) { checkWalk("cmu_02_02_walk_dazstyle.bvh"); }
 
+// Where a hip bone and a clavicle sit on the pelvis and chest is the avatar's build: a
+// capture whose own hip bones and clavicles never turn (the Daz-style walk: lButtock and
+// lCollar are zero in every frame) leaves the avatar's thighs and shoulders where they are
+// on its hips and chest. Turned onto the capture's hip bone (2.8 cm, down and back), the
+// thighs' joints were carried up to 15 cm on the hips, and the shoulders 5 cm off the
+// chest; a dress's yoke tore.
+TEST(Retarget, ACapturesStillHipBonesAndClaviclesLeaveTheAvatarsBuildAsItIs) {
+  const scene::Avatar& avatar = makeHuman();
+  const Clip clip = loadClip(std::string(DRAPE_DATA_DIR) + "/mocap/cmu_02_02_walk_dazstyle.bvh");
+  const JointMap map = chooseJointMap(shippedMaps(), clip.skeleton, avatar);
+  ASSERT_EQ(map.name, "daz");
+  const AvatarAnimation anim = AvatarAnimation::build(avatar, clip, map);
+  const auto joint = [&](const char* name) {
+    const int j = avatar.findJoint(name);
+    EXPECT_GE(j, 0) << name;
+    return static_cast<std::size_t>(j);
+  };
+  double farthest = 0.0;
+  for (const auto& [trunk, carried] : {std::pair{"Hips", "LeftUpLeg"}, std::pair{"Hips", "RightUpLeg"},
+                                       std::pair{"Spine1", "LeftArm"}, std::pair{"Spine1", "RightArm"}}) {
+    const std::size_t t = joint(trunk), c = joint(carried);
+    const Vec3 atRest = avatar.joints[t].restWorld().inverse().apply(avatar.joints[c].restCenter);
+    for (std::size_t f = 0; f < anim.frameCount(); ++f) {
+      const auto world = anim.frame(f);
+      const double moved = (world[t].inverse().apply(world[c].translation) - atRest).norm();
+      farthest = std::max(farthest, moved);
+      ASSERT_LT(moved, 1e-6) << carried << " on " << trunk << ", frame " << f;
+    }
+  }
+  std::printf("thighs and shoulders on the hips and chest: %.2g m from where they rest at most\n", farthest);
+}
+
 // The CMU originals (Acclaim ASF/AMC, a soccer kick) drive the MakeHuman body through the
 // shipped 'acclaim' map: every bone is paired, and each limb on the avatar points where the
 // motion's does on every frame (a wrong pairing, such as left for right or thigh for shin,

@@ -121,4 +121,9 @@ struct LowerBody {
 /// drape::Error naming the avatar when it is not humanoid.
 [[nodiscard]] std::vector<std::string> findForearmsAndHands(const Avatar& avatar);
 
+/// The segments of the upper arms and forearms, found by the avatar's shape: the parts a
+/// walk swings into the hips, which a scene's keepApart turns out of them. Throws
+/// drape::Error naming the avatar when it is not humanoid.
+[[nodiscard]] std::vector<std::string> findUpperArmsAndForearms(const Avatar& avatar);
+
 }  // namespace drape::scene

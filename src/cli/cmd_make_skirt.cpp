@@ -184,6 +184,22 @@ void chooseArmSegments(const scene::Avatar& avatar, MakeSkirtOptions& o) {
   o.keptApart = scene::findUpperArmsAndForearms(avatar);
 }
 
+/// --add-to --with-arms: the scene's Simulation is its own, so where its keepApart leaves out
+/// arms the skirt now collides with, the user is told how to keep them out of the body.
+void sayWhichArmsTheSceneLetsIn(const std::vector<std::string>& keptApart, const std::vector<std::string>& arms,
+                                const std::string& scene) {
+  std::vector<std::string> missing;
+  for (const std::string& a : arms)
+    if (std::find(keptApart.begin(), keptApart.end(), a) == keptApart.end()) missing.push_back(a);
+  if (missing.empty()) return;
+  std::vector<std::string> wanted = keptApart;
+  wanted.insert(wanted.end(), missing.begin(), missing.end());
+  fmt::print("note: {} keeps {} out of the body; a walk swings the arms into the hips, through the waistband, "
+             "which cannot give way: add {} to its Simulation node's keepApart, or run it with --keep-apart {}\n",
+             scene, keptApart.empty() ? "no parts" : "only " + fmt::format("{}", fmt::join(keptApart, ", ")),
+             fmt::join(missing, ", "), fmt::join(wanted, ","));
+}
+
 /// The OBJ files' stems: skirt and waistband for the default name, else NAME and NAME_waistband.
 std::pair<std::string, std::string> objStems(const std::string& name) {
   if (name == "Skirt") return {"skirt", "waistband"};
@@ -260,6 +276,7 @@ int addSkirt(MakeSkirtOptions o) {
   chooseSegments(avatar, o, whose);
   checkSegments(avatar, o, whose);
   chooseArmSegments(avatar, o);
+  sayWhichArmsTheSceneLetsIn(dress.scene.simulation.keepApart, o.keptApart, o.add.scene);
   checkNewGarment(dress, o.name, o.add.over);
   // A small character's skirt sits as near its body, and as near the skirt under it, as a
   // person's does, for its size; the scene's voxel and offsets are its own.

@@ -146,7 +146,7 @@ std::vector<std::uint8_t> girdleJoints(const scene::Avatar& avatar) {
 // (`girdle`): where they sit on the pelvis and chest is the avatar's build, not its pose, and
 // turned onto the capture's they moved the joints they carry: a Daz capture's hip bone (2.8
 // cm, pointing down and back) carried MakeHuman's thighs 15 cm on its hips; the CMU walk's
-// turned its hip bones 34 degrees and its clavicles 21 (the thighs and shoulders about 6 cm
+// turned its hip bones 34 degrees and its clavicles 21 (the thighs 7 cm and the shoulders 5 cm
 // off their places), so that the thighs stood 48 mm inside each other through the whole
 // walk. The Daz walk's clavicles tore a jacket's yoke from its skirt.
 // The capture's own turns of those bones still reach them, from the avatar's rest.

@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <fmt/ostream.h>
+#include <spdlog/spdlog.h>
 
 #include "avatar_scale.hpp"
 #include "command.hpp"
@@ -185,7 +186,7 @@ void chooseArmSegments(const scene::Avatar& avatar, MakeSkirtOptions& o) {
 }
 
 /// --add-to --with-arms: the scene's Simulation is its own, so where its keepApart leaves out
-/// arms the skirt now collides with, the user is told how to keep them out of the body.
+/// arms the skirt now collides with, the user is warned and told how to keep them out of the body.
 void sayWhichArmsTheSceneLetsIn(const std::vector<std::string>& keptApart, const std::vector<std::string>& arms,
                                 const std::string& scene) {
   std::vector<std::string> missing;
@@ -194,10 +195,10 @@ void sayWhichArmsTheSceneLetsIn(const std::vector<std::string>& keptApart, const
   if (missing.empty()) return;
   std::vector<std::string> wanted = keptApart;
   wanted.insert(wanted.end(), missing.begin(), missing.end());
-  fmt::print("note: {} keeps {} out of the body; a walk swings the arms into the hips, through the waistband, "
-             "which cannot give way: add {} to its Simulation node's keepApart, or run it with --keep-apart {}\n",
-             scene, keptApart.empty() ? "no parts" : "only " + fmt::format("{}", fmt::join(keptApart, ", ")),
-             fmt::join(missing, ", "), fmt::join(wanted, ","));
+  spdlog::warn("{} keeps {} out of the body; a walk swings the arms into the hips, through the waistband, which "
+               "cannot give way: add {} to its Simulation node's keepApart, or run it with --keep-apart {}",
+               scene, keptApart.empty() ? "no parts" : "only " + fmt::format("{}", fmt::join(keptApart, ", ")),
+               fmt::join(missing, ", "), fmt::join(wanted, ","));
 }
 
 /// The OBJ files' stems: skirt and waistband for the default name, else NAME and NAME_waistband.

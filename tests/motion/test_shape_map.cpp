@@ -141,6 +141,13 @@ TEST(ShapeMap, PairsTheBonesTheShippedMapsPairByName) {
       // reached 15.9 and 16.5 degrees, against 4.7 and 7.6 now.
       EXPECT_LT(trunk, 19.0) << capture.file << " on " << rig;
       EXPECT_LT(trunkByName, 19.0) << capture.file << " on " << rig;
+      // On the CMU rig, whose clavicles start in front of its chest joint, the chest is not
+      // turned by where the Daz walk's and the kick's start (behind theirs): 4.7 to 7.6
+      // degrees. Turned by them as by its neck, it leaned 15.9 and 16.5.
+      if (std::string(rig) == "makehuman_rig_cmu_mb.mhskel" && capture.file != "cmu_12_03_walk.bvh") {
+        EXPECT_LT(trunk, 10.0) << capture.file;
+        EXPECT_LT(trunkByName, 10.0) << capture.file;
+      }
     }
   }
 }

@@ -197,6 +197,9 @@ void applyOverrides(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   if (app.count("--max-refinement")) s.maxRefinement = o.settings.maxRefinement;
   if (app.count("--strain-limit")) applyStrainLimit(o.strainLimit, s);
   if (app.count("--integrator")) s.integrator = cloth::parseIntegrator(o.integrator, "--integrator");
+  // The implicit solve takes bending in every substep: a scene's rhythm gives way to it
+  // unless --bend-every says otherwise (which validate() then refuses, naming why).
+  if (s.integrator == cloth::IntegratorKind::BackwardEuler && !app.count("--bend-every")) s.bendEvery = 1;
   if (app.count("--wind")) s.wind_m_s = parseVec3(o.wind, "--wind");
   if (app.count("--gravity")) s.gravity_m_s2 = parseVec3(o.gravity, "--gravity");
   for (GarmentSetup& g : setup.garments) {
@@ -541,8 +544,10 @@ RunFunction setupRun(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--frame-rate", s.frameRate_hz, "Frames per second")->capture_default_str();
   app.add_option("--integrator", o->integrator,
-                 "symplectic-euler or forward-euler (the paper's; stable only with --damping inside a window the "
-                 "substep sets, which a refusal names)")
+                 "symplectic-euler, forward-euler (the paper's; stable only with --damping inside a window the "
+                 "substep sets, which a refusal names) or backward-euler (implicit, stable at long substeps: try "
+                 "--substeps 4; each substep solves a linear system, one force evaluation per iteration, and "
+                 "bends every substep)")
       ->capture_default_str();
   app.add_option("--air-viscosity", s.airViscosity_Ns_m3, "Linear air drag per area, N s/m^3")->capture_default_str();
   app.add_option("--wind", o->wind, "Wind velocity x,y,z, m/s");

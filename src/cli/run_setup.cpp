@@ -992,7 +992,11 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
                    settings.bendEvery, 1e3 * settings.bendEvery * settings.substep_s(),
                    100.0 * settings.bendEvery * settings.substep_s() / r.model->bendingStableStep_s());
     logDamping(g.name, *r.solver);
-    if (settings.substep_s() > stable)
+    if (settings.integrator == cloth::IntegratorKind::BackwardEuler)
+      spdlog::info("{}: backward Euler, {} substeps per frame ({:.3g} ms, {:.3g} times the explicit steps' estimated "
+                   "stable step); each solves by conjugate gradients, one force evaluation an iteration",
+                   g.name, settings.substepsPerFrame, 1e3 * settings.substep_s(), settings.substep_s() / stable);
+    else if (settings.substep_s() > stable)
       spdlog::warn("{}: the substep {:.3g} s is longer than the estimated stable step {:.3g} s; "
                    "the run may diverge (try --substeps {} or more)",
                    g.name, settings.substep_s(), stable,
@@ -1164,6 +1168,14 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
                             {"strain_limit_corrections", runs[g].solver->strainLimitCorrections()},
                             {"stitches", runs[g].solver->stitches().size()},
                             {"stitch_corrections", runs[g].solver->stitchCorrections()}};
+    if (settings.integrator == cloth::IntegratorKind::BackwardEuler) {
+      const cloth::SolveStats solves = runs[g].solver->solveStats();
+      entry["implicit_solves"] = {{"substeps", solves.solves},
+                                  {"iterations", solves.iterations},
+                                  {"mean_iterations", solves.meanIterations()},
+                                  {"unconverged", solves.unconverged},
+                                  {"indefinite", solves.indefinite}};
+    }
     const long limitedFrom = runs[g].solver->strainLimitedFrom();
     entry["strain_limited_from_frame"] = limitedFrom > 0 ? nlohmann::json(limitedFrom) : nlohmann::json(nullptr);
     if (runs[g].collider) {

@@ -1,5 +1,7 @@
 #include "drape/cloth/integrator.hpp"
 
+#include "drape/cloth/backward_euler.hpp"
+
 namespace drape::cloth {
 namespace {
 
@@ -41,7 +43,7 @@ void step(const ClothModel& model, const Vec3& g, double dt, ClothState& s) {
 class SymplecticEuler final : public Integrator {
  public:
   [[nodiscard]] IntegratorKind kind() const override { return IntegratorKind::SymplecticEuler; }
-  void advance(const ClothModel& model, const Vec3& g, double dt, ClothState& s) const override {
+  void advance(const ClothModel& model, const Vec3& g, double dt, ClothState& s, const ForceEvaluator&) override {
     step<Order::VelocityFirst>(model, g, dt, s);
   }
 };
@@ -51,7 +53,7 @@ class SymplecticEuler final : public Integrator {
 class ForwardEuler final : public Integrator {
  public:
   [[nodiscard]] IntegratorKind kind() const override { return IntegratorKind::ForwardEuler; }
-  void advance(const ClothModel& model, const Vec3& g, double dt, ClothState& s) const override {
+  void advance(const ClothModel& model, const Vec3& g, double dt, ClothState& s, const ForceEvaluator&) override {
     step<Order::PositionFirst>(model, g, dt, s);
   }
 };
@@ -61,6 +63,7 @@ class ForwardEuler final : public Integrator {
 std::unique_ptr<Integrator> makeIntegrator(IntegratorKind kind) {
   switch (kind) {
     case IntegratorKind::ForwardEuler: return std::make_unique<ForwardEuler>();
+    case IntegratorKind::BackwardEuler: return std::make_unique<BackwardEuler>();
     case IntegratorKind::SymplecticEuler: break;
   }
   return std::make_unique<SymplecticEuler>();

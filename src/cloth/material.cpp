@@ -44,6 +44,7 @@ std::string integratorName(IntegratorKind kind) {
   switch (kind) {
     case IntegratorKind::SymplecticEuler: return "symplectic-euler";
     case IntegratorKind::ForwardEuler: return "forward-euler";
+    case IntegratorKind::BackwardEuler: return "backward-euler";
   }
   return "unknown";
 }
@@ -51,7 +52,8 @@ std::string integratorName(IntegratorKind kind) {
 IntegratorKind parseIntegrator(const std::string& text, const std::string& option) {
   if (text == "symplectic-euler") return IntegratorKind::SymplecticEuler;
   if (text == "forward-euler") return IntegratorKind::ForwardEuler;
-  throw Error(fmt::format("{} must be symplectic-euler or forward-euler, got '{}'", option, text));
+  if (text == "backward-euler") return IntegratorKind::BackwardEuler;
+  throw Error(fmt::format("{} must be symplectic-euler, forward-euler or backward-euler, got '{}'", option, text));
 }
 
 void StepSettings::validate(const std::string& prefix) const {
@@ -65,6 +67,8 @@ void StepSettings::validate(const std::string& prefix) const {
           maxAddedMass);
   require(bendEvery >= 1 && bendEvery <= substepsPerFrame, prefix, "bend-every",
           fmt::format("in [1, {}] (the substeps per frame)", substepsPerFrame), bendEvery);
+  require(bendEvery == 1 || integrator != IntegratorKind::BackwardEuler, prefix, "bend-every",
+          "1 with the backward-euler integrator (its solve takes the bending forces in every substep)", bendEvery);
   require(maxRefinement >= 1 && maxRefinement <= 64, prefix, "max-refinement", "in [1, 64]", maxRefinement);
   require(strainLimit >= 0.0 && strainLimit <= 10.0, prefix, "strain-limit",
           "in [0, 10] (a stretch beyond the rest length)", strainLimit);

@@ -45,11 +45,14 @@ ClothSolver::ClothSolver(std::shared_ptr<const ClothModel> model, const StepSett
   strainWeight_ = model_->inverseMass();
   for (const PinGroup& g : pins_)
     for (const std::uint32_t v : g.vertices) strainWeight_[v] = 0.0;  // placed by their fixtures
+  std::vector<std::uint8_t> fixed(model_->vertexCount(), 0);
+  for (const PinGroup& g : pins_)
+    for (const std::uint32_t v : g.vertices) fixed[v] = 1;
+  integrator_->prepare(*model_, settings_, fixed);
+  // The explicit steps' stability with damping; the implicit one is stable at any step.
   const bool forwardEuler = settings_.integrator == IntegratorKind::ForwardEuler;
-  if (model_->material().damping_s > 0.0 || forwardEuler) {
-    std::vector<std::uint8_t> fixed(model_->vertexCount(), 0);
-    for (const PinGroup& g : pins_)
-      for (const std::uint32_t v : g.vertices) fixed[v] = 1;
+  const bool implicit = settings_.integrator == IntegratorKind::BackwardEuler;
+  if ((model_->material().damping_s > 0.0 && !implicit) || forwardEuler) {
     dampedOmega_ = model_->membraneFrequency_rad_s(fixed);
     if (forwardEuler) checkForwardEulerStep(*model_, settings_, dampedOmega_);
     else checkDampedStep(*model_, settings_, dampedOmega_);
@@ -252,6 +255,13 @@ void ClothSolver::accumulateForces() {
   accumulateDragForces(*model_, settings_, state_);
 }
 
+void ClothSolver::evaluateForces(ClothState& s) {
+  clearForces(s);
+  accumulateMembraneForces(*model_, s, parallelForces_ ? &forceLoops_ : nullptr);
+  accumulateBendingForces(*model_, s, 1.0, parallelForces_ ? &forceLoops_ : nullptr);
+  accumulateDragForces(*model_, settings_, s);
+}
+
 void ClothSolver::setStitches(std::vector<Stitch> stitches, const std::string& garment) {
   const std::size_t n = model_->vertexCount();
   for (const Stitch& st : stitches) {
@@ -270,7 +280,12 @@ void ClothSolver::limitStrain() {
   strainLimitCorrections_ += cloth::limitStrain(*model_, strainWeight_, strainLimit_, kStrainLimitSweeps, state_);
 }
 
-void ClothSolver::integrate(double dt) { integrator_->advance(*model_, settings_.gravity_m_s2, dt, state_); }
+void ClothSolver::integrate(double dt) {
+  // Made here, not kept, so that a moved solver hands on its own `this`; one pointer's
+  // capture sits in std::function's own storage (no allocation).
+  const ForceEvaluator forces = [this](ClothState& s) { evaluateForces(s); };
+  integrator_->advance(*model_, settings_.gravity_m_s2, dt, state_, forces);
+}
 
 void ClothSolver::collide(double t0, double t1) {
   for (Collider* c : colliders_) c->collide(*model_, t0, t1, state_);

@@ -159,7 +159,7 @@ double growthOfTheStiffestMode(const mesh::TriMesh& sheet, double damping_s, dou
   for (int k = 0; k < steps; ++k) {
     clearForces(s);
     accumulateMembraneForces(*model, s);
-    integrator->advance(*model, Vec3::Zero(), dt, s);
+    integrator->advance(*model, Vec3::Zero(), dt, s, {});
   }
   return displacement() / start;
 }
@@ -179,6 +179,25 @@ TEST(DampedStep, TheBoundHoldsForTheStiffestModeAndNoFurther) {
               1e-15);
   EXPECT_NEAR(dampedStableStep_s(omega, largestStableDamping_s(omega, dt)), dt, 1e-12 * dt);
   EXPECT_NEAR(dampedStableStep_s(omega, 0.0), 2.0 * kDampedStepMargin / omega, 1e-15);
+}
+
+TEST(DampedStep, BackwardEulerDampsTheStiffestModeAtAnySubstep) {
+  // Backward Euler maps the mode (x, v) by the inverse of [[1, -dt], [omega^2 dt, 1]], whose
+  // eigenvalues have modulus 1 / sqrt(1 + omega^2 dt^2): undamped, the mode decays at any
+  // substep, where symplectic Euler's grows beyond 2 / omega.
+  const mesh::TriMesh sheet = irregularSheet(5, 7);
+  const double omega = testing::makeModel(sheet, dampedKnit(0.0))->membraneFrequency_rad_s();
+  // (At omega dt far beyond 10 the mode's x1 = x0 / (1 + omega^2 dt^2) is the difference of
+  // x0 and dt v1, and the solve's tolerance, 1e-4 of dv, dominates it.)
+  for (const double omegaDt : {4.0, 10.0}) {
+    const double dt = omegaDt / omega;
+    const int steps = omegaDt < 5 ? 6 : 3;
+    const double decay = std::pow(1.0 + omegaDt * omegaDt, -0.5 * steps);
+    const double growth = growthOfTheStiffestMode(sheet, 0.0, dt, steps, IntegratorKind::BackwardEuler);
+    EXPECT_LT(growth, 2.0 * decay) << "omega dt " << omegaDt;
+    EXPECT_GT(growth, 0.1 * decay) << "omega dt " << omegaDt;  // the step's own decay, not a frozen mode
+    EXPECT_GT(growthOfTheStiffestMode(sheet, 0.0, dt, 40), 1e3) << "symplectic Euler, omega dt " << omegaDt;
+  }
 }
 
 TEST(DampedStep, TheSolverRefusesDampingItsSubstepCannotCarryAndSaysWhatWould) {

@@ -1,11 +1,13 @@
 #pragma once
 // Time integrators behind one interface. The explicit one-stage integrators take the forces
 // the step accumulated for this substep; gravity enters as a body acceleration (so a vertex
-// of zero mass still falls). Multi-stage ones (Runge-Kutta, the paper's future work) would
-// re-evaluate forces through `evaluateForces`.
+// of zero mass still falls). The implicit one (backward Euler, the paper's future work)
+// evaluates the forces again at nearby states through the solver's ForceEvaluator.
 
+#include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 
 #include "drape/cloth/material.hpp"
 #include "drape/cloth/model.hpp"
@@ -13,12 +15,37 @@
 
 namespace drape::cloth {
 
+/// Fills s.f* with every force the step applies (membrane, bending at its full rate, drag)
+/// at s's positions and velocities, using s.work as the kernels' workspace.
+using ForceEvaluator = std::function<void(ClothState& s)>;
+
+/// What an implicit integrator's linear solves took, summed over the substeps so far.
+struct SolveStats {
+  long solves = 0;       ///< substeps solved
+  long iterations = 0;   ///< conjugate-gradient iterations (one force evaluation each)
+  long unconverged = 0;  ///< solves that reached the iteration cap above the tolerance
+  /// Solves stopped where the system was not positive definite (the cloth compressed or
+  /// folded past what the linearisation holds): the step so far was taken.
+  long indefinite = 0;
+  [[nodiscard]] double meanIterations() const {
+    return solves > 0 ? static_cast<double>(iterations) / static_cast<double>(solves) : 0.0;
+  }
+};
+
 class Integrator {
  public:
   virtual ~Integrator() = default;
   [[nodiscard]] virtual IntegratorKind kind() const = 0;
-  /// Advances positions and velocities by dt_s from the forces in io.f*.
-  virtual void advance(const ClothModel& model, const Vec3& gravity_m_s2, double dt_s, ClothState& io) const = 0;
+  /// Sizes the workspace for `model` (no allocation afterwards), takes the drag of
+  /// `settings`, and names the vertices the fixtures place (one flag per vertex, or none),
+  /// which an implicit solve holds.
+  virtual void prepare(const ClothModel& /*model*/, const StepSettings& /*settings*/,
+                       std::span<const std::uint8_t> /*fixed*/) {}
+  /// Advances positions and velocities by dt_s from the forces in io.f* (those of io's
+  /// state, as `forces` would compute them).
+  virtual void advance(const ClothModel& model, const Vec3& gravity_m_s2, double dt_s, ClothState& io,
+                       const ForceEvaluator& forces) = 0;
+  [[nodiscard]] virtual SolveStats solveStats() const { return {}; }
 };
 
 [[nodiscard]] std::unique_ptr<Integrator> makeIntegrator(IntegratorKind kind);

@@ -36,9 +36,12 @@ struct Material {
 enum class IntegratorKind {
   SymplecticEuler,  ///< v += a dt; x += v dt (default: stable for oscillators, energy bounded)
   ForwardEuler,     ///< x += v dt; v += a dt (the paper's solver)
+  /// v += dt a(x + dt v_new, v_new), linearised once per substep and solved by conjugate
+  /// gradients (Baraff and Witkin 1998; the paper's future work): stable at any substep.
+  BackwardEuler,
 };
 
-/// "symplectic-euler" / "forward-euler".
+/// "symplectic-euler" / "forward-euler" / "backward-euler".
 [[nodiscard]] std::string integratorName(IntegratorKind kind);
 /// Parses the names above; throws drape::Error naming `option` otherwise.
 [[nodiscard]] IntegratorKind parseIntegrator(const std::string& text, const std::string& option = "--integrator");
@@ -83,9 +86,12 @@ struct StepSettings {
   double rescueStrainLimit = 0.5;
 
   [[nodiscard]] double substep_s() const { return 1.0 / (frameRate_hz * substepsPerFrame); }
-  /// What ClothModel::build needs to honour maxAddedMass.
+  /// What ClothModel::build needs to honour maxAddedMass: none for the implicit step, which
+  /// needs no mass added to be stable.
   [[nodiscard]] MassScaling massScaling() const {
-    return maxAddedMass > 0.0 ? MassScaling{substep_s(), maxAddedMass, frameRate_hz} : MassScaling{};
+    return maxAddedMass > 0.0 && integrator != IntegratorKind::BackwardEuler
+               ? MassScaling{substep_s(), maxAddedMass, frameRate_hz}
+               : MassScaling{};
   }
   void validate(const std::string& prefix = "--") const;
 };

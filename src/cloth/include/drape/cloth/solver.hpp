@@ -152,6 +152,8 @@ class ClothSolver {
   [[nodiscard]] double dampedMembraneFrequency_rad_s() const { return dampedOmega_; }
   /// Total energy (kinetic + gravitational + membrane + bending), J.
   [[nodiscard]] double totalEnergy() const;
+  /// The implicit integrator's linear solves so far (zeros for the explicit ones).
+  [[nodiscard]] SolveStats solveStats() const { return integrator_->solveStats(); }
 
  private:
   /// The frame at 1, 2, 4, ... times the settings' substeps up to maxRefinement, each attempt
@@ -163,6 +165,9 @@ class ClothSolver {
   bool runFrame(long frame, int refinement);
   void limitStrain();
   void accumulateForces();
+  /// Every force at s's state into s.f*, bending at its full rate: what the implicit
+  /// integrator differences.
+  void evaluateForces(ClothState& s);
   void integrate(double dt_s);
   void collide(double t0_s, double t1_s);
   void applyFixtures(double t0_s, double t1_s, double dt_s);

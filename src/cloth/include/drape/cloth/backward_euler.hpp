@@ -1,0 +1,77 @@
+#pragma once
+// Backward Euler for the cloth, the implicit step the paper leaves to future work (its
+// section 6: "compatibility with lower frequency solvers, such as Runge Kutta and Implicit
+// methods"), as Baraff and Witkin (1998) take it: one Newton step of
+//
+//   v1 = v0 + h M^-1 f(x0 + h v1, v1) + h g,   x1 = x0 + h v1,
+//
+// linearised at (x0, v0), with K = df/dx and D = df/dv:
+//
+//   (M - h D - h^2 K) dv = h (f0 + M g) + h^2 K v0,   v1 = v0 + dv.
+//
+// The forces f0 are the explicit step's own (every kernel, to the bit). The matrices are
+// the positive semi-definite parts of the true ones, so that the system is positive
+// definite and conjugate gradients solve it (the projected Newton step of modern cloth
+// solvers; Baraff and Witkin dropped the same terms):
+// - membrane: the material stiffness A (dE/dx)^T C (dE/dx) in full, and the geometric
+//   stiffness (grad N_i . S grad N_j) I with the stress S's compressive principal part
+//   dropped (a compressed triangle buckles, it does not push its corners apart harder as it
+//   is pressed), and the internal damping as beta times the material stiffness;
+// - bending: the Gauss-Newton term k grad psi grad psi^T (the term in (psi - psi0) dropped);
+// - drag: c A_v on the diagonal.
+// The system is never assembled: each conjugate-gradient iteration applies it element by
+// element from the deformation gradients, clamped stresses and hinge gradients computed
+// once per substep. The vertices the fixtures place are held (their dv is 0 in the solve,
+// Baraff and Witkin's constraint filter), and the fixtures then place them. The
+// preconditioner is block Jacobi: the inverse of each vertex's 3x3 block of the system.
+// docs/PHYSICS.md.
+
+#include <vector>
+
+#include "drape/cloth/integrator.hpp"
+
+namespace drape::cloth {
+
+class BackwardEuler final : public Integrator {
+ public:
+  /// Relative residual (in the preconditioner's norm) at which a solve stops.
+  static constexpr double kTolerance = 1e-4;
+  /// Conjugate-gradient iterations at most per substep.
+  static constexpr int kMaxIterations = 200;
+
+  [[nodiscard]] IntegratorKind kind() const override { return IntegratorKind::BackwardEuler; }
+  void prepare(const ClothModel& model, const StepSettings& settings, std::span<const std::uint8_t> fixed) override;
+  void advance(const ClothModel& model, const Vec3& gravity_m_s2, double dt_s, ClothState& io,
+               const ForceEvaluator& forces) override;
+  [[nodiscard]] SolveStats solveStats() const override { return stats_; }
+
+  /// The forces' linearisation at `s`'s positions (deformation gradients, clamped
+  /// stresses, hinge gradients), which stiffnessTimes then applies. Exposed for tests.
+  void linearise(const ClothModel& model, const ClothState& s);
+  /// out = (material (K_membrane,material) + geometric (K_membrane,geometric + K_bending)) p
+  /// at the last linearisation, with K the stiffness -df/dx as described above; p and out
+  /// hold 3 n values, the x block, then y, then z.
+  void stiffnessTimes(const ClothModel& model, std::span<const double> p, double material, double geometric,
+                      std::span<double> out) const;
+
+ private:
+  /// A p = M p + (h^2 + h beta) K_m p + h^2 (K_g + K_b) p + h c A_v p for the free vertices,
+  /// 0 for the held ones.
+  void applySystem(const ClothModel& model, double h, std::span<const double> p, std::span<double> out) const;
+  void filter(std::span<double> v) const;
+  /// precond_: per free vertex the inverse of the system's 3x3 diagonal block at the last
+  /// linearisation (block Jacobi); zeros for the held ones.
+  void invertDiagonalBlocks(const ClothModel& model, double h);
+
+  std::vector<std::uint8_t> held_;  ///< per vertex: placed by a fixture, or massless
+  /// Per membrane element, at the last linearisation: the deformation gradient's columns
+  /// (Fu, Fv: 6 values) and the stress with its compressive part dropped (S11, S22, S12).
+  std::vector<double> gradient_, stress_;
+  /// Per hinge: sqrt(k) grad psi for its corners a, b, e0, e1 (12 values).
+  std::vector<double> hinge_;
+  double dragPerArea_ = 0.0;  ///< the settings' air viscosity c, N s/m^3
+  std::vector<double> rhs_, dv_, r_, z_, d_, q_, precond_;
+  SolveStats stats_;
+};
+
+}  // namespace drape::cloth

@@ -1,0 +1,342 @@
+// Backward Euler (the implicit step): its linearisation against the forces' own
+// derivative, its solve against a dense direct one, and its physics against analytic answers
+// at substeps the explicit steps cannot take.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <random>
+
+#include "cloth_fixture.hpp"
+#include "drape/cloth/backward_euler.hpp"
+#include "drape/core/error.hpp"
+
+namespace drape::cloth {
+namespace {
+
+using testing::makeModel;
+using testing::pinAt;
+using testing::row;
+using testing::run;
+using testing::settingsWithStep;
+
+Material fabric(double E, double t, double rho) {
+  Material m;
+  m.youngsModulus_Pa = E;
+  m.thickness_m = t;
+  m.density_kg_m3 = rho;
+  return m;
+}
+
+/// Membrane and bending forces at s's positions (no damping: s's velocities are zero).
+std::vector<double> forcesAt(const ClothModel& model, ClothState s) {
+  clearForces(s);
+  accumulateMembraneForces(model, s);
+  accumulateBendingForces(model, s);
+  std::vector<double> f(3 * s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) f[i] = s.fx[i], f[s.size() + i] = s.fy[i], f[2 * s.size() + i] = s.fz[i];
+  return f;
+}
+
+/// s moved by eps p (3 n values, x block, y block, z block).
+ClothState moved(ClothState s, const std::vector<double>& p, double eps) {
+  const std::size_t n = s.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    s.x[i] += eps * p[i];
+    s.y[i] += eps * p[n + i];
+    s.z[i] += eps * p[2 * n + i];
+  }
+  return s;
+}
+
+/// -df/dx p by central differences of the forces.
+std::vector<double> stiffnessByDifferences(const ClothModel& model, const ClothState& s, const std::vector<double>& p) {
+  const double eps = 1e-7;
+  const std::vector<double> plus = forcesAt(model, moved(s, p, eps)), minus = forcesAt(model, moved(s, p, -eps));
+  std::vector<double> out(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) out[i] = -(plus[i] - minus[i]) / (2 * eps);
+  return out;
+}
+
+double norm(const std::vector<double>& v) { return std::sqrt(std::inner_product(v.begin(), v.end(), v.begin(), 0.0)); }
+
+std::vector<double> randomVector(std::size_t size, std::mt19937& rng) {
+  std::normal_distribution<double> d(0.0, 1.0);
+  std::vector<double> v(size);
+  for (double& x : v) x = d(rng);
+  return v;
+}
+
+/// A curved, irregular sheet (its rest shape bent, so the hinges carry a rest angle).
+std::shared_ptr<const ClothModel> curvedSheet(const Material& material, std::uint32_t seed) {
+  SheetSpec spec{0.2, 0.2, 6, 6, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), "sheet"};
+  mesh::TriMesh m = irregularSheet(spec, 0.3, seed);
+  for (Vec3& p : m.positions) p.z() = 0.4 * p.x() * p.x() + 0.2 * p.x() * p.y();
+  return makeModel(m, material);
+}
+
+// ---------------------------------------------------------------------------------------
+// Where it drops nothing the linearisation is the forces' exact derivative: at rest (the
+// stress and every psi - psi0 are zero: only the material and Gauss-Newton terms remain),
+// and stretched in every direction (no compressive stress to drop), without hinges.
+TEST(BackwardEuler, StiffnessIsTheForcesDerivativeWhereNothingIsDropped) {
+  std::mt19937 rng(11);
+  for (std::uint32_t seed = 1; seed <= 6; ++seed) {
+    Material knit = fabric(5e4, 5e-4, 300);
+    knit.bendingStiffness_Nm = 2e-4;  // a hinge force of the membrane's order, so both are checked
+    const auto model = curvedSheet(knit, seed);
+    BackwardEuler be;
+    be.prepare(*model, StepSettings{}, {});
+    const ClothState rest = ClothState::atRest(*model);
+    be.linearise(*model, rest);
+    const std::vector<double> p = randomVector(3 * model->vertexCount(), rng);
+    std::vector<double> product(p.size());
+    be.stiffnessTimes(*model, p, 1.0, 1.0, product);
+    const std::vector<double> reference = stiffnessByDifferences(*model, rest, p);
+    std::vector<double> error(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) error[i] = product[i] - reference[i];
+    ASSERT_GT(norm(reference), 1.0);
+    EXPECT_LT(norm(error), 1e-5 * norm(reference)) << "at rest, seed " << seed;
+
+    // Stretched by 3 to 8 % in every direction, without hinges.
+    Material flat = knit;
+    flat.bendingStiffness_Nm = 0.0;
+    const auto membrane = curvedSheet(flat, seed);
+    BackwardEuler stretched;
+    stretched.prepare(*membrane, StepSettings{}, {});
+    ClothState s = ClothState::atRest(*membrane);
+    std::uniform_real_distribution<double> stretch(1.03, 1.08);
+    const double a = stretch(rng), b = stretch(rng);
+    for (std::size_t i = 0; i < s.size(); ++i) s.x[i] *= a, s.y[i] *= b, s.z[i] *= std::sqrt(a * b);
+    stretched.linearise(*membrane, s);
+    stretched.stiffnessTimes(*membrane, p, 1.0, 1.0, product);
+    const std::vector<double> tense = stiffnessByDifferences(*membrane, s, p);
+    for (std::size_t i = 0; i < p.size(); ++i) error[i] = product[i] - tense[i];
+    EXPECT_LT(norm(error), 1e-5 * norm(tense)) << "stretched, seed " << seed;
+  }
+}
+
+// Crumpled at random (compressed and folded), the linearisation is still symmetric and
+// positive semi-definite: what lets conjugate gradients solve the step.
+TEST(BackwardEuler, StiffnessStaysSymmetricAndPositiveWhereTheClothCrumples) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> jitter(-0.02, 0.02), squeeze(0.7, 1.0);
+  for (std::uint32_t seed = 1; seed <= 20; ++seed) {
+    const auto model = curvedSheet(fabric(5e4, 5e-4, 300), seed);
+    BackwardEuler be;
+    be.prepare(*model, StepSettings{}, {});
+    ClothState s = ClothState::atRest(*model);
+    const double sx = squeeze(rng);
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      s.x[i] = sx * s.x[i] + jitter(rng);
+      s.y[i] += jitter(rng);
+      s.z[i] += jitter(rng);
+    }
+    be.linearise(*model, s);
+    const std::size_t size = 3 * model->vertexCount();
+    const std::vector<double> p = randomVector(size, rng), q = randomVector(size, rng);
+    std::vector<double> kp(size), kq(size);
+    be.stiffnessTimes(*model, p, 1.0, 1.0, kp);
+    be.stiffnessTimes(*model, q, 1.0, 1.0, kq);
+    const double qkp = std::inner_product(q.begin(), q.end(), kp.begin(), 0.0);
+    const double pkq = std::inner_product(p.begin(), p.end(), kq.begin(), 0.0);
+    const double pkp = std::inner_product(p.begin(), p.end(), kp.begin(), 0.0);
+    EXPECT_NEAR(qkp, pkq, 1e-10 * (std::abs(qkp) + std::abs(pkq))) << "seed " << seed;
+    EXPECT_GE(pkp, 0.0) << "seed " << seed;
+  }
+}
+
+// A flat sheet pressed together in its plane: its exact stiffness is negative for every
+// motion out of the plane (the compressive stress pulls a buckle further: the material
+// term is zero there to first order), where the linearisation's is zero, not negative.
+TEST(BackwardEuler, DropsWhatMakesACompressedSheetIndefinite) {
+  std::mt19937 rng(9);
+  Material flat = fabric(5e4, 5e-4, 300);
+  flat.bendingStiffness_Nm = 0.0;
+  SheetSpec spec{0.2, 0.2, 6, 6, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), "sheet"};
+  const auto model = makeModel(irregularSheet(spec), flat);
+  ClothState s = ClothState::atRest(*model);
+  for (std::size_t i = 0; i < s.size(); ++i) s.x[i] *= 0.9, s.y[i] *= 0.95;
+  BackwardEuler be;
+  be.prepare(*model, StepSettings{}, {});
+  be.linearise(*model, s);
+  const std::size_t n = model->vertexCount();
+  std::vector<double> p(3 * n, 0.0), kp(3 * n);
+  std::normal_distribution<double> d(0.0, 1.0);
+  for (int k = 0; k < 10; ++k) {
+    for (std::size_t i = 0; i < n; ++i) p[2 * n + i] = d(rng);
+    const std::vector<double> exact = stiffnessByDifferences(*model, s, p);
+    be.stiffnessTimes(*model, p, 1.0, 1.0, kp);
+    const double exactCurvature = std::inner_product(p.begin(), p.end(), exact.begin(), 0.0);
+    const double curvature = std::inner_product(p.begin(), p.end(), kp.begin(), 0.0);
+    EXPECT_LT(exactCurvature, 0.0);
+    EXPECT_NEAR(curvature, 0.0, 1e-9 * std::abs(exactCurvature));
+  }
+}
+
+// One step's velocity change against a dense direct solve of the same linear system,
+// assembled column by column from the products.
+TEST(BackwardEuler, ConjugateGradientsSolveTheLinearisedSystem) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> d(-0.01, 0.01);
+  SheetSpec spec{0.2, 0.2, 5, 5, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), "sheet"};
+  Material m = fabric(5e4, 5e-4, 300);
+  m.damping_s = 1e-3;
+  const auto model = makeModel(irregularSheet(spec), m);
+  const std::size_t n = model->vertexCount(), size = 3 * n;
+  StepSettings settings;
+  settings.airViscosity_Ns_m3 = 0.5;
+  const std::vector<std::uint32_t> top = row(spec, spec.cellsV);
+  std::vector<std::uint8_t> fixed(n, 0);
+  for (const std::uint32_t v : top) fixed[v] = 1;
+  ClothState s = ClothState::atRest(*model);
+  for (std::size_t i = 0; i < n; ++i) {
+    s.x[i] += d(rng), s.y[i] += d(rng), s.z[i] += d(rng);
+    s.vx[i] = 10 * d(rng), s.vy[i] = 10 * d(rng), s.vz[i] = 10 * d(rng);
+  }
+  clearForces(s);
+  accumulateMembraneForces(*model, s);
+  accumulateBendingForces(*model, s);
+  accumulateDragForces(*model, settings, s);
+  const double h = 10 * model->estimatedStableStep_s();
+  const Vec3 g = settings.gravity_m_s2;
+
+  // The dense system: A = M + (h^2 + h beta) K_material + h^2 K_geometric + h c A_v on the
+  // free vertices, b = h (f0 + M g) - h^2 K v0.
+  BackwardEuler dense;
+  dense.prepare(*model, settings, fixed);
+  dense.linearise(*model, s);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(size), static_cast<Eigen::Index>(size));
+  std::vector<double> e(size), kMat(size), kGeo(size);
+  for (std::size_t j = 0; j < size; ++j) {
+    std::fill(e.begin(), e.end(), 0.0);
+    e[j] = 1.0;
+    dense.stiffnessTimes(*model, e, 1.0, 0.0, kMat);
+    dense.stiffnessTimes(*model, e, 0.0, 1.0, kGeo);
+    for (std::size_t i = 0; i < size; ++i)
+      A(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = (h * h + h * m.damping_s) * kMat[i] + h * h * kGeo[i];
+    A(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(j)) +=
+        model->mass()[j % n] + h * settings.airViscosity_Ns_m3 * model->vertexArea()[j % n];
+  }
+  std::vector<double> v0(size);
+  for (std::size_t i = 0; i < n; ++i) v0[i] = s.vx[i], v0[n + i] = s.vy[i], v0[2 * n + i] = s.vz[i];
+  std::vector<double> kv(size);
+  dense.stiffnessTimes(*model, v0, 1.0, 1.0, kv);
+  const double gc[3] = {g.x(), g.y(), g.z()};
+  const double* f0[3] = {s.fx.data(), s.fy.data(), s.fz.data()};
+  std::vector<Eigen::Index> free;
+  Eigen::VectorXd b(static_cast<Eigen::Index>(size));
+  for (std::size_t c = 0; c < 3; ++c)
+    for (std::size_t i = 0; i < n; ++i) {
+      b(static_cast<Eigen::Index>(c * n + i)) = h * (f0[c][i] + model->mass()[i] * gc[c]) - h * h * kv[c * n + i];
+      if (!fixed[i]) free.push_back(static_cast<Eigen::Index>(c * n + i));
+    }
+  const Eigen::MatrixXd Af = A(free, free);
+  const Eigen::VectorXd expected = Af.llt().solve(b(free));
+
+  BackwardEuler be;
+  be.prepare(*model, settings, fixed);
+  ClothState stepped = s;
+  be.advance(*model, g, h, stepped, {});
+  Eigen::VectorXd got(static_cast<Eigen::Index>(free.size()));
+  const std::vector<double>* v1[3] = {&stepped.vx, &stepped.vy, &stepped.vz};
+  const std::vector<double>* vs[3] = {&s.vx, &s.vy, &s.vz};
+  for (std::size_t k = 0; k < free.size(); ++k) {
+    const auto idx = static_cast<std::size_t>(free[k]);
+    got(static_cast<Eigen::Index>(k)) = (*v1[idx / n])[idx % n] - (*vs[idx / n])[idx % n];
+  }
+  EXPECT_LT((got - expected).norm(), 1e-3 * expected.norm());
+  EXPECT_EQ(be.solveStats().solves, 1);
+  EXPECT_EQ(be.solveStats().unconverged, 0);
+  EXPECT_EQ(be.solveStats().indefinite, 0);
+  // Positions follow the new velocities; the held vertices took gravity alone.
+  for (std::size_t i = 0; i < n; ++i) EXPECT_DOUBLE_EQ(stepped.y[i], s.y[i] + h * stepped.vy[i]);
+  for (const std::uint32_t v : top) EXPECT_DOUBLE_EQ(stepped.vy[v], s.vy[v] + h * g.y());
+}
+
+// ---------------------------------------------------------------------------------------
+// Free fall: no internal force acts on a rigid translation, so the centre of mass falls at g
+// exactly as the explicit steps have it: x_k = x_0 + h^2 g k (k + 1) / 2.
+TEST(BackwardEuler, CentreOfMassFallsAtG) {
+  SheetSpec spec{0.3, 0.3, 6, 6, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), "sheet"};
+  const auto model = makeModel(irregularSheet(spec), fabric(1e5, 1e-3, 300));
+  StepSettings settings = settingsWithStep(20 * model->estimatedStableStep_s());
+  settings.integrator = IntegratorKind::BackwardEuler;
+  ClothSolver solver(model, settings);
+  const int steps = 40;
+  ASSERT_TRUE(run(solver, steps));
+  const double h = settings.substep_s();
+  double y = 0.0;
+  for (std::size_t i = 0; i < model->vertexCount(); ++i) y += model->mass()[i] * solver.state().y[i];
+  y /= model->totalMass_kg();
+  const double expected = -9.81 * h * h * steps * (steps + 1) / 2.0;
+  EXPECT_NEAR(y, expected, 1e-6 * std::abs(expected));
+  EXPECT_EQ(solver.solveStats().solves, steps);
+}
+
+// A strip hanging from its top edge settles to rho g L^2 / (2 E) at a substep 30 times the
+// explicit steps' stable one, at which symplectic Euler diverges within a few substeps.
+TEST(BackwardEuler, HangingStripElongationAtThirtyTimesTheExplicitStep) {
+  const double L = 1.0, W = 0.1, E = 1e6, rho = 1000, t = 1e-3;
+  SheetSpec spec{W, L, 4, 40, Vec3(0, -L, 0), Vec3::UnitX(), Vec3::UnitY(), "strip"};
+  const auto model = makeModel(gridSheet(spec), fabric(E, t, rho));
+  const double h = 30 * model->estimatedStableStep_s();
+  StepSettings settings = settingsWithStep(h, 10.0);
+  settings.maxRefinement = 1;
+  settings.rescueStrainLimit = 0.0;
+  const PinGroup top = pinAt(*model, row(spec, spec.cellsV));
+
+  ClothSolver explicitStep(model, settings, {top});
+  EXPECT_FALSE(run(explicitStep, 200)) << "symplectic Euler was stable at 30 times its estimated step";
+
+  settings.integrator = IntegratorKind::BackwardEuler;
+  ClothSolver solver(model, settings, {top});
+  ASSERT_TRUE(run(solver, static_cast<long>(1.5 / settings.substep_s())));
+  double drop = 0.0;
+  for (std::uint32_t v : row(spec, 0)) drop += model->restY()[v] - solver.state().y[v];
+  drop /= spec.cellsU + 1;
+  const double expected = rho * 9.81 * L * L / (2 * E);
+  EXPECT_NEAR(drop, expected, 0.05 * expected);
+  EXPECT_EQ(solver.solveStats().unconverged, 0);
+  EXPECT_EQ(solver.solveStats().indefinite, 0);
+}
+
+// Undamped and without drag, a swinging sheet's energy never grows under backward Euler
+// (beyond the solve's tolerance): the step dissipates, it does not blow up, at ten times the
+// explicit step.
+TEST(BackwardEuler, SwingingSheetLosesEnergyInsteadOfGainingIt) {
+  SheetSpec spec{0.3, 0.3, 6, 6, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), "sheet"};
+  const auto model = makeModel(gridSheet(spec), fabric(2e4, 1e-3, 300));
+  StepSettings settings = settingsWithStep(10 * model->estimatedStableStep_s(), 0.0);
+  settings.integrator = IntegratorKind::BackwardEuler;
+  ClothSolver solver(model, settings, {pinAt(*model, {sheetVertex(spec, 0, 0), sheetVertex(spec, 6, 0)})});
+  const double e0 = solver.totalEnergy();
+  double previous = e0, kinetic = 0.0;
+  for (int k = 0; k < 100; ++k) {
+    ASSERT_TRUE(run(solver, 5));
+    const double e = solver.totalEnergy();
+    EXPECT_LE(e, previous + 1e-6 * std::abs(e0)) << "after " << 5 * (k + 1) << " substeps";
+    previous = e;
+    kinetic = std::max(kinetic, kineticEnergy(*model, solver.state()));
+  }
+  EXPECT_GT(kinetic, 1e-3);  // it swung
+  EXPECT_LT(previous, e0);
+}
+
+TEST(BackwardEuler, RefusesABendingRhythm) {
+  StepSettings settings;
+  settings.integrator = IntegratorKind::BackwardEuler;
+  settings.bendEvery = 8;
+  try {
+    settings.validate("--");
+    FAIL() << "bendEvery 8 accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--bend-every must be 1 with the backward-euler integrator"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(parseIntegrator("backward-euler"), IntegratorKind::BackwardEuler);
+  EXPECT_EQ(integratorName(IntegratorKind::BackwardEuler), "backward-euler");
+}
+
+}  // namespace
+}  // namespace drape::cloth

@@ -234,7 +234,7 @@ void BackwardEuler::applySystem(const ClothModel& model, double h, std::span<con
   filter(out);
 }
 
-void BackwardEuler::advance(const ClothModel& model, const Vec3& g, double h, ClothState& s, const ForceEvaluator&) {
+void BackwardEuler::advance(const ClothModel& model, const Vec3& g, double h, ClothState& s) {
   const std::size_t n = s.size();
   if (held_.size() != n) prepare(model, StepSettings{}, {});  // a caller that did not (tests of the integrator alone)
   const std::vector<double>& m = model.mass();

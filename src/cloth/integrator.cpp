@@ -43,7 +43,7 @@ void step(const ClothModel& model, const Vec3& g, double dt, ClothState& s) {
 class SymplecticEuler final : public Integrator {
  public:
   [[nodiscard]] IntegratorKind kind() const override { return IntegratorKind::SymplecticEuler; }
-  void advance(const ClothModel& model, const Vec3& g, double dt, ClothState& s, const ForceEvaluator&) override {
+  void advance(const ClothModel& model, const Vec3& g, double dt, ClothState& s) override {
     step<Order::VelocityFirst>(model, g, dt, s);
   }
 };
@@ -53,7 +53,7 @@ class SymplecticEuler final : public Integrator {
 class ForwardEuler final : public Integrator {
  public:
   [[nodiscard]] IntegratorKind kind() const override { return IntegratorKind::ForwardEuler; }
-  void advance(const ClothModel& model, const Vec3& g, double dt, ClothState& s, const ForceEvaluator&) override {
+  void advance(const ClothModel& model, const Vec3& g, double dt, ClothState& s) override {
     step<Order::PositionFirst>(model, g, dt, s);
   }
 };

@@ -255,13 +255,6 @@ void ClothSolver::accumulateForces() {
   accumulateDragForces(*model_, settings_, state_);
 }
 
-void ClothSolver::evaluateForces(ClothState& s) {
-  clearForces(s);
-  accumulateMembraneForces(*model_, s, parallelForces_ ? &forceLoops_ : nullptr);
-  accumulateBendingForces(*model_, s, 1.0, parallelForces_ ? &forceLoops_ : nullptr);
-  accumulateDragForces(*model_, settings_, s);
-}
-
 void ClothSolver::setStitches(std::vector<Stitch> stitches, const std::string& garment) {
   const std::size_t n = model_->vertexCount();
   for (const Stitch& st : stitches) {
@@ -281,10 +274,7 @@ void ClothSolver::limitStrain() {
 }
 
 void ClothSolver::integrate(double dt) {
-  // Made here, not kept, so that a moved solver hands on its own `this`; one pointer's
-  // capture sits in std::function's own storage (no allocation).
-  const ForceEvaluator forces = [this](ClothState& s) { evaluateForces(s); };
-  integrator_->advance(*model_, settings_.gravity_m_s2, dt, state_, forces);
+  integrator_->advance(*model_, settings_.gravity_m_s2, dt, state_);
 }
 
 void ClothSolver::collide(double t0, double t1) {

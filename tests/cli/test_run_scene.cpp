@@ -356,6 +356,36 @@ TEST(RunScene, DampingTheSubstepCannotCarryIsRefusedWithTheWayOut) {
   EXPECT_NE(ok.err.find("Skirt: internal damping 10 ms, 9"), std::string::npos) << ok.err;
 }
 
+TEST(RunScene, BackwardEulerWalksTheSkirtAtFourSubstepsAFrame) {
+  // The implicit step at an eighth of the scene's substeps (8.3 ms, about eight times the
+  // explicit steps' estimated stable one): the skirt stays out of the body, every solve
+  // converges, and the scene's bending rhythm (8) gives way to bending every substep.
+  ScratchDir dir("run-backward-euler");
+  const std::string scene = "run '" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir +
+                            "/walk.bvh' --frames 30 --integrator backward-euler --substeps 4 ";
+  const CliResult ok = runDrape(scene + "--out '" + (dir / "ok") + "'", dir);
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_NE(ok.err.find("Skirt: backward Euler, 4 substeps per frame (8.33 ms"), std::string::npos) << ok.err;
+  const nlohmann::json stats = statsOf(dir / "ok");
+  EXPECT_EQ(stats["integrator"].get<std::string>(), "backward-euler");
+  EXPECT_FALSE(stats["unstable"].get<bool>());
+  EXPECT_EQ(stats["vertex_substeps_inside_body"].get<long>(), 0);
+  const nlohmann::json& skirt = stats["garments"][0];
+  EXPECT_EQ(skirt["added_mass_kg"].get<double>(), 0.0);
+  EXPECT_EQ(skirt["frames_refined"].get<long>(), 0);
+  const nlohmann::json& solves = skirt["implicit_solves"];
+  EXPECT_EQ(solves["substeps"].get<long>(), 30 * 4);
+  EXPECT_EQ(solves["unconverged"].get<long>(), 0);
+  EXPECT_EQ(solves["indefinite"].get<long>(), 0);
+  EXPECT_GT(solves["mean_iterations"].get<double>(), 1.0);
+  EXPECT_TRUE(skirt["strain_limited_from_frame"].is_null());
+
+  const CliResult rhythm = runDrape(scene + "--bend-every 2 --out '" + (dir / "rhythm") + "'", dir);
+  EXPECT_EQ(rhythm.code, 2) << rhythm.err;
+  EXPECT_NE(rhythm.err.find("--bend-every must be 1 with the backward-euler integrator"), std::string::npos)
+      << rhythm.err;
+}
+
 TEST(RunScene, ForwardEulerRunsInsideItsDampingWindowOnly) {
   // The paper's integrator: the skirt's 2 ms of damping lies inside the window its 1.01 ms
   // substep allows; undamped, every mode would grow, and the run is refused with the window.

@@ -236,7 +236,7 @@ TEST(BackwardEuler, ConjugateGradientsSolveTheLinearisedSystem) {
   BackwardEuler be;
   be.prepare(*model, settings, fixed);
   ClothState stepped = s;
-  be.advance(*model, g, h, stepped, {});
+  be.advance(*model, g, h, stepped);
   Eigen::VectorXd got(static_cast<Eigen::Index>(free.size()));
   const std::vector<double>* v1[3] = {&stepped.vx, &stepped.vy, &stepped.vz};
   const std::vector<double>* vs[3] = {&s.vx, &s.vy, &s.vz};

@@ -159,7 +159,7 @@ double growthOfTheStiffestMode(const mesh::TriMesh& sheet, double damping_s, dou
   for (int k = 0; k < steps; ++k) {
     clearForces(s);
     accumulateMembraneForces(*model, s);
-    integrator->advance(*model, Vec3::Zero(), dt, s, {});
+    integrator->advance(*model, Vec3::Zero(), dt, s);
   }
   return displacement() / start;
 }

@@ -41,8 +41,7 @@ class BackwardEuler final : public Integrator {
 
   [[nodiscard]] IntegratorKind kind() const override { return IntegratorKind::BackwardEuler; }
   void prepare(const ClothModel& model, const StepSettings& settings, std::span<const std::uint8_t> fixed) override;
-  void advance(const ClothModel& model, const Vec3& gravity_m_s2, double dt_s, ClothState& io,
-               const ForceEvaluator& forces) override;
+  void advance(const ClothModel& model, const Vec3& gravity_m_s2, double dt_s, ClothState& io) override;
   [[nodiscard]] SolveStats solveStats() const override { return stats_; }
 
   /// The forces' linearisation at `s`'s positions (deformation gradients, clamped

@@ -2,10 +2,9 @@
 // Time integrators behind one interface. The explicit one-stage integrators take the forces
 // the step accumulated for this substep; gravity enters as a body acceleration (so a vertex
 // of zero mass still falls). The implicit one (backward Euler, the paper's future work)
-// evaluates the forces again at nearby states through the solver's ForceEvaluator.
+// linearises the forces at the substep's start as well (backward_euler.hpp).
 
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <span>
 
@@ -14,10 +13,6 @@
 #include "drape/cloth/state.hpp"
 
 namespace drape::cloth {
-
-/// Fills s.f* with every force the step applies (membrane, bending at its full rate, drag)
-/// at s's positions and velocities, using s.work as the kernels' workspace.
-using ForceEvaluator = std::function<void(ClothState& s)>;
 
 /// What an implicit integrator's linear solves took, summed over the substeps so far.
 struct SolveStats {
@@ -42,9 +37,8 @@ class Integrator {
   virtual void prepare(const ClothModel& /*model*/, const StepSettings& /*settings*/,
                        std::span<const std::uint8_t> /*fixed*/) {}
   /// Advances positions and velocities by dt_s from the forces in io.f* (those of io's
-  /// state, as `forces` would compute them).
-  virtual void advance(const ClothModel& model, const Vec3& gravity_m_s2, double dt_s, ClothState& io,
-                       const ForceEvaluator& forces) = 0;
+  /// state: every force the step applies).
+  virtual void advance(const ClothModel& model, const Vec3& gravity_m_s2, double dt_s, ClothState& io) = 0;
   [[nodiscard]] virtual SolveStats solveStats() const { return {}; }
 };
 

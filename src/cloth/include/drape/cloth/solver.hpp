@@ -165,9 +165,6 @@ class ClothSolver {
   bool runFrame(long frame, int refinement);
   void limitStrain();
   void accumulateForces();
-  /// Every force at s's state into s.f*, bending at its full rate: what the implicit
-  /// integrator differences.
-  void evaluateForces(ClothState& s);
   void integrate(double dt_s);
   void collide(double t0_s, double t1_s);
   void applyFixtures(double t0_s, double t1_s, double dt_s);

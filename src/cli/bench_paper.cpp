@@ -49,6 +49,8 @@ struct PaperBenchOptions {
   int runs = 3;
   int collisionEvery = 0;  // 0: as the scene says
   int bendEvery = 0;       // 0: as the scene says
+  int substeps = 0;        // 0: as the scene says
+  std::string integrator;  // empty: as the scene says
   bool exactSliding = false;  // sliding pairs read the field on every test (no contact planes)
   bool freePinches = false;   // pinched points move freely between reduced-frequency tests
   std::optional<std::vector<std::string>> keepApart;  // parts kept out of the others, instead of the scene's
@@ -66,6 +68,8 @@ struct PaperRun {
   double colliderPoseSeconds = 0;  ///< the collider's, inside the collide stage
   int collisionEvery = 1;
   int bendEvery = 1;
+  cloth::IntegratorKind integrator = cloth::IntegratorKind::SymplecticEuler;
+  cloth::SolveStats solves;  ///< the implicit integrator's, summed over the garments
   cloth::FieldCollisionCounters counters;
   cloth::LayerCounters self;  ///< the garments' layer collision (their own, those below), summed
   double selfThickness_m = 0;  ///< the largest
@@ -97,7 +101,14 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
   if (!character) throw Error(fmt::format("{}: the scene has no avatar", o.scene));
   if (o.collisionEvery > 0)
     for (GarmentSetup& g : setup.garments) g.collisionEvery = o.collisionEvery;
+  if (!o.integrator.empty()) {
+    setup.settings.integrator = cloth::parseIntegrator(o.integrator, "--integrator");
+    // As drape run has it: the implicit solve bends every substep unless told otherwise.
+    if (setup.settings.integrator == cloth::IntegratorKind::BackwardEuler) setup.settings.bendEvery = 1;
+  }
   if (o.bendEvery > 0) setup.settings.bendEvery = o.bendEvery;
+  if (o.substeps > 0) setup.settings.substepsPerFrame = o.substeps;
+  setup.settings.validate("--");
   if (o.faceSamplesWith)
     for (GarmentSetup& g : setup.garments) g.faceSamplesWith = *o.faceSamplesWith;
   if (o.selfCollision_m)
@@ -119,6 +130,7 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
   r.substeps = setup.settings.substepsPerFrame;
   r.collisionEvery = setup.garments.empty() ? 1 : setup.garments.front().collisionEvery;
   r.bendEvery = setup.settings.bendEvery;
+  r.integrator = setup.settings.integrator;
   r.fieldBuildSeconds = world.fieldBuild_s();
   for (std::size_t g = 0; g < world.garmentCount(); ++g) r.triangles += world.garment(g).mesh.triangleCount();
   r.frames = o.frames > 0 ? o.frames : defaultFrames(setup);
@@ -154,6 +166,11 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
       r.selfThickness_m = std::max(r.selfThickness_m, self->thickness_m());
     }
     r.framesRefined += world.solver(g).refinedFrames();
+    const cloth::SolveStats solves = world.solver(g).solveStats();
+    r.solves.solves += solves.solves;
+    r.solves.iterations += solves.iterations;
+    r.solves.unconverged += solves.unconverged;
+    r.solves.indefinite += solves.indefinite;
   }
   return r;
 }
@@ -172,6 +189,10 @@ RunFunction setupPaperBench(CLI::App& app) {
   app.add_option("--bend-every", o.bendEvery,
                  "Bending forces every K substeps as an impulse (multiple time stepping), overriding the scene")
       ->check(CLI::Range(1, 1000));
+  app.add_option("--substeps", o.substeps, "Substeps per frame, overriding the scene")->check(CLI::Range(1, 100000));
+  app.add_option("--integrator", o.integrator,
+                 "symplectic-euler, forward-euler or backward-euler, overriding the scene (backward-euler bends every "
+                 "substep unless --bend-every says otherwise)");
   app.add_flag("--exact-sliding", o.exactSliding,
                "Sliding points read the distance field on every test instead of their contact planes "
                "(the reference the planes are measured against)");
@@ -233,6 +254,9 @@ RunFunction setupPaperBench(CLI::App& app) {
     j["substeps_per_frame"] = r.substeps;
     j["collision_every"] = r.collisionEvery;
     j["bend_every"] = r.bendEvery;
+    j["integrator"] = cloth::integratorName(r.integrator);
+    if (r.integrator == cloth::IntegratorKind::BackwardEuler)
+      j["implicit_mean_iterations"] = r.solves.meanIterations();
     j["sim_fps"] = r.frames / r.simSeconds;
     j["ms_per_frame"] = 1e3 * r.simSeconds / r.frames;
     j["cpu_ms_per_frame"] = 1e3 * r.simCpuSeconds / r.frames;

@@ -194,6 +194,7 @@ void applyOverrides(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   if (app.count("--max-speed")) s.maxSpeed_m_s = o.settings.maxSpeed_m_s;
   if (app.count("--max-added-mass")) s.maxAddedMass = o.settings.maxAddedMass;
   if (app.count("--bend-every")) s.bendEvery = o.settings.bendEvery;
+  if (app.count("--implicit-tolerance")) s.implicitTolerance = o.settings.implicitTolerance;
   if (app.count("--max-refinement")) s.maxRefinement = o.settings.maxRefinement;
   if (app.count("--strain-limit")) applyStrainLimit(o.strainLimit, s);
   if (app.count("--integrator")) s.integrator = cloth::parseIntegrator(o.integrator, "--integrator");
@@ -548,6 +549,10 @@ RunFunction setupRun(CLI::App& app) {
                  "substep sets, which a refusal names) or backward-euler (implicit, stable at long substeps: try "
                  "--substeps 4; each substep solves a linear system, one force evaluation per iteration, and "
                  "bends every substep)")
+      ->capture_default_str();
+  app.add_option("--implicit-tolerance", s.implicitTolerance,
+                 "backward-euler: each substep's linear solve stops at this residual relative to its right-hand "
+                 "side (smaller: more iterations, closer to the exact implicit step)")
       ->capture_default_str();
   app.add_option("--air-viscosity", s.airViscosity_Ns_m3, "Linear air drag per area, N s/m^3")->capture_default_str();
   app.add_option("--wind", o->wind, "Wind velocity x,y,z, m/s");

@@ -1,6 +1,7 @@
 #include "drape/cloth/backward_euler.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "drape/core/error.hpp"
@@ -60,11 +61,13 @@ void BackwardEuler::prepare(const ClothModel& model, const StepSettings& setting
   for (std::size_t v = 0; v < n; ++v)
     held_[v] = static_cast<std::uint8_t>((!fixed.empty() && fixed[v]) || !(model.inverseMass()[v] > 0.0));
   dragPerArea_ = settings.airViscosity_Ns_m3;
+  tolerance_ = settings.implicitTolerance;
   gradient_.assign(6 * model.membrane().size(), 0.0);
   stress_.assign(3 * model.membrane().size(), 0.0);
   hinge_.assign(12 * model.bending().size(), 0.0);
   for (std::vector<double>* v : {&rhs_, &dv_, &r_, &z_, &d_, &q_}) v->assign(3 * n, 0.0);
   precond_.assign(9 * n, 0.0);
+  buildPattern(model);
 }
 
 void BackwardEuler::linearise(const ClothModel& model, const ClothState& s) {
@@ -149,70 +152,139 @@ void BackwardEuler::stiffnessTimes(const ClothModel& model, std::span<const doub
   }
 }
 
-void BackwardEuler::invertDiagonalBlocks(const ClothModel& model, double h) {
-  // The system's 3x3 blocks on the diagonal, from the same terms as applySystem with one
-  // vertex moving: with a = Fu g_u, b = Fv g_v, c = (Fu g_v + Fv g_u) / 2 for the vertex's
-  // barycentric gradient g, its membrane block is A (lambda (a + b)(a + b)^T + 2 mu (a a^T +
-  // b b^T + 2 c c^T)) (material) plus A (g . S+ g) I (geometric); a hinge adds w w^T.
+void BackwardEuler::buildPattern(const ClothModel& model) {
+  // Each vertex's neighbours through a triangle or a hinge (the hinge's two tips are coupled
+  // though no edge joins them), itself included, in order: the rows of a block CSR matrix.
   const std::size_t n = model.vertexCount();
+  std::vector<std::vector<std::uint32_t>> near(n);
+  const auto couple = [&](std::span<const std::uint32_t> corners) {
+    for (const std::uint32_t r : corners)
+      for (const std::uint32_t c : corners) near[r].push_back(c);
+  };
+  for (const MembraneElement& el : model.membrane()) couple(std::array<std::uint32_t, 3>{el.v0, el.v1, el.v2});
+  for (const BendElement& hg : model.bending()) couple(std::array<std::uint32_t, 4>{hg.a, hg.b, hg.e0, hg.e1});
+  rowStart_.assign(n + 1, 0);
+  column_.clear();
+  diagonal_.assign(n, 0);
+  for (std::size_t v = 0; v < n; ++v) {
+    near[v].push_back(static_cast<std::uint32_t>(v));
+    std::sort(near[v].begin(), near[v].end());
+    near[v].erase(std::unique(near[v].begin(), near[v].end()), near[v].end());
+    for (const std::uint32_t c : near[v]) {
+      if (c == v) diagonal_[v] = static_cast<std::uint32_t>(column_.size());
+      column_.push_back(c);
+    }
+    rowStart_[v + 1] = static_cast<std::uint32_t>(column_.size());
+  }
+  const auto block = [&](std::uint32_t r, std::uint32_t c) {
+    const auto first = column_.begin() + rowStart_[r], last = column_.begin() + rowStart_[r + 1];
+    return static_cast<std::uint32_t>(std::lower_bound(first, last, c) - column_.begin());
+  };
+  membraneBlock_.clear();
+  for (const MembraneElement& el : model.membrane()) {
+    const std::uint32_t v[3] = {el.v0, el.v1, el.v2};
+    for (const std::uint32_t r : v)
+      for (const std::uint32_t c : v) membraneBlock_.push_back(block(r, c));
+  }
+  hingeBlock_.clear();
+  for (const BendElement& hg : model.bending()) {
+    const std::uint32_t v[4] = {hg.a, hg.b, hg.e0, hg.e1};
+    for (const std::uint32_t r : v)
+      for (const std::uint32_t c : v) hingeBlock_.push_back(block(r, c));
+  }
+  matrix_.assign(9 * column_.size(), 0.0);
+}
+
+void BackwardEuler::assemble(const ClothModel& model, double h) {
+  // The blocks of applySystem's operator. Membrane, corners r and c with barycentric
+  // gradients g_r, g_c: with a = Fu g_u, b = Fv g_v, e = (Fu g_v + Fv g_u) / 2 per corner,
+  // the material block is A (lambda (a_r + b_r)(a_c + b_c)^T + 2 mu (a_r a_c^T + b_r b_c^T +
+  // 2 e_r e_c^T)) and the geometric one A (g_r . S+ g_c) I; a hinge's is w_r w_c^T.
   const double beta = model.material().damping_s;
   const double material = h * h + h * beta, geometric = h * h;
   const double lambda = model.lambdaT(), mu = model.muT();
-  std::fill(precond_.begin(), precond_.end(), 0.0);
-  const auto addOuter = [&](std::size_t v, const P3& a, const P3& b, double s) {
-    double* m = &precond_[9 * v];
-    const double av[3] = {a.x, a.y, a.z}, bv[3] = {b.x, b.y, b.z};
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) m[3 * r + c] += s * av[r] * bv[c];
+  std::fill(matrix_.begin(), matrix_.end(), 0.0);
+  // Block (r, c) and, off the diagonal, its transpose at (c, r): the matrix is symmetric.
+  const auto addBlock = [&](std::uint32_t rc, std::uint32_t cr, const double* k) {
+    double* m = &matrix_[9 * static_cast<std::size_t>(rc)];
+    for (int i = 0; i < 9; ++i) m[i] += k[i];
+    if (cr == rc) return;
+    double* t = &matrix_[9 * static_cast<std::size_t>(cr)];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) t[3 * j + i] += k[3 * i + j];
   };
   const std::vector<MembraneElement>& elements = model.membrane();
   for (std::size_t t = 0; t < elements.size(); ++t) {
     const MembraneElement& el = elements[t];
     const double* g = &gradient_[6 * t];
-    const P3 fu{g[0], g[1], g[2]}, fv{g[3], g[4], g[5]};
+    const double fu[3] = {g[0], g[1], g[2]}, fv[3] = {g[3], g[4], g[5]};
     const double s11 = stress_[3 * t], s22 = stress_[3 * t + 1], s12 = stress_[3 * t + 2];
-    const std::uint32_t corner[3] = {el.v0, el.v1, el.v2};
     const double gu[3] = {-(el.g1u + el.g2u), el.g1u, el.g2u}, gv[3] = {-(el.g1v + el.g2v), el.g1v, el.g2v};
-    for (int k = 0; k < 3; ++k) {
-      const P3 a = fu * gu[k], b = fv * gv[k], c = (fu * gv[k] + fv * gu[k]) * 0.5;
-      const double A = el.restArea_m2 * material;
-      addOuter(corner[k], a + b, a + b, A * lambda);
-      addOuter(corner[k], a, a, 2.0 * mu * A);
-      addOuter(corner[k], b, b, 2.0 * mu * A);
-      addOuter(corner[k], c, c, 4.0 * mu * A);
-      const double geo = el.restArea_m2 * geometric * (gu[k] * (s11 * gu[k] + s12 * gv[k]) + gv[k] * (s12 * gu[k] + s22 * gv[k]));
-      double* m = &precond_[9 * corner[k]];
-      m[0] += geo, m[4] += geo, m[8] += geo;
-    }
+    // With a_r, b_r, e_r combinations of Fu and Fv, each block is a combination of Fu Fu^T,
+    // Fv Fv^T, Fu Fv^T and its transpose, with coefficients from g_r and g_c.
+    double uu[9], vv[9], uv[9];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        uu[3 * i + j] = fu[i] * fu[j];
+        vv[3 * i + j] = fv[i] * fv[j];
+        uv[3 * i + j] = fu[i] * fv[j];
+      }
+    const double A = el.restArea_m2 * material, G = el.restArea_m2 * geometric;
+    const std::uint32_t* blocks = &membraneBlock_[9 * t];
+    for (int r = 0; r < 3; ++r)
+      for (int c = r; c < 3; ++c) {
+        const double cuu = A * ((lambda + 2.0 * mu) * gu[r] * gu[c] + mu * gv[r] * gv[c]);
+        const double cvv = A * ((lambda + 2.0 * mu) * gv[r] * gv[c] + mu * gu[r] * gu[c]);
+        const double cuv = A * (lambda * gu[r] * gv[c] + mu * gv[r] * gu[c]);
+        const double cvu = A * (lambda * gv[r] * gu[c] + mu * gu[r] * gv[c]);
+        const double geo = G * (gu[r] * (s11 * gu[c] + s12 * gv[c]) + gv[r] * (s12 * gu[c] + s22 * gv[c]));
+        double k[9];
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            k[3 * i + j] = cuu * uu[3 * i + j] + cvv * vv[3 * i + j] + cuv * uv[3 * i + j] + cvu * uv[3 * j + i];
+        k[0] += geo, k[4] += geo, k[8] += geo;
+        addBlock(blocks[3 * r + c], blocks[3 * c + r], k);
+      }
   }
   const std::vector<BendElement>& hinges = model.bending();
   for (std::size_t i = 0; i < hinges.size(); ++i) {
-    const BendElement& hg = hinges[i];
     const double* w = &hinge_[12 * i];
-    const std::uint32_t v[4] = {hg.a, hg.b, hg.e0, hg.e1};
-    for (int k = 0; k < 4; ++k) {
-      const P3 wk{w[3 * k], w[3 * k + 1], w[3 * k + 2]};
-      addOuter(v[k], wk, wk, geometric);
-    }
+    const std::uint32_t* blocks = &hingeBlock_[16 * i];
+    for (int r = 0; r < 4; ++r)
+      for (int c = r; c < 4; ++c) {
+        double k[9];
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) k[3 * a + b] = geometric * w[3 * r + a] * w[3 * c + b];
+        addBlock(blocks[4 * r + c], blocks[4 * c + r], k);
+      }
   }
+  const std::size_t n = model.vertexCount();
   const std::vector<double>& m = model.mass();
   const std::vector<double>& area = model.vertexArea();
   for (std::size_t v = 0; v < n; ++v) {
-    double* b = &precond_[9 * v];
+    double* d = &matrix_[9 * static_cast<std::size_t>(diagonal_[v])];
+    const double diagonal = m[v] + h * dragPerArea_ * area[v];
+    d[0] += diagonal, d[4] += diagonal, d[8] += diagonal;
+  }
+  invertDiagonalBlocks();
+}
+
+void BackwardEuler::invertDiagonalBlocks() {
+  const std::size_t n = held_.size();
+  for (std::size_t v = 0; v < n; ++v) {
+    double* inverse = &precond_[9 * v];
     if (held_[v]) {
-      std::fill(b, b + 9, 0.0);
+      std::fill(inverse, inverse + 9, 0.0);
       continue;
     }
-    const double diagonal = m[v] + h * dragPerArea_ * area[v];
-    b[0] += diagonal, b[4] += diagonal, b[8] += diagonal;
     // The inverse of a symmetric positive definite 3x3 by its adjugate.
+    const double* b = &matrix_[9 * static_cast<std::size_t>(diagonal_[v])];
     const double c00 = b[4] * b[8] - b[5] * b[7], c01 = b[2] * b[7] - b[1] * b[8], c02 = b[1] * b[5] - b[2] * b[4];
     const double c11 = b[0] * b[8] - b[2] * b[6], c12 = b[2] * b[3] - b[0] * b[5], c22 = b[0] * b[4] - b[1] * b[3];
-    const double det = b[0] * c00 + b[1] * (b[5] * b[6] - b[3] * b[8]) + b[2] * (b[3] * b[7] - b[4] * b[6]);
-    const double inv = 1.0 / det;
-    b[0] = c00 * inv, b[1] = c01 * inv, b[2] = c02 * inv;
-    b[3] = c01 * inv, b[4] = c11 * inv, b[5] = c12 * inv;
-    b[6] = c02 * inv, b[7] = c12 * inv, b[8] = c22 * inv;
+    const double inv = 1.0 / (b[0] * c00 + b[1] * (b[5] * b[6] - b[3] * b[8]) + b[2] * (b[3] * b[7] - b[4] * b[6]));
+    inverse[0] = c00 * inv, inverse[1] = c01 * inv, inverse[2] = c02 * inv;
+    inverse[3] = c01 * inv, inverse[4] = c11 * inv, inverse[5] = c12 * inv;
+    inverse[6] = c02 * inv, inverse[7] = c12 * inv, inverse[8] = c22 * inv;
   }
 }
 
@@ -222,16 +294,23 @@ void BackwardEuler::filter(std::span<double> v) const {
     if (held_[i]) v[i] = v[n + i] = v[2 * n + i] = 0.0;
 }
 
-void BackwardEuler::applySystem(const ClothModel& model, double h, std::span<const double> p,
-                                std::span<double> out) const {
-  const double beta = model.material().damping_s;
-  stiffnessTimes(model, p, h * h + h * beta, h * h, out);
-  const std::size_t n = model.vertexCount();
-  const std::vector<double>& m = model.mass();
-  const std::vector<double>& area = model.vertexArea();
-  for (std::size_t c = 0; c < 3; ++c)
-    for (std::size_t i = 0; i < n; ++i) out[c * n + i] += (m[i] + h * dragPerArea_ * area[i]) * p[c * n + i];
-  filter(out);
+void BackwardEuler::applySystem(std::span<const double> p, std::span<double> out) const {
+  const std::size_t n = held_.size();
+  for (std::size_t v = 0; v < n; ++v) {
+    double ox = 0.0, oy = 0.0, oz = 0.0;
+    if (!held_[v])
+      for (std::uint32_t k = rowStart_[v]; k < rowStart_[v + 1]; ++k) {
+        const double* m = &matrix_[9 * static_cast<std::size_t>(k)];
+        const std::size_t c = column_[k];
+        const double px = p[c], py = p[n + c], pz = p[2 * n + c];
+        ox += m[0] * px + m[1] * py + m[2] * pz;
+        oy += m[3] * px + m[4] * py + m[5] * pz;
+        oz += m[6] * px + m[7] * py + m[8] * pz;
+      }
+    out[v] = ox;
+    out[n + v] = oy;
+    out[2 * n + v] = oz;
+  }
 }
 
 void BackwardEuler::advance(const ClothModel& model, const Vec3& g, double h, ClothState& s) {
@@ -251,7 +330,7 @@ void BackwardEuler::advance(const ClothModel& model, const Vec3& g, double h, Cl
     for (std::size_t i = 0; i < n; ++i) rhs_[c * n + i] = h * (f0[c][i] + m[i] * gravity[c]) - rhs_[c * n + i];
   filter(rhs_);
 
-  invertDiagonalBlocks(model, h);
+  assemble(model, h);
   const auto precondition = [&](std::span<const double> in, std::span<double> out) {
     for (std::size_t i = 0; i < n; ++i) {
       const double* b = &precond_[9 * i];
@@ -264,15 +343,17 @@ void BackwardEuler::advance(const ClothModel& model, const Vec3& g, double h, Cl
 
   // Preconditioned conjugate gradients from dv = 0. The system is positive definite by
   // construction; the curvature test guards against what rounding could still make of it.
-  std::fill(dv_.begin(), dv_.end(), 0.0);
-  std::copy(rhs_.begin(), rhs_.end(), r_.begin());
+  precondition(rhs_, d_);
+  const double target = tolerance_ * tolerance_ * dot(rhs_, d_);
+  // Warm start: the last substep's dv (filtered: the held vertices' entries are 0).
+  applySystem(dv_, q_);
+  for (std::size_t i = 0; i < 3 * n; ++i) r_[i] = rhs_[i] - q_[i];
   precondition(r_, d_);
   double rz = dot(r_, d_);
-  const double target = kTolerance * kTolerance * rz;
   ++stats_.solves;
-  bool converged = !(rz > 0.0);
+  bool converged = !(rz > target);
   for (int k = 0; k < kMaxIterations && !converged; ++k) {
-    applySystem(model, h, d_, q_);
+    applySystem(d_, q_);
     ++stats_.iterations;
     const double curvature = dot(d_, q_);
     if (!(curvature > 0.0)) {

@@ -67,6 +67,8 @@ void StepSettings::validate(const std::string& prefix) const {
           maxAddedMass);
   require(bendEvery >= 1 && bendEvery <= substepsPerFrame, prefix, "bend-every",
           fmt::format("in [1, {}] (the substeps per frame)", substepsPerFrame), bendEvery);
+  require(implicitTolerance > 0.0 && implicitTolerance < 1.0, prefix, "implicit-tolerance", "in (0, 1)",
+          implicitTolerance);
   require(bendEvery == 1 || integrator != IntegratorKind::BackwardEuler, prefix, "bend-every",
           "1 with the backward-euler integrator (its solve takes the bending forces in every substep)", bendEvery);
   require(maxRefinement >= 1 && maxRefinement <= 64, prefix, "max-refinement", "in [1, 64]", maxRefinement);

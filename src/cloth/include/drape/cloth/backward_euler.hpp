@@ -19,9 +19,10 @@
 //   is pressed), and the internal damping as beta times the material stiffness;
 // - bending: the Gauss-Newton term k grad psi grad psi^T (the term in (psi - psi0) dropped);
 // - drag: c A_v on the diagonal.
-// The system is never assembled: each conjugate-gradient iteration applies it element by
-// element from the deformation gradients, clamped stresses and hinge gradients computed
-// once per substep. The vertices the fixtures place are held (their dv is 0 in the solve,
+// Each substep assembles the system as 3x3 blocks over the vertices that share a triangle
+// or a hinge (the pattern built once), from the deformation gradients, clamped stresses and
+// hinge gradients at the substep's start; each conjugate-gradient iteration is one product
+// with it, warm-started from the last substep's dv. The vertices the fixtures place are held (their dv is 0 in the solve,
 // Baraff and Witkin's constraint filter), and the fixtures then place them. The
 // preconditioner is block Jacobi: the inverse of each vertex's 3x3 block of the system.
 // docs/PHYSICS.md.
@@ -34,8 +35,6 @@ namespace drape::cloth {
 
 class BackwardEuler final : public Integrator {
  public:
-  /// Relative residual (in the preconditioner's norm) at which a solve stops.
-  static constexpr double kTolerance = 1e-4;
   /// Conjugate-gradient iterations at most per substep.
   static constexpr int kMaxIterations = 200;
 
@@ -54,13 +53,16 @@ class BackwardEuler final : public Integrator {
                       std::span<double> out) const;
 
  private:
-  /// A p = M p + (h^2 + h beta) K_m p + h^2 (K_g + K_b) p + h c A_v p for the free vertices,
-  /// 0 for the held ones.
-  void applySystem(const ClothModel& model, double h, std::span<const double> p, std::span<double> out) const;
+  /// The block CSR pattern of the system (prepare): rows per vertex, 3x3 blocks.
+  void buildPattern(const ClothModel& model);
+  /// The system's blocks at the last linearisation, A = M + (h^2 + h beta) K_m + h^2 (K_g +
+  /// K_b) + h c A_v (the operator stiffnessTimes applies, with the mass and drag), and the
+  /// inverses of its diagonal blocks for the preconditioner.
+  void assemble(const ClothModel& model, double h);
+  void invertDiagonalBlocks();
+  /// out = A p for the free vertices, 0 for the held ones (p's held entries must be 0).
+  void applySystem(std::span<const double> p, std::span<double> out) const;
   void filter(std::span<double> v) const;
-  /// precond_: per free vertex the inverse of the system's 3x3 diagonal block at the last
-  /// linearisation (block Jacobi); zeros for the held ones.
-  void invertDiagonalBlocks(const ClothModel& model, double h);
 
   std::vector<std::uint8_t> held_;  ///< per vertex: placed by a fixture, or massless
   /// Per membrane element, at the last linearisation: the deformation gradient's columns
@@ -68,7 +70,13 @@ class BackwardEuler final : public Integrator {
   std::vector<double> gradient_, stress_;
   /// Per hinge: sqrt(k) grad psi for its corners a, b, e0, e1 (12 values).
   std::vector<double> hinge_;
+  /// The system as block CSR: row v's blocks rowStart_[v] .. rowStart_[v + 1] in column
+  /// order, 9 values each (row-major) in matrix_; the diagonal block's index per vertex; each
+  /// membrane element's 9 and each hinge's 16 block indices (corner r, corner c).
+  std::vector<std::uint32_t> rowStart_, column_, diagonal_, membraneBlock_, hingeBlock_;
+  std::vector<double> matrix_;
   double dragPerArea_ = 0.0;  ///< the settings' air viscosity c, N s/m^3
+  double tolerance_ = 1e-3;   ///< the settings' implicitTolerance
   std::vector<double> rhs_, dv_, r_, z_, d_, q_, precond_;
   SolveStats stats_;
 };

@@ -84,6 +84,9 @@ struct StepSettings {
   /// of the run (ClothSolver::stepFrame); 0: the instability is reported instead. Without
   /// effect when strainLimit is already on.
   double rescueStrainLimit = 0.5;
+  /// Backward Euler: a substep's linear solve stops when its residual, in the
+  /// preconditioner's norm, is this fraction of the right-hand side's.
+  double implicitTolerance = 1e-3;
 
   [[nodiscard]] double substep_s() const { return 1.0 / (frameRate_hz * substepsPerFrame); }
   /// What ClothModel::build needs to honour maxAddedMass: none for the implicit step, which

@@ -429,6 +429,21 @@ TEST(BenchPaper, PrintsTableThreeFiguresAndTakesTheCollisionFrequency) {
     const testing::CliResult bad = testing::runDrape(std::string("bench paper --json ") + option, dir);
     EXPECT_NE(bad.code, 0) << option;
   }
+  // The implicit step at 4 substeps a frame: bending every substep, its iterations reported.
+  const nlohmann::json implicit = bench("--integrator backward-euler --substeps 4");
+  EXPECT_EQ(implicit["integrator"], "backward-euler");
+  EXPECT_EQ(every["integrator"], "symplectic-euler");
+  EXPECT_FALSE(every.contains("implicit_mean_iterations"));
+  EXPECT_EQ(implicit["substeps_per_frame"], 4);
+  EXPECT_EQ(implicit["bend_every"], 1);
+  EXPECT_GT(implicit["implicit_mean_iterations"].get<double>(), 1.0);
+  EXPECT_EQ(implicit["vertex_substeps_inside_body"], 0);
+  EXPECT_EQ(implicit["frames_refined"], 0);
+  const testing::CliResult rhythm =
+      testing::runDrape("bench paper --json --integrator backward-euler --bend-every 2 --frames 1", dir);
+  EXPECT_EQ(rhythm.code, 2) << rhythm.err;
+  EXPECT_NE(rhythm.err.find("--bend-every must be 1 with the backward-euler integrator"), std::string::npos)
+      << rhythm.err;
   // --keep-apart names parts of the scene's avatar, checked before any field is built.
   const testing::CliResult tail = testing::runDrape("bench paper --json --keep-apart LeftForeArm,Tail", dir);
   EXPECT_EQ(tail.code, 2) << tail.err;

@@ -376,6 +376,9 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   if (app.count("--substeps") || o.scene.empty()) {
     const int substeps = substepsFrom(o.substeps);
     setup.settings.substepsPerFrame = substeps > 0 ? substeps : 1;
+    if (substeps == 0 && setup.settings.integrator == cloth::IntegratorKind::BackwardEuler)
+      throw Error("--substeps auto finds the fewest substeps the explicit integrators are stable at; backward-euler "
+                  "is stable at any: give a count (--substeps 4 walks the bundled skirt, 20 the bundled dress)");
     if (substeps == 0) {
       setup.settings.substepsPerFrame = stableSubsteps(setup);
       spdlog::info("--substeps auto: {} substeps per frame ({:.3f} ms){}", setup.settings.substepsPerFrame,

@@ -380,6 +380,12 @@ TEST(RunScene, BackwardEulerWalksTheSkirtAtFourSubstepsAFrame) {
   EXPECT_GT(solves["mean_iterations"].get<double>(), 1.0);
   EXPECT_TRUE(skirt["strain_limited_from_frame"].is_null());
 
+  const CliResult automatic = runDrape("run '" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir +
+                                           "/walk.bvh' --frames 3 --integrator backward-euler --substeps auto --out '" +
+                                           (dir / "auto") + "'",
+                                       dir);
+  EXPECT_EQ(automatic.code, 2) << automatic.err;
+  EXPECT_NE(automatic.err.find("backward-euler is stable at any: give a count"), std::string::npos) << automatic.err;
   const CliResult rhythm = runDrape(scene + "--bend-every 2 --out '" + (dir / "rhythm") + "'", dir);
   EXPECT_EQ(rhythm.code, 2) << rhythm.err;
   EXPECT_NE(rhythm.err.find("--bend-every must be 1 with the backward-euler integrator"), std::string::npos)

@@ -380,6 +380,16 @@ TEST(RunScene, BackwardEulerWalksTheSkirtAtFourSubstepsAFrame) {
   EXPECT_GT(solves["mean_iterations"].get<double>(), 1.0);
   EXPECT_TRUE(skirt["strain_limited_from_frame"].is_null());
 
+  EXPECT_EQ(ok.err.find("fewer run faster"), std::string::npos) << ok.err;
+  // At the scene's own 33 substeps it runs, and says that fewer would do.
+  const CliResult many = runDrape("run '" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir +
+                                      "/walk.bvh' --frames 1 --integrator backward-euler --out '" + (dir / "many") + "'",
+                                  dir);
+  EXPECT_EQ(many.code, 0) << many.err;
+  EXPECT_NE(many.err.find("warning: Skirt: backward Euler is stable at substeps many times the explicit steps' "
+                          "1.23 ms; fewer run faster (e.g. --substeps 5, an eighth)"),
+            std::string::npos)
+      << many.err;
   const CliResult automatic = runDrape("run '" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir +
                                            "/walk.bvh' --frames 3 --integrator backward-euler --substeps auto --out '" +
                                            (dir / "auto") + "'",

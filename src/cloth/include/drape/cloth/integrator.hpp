@@ -17,7 +17,7 @@ namespace drape::cloth {
 /// What an implicit integrator's linear solves took, summed over the substeps so far.
 struct SolveStats {
   long solves = 0;       ///< substeps solved
-  long iterations = 0;   ///< conjugate-gradient iterations (one force evaluation each)
+  long iterations = 0;   ///< conjugate-gradient iterations (one product with the system each)
   long unconverged = 0;  ///< solves that reached the iteration cap above the tolerance
   /// Solves stopped where the system was not positive definite (the cloth compressed or
   /// folded past what the linearisation holds): the step so far was taken.

@@ -341,15 +341,22 @@ void BackwardEuler::advance(const ClothModel& model, const Vec3& g, double h, Cl
     }
   };
 
-  // Preconditioned conjugate gradients from dv = 0. The system is positive definite by
-  // construction; the curvature test guards against what rounding could still make of it.
+  // Preconditioned conjugate gradients from the last substep's dv (filtered: the held
+  // vertices' entries are 0). The system is positive definite by construction; the
+  // curvature test guards against what rounding could still make of it.
   precondition(rhs_, d_);
-  const double target = tolerance_ * tolerance_ * dot(rhs_, d_);
-  // Warm start: the last substep's dv (filtered: the held vertices' entries are 0).
+  const double fromZero = dot(rhs_, d_);  // the residual's measure starting from dv = 0
+  const double target = tolerance_ * tolerance_ * fromZero;
   applySystem(dv_, q_);
   for (std::size_t i = 0; i < 3 * n; ++i) r_[i] = rhs_[i] - q_[i];
   precondition(r_, d_);
   double rz = dot(r_, d_);
+  if (!(rz <= fromZero)) {  // a worse start than none (after a substep that went unstable): from 0
+    std::fill(dv_.begin(), dv_.end(), 0.0);
+    std::copy(rhs_.begin(), rhs_.end(), r_.begin());
+    precondition(r_, d_);
+    rz = fromZero;
+  }
   ++stats_.solves;
   bool converged = !(rz > target);
   for (int k = 0; k < kMaxIterations && !converged; ++k) {
@@ -358,7 +365,8 @@ void BackwardEuler::advance(const ClothModel& model, const Vec3& g, double h, Cl
     const double curvature = dot(d_, q_);
     if (!(curvature > 0.0)) {
       ++stats_.indefinite;
-      if (k == 0) precondition(r_, dv_);
+      if (k == 0)  // the preconditioned residual from the warm start: a damped explicit step
+        for (std::size_t i = 0; i < 3 * n; ++i) dv_[i] += d_[i];
       converged = true;
       break;
     }

@@ -27,6 +27,24 @@ inline Material knit() {
   return m;
 }
 
+/// An isotropic sheet material: Young's modulus E (Pa), thickness t (m), density rho
+/// (kg/m^3), Poisson ratio nu; undamped, bending from E t^3 / (12 (1 - nu^2)).
+inline Material fabric(double E, double t, double rho, double nu = 0.3) {
+  Material m;
+  m.youngsModulus_Pa = E;
+  m.thickness_m = t;
+  m.density_kg_m3 = rho;
+  m.poissonRatio = nu;
+  return m;
+}
+
+/// How far the given vertices hang below their rest places, on average, m.
+inline double meanDrop(const ClothModel& model, const ClothState& state, const std::vector<std::uint32_t>& vertices) {
+  double drop = 0.0;
+  for (const std::uint32_t v : vertices) drop += model.restY()[v] - state.y[v];
+  return drop / static_cast<double>(vertices.size());
+}
+
 /// The given vertices held where the model's rest shape has them.
 inline PinGroup pinAt(const ClothModel& model, std::vector<std::uint32_t> vertices) {
   return PinGroup::atRest(std::move(vertices), model.restX(), model.restY(), model.restZ());

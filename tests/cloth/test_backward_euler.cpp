@@ -14,19 +14,12 @@
 namespace drape::cloth {
 namespace {
 
+using testing::fabric;
 using testing::makeModel;
 using testing::pinAt;
 using testing::row;
 using testing::run;
 using testing::settingsWithStep;
-
-Material fabric(double E, double t, double rho) {
-  Material m;
-  m.youngsModulus_Pa = E;
-  m.thickness_m = t;
-  m.density_kg_m3 = rho;
-  return m;
-}
 
 /// Membrane and bending forces at s's positions (no damping: s's velocities are zero).
 std::vector<double> forcesAt(const ClothModel& model, ClothState s) {
@@ -293,9 +286,7 @@ TEST(BackwardEuler, HangingStripElongationAtThirtyTimesTheExplicitStep) {
   settings.integrator = IntegratorKind::BackwardEuler;
   ClothSolver solver(model, settings, {top});
   ASSERT_TRUE(run(solver, static_cast<long>(1.5 / settings.substep_s())));
-  double drop = 0.0;
-  for (std::uint32_t v : row(spec, 0)) drop += model->restY()[v] - solver.state().y[v];
-  drop /= spec.cellsU + 1;
+  const double drop = testing::meanDrop(*model, solver.state(), row(spec, 0));
   const double expected = rho * 9.81 * L * L / (2 * E);
   EXPECT_NEAR(drop, expected, 0.05 * expected);
   EXPECT_EQ(solver.solveStats().unconverged, 0);

@@ -19,15 +19,6 @@ using testing::pinAt;
 using testing::run;
 using testing::settingsWithStep;
 
-Material plate(double E, double t, double rho) {
-  Material m;
-  m.youngsModulus_Pa = E;
-  m.thickness_m = t;
-  m.density_kg_m3 = rho;
-  m.poissonRatio = 0.3;
-  return m;
-}
-
 /// The largest k whose k substeps stay within the bending forces' stable step.
 int largestBendEvery(const ClothModel& model, const StepSettings& s) {
   return static_cast<int>(std::min<double>(s.substepsPerFrame, model.bendingStableStep_s() / s.substep_s()));
@@ -43,13 +34,13 @@ struct Cantilever {
                  Vec3(-h, 0, 0), Vec3::UnitX(), Vec3::UnitZ(), "cantilever"};
 
   [[nodiscard]] double expectedTip() const {
-    const double D = plate(E, t, rho).bendingModulus();
+    const double D = testing::fabric(E, t, rho).bendingModulus();
     return rho * t * 9.81 * std::pow(L + 0.5 * h, 4) / (8 * D);
   }
   /// Tip deflection after `seconds` with bending every `every` substeps (0: the largest
   /// stable k, returned in *used).
   double tip(int every, double seconds, int* used = nullptr) const {
-    auto model = makeModel(gridSheet(spec), plate(E, t, rho));
+    auto model = makeModel(gridSheet(spec), testing::fabric(E, t, rho));
     StepSettings settings = settingsWithStep(0.5 * model->estimatedStableStep_s(), 60.0);
     settings.bendEvery = every > 0 ? every : std::min(8, largestBendEvery(*model, settings));
     if (used != nullptr) *used = settings.bendEvery;
@@ -79,7 +70,7 @@ TEST(MultirateBending, CantileverSagsAsWhenBendingEverySubstep) {
 // method is symplectic, like the symplectic Euler step inside it).
 TEST(MultirateBending, EnergyStaysBounded) {
   SheetSpec spec{0.3, 0.3, 6, 6, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), "sheet"};
-  Material m = plate(2e4, 1e-3, 300);
+  Material m = testing::fabric(2e4, 1e-3, 300);
   m.bendingStiffness_Nm = 2e-5;  // a fold that swings: bending matters to the motion
   auto model = makeModel(gridSheet(spec), m);
   StepSettings settings = settingsWithStep(0.3 * model->estimatedStableStep_s(), 0.0);
@@ -101,7 +92,7 @@ TEST(MultirateBending, EnergyStaysBounded) {
 
 TEST(MultirateBending, ASpanBeyondTheStableStepIsRefusedNamingTheLargest) {
   SheetSpec spec{0.3, 0.3, 6, 6, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitZ(), "stiff"};
-  Material m = plate(2e4, 1e-3, 300);
+  Material m = testing::fabric(2e4, 1e-3, 300);
   m.bendingStiffness_Nm = 1e-2;  // bending-limited: the largest stable k is small
   auto model = makeModel(gridSheet(spec), m);
   StepSettings settings = settingsWithStep(0.5 * model->estimatedStableStep_s(), 0.0);

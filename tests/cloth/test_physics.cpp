@@ -10,20 +10,12 @@ namespace drape::cloth {
 namespace {
 
 using testing::column;
+using testing::fabric;
 using testing::makeModel;
 using testing::pinAt;
 using testing::row;
 using testing::run;
 using testing::settingsWithStep;
-
-Material fabric(double E, double t, double rho, double nu = 0.3) {
-  Material m;
-  m.youngsModulus_Pa = E;
-  m.thickness_m = t;
-  m.density_kg_m3 = rho;
-  m.poissonRatio = nu;
-  return m;
-}
 
 // ---------------------------------------------------------------------------------------
 TEST(FreeFall, CentreOfMassFallsAtGAndInternalForcesSumToZero) {
@@ -108,9 +100,7 @@ TEST(Membrane, HangingStripElongation) {
   StepSettings settings = settingsWithStep(0.5 * model->estimatedStableStep_s(), 10.0);
   ClothSolver solver(model, settings, {pinAt(*model, row(spec, spec.cellsV))});
   ASSERT_TRUE(run(solver, static_cast<long>(1.5 / settings.substep_s())));
-  double drop = 0.0;
-  for (std::uint32_t v : row(spec, 0)) drop += model->restY()[v] - solver.state().y[v];
-  drop /= spec.cellsU + 1;
+  const double drop = testing::meanDrop(*model, solver.state(), row(spec, 0));
   const double expected = rho * 9.81 * L * L / (2 * E);
   EXPECT_NEAR(drop, expected, 0.05 * expected);
 }

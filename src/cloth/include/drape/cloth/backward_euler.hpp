@@ -11,20 +11,21 @@
 //
 // The forces f0 are the explicit step's own (every kernel, to the bit). The matrices are
 // the positive semi-definite parts of the true ones, so that the system is positive
-// definite and conjugate gradients solve it (the projected Newton step of modern cloth
-// solvers; Baraff and Witkin dropped the same terms):
+// definite and conjugate gradients solve it (a projected Newton step):
 // - membrane: the material stiffness A (dE/dx)^T C (dE/dx) in full, and the geometric
 //   stiffness (grad N_i . S grad N_j) I with the stress S's compressive principal part
-//   dropped (a compressed triangle buckles, it does not push its corners apart harder as it
-//   is pressed), and the internal damping as beta times the material stiffness;
+//   dropped (under compression the exact stiffness is negative out of the sheet's plane: a
+//   step that followed it would push a buckle further), and the internal damping as beta
+//   times the material stiffness;
 // - bending: the Gauss-Newton term k grad psi grad psi^T (the term in (psi - psi0) dropped);
 // - drag: c A_v on the diagonal.
 // Each substep assembles the system as 3x3 blocks over the vertices that share a triangle
 // or a hinge (the pattern built once), from the deformation gradients, clamped stresses and
 // hinge gradients at the substep's start; each conjugate-gradient iteration is one product
-// with it, warm-started from the last substep's dv. The vertices the fixtures place are held (their dv is 0 in the solve,
-// Baraff and Witkin's constraint filter), and the fixtures then place them. The
-// preconditioner is block Jacobi: the inverse of each vertex's 3x3 block of the system.
+// with it, warm-started from the last substep's dv. The vertices the fixtures place are
+// held (their dv is 0 in the solve, Baraff and Witkin's constraint filter), and the
+// fixtures then place them. The preconditioner is block Jacobi: the inverse of each
+// vertex's 3x3 block of the system.
 // docs/PHYSICS.md.
 
 #include <vector>

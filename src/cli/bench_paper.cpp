@@ -101,11 +101,7 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
   if (!character) throw Error(fmt::format("{}: the scene has no avatar", o.scene));
   if (o.collisionEvery > 0)
     for (GarmentSetup& g : setup.garments) g.collisionEvery = o.collisionEvery;
-  if (!o.integrator.empty()) {
-    setup.settings.integrator = cloth::parseIntegrator(o.integrator, "--integrator");
-    // As drape run has it: the implicit solve bends every substep unless told otherwise.
-    if (setup.settings.integrator == cloth::IntegratorKind::BackwardEuler) setup.settings.bendEvery = 1;
-  }
+  if (!o.integrator.empty()) setup.settings.useIntegrator(cloth::parseIntegrator(o.integrator, "--integrator"));
   if (o.bendEvery > 0) setup.settings.bendEvery = o.bendEvery;
   if (o.substeps > 0) setup.settings.substepsPerFrame = o.substeps;
   setup.settings.validate("--");
@@ -166,11 +162,7 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
       r.selfThickness_m = std::max(r.selfThickness_m, self->thickness_m());
     }
     r.framesRefined += world.solver(g).refinedFrames();
-    const cloth::SolveStats solves = world.solver(g).solveStats();
-    r.solves.solves += solves.solves;
-    r.solves.iterations += solves.iterations;
-    r.solves.unconverged += solves.unconverged;
-    r.solves.indefinite += solves.indefinite;
+    r.solves += world.solver(g).solveStats();
   }
   return r;
 }

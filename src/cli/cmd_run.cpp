@@ -193,14 +193,13 @@ void applyOverrides(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   if (app.count("--air-viscosity")) s.airViscosity_Ns_m3 = o.settings.airViscosity_Ns_m3;
   if (app.count("--max-speed")) s.maxSpeed_m_s = o.settings.maxSpeed_m_s;
   if (app.count("--max-added-mass")) s.maxAddedMass = o.settings.maxAddedMass;
+  // The integrator before the rhythm: switching to backward Euler resets it (useIntegrator), and
+  // a --bend-every given with it is then refused by validate(), naming why.
+  if (app.count("--integrator")) s.useIntegrator(cloth::parseIntegrator(o.integrator, "--integrator"));
   if (app.count("--bend-every")) s.bendEvery = o.settings.bendEvery;
   if (app.count("--implicit-tolerance")) s.implicitTolerance = o.settings.implicitTolerance;
   if (app.count("--max-refinement")) s.maxRefinement = o.settings.maxRefinement;
   if (app.count("--strain-limit")) applyStrainLimit(o.strainLimit, s);
-  if (app.count("--integrator")) s.integrator = cloth::parseIntegrator(o.integrator, "--integrator");
-  // The implicit solve takes bending in every substep: a scene's rhythm gives way to it
-  // unless --bend-every says otherwise (which validate() then refuses, naming why).
-  if (s.integrator == cloth::IntegratorKind::BackwardEuler && !app.count("--bend-every")) s.bendEvery = 1;
   if (app.count("--wind")) s.wind_m_s = parseVec3(o.wind, "--wind");
   if (app.count("--gravity")) s.gravity_m_s2 = parseVec3(o.gravity, "--gravity");
   for (GarmentSetup& g : setup.garments) {

@@ -22,6 +22,13 @@ struct SolveStats {
   /// Solves stopped where the system was not positive definite (the cloth compressed or
   /// folded past what the linearisation holds): the step so far was taken.
   long indefinite = 0;
+  SolveStats& operator+=(const SolveStats& o) {
+    solves += o.solves;
+    iterations += o.iterations;
+    unconverged += o.unconverged;
+    indefinite += o.indefinite;
+    return *this;
+  }
   [[nodiscard]] double meanIterations() const {
     return solves > 0 ? static_cast<double>(iterations) / static_cast<double>(solves) : 0.0;
   }

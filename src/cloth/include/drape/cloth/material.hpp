@@ -89,6 +89,12 @@ struct StepSettings {
   double implicitTolerance = 1e-3;
 
   [[nodiscard]] double substep_s() const { return 1.0 / (frameRate_hz * substepsPerFrame); }
+  /// Switches to `kind`. Backward Euler takes bending into its solve every substep, so a
+  /// rhythm set for the explicit steps (bendEvery) gives way to 1.
+  void useIntegrator(IntegratorKind kind) {
+    integrator = kind;
+    if (kind == IntegratorKind::BackwardEuler) bendEvery = 1;
+  }
   /// What ClothModel::build needs to honour maxAddedMass: none for the implicit step, which
   /// needs no mass added to be stable.
   [[nodiscard]] MassScaling massScaling() const {

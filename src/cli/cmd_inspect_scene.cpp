@@ -184,9 +184,10 @@ void inspectScene(const std::string& path, std::ostream& out) {
   fmt::print(out, "simulation{}:\n", s.hasSimulationNode ? "" : " (defaults: no Simulation node)");
   fmt::print(out, "  gravity ({:g} {:g} {:g}) m/s^2, wind ({:g} {:g} {:g}) m/s, air viscosity {:g}\n", sim.gravity.x(),
              sim.gravity.y(), sim.gravity.z(), sim.wind.x(), sim.wind.y(), sim.wind.z(), sim.airViscosity);
-  fmt::print(out, "  {:g} frames/s x {} steps/frame ({}), collisions every {} step{}, bending every {} step{}\n",
-             sim.frameRate, sim.stepsPerFrame, sim.integrator, sim.collisionEvery, sim.collisionEvery == 1 ? "" : "s",
-             sim.bendEvery, sim.bendEvery == 1 ? "" : "s");
+  fmt::print(out, "  {:g} frames/s x {} steps/frame ({}{}), collisions every {} step{}, bending every {} step{}\n",
+             sim.frameRate, sim.stepsPerFrame, sim.integrator,
+             sim.integrator == "backward-euler" ? fmt::format(", solves to {:g}", sim.implicitTolerance) : "",
+             sim.collisionEvery, sim.collisionEvery == 1 ? "" : "s", sim.bendEvery, sim.bendEvery == 1 ? "" : "s");
   fmt::print(out, "  offsets T0..T3 {:g} {:g} {:g} {:g} m, voxel size {:g} m, unit scale {:g} m per file unit\n",
              sim.offsets[0], sim.offsets[1], sim.offsets[2], sim.offsets[3], sim.voxelSize, sim.unitScale);
   fmt::print(out, "  an unstable frame is computed again with up to {} times the steps{}\n", sim.maxRefinement,

@@ -67,6 +67,8 @@ struct MakeSceneOptions {
   double maxAddedMass = 0.02;
   int bendEvery = 0;  ///< --bend-every, or 0: chosen by makeScene from the garment
   int collisionEvery = 1;  ///< --collision-every
+  cloth::IntegratorKind integrator = cloth::IntegratorKind::SymplecticEuler;  ///< --integrator
+  double implicitTolerance = 1e-3;                                             ///< --implicit-tolerance
   double bindThreshold_m = 0.04;
   double selfCollision_m = 0.0;  ///< --self-collision: the ClothSet's selfCollision (0: none)
   double stitchGaps_m = 0.0;  ///< --stitch-gaps: sew boundary vertices facing each other within this, m (0: none)
@@ -166,8 +168,9 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
   fmt::print(os,
              "DEF Simulation Simulation {{\n  gravity 0 -9.81 0\n  frameRate {:g}\n  stepsPerFrame {}\n"
              "  maxAddedMass {:g}\n  airViscosity 0.5\n  offsets [ {:g} {:g} {:g} {:g} ]\n  voxelSize {:g}\n"
-             "  integrator \"symplectic-euler\"\n  collisionEvery {}\n  bendEvery {}\n{}}}\n\n",
-             o.frameRate, o.stepsPerFrame, o.maxAddedMass, t[0], t[1], t[2], t[3], v, o.collisionEvery, o.bendEvery,
+             "{}  collisionEvery {}\n  bendEvery {}\n{}}}\n\n",
+             o.frameRate, o.stepsPerFrame, o.maxAddedMass, t[0], t[1], t[2], t[3], v,
+             integratorFields(o.integrator, o.implicitTolerance), o.collisionEvery, o.bendEvery,
              o.keepApart.empty() ? "" : fmt::format("  keepApart [ \"{}\" ]\n", fmt::join(o.keepApart, "\", \"")));
   writeMaterial(os, o.material);
   fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n{}{}{}{}}}\n\n", o.avatarUrl,
@@ -250,28 +253,47 @@ int makeScene(MakeSceneOptions& o) {
   // The fewest substeps per frame, at least the paper's 33, that mass scaling keeps stable
   // within the allowance; or the count asked for, and what it needs.
   const mesh::Topology topology = mesh::Topology::build(garment);
-  const cloth::SubstepChoice choice =
-      cloth::fewestStableSubsteps(garment, topology, o.material, o.frameRate, o.maxAddedMass, std::max(33, o.stepsPerFrame));
-  if (o.stepsPerFrame == 0) o.stepsPerFrame = choice.substepsPerFrame;
-  const double added = o.stepsPerFrame == choice.substepsPerFrame ? choice.addedMassFraction
-                                                                    : cloth::addedMassFractionAt(garment, topology, o.material,
-                                                                                                 o.frameRate, o.stepsPerFrame);
-  if (added > o.maxAddedMass)
-    throw Error(fmt::format("--substeps {}: mass scaling would add {:.2f} % of the garment's mass, more than "
-                            "--max-added-mass {:g}; {} substeps per frame need no more than that",
-                            o.stepsPerFrame, 100.0 * added, o.maxAddedMass, choice.substepsPerFrame));
-
-  // Unscaled masses: scaling only adds mass, which slows bending, so this is the cautious rhythm;
-  // a rhythm asked for is held to the bending forces' stable step, as drape run holds it.
-  const auto unscaled = cloth::ClothModel::build(garment, topology, o.material);
-  if (o.bendEvery == 0) {
-    o.bendEvery = cloth::suggestedBendEvery(*unscaled, 1.0 / (o.frameRate * o.stepsPerFrame));
+  const bool implicit = o.integrator == cloth::IntegratorKind::BackwardEuler;
+  const cloth::SubstepChoice choice = cloth::fewestStableSubsteps(
+      garment, topology, o.material, o.frameRate, o.maxAddedMass, std::max(33, implicit ? 0 : o.stepsPerFrame));
+  std::string substeps;  // what the choice was, for the summary
+  if (implicit) {
+    // Stable at any substep, with no mass added and bending in every solve: an eighth of the
+    // explicit steps' count unless asked.
+    if (o.bendEvery > 1)
+      throw Error(fmt::format("--bend-every {}: backward Euler takes bending into its solve every substep; leave "
+                              "--bend-every out with --integrator backward-euler",
+                              o.bendEvery));
+    o.bendEvery = 1;
+    o.maxAddedMass = 0.0;
+    if (o.stepsPerFrame == 0) o.stepsPerFrame = cloth::implicitSubstepsFor(choice.substepsPerFrame);
+    substeps = fmt::format("{} substeps per frame at {:g} frames/s, each a backward-Euler solve (the explicit steps "
+                           "would take {} with {:.2f} % of the mass added)",
+                           o.stepsPerFrame, o.frameRate, choice.substepsPerFrame, 100.0 * choice.addedMassFraction);
   } else {
-    cloth::StepSettings rhythm;
-    rhythm.frameRate_hz = o.frameRate;
-    rhythm.substepsPerFrame = o.stepsPerFrame;
-    rhythm.bendEvery = o.bendEvery;
-    cloth::checkBendingStep(*unscaled, rhythm);
+    if (o.stepsPerFrame == 0) o.stepsPerFrame = choice.substepsPerFrame;
+    const double added = o.stepsPerFrame == choice.substepsPerFrame
+                             ? choice.addedMassFraction
+                             : cloth::addedMassFractionAt(garment, topology, o.material, o.frameRate, o.stepsPerFrame);
+    if (added > o.maxAddedMass)
+      throw Error(fmt::format("--substeps {}: mass scaling would add {:.2f} % of the garment's mass, more than "
+                              "--max-added-mass {:g}; {} substeps per frame need no more than that",
+                              o.stepsPerFrame, 100.0 * added, o.maxAddedMass, choice.substepsPerFrame));
+    // Unscaled masses: scaling only adds mass, which slows bending, so this is the cautious
+    // rhythm; a rhythm asked for is held to the bending forces' stable step, as drape run
+    // holds it.
+    const auto unscaled = cloth::ClothModel::build(garment, topology, o.material);
+    if (o.bendEvery == 0) {
+      o.bendEvery = cloth::suggestedBendEvery(*unscaled, 1.0 / (o.frameRate * o.stepsPerFrame));
+    } else {
+      cloth::StepSettings rhythm;
+      rhythm.frameRate_hz = o.frameRate;
+      rhythm.substepsPerFrame = o.stepsPerFrame;
+      rhythm.bendEvery = o.bendEvery;
+      cloth::checkBendingStep(*unscaled, rhythm);
+    }
+    substeps = fmt::format("{} substeps per frame at {:g} frames/s (mass scaling adds {:.2f} % of the mass)",
+                           o.stepsPerFrame, o.frameRate, 100.0 * added);
   }
 
   if (o.stitchGaps_m > 0.0) o.stitches = openingsToSew(garment, topology, o.name, o.stitchGaps_m);
@@ -286,8 +308,7 @@ int makeScene(MakeSceneOptions& o) {
   fmt::print("{}: {} vertices, {} triangles; mask {} vertices\n", o.name, garment.vertexCount(),
              garment.triangleCount(), mask.vertexCount());
   fmt::print("collides with {}\n", fmt::join(o.collidesWith, ", "));
-  fmt::print("{} substeps per frame at {:g} frames/s (mass scaling adds {:.2f} % of the mass)\n", o.stepsPerFrame,
-             o.frameRate, 100.0 * added);
+  fmt::print("{}\n", substeps);
   if (!o.stitches.empty())
     fmt::print("{} stitches across gaps of up to {:.1f} mm\n", o.stitches.size(), 1e3 * widestStitch_m(garment, o.stitches));
   fmt::print("wrote {}/scene.wrl, {}.obj, {}_mask.obj\n", o.out, o.name, o.name);
@@ -421,6 +442,15 @@ RunFunction setupMakeScene(CLI::App& app) {
       ->check(CLI::Range(1, 1000));
   app.add_option("--max-added-mass", o.maxAddedMass, "Mass scaling allowed, a fraction of the garment's mass")
       ->capture_default_str();
+  app.add_option_function<std::string>(
+      "--integrator", [](const std::string& name) { o.integrator = cloth::parseIntegrator(name); },
+      "The scene's integrator: symplectic-euler (default), forward-euler or backward-euler (implicit: no mass "
+      "added, bending every substep, and by default an eighth of the explicit steps' substeps)");
+  app.add_option("--implicit-tolerance", o.implicitTolerance,
+                 "backward-euler: the residual at which each substep's solve stops, written as the scene's "
+                 "implicitTolerance")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-12, 0.999));
   app.add_option("--youngs-modulus", o.material.youngsModulus_Pa, "The knit's Young's modulus, Pa")->capture_default_str();
   app.add_option("--bind-threshold", o.bindThreshold_m, "Written into the ClothSet, m")->capture_default_str();
   app.add_option("--stitch-gaps", o.stitchGaps_m,
@@ -441,8 +471,8 @@ RunFunction setupMakeScene(CLI::App& app) {
       throw Error(fmt::format("--units {}: applies to OBJ files; {} and {} state their own unit", o.units, o.garment, o.mask));
     if (!addingToScene(app, o.add, "make-scene", o.avatar, o.out,
                        {"--out", "--avatar-url", "--title", "--voxel", "--frame-rate", "--substeps", "--bend-every",
-                        "--collision-every", "--max-added-mass", "--keep-apart", "--cut-at-joints", "--avatar-meshes",
-                        "--avatar-drawn-meshes"}))
+                        "--collision-every", "--max-added-mass", "--integrator", "--implicit-tolerance",
+                        "--keep-apart", "--cut-at-joints", "--avatar-meshes", "--avatar-drawn-meshes"}))
       return makeScene(o);
     return addGarment(o);
   };

@@ -50,6 +50,8 @@ struct MakeSkirtOptions {
   bool bindThresholdGiven = false;  ///< --bind-threshold given (else: as far as the waistband needs, at least 0.04 m)
   bool waistGiven = false, hipsGiven = false, legsGiven = false;  ///< --waist-segment, --hip-segments, --leg-segments
   bool withArms = false;                  ///< --with-arms
+  cloth::IntegratorKind integrator = cloth::IntegratorKind::SymplecticEuler;  ///< --integrator
+  double implicitTolerance = 1e-3;                                             ///< --implicit-tolerance
   std::vector<std::string> armSegments;   ///< with --with-arms: the forearms, hands and fingers, collidable too
   std::vector<std::string> keptApart;     ///< with --with-arms: the upper arms and forearms, the scene's keepApart
   std::string avatarRotation;             ///< the Avatar node's rotation that stands a body up along +y; "" : none
@@ -91,10 +93,15 @@ int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::S
   const cloth::Material m = knit();
   // The paper's 33 substeps per frame, or as many more as this skirt's smallest elements and
   // the knit's damping need (a small avatar's skirt has smaller, stiffer triangles).
-  const int kSubsteps =
+  const int explicitSubsteps =
       cloth::fewestStableSubsteps(skirt.mesh, mesh::Topology::build(skirt.mesh), m, kFrameRate, 0.0, 33).substepsPerFrame;
-  const int bendEvery = cloth::suggestedBendEvery(
-      *cloth::ClothModel::build(skirt.mesh, mesh::Topology::build(skirt.mesh), m), 1.0 / (kFrameRate * kSubsteps));
+  // Backward Euler: an eighth of those, bending in every solve.
+  const bool implicit = o.integrator == cloth::IntegratorKind::BackwardEuler;
+  const int kSubsteps = implicit ? cloth::implicitSubstepsFor(explicitSubsteps) : explicitSubsteps;
+  const int bendEvery =
+      implicit ? 1
+               : cloth::suggestedBendEvery(*cloth::ClothModel::build(skirt.mesh, mesh::Topology::build(skirt.mesh), m),
+                                           1.0 / (kFrameRate * kSubsteps));
   std::ofstream os(path);
   fmt::print(os, "#VRML V2.0 utf8\n");
   const std::string own = ownMotionText(avatar);
@@ -113,9 +120,10 @@ int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::S
   const int digits = voxel >= 0.001 ? 3 : 5;  // whole millimetres, or a small avatar's hundredths
   fmt::print(os, "DEF Simulation Simulation {{\n  gravity 0 -9.81 0\n  frameRate {:g}\n  stepsPerFrame {}\n"
                  "  airViscosity 0.5\n  offsets [ {:.{}f} {:.{}f} {:.{}f} {:.{}f} ]\n  voxelSize {:.{}f}\n"
-                 "  integrator \"symplectic-euler\"\n  collisionEvery 1\n  bendEvery {}\n{}}}\n\n",
+                 "{}  collisionEvery 1\n  bendEvery {}\n{}}}\n\n",
              kFrameRate, kSubsteps, voxel, digits, 2 * voxel, digits, 3 * voxel, digits, 6 * voxel, digits, voxel,
-             digits, bendEvery, stringsField("keepApart", o.keptApart));
+             digits, integratorFields(o.integrator, o.implicitTolerance), bendEvery,
+             stringsField("keepApart", o.keptApart));
   writeMaterial(os, m);
   fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n{}{}{}}}\n\n", o.avatarUrl,
              o.avatarRotation.empty() ? "" : fmt::format("  rotation {}\n", o.avatarRotation),
@@ -260,7 +268,8 @@ int makeSkirt(MakeSkirtOptions o) {
                     "drape make-skirt: constraint mask (m)");
   const int substeps = writeScene((dir / "scene.wrl").string(), written, skirt, avatar);
   printSkirt(o.name == "Skirt" ? "skirt" : o.name, skirt);
-  fmt::print("; {} substeps per frame\n", substeps);
+  fmt::print("; {} substeps per frame{}\n", substeps,
+             o.integrator == cloth::IntegratorKind::BackwardEuler ? ", each a backward-Euler solve" : "");
   sayWhereTheVoxelIsScaled(
       scale, o.avatar,
       o.clearanceGiven ? "" : "; " + scaledClearance(o.fit.clearance_m));
@@ -365,6 +374,15 @@ RunFunction setupMakeSkirt(CLI::App& app) {
                  "or found as the waist is); its default length reaches a little above the knees")
       ->delimiter(',')
       ->capture_default_str();
+  app.add_option_function<std::string>(
+      "--integrator", [](const std::string& name) { o.integrator = cloth::parseIntegrator(name); },
+      "The scene's integrator: symplectic-euler (default), forward-euler or backward-euler (implicit: an eighth "
+      "of the explicit steps' substeps, bending in every one)");
+  app.add_option("--implicit-tolerance", o.implicitTolerance,
+                 "backward-euler: the residual at which each substep's solve stops, written as the scene's "
+                 "implicitTolerance")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-12, 0.999));
   app.add_flag("--with-arms", o.withArms,
                "Collide with the forearms, hands and fingers too (found by the skeleton's shape), so that swinging "
                "arms push the skirt instead of sinking into it; costs a collision test per part");
@@ -379,7 +397,7 @@ RunFunction setupMakeSkirt(CLI::App& app) {
     o.waistGiven = app.count("--waist-segment") > 0;
     o.hipsGiven = app.count("--hip-segments") > 0;
     o.legsGiven = app.count("--leg-segments") > 0;
-    if (!addingToScene(app, o.add, "make-skirt", o.avatar, o.out, {"--out", "--avatar-url", "--avatar-meshes", "--avatar-drawn-meshes"})) return makeSkirt(o);
+    if (!addingToScene(app, o.add, "make-skirt", o.avatar, o.out, {"--out", "--avatar-url", "--avatar-meshes", "--avatar-drawn-meshes", "--integrator", "--implicit-tolerance"})) return makeSkirt(o);
     return addSkirt(o);
   };
 }

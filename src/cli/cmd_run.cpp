@@ -554,8 +554,8 @@ RunFunction setupRun(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--implicit-tolerance", s.implicitTolerance,
                  "backward-euler: each substep's linear solve stops at this residual relative to its right-hand "
-                 "side (smaller: more iterations, closer to the exact implicit step)")
-      ->capture_default_str();
+                 "side (smaller: more iterations, closer to the exact implicit step; default: the scene's "
+                 "implicitTolerance, 0.001)");
   app.add_option("--air-viscosity", s.airViscosity_Ns_m3, "Linear air drag per area, N s/m^3")->capture_default_str();
   app.add_option("--wind", o->wind, "Wind velocity x,y,z, m/s");
   app.add_option("--gravity", o->gravity, "Gravity x,y,z, m/s^2 (default 0,-9.81,0)");

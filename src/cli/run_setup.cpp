@@ -1000,7 +1000,7 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
       if (settings.substepsPerFrame > 8 && settings.substep_s() < 2.0 * stable)
         spdlog::warn("{}: backward Euler is stable at substeps many times the explicit steps' {:.3g} ms; fewer "
                      "run faster (e.g. --substeps {}, an eighth)",
-                     g.name, 1e3 * stable, (settings.substepsPerFrame + 7) / 8);
+                     g.name, 1e3 * stable, cloth::implicitSubstepsFor(settings.substepsPerFrame));
     } else if (settings.substep_s() > stable)
       spdlog::warn("{}: the substep {:.3g} s is longer than the estimated stable step {:.3g} s; "
                    "the run may diverge (try --substeps {} or more)",

@@ -28,6 +28,14 @@ inline std::string stringsField(const std::string& name, const std::vector<std::
   return fmt::format("  {} [ {} ]\n", name, fmt::join(quoted, ", "));
 }
 
+/// A Simulation node's integrator lines: its name and, for backward Euler, the tolerance of
+/// its solves.
+inline std::string integratorFields(cloth::IntegratorKind kind, double implicitTolerance) {
+  std::string text = fmt::format("  integrator \"{}\"\n", cloth::integratorName(kind));
+  if (kind == cloth::IntegratorKind::BackwardEuler) text += fmt::format("  implicitTolerance {:g}\n", implicitTolerance);
+  return text;
+}
+
 /// The coord and coordIndex fields of an IndexedFaceSet, one vertex or triangle per line.
 inline void writeIndexedFaceSet(std::ostream& os, const mesh::TriMesh& m, const std::string& indent) {
   fmt::print(os, "{}coord Coordinate {{ point [\n", indent);

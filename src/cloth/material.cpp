@@ -56,6 +56,8 @@ IntegratorKind parseIntegrator(const std::string& text, const std::string& optio
   throw Error(fmt::format("{} must be symplectic-euler, forward-euler or backward-euler, got '{}'", option, text));
 }
 
+int implicitSubstepsFor(int explicitSubsteps) { return std::max(2, (explicitSubsteps + 7) / 8); }
+
 void StepSettings::validate(const std::string& prefix) const {
   require(frameRate_hz > 0.0 && std::isfinite(frameRate_hz), prefix, "frame-rate", "> 0 frames/s", frameRate_hz);
   require(substepsPerFrame >= 1 && substepsPerFrame <= 100000, prefix, "substeps", "in [1, 100000]",

@@ -126,6 +126,11 @@ void validate(const SimulationSettings& s) {
   };
   stretch(s.strainLimit, "strainLimit");
   stretch(s.rescueStrainLimit, "rescueStrainLimit");
+  if (!(s.implicitTolerance > 0.0 && s.implicitTolerance < 1.0))
+    bad(s.source, node,
+        fmt::format("implicitTolerance {:g} must be a fraction in (0, 1) (the residual at which a backward-Euler "
+                    "solve stops, against its start's; default 0.001)",
+                    s.implicitTolerance));
   if (!std::isfinite(s.airViscosity) || s.airViscosity < 0.0)
     bad(s.source, node, fmt::format("airViscosity {:g} is negative", s.airViscosity));
   if (!s.gravity.allFinite() || !s.wind.allFinite()) bad(s.source, node, "gravity and wind must be finite");

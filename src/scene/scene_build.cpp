@@ -165,6 +165,8 @@ class Builder {
       take("strainLimit", [&] { s.strainLimit = number(n, "strainLimit", s.strainLimit); });
       take("rescueStrainLimit",
            [&] { s.rescueStrainLimit = number(n, "rescueStrainLimit", s.rescueStrainLimit); });
+      take("implicitTolerance",
+           [&] { s.implicitTolerance = number(n, "implicitTolerance", s.implicitTolerance); });
       take("keepApart", [&] { s.keepApart = strings(n, "keepApart"); });
       if (const Field* f = n.field("unitScale"); f != nullptr && !f->isDefault)
         take("unitScale", [&] { s.unitScale = number(n, "unitScale", 1.0); });

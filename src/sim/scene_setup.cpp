@@ -65,6 +65,7 @@ cloth::StepSettings toStepSettings(const scene::SimulationSettings& s) {
   c.maxRefinement = s.maxRefinement;
   c.strainLimit = s.strainLimit;
   c.rescueStrainLimit = s.rescueStrainLimit;
+  c.implicitTolerance = s.implicitTolerance;
   c.integrator = cloth::parseIntegrator(s.integrator, "Simulation.integrator");
   return c;
 }

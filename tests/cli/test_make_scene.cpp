@@ -360,5 +360,61 @@ TEST(MakeScene, TooFewSubstepsForTheAddedMassIsAClearError) {
   EXPECT_NE(ran.err.find("substeps per frame"), std::string::npos) << ran.err;
 }
 
+TEST(MakeScene, BackwardEulerAsksAnEighthOfTheSubstepsAndNoMass) {
+  // The walking dress as its README makes it, but implicit: where the explicit steps need
+  // about 150 substeps a frame with mass added, an eighth of them, nothing added and bending
+  // every substep; it walks out of the body.
+  ScratchDir dir("make-scene-implicit");
+  const std::string sceneDir = dir / "dress";
+  const CliResult made = runDrape(
+      "make-scene '" + kSource + "/data/avatars/makehuman_rig_cmu_mb.mhskel' --garment '" + kSource +
+          "/data/garments/makehuman_female_elegantsuit01_dress.mhclo' --units dm --mask '" + kSource +
+          "/examples/walking_dress/mask.obj' --name dress --offsets 0.002,0.004,0.006,0.016 --collides-with "
+          "Hips,LowerBack,Spine,Spine1,Neck,LeftShoulder,RightShoulder,LeftArm,RightArm,LeftForeArm,RightForeArm,"
+          "LeftUpLeg,RightUpLeg,LeftLeg,RightLeg --face-samples-with LeftUpLeg,RightUpLeg,LeftLeg,RightLeg "
+          "--keep-apart LeftForeArm,RightForeArm,LeftArm,RightArm --cut-at-joints LeftArm,RightArm,LeftUpLeg,RightUpLeg "
+          "--stitch-gaps 0.02 --integrator backward-euler --out '" +
+          sceneDir + "'",
+      dir);
+  ASSERT_EQ(made.code, 0) << made.err;
+  const scene::Scene sc = scene::loadScene(sceneDir + "/scene.wrl");
+  EXPECT_EQ(sc.simulation.integrator, "backward-euler");
+  EXPECT_EQ(sc.simulation.maxAddedMass, 0.0);
+  EXPECT_EQ(sc.simulation.bendEvery, 1);
+  EXPECT_NEAR(sc.simulation.implicitTolerance, 1e-3, 1e-9);
+  EXPECT_GE(sc.simulation.stepsPerFrame, 15);
+  EXPECT_LE(sc.simulation.stepsPerFrame, 25);
+  EXPECT_NE(made.out.find(std::to_string(sc.simulation.stepsPerFrame) +
+                          " substeps per frame at 30 frames/s, each a backward-Euler solve (the explicit steps would "
+                          "take "),
+            std::string::npos)
+      << made.out;
+  const std::string out = dir / "out";
+  const CliResult ran = runDrape("run '" + sceneDir + "/scene.wrl' --motion '" + kSource +
+                                     "/examples/walking_skirt/walk.bvh' --frames 10 --out '" + out + "'",
+                                 dir);
+  ASSERT_EQ(ran.code, 0) << ran.err;
+  EXPECT_EQ(ran.err.find("fewer run faster"), std::string::npos) << ran.err;
+  const nlohmann::json stats = statsOf(out);
+  EXPECT_EQ(stats["integrator"], "backward-euler");
+  EXPECT_EQ(stats["vertex_substeps_inside_body"].get<long>(), 0);
+  const nlohmann::json& g = stats["garments"][0];
+  EXPECT_EQ(g["added_mass_kg"].get<double>(), 0.0);
+  EXPECT_EQ(g["implicit_solves"]["unconverged"].get<long>(), 0);
+
+  // A bending rhythm cannot go with it; a name that is not an integrator is refused.
+  const CliResult rhythm =
+      runDrape(makeDressScene("obj", "--integrator backward-euler --bend-every 2", dir / "rhythm"), dir);
+  EXPECT_EQ(rhythm.code, 2) << rhythm.err;
+  EXPECT_NE(rhythm.err.find("--bend-every 2: backward Euler takes bending into its solve every substep"),
+            std::string::npos)
+      << rhythm.err;
+  const CliResult unknown = runDrape(makeDressScene("obj", "--integrator implicit", dir / "unknown"), dir);
+  EXPECT_NE(unknown.code, 0);
+  EXPECT_NE(unknown.err.find("--integrator must be symplectic-euler, forward-euler or backward-euler, got 'implicit'"),
+            std::string::npos)
+      << unknown.err;
+}
+
 }  // namespace
 }  // namespace drape

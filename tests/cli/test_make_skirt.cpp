@@ -569,5 +569,39 @@ TEST(MakeSkirt, CesiumMansWalkAsColladaAndFbxDrivesTheSameBody) {
   }
 }
 
+TEST(MakeSkirt, BackwardEulerWritesAnImplicitSceneThatWalks) {
+  // An eighth of the paper's 33 substeps, rounded up, each a backward-Euler solve to the
+  // tolerance asked for; the skirt walks out of the body with every solve converged.
+  ScratchDir dir("make-skirt-implicit");
+  const std::string out = dir / "skirt";
+  const CliResult r = runDrape("make-skirt '" + kAvatars +
+                                   "/makehuman_rig_cmu_mb.mhskel' --integrator backward-euler --implicit-tolerance "
+                                   "0.0005 --out '" + out + "'",
+                               dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("; 5 substeps per frame, each a backward-Euler solve\n"), std::string::npos) << r.out;
+  const scene::Scene sc = scene::loadScene(out + "/scene.wrl");
+  EXPECT_EQ(sc.simulation.integrator, "backward-euler");
+  EXPECT_EQ(sc.simulation.stepsPerFrame, 5);
+  EXPECT_EQ(sc.simulation.bendEvery, 1);
+  EXPECT_NEAR(sc.simulation.implicitTolerance, 5e-4, 1e-10);
+  const CliResult ran = walk(dir, out + "/scene.wrl", 40);
+  ASSERT_EQ(ran.code, 0) << ran.err;
+  EXPECT_NE(ran.err.find("Skirt: backward Euler, 5 substeps per frame"), std::string::npos) << ran.err;
+  const nlohmann::json stats = statsOf(dir / "walk");
+  EXPECT_EQ(stats["vertex_substeps_inside_body"].get<long>(), 0);
+  const nlohmann::json& solves = stats["garments"][0]["implicit_solves"];
+  EXPECT_GE(solves["substeps"].get<long>(), 40 * 5);
+  EXPECT_EQ(solves["unconverged"].get<long>(), 0);
+  // The scene's tolerance is the run's: a tighter one takes more iterations per solve.
+  const CliResult looser = runDrape("run '" + out + "/scene.wrl' --motion '" + std::string(DRAPE_SOURCE_DIR) +
+                                        "/examples/walking_skirt/walk.bvh' --frames 40 --implicit-tolerance 0.01 "
+                                        "--out '" + (dir / "looser") + "'",
+                                    dir);
+  ASSERT_EQ(looser.code, 0) << looser.err;
+  EXPECT_LT(statsOf(dir / "looser")["garments"][0]["implicit_solves"]["mean_iterations"].get<double>(),
+            solves["mean_iterations"].get<double>());
+}
+
 }  // namespace
 }  // namespace drape

@@ -92,7 +92,7 @@ TEST(VrmlScene, EveryFieldWithValues) {
       "#VRML V2.0 utf8\n"
       "Simulation { gravity 0 0 -9.8 frameRate 25 stepsPerFrame 40 airViscosity 0.05 wind 1 0 0.5\n"
       "  offsets [ 0.001 0.002 0.003 0.004 ] voxelSize 0.005 integrator \"euler\" collisionEvery 2 bendEvery 4 unitScale 0.01\n"
-      "  maxRefinement 4 strainLimit 0.25 rescueStrainLimit 0.75\n"
+      "  maxRefinement 4 strainLimit 0.25 rescueStrainLimit 0.75 implicitTolerance 0.0002\n"
       "  keepApart [ \"LeftForeArm\", \"RightForeArm\" ] }\n"
       "DEF Body Humanoid { humanoidBody DEF Root Joint { name \"root\" children [ DEF Hips Segment { name \"hips\" "
       "children Shape { geometry Box { } } } ] } }\n"
@@ -122,6 +122,7 @@ TEST(VrmlScene, EveryFieldWithValues) {
   EXPECT_EQ(sim.maxRefinement, 4);
   EXPECT_NEAR(sim.strainLimit, 0.25, 1e-7);
   EXPECT_NEAR(sim.rescueStrainLimit, 0.75, 1e-7);
+  EXPECT_NEAR(sim.implicitTolerance, 0.0002, 1e-10);
   EXPECT_EQ(sim.keepApart, (std::vector<std::string>{"LeftForeArm", "RightForeArm"}));
   EXPECT_NEAR(sim.unitScale, 0.01, 1e-9);
 
@@ -184,6 +185,7 @@ TEST(VrmlScene, EveryFieldDefaults) {
   EXPECT_EQ(s.simulation.maxRefinement, defaults.maxRefinement);
   EXPECT_EQ(s.simulation.strainLimit, defaults.strainLimit);
   EXPECT_NEAR(s.simulation.rescueStrainLimit, defaults.rescueStrainLimit, 1e-7);
+  EXPECT_NEAR(s.simulation.implicitTolerance, defaults.implicitTolerance, 1e-10);
   EXPECT_TRUE(s.simulation.keepApart.empty());
   EXPECT_EQ(s.simulation.unitScale, 1.0);
   const ClothMaterial md;
@@ -417,6 +419,13 @@ TEST(VrmlScene, MoreDomainErrors) {
   EXPECT_NE(errorOf([&] { (void)fromText("#VRML V2.0 utf8\nSimulation { rescueStrainLimit 11 }\n"); })
                 .find("rescueStrainLimit 11 must be a stretch beyond the rest length in [0, 10]"),
             std::string::npos);
+  for (const char* tolerance : {"0", "1", "-0.1"})
+    EXPECT_NE(errorOf([&] {
+                (void)fromText(std::string("#VRML V2.0 utf8\nSimulation {\n  implicitTolerance ") + tolerance + " }\n");
+              }).find(std::string("scene.wrl:3: Simulation: implicitTolerance ") + tolerance +
+                      " must be a fraction in (0, 1)"),
+              std::string::npos)
+        << tolerance;
 }
 
 // The CLI: `drape inspect` on a scene and on a bad file (exit code 2, one line).

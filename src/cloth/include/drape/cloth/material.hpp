@@ -45,6 +45,12 @@ enum class IntegratorKind {
 [[nodiscard]] std::string integratorName(IntegratorKind kind);
 /// Parses the names above; throws drape::Error naming `option` otherwise.
 [[nodiscard]] IntegratorKind parseIntegrator(const std::string& text, const std::string& option = "--integrator");
+/// Substeps per frame to give backward Euler where the explicit steps need
+/// `explicitSubsteps`: an eighth, at least 2. Measured on the bundled garments
+/// (docs/PERFORMANCE.md, "Backward Euler"): the skirt's 33 and the dress's 155 at an eighth
+/// keep them out of the body, and the implicit step costs about what an eighth of the
+/// explicit ones would have (fewer give a longer stride to the collision response).
+[[nodiscard]] int implicitSubstepsFor(int explicitSubsteps);
 
 /// Mass scaling (explicit finite elements' standard remedy for a few tiny elements): mass is
 /// added to the triangles and hinges whose own stable step is shorter than targetStep_s,

@@ -60,6 +60,9 @@ struct SimulationSettings {
   /// The same, from a frame no refinement keeps stable on, for the rest of the run; 0: such a
   /// frame stops the run. Without effect while strainLimit is on.
   double rescueStrainLimit = 0.5;
+  /// Backward Euler's linear solves stop at this residual, a fraction of the right-hand
+  /// side's (cloth::StepSettings::implicitTolerance).
+  double implicitTolerance = 1e-3;
   double unitScale = 1.0;                       ///< metres per file unit (applied to all geometry on load)
   /// Body parts whose motion is corrected to keep them out of the collidable parts they go
   /// into (a forearm swung through the back; sim/keep_apart.hpp).

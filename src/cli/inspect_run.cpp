@@ -264,7 +264,7 @@ void printSummary(const std::string& directory, const render::RunReplay& run, co
           : fmt::format("largest edge strain {:.1f} % (stretched or compressed)", 100.0 * number("max_strain"));
   fmt::print(out,
              "  stats.json: {:.0f} frames simulated, {:.3f} ms per frame; vertex-substeps inside the body {:.0f} of {:.0f} "
-             "(deepest {:.1f} mm), below T1 {:.0f}; {} (at the end of a frame); {}\n",
+             "(deepest {:.3g} mm), below T1 {:.0f}; {} (at the end of a frame); {}\n",
              number("frames"), number("ms_per_frame"), number("vertex_substeps_inside_body"), number("vertex_substeps"),
              number("max_penetration_m") * 1000.0, number("vertex_substeps_below_T1"), strain,
              unstable ? "went unstable (see its \"instability\")" : "stable");

@@ -67,8 +67,7 @@ struct MakeSceneOptions {
   double maxAddedMass = 0.02;
   int bendEvery = 0;  ///< --bend-every, or 0: chosen by makeScene from the garment
   int collisionEvery = 1;  ///< --collision-every
-  cloth::IntegratorKind integrator = cloth::IntegratorKind::SymplecticEuler;  ///< --integrator
-  double implicitTolerance = 1e-3;                                             ///< --implicit-tolerance
+  SceneIntegrator integrator;  ///< --integrator, --implicit-tolerance
   double bindThreshold_m = 0.04;
   double selfCollision_m = 0.0;  ///< --self-collision: the ClothSet's selfCollision (0: none)
   double stitchGaps_m = 0.0;  ///< --stitch-gaps: sew boundary vertices facing each other within this, m (0: none)
@@ -169,8 +168,8 @@ void writeScene(const std::string& path, const MakeSceneOptions& o, const mesh::
              "DEF Simulation Simulation {{\n  gravity 0 -9.81 0\n  frameRate {:g}\n  stepsPerFrame {}\n"
              "  maxAddedMass {:g}\n  airViscosity 0.5\n  offsets [ {:g} {:g} {:g} {:g} ]\n  voxelSize {:g}\n"
              "{}  collisionEvery {}\n  bendEvery {}\n{}}}\n\n",
-             o.frameRate, o.stepsPerFrame, o.maxAddedMass, t[0], t[1], t[2], t[3], v,
-             integratorFields(o.integrator, o.implicitTolerance), o.collisionEvery, o.bendEvery,
+             o.frameRate, o.stepsPerFrame, o.maxAddedMass, t[0], t[1], t[2], t[3], v, o.integrator.fields(),
+             o.collisionEvery, o.bendEvery,
              o.keepApart.empty() ? "" : fmt::format("  keepApart [ \"{}\" ]\n", fmt::join(o.keepApart, "\", \"")));
   writeMaterial(os, o.material);
   fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n{}{}{}{}}}\n\n", o.avatarUrl,
@@ -253,7 +252,7 @@ int makeScene(MakeSceneOptions& o) {
   // The fewest substeps per frame, at least the paper's 33, that mass scaling keeps stable
   // within the allowance; or the count asked for, and what it needs.
   const mesh::Topology topology = mesh::Topology::build(garment);
-  const bool implicit = o.integrator == cloth::IntegratorKind::BackwardEuler;
+  const bool implicit = o.integrator.implicit();
   const cloth::SubstepChoice choice = cloth::fewestStableSubsteps(
       garment, topology, o.material, o.frameRate, o.maxAddedMass, std::max(33, implicit ? 0 : o.stepsPerFrame));
   std::string substeps;  // what the choice was, for the summary
@@ -442,15 +441,7 @@ RunFunction setupMakeScene(CLI::App& app) {
       ->check(CLI::Range(1, 1000));
   app.add_option("--max-added-mass", o.maxAddedMass, "Mass scaling allowed, a fraction of the garment's mass")
       ->capture_default_str();
-  app.add_option_function<std::string>(
-      "--integrator", [](const std::string& name) { o.integrator = cloth::parseIntegrator(name); },
-      "The scene's integrator: symplectic-euler (default), forward-euler or backward-euler (implicit: no mass "
-      "added, bending every substep, and by default an eighth of the explicit steps' substeps)");
-  app.add_option("--implicit-tolerance", o.implicitTolerance,
-                 "backward-euler: the residual at which each substep's solve stops, written as the scene's "
-                 "implicitTolerance")
-      ->capture_default_str()
-      ->check(CLI::Range(1e-12, 0.999));
+  o.integrator.addOptions(app, "and by default an eighth of the explicit steps' substeps");
   app.add_option("--youngs-modulus", o.material.youngsModulus_Pa, "The knit's Young's modulus, Pa")->capture_default_str();
   app.add_option("--bind-threshold", o.bindThreshold_m, "Written into the ClothSet, m")->capture_default_str();
   app.add_option("--stitch-gaps", o.stitchGaps_m,

@@ -50,8 +50,7 @@ struct MakeSkirtOptions {
   bool bindThresholdGiven = false;  ///< --bind-threshold given (else: as far as the waistband needs, at least 0.04 m)
   bool waistGiven = false, hipsGiven = false, legsGiven = false;  ///< --waist-segment, --hip-segments, --leg-segments
   bool withArms = false;                  ///< --with-arms
-  cloth::IntegratorKind integrator = cloth::IntegratorKind::SymplecticEuler;  ///< --integrator
-  double implicitTolerance = 1e-3;                                             ///< --implicit-tolerance
+  SceneIntegrator integrator;  ///< --integrator, --implicit-tolerance
   std::vector<std::string> armSegments;   ///< with --with-arms: the forearms, hands and fingers, collidable too
   std::vector<std::string> keptApart;     ///< with --with-arms: the upper arms and forearms, the scene's keepApart
   std::string avatarRotation;             ///< the Avatar node's rotation that stands a body up along +y; "" : none
@@ -96,7 +95,7 @@ int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::S
   const int explicitSubsteps =
       cloth::fewestStableSubsteps(skirt.mesh, mesh::Topology::build(skirt.mesh), m, kFrameRate, 0.0, 33).substepsPerFrame;
   // Backward Euler: an eighth of those, bending in every solve.
-  const bool implicit = o.integrator == cloth::IntegratorKind::BackwardEuler;
+  const bool implicit = o.integrator.implicit();
   const int kSubsteps = implicit ? cloth::implicitSubstepsFor(explicitSubsteps) : explicitSubsteps;
   const int bendEvery =
       implicit ? 1
@@ -122,7 +121,7 @@ int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::S
                  "  airViscosity 0.5\n  offsets [ {:.{}f} {:.{}f} {:.{}f} {:.{}f} ]\n  voxelSize {:.{}f}\n"
                  "{}  collisionEvery 1\n  bendEvery {}\n{}}}\n\n",
              kFrameRate, kSubsteps, voxel, digits, 2 * voxel, digits, 3 * voxel, digits, 6 * voxel, digits, voxel,
-             digits, integratorFields(o.integrator, o.implicitTolerance), bendEvery,
+             digits, o.integrator.fields(), bendEvery,
              stringsField("keepApart", o.keptApart));
   writeMaterial(os, m);
   fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n{}{}{}}}\n\n", o.avatarUrl,
@@ -269,7 +268,7 @@ int makeSkirt(MakeSkirtOptions o) {
   const int substeps = writeScene((dir / "scene.wrl").string(), written, skirt, avatar);
   printSkirt(o.name == "Skirt" ? "skirt" : o.name, skirt);
   fmt::print("; {} substeps per frame{}\n", substeps,
-             o.integrator == cloth::IntegratorKind::BackwardEuler ? ", each a backward-Euler solve" : "");
+             o.integrator.implicit() ? ", each a backward-Euler solve" : "");
   sayWhereTheVoxelIsScaled(
       scale, o.avatar,
       o.clearanceGiven ? "" : "; " + scaledClearance(o.fit.clearance_m));
@@ -374,15 +373,7 @@ RunFunction setupMakeSkirt(CLI::App& app) {
                  "or found as the waist is); its default length reaches a little above the knees")
       ->delimiter(',')
       ->capture_default_str();
-  app.add_option_function<std::string>(
-      "--integrator", [](const std::string& name) { o.integrator = cloth::parseIntegrator(name); },
-      "The scene's integrator: symplectic-euler (default), forward-euler or backward-euler (implicit: an eighth "
-      "of the explicit steps' substeps, bending in every one)");
-  app.add_option("--implicit-tolerance", o.implicitTolerance,
-                 "backward-euler: the residual at which each substep's solve stops, written as the scene's "
-                 "implicitTolerance")
-      ->capture_default_str()
-      ->check(CLI::Range(1e-12, 0.999));
+  o.integrator.addOptions(app, "an eighth of the explicit steps' substeps");
   app.add_flag("--with-arms", o.withArms,
                "Collide with the forearms, hands and fingers too (found by the skeleton's shape), so that swinging "
                "arms push the skirt instead of sinking into it; costs a collision test per part");

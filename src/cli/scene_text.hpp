@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <fmt/ostream.h>
 #include <fmt/ranges.h>
@@ -28,13 +29,33 @@ inline std::string stringsField(const std::string& name, const std::vector<std::
   return fmt::format("  {} [ {} ]\n", name, fmt::join(quoted, ", "));
 }
 
-/// A Simulation node's integrator lines: its name and, for backward Euler, the tolerance of
-/// its solves.
-inline std::string integratorFields(cloth::IntegratorKind kind, double implicitTolerance) {
-  std::string text = fmt::format("  integrator \"{}\"\n", cloth::integratorName(kind));
-  if (kind == cloth::IntegratorKind::BackwardEuler) text += fmt::format("  implicitTolerance {:g}\n", implicitTolerance);
-  return text;
-}
+/// The integrator a written scene's Simulation node names (`--integrator`,
+/// `--implicit-tolerance` of make-skirt and make-scene).
+struct SceneIntegrator {
+  cloth::IntegratorKind kind = cloth::IntegratorKind::SymplecticEuler;
+  double implicitTolerance = 1e-3;
+
+  [[nodiscard]] bool implicit() const { return kind == cloth::IntegratorKind::BackwardEuler; }
+  /// The node's lines: the integrator's name and, for backward Euler, its solves' tolerance.
+  [[nodiscard]] std::string fields() const {
+    std::string text = fmt::format("  integrator \"{}\"\n", cloth::integratorName(kind));
+    if (implicit()) text += fmt::format("  implicitTolerance {:g}\n", implicitTolerance);
+    return text;
+  }
+  /// Adds the two options to `app`; `implicitSubsteps` says what backward Euler's substeps
+  /// default to.
+  void addOptions(CLI::App& app, const std::string& implicitSubsteps) {
+    app.add_option_function<std::string>(
+        "--integrator", [this](const std::string& name) { kind = cloth::parseIntegrator(name); },
+        "The scene's integrator: symplectic-euler (default), forward-euler or backward-euler (implicit: no mass "
+        "added, bending every substep, " + implicitSubsteps + ")");
+    app.add_option("--implicit-tolerance", implicitTolerance,
+                   "backward-euler: the residual at which each substep's solve stops, written as the scene's "
+                   "implicitTolerance")
+        ->capture_default_str()
+        ->check(CLI::Range(1e-12, 0.999));
+  }
+};
 
 /// The coord and coordIndex fields of an IndexedFaceSet, one vertex or triangle per line.
 inline void writeIndexedFaceSet(std::ostream& os, const mesh::TriMesh& m, const std::string& indent) {

@@ -121,8 +121,7 @@ int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::S
                  "  airViscosity 0.5\n  offsets [ {:.{}f} {:.{}f} {:.{}f} {:.{}f} ]\n  voxelSize {:.{}f}\n"
                  "{}  collisionEvery 1\n  bendEvery {}\n{}}}\n\n",
              kFrameRate, kSubsteps, voxel, digits, 2 * voxel, digits, 3 * voxel, digits, 6 * voxel, digits, voxel,
-             digits, o.integrator.fields(), bendEvery,
-             stringsField("keepApart", o.keptApart));
+             digits, o.integrator.fields(), bendEvery, stringsField("keepApart", o.keptApart));
   writeMaterial(os, m);
   fmt::print(os, "DEF Body Avatar {{\n  url \"{}\"\n{}{}{}}}\n\n", o.avatarUrl,
              o.avatarRotation.empty() ? "" : fmt::format("  rotation {}\n", o.avatarRotation),
@@ -388,7 +387,10 @@ RunFunction setupMakeSkirt(CLI::App& app) {
     o.waistGiven = app.count("--waist-segment") > 0;
     o.hipsGiven = app.count("--hip-segments") > 0;
     o.legsGiven = app.count("--leg-segments") > 0;
-    if (!addingToScene(app, o.add, "make-skirt", o.avatar, o.out, {"--out", "--avatar-url", "--avatar-meshes", "--avatar-drawn-meshes", "--integrator", "--implicit-tolerance"})) return makeSkirt(o);
+    if (!addingToScene(app, o.add, "make-skirt", o.avatar, o.out,
+                       {"--out", "--avatar-url", "--avatar-meshes", "--avatar-drawn-meshes", "--integrator",
+                        "--implicit-tolerance"}))
+      return makeSkirt(o);
     return addSkirt(o);
   };
 }

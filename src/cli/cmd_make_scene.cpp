@@ -453,6 +453,7 @@ RunFunction setupMakeScene(CLI::App& app) {
     o.material.validate("--");
     if (!(o.voxel_m > 0.0)) throw Error(fmt::format("--voxel must be > 0 m, got {}", o.voxel_m));
     o.voxelGiven = app.count("--voxel") > 0;
+    o.integrator.check(app);
     o.add.overGapGiven = app.count("--over-gap") > 0;
     if (!(o.frameRate > 0.0)) throw Error(fmt::format("--frame-rate must be > 0, got {}", o.frameRate));
     if (o.stepsPerFrame < 0) throw Error(fmt::format("--substeps must be >= 1, got {}", o.stepsPerFrame));

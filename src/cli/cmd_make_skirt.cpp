@@ -384,6 +384,7 @@ RunFunction setupMakeSkirt(CLI::App& app) {
     o.bindThresholdGiven = app.count("--bind-threshold") > 0;
     o.clearanceGiven = app.count("--clearance") > 0;
     o.add.overGapGiven = app.count("--over-gap") > 0;
+    o.integrator.check(app);
     o.waistGiven = app.count("--waist-segment") > 0;
     o.hipsGiven = app.count("--hip-segments") > 0;
     o.legsGiven = app.count("--leg-segments") > 0;

@@ -55,6 +55,12 @@ struct SceneIntegrator {
         ->capture_default_str()
         ->check(CLI::Range(1e-12, 0.999));
   }
+  /// Throws drape::Error when `app` was given a tolerance for an integrator that solves nothing.
+  void check(const CLI::App& app) const {
+    if (app.count("--implicit-tolerance") > 0 && !implicit())
+      throw Error(fmt::format("--implicit-tolerance applies to --integrator backward-euler, not {}",
+                              cloth::integratorName(kind)));
+  }
 };
 
 /// The coord and coordIndex fields of an IndexedFaceSet, one vertex or triangle per line.

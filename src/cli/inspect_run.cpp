@@ -262,11 +262,19 @@ void printSummary(const std::string& directory, const render::RunReplay& run, co
           ? fmt::format("edges at most {:.1f} % longer and {:.1f} % shorter than at rest", 100.0 * number("max_stretch"),
                         100.0 * number("max_compression"))
           : fmt::format("largest edge strain {:.1f} % (stretched or compressed)", 100.0 * number("max_strain"));
+  // `format` takes the count of those pinched, from runs whose stats.json tells them apart.
+  const auto pinched = [&](const char* total, const char* key, const char* format) {
+    return number(total) > 0.0 && stats.contains(key) ? fmt::format(fmt::runtime(format), number(key)) : std::string();
+  };
   fmt::print(out,
              "  stats.json: {:.0f} frames simulated, {:.3f} ms per frame; vertex-substeps inside the body {:.0f} of {:.0f} "
-             "(deepest {:.3g} mm), below T1 {:.0f}; {} (at the end of a frame); {}\n",
+             "(deepest {:.3g} mm{}), below T1 {:.0f}{}; {} (at the end of a frame); {}\n",
              number("frames"), number("ms_per_frame"), number("vertex_substeps_inside_body"), number("vertex_substeps"),
-             number("max_penetration_m") * 1000.0, number("vertex_substeps_below_T1"), strain,
+             number("max_penetration_m") * 1000.0,
+             pinched("vertex_substeps_inside_body", "vertex_substeps_inside_body_pinched", "; {:.0f} pinched between parts"),
+             number("vertex_substeps_below_T1"),
+             pinched("vertex_substeps_below_T1", "vertex_substeps_below_T1_pinched", " ({:.0f} pinched between parts)"),
+             strain,
              unstable ? "went unstable (see its \"instability\")" : "stable");
   printLayers(stats, out);
   printSlowestFrame(run, stats, out);

@@ -177,6 +177,8 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
   stats["vertex_substeps_below_T1"] = sum.vertexSubstepsBelowT1;
   stats["vertex_substeps_below_T0"] = sum.vertexSubstepsBelowT0;
   stats["vertex_substeps_inside_body"] = sum.vertexSubstepsInsideBody;
+  stats["vertex_substeps_below_T1_pinched"] = sum.vertexSubstepsBelowT1Pinched;
+  stats["vertex_substeps_inside_body_pinched"] = sum.vertexSubstepsInsideBodyPinched;
   stats["max_penetration_m"] = sum.maxPenetration_m;
   stats["collisions_registered"] = sum.collisions;
   stats["last_resort_projections"] = sum.projections;

@@ -289,6 +289,9 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   askers_.assign(n, 0);
   pinchCall_.assign(n, -1);
   pinchParts_.assign(n, 0);
+  pinchedNow_.assign(n, 0);
+  pinchedPoints_.clear();
+  pinchedPoints_.reserve(n);
   partVelocity_.assign(n, Vec3::Zero());
   field_.embeddedAtStart = 0;
   for (std::vector<double>* v : {&endVoxelX_, &endVoxelY_, &endVoxelZ_, &nearest_}) v->assign(n, 0.0);
@@ -332,6 +335,8 @@ void FieldCollider::restartFrame(const ClothState& state, double t_s) {
   held_.clear();
   heldParts_.clear();
   std::fill(holds_.begin(), holds_.end(), std::uint8_t{0});
+  for (const std::uint32_t i : pinchedPoints_) pinchedNow_[i] = 0;
+  pinchedPoints_.clear();
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     const field::DistanceField& f = *parts_[k].field;
     const Affine toVoxel = worldToVoxel(f, parts_[k].motion->poseAt(t_s));
@@ -593,11 +598,15 @@ void FieldCollider::countPenetration() {
 
 void FieldCollider::countNearest() {
   field_.vertexSubsteps += freeCount_;
-  for (const double nearest : nearest_) {
-    field_.vertexSubstepsBelowT1 += nearest < offsets_.t1_m;
+  for (std::size_t i = 0; i < nearest_.size(); ++i) {
+    const double nearest = nearest_[i];
+    const bool belowT1 = nearest < offsets_.t1_m, pinched = pinchedNow_[i] != 0;
+    field_.vertexSubstepsBelowT1 += belowT1;
+    field_.vertexSubstepsBelowT1Pinched += belowT1 && pinched;
     field_.vertexSubstepsBelowT0 += nearest < offsets_.t0_m;
     if (nearest < 0) {
       ++field_.vertexSubstepsInsideBody;
+      field_.vertexSubstepsInsideBodyPinched += pinched;
       field_.maxPenetration_m = std::max(field_.maxPenetration_m, -nearest);
     }
   }
@@ -927,10 +936,20 @@ void FieldCollider::collectPinches(double dt_s, ClothState& io) {
   held_.clear();
   heldParts_.clear();
   std::fill(holds_.begin(), holds_.end(), std::uint8_t{0});
-  if (!pinchHold_) return;
+  for (const std::uint32_t i : pinchedPoints_) pinchedNow_[i] = 0;
+  pinchedPoints_.clear();
   for (const auto& [k, i] : corrected_) {
     ++askers_[i];
     partVelocity_[i].setZero();
+  }
+  for (const auto& [k, i] : corrected_)
+    if (askers_[i] >= 2 && !pinchedNow_[i]) {
+      pinchedNow_[i] = 1;
+      pinchedPoints_.push_back(i);
+    }
+  if (!pinchHold_) {
+    for (const auto& [k, i] : corrected_) askers_[i] = 0;
+    return;
   }
   pinched_.clear();
   for (const auto& [k, i] : corrected_) {
@@ -1233,7 +1252,10 @@ FieldCollisionCounters& FieldCollisionCounters::operator+=(const FieldCollisionC
   for (auto [a, b] : {std::pair{&tests, o.tests}, {&traces, o.traces}, {&traceVoxels, o.traceVoxels},
                       {&collisions, o.collisions}, {&projections, o.projections},
                       {&vertexSubstepsBelowT1, o.vertexSubstepsBelowT1}, {&vertexSubstepsBelowT0, o.vertexSubstepsBelowT0},
-                      {&vertexSubstepsInsideBody, o.vertexSubstepsInsideBody}, {&vertexSubsteps, o.vertexSubsteps},
+                      {&vertexSubstepsInsideBody, o.vertexSubstepsInsideBody},
+                      {&vertexSubstepsBelowT1Pinched, o.vertexSubstepsBelowT1Pinched},
+                      {&vertexSubstepsInsideBodyPinched, o.vertexSubstepsInsideBodyPinched},
+                      {&vertexSubsteps, o.vertexSubsteps},
                       {&clearanceSkips, o.clearanceSkips}, {&restingSkips, o.restingSkips},
                       {&embeddedAtStart, o.embeddedAtStart},
                       {&embeddedTimedOut, o.embeddedTimedOut},

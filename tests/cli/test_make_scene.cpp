@@ -401,6 +401,16 @@ TEST(MakeScene, BackwardEulerAsksAnEighthOfTheSubstepsAndNoMass) {
   const nlohmann::json& g = stats["garments"][0];
   EXPECT_EQ(g["added_mass_kg"].get<double>(), 0.0);
   EXPECT_EQ(g["implicit_solves"]["unconverged"].get<long>(), 0);
+  // drape inspect says how many of the vertex-substeps below T1 were pinched between parts.
+  const long belowT1 = stats["vertex_substeps_below_T1"].get<long>();
+  const long pinched = stats["vertex_substeps_below_T1_pinched"].get<long>();
+  ASSERT_GT(belowT1, 0);
+  EXPECT_LE(pinched, belowT1);
+  const CliResult inspected = runDrape("inspect '" + out + "'", dir);
+  ASSERT_EQ(inspected.code, 0) << inspected.err;
+  EXPECT_NE(inspected.out.find(fmt::format("below T1 {} ({} pinched between parts)", belowT1, pinched)),
+            std::string::npos)
+      << inspected.out;
 
   // A bending rhythm cannot go with it; a name that is not an integrator is refused.
   const CliResult rhythm =

@@ -208,8 +208,12 @@ TEST(RunScene, WalkingSkirtWritesEverything) {
   const nlohmann::json stats = statsOf(out);
   for (const char* key : {"collision_time_share", "mean_collision_path_voxels", "points_per_state",
                           "vertex_substeps_below_T1", "vertex_substeps_below_T0", "vertex_substeps_inside_body",
+                          "vertex_substeps_below_T1_pinched", "vertex_substeps_inside_body_pinched",
                           "max_penetration_m", "distance_fields", "body_overlaps"})
     EXPECT_TRUE(stats.contains(key)) << key;
+  EXPECT_LE(stats["vertex_substeps_below_T1_pinched"].get<long>(), stats["vertex_substeps_below_T1"].get<long>());
+  EXPECT_LE(stats["vertex_substeps_inside_body_pinched"].get<long>(),
+            stats["vertex_substeps_inside_body"].get<long>());
   // Walking, the segmented thigh swung forward presses into the belly's part
   // (docs/ARCHITECTURE.md, body overlaps).
   bool thigh = false;

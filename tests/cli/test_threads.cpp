@@ -39,8 +39,9 @@ TEST(Threads, ALargeGarmentRunsTheSameWithOneThreadAndWithTwo) {
   EXPECT_TRUE(slurp(one + "/garment.states") == slurp(two + "/garment.states"));
   const nlohmann::json a = statsOf(one), b = statsOf(two);
   for (const char* key : {"collisions_registered", "vertex_substeps", "vertex_substeps_below_T1",
-                          "vertex_substeps_inside_body", "mean_collision_path_voxels", "max_penetration_m",
-                          "max_strain", "max_stretch", "max_compression", "vertex_tests_pinched", "face_tests", "face_contacts"})
+                          "vertex_substeps_below_T1_pinched", "vertex_substeps_inside_body",
+                          "mean_collision_path_voxels", "max_penetration_m", "max_strain", "max_stretch",
+                          "max_compression", "vertex_tests_pinched", "face_tests", "face_contacts"})
     EXPECT_EQ(a[key], b[key]) << key;
   // The walk must reach the body: what is compared includes collisions.
   EXPECT_GT(a["collisions_registered"].get<long>(), 0);

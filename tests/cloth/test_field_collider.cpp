@@ -744,6 +744,14 @@ TEST(FieldCollider, APointPinchedBetweenTwoPartsSettlesBetweenThem) {
   EXPECT_TRUE(pinched);
   EXPECT_EQ(c.state(0, 0), PointState::OnSurf);
   EXPECT_EQ(c.state(1, 0), PointState::OnSurf);
+  // The middle of faces closer than 2 T1 is below T1 of both: every such substep counts as
+  // pinched, and none before the boxes were close enough to press it from both sides.
+  const FieldCollisionCounters& f = c.fieldCounters();
+  EXPECT_GT(f.vertexSubstepsBelowT1, 10u);
+  EXPECT_EQ(f.vertexSubstepsBelowT1Pinched, f.vertexSubstepsBelowT1);
+  EXPECT_EQ(f.vertexSubstepsInsideBodyPinched, f.vertexSubstepsInsideBody);
+  EXPECT_LT(f.pinchedVertexTests, 250u);
+  EXPECT_GE(f.pinchedVertexTests, f.vertexSubstepsBelowT1Pinched);
   // What an instability report names: both parts, at the last test.
   EXPECT_EQ(c.lastPinch(0).parts, (std::vector<std::string>{"left", "right"}));
   EXPECT_EQ(c.lastPinch(0).substepsAgo, 0);
@@ -892,7 +900,8 @@ TEST(FieldCollider, CountersOfTwoGarmentsAddUp) {
   std::uint64_t value = 1;
   for (std::uint64_t* f : {&a.tests, &a.traces, &a.traceVoxels, &a.collisions, &a.projections,
                            &a.vertexSubstepsBelowT1, &a.vertexSubstepsBelowT0, &a.vertexSubstepsInsideBody,
-                           &a.vertexSubsteps, &a.clearanceSkips, &a.embeddedAtStart, &a.planeEstimates, &a.planeReads,
+                           &a.vertexSubstepsBelowT1Pinched, &a.vertexSubstepsInsideBodyPinched, &a.vertexSubsteps,
+                           &a.clearanceSkips, &a.embeddedAtStart, &a.planeEstimates, &a.planeReads,
                            &a.heldVertexSubsteps, &a.embeddedTimedOut, &a.restingSkips,
                            &a.pinchedVertexTests, &a.faceTests, &a.faceContacts, &a.facesInsideBody})
     *f = value++;
@@ -907,14 +916,15 @@ TEST(FieldCollider, CountersOfTwoGarmentsAddUp) {
   value = 1;
   for (const std::uint64_t* f : {&c.tests, &c.traces, &c.traceVoxels, &c.collisions, &c.projections,
                                  &c.vertexSubstepsBelowT1, &c.vertexSubstepsBelowT0, &c.vertexSubstepsInsideBody,
-                                 &c.vertexSubsteps, &c.clearanceSkips, &c.embeddedAtStart, &c.planeEstimates,
+                                 &c.vertexSubstepsBelowT1Pinched, &c.vertexSubstepsInsideBodyPinched, &c.vertexSubsteps,
+                                 &c.clearanceSkips, &c.embeddedAtStart, &c.planeEstimates,
                                  &c.planeReads, &c.heldVertexSubsteps, &c.embeddedTimedOut, &c.restingSkips,
                                  &c.pinchedVertexTests, &c.faceTests, &c.faceContacts, &c.facesInsideBody})
     EXPECT_EQ(*f, 2 * value++);
   for (const auto& row : c.transitions)
     for (const std::uint64_t t : row) EXPECT_EQ(t, 2 * value++);
   EXPECT_EQ(c.maxPenetration_m, 0.003);  // the deepest, not a sum
-  EXPECT_DOUBLE_EQ(c.slidingReadsFromPlanes(), 12.0 / (12.0 + 13.0));
+  EXPECT_DOUBLE_EQ(c.slidingReadsFromPlanes(), 14.0 / (14.0 + 15.0));
 }
 
 TEST(FieldCollider, MeasuringPenetrationMovesNothing) {

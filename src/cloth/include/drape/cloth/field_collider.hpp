@@ -180,6 +180,11 @@ struct FieldCollisionCounters {
   std::uint64_t vertexSubstepsBelowT1 = 0;   ///< after the response, nearest part below T1
   std::uint64_t vertexSubstepsBelowT0 = 0;
   std::uint64_t vertexSubstepsInsideBody = 0;  ///< signed distance < 0 after the response
+  /// Of those below T1 and inside the body, the points two or more parts moved at the last
+  /// test (a pinch: where the parts' offset surfaces overlap, no place is outside them all,
+  /// and the mean of their corrections leaves the point below T1 of each).
+  std::uint64_t vertexSubstepsBelowT1Pinched = 0;
+  std::uint64_t vertexSubstepsInsideBodyPinched = 0;
   std::uint64_t vertexSubsteps = 0;            ///< vertices x collision substeps
   double maxPenetration_m = 0;      ///< deepest point below the body surface after the response
   std::uint64_t clearanceSkips = 0;  ///< pairs that stayed InsideVol without a trilinear read
@@ -431,9 +436,10 @@ class FieldCollider final : public Collider {
   void countNearest();
   /// The penetration figures of an untested substep ending at t_s (setCountEverySubstep).
   void countUntested(const ClothState& io, double t_s);
-  /// After a test's corrections: the points two or more parts asked to move take the mean
-  /// of those parts' velocities at them and, with reduced-frequency tests, are held until
-  /// the next (setPinchHold). dt_s: the interval the test covered.
+  /// After a test's corrections: the points two or more parts asked to move are marked
+  /// pinched (pinchedNow_) and, with the pinch hold on, take the mean of those parts'
+  /// velocities at them and, with reduced-frequency tests, are held until the next
+  /// (setPinchHold). dt_s: the interval the test covered.
   void collectPinches(double dt_s, ClothState& io);
   /// On an untested substep t0 -> t1: the held points move with their parts.
   void holdPinches(double t0_s, double t1_s, ClothState& io);
@@ -532,6 +538,10 @@ class FieldCollider final : public Collider {
   std::vector<std::uint8_t> askers_;  ///< per vertex, scratch: how many parts asked to move it this test
   std::vector<long> pinchCall_;             ///< per vertex: the call (calls_) of its last pinch, -1 if none
   std::vector<std::uint64_t> pinchParts_;   ///< per vertex: the parts of that pinch, one bit each (parts < 64)
+  /// Per vertex: two or more parts moved it at the last test (whether or not they hold it),
+  /// for the penetration counters; pinchedPoints_ lists the set ones.
+  std::vector<std::uint8_t> pinchedNow_;
+  std::vector<std::uint32_t> pinchedPoints_;
   std::vector<Vec3> partVelocity_;    ///< per vertex, scratch: the sum of its pinching parts' velocities there
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pinched_;  ///< scratch: (vertex, part), sorted
   ColliderCounters counters_;

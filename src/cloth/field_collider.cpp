@@ -273,6 +273,8 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   easeUntil_s_.assign(parts_.size(), std::vector<double>(n, 0.0));
   for (std::vector<double>* v : {&correctionX_, &correctionY_, &correctionZ_}) v->assign(n, 0.0);
   corrections_.assign(n, 0);
+  firstAsk_.assign(n, Vec3::Zero());
+  secondAsk_.assign(n, Vec3::Zero());
   correctedPoints_.clear();
   correctedPoints_.reserve(n);  // each point once per test: no allocation in the tests
   slidingParts_.assign(n, 0);
@@ -1055,20 +1057,51 @@ std::string describePinch(const NearestPinch& near, std::uint32_t vertex) {
                      when, who, fmt::join(pinch.parts, ", "));
 }
 
+std::optional<Vec3> pinchMove(const Vec3& a, const Vec3& b) {
+  const double da = a.norm(), db = b.norm();
+  if (!(da > 0.0) || !(db > 0.0)) return std::nullopt;  // an ask with no direction
+  const Vec3 na = a / da, nb = b / db;
+  // The nearest point of one half-space that lies in the other is the nearest of both.
+  if (nb.dot(a) >= db) return a;
+  if (na.dot(b) >= da) return b;
+  // Otherwise both bound it: x = la na + lb nb on both planes, with la, lb >= 0.
+  const double c = na.dot(nb), det = 1.0 - c * c;
+  if (!(det > 1e-9)) return std::nullopt;  // parallel planes facing each other: no point outside both
+  const double la = (da - c * db) / det, lb = (db - c * da) / det;
+  if (la < 0.0 || lb < 0.0) return std::nullopt;
+  const Vec3 x = la * na + lb * nb;
+  if (x.norm() > kCreaseReach * std::max(da, db)) return std::nullopt;
+  return x;
+}
+
 void FieldCollider::addCorrection(RangeTally& __restrict t, std::size_t i, const Vec3& displacement) {
   correctionX_[i] += displacement.x();
   correctionY_[i] += displacement.y();
   correctionZ_[i] += displacement.z();
-  if (corrections_[i]++ == 0) t.correctedPoints.push_back(static_cast<std::uint32_t>(i));
+  const std::uint16_t asked = corrections_[i]++;
+  if (asked == 0) {
+    firstAsk_[i] = displacement;
+    t.correctedPoints.push_back(static_cast<std::uint32_t>(i));
+  } else if (asked == 1) {
+    secondAsk_[i] = displacement;
+  }
 }
 
 void FieldCollider::applyCorrections(ClothState& io) {
   // A few dozen points of hundreds: by their list, leaving the sums at zero for the next test.
   for (const std::uint32_t i : correctedPoints_) {
-    const double share = 1.0 / corrections_[i];
-    io.x[i] += share * correctionX_[i];
-    io.y[i] += share * correctionY_[i];
-    io.z[i] += share * correctionZ_[i];
+    const std::optional<Vec3> crease =
+        corrections_[i] == 2 && creaseMoves_ ? pinchMove(firstAsk_[i], secondAsk_[i]) : std::nullopt;
+    if (crease) {
+      io.x[i] += crease->x();
+      io.y[i] += crease->y();
+      io.z[i] += crease->z();
+    } else {
+      const double share = 1.0 / corrections_[i];
+      io.x[i] += share * correctionX_[i];
+      io.y[i] += share * correctionY_[i];
+      io.z[i] += share * correctionZ_[i];
+    }
     correctionX_[i] = correctionY_[i] = correctionZ_[i] = 0.0;
     corrections_[i] = 0;
   }

@@ -146,7 +146,11 @@ TEST(MakeScene, DressOnTheWalkingBody) {
   ASSERT_EQ(ran.code, 0) << ran.err;
   const nlohmann::json stats = statsOf(out);
   EXPECT_EQ(stats["frames"].get<int>(), 3);
-  EXPECT_EQ(stats["vertex_substeps_inside_body"].get<long>(), 0);
+  // A pair the garment held below T2 past its easing time (pairs_embedded_timed_out) is
+  // projected onto T2 in one test from as deep as the dress is modelled, along the normal
+  // where it lies: a vertex-substep may end a fraction of a millimetre short.
+  EXPECT_LE(stats["vertex_substeps_inside_body"].get<long>(), 3);
+  EXPECT_LT(stats["max_penetration_m"].get<double>(), 0.001);
   EXPECT_GT(stats["pairs_embedded_at_start"].get<long>(), 0) << "the dress is modelled tight on the body";
   const nlohmann::json& g = stats["garments"][0];
   EXPECT_GT(g["added_mass_kg"].get<double>(), 0.0);

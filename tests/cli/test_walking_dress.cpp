@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <string>
 
@@ -239,11 +240,12 @@ TEST(WalkingDress, RunsTheDazStyleWalkToTheEnd) {
 
 /// `drape run` of the dress on cmu_walk_delfem2 as captured (--keep-apart none), on the body
 /// with the upper arms' parts whole (--cut-at-joints none), writing into DIR/out, with
-/// `options`. Whole, the pinch the tests below follow comes in frame 35 in every build. Cut
-/// at the shoulders (the scene), the pinch is shallower, and which vertex runs away first
-/// depends on the build's floating-point paths. (Before the avatar's clavicles were kept on
-/// its chest, its shoulders sat farther back and the pinch came in frame 26, the left
-/// forearm in the small of the back.)
+/// `options`. Whole, the left upper arm swings 30 mm into the chest's part and 13 mm into the
+/// lower back's, and the cloth between them runs away in frame 28 (frame 35 before points
+/// pinched in a crease moved outside both parts; frame 26 before the avatar's clavicles were
+/// kept on its chest, the left forearm in the small of the back). Where and which vertex
+/// depend on every change to the collision response, so the tests below read them from the
+/// report. Cut at the shoulders (the scene), the pinch is shallower.
 CliResult runDelfem2AsCaptured(const ScratchDir& dir, const std::string& options) {
   return runDrape("run '" + kDressScene + "' --motion '" + kDressSource +
                       "/data/mocap/cmu_walk_delfem2.bvh' --keep-apart none --cut-at-joints none --every 1000 " +
@@ -263,13 +265,17 @@ TEST(WalkingDress, AnInstabilitySaysWhichPartsPinchedTheCloth) {
   const CliResult r = runDelfem2AsCaptured(dir, "--max-refinement 1 --strain-limit none");
   ASSERT_EQ(r.code, 3) << r.err;
   EXPECT_NE(r.err.find("garment 'dress': vertex "), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("was pressed by LowerBack, LeftArm at once (a pinch"), std::string::npos) << r.err;
+  // The pinch's parts, the left upper arm among them, named before "at once".
+  const std::size_t pressed = r.err.find("was pressed by ");
+  ASSERT_NE(pressed, std::string::npos) << r.err;
+  const std::size_t once = r.err.find(" at once (a pinch", pressed);
+  ASSERT_NE(once, std::string::npos) << r.err;
+  EXPECT_NE(r.err.substr(pressed, once - pressed).find("LeftArm"), std::string::npos) << r.err;
   const nlohmann::json stats = statsOf(dir / "out");
   EXPECT_NE(stats["instability"].get<std::string>().find("was pressed by"), std::string::npos);
   // And that the motion puts the pinch's parts inside each other there: on this body the
-  // walk swings the left upper arm against the small of the back.
-  EXPECT_NE(r.err.find("; in that frame the motion puts the body inside itself: LowerBack is "), std::string::npos)
-      << r.err;
+  // walk swings the left upper arm against the chest and the small of the back.
+  EXPECT_NE(r.err.find("; in that frame the motion puts the body inside itself: "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find(" mm into LeftArm"), std::string::npos) << r.err;
   bool armInBack = false;
   for (const auto& o : stats["body_overlaps"])
@@ -284,7 +290,12 @@ TEST(WalkingDress, WhereNoSubstepsKeepTheFrameStableItsEdgesAreHeldToALimit) {
   ScratchDir dir("walking-dress-rescued");
   const CliResult r = runDelfem2AsCaptured(dir, "--max-refinement 1 --frames 40");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find("in frame 35, substep"), std::string::npos) << r.err;
+  const std::size_t at = r.err.find(" in frame ");
+  ASSERT_NE(at, std::string::npos) << r.err;
+  const int frame = std::atoi(r.err.c_str() + at + 10);
+  EXPECT_GE(frame, 20) << r.err;
+  EXPECT_LT(frame, 40) << r.err;
+  EXPECT_NE(r.err.find(fmt::format("in frame {}, substep", frame)), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("; computed again with its edges held to 1.5 times their rest length (strain limiting), "
                        "which stays on for the rest of the run"),
             std::string::npos)
@@ -293,7 +304,7 @@ TEST(WalkingDress, WhereNoSubstepsKeepTheFrameStableItsEdgesAreHeldToALimit) {
   EXPECT_EQ(stats["frames"].get<int>(), 40);
   EXPECT_FALSE(stats["unstable"].get<bool>());
   const nlohmann::json& g = stats["garments"][0];
-  EXPECT_EQ(g["strain_limited_from_frame"].get<int>(), 35);
+  EXPECT_EQ(g["strain_limited_from_frame"].get<int>(), frame);
   EXPECT_EQ(g["strain_limit"].get<double>(), 0.5);
   EXPECT_GT(g["strain_limit_corrections"].get<long>(), 0);
   EXPECT_GT(stats["ms_per_stage"]["strain_limit"].get<double>(), 0.0);
@@ -302,16 +313,15 @@ TEST(WalkingDress, WhereNoSubstepsKeepTheFrameStableItsEdgesAreHeldToALimit) {
 TEST(WalkingDress, ThePinchIsWeatheredByComputingItsFramesAgain) {
   DRAPE_LONG_SCENARIO();
   // The same walk as captured, with frames computed again when they go unstable (the
-  // default): frame 35, where the pinch above stopped the run, and frame 36 take twice the
-  // substeps, and the run goes on.
+  // default): the frame where the pinch above stopped the run, and frames after it, take
+  // twice the substeps or more, and the run goes on.
   ScratchDir dir("walking-dress-refined");
   const CliResult r = runDelfem2AsCaptured(dir, "--frames 40");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find("in frame 35, substep"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("; computed again with 2 times the substeps (310 per frame)"), std::string::npos) << r.err;
   const nlohmann::json stats = statsOf(dir / "out");
   EXPECT_EQ(stats["frames"].get<int>(), 40);
-  EXPECT_NE(r.err.find("in frame 36, substep"), std::string::npos) << r.err;
+  EXPECT_FALSE(stats["unstable"].get<bool>());
   EXPECT_GE(stats["garments"][0]["frames_refined"].get<int>(), 2);
 }
 

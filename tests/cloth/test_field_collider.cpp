@@ -3,8 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <numbers>
+#include <optional>
 #include <random>
 
 #include <tbb/global_control.h>
@@ -755,6 +758,104 @@ TEST(FieldCollider, APointPinchedBetweenTwoPartsSettlesBetweenThem) {
   // What an instability report names: both parts, at the last test.
   EXPECT_EQ(c.lastPinch(0).parts, (std::vector<std::string>{"left", "right"}));
   EXPECT_EQ(c.lastPinch(0).substepsAgo, 0);
+}
+
+/// The projection of 0 onto the intersection of the half-spaces n . x >= d through `a` and
+/// `b` (pinchMove's words), by Dykstra's alternating projections: a reference that knows
+/// nothing of which half-space bounds the answer.
+Vec3 dykstra(const Vec3& a, const Vec3& b) {
+  const auto project = [](const Vec3& z, const Vec3& ask) {
+    const Vec3 n = ask.normalized();
+    return Vec3(z + std::max(0.0, ask.norm() - n.dot(z)) * n);
+  };
+  Vec3 x = Vec3::Zero(), p = Vec3::Zero(), q = Vec3::Zero();
+  for (int k = 0; k < 200000; ++k) {
+    const Vec3 y = project(x + p, a);
+    p = x + p - y;
+    const Vec3 next = project(y + q, b);
+    q = y + q - next;
+    const bool settled = (next - x).norm() < 1e-16;
+    x = next;
+    if (settled) break;
+  }
+  return x;
+}
+
+TEST(PinchMove, IsTheNearestPointOutsideBothOrNothingBeyondItsReach) {
+  // Random asks of 0.1 to 10 mm in random directions up to 150 degrees apart (where the
+  // alternating projections converge fast enough to be the reference): the move is
+  // Dykstra's point whenever that lies within kCreaseReach times the longer ask, and
+  // nothing otherwise.
+  std::mt19937 rng(20261206);
+  std::normal_distribution<double> gauss;
+  std::uniform_real_distribution<double> length(1e-4, 1e-2);
+  int creases = 0, beyond = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    const Vec3 na = Vec3(gauss(rng), gauss(rng), gauss(rng)).normalized();
+    Vec3 nb = Vec3(gauss(rng), gauss(rng), gauss(rng)).normalized();
+    if (na.dot(nb) < std::cos(150.0 * std::numbers::pi / 180.0)) nb = -nb;
+    const Vec3 a = length(rng) * na, b = length(rng) * nb;
+    const Vec3 reference = dykstra(a, b);
+    const double longer = std::max(a.norm(), b.norm());
+    const std::optional<Vec3> move = pinchMove(a, b);
+    if (reference.norm() > kCreaseReach * longer * (1 + 1e-9)) {
+      EXPECT_FALSE(move) << "trial " << trial;
+      ++beyond;
+      continue;
+    }
+    if (reference.norm() > kCreaseReach * longer * (1 - 1e-9)) continue;  // on the edge of its reach
+    ASSERT_TRUE(move) << "trial " << trial;
+    EXPECT_LT((*move - reference).norm(), 1e-9 * longer) << "trial " << trial;
+    EXPECT_GE(move->dot(na), a.norm() * (1 - 1e-12)) << "trial " << trial;
+    EXPECT_GE(move->dot(nb), b.norm() * (1 - 1e-12)) << "trial " << trial;
+    creases += (*move - a).norm() > 1e-12 && (*move - b).norm() > 1e-12;  // both planes bound it
+  }
+  EXPECT_GT(creases, 500);
+  EXPECT_GT(beyond, 100);
+  // Two parts asking the same way: the longer ask, which satisfies both. Facing each other
+  // (the thighs): nothing, the mean is the compromise. At right angles: the sum.
+  const Vec3 x = Vec3::UnitX() * 0.004, y = Vec3::UnitY() * 0.003;
+  EXPECT_EQ(pinchMove(x, 0.5 * x), x);
+  EXPECT_FALSE(pinchMove(x, -0.5 * x));
+  EXPECT_LT((*pinchMove(x, y) - (x + y)).norm(), 1e-15);
+  EXPECT_FALSE(pinchMove(x, Vec3::Zero()));
+}
+
+TEST(FieldCollider, APointPressedIntoACreaseEndsOutsideBothParts) {
+  // A wall (x < 0) and a floor (y < 0), two parts meeting at a right angle; something
+  // throws the point into the corner at 1 m/s before every test. Each part asks to move it
+  // back onto its T2: the crease move puts it on both, where the mean of the two asks left
+  // it halfway, below T2 of each (the walking dress's crease of hip and lower back).
+  const field::DistanceField wallField = buildField(field::makeBox(Vec3(-0.1, -0.1, -0.05), Vec3(0.0, 0.1, 0.05)));
+  const field::DistanceField floorField = buildField(field::makeBox(Vec3(-0.1, -0.1, -0.05), Vec3(0.1, 0.0, 0.05)));
+  const std::vector<CollisionPart> parts = {{"wall", &wallField, std::make_shared<StaticMotion>()},
+                                            {"floor", &floorField, std::make_shared<StaticMotion>()}};
+  const Vec3 into = Vec3(-1, -1, 0).normalized();
+  for (const bool crease : {true, false}) {
+    Point p(Vec3::Zero());
+    FieldCollider c("test", parts, kOffsets, 0.0, 0.0);
+    c.setCreaseMoves(crease);
+    initialiseArriving(c, p, Vec3(0.03, 0.03, 0));
+    const double dt = 1e-3;
+    double lowest = 1.0;  // the lower of the two distances after the last 20 tests, m
+    for (int step = 0; step < 60; ++step) {
+      p.state.setVelocity(0, into);
+      p.state.setPosition(0, p.state.position(0) + p.state.velocity(0) * dt);
+      c.collide(*p.model, step * dt, (step + 1) * dt, p.state);
+      const Vec3 at = p.state.position(0);
+      if (step >= 40) lowest = std::min({lowest, wallField.distanceAt(at), floorField.distanceAt(at)});
+    }
+    ASSERT_EQ(c.state(0, 0), PointState::OnSurf) << crease;
+    ASSERT_EQ(c.state(1, 0), PointState::OnSurf) << crease;
+    if (crease) {
+      EXPECT_NEAR(lowest, kOffsets.t2_m, 1e-6) << "on T2 of both";
+      EXPECT_EQ(c.fieldCounters().vertexSubstepsBelowT1, 0u);
+    } else {
+      // Each test moves it back by half of the 0.71 mm per axis it was thrown: it settles
+      // that far below T2 of both.
+      EXPECT_NEAR(lowest, kOffsets.t2_m - into.x() * -dt, 1e-5) << "halfway: below T2 of each";
+    }
+  }
 }
 
 /// A point 12 mm from each of two boxes that move together (closer than twice T2 apart),

@@ -39,8 +39,10 @@
 // collision step, each point moved by the mean of the displacements its parts asked for
 // (Jacobi averaging): where two parts' offset surfaces overlap (cloth pinched between arm and
 // chest, thigh and hips) the point settles between them instead of being pushed back and
-// forth, and a point one part touches moves exactly as that part asks. Velocity responses
-// apply part by part.
+// forth, and a point one part touches moves exactly as that part asks. A point two parts
+// ask to move where their surfaces meet at an angle (a crease) moves instead by the shortest
+// move outside both, to first order (pinchMove): the mean stopped it halfway, below T2 of
+// each. Velocity responses apply part by part.
 //
 // Pinches between reduced-frequency tests (every > 1): the Jacobi mean leaves a point that
 // two parts press from both sides off the offset surface it would take with either alone,
@@ -277,6 +279,10 @@ class FieldCollider final : public Collider {
   /// response and reduced-frequency tests as they are), where the cloth's forces can throw
   /// it into a part before the next test. On by default.
   void setPinchHold(bool on) { pinchHold_ = on; }
+  /// Off: a point two parts asked to move at a test always moves by the mean of their asks
+  /// (Jacobi averaging), as before crease moves. On by default: where the two parts' offset
+  /// surfaces meet at an angle, it moves outside both (pinchMove).
+  void setCreaseMoves(bool on) { creaseMoves_ = on; }
   /// The points held now (pinched at the last test).
   [[nodiscard]] std::size_t heldPoints() const { return held_.size(); }
   /// Off: no pair skips its distance reads through the clearance bits (nor, so, settles
@@ -455,6 +461,7 @@ class FieldCollider final : public Collider {
   bool contactPlanes_ = true;
   bool measurePenetration_ = true;
   bool pinchHold_ = true;
+  bool creaseMoves_ = true;
   bool restingBalls_ = true;
   std::uint64_t faceParts_ = 0;  ///< bit k: part k takes face samples
   long calls_ = 0;
@@ -482,6 +489,7 @@ class FieldCollider final : public Collider {
   /// their number (addCorrection); the (part, vertex) pairs that asked.
   std::vector<double> correctionX_, correctionY_, correctionZ_;
   std::vector<std::uint16_t> corrections_;
+  std::vector<Vec3> firstAsk_, secondAsk_;  ///< per vertex, this test: the first two displacements asked (pinchMove)
   std::vector<std::uint32_t> correctedPoints_;  ///< the points with corrections this test, each once
   std::vector<std::pair<std::uint32_t, std::uint32_t>> corrected_;
   /// Per vertex, this test: the parts it slides on, one bit each (parts < 64), and the face
@@ -560,6 +568,22 @@ class FieldCollider final : public Collider {
   const field::GridDims& d = field.dims();
   return p.x() >= 1 && p.y() >= 1 && p.z() >= 1 && p.x() < d.nx - 1 && p.y() < d.ny - 1 && p.z() < d.nz - 1;
 }
+
+/// How far, in multiples of the longer of two parts' asks, a crease's move may take a point
+/// (pinchMove): beyond it the offset surfaces are taken to overlap.
+inline constexpr double kCreaseReach = 2.0;
+
+/// The move for a point that two parts asked to move at one test, by `a` and `b` (each onto
+/// its own offset surface T2, from where the point ended the substep). Where the parts'
+/// surfaces meet at an angle (a crease: the hip's crease, a thigh against the lower back's
+/// side), the shortest move that puts the point outside both to first order: the projection
+/// of the point onto the intersection of the half-spaces x . a / |a| >= |a| and
+/// x . b / |b| >= |b|. The Jacobi mean of the asks, which the collider used alone before,
+/// stops such a point halfway, below T2 (and often T1) of each. Where no such move within
+/// kCreaseReach times the longer ask exists (the surfaces face each other: the thighs, a
+/// cloth squeezed between two parts that overlap), no place near is outside both, and
+/// nothing is returned: the mean is the compromise there.
+[[nodiscard]] std::optional<Vec3> pinchMove(const Vec3& a, const Vec3& b);
 
 /// The pinch nearest to `vertex` (on the garment as modelled, within 5 cm) in the last
 /// `withinSubsteps` substeps: the pinched vertex, how far from `vertex` it is (m), its parts

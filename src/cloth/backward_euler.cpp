@@ -60,6 +60,8 @@ void BackwardEuler::prepare(const ClothModel& model, const StepSettings& setting
   held_.assign(n, 0);
   for (std::size_t v = 0; v < n; ++v)
     held_[v] = static_cast<std::uint8_t>((!fixed.empty() && fixed[v]) || !(model.inverseMass()[v] > 0.0));
+  pinched_.clear();
+  pinched_.reserve(n);
   dragPerArea_ = settings.airViscosity_Ns_m3;
   tolerance_ = settings.implicitTolerance;
   gradient_.assign(6 * model.membrane().size(), 0.0);
@@ -68,6 +70,20 @@ void BackwardEuler::prepare(const ClothModel& model, const StepSettings& setting
   for (std::vector<double>* v : {&rhs_, &dv_, &r_, &z_, &d_, &q_}) v->assign(3 * n, 0.0);
   precond_.assign(9 * n, 0.0);
   buildPattern(model);
+}
+
+void BackwardEuler::holdPinched(std::span<const PinchedPoint> points) {
+  for (const PinchedPoint& p : points) {
+    if (p.vertex >= held_.size() || held_[p.vertex]) continue;
+    Pinched q{p.vertex, 0, {}};
+    for (const Vec3& along : p.along) {
+      Vec3 e = along;
+      for (int k = 0; k < q.directions; ++k) e -= e.dot(q.e[k]) * q.e[k];
+      const double length = e.norm();
+      if (length > 1e-3) q.e[q.directions++] = e / length;  // not along one it holds already
+    }
+    if (q.directions > 0) pinched_.push_back(q);
+  }
 }
 
 void BackwardEuler::linearise(const ClothModel& model, const ClothState& s) {
@@ -292,6 +308,17 @@ void BackwardEuler::filter(std::span<double> v) const {
   const std::size_t n = held_.size();
   for (std::size_t i = 0; i < n; ++i)
     if (held_[i]) v[i] = v[n + i] = v[2 * n + i] = 0.0;
+  filterPinched(v);
+}
+
+void BackwardEuler::filterPinched(std::span<double> v) const {
+  const std::size_t n = held_.size();
+  for (const Pinched& p : pinched_) {
+    const std::size_t i = p.vertex;
+    Vec3 a(v[i], v[n + i], v[2 * n + i]);
+    for (int k = 0; k < p.directions; ++k) a -= a.dot(p.e[k]) * p.e[k];
+    v[i] = a.x(), v[n + i] = a.y(), v[2 * n + i] = a.z();
+  }
 }
 
 void BackwardEuler::applySystem(std::span<const double> p, std::span<double> out) const {
@@ -339,15 +366,19 @@ void BackwardEuler::advance(const ClothModel& model, const Vec3& g, double h, Cl
       out[n + i] = b[3] * px + b[4] * py + b[5] * pz;
       out[2 * n + i] = b[6] * px + b[7] * py + b[8] * pz;
     }
+    filterPinched(out);  // S P^-1 S: the held ones' blocks are zero already
   };
 
-  // Preconditioned conjugate gradients from the last substep's dv (filtered: the held
-  // vertices' entries are 0). The system is positive definite by construction; the
-  // curvature test guards against what rounding could still make of it.
+  // Preconditioned conjugate gradients from the last substep's dv, filtered (Baraff and
+  // Witkin's modified PCG: every vector stays in the filter's range). The system is positive
+  // definite by construction; the curvature test guards against what rounding could still
+  // make of it.
   precondition(rhs_, d_);
   const double fromZero = dot(rhs_, d_);  // the residual's measure starting from dv = 0
   const double target = tolerance_ * tolerance_ * fromZero;
+  filter(dv_);  // a vertex held now may have moved freely in the last solve
   applySystem(dv_, q_);
+  filterPinched(q_);
   for (std::size_t i = 0; i < 3 * n; ++i) r_[i] = rhs_[i] - q_[i];
   precondition(r_, d_);
   double rz = dot(r_, d_);
@@ -361,6 +392,7 @@ void BackwardEuler::advance(const ClothModel& model, const Vec3& g, double h, Cl
   bool converged = !(rz > target);
   for (int k = 0; k < kMaxIterations && !converged; ++k) {
     applySystem(d_, q_);
+    filterPinched(q_);
     ++stats_.iterations;
     const double curvature = dot(d_, q_);
     if (!(curvature > 0.0)) {
@@ -388,7 +420,8 @@ void BackwardEuler::advance(const ClothModel& model, const Vec3& g, double h, Cl
   if (!converged) ++stats_.unconverged;
 
   // v1 = v0 + dv; the held vertices take gravity alone (the fixtures place the bound ones,
-  // and a massless vertex falls, as in the explicit steps); x1 = x0 + h v1.
+  // and a massless vertex falls, as in the explicit steps), the pinched ones keep their
+  // velocity along the parts' normals (their dv has no component there); x1 = x0 + h v1.
   double* const v[3] = {s.vx.data(), s.vy.data(), s.vz.data()};
   double* const x[3] = {s.x.data(), s.y.data(), s.z.data()};
   for (std::size_t c = 0; c < 3; ++c)
@@ -396,6 +429,7 @@ void BackwardEuler::advance(const ClothModel& model, const Vec3& g, double h, Cl
       v[c][i] += held_[i] ? h * gravity[c] : dv_[c * n + i];
       x[c][i] += h * v[c][i];
     }
+  pinched_.clear();  // for this solve alone
 }
 
 }  // namespace drape::cloth

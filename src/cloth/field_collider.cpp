@@ -337,7 +337,7 @@ void FieldCollider::restartFrame(const ClothState& state, double t_s) {
   held_.clear();
   heldParts_.clear();
   std::fill(holds_.begin(), holds_.end(), std::uint8_t{0});
-  for (const std::uint32_t i : pinchedPoints_) pinchedNow_[i] = 0;
+  for (const PinchedPoint& p : pinchedPoints_) pinchedNow_[p.vertex] = 0;
   pinchedPoints_.clear();
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     const field::DistanceField& f = *parts_[k].field;
@@ -938,7 +938,7 @@ void FieldCollider::collectPinches(double dt_s, ClothState& io) {
   held_.clear();
   heldParts_.clear();
   std::fill(holds_.begin(), holds_.end(), std::uint8_t{0});
-  for (const std::uint32_t i : pinchedPoints_) pinchedNow_[i] = 0;
+  for (const PinchedPoint& p : pinchedPoints_) pinchedNow_[p.vertex] = 0;
   pinchedPoints_.clear();
   for (const auto& [k, i] : corrected_) {
     ++askers_[i];
@@ -947,7 +947,11 @@ void FieldCollider::collectPinches(double dt_s, ClothState& io) {
   for (const auto& [k, i] : corrected_)
     if (askers_[i] >= 2 && !pinchedNow_[i]) {
       pinchedNow_[i] = 1;
-      pinchedPoints_.push_back(i);
+      const auto direction = [](const Vec3& ask) {
+        const double length = ask.norm();
+        return length > 0.0 ? Vec3(ask / length) : Vec3::Zero();
+      };
+      pinchedPoints_.push_back({i, {direction(firstAsk_[i]), direction(secondAsk_[i])}});
     }
   if (!pinchHold_) {
     for (const auto& [k, i] : corrected_) askers_[i] = 0;

@@ -273,7 +273,10 @@ void ClothSolver::limitStrain() {
   strainLimitCorrections_ += cloth::limitStrain(*model_, strainWeight_, strainLimit_, kStrainLimitSweeps, state_);
 }
 
-void ClothSolver::integrate(double dt) { integrator_->advance(*model_, settings_.gravity_m_s2, dt, state_); }
+void ClothSolver::integrate(double dt) {
+  for (const Collider* c : colliders_) integrator_->holdPinched(c->pinched());
+  integrator_->advance(*model_, settings_.gravity_m_s2, dt, state_);
+}
 
 void ClothSolver::collide(double t0, double t1) {
   for (Collider* c : colliders_) c->collide(*model_, t0, t1, state_);

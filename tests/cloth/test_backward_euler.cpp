@@ -169,83 +169,174 @@ TEST(BackwardEuler, DropsWhatMakesACompressedSheetIndefinite) {
 
 // One step's velocity change against a dense direct solve of the same linear system,
 // assembled column by column from the products.
-TEST(BackwardEuler, ConjugateGradientsSolveTheLinearisedSystem) {
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> d(-0.01, 0.01);
-  SheetSpec spec{0.2, 0.2, 5, 5, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), "sheet"};
-  Material m = fabric(5e4, 5e-4, 300);
-  m.damping_s = 1e-3;
-  const auto model = makeModel(irregularSheet(spec), m);
-  const std::size_t n = model->vertexCount(), size = 3 * n;
+/// A randomly displaced and moving irregular sheet with its top row held, its forces
+/// accumulated, and the backward-Euler system at ten times its explicit step, dense: A = M +
+/// (h^2 + h beta) K_material + h^2 K_geometric + h c A_v over all 3 n unknowns (x block, y
+/// block, z block), b = h (f0 + M g) - h^2 K v0.
+struct DenseCase {
+  std::shared_ptr<const ClothModel> model;
   StepSettings settings;
-  settings.airViscosity_Ns_m3 = 0.5;
-  settings.implicitTolerance = 1e-9;  // the solve to its end, to compare with the direct one
-  const std::vector<std::uint32_t> top = row(spec, spec.cellsV);
-  std::vector<std::uint8_t> fixed(n, 0);
-  for (const std::uint32_t v : top) fixed[v] = 1;
-  ClothState s = ClothState::atRest(*model);
-  for (std::size_t i = 0; i < n; ++i) {
-    s.x[i] += d(rng), s.y[i] += d(rng), s.z[i] += d(rng);
-    s.vx[i] = 10 * d(rng), s.vy[i] = 10 * d(rng), s.vz[i] = 10 * d(rng);
-  }
-  clearForces(s);
-  accumulateMembraneForces(*model, s);
-  accumulateBendingForces(*model, s);
-  accumulateDragForces(*model, settings, s);
-  const double h = 10 * model->estimatedStableStep_s();
-  const Vec3 g = settings.gravity_m_s2;
+  std::vector<std::uint32_t> top;
+  std::vector<std::uint8_t> fixed;
+  ClothState s;
+  double h = 0.0;
+  Eigen::MatrixXd A;
+  Eigen::VectorXd b;
 
-  // The dense system: A = M + (h^2 + h beta) K_material + h^2 K_geometric + h c A_v on the
-  // free vertices, b = h (f0 + M g) - h^2 K v0.
-  BackwardEuler dense;
-  dense.prepare(*model, settings, fixed);
-  dense.linearise(*model, s);
-  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(size), static_cast<Eigen::Index>(size));
-  std::vector<double> e(size), kMat(size), kGeo(size);
-  for (std::size_t j = 0; j < size; ++j) {
-    std::fill(e.begin(), e.end(), 0.0);
-    e[j] = 1.0;
-    dense.stiffnessTimes(*model, e, 1.0, 0.0, kMat);
-    dense.stiffnessTimes(*model, e, 0.0, 1.0, kGeo);
-    for (std::size_t i = 0; i < size; ++i)
-      A(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = (h * h + h * m.damping_s) * kMat[i] + h * h * kGeo[i];
-    A(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(j)) +=
-        model->mass()[j % n] + h * settings.airViscosity_Ns_m3 * model->vertexArea()[j % n];
-  }
-  std::vector<double> v0(size);
-  for (std::size_t i = 0; i < n; ++i) v0[i] = s.vx[i], v0[n + i] = s.vy[i], v0[2 * n + i] = s.vz[i];
-  std::vector<double> kv(size);
-  dense.stiffnessTimes(*model, v0, 1.0, 1.0, kv);
-  const double gc[3] = {g.x(), g.y(), g.z()};
-  const double* f0[3] = {s.fx.data(), s.fy.data(), s.fz.data()};
-  std::vector<Eigen::Index> free;
-  Eigen::VectorXd b(static_cast<Eigen::Index>(size));
-  for (std::size_t c = 0; c < 3; ++c)
+  DenseCase() {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> d(-0.01, 0.01);
+    SheetSpec spec{0.2, 0.2, 5, 5, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), "sheet"};
+    Material m = fabric(5e4, 5e-4, 300);
+    m.damping_s = 1e-3;
+    model = makeModel(irregularSheet(spec), m);
+    const std::size_t n = model->vertexCount(), size = 3 * n;
+    settings.airViscosity_Ns_m3 = 0.5;
+    settings.implicitTolerance = 1e-9;  // the solve to its end, to compare with the direct one
+    top = row(spec, spec.cellsV);
+    fixed.assign(n, 0);
+    for (const std::uint32_t v : top) fixed[v] = 1;
+    s = ClothState::atRest(*model);
     for (std::size_t i = 0; i < n; ++i) {
-      b(static_cast<Eigen::Index>(c * n + i)) = h * (f0[c][i] + model->mass()[i] * gc[c]) - h * h * kv[c * n + i];
-      if (!fixed[i]) free.push_back(static_cast<Eigen::Index>(c * n + i));
+      s.x[i] += d(rng), s.y[i] += d(rng), s.z[i] += d(rng);
+      s.vx[i] = 10 * d(rng), s.vy[i] = 10 * d(rng), s.vz[i] = 10 * d(rng);
     }
-  const Eigen::MatrixXd Af = A(free, free);
-  const Eigen::VectorXd expected = Af.llt().solve(b(free));
+    clearForces(s);
+    accumulateMembraneForces(*model, s);
+    accumulateBendingForces(*model, s);
+    accumulateDragForces(*model, settings, s);
+    h = 10 * model->estimatedStableStep_s();
+
+    BackwardEuler dense;
+    dense.prepare(*model, settings, fixed);
+    dense.linearise(*model, s);
+    A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(size), static_cast<Eigen::Index>(size));
+    std::vector<double> e(size), kMat(size), kGeo(size);
+    for (std::size_t j = 0; j < size; ++j) {
+      std::fill(e.begin(), e.end(), 0.0);
+      e[j] = 1.0;
+      dense.stiffnessTimes(*model, e, 1.0, 0.0, kMat);
+      dense.stiffnessTimes(*model, e, 0.0, 1.0, kGeo);
+      for (std::size_t i = 0; i < size; ++i)
+        A(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) =
+            (h * h + h * m.damping_s) * kMat[i] + h * h * kGeo[i];
+      A(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(j)) +=
+          model->mass()[j % n] + h * settings.airViscosity_Ns_m3 * model->vertexArea()[j % n];
+    }
+    std::vector<double> v0(size);
+    for (std::size_t i = 0; i < n; ++i) v0[i] = s.vx[i], v0[n + i] = s.vy[i], v0[2 * n + i] = s.vz[i];
+    std::vector<double> kv(size);
+    dense.stiffnessTimes(*model, v0, 1.0, 1.0, kv);
+    const Vec3 g = settings.gravity_m_s2;
+    const double gc[3] = {g.x(), g.y(), g.z()};
+    const double* f0[3] = {s.fx.data(), s.fy.data(), s.fz.data()};
+    b.resize(static_cast<Eigen::Index>(size));
+    for (std::size_t c = 0; c < 3; ++c)
+      for (std::size_t i = 0; i < n; ++i)
+        b(static_cast<Eigen::Index>(c * n + i)) = h * (f0[c][i] + model->mass()[i] * gc[c]) - h * h * kv[c * n + i];
+  }
+
+  /// The velocity change a step took, all 3 n values.
+  [[nodiscard]] Eigen::VectorXd change(const ClothState& stepped) const {
+    const std::size_t n = s.size();
+    Eigen::VectorXd dv(static_cast<Eigen::Index>(3 * n));
+    for (std::size_t i = 0; i < n; ++i) {
+      dv(static_cast<Eigen::Index>(i)) = stepped.vx[i] - s.vx[i];
+      dv(static_cast<Eigen::Index>(n + i)) = stepped.vy[i] - s.vy[i];
+      dv(static_cast<Eigen::Index>(2 * n + i)) = stepped.vz[i] - s.vz[i];
+    }
+    return dv;
+  }
+};
+
+TEST(BackwardEuler, ConjugateGradientsSolveTheLinearisedSystem) {
+  const DenseCase c;
+  const std::size_t n = c.model->vertexCount();
+  std::vector<Eigen::Index> free;
+  for (std::size_t k = 0; k < 3 * n; ++k)
+    if (!c.fixed[k % n]) free.push_back(static_cast<Eigen::Index>(k));
+  const Eigen::MatrixXd Af = c.A(free, free);
+  const Eigen::VectorXd expected = Af.llt().solve(c.b(free));
 
   BackwardEuler be;
-  be.prepare(*model, settings, fixed);
-  ClothState stepped = s;
-  be.advance(*model, g, h, stepped);
-  Eigen::VectorXd got(static_cast<Eigen::Index>(free.size()));
-  const std::vector<double>* v1[3] = {&stepped.vx, &stepped.vy, &stepped.vz};
-  const std::vector<double>* vs[3] = {&s.vx, &s.vy, &s.vz};
-  for (std::size_t k = 0; k < free.size(); ++k) {
-    const auto idx = static_cast<std::size_t>(free[k]);
-    got(static_cast<Eigen::Index>(k)) = (*v1[idx / n])[idx % n] - (*vs[idx / n])[idx % n];
-  }
+  be.prepare(*c.model, c.settings, c.fixed);
+  ClothState stepped = c.s;
+  be.advance(*c.model, c.settings.gravity_m_s2, c.h, stepped);
+  const Eigen::VectorXd got = c.change(stepped)(free);
   EXPECT_LT((got - expected).norm(), 1e-7 * expected.norm());
   EXPECT_EQ(be.solveStats().solves, 1);
   EXPECT_EQ(be.solveStats().unconverged, 0);
   EXPECT_EQ(be.solveStats().indefinite, 0);
   // Positions follow the new velocities; the held vertices took gravity alone.
-  for (std::size_t i = 0; i < n; ++i) EXPECT_DOUBLE_EQ(stepped.y[i], s.y[i] + h * stepped.vy[i]);
-  for (const std::uint32_t v : top) EXPECT_DOUBLE_EQ(stepped.vy[v], s.vy[v] + h * g.y());
+  for (std::size_t i = 0; i < n; ++i) EXPECT_DOUBLE_EQ(stepped.y[i], c.s.y[i] + c.h * stepped.vy[i]);
+  for (const std::uint32_t v : c.top) EXPECT_DOUBLE_EQ(stepped.vy[v], c.s.vy[v] + c.h * c.settings.gravity_m_s2.y());
+}
+
+// A point pinched between two parts is held along their normals for one solve (Baraff and
+// Witkin's filter with one or two directions): the step is the linearised system's solution
+// over the velocity changes that leave those directions alone, against a dense solve in a
+// basis of them; the next solve frees it.
+TEST(BackwardEuler, PinchedPointsAreHeldAlongTheirPartsNormalsForOneSolve) {
+  const DenseCase c;
+  const std::size_t n = c.model->vertexCount();
+  std::mt19937 rng(11);
+  std::normal_distribution<double> gauss;
+  const auto unit = [&] { return Vec3(gauss(rng), gauss(rng), gauss(rng)).normalized(); };
+  // Vertex 8 between two parts (free along their crease), vertex 15 on one part's normal
+  // alone (the second direction along the first: nothing more), and a fixed vertex, which
+  // stays held as before.
+  const std::vector<PinchedPoint> pinched = {{8, {unit(), unit()}}, {15, {unit(), Vec3::Zero()}}, {c.top[0], {unit()}}};
+  ASSERT_FALSE(c.fixed[8] || c.fixed[15]);
+  // A basis of the velocity changes the filter lets through: each free vertex's axes, the
+  // pinched ones' directions orthogonal to theirs.
+  std::vector<Eigen::VectorXd> basis;
+  const auto add = [&](std::size_t v, const Vec3& direction) {
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * n));
+    for (int axis = 0; axis < 3; ++axis) e(static_cast<Eigen::Index>(axis * n + v)) = direction(axis);
+    basis.push_back(e);
+  };
+  for (std::size_t v = 0; v < n; ++v) {
+    if (c.fixed[v]) continue;
+    if (v == 8) {
+      add(v, pinched[0].along[0].cross(pinched[0].along[1]).normalized());
+    } else if (v == 15) {
+      const Vec3 a = pinched[1].along[0].unitOrthogonal();
+      add(v, a);
+      add(v, pinched[1].along[0].cross(a));
+    } else {
+      for (int axis = 0; axis < 3; ++axis) add(v, Vec3::Unit(axis));
+    }
+  }
+  Eigen::MatrixXd Q(static_cast<Eigen::Index>(3 * n), static_cast<Eigen::Index>(basis.size()));
+  for (std::size_t k = 0; k < basis.size(); ++k) Q.col(static_cast<Eigen::Index>(k)) = basis[k];
+  const Eigen::VectorXd expected = Q * (Q.transpose() * c.A * Q).llt().solve(Q.transpose() * c.b);
+
+  BackwardEuler be;
+  be.prepare(*c.model, c.settings, c.fixed);
+  be.holdPinched(pinched);
+  ClothState stepped = c.s;
+  be.advance(*c.model, c.settings.gravity_m_s2, c.h, stepped);
+  Eigen::VectorXd got = c.change(stepped);
+  for (const std::uint32_t v : c.top)  // the fixed vertices took gravity, as before
+    got(static_cast<Eigen::Index>(n + v)) -= c.h * c.settings.gravity_m_s2.y();
+  EXPECT_LT((got - expected).norm(), 1e-7 * expected.norm());
+  const auto dvOf = [&](const Eigen::VectorXd& dv, std::size_t v) {
+    return Vec3(dv(static_cast<Eigen::Index>(v)), dv(static_cast<Eigen::Index>(n + v)),
+                dv(static_cast<Eigen::Index>(2 * n + v)));
+  };
+  for (const Vec3& along : pinched[0].along) EXPECT_NEAR(dvOf(got, 8).dot(along), 0.0, 1e-12);
+  EXPECT_NEAR(dvOf(got, 15).dot(pinched[1].along[0]), 0.0, 1e-12);
+  EXPECT_GT(dvOf(got, 15).norm(), 1e-6) << "free along the part's surface";
+
+  // The next solve, with no pinch, moves them along those directions again.
+  ClothState next = stepped;
+  clearForces(next);
+  accumulateMembraneForces(*c.model, next);
+  accumulateBendingForces(*c.model, next);
+  const ClothState before = next;
+  be.advance(*c.model, c.settings.gravity_m_s2, c.h, next);
+  const Vec3 dv8(next.vx[8] - before.vx[8], next.vy[8] - before.vy[8], next.vz[8] - before.vz[8]);
+  EXPECT_GT(std::abs(dv8.dot(pinched[0].along[0])), 1e-6);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -24,7 +24,11 @@
 // hinge gradients at the substep's start; each conjugate-gradient iteration is one product
 // with it, warm-started from the last substep's dv. The vertices the fixtures place are
 // held (their dv is 0 in the solve, Baraff and Witkin's constraint filter), and the
-// fixtures then place them. The preconditioner is block Jacobi: the inverse of each
+// fixtures then place them. The points the colliders found pinched between two parts at
+// their last test are held along those parts' normals for one solve (the same filter with
+// one or two directions, free along the crease): they keep the velocity the collider gave
+// them there (their parts' mean) instead of being pulled deeper between the parts by the
+// cloth around them over a substep eight times the explicit one's. The preconditioner is block Jacobi: the inverse of each
 // vertex's 3x3 block of the system.
 // docs/PHYSICS.md.
 
@@ -43,6 +47,7 @@ class BackwardEuler final : public Integrator {
   void prepare(const ClothModel& model, const StepSettings& settings, std::span<const std::uint8_t> fixed) override;
   void advance(const ClothModel& model, const Vec3& gravity_m_s2, double dt_s, ClothState& io) override;
   [[nodiscard]] SolveStats solveStats() const override { return stats_; }
+  void holdPinched(std::span<const PinchedPoint> points) override;
 
   /// The forces' linearisation at `s`'s positions (deformation gradients, clamped
   /// stresses, hinge gradients), which stiffnessTimes then applies. Exposed for tests.
@@ -63,9 +68,22 @@ class BackwardEuler final : public Integrator {
   void invertDiagonalBlocks();
   /// out = A p for the free vertices, 0 for the held ones (p's held entries must be 0).
   void applySystem(std::span<const double> p, std::span<double> out) const;
+  /// Zeroes v's entries of the held vertices and the pinched ones' components along their
+  /// constrained directions (Baraff and Witkin's filter S).
   void filter(std::span<double> v) const;
+  /// The pinched vertices' part of filter alone: applySystem and the preconditioner leave
+  /// the held ones at zero already.
+  void filterPinched(std::span<double> v) const;
 
   std::vector<std::uint8_t> held_;  ///< per vertex: placed by a fixture, or massless
+  /// For this solve alone: the vertices pinched between parts at the last collision test,
+  /// each with an orthonormal basis of the directions it may not move along (one or two).
+  struct Pinched {
+    std::uint32_t vertex = 0;
+    int directions = 0;
+    Vec3 e[2] = {Vec3::Zero(), Vec3::Zero()};
+  };
+  std::vector<Pinched> pinched_;
   /// Per membrane element, at the last linearisation: the deformation gradient's columns
   /// (Fu, Fv: 6 values) and the stress with its compressive part dropped (S11, S22, S12).
   std::vector<double> gradient_, stress_;

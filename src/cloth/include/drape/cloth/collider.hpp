@@ -7,6 +7,7 @@
 // the same interface.
 
 #include <cstdint>
+#include <span>
 #include <string>
 
 #include "drape/cloth/model.hpp"
@@ -23,6 +24,14 @@ struct ColliderCounters {
   double maxPenetration_m = 0.0;     ///< deepest correction, m
 };
 
+/// A point two or more parts moved at a collider's test (pinched between them), and the
+/// directions (unit, world) in which the first two of them moved it: their surfaces'
+/// normals there, to first order. A zero direction is none.
+struct PinchedPoint {
+  std::uint32_t vertex = 0;
+  Vec3 along[2] = {Vec3::Zero(), Vec3::Zero()};
+};
+
 class Collider {
  public:
   virtual ~Collider() = default;
@@ -30,6 +39,9 @@ class Collider {
   /// Corrects io's positions and velocities at the end of the substep [t0_s, t1_s].
   virtual void collide(const ClothModel& model, double t0_s, double t1_s, ClothState& io) = 0;
   [[nodiscard]] virtual ColliderCounters counters() const = 0;
+  /// The points pinched at the collider's last test, each once; an implicit step keeps them
+  /// from moving along those directions in its next solve (BackwardEuler).
+  [[nodiscard]] virtual std::span<const PinchedPoint> pinched() const { return {}; }
   /// The solver is about to compute a frame it may compute again (StepSettings::
   /// maxRefinement): keep what restartFrame needs.
   virtual void beginFrame() = 0;

@@ -283,6 +283,10 @@ class FieldCollider final : public Collider {
   /// (Jacobi averaging), as before crease moves. On by default: where the two parts' offset
   /// surfaces meet at an angle, it moves outside both (pinchMove).
   void setCreaseMoves(bool on) { creaseMoves_ = on; }
+  /// With the pinch hold on (setPinchHold); without it a pinched point moves as it would.
+  [[nodiscard]] std::span<const PinchedPoint> pinched() const override {
+    return pinchHold_ ? std::span<const PinchedPoint>(pinchedPoints_) : std::span<const PinchedPoint>();
+  }
   /// The points held now (pinched at the last test).
   [[nodiscard]] std::size_t heldPoints() const { return held_.size(); }
   /// Off: no pair skips its distance reads through the clearance bits (nor, so, settles
@@ -549,7 +553,7 @@ class FieldCollider final : public Collider {
   /// Per vertex: two or more parts moved it at the last test (whether or not they hold it),
   /// for the penetration counters; pinchedPoints_ lists the set ones.
   std::vector<std::uint8_t> pinchedNow_;
-  std::vector<std::uint32_t> pinchedPoints_;
+  std::vector<PinchedPoint> pinchedPoints_;
   std::vector<Vec3> partVelocity_;    ///< per vertex, scratch: the sum of its pinching parts' velocities there
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pinched_;  ///< scratch: (vertex, part), sorted
   ColliderCounters counters_;

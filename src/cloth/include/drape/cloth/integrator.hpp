@@ -8,6 +8,7 @@
 #include <memory>
 #include <span>
 
+#include "drape/cloth/collider.hpp"
 #include "drape/cloth/material.hpp"
 #include "drape/cloth/model.hpp"
 #include "drape/cloth/state.hpp"
@@ -46,6 +47,11 @@ class Integrator {
   /// Advances positions and velocities by dt_s from the forces in io.f* (those of io's
   /// state: every force the step applies).
   virtual void advance(const ClothModel& model, const Vec3& gravity_m_s2, double dt_s, ClothState& io) = 0;
+  /// The points the colliders found pinched between parts at their last test, for the next
+  /// advance alone. An implicit solve keeps their velocity along the parts' normals (the
+  /// velocity the colliders gave them, their parts' mean); an explicit step ignores them,
+  /// its substeps being short.
+  virtual void holdPinched(std::span<const PinchedPoint> /*points*/) {}
   [[nodiscard]] virtual SolveStats solveStats() const { return {}; }
 };
 

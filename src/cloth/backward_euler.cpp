@@ -62,6 +62,7 @@ void BackwardEuler::prepare(const ClothModel& model, const StepSettings& setting
     held_[v] = static_cast<std::uint8_t>((!fixed.empty() && fixed[v]) || !(model.inverseMass()[v] > 0.0));
   pinched_.clear();
   pinched_.reserve(n);
+  isPinched_.assign(n, 0);
   dragPerArea_ = settings.airViscosity_Ns_m3;
   tolerance_ = settings.implicitTolerance;
   gradient_.assign(6 * model.membrane().size(), 0.0);
@@ -74,7 +75,7 @@ void BackwardEuler::prepare(const ClothModel& model, const StepSettings& setting
 
 void BackwardEuler::holdPinched(std::span<const PinchedPoint> points) {
   for (const PinchedPoint& p : points) {
-    if (p.vertex >= held_.size() || held_[p.vertex]) continue;
+    if (p.vertex >= held_.size() || held_[p.vertex] || isPinched_[p.vertex]) continue;  // one hold a vertex
     Pinched q{p.vertex, 0, {}};
     for (const Vec3& along : p.along) {
       Vec3 e = along;
@@ -82,7 +83,9 @@ void BackwardEuler::holdPinched(std::span<const PinchedPoint> points) {
       const double length = e.norm();
       if (length > 1e-3) q.e[q.directions++] = e / length;  // not along one it holds already
     }
-    if (q.directions > 0) pinched_.push_back(q);
+    if (q.directions == 0) continue;
+    isPinched_[p.vertex] = 1;
+    pinched_.push_back(q);
   }
 }
 
@@ -429,7 +432,8 @@ void BackwardEuler::advance(const ClothModel& model, const Vec3& g, double h, Cl
       v[c][i] += held_[i] ? h * gravity[c] : dv_[c * n + i];
       x[c][i] += h * v[c][i];
     }
-  pinched_.clear();  // for this solve alone
+  for (const Pinched& p : pinched_) isPinched_[p.vertex] = 0;  // for this solve alone
+  pinched_.clear();
 }
 
 }  // namespace drape::cloth

@@ -283,9 +283,10 @@ TEST(BackwardEuler, PinchedPointsAreHeldAlongTheirPartsNormalsForOneSolve) {
   std::normal_distribution<double> gauss;
   const auto unit = [&] { return Vec3(gauss(rng), gauss(rng), gauss(rng)).normalized(); };
   // Vertex 8 between two parts (free along their crease), vertex 15 on one part's normal
-  // alone (the second direction along the first: nothing more), and a fixed vertex, which
-  // stays held as before.
-  const std::vector<PinchedPoint> pinched = {{8, {unit(), unit()}}, {15, {unit(), Vec3::Zero()}}, {c.top[0], {unit()}}};
+  // alone, a fixed vertex, which stays held as before, and vertex 8 again (from another
+  // collider): its first hold stands.
+  const std::vector<PinchedPoint> pinched = {
+      {8, {unit(), unit()}}, {15, {unit(), Vec3::Zero()}}, {c.top[0], {unit()}}, {8, {unit(), unit()}}};
   ASSERT_FALSE(c.fixed[8] || c.fixed[15]);
   // A basis of the velocity changes the filter lets through: each free vertex's axes, the
   // pinched ones' directions orthogonal to theirs.

@@ -84,6 +84,7 @@ class BackwardEuler final : public Integrator {
     Vec3 e[2] = {Vec3::Zero(), Vec3::Zero()};
   };
   std::vector<Pinched> pinched_;
+  std::vector<std::uint8_t> isPinched_;  ///< per vertex: in pinched_
   /// Per membrane element, at the last linearisation: the deformation gradient's columns
   /// (Fu, Fv: 6 values) and the stress with its compressive part dropped (S11, S22, S12).
   std::vector<double> gradient_, stress_;

@@ -28,8 +28,8 @@
 // their last test are held along those parts' normals for one solve (the same filter with
 // one or two directions, free along the crease): they keep the velocity the collider gave
 // them there (their parts' mean) instead of being pulled deeper between the parts by the
-// cloth around them over a substep eight times the explicit one's. The preconditioner is block Jacobi: the inverse of each
-// vertex's 3x3 block of the system.
+// cloth around them over a substep eight times the explicit one's. The preconditioner is
+// block Jacobi: the inverse of each vertex's 3x3 block of the system.
 // docs/PHYSICS.md.
 
 #include <vector>

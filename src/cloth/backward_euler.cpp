@@ -379,7 +379,7 @@ void BackwardEuler::advance(const ClothModel& model, const Vec3& g, double h, Cl
   precondition(rhs_, d_);
   const double fromZero = dot(rhs_, d_);  // the residual's measure starting from dv = 0
   const double target = tolerance_ * tolerance_ * fromZero;
-  filter(dv_);  // a vertex held now may have moved freely in the last solve
+  filterPinched(dv_);  // a vertex held now may have moved freely in the last solve (held ones' dv stays 0)
   applySystem(dv_, q_);
   filterPinched(q_);
   for (std::size_t i = 0; i < 3 * n; ++i) r_[i] = rhs_[i] - q_[i];

@@ -944,13 +944,13 @@ void FieldCollider::collectPinches(double dt_s, ClothState& io) {
     ++askers_[i];
     partVelocity_[i].setZero();
   }
+  const auto direction = [](const Vec3& ask) {
+    const double length = ask.norm();
+    return length > 0.0 ? Vec3(ask / length) : Vec3::Zero();
+  };
   for (const auto& [k, i] : corrected_)
     if (askers_[i] >= 2 && !pinchedNow_[i]) {
       pinchedNow_[i] = 1;
-      const auto direction = [](const Vec3& ask) {
-        const double length = ask.norm();
-        return length > 0.0 ? Vec3(ask / length) : Vec3::Zero();
-      };
       pinchedPoints_.push_back({i, {direction(firstAsk_[i]), direction(secondAsk_[i])}});
     }
   if (!pinchHold_) {

@@ -184,7 +184,8 @@ struct FieldCollisionCounters {
   std::uint64_t vertexSubstepsInsideBody = 0;  ///< signed distance < 0 after the response
   /// Of those below T1 and inside the body, the points two or more parts moved at the last
   /// test (a pinch: where the parts' offset surfaces overlap, no place is outside them all,
-  /// and the mean of their corrections leaves the point below T1 of each).
+  /// and the mean of their corrections leaves the point below T1 of each; a point in a
+  /// crease moves outside both, pinchMove).
   std::uint64_t vertexSubstepsBelowT1Pinched = 0;
   std::uint64_t vertexSubstepsInsideBodyPinched = 0;
   std::uint64_t vertexSubsteps = 0;            ///< vertices x collision substeps

@@ -28,6 +28,10 @@ constexpr double kEaseTimeFactor = 2.0;
 /// propagation beyond the shell: at most 0.25, FIELDS.md; the fixed-point rounding 1/128):
 /// the resting balls' margin.
 constexpr double kFieldSlack_voxels = 0.5;
+/// A projection onto T2 longer than this reads the field again where it lands (ontoT2), up
+/// to kProjectionReads reads in all.
+constexpr double kOneMoveReach_voxels = 1.0;
+constexpr int kProjectionReads = 3;
 constexpr double kSqrt3 = 1.7320508075688772;
 /// The share of a face sample's depth below T2 its triangle is moved out by per test
 /// (collideFaces).
@@ -274,6 +278,7 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   for (std::vector<double>* v : {&correctionX_, &correctionY_, &correctionZ_}) v->assign(n, 0.0);
   corrections_.assign(n, 0);
   firstAsk_.assign(n, Vec3::Zero());
+  askParts_.assign(n, {0, 0});
   secondAsk_.assign(n, Vec3::Zero());
   correctedPoints_.clear();
   correctedPoints_.reserve(n);  // each point once per test: no allocation in the tests
@@ -731,8 +736,7 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
       const double s = len2 > 0 ? std::clamp((hitVoxel.cast<double>() - c0).dot(seg) / len2, 0.0, 1.0) : 1.0;
       c = c0 + s * seg;
     }
-    at = f.sampleAtVoxel(c);
-    c += (offsets_.t2_m - at.distance_m) / h * at.normal;
+    c = ontoT2(f, c, f.sampleAtVoxel(c));
     moved = true;
     state = PointState::OnSurf;
     ++t.field.collisions;
@@ -741,7 +745,7 @@ void FieldCollider::countUntested(const ClothState& io, double t_s) {
     if (at.distance_m > offsets_.t3_m) {
       state = PointState::InsideVol;  // carried away by forces
     } else if (at.distance_m < offsets_.t0_m) {
-      c += (offsets_.t2_m - at.distance_m) / h * at.normal;  // last resort
+      c = ontoT2(f, c, at);  // last resort
       moved = true;
       ++t.field.projections;
       ++t.contacts;
@@ -799,7 +803,7 @@ void FieldCollider::moveAndRespond(RangeTally& __restrict t, std::size_t k, cons
   Vec3 world1;  // where the point is to be, in the world at the interval's end
   if (moved) {
     world1 = frame.toWorld1.apply(c);
-    addCorrection(t, i, world1 - io.position(i));
+    addCorrection(t, k, i, world1 - io.position(i));
     t.corrected.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(i)});
   } else {
     nearest_[i] = std::min(nearest_[i], at.distance_m);  // corrected pairs: applyCorrections
@@ -808,6 +812,19 @@ void FieldCollider::moveAndRespond(RangeTally& __restrict t, std::size_t k, cons
   if (onSurf && (moved || inContact(at))) {
     if (!moved) world1 = frame.toWorld1.apply(c);
     respondOnSurface(frame, c, world1, at, i, dt_s, io);
+  }
+}
+
+// One move along the normal where the point lies is exact while the offset surface is flat
+// over the move. A longer one, from deep below it (a collision between tests far apart, a
+// pair the garment held down past its easing time), can cross where the normal turns and
+// land short of T2, or inside the body: read the field again where it lands and move again.
+Vec3 FieldCollider::ontoT2(const field::DistanceField& f, Vec3 c, field::FieldSample at) const {
+  for (int read = 1;; ++read) {
+    const double move_voxels = (offsets_.t2_m - at.distance_m) / f.voxelSize();
+    c += move_voxels * at.normal;
+    if (std::abs(move_voxels) <= kOneMoveReach_voxels || read == kProjectionReads) return c;
+    at = f.sampleAtVoxel(c);
   }
 }
 
@@ -1078,24 +1095,47 @@ std::optional<Vec3> pinchMove(const Vec3& a, const Vec3& b) {
   return x;
 }
 
-void FieldCollider::addCorrection(RangeTally& __restrict t, std::size_t i, const Vec3& displacement) {
+void FieldCollider::addCorrection(RangeTally& __restrict t, std::size_t k, std::size_t i, const Vec3& displacement) {
   correctionX_[i] += displacement.x();
   correctionY_[i] += displacement.y();
   correctionZ_[i] += displacement.z();
   const std::uint16_t asked = corrections_[i]++;
   if (asked == 0) {
     firstAsk_[i] = displacement;
+    askParts_[i][0] = static_cast<std::uint16_t>(k);
     t.correctedPoints.push_back(static_cast<std::uint32_t>(i));
   } else if (asked == 1) {
     secondAsk_[i] = displacement;
+    askParts_[i][1] = static_cast<std::uint16_t>(k);
   }
+}
+
+// The crease move is first order: each part's surface taken for the plane its ask ends on.
+// Across a long move the surfaces curve away from those planes, most where the two face each
+// other at a wide angle (the move then runs far along the gap between them), and the move can
+// end deeper in one part than the mean would. So both places are read in both parts' fields,
+// and the crease move is taken only where it ends the farther out of the two.
+std::optional<Vec3> FieldCollider::creaseMove(std::uint32_t i, const ClothState& io) const {
+  const std::optional<Vec3> move = pinchMove(firstAsk_[i], secondAsk_[i]);
+  if (!move) return std::nullopt;
+  const Vec3 x = io.position(i);
+  const auto clearance = [&](const Vec3& at) {
+    double least = std::numeric_limits<double>::infinity();
+    for (const std::uint16_t k : askParts_[i]) {
+      const field::DistanceField& f = *parts_[k].field;
+      const Vec3 c = frames_[k].toVoxel1.apply(at);
+      if (walkable(f, roundVoxel(c))) least = std::min(least, f.distanceAtVoxel(c));
+    }
+    return least;
+  };
+  const Vec3 mean = x + 0.5 * (firstAsk_[i] + secondAsk_[i]);
+  return clearance(x + *move) >= clearance(mean) ? move : std::nullopt;
 }
 
 void FieldCollider::applyCorrections(ClothState& io) {
   // A few dozen points of hundreds: by their list, leaving the sums at zero for the next test.
   for (const std::uint32_t i : correctedPoints_) {
-    const std::optional<Vec3> crease =
-        corrections_[i] == 2 && creaseMoves_ ? pinchMove(firstAsk_[i], secondAsk_[i]) : std::nullopt;
+    const std::optional<Vec3> crease = corrections_[i] == 2 && creaseMoves_ ? creaseMove(i, io) : std::nullopt;
     if (crease) {
       io.x[i] += crease->x();
       io.y[i] += crease->y();
@@ -1278,7 +1318,7 @@ void FieldCollider::releaseEmbedded(RangeTally& __restrict t, std::size_t k, con
   const Vec3 v = io.velocity(i);
   const double vn = (v - partVelocity).dot(n);
   if (vn < 0) io.setVelocity(i, v - vn * n);
-  addCorrection(t, i, world - io.position(i));
+  addCorrection(t, k, i, world - io.position(i));
   if (step == rest) {  // on T2 now (to the field's accuracy): slide from here
     embedded_[k][i] = 0;
     state = PointState::OnSurf;

@@ -146,11 +146,11 @@ TEST(MakeScene, DressOnTheWalkingBody) {
   ASSERT_EQ(ran.code, 0) << ran.err;
   const nlohmann::json stats = statsOf(out);
   EXPECT_EQ(stats["frames"].get<int>(), 3);
-  // A pair the garment held below T2 past its easing time (pairs_embedded_timed_out) is
-  // projected onto T2 in one test from as deep as the dress is modelled, along the normal
-  // where it lies: a vertex-substep may end a fraction of a millimetre short.
-  EXPECT_LE(stats["vertex_substeps_inside_body"].get<long>(), 3);
-  EXPECT_LT(stats["max_penetration_m"].get<double>(), 0.001);
+  // Pairs the garment held below T2 past their easing time (pairs_embedded_timed_out) are
+  // projected onto T2 from as deep as the dress is modelled: read again where each move
+  // lands, none ends inside the body.
+  EXPECT_GT(stats["pairs_embedded_timed_out"].get<long>(), 0);
+  EXPECT_EQ(stats["vertex_substeps_inside_body"].get<long>(), 0);
   EXPECT_GT(stats["pairs_embedded_at_start"].get<long>(), 0) << "the dress is modelled tight on the body";
   const nlohmann::json& g = stats["garments"][0];
   EXPECT_GT(g["added_mass_kg"].get<double>(), 0.0);
@@ -395,7 +395,7 @@ TEST(MakeScene, BackwardEulerAsksAnEighthOfTheSubstepsAndNoMass) {
       << made.out;
   const std::string out = dir / "out";
   const CliResult ran = runDrape("run '" + sceneDir + "/scene.wrl' --motion '" + kSource +
-                                     "/examples/walking_skirt/walk.bvh' --frames 10 --out '" + out + "'",
+                                     "/examples/walking_skirt/walk.bvh' --frames 15 --out '" + out + "'",
                                  dir);
   ASSERT_EQ(ran.code, 0) << ran.err;
   EXPECT_EQ(ran.err.find("fewer run faster"), std::string::npos) << ran.err;

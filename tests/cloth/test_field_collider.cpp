@@ -709,7 +709,7 @@ TEST(FieldCollider, CountingEverySubstepReadsTheUntestedOnesAndMovesNothing) {
   EXPECT_EQ(cb.vertexSubsteps, 25u * n);
   EXPECT_EQ(ca.collisions, cb.collisions);
   EXPECT_EQ(ca.tests, cb.tests);
-  EXPECT_GT(bruteForceInside, 20u) << "the sphere must overrun points between the tests";
+  EXPECT_GT(bruteForceInside, 10u) << "the sphere must overrun points between the tests";
   EXPECT_EQ(untestedInside, bruteForceInside);
   EXPECT_EQ(ca.vertexSubstepsInsideBody - cb.vertexSubstepsInsideBody, untestedInside);
   EXPECT_GE(ca.maxPenetration_m, cb.maxPenetration_m);
@@ -1219,6 +1219,98 @@ TEST(FieldCollider, APointHeldBelowT2WhileEasedCollidesAsAnyOtherInTime) {
   // of the field's normal from 2.7 mm lands at 12 mm), out of the penalty zone.
   EXPECT_EQ(c.fieldCounters().projections, 1u);
   EXPECT_GT(s.field.distanceAt(p.state.position(0)), kOffsets.t1_m);
+}
+
+/// An L-shaped prism: the square [0, 2u] x [0, 2u] less its corner [u, 2u] x [u, 2u], from
+/// z = -u to u. Its inner edge, the line x = y = u, is concave: the field's normal turns by a
+/// right angle around it.
+mesh::TriMesh makeLPrism(double u) {
+  const std::array<Vec3, 6> outline = {Vec3(0, 0, 0), Vec3(2 * u, 0, 0), Vec3(2 * u, u, 0),
+                                       Vec3(u, u, 0),  Vec3(u, 2 * u, 0), Vec3(0, 2 * u, 0)};  // anticlockwise
+  mesh::TriMesh m;
+  for (const Vec3& p : outline) m.positions.push_back(p - Vec3(0, 0, u));
+  for (const Vec3& p : outline) m.positions.push_back(p + Vec3(0, 0, u));
+  for (std::uint32_t i = 1; i + 1 < 6; ++i) {  // the caps, fanned from the convex corner 0
+    m.triangles.push_back({0, i + 1, i});
+    m.triangles.push_back({6, 6 + i, 6 + i + 1});
+  }
+  for (std::uint32_t i = 0; i < 6; ++i) {  // the sides, facing out
+    const std::uint32_t j = (i + 1) % 6;
+    m.triangles.push_back({i, j, 6 + j});
+    m.triangles.push_back({i, 6 + j, 6 + i});
+  }
+  return m;
+}
+
+TEST(FieldCollider, ALongProjectionReadsTheFieldAgainWhereItLands) {
+  // A sliding point found deep inside the body under a concave edge (a garment held below T0
+  // by its own pull, then projected as the last resort): the field's normal there points
+  // across the edge, diagonally, and one move along it by its depth below T2 lands beside the
+  // face it came through, below T1. Read again where it lands and moved again, it ends on T2.
+  const double u = 0.05;
+  BodySetup s(makeLPrism(u), std::make_shared<StaticMotion>());
+  Point p(Vec3::Zero());
+  FieldCollider c("test", s.parts, kOffsets, 0.0, 0.0);
+  const double dt = 1e-3;
+  // First it lands on the top face of the L's lower arm, far from the edge, and slides there.
+  initialiseArriving(c, p, Vec3(1.6 * u, u + 0.02, 0));
+  p.state.setPosition(0, Vec3(1.6 * u, u + 0.012, 0));
+  c.collide(*p.model, 0, dt, p.state);
+  ASSERT_EQ(c.state(0, 0), PointState::OnSurf);
+  // Then the garment pulls it into the body, 12 mm under the edge.
+  const Vec3 inside(u - 0.001, u - 0.012, 0);
+  const field::FieldSample at = s.field.sampleAtVoxel(s.field.toVoxel(inside));
+  ASSERT_LT(at.distance_m, 0.0);
+  const Vec3 oneMove = inside + (kOffsets.t2_m - at.distance_m) * at.normal;
+  ASSERT_LT(s.field.distanceAt(oneMove), kOffsets.t1_m) << "the premise: one move lands below T1";
+  p.state.setPosition(0, inside);
+  p.state.setVelocity(0, Vec3::Zero());
+  c.collide(*p.model, dt, 2 * dt, p.state);
+  EXPECT_EQ(c.fieldCounters().projections, 1u);
+  const Vec3 end = p.state.position(0);
+  EXPECT_GT(end.x(), u + kOffsets.t1_m) << "across the edge";
+  EXPECT_NEAR(s.field.distanceAt(end), kOffsets.t2_m, 0.2 * kVoxel) << "on T2";
+}
+
+TEST(FieldCollider, ACreaseMoveNeverEndsDeeperThanTheMean) {
+  // The crease move is first order: each part's surface taken for the plane its ask ends on.
+  // Beside a concave edge (the L's) the surface turns away from that plane, and across a
+  // channel narrower than 2 T2 the move runs far along it: it can end deeper in a part than
+  // the mean of the asks. A box stands on the L's lower arm, 25 mm from its upper arm (a
+  // crease with the lower arm's top face, a channel with the upper arm). Random points thrown
+  // into the corner, one test each, with crease moves and with the mean alone: with crease
+  // moves each ends at least as far out of both parts as with the mean, and further out in
+  // many. (Taking every crease move, a third of them ended deeper.)
+  const double u = 0.05, gap = 0.025;
+  const field::DistanceField lField = buildField(makeLPrism(u));
+  const field::DistanceField boxField = buildField(field::makeBox(Vec3(u + gap, u - 0.01, -u), Vec3(2.5 * u, 2.5 * u, u)));
+  const std::vector<CollisionPart> parts = {{"L", &lField, std::make_shared<StaticMotion>()},
+                                            {"box", &boxField, std::make_shared<StaticMotion>()}};
+  const auto clearance = [&](const Vec3& x) { return std::min(lField.distanceAt(x), boxField.distanceAt(x)); };
+  std::mt19937 rng(20261207);
+  std::uniform_real_distribution<double> where(u - 0.004, u + gap + 0.004), speed(0.5, 4.0);
+  std::normal_distribution<double> gauss;
+  const double dt = 1e-3;
+  int pinched = 0, better = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const Vec3 from(where(rng), where(rng), 0.01 * gauss(rng));
+    const Vec3 v = speed(rng) * Vec3(gauss(rng), gauss(rng), 0.3 * gauss(rng)).normalized();
+    std::array<double, 2> ends{};
+    for (const bool crease : {true, false}) {
+      Point p(Vec3::Zero());
+      FieldCollider c("test", parts, kOffsets, 0.0, 0.0);
+      c.setCreaseMoves(crease);
+      initialiseArriving(c, p, from + v * dt);
+      p.state.setVelocity(0, v);
+      c.collide(*p.model, 0, dt, p.state);
+      ends[crease ? 0 : 1] = clearance(p.state.position(0));
+      if (crease) pinched += c.fieldCounters().pinchedVertexTests > 0;
+    }
+    EXPECT_GE(ends[0], ends[1] - 1e-12) << "trial " << trial;
+    better += ends[0] > ends[1] + 1e-4;
+  }
+  EXPECT_GT(pinched, 500);
+  EXPECT_GT(better, 100) << "of " << pinched << " pinched";
 }
 
 /// One triangle over the pole of a ball of radius 5 cm, its vertices 30 degrees from the

@@ -416,6 +416,9 @@ class FieldCollider final : public Collider {
   void wake(std::size_t k, std::size_t vertex);
   /// Pair (k, vertex) ended this test InsideVol and unmoved at c1: its resting ball.
   void rest(std::size_t k, std::size_t vertex, const Vec3& c1);
+  /// c, where the field reads `at`, moved along the normal onto T2; a move longer than a
+  /// voxel is read again where it lands and mended.
+  [[nodiscard]] Vec3 ontoT2(const field::DistanceField& f, Vec3 c, field::FieldSample at) const;
   /// The field at c for sliding pair (k, vertex): from its contact plane when the plane
   /// reaches c, else read (and the plane moved there).
   [[nodiscard]] field::FieldSample slidingSample(RangeTally& t, std::size_t k, std::size_t vertex, const Vec3& c);
@@ -430,8 +433,11 @@ class FieldCollider final : public Collider {
   /// voxel coordinates `voxel`, which are `world` in the world at the interval's end.
   void respondOnSurface(const PartFrame& frame, const Vec3& voxel, const Vec3& world, const field::FieldSample& at,
                         std::size_t vertex, double dt_s, ClothState& io) const;
-  /// A part asks to move the point by `displacement` (world, m) this collision step.
-  void addCorrection(RangeTally& t, std::size_t vertex, const Vec3& displacement);
+  /// Part k asks to move the point by `displacement` (world, m) this collision step.
+  void addCorrection(RangeTally& t, std::size_t k, std::size_t vertex, const Vec3& displacement);
+  /// Vertex's move at this test when two parts asked it to move: pinchMove's, where it ends
+  /// farther out of both parts (read in their fields) than the mean of the asks; else none.
+  [[nodiscard]] std::optional<Vec3> creaseMove(std::uint32_t vertex, const ClothState& io) const;
   /// Moves every point by the mean of its parts' displacements.
   void applyCorrections(ClothState& io);
   /// The lists collideFaces walks, from the garment's triangles (at its first call).
@@ -495,6 +501,7 @@ class FieldCollider final : public Collider {
   std::vector<double> correctionX_, correctionY_, correctionZ_;
   std::vector<std::uint16_t> corrections_;
   std::vector<Vec3> firstAsk_, secondAsk_;  ///< per vertex, this test: the first two displacements asked (pinchMove)
+  std::vector<std::array<std::uint16_t, 2>> askParts_;  ///< per vertex, this test: the parts that asked them
   std::vector<std::uint32_t> correctedPoints_;  ///< the points with corrections this test, each once
   std::vector<std::pair<std::uint32_t, std::uint32_t>> corrected_;
   /// Per vertex, this test: the parts it slides on, one bit each (parts < 64), and the face

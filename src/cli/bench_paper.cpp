@@ -271,6 +271,8 @@ RunFunction setupPaperBench(CLI::App& app) {
     j["pinch_hold"] = !o.freePinches;
     j["vertex_substeps_held_in_pinches"] = r.counters.heldVertexSubsteps;
     j["vertex_tests_pinched"] = r.counters.pinchedVertexTests;
+    j["crease_moves"] = r.counters.creaseMoves;
+    j["crease_moves_refused"] = r.counters.creaseMovesRefused;
     j["face_tests"] = r.counters.faceTests;
     j["face_contacts"] = r.counters.faceContacts;
     j["self_collision_m"] = r.selfThickness_m;  // 0: none (its time is in the collision's)

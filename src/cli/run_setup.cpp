@@ -187,6 +187,8 @@ void addCollisionStats(nlohmann::json& stats, const std::vector<GarmentRun>& run
   stats["sliding_reads_from_contact_planes"] = sum.slidingReadsFromPlanes();
   stats["vertex_substeps_held_in_pinches"] = sum.heldVertexSubsteps;
   stats["vertex_tests_pinched"] = sum.pinchedVertexTests;
+  stats["crease_moves"] = sum.creaseMoves;
+  stats["crease_moves_refused"] = sum.creaseMovesRefused;
   stats["part_tests_out_of_reach"] = sum.partsOutOfReach;
   stats["face_tests"] = sum.faceTests;
   stats["face_contacts"] = sum.faceContacts;

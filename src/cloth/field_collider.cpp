@@ -1115,7 +1115,7 @@ void FieldCollider::addCorrection(RangeTally& __restrict t, std::size_t k, std::
 // other at a wide angle (the move then runs far along the gap between them), and the move can
 // end deeper in one part than the mean would. So both places are read in both parts' fields,
 // and the crease move is taken only where it ends the farther out of the two.
-std::optional<Vec3> FieldCollider::creaseMove(std::uint32_t i, const ClothState& io) const {
+std::optional<Vec3> FieldCollider::creaseMove(std::uint32_t i, const ClothState& io) {
   const std::optional<Vec3> move = pinchMove(firstAsk_[i], secondAsk_[i]);
   if (!move) return std::nullopt;
   const Vec3 x = io.position(i);
@@ -1129,7 +1129,12 @@ std::optional<Vec3> FieldCollider::creaseMove(std::uint32_t i, const ClothState&
     return least;
   };
   const Vec3 mean = x + 0.5 * (firstAsk_[i] + secondAsk_[i]);
-  return clearance(x + *move) >= clearance(mean) ? move : std::nullopt;
+  if (clearance(x + *move) >= clearance(mean)) {
+    ++field_.creaseMoves;
+    return move;
+  }
+  ++field_.creaseMovesRefused;
+  return std::nullopt;
 }
 
 void FieldCollider::applyCorrections(ClothState& io) {
@@ -1338,6 +1343,7 @@ FieldCollisionCounters& FieldCollisionCounters::operator+=(const FieldCollisionC
                       {&embeddedTimedOut, o.embeddedTimedOut},
                       {&planeEstimates, o.planeEstimates}, {&planeReads, o.planeReads},
                       {&heldVertexSubsteps, o.heldVertexSubsteps}, {&pinchedVertexTests, o.pinchedVertexTests},
+                      {&creaseMoves, o.creaseMoves}, {&creaseMovesRefused, o.creaseMovesRefused},
                       {&faceTests, o.faceTests}, {&faceContacts, o.faceContacts}, {&facesInsideBody, o.facesInsideBody},
                       {&partsOutOfReach, o.partsOutOfReach}})
     *a += b;

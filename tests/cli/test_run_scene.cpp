@@ -209,8 +209,11 @@ TEST(RunScene, WalkingSkirtWritesEverything) {
   for (const char* key : {"collision_time_share", "mean_collision_path_voxels", "points_per_state",
                           "vertex_substeps_below_T1", "vertex_substeps_below_T0", "vertex_substeps_inside_body",
                           "vertex_substeps_below_T1_pinched", "vertex_substeps_inside_body_pinched",
-                          "max_penetration_m", "distance_fields", "body_overlaps"})
+                          "max_penetration_m", "crease_moves", "crease_moves_refused", "distance_fields",
+                          "body_overlaps"})
     EXPECT_TRUE(stats.contains(key)) << key;
+  EXPECT_LE(stats["crease_moves"].get<long>() + stats["crease_moves_refused"].get<long>(),
+            stats["vertex_tests_pinched"].get<long>());
   EXPECT_LE(stats["vertex_substeps_below_T1_pinched"].get<long>(), stats["vertex_substeps_below_T1"].get<long>());
   EXPECT_LE(stats["vertex_substeps_inside_body_pinched"].get<long>(),
             stats["vertex_substeps_inside_body"].get<long>());

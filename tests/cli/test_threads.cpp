@@ -41,7 +41,8 @@ TEST(Threads, ALargeGarmentRunsTheSameWithOneThreadAndWithTwo) {
   for (const char* key : {"collisions_registered", "vertex_substeps", "vertex_substeps_below_T1",
                           "vertex_substeps_below_T1_pinched", "vertex_substeps_inside_body",
                           "mean_collision_path_voxels", "max_penetration_m", "max_strain", "max_stretch",
-                          "max_compression", "vertex_tests_pinched", "face_tests", "face_contacts"})
+                          "max_compression", "vertex_tests_pinched", "crease_moves", "crease_moves_refused", "face_tests",
+                          "face_contacts"})
     EXPECT_EQ(a[key], b[key]) << key;
   // The walk must reach the body: what is compared includes collisions.
   EXPECT_GT(a["collisions_registered"].get<long>(), 0);

@@ -850,6 +850,8 @@ TEST(FieldCollider, APointPressedIntoACreaseEndsOutsideBothParts) {
     if (crease) {
       EXPECT_NEAR(lowest, kOffsets.t2_m, 1e-6) << "on T2 of both";
       EXPECT_EQ(c.fieldCounters().vertexSubstepsBelowT1, 0u);
+      EXPECT_GT(c.fieldCounters().creaseMoves, 40u);
+      EXPECT_EQ(c.fieldCounters().creaseMovesRefused, 0u) << "planes: first order is exact";
     } else {
       // Each test moves it back by half of the 0.71 mm per axis it was thrown: it settles
       // that far below T2 of both.
@@ -1004,7 +1006,8 @@ TEST(FieldCollider, CountersOfTwoGarmentsAddUp) {
                            &a.vertexSubstepsBelowT1Pinched, &a.vertexSubstepsInsideBodyPinched, &a.vertexSubsteps,
                            &a.clearanceSkips, &a.embeddedAtStart, &a.planeEstimates, &a.planeReads,
                            &a.heldVertexSubsteps, &a.embeddedTimedOut, &a.restingSkips,
-                           &a.pinchedVertexTests, &a.faceTests, &a.faceContacts, &a.facesInsideBody})
+                           &a.pinchedVertexTests, &a.creaseMoves, &a.creaseMovesRefused, &a.faceTests,
+                           &a.faceContacts, &a.facesInsideBody})
     *f = value++;
   for (auto& row : a.transitions)
     for (std::uint64_t& t : row) t = value++;
@@ -1020,7 +1023,8 @@ TEST(FieldCollider, CountersOfTwoGarmentsAddUp) {
                                  &c.vertexSubstepsBelowT1Pinched, &c.vertexSubstepsInsideBodyPinched, &c.vertexSubsteps,
                                  &c.clearanceSkips, &c.embeddedAtStart, &c.planeEstimates,
                                  &c.planeReads, &c.heldVertexSubsteps, &c.embeddedTimedOut, &c.restingSkips,
-                                 &c.pinchedVertexTests, &c.faceTests, &c.faceContacts, &c.facesInsideBody})
+                                 &c.pinchedVertexTests, &c.creaseMoves, &c.creaseMovesRefused, &c.faceTests,
+                                 &c.faceContacts, &c.facesInsideBody})
     EXPECT_EQ(*f, 2 * value++);
   for (const auto& row : c.transitions)
     for (const std::uint64_t t : row) EXPECT_EQ(t, 2 * value++);
@@ -1292,6 +1296,7 @@ TEST(FieldCollider, ACreaseMoveNeverEndsDeeperThanTheMean) {
   std::normal_distribution<double> gauss;
   const double dt = 1e-3;
   int pinched = 0, better = 0;
+  std::uint64_t taken = 0, refused = 0;  // crease moves (stats.json's crease_moves, crease_moves_refused)
   for (int trial = 0; trial < 3000; ++trial) {
     const Vec3 from(where(rng), where(rng), 0.01 * gauss(rng));
     const Vec3 v = speed(rng) * Vec3(gauss(rng), gauss(rng), 0.3 * gauss(rng)).normalized();
@@ -1304,13 +1309,23 @@ TEST(FieldCollider, ACreaseMoveNeverEndsDeeperThanTheMean) {
       p.state.setVelocity(0, v);
       c.collide(*p.model, 0, dt, p.state);
       ends[crease ? 0 : 1] = clearance(p.state.position(0));
-      if (crease) pinched += c.fieldCounters().pinchedVertexTests > 0;
+      const FieldCollisionCounters& f = c.fieldCounters();
+      if (crease) {
+        pinched += f.pinchedVertexTests > 0;
+        taken += f.creaseMoves;
+        refused += f.creaseMovesRefused;
+      } else {
+        EXPECT_EQ(f.creaseMoves + f.creaseMovesRefused, 0u);
+      }
     }
     EXPECT_GE(ends[0], ends[1] - 1e-12) << "trial " << trial;
     better += ends[0] > ends[1] + 1e-4;
   }
   EXPECT_GT(pinched, 500);
   EXPECT_GT(better, 100) << "of " << pinched << " pinched";
+  EXPECT_GE(taken, static_cast<std::uint64_t>(better));
+  EXPECT_GT(refused, 100u) << "taken " << taken;
+  EXPECT_LE(taken + refused, static_cast<std::uint64_t>(pinched));
 }
 
 /// One triangle over the pole of a ball of radius 5 cm, its vertices 30 degrees from the

@@ -198,6 +198,8 @@ struct FieldCollisionCounters {
   std::uint64_t planeReads = 0;      ///< sliding pairs' field reads that went to the field
   std::uint64_t heldVertexSubsteps = 0;  ///< untested substeps of points held in a pinch (setPinchHold)
   std::uint64_t pinchedVertexTests = 0;  ///< tests at which two or more parts moved a point (setPinchHold)
+  std::uint64_t creaseMoves = 0;  ///< of the points two parts moved at a test, those moved outside both (creaseMove)
+  std::uint64_t creaseMovesRefused = 0;  ///< those whose crease move would have ended deeper than the mean: the mean
   std::uint64_t faceTests = 0;     ///< (triangle, part) pairs whose centroid was read (face samples)
   std::uint64_t faceContacts = 0;  ///< of those, centroids below T2: their triangle moved out
   std::uint64_t facesInsideBody = 0;  ///< of those, centroids inside the body (signed distance < 0) before the move
@@ -437,7 +439,7 @@ class FieldCollider final : public Collider {
   void addCorrection(RangeTally& t, std::size_t k, std::size_t vertex, const Vec3& displacement);
   /// Vertex's move at this test when two parts asked it to move: pinchMove's, where it ends
   /// farther out of both parts (read in their fields) than the mean of the asks; else none.
-  [[nodiscard]] std::optional<Vec3> creaseMove(std::uint32_t vertex, const ClothState& io) const;
+  [[nodiscard]] std::optional<Vec3> creaseMove(std::uint32_t vertex, const ClothState& io);
   /// Moves every point by the mean of its parts' displacements.
   void applyCorrections(ClothState& io);
   /// The lists collideFaces walks, from the garment's triangles (at its first call).

@@ -42,7 +42,8 @@
 // forth, and a point one part touches moves exactly as that part asks. A point two parts
 // ask to move where their surfaces meet at an angle (a crease) moves instead by the shortest
 // move outside both, to first order (pinchMove): the mean stopped it halfway, below T2 of
-// each. Velocity responses apply part by part.
+// each. That move is taken only where, read in both parts' fields, it ends no deeper than
+// the mean would (creaseMove). Velocity responses apply part by part.
 //
 // Pinches between reduced-frequency tests (every > 1): the Jacobi mean leaves a point that
 // two parts press from both sides off the offset surface it would take with either alone,
@@ -284,7 +285,8 @@ class FieldCollider final : public Collider {
   void setPinchHold(bool on) { pinchHold_ = on; }
   /// Off: a point two parts asked to move at a test always moves by the mean of their asks
   /// (Jacobi averaging), as before crease moves. On by default: where the two parts' offset
-  /// surfaces meet at an angle, it moves outside both (pinchMove).
+  /// surfaces meet at an angle, it moves outside both (pinchMove), where that ends no deeper
+  /// in either part than the mean (creaseMove).
   void setCreaseMoves(bool on) { creaseMoves_ = on; }
   /// With the pinch hold on (setPinchHold); without it a pinched point moves as it would.
   [[nodiscard]] std::span<const PinchedPoint> pinched() const override {

@@ -48,9 +48,10 @@ enum class IntegratorKind {
 /// Substeps per frame to give backward Euler where the explicit steps need
 /// `explicitSubsteps`: an eighth, at least 2. Measured on the bundled garments
 /// (docs/PERFORMANCE.md, "Backward Euler"): the skirt at an eighth of its 33 stays out of
-/// the body; the dress at an eighth of its 155 stays out of it too, with about twice the
+/// the body; the dress at an eighth of its 155 stays out of it too, with about 1.3 times the
 /// explicit step's share of vertex-substeps below T1 (its pinched points held in the solve,
-/// "Pinched points held in the implicit solve"), at 1.1 to 1.5 times its speed; fewer
+/// crease moves checked: "Long projections read again, crease moves checked"), at 1.1 to 1.5
+/// times its speed; fewer
 /// substeps lengthen the collision response's stride further.
 [[nodiscard]] int implicitSubstepsFor(int explicitSubsteps);
 

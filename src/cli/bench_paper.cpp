@@ -183,8 +183,8 @@ RunFunction setupPaperBench(CLI::App& app) {
       ->check(CLI::Range(1, 1000));
   app.add_option("--substeps", o.substeps, "Substeps per frame, overriding the scene")->check(CLI::Range(1, 100000));
   app.add_option("--integrator", o.integrator,
-                 "symplectic-euler, forward-euler or backward-euler, overriding the scene (backward-euler bends every "
-                 "substep unless --bend-every says otherwise)");
+                 "symplectic-euler, forward-euler, backward-euler or runge-kutta-4, overriding the scene "
+                 "(backward-euler and runge-kutta-4 bend every substep)");
   app.add_flag("--exact-sliding", o.exactSliding,
                "Sliding points read the distance field on every test instead of their contact planes "
                "(the reference the planes are measured against)");

@@ -270,19 +270,34 @@ int makeScene(MakeSceneOptions& o) {
                            "would take {} with {:.2f} % of the mass added)",
                            o.stepsPerFrame, o.frameRate, choice.substepsPerFrame, 100.0 * choice.addedMassFraction);
   } else {
-    if (o.stepsPerFrame == 0) o.stepsPerFrame = choice.substepsPerFrame;
-    const double added = o.stepsPerFrame == choice.substepsPerFrame
-                             ? choice.addedMassFraction
-                             : cloth::addedMassFractionAt(garment, topology, o.material, o.frameRate, o.stepsPerFrame);
-    if (added > o.maxAddedMass)
-      throw Error(fmt::format("--substeps {}: mass scaling would add {:.2f} % of the garment's mass, more than "
-                              "--max-added-mass {:g}; {} substeps per frame need no more than that",
-                              o.stepsPerFrame, 100.0 * added, o.maxAddedMass, choice.substepsPerFrame));
     // Unscaled masses: scaling only adds mass, which slows bending, so this is the cautious
     // rhythm; a rhythm asked for is held to the bending forces' stable step, as drape run
     // holds it.
     const auto unscaled = cloth::ClothModel::build(garment, topology, o.material);
-    if (o.bendEvery == 0) {
+    // Runge-Kutta: symplectic Euler's count and mass scaling are stable for it, and its own
+    // bound on the unscaled membrane may ask fewer substeps and no mass.
+    const bool rungeKutta = o.integrator.kind == cloth::IntegratorKind::RungeKutta4;
+    const int rungeKuttaCount = rungeKutta ? cloth::rungeKuttaSubsteps(*unscaled, o.frameRate) : 0;
+    if (o.stepsPerFrame == 0)
+      o.stepsPerFrame = rungeKutta ? std::min(rungeKuttaCount, choice.substepsPerFrame) : choice.substepsPerFrame;
+    const bool unscaledRungeKutta = rungeKutta && o.stepsPerFrame >= rungeKuttaCount;
+    if (unscaledRungeKutta) o.maxAddedMass = 0.0;
+    const double added =
+        unscaledRungeKutta                           ? 0.0
+        : o.stepsPerFrame == choice.substepsPerFrame ? choice.addedMassFraction
+                                                     : cloth::addedMassFractionAt(garment, topology, o.material,
+                                                                                  o.frameRate, o.stepsPerFrame);
+    if (added > o.maxAddedMass)
+      throw Error(fmt::format("--substeps {}: mass scaling would add {:.2f} % of the garment's mass, more than "
+                              "--max-added-mass {:g}; {} substeps per frame need no more than that",
+                              o.stepsPerFrame, 100.0 * added, o.maxAddedMass, choice.substepsPerFrame));
+    if (!cloth::StepSettings::oneStageExplicit(o.integrator.kind)) {
+      if (o.bendEvery > 1)
+        throw Error(fmt::format("--bend-every {}: the {} step takes bending into each of its stages; leave "
+                                "--bend-every out with it",
+                                o.bendEvery, cloth::integratorName(o.integrator.kind)));
+      o.bendEvery = 1;
+    } else if (o.bendEvery == 0) {
       o.bendEvery = cloth::suggestedBendEvery(*unscaled, 1.0 / (o.frameRate * o.stepsPerFrame));
     } else {
       cloth::StepSettings rhythm;
@@ -291,8 +306,14 @@ int makeScene(MakeSceneOptions& o) {
       rhythm.bendEvery = o.bendEvery;
       cloth::checkBendingStep(*unscaled, rhythm);
     }
-    substeps = fmt::format("{} substeps per frame at {:g} frames/s (mass scaling adds {:.2f} % of the mass)",
-                           o.stepsPerFrame, o.frameRate, 100.0 * added);
+    substeps = unscaledRungeKutta
+                   ? fmt::format("{} substeps per frame at {:g} frames/s, each a fourth-order Runge-Kutta step, no "
+                                 "mass added (symplectic Euler would take {} with {:.2f} % of the mass added)",
+                                 o.stepsPerFrame, o.frameRate, choice.substepsPerFrame,
+                                 100.0 * choice.addedMassFraction)
+                   : fmt::format("{} substeps per frame at {:g} frames/s{} (mass scaling adds {:.2f} % of the mass)",
+                                 o.stepsPerFrame, o.frameRate,
+                                 rungeKutta ? ", each a fourth-order Runge-Kutta step" : "", 100.0 * added);
   }
 
   if (o.stitchGaps_m > 0.0) o.stitches = openingsToSew(garment, topology, o.name, o.stitchGaps_m);

@@ -96,11 +96,16 @@ int writeScene(const std::string& path, const MakeSkirtOptions& o, const mesh::S
       cloth::fewestStableSubsteps(skirt.mesh, mesh::Topology::build(skirt.mesh), m, kFrameRate, 0.0, 33).substepsPerFrame;
   // Backward Euler: an eighth of those, bending in every solve.
   const bool implicit = o.integrator.implicit();
-  const int kSubsteps = implicit ? cloth::implicitSubstepsFor(explicitSubsteps) : explicitSubsteps;
-  const int bendEvery =
-      implicit ? 1
-               : cloth::suggestedBendEvery(*cloth::ClothModel::build(skirt.mesh, mesh::Topology::build(skirt.mesh), m),
-                                           1.0 / (kFrameRate * kSubsteps));
+  const auto model = cloth::ClothModel::build(skirt.mesh, mesh::Topology::build(skirt.mesh), m);
+  // Runge-Kutta: as few as its bound on the membrane's stiffest mode allows.
+  const int kSubsteps = implicit ? cloth::implicitSubstepsFor(explicitSubsteps)
+                        : o.integrator.kind == cloth::IntegratorKind::RungeKutta4
+                            ? std::min(explicitSubsteps, cloth::rungeKuttaSubsteps(*model, kFrameRate))
+                            : explicitSubsteps;
+  // Bending as an impulse suits the one-stage explicit steps alone.
+  const int bendEvery = !cloth::StepSettings::oneStageExplicit(o.integrator.kind)
+                            ? 1
+                            : cloth::suggestedBendEvery(*model, 1.0 / (kFrameRate * kSubsteps));
   std::ofstream os(path);
   fmt::print(os, "#VRML V2.0 utf8\n");
   const std::string own = ownMotionText(avatar);
@@ -266,8 +271,10 @@ int makeSkirt(MakeSkirtOptions o) {
                     "drape make-skirt: constraint mask (m)");
   const int substeps = writeScene((dir / "scene.wrl").string(), written, skirt, avatar);
   printSkirt(o.name == "Skirt" ? "skirt" : o.name, skirt);
-  fmt::print("; {} substeps per frame{}\n", substeps,
-             o.integrator.implicit() ? ", each a backward-Euler solve" : "");
+  const char* each = o.integrator.implicit() ? ", each a backward-Euler solve"
+                     : o.integrator.kind == cloth::IntegratorKind::RungeKutta4 ? ", each a fourth-order Runge-Kutta step"
+                                                                              : "";
+  fmt::print("; {} substeps per frame{}\n", substeps, each);
   sayWhereTheVoxelIsScaled(
       scale, o.avatar,
       o.clearanceGiven ? "" : "; " + scaledClearance(o.fit.clearance_m));

@@ -193,7 +193,7 @@ void applyOverrides(const CLI::App& app, const RunOptions& o, RunSetup& setup) {
   if (app.count("--air-viscosity")) s.airViscosity_Ns_m3 = o.settings.airViscosity_Ns_m3;
   if (app.count("--max-speed")) s.maxSpeed_m_s = o.settings.maxSpeed_m_s;
   if (app.count("--max-added-mass")) s.maxAddedMass = o.settings.maxAddedMass;
-  // The integrator before the rhythm: switching to backward Euler resets it (useIntegrator), and
+  // The integrator before the rhythm: switching to backward Euler or Runge-Kutta resets it (useIntegrator), and
   // a --bend-every given with it is then refused by validate(), naming why.
   if (app.count("--integrator")) s.useIntegrator(cloth::parseIntegrator(o.integrator, "--integrator"));
   if (app.count("--bend-every")) s.bendEvery = o.settings.bendEvery;
@@ -380,9 +380,19 @@ int runCommand(const CLI::App& app, RunOptions& o) {
                   "is stable at any: give a count (--substeps 4 walks the bundled skirt, 20 the bundled dress)");
     if (substeps == 0) {
       setup.settings.substepsPerFrame = stableSubsteps(setup);
+      bool scaled = setup.settings.maxAddedMass > 0.0;
+      // Runge-Kutta: symplectic Euler's count (with its mass scaling) is stable for it too, and
+      // its own bound on the unscaled membrane may need fewer.
+      if (setup.settings.integrator == cloth::IntegratorKind::RungeKutta4) {
+        const int unscaled = rungeKuttaSubsteps(setup);
+        if (unscaled <= setup.settings.substepsPerFrame) {
+          setup.settings.substepsPerFrame = unscaled;
+          setup.settings.maxAddedMass = 0.0;
+          scaled = false;
+        }
+      }
       spdlog::info("--substeps auto: {} substeps per frame ({:.3f} ms){}", setup.settings.substepsPerFrame,
-                   1e3 * setup.settings.substep_s(),
-                   setup.settings.maxAddedMass > 0.0 ? ", with mass scaling within --max-added-mass" : "");
+                   1e3 * setup.settings.substep_s(), scaled ? ", with mass scaling within --max-added-mass" : "");
     }
   }
   // Frames: as asked, or the lead-in plus the whole motion (a live one: as long as it comes).
@@ -550,7 +560,8 @@ RunFunction setupRun(CLI::App& app) {
                  "symplectic-euler, forward-euler (the paper's; stable only with --damping inside a window the "
                  "substep sets, which a refusal names) or backward-euler (implicit, stable at long substeps, with "
                  "--substeps N: 4 walks the bundled skirt, 20 the dress; each substep solves a linear system, no "
-                 "mass is added, and bending runs every substep)")
+                 "mass is added, and bending runs every substep) or runge-kutta-4 (classical fourth order: four "
+                 "force evaluations per substep, bending in each; stable at the explicit substeps)")
       ->capture_default_str();
   app.add_option("--implicit-tolerance", s.implicitTolerance,
                  "backward-euler: each substep's linear solve stops at this residual relative to its right-hand "

@@ -64,6 +64,7 @@ void logEasedPairs(const std::string& garment, const cloth::FieldCollider& colli
 void logDamping(const std::string& garment, const cloth::ClothSolver& solver) {
   const double omega = solver.dampedMembraneFrequency_rad_s();
   if (!(omega > 0.0)) return;  // undamped symplectic Euler
+  if (solver.settings().integrator == cloth::IntegratorKind::RungeKutta4) return;  // its own line
   const double beta = solver.model().material().damping_s;
   const double dt = solver.settings().substep_s();
   if (solver.settings().integrator == cloth::IntegratorKind::ForwardEuler) {
@@ -775,6 +776,16 @@ int stableSubsteps(const RunSetup& setup) {
   return n;
 }
 
+int rungeKuttaSubsteps(const RunSetup& setup) {
+  int n = 1;
+  for (const GarmentSetup& g : setup.garments) {
+    const auto model =
+        cloth::ClothModel::build(g.mesh, mesh::Topology::build(g.mesh, kMinTriangleArea_m2), g.material);
+    n = std::max(n, cloth::rungeKuttaSubsteps(*model, setup.settings.frameRate_hz));
+  }
+  return n;
+}
+
 std::vector<std::string> facePartsOption(const std::vector<std::string>& given) {
   return given == std::vector<std::string>{"none"} ? std::vector<std::string>{} : given;
 }
@@ -1005,6 +1016,15 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
         spdlog::warn("{}: backward Euler is stable at substeps many times the explicit steps' {:.3g} ms; fewer "
                      "run faster (e.g. --substeps {}, an eighth)",
                      g.name, 1e3 * stable, cloth::implicitSubstepsFor(settings.substepsPerFrame));
+    } else if (settings.integrator == cloth::IntegratorKind::RungeKutta4) {
+      // Judged by the membrane's stiffest mode (the solver refused a longer substep), not by
+      // the wave-speed estimate, which is symplectic Euler's.
+      const double most =
+          cloth::rungeKuttaStableStep_s(r.solver->dampedMembraneFrequency_rad_s(), r.model->material().damping_s);
+      spdlog::info("{}: Runge-Kutta (fourth order), {} substeps per frame ({:.3g} ms, {:.0f} % of the {:.3g} ms the "
+                   "membrane's stiffest mode allows), four force evaluations each",
+                   g.name, settings.substepsPerFrame, 1e3 * settings.substep_s(),
+                   100.0 * settings.substep_s() / most, 1e3 * most);
     } else if (settings.substep_s() > stable)
       spdlog::warn("{}: the substep {:.3g} s is longer than the estimated stable step {:.3g} s; "
                    "the run may diverge (try --substeps {} or more)",

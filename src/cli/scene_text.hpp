@@ -47,8 +47,9 @@ struct SceneIntegrator {
   void addOptions(CLI::App& app, const std::string& implicitSubsteps) {
     app.add_option_function<std::string>(
         "--integrator", [this](const std::string& name) { kind = cloth::parseIntegrator(name); },
-        "The scene's integrator: symplectic-euler (default), forward-euler or backward-euler (implicit: no mass "
-        "added, bending every substep, " + implicitSubsteps + ")");
+        "The scene's integrator: symplectic-euler (default), forward-euler, backward-euler (implicit: no mass "
+        "added, bending every substep, " + implicitSubsteps + ") or runge-kutta-4 (four force evaluations per "
+        "substep, bending in each)");
     app.add_option("--implicit-tolerance", implicitTolerance,
                    "backward-euler: the residual at which each substep's solve stops, written as the scene's "
                    "implicitTolerance")

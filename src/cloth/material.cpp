@@ -45,6 +45,7 @@ std::string integratorName(IntegratorKind kind) {
     case IntegratorKind::SymplecticEuler: return "symplectic-euler";
     case IntegratorKind::ForwardEuler: return "forward-euler";
     case IntegratorKind::BackwardEuler: return "backward-euler";
+    case IntegratorKind::RungeKutta4: return "runge-kutta-4";
   }
   return "unknown";
 }
@@ -53,7 +54,9 @@ IntegratorKind parseIntegrator(const std::string& text, const std::string& optio
   if (text == "symplectic-euler") return IntegratorKind::SymplecticEuler;
   if (text == "forward-euler") return IntegratorKind::ForwardEuler;
   if (text == "backward-euler") return IntegratorKind::BackwardEuler;
-  throw Error(fmt::format("{} must be symplectic-euler, forward-euler or backward-euler, got '{}'", option, text));
+  if (text == "runge-kutta-4") return IntegratorKind::RungeKutta4;
+  throw Error(fmt::format("{} must be symplectic-euler, forward-euler, backward-euler or runge-kutta-4, got '{}'",
+                          option, text));
 }
 
 int implicitSubstepsFor(int explicitSubsteps) { return std::max(2, (explicitSubsteps + 7) / 8); }
@@ -73,6 +76,8 @@ void StepSettings::validate(const std::string& prefix) const {
           implicitTolerance);
   require(bendEvery == 1 || integrator != IntegratorKind::BackwardEuler, prefix, "bend-every",
           "1 with the backward-euler integrator (its solve takes the bending forces in every substep)", bendEvery);
+  require(bendEvery == 1 || integrator != IntegratorKind::RungeKutta4, prefix, "bend-every",
+          "1 with the runge-kutta-4 integrator (each of its stages takes the bending forces)", bendEvery);
   require(maxRefinement >= 1 && maxRefinement <= 64, prefix, "max-refinement", "in [1, 64]", maxRefinement);
   require(strainLimit >= 0.0 && strainLimit <= 10.0, prefix, "strain-limit",
           "in [0, 10] (a stretch beyond the rest length)", strainLimit);

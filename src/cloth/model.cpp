@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <complex>
 #include <limits>
 #include <numeric>
 #include <optional>
@@ -506,6 +507,51 @@ double dampedStableStep_s(double omega_rad_s, double damping_s) {
   if (!(omega_rad_s > 0.0)) return std::numeric_limits<double>::infinity();
   const double w = omega_rad_s / kDampedStepMargin;
   return std::sqrt(damping_s * damping_s + 4.0 / (w * w)) - damping_s;
+}
+
+namespace {
+
+/// |R(z)| for the classical Runge-Kutta step's stability polynomial.
+double rungeKuttaGain(std::complex<double> z) {
+  return std::abs(1.0 + z * (1.0 + z * (0.5 + z * (1.0 / 6.0 + z / 24.0))));
+}
+
+/// The first s > 0 at which |R(s d)| exceeds 1 along the ray of direction d (|d| = 1, in the
+/// left half-plane): scanned in steps of 0.01, then bisected.
+double rungeKuttaReach(std::complex<double> d) {
+  double inside = 0.0;
+  double outside = 0.0;
+  for (double s = 0.01; s < 10.0; s += 0.01) {
+    if (rungeKuttaGain(s * d) > 1.0) {
+      outside = s;
+      break;
+    }
+    inside = s;
+  }
+  if (outside == 0.0) return 10.0;
+  for (int k = 0; k < 50; ++k) {
+    const double mid = 0.5 * (inside + outside);
+    (rungeKuttaGain(mid * d) > 1.0 ? outside : inside) = mid;
+  }
+  return inside;
+}
+
+}  // namespace
+
+double rungeKuttaStableStep_s(double omega_rad_s, double damping_s) {
+  if (!(omega_rad_s > 0.0)) return std::numeric_limits<double>::infinity();
+  const double w = omega_rad_s / kDampedStepMargin;
+  const double zeta = 0.5 * damping_s * w;
+  if (zeta < 1.0)  // a complex pair of magnitude w
+    return rungeKuttaReach(std::complex<double>(-zeta, std::sqrt(1.0 - zeta * zeta))) / w;
+  // Two real eigenvalues; the larger in magnitude bounds the step.
+  const double largest = w * (zeta + std::sqrt(zeta * zeta - 1.0));
+  return rungeKuttaReach(std::complex<double>(-1.0, 0.0)) / largest;
+}
+
+int rungeKuttaSubsteps(const ClothModel& model, double frameRate_hz) {
+  const double most = rungeKuttaStableStep_s(model.membraneFrequency_rad_s(), model.material().damping_s);
+  return std::clamp(static_cast<int>(std::ceil(1.0 / (frameRate_hz * most))), 1, 100000);
 }
 
 double largestStableDamping_s(double omega_rad_s, double step_s) {

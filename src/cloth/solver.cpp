@@ -50,11 +50,15 @@ ClothSolver::ClothSolver(std::shared_ptr<const ClothModel> model, const StepSett
     for (const std::uint32_t v : g.vertices) fixed[v] = 1;
   integrator_->prepare(*model_, settings_, fixed);
   // The explicit steps' stability with damping; the implicit one is stable at any step.
+  // Runge-Kutta's, damped or not: the wave-speed estimate is symplectic Euler's, and its
+  // bound moves with the damping the other way.
   const bool forwardEuler = settings_.integrator == IntegratorKind::ForwardEuler;
   const bool implicit = settings_.integrator == IntegratorKind::BackwardEuler;
-  if ((model_->material().damping_s > 0.0 && !implicit) || forwardEuler) {
+  const bool rungeKutta = settings_.integrator == IntegratorKind::RungeKutta4;
+  if ((model_->material().damping_s > 0.0 && !implicit) || forwardEuler || rungeKutta) {
     dampedOmega_ = model_->membraneFrequency_rad_s(fixed);
     if (forwardEuler) checkForwardEulerStep(*model_, settings_, dampedOmega_);
+    else if (rungeKutta) checkRungeKuttaStep(*model_, settings_, dampedOmega_);
     else checkDampedStep(*model_, settings_, dampedOmega_);
   }
 }
@@ -104,6 +108,18 @@ void checkForwardEulerStep(const ClothModel& model, const StepSettings& settings
                           "use more than {} substeps per frame (then damping above the substep), or --integrator "
                           "symplectic-euler",
                           head, omega, substeps));
+}
+
+void checkRungeKuttaStep(const ClothModel& model, const StepSettings& settings, double omega) {
+  const double beta = model.material().damping_s;
+  const double dt = settings.substep_s();
+  const double most = rungeKuttaStableStep_s(omega, beta);
+  if (dt <= most) return;
+  const long substeps = static_cast<long>(std::ceil(1.0 / (settings.frameRate_hz * most)));
+  throw Error(fmt::format("garment '{}': the runge-kutta-4 step is unstable at a substep of {:.3g} ms (the membrane's "
+                          "stiffest mode, {:.4g} rad/s, with internal damping of {:.3g} ms allows at most {:.3g} ms); "
+                          "use {} substeps per frame or more",
+                          model.name(), 1e3 * dt, omega, 1e3 * beta, 1e3 * most, substeps));
 }
 
 void checkBendingStep(const ClothModel& model, const StepSettings& settings) {
@@ -273,8 +289,34 @@ void ClothSolver::limitStrain() {
   strainLimitCorrections_ += cloth::limitStrain(*model_, strainWeight_, strainLimit_, kStrainLimitSweeps, state_);
 }
 
+namespace {
+
+/// The Runge-Kutta step's later stages: membrane, bending (every stage, unscaled) and drag,
+/// on the solver's threads as its own forces are.
+class SolverStageForces final : public StageForces {
+ public:
+  SolverStageForces(const ClothModel& model, const StepSettings& settings, ForceLoops* loops)
+      : model_(model), settings_(settings), loops_(loops) {}
+  void accumulate(ClothState& io) override {
+    clearForces(io);
+    accumulateMembraneForces(model_, io, loops_);
+    accumulateBendingForces(model_, io, 1.0, loops_);
+    accumulateDragForces(model_, settings_, io);
+  }
+
+ private:
+  const ClothModel& model_;
+  const StepSettings& settings_;
+  ForceLoops* loops_;
+};
+
+}  // namespace
+
 void ClothSolver::integrate(double dt) {
   for (const Collider* c : colliders_) integrator_->holdPinched(c->pinched());
+  // Given every substep, so a moved solver gives its own (the integrator keeps no solver).
+  SolverStageForces stageForces(*model_, settings_, parallelForces_ ? &forceLoops_ : nullptr);
+  integrator_->useStageForces(&stageForces);
   integrator_->advance(*model_, settings_.gravity_m_s2, dt, state_);
 }
 

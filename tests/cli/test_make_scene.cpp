@@ -423,9 +423,31 @@ TEST(MakeScene, BackwardEulerAsksAnEighthOfTheSubstepsAndNoMass) {
   EXPECT_NE(rhythm.err.find("--bend-every 2: backward Euler takes bending into its solve every substep"),
             std::string::npos)
       << rhythm.err;
+  const CliResult rungeKuttaRhythm =
+      runDrape(makeDressScene("obj", "--integrator runge-kutta-4 --bend-every 2", dir / "rk-rhythm"), dir);
+  EXPECT_EQ(rungeKuttaRhythm.code, 2) << rungeKuttaRhythm.err;
+  EXPECT_NE(rungeKuttaRhythm.err.find("--bend-every 2: the runge-kutta-4 step takes bending into each of its stages"),
+            std::string::npos)
+      << rungeKuttaRhythm.err;
+  // The Runge-Kutta step on the dress, damped as make-scene's material is: its own bound on
+  // the unscaled membrane asks fewer substeps than symplectic Euler's count with mass added,
+  // and those are written, with no mass added.
+  const CliResult rungeKutta = runDrape(makeDressScene("obj", "--integrator runge-kutta-4", dir / "rk"), dir);
+  ASSERT_EQ(rungeKutta.code, 0) << rungeKutta.err;
+  const scene::Scene rk = scene::loadScene(dir / "rk" + "/scene.wrl");
+  EXPECT_EQ(rk.simulation.integrator, "runge-kutta-4");
+  EXPECT_EQ(rk.simulation.bendEvery, 1);
+  EXPECT_EQ(rk.simulation.maxAddedMass, 0.0);
+  const std::string head = std::to_string(rk.simulation.stepsPerFrame) +
+                           " substeps per frame at 30 frames/s, each a fourth-order Runge-Kutta step, no mass added "
+                           "(symplectic Euler would take ";
+  const std::size_t at = rungeKutta.out.find(head);
+  ASSERT_NE(at, std::string::npos) << rungeKutta.out;
+  EXPECT_LT(rk.simulation.stepsPerFrame, std::stoi(rungeKutta.out.substr(at + head.size()))) << rungeKutta.out;
   const CliResult unknown = runDrape(makeDressScene("obj", "--integrator implicit", dir / "unknown"), dir);
   EXPECT_NE(unknown.code, 0);
-  EXPECT_NE(unknown.err.find("--integrator must be symplectic-euler, forward-euler or backward-euler, got 'implicit'"),
+  EXPECT_NE(unknown.err.find(
+                "--integrator must be symplectic-euler, forward-euler, backward-euler or runge-kutta-4, got 'implicit'"),
             std::string::npos)
       << unknown.err;
 }

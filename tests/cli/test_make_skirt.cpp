@@ -569,6 +569,22 @@ TEST(MakeSkirt, CesiumMansWalkAsColladaAndFbxDrivesTheSameBody) {
   }
 }
 
+TEST(MakeSkirt, RungeKuttaWritesTheSubstepsItsBoundAllows) {
+  // The fourth-order step's bound on the skirt's stiffest mode, damped as the knit is: 10
+  // substeps a frame instead of 33, bending in each stage (drape run walks it:
+  // RunScene.RungeKuttaWalksTheSkirtAtTheSubstepsItsBoundAllows).
+  ScratchDir dir("make-skirt-runge-kutta");
+  const std::string out = dir / "skirt";
+  const CliResult r = runDrape(
+      "make-skirt '" + kAvatars + "/makehuman_rig_cmu_mb.mhskel' --integrator runge-kutta-4 --out '" + out + "'", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("; 10 substeps per frame, each a fourth-order Runge-Kutta step\n"), std::string::npos) << r.out;
+  const scene::Scene sc = scene::loadScene(out + "/scene.wrl");
+  EXPECT_EQ(sc.simulation.integrator, "runge-kutta-4");
+  EXPECT_EQ(sc.simulation.stepsPerFrame, 10);
+  EXPECT_EQ(sc.simulation.bendEvery, 1);
+}
+
 TEST(MakeSkirt, BackwardEulerWritesAnImplicitSceneThatWalks) {
   // An eighth of the paper's 33 substeps, rounded up, each a backward-Euler solve to the
   // tolerance asked for; the skirt walks out of the body with every solve converged.

@@ -430,6 +430,57 @@ TEST(RunScene, ForwardEulerRunsInsideItsDampingWindowOnly) {
   EXPECT_NE(undamped.err.find("set damping above 1.01 ms and at most 4.88 ms"), std::string::npos) << undamped.err;
 }
 
+TEST(RunScene, RungeKuttaWalksTheSkirtAtTheSubstepsItsBoundAllows) {
+  // The classical Runge-Kutta step: --substeps auto asks what its bound on the membrane's
+  // stiffest mode allows with the skirt's 2 ms of damping (10 a frame, a third of the scene's
+  // 33), and the skirt walks out of the body at them; past the bound the run is refused with
+  // the count that holds, and a bending rhythm cannot go with it.
+  ScratchDir dir("run-runge-kutta");
+  const std::string scene = "run '" + kSkirtDir + "/scene.wrl' --motion '" + kSkirtDir +
+                            "/walk.bvh' --integrator runge-kutta-4 ";
+  const CliResult ok = runDrape(scene + "--frames 60 --substeps auto --out '" + (dir / "ok") + "'", dir);
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_NE(ok.err.find("--substeps auto: 10 substeps per frame (3.333 ms)\n"), std::string::npos) << ok.err;
+  EXPECT_NE(ok.err.find("Skirt: Runge-Kutta (fourth order), 10 substeps per frame (3.33 ms, 84 % of the 3.98 ms"),
+            std::string::npos)
+      << ok.err;
+  const nlohmann::json stats = statsOf(dir / "ok");
+  EXPECT_EQ(stats["integrator"].get<std::string>(), "runge-kutta-4");
+  EXPECT_EQ(stats["substeps_per_frame"].get<int>(), 10);
+  EXPECT_FALSE(stats["unstable"].get<bool>());
+  EXPECT_EQ(stats["vertex_substeps_inside_body"].get<long>(), 0);
+  EXPECT_EQ(stats["garments"][0]["frames_refined"].get<long>(), 0);
+  EXPECT_EQ(stats["garments"][0]["added_mass_kg"].get<double>(), 0.0);
+
+  const CliResult fast = runDrape(scene + "--frames 3 --substeps 8 --out '" + (dir / "fast") + "'", dir);
+  EXPECT_EQ(fast.code, 2) << fast.err;
+  EXPECT_NE(fast.err.find("garment 'Skirt': the runge-kutta-4 step is unstable at a substep of 4.17 ms (the "
+                          "membrane's stiffest mode, 605.5 rad/s, with internal damping of 2 ms allows at most "
+                          "3.98 ms); use 9 substeps per frame or more"),
+            std::string::npos)
+      << fast.err;
+  const CliResult rhythm = runDrape(scene + "--frames 3 --bend-every 2 --out '" + (dir / "rhythm") + "'", dir);
+  EXPECT_EQ(rhythm.code, 2) << rhythm.err;
+  EXPECT_NE(rhythm.err.find("--bend-every must be 1 with the runge-kutta-4 integrator"), std::string::npos)
+      << rhythm.err;
+
+  // The walking dress's slivers, overdamped at their frequency, hold the step to more
+  // substeps unscaled than symplectic Euler's count with its 2 % of mass added, which is
+  // stable for this step too: --substeps auto takes that count and that scaling.
+  const CliResult dress = runDrape("run '" + std::string(DRAPE_SOURCE_DIR) + "/examples/walking_dress/scene.wrl' "
+                                   "--integrator runge-kutta-4 --substeps auto --frames 1 --out '" + (dir / "dress") +
+                                   "'",
+                                   dir);
+  ASSERT_EQ(dress.code, 0) << dress.err;
+  EXPECT_NE(dress.err.find("substeps per frame (0.219 ms), with mass scaling within --max-added-mass"),
+            std::string::npos)
+      << dress.err;
+  EXPECT_NE(dress.err.find("dress: Runge-Kutta (fourth order), 152 substeps per frame (0.219 ms, 42 % of the"),
+            std::string::npos)
+      << dress.err;
+  EXPECT_GT(statsOf(dir / "dress")["garments"][0]["added_mass_kg"].get<double>(), 0.0);
+}
+
 }  // namespace
 }  // namespace drape
 

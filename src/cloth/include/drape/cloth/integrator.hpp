@@ -1,8 +1,10 @@
 #pragma once
 // Time integrators behind one interface. The explicit one-stage integrators take the forces
 // the step accumulated for this substep; gravity enters as a body acceleration (so a vertex
-// of zero mass still falls). The implicit one (backward Euler, the paper's future work)
-// linearises the forces at the substep's start as well (backward_euler.hpp).
+// of zero mass still falls). The classical Runge-Kutta step (the paper's future work) takes
+// them as its first stage and asks StageForces for three more. The implicit one (backward
+// Euler, the paper's other future work) linearises the forces at the substep's start as well
+// (backward_euler.hpp).
 
 #include <cstdint>
 #include <memory>
@@ -35,6 +37,14 @@ struct SolveStats {
   }
 };
 
+/// The forces at a stage of a multi-stage step: every force the step applies (membrane,
+/// bending, drag), for the positions and velocities in `io`, into io.f* (cleared first).
+class StageForces {
+ public:
+  virtual ~StageForces() = default;
+  virtual void accumulate(ClothState& io) = 0;
+};
+
 class Integrator {
  public:
   virtual ~Integrator() = default;
@@ -52,6 +62,9 @@ class Integrator {
   /// velocity the colliders gave them, their parts' mean); an explicit step ignores them,
   /// its substeps being short.
   virtual void holdPinched(std::span<const PinchedPoint> /*points*/) {}
+  /// Where the next advance evaluates its further stages' forces (the multi-stage steps
+  /// alone; the others ignore it). Given before each advance: the caller owns it.
+  virtual void useStageForces(StageForces* /*forces*/) {}
   [[nodiscard]] virtual SolveStats solveStats() const { return {}; }
 };
 

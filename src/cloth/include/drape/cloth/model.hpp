@@ -226,6 +226,18 @@ struct ForwardEulerDampingWindow {
 };
 [[nodiscard]] ForwardEulerDampingWindow forwardEulerDampingWindow(double omega_rad_s, double step_s);
 
+/// The classical Runge-Kutta step on the same mode (eigenvalues lambda = omega (-zeta +-
+/// sqrt(zeta^2 - 1)), zeta = damping_s omega / 2) is stable while every |R(lambda dt)| <= 1,
+/// R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24: undamped to omega dt = 2 sqrt(2) (symplectic
+/// Euler's 2), and damping, which shortens symplectic Euler's step, lengthens or keeps this
+/// one up to zeta = 1 (2.63 at the bundled skirt's zeta 0.6). The longest such step, found
+/// along the eigenvalues' rays by bisection, with omega / kDampedStepMargin (infinite for
+/// omega = 0).
+[[nodiscard]] double rungeKuttaStableStep_s(double omega_rad_s, double damping_s);
+/// The fewest substeps per frame of `frameRate_hz` at which the Runge-Kutta step keeps the
+/// model's membrane stable, every vertex free (at least the frequency with pins held).
+[[nodiscard]] int rungeKuttaSubsteps(const ClothModel& model, double frameRate_hz);
+
 /// A substep count and the mass scaling it needs.
 struct SubstepChoice {
   int substepsPerFrame = 0;

@@ -37,7 +37,7 @@ struct StageTicks {
 /// Seconds spent per phase, accumulated over the substeps run so far.
 struct StageTimes {
   double forces_s = 0.0;
-  double integrate_s = 0.0;
+  double integrate_s = 0.0;     ///< with the Runge-Kutta step's three later stages' forces
   double collide_s = 0.0;
   double fixtures_s = 0.0;      ///< the fixtures, and the stitches held after them (ClothSolver::setStitches)
   double fixturePoses_s = 0.0;  ///< the part of fixtures_s spent asking for the fixtures' poses
@@ -82,6 +82,12 @@ void checkDampedStep(const ClothModel& model, const StepSettings& settings, doub
 /// internal damping outside forwardEulerDampingWindow(omega_rad_s, dt), undamped included.
 /// The solver checks it for forward Euler, with omega_rad_s measured with the pins held.
 void checkForwardEulerStep(const ClothModel& model, const StepSettings& settings, double omega_rad_s);
+
+/// Throws drape::Error, naming the garment, the longest stable substep and the substeps per
+/// frame it needs, when the classical Runge-Kutta step cannot keep the membrane's stiffest
+/// mode (`omega_rad_s`, measured with the pins held) stable at the settings' substep with the
+/// material's damping (rungeKuttaStableStep_s). The solver checks it for that integrator.
+void checkRungeKuttaStep(const ClothModel& model, const StepSettings& settings, double omega_rad_s);
 
 class ClothSolver {
  public:
@@ -146,9 +152,10 @@ class ClothSolver {
   [[nodiscard]] const std::vector<Collider*>& colliders() const { return colliders_; }
   /// The pinned vertices (no motion) and the bound ones (following a body part).
   [[nodiscard]] const std::vector<PinGroup>& pins() const { return pins_; }
-  /// With internal damping and symplectic Euler, or with forward Euler: the membrane's
-  /// highest frequency with the pinned and bound vertices held, which checkDampedStep or
-  /// checkForwardEulerStep judged the substep by; else 0.
+  /// With internal damping and symplectic Euler, with forward Euler, or with Runge-Kutta: the
+  /// membrane's highest frequency with the pinned and bound vertices held, which
+  /// checkDampedStep, checkForwardEulerStep or checkRungeKuttaStep judged the substep by;
+  /// else 0.
   [[nodiscard]] double dampedMembraneFrequency_rad_s() const { return dampedOmega_; }
   /// Total energy (kinetic + gravitational + membrane + bending), J.
   [[nodiscard]] double totalEnergy() const;

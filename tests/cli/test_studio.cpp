@@ -811,9 +811,10 @@ TEST(Studio, ALiveCaptureIsShownInAWindowThatStaysLiveWhileItsSourceIsSilent) {
   DrapeProcess play("play '" + kScene + "' --live " + capture.url() + " --size 320x240 --screenshot '" + shot + "'", dir,
                     "play", "xvfb-run -a");
   ASSERT_TRUE(said(play, "waiting for motion frames from " + capture.url())) << play.errSoFar();
-  // Ctrl-C to drape itself, not to xvfb-run: the one process whose command line starts with it.
+  // Ctrl-C to drape itself, not to xvfb-run: the one process whose command line starts with
+  // it. The space after "play" keeps a `drape player` another test runs meanwhile out of it.
   std::string pattern = "^";
-  for (const char c : std::string(DRAPE_EXE) + " play")
+  for (const char c : std::string(DRAPE_EXE) + " play ")
     pattern += std::isalnum(static_cast<unsigned char>(c)) || c == ' ' || c == '/' ? std::string(1, c) : std::string("\\") + c;
   ASSERT_EQ(std::system(("pkill -INT -f '" + pattern + "'").c_str()), 0);
   const CliResult shown = play.wait();

@@ -63,7 +63,8 @@ struct PaperBenchOptions {
 struct PaperRun {
   long frames = 0;
   long framesRefined = 0;  ///< frames computed again with more substeps (StepSettings::maxRefinement)
-  double simSeconds = 0, simCpuSeconds = 0, collideSeconds = 0, forcesSeconds = 0, stepSeconds = 0;
+  double simSeconds = 0, simCpuSeconds = 0, collideSeconds = 0, forcesSeconds = 0, integrateSeconds = 0;
+  double stepSeconds = 0;
   double poseSeconds = 0;  ///< pose fetches (animation, interpolation) by the collider and the fixtures
   double colliderPoseSeconds = 0;  ///< the collider's, inside the collide stage
   int collisionEvery = 1;
@@ -153,6 +154,7 @@ PaperRun runOnce(const PaperBenchOptions& o, bool measure) {
     const cloth::StageTimes& t = world.solver(g).stageTimes();
     r.collideSeconds += t.collide_s;
     r.forcesSeconds += t.forces_s;
+    r.integrateSeconds += t.integrate_s;
     r.stepSeconds += stepSeconds(t);
     r.colliderPoseSeconds += world.collider(g)->poseSeconds();
     r.poseSeconds += world.collider(g)->poseSeconds() + t.fixturePoses_s;
@@ -255,6 +257,8 @@ RunFunction setupPaperBench(CLI::App& app) {
     j["collide_ms_per_frame"] = 1e3 * (r.collideSeconds - r.colliderPoseSeconds) / r.frames;
     j["animation_ms_per_frame"] = 1e3 * r.poseSeconds / r.frames;
     j["forces_ms_per_frame"] = 1e3 * r.forcesSeconds / r.frames;
+    // The step's update, with backward Euler's solve and the Runge-Kutta step's later stages.
+    j["integrate_ms_per_frame"] = 1e3 * r.integrateSeconds / r.frames;
     // The paper's definition: collision tests over the simulation time, both without the
     // animation and its interpolation (here the pose fetches of the collider and the fixtures).
     const double simulated = r.stepSeconds - r.poseSeconds;

@@ -258,17 +258,42 @@ bool ClothSolver::substep(double t0, double t1, long frame, int substepIndex) {
   return stable;
 }
 
+namespace {
+
+/// Every force the step applies, into io.f*: membrane, bending (when `bendScale` > 0, times
+/// it) and drag. The substep's own forces and the Runge-Kutta step's stages alike.
+void accumulateStepForces(const ClothModel& model, const StepSettings& settings, double bendScale,
+                          ForceLoops* loops, ClothState& io) {
+  clearForces(io);
+  accumulateMembraneForces(model, io, loops);
+  if (bendScale > 0.0) accumulateBendingForces(model, io, bendScale, loops);
+  accumulateDragForces(model, settings, io);
+}
+
+/// The Runge-Kutta step's later stages: bending in every stage, unscaled, on the solver's
+/// threads as its own forces are.
+class SolverStageForces final : public StageForces {
+ public:
+  SolverStageForces(const ClothModel& model, const StepSettings& settings, ForceLoops* loops)
+      : model_(model), settings_(settings), loops_(loops) {}
+  void accumulate(ClothState& io) override { accumulateStepForces(model_, settings_, 1.0, loops_, io); }
+
+ private:
+  const ClothModel& model_;
+  const StepSettings& settings_;
+  ForceLoops* loops_;
+};
+
+}  // namespace
+
 void ClothSolver::accumulateForces() {
-  clearForces(state_);
-  accumulateMembraneForces(*model_, state_, parallelForces_ ? &forceLoops_ : nullptr);
   // The impulse method (Verlet-I / r-RESPA) for the slow force: one kick of bendEvery
   // substeps' worth at the first of every bendEvery substeps. Symplectic with the
   // symplectic inner step; counted over the whole take so that the rhythm runs on across
   // frame boundaries.
   const int every = settings_.bendEvery;
-  if (substepCount_++ % every == 0)
-    accumulateBendingForces(*model_, state_, static_cast<double>(every), parallelForces_ ? &forceLoops_ : nullptr);
-  accumulateDragForces(*model_, settings_, state_);
+  const double bendScale = substepCount_++ % every == 0 ? static_cast<double>(every) : 0.0;
+  accumulateStepForces(*model_, settings_, bendScale, parallelForces_ ? &forceLoops_ : nullptr, state_);
 }
 
 void ClothSolver::setStitches(std::vector<Stitch> stitches, const std::string& garment) {
@@ -288,29 +313,6 @@ void ClothSolver::setStitches(std::vector<Stitch> stitches, const std::string& g
 void ClothSolver::limitStrain() {
   strainLimitCorrections_ += cloth::limitStrain(*model_, strainWeight_, strainLimit_, kStrainLimitSweeps, state_);
 }
-
-namespace {
-
-/// The Runge-Kutta step's later stages: membrane, bending (every stage, unscaled) and drag,
-/// on the solver's threads as its own forces are.
-class SolverStageForces final : public StageForces {
- public:
-  SolverStageForces(const ClothModel& model, const StepSettings& settings, ForceLoops* loops)
-      : model_(model), settings_(settings), loops_(loops) {}
-  void accumulate(ClothState& io) override {
-    clearForces(io);
-    accumulateMembraneForces(model_, io, loops_);
-    accumulateBendingForces(model_, io, 1.0, loops_);
-    accumulateDragForces(model_, settings_, io);
-  }
-
- private:
-  const ClothModel& model_;
-  const StepSettings& settings_;
-  ForceLoops* loops_;
-};
-
-}  // namespace
 
 void ClothSolver::integrate(double dt) {
   for (const Collider* c : colliders_) integrator_->holdPinched(c->pinched());

@@ -2,6 +2,7 @@
 // Shared set-up for the cloth tests: a sheet, a model and a solver in a line or two.
 
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "drape/cloth/model.hpp"
 #include "drape/cloth/sheets.hpp"
 #include "drape/cloth/solver.hpp"
+#include "drape/core/error.hpp"
 #include "drape/mesh/topology.hpp"
 
 namespace drape::cloth::testing {
@@ -99,6 +101,16 @@ inline long firstUnstableFrame(ClothSolver& solver, long frames) {
   for (long f = 1; f <= frames; ++f)
     if (!solver.stepFrame(f)) return f;
   return 0;
+}
+
+/// What settings.validate("--") refuses them with; empty when it accepts them.
+inline std::string refusal(const StepSettings& settings) {
+  try {
+    settings.validate("--");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
 }
 
 /// Settings with a given substep (frame rate 30, substeps chosen to give at most dt).

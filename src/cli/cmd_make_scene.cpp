@@ -274,23 +274,28 @@ int makeScene(MakeSceneOptions& o) {
     // rhythm; a rhythm asked for is held to the bending forces' stable step, as drape run
     // holds it.
     const auto unscaled = cloth::ClothModel::build(garment, topology, o.material);
-    // Runge-Kutta: symplectic Euler's count and mass scaling are stable for it, and its own
-    // bound on the unscaled membrane may ask fewer substeps and no mass.
+    // Runge-Kutta: its own bound, and mass scaling for it, from any count up; where its count
+    // needs no mass on the unscaled membrane, none is added, not even the little the element
+    // estimates would add.
     const bool rungeKutta = o.integrator.kind == cloth::IntegratorKind::RungeKutta4;
+    const cloth::IntegratorKind bound = rungeKutta ? o.integrator.kind : cloth::IntegratorKind::SymplecticEuler;
+    const cloth::SubstepChoice own =
+        rungeKutta ? cloth::fewestStableSubsteps(garment, topology, o.material, o.frameRate, o.maxAddedMass,
+                                                 std::max(1, o.stepsPerFrame), bound)
+                   : choice;
     const int rungeKuttaCount = rungeKutta ? cloth::rungeKuttaSubsteps(*unscaled, o.frameRate) : 0;
-    if (o.stepsPerFrame == 0)
-      o.stepsPerFrame = rungeKutta ? std::min(rungeKuttaCount, choice.substepsPerFrame) : choice.substepsPerFrame;
+    if (o.stepsPerFrame == 0) o.stepsPerFrame = own.substepsPerFrame;
     const bool unscaledRungeKutta = rungeKutta && o.stepsPerFrame >= rungeKuttaCount;
     if (unscaledRungeKutta) o.maxAddedMass = 0.0;
     const double added =
-        unscaledRungeKutta                           ? 0.0
-        : o.stepsPerFrame == choice.substepsPerFrame ? choice.addedMassFraction
-                                                     : cloth::addedMassFractionAt(garment, topology, o.material,
-                                                                                  o.frameRate, o.stepsPerFrame);
+        unscaledRungeKutta                        ? 0.0
+        : o.stepsPerFrame == own.substepsPerFrame ? own.addedMassFraction
+                                                  : cloth::addedMassFractionAt(garment, topology, o.material,
+                                                                               o.frameRate, o.stepsPerFrame, bound);
     if (added > o.maxAddedMass)
       throw Error(fmt::format("--substeps {}: mass scaling would add {:.2f} % of the garment's mass, more than "
                               "--max-added-mass {:g}; {} substeps per frame need no more than that",
-                              o.stepsPerFrame, 100.0 * added, o.maxAddedMass, choice.substepsPerFrame));
+                              o.stepsPerFrame, 100.0 * added, o.maxAddedMass, own.substepsPerFrame));
     if (!cloth::StepSettings::oneStageExplicit(o.integrator.kind)) {
       if (o.bendEvery > 1)
         throw Error(fmt::format("--bend-every {}: the {} step takes bending into each of its stages; leave "
@@ -306,14 +311,18 @@ int makeScene(MakeSceneOptions& o) {
       rhythm.bendEvery = o.bendEvery;
       cloth::checkBendingStep(*unscaled, rhythm);
     }
-    substeps = unscaledRungeKutta
-                   ? fmt::format("{} substeps per frame at {:g} frames/s, each a fourth-order Runge-Kutta step, no "
-                                 "mass added (symplectic Euler would take {} with {:.2f} % of the mass added)",
-                                 o.stepsPerFrame, o.frameRate, choice.substepsPerFrame,
-                                 100.0 * choice.addedMassFraction)
-                   : fmt::format("{} substeps per frame at {:g} frames/s{} (mass scaling adds {:.2f} % of the mass)",
-                                 o.stepsPerFrame, o.frameRate,
-                                 rungeKutta ? ", each a fourth-order Runge-Kutta step" : "", 100.0 * added);
+    const std::string symplectic = fmt::format("symplectic Euler would take {} with {:.2f} % of the mass added",
+                                               choice.substepsPerFrame, 100.0 * choice.addedMassFraction);
+    substeps =
+        unscaledRungeKutta
+            ? fmt::format("{} substeps per frame at {:g} frames/s, each a fourth-order Runge-Kutta step, no mass added "
+                          "({})",
+                          o.stepsPerFrame, o.frameRate, symplectic)
+        : rungeKutta ? fmt::format("{} substeps per frame at {:g} frames/s, each a fourth-order Runge-Kutta step "
+                                   "(mass scaling adds {:.2f} % of the mass; {})",
+                                   o.stepsPerFrame, o.frameRate, 100.0 * added, symplectic)
+                     : fmt::format("{} substeps per frame at {:g} frames/s (mass scaling adds {:.2f} % of the mass)",
+                                   o.stepsPerFrame, o.frameRate, 100.0 * added);
   }
 
   if (o.stitchGaps_m > 0.0) o.stitches = openingsToSew(garment, topology, o.name, o.stitchGaps_m);

@@ -381,8 +381,8 @@ int runCommand(const CLI::App& app, RunOptions& o) {
     if (substeps == 0) {
       setup.settings.substepsPerFrame = stableSubsteps(setup);
       bool scaled = setup.settings.maxAddedMass > 0.0;
-      // Runge-Kutta: symplectic Euler's count (with its mass scaling) is stable for it too, and
-      // its own bound on the unscaled membrane may need fewer.
+      // Runge-Kutta: where its own count needs no mass (every vertex free), none is added,
+      // not even the little the element estimates would add to slivers.
       if (setup.settings.integrator == cloth::IntegratorKind::RungeKutta4) {
         const int unscaled = rungeKuttaSubsteps(setup);
         if (unscaled <= setup.settings.substepsPerFrame) {

@@ -770,7 +770,8 @@ int stableSubsteps(const RunSetup& setup) {
   for (const GarmentSetup& g : setup.garments) {
     const cloth::SubstepChoice c =
         cloth::fewestStableSubsteps(g.mesh, mesh::Topology::build(g.mesh, kMinTriangleArea_m2), g.material,
-                                    setup.settings.frameRate_hz, setup.settings.maxAddedMass, n);
+                                    setup.settings.frameRate_hz, setup.settings.maxAddedMass, n,
+                                    setup.settings.massScalingBound());
     n = std::max(n, c.substepsPerFrame);
   }
   return n;

@@ -269,9 +269,10 @@ void setKeepApart(CharacterSetup& character, const std::vector<std::string>& opt
 /// (BadInput) with one line naming what is wrong.
 void validateRunSetup(const RunSetup& setup);
 
-/// The smallest substep count per frame that the explicit integrators are estimated to
-/// keep stable for every garment, with mass scaling adding at most the settings'
-/// maxAddedMass of each (cloth::fewestStableSubsteps), at least 1.
+/// The smallest substep count per frame that the settings' explicit integrator is estimated
+/// to keep stable for every garment, with mass scaling adding at most the settings'
+/// maxAddedMass of each (cloth::fewestStableSubsteps: the Runge-Kutta step's own bound and
+/// scaling for it, symplectic Euler's for the others), at least 1.
 [[nodiscard]] int stableSubsteps(const RunSetup& setup);
 /// The smallest substep count per frame at which the Runge-Kutta step keeps every garment's
 /// membrane stable with no mass added (cloth::rungeKuttaStableStep_s), at least 1.

@@ -230,12 +230,17 @@ void checkNewGarment(const SceneToDress& dress, const std::string& name, const s
 double checkSceneSteps(const SceneToDress& dress, const mesh::TriMesh& garment, const cloth::Material& material,
                        const std::string& name) {
   const scene::SimulationSettings& s = dress.scene.simulation;
+  const cloth::StepSettings steps = sim::toStepSettings(s);
   const mesh::Topology topology = mesh::Topology::build(garment);
-  const double added = cloth::addedMassFractionAt(garment, topology, material, s.frameRate, s.stepsPerFrame);
+  // Backward Euler is stable at any substep with no mass added.
+  const double added = steps.integrator == cloth::IntegratorKind::BackwardEuler
+                           ? 0.0
+                           : cloth::addedMassFractionAt(garment, topology, material, s.frameRate, s.stepsPerFrame,
+                                                        steps.massScalingBound());
   if (added > s.maxAddedMass) {
-    const int needed =
-        cloth::fewestStableSubsteps(garment, topology, material, s.frameRate, s.maxAddedMass, s.stepsPerFrame)
-            .substepsPerFrame;
+    const int needed = cloth::fewestStableSubsteps(garment, topology, material, s.frameRate, s.maxAddedMass,
+                                                   s.stepsPerFrame, steps.massScalingBound())
+                           .substepsPerFrame;
     throw Error(fmt::format("--add-to {}: the scene steps {} substeps per frame, and '{}' needs {} to be stable (mass "
                             "scaling within the scene's maxAddedMass {:g}); set stepsPerFrame {} in its Simulation "
                             "node first",
@@ -246,7 +251,7 @@ double checkSceneSteps(const SceneToDress& dress, const mesh::TriMesh& garment, 
   named.name = name;
   const auto model = cloth::ClothModel::build(named, topology, material);
   try {
-    cloth::checkBendingStep(*model, sim::toStepSettings(s));
+    cloth::checkBendingStep(*model, steps);
   } catch (const Error& e) {
     throw Error(fmt::format("--add-to {}: the scene's bendEvery {} is too long for the new garment: {}", dress.path,
                             s.bendEvery, e.what()));

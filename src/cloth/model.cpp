@@ -240,21 +240,29 @@ void ClothModel::applyMassScaling(const mesh::TriMesh& mesh, const MassScaling& 
   if (!(scaling.targetStep_s > 0.0)) return;
   const double step = scaling.targetStep_s;
   const double beta = material_.damping_s;
+  const bool rungeKutta = scaling.integrator == IntegratorKind::RungeKutta4;
   const double unscaledStep = estimatedStableStep_s();  // for the error message
   const double baseMass = totalMass_;
   const std::vector<double> base = mass_;
-  scaleMassesFor(mesh, base, step, step);
-  if (beta > 0.0) holdDampedStep(mesh, base, step);
+  if (rungeKutta) {
+    scaleForRungeKutta(mesh, base, step);
+  } else {
+    scaleMassesFor(mesh, base, step, step);
+    // With damping, the measured stiffest mode is what the solver holds the step to.
+    if (beta > 0.0) holdMeasuredStep(mesh, base, step, step, stableOmega(scaling.integrator, step, beta));
+  }
   addedMass_ = totalMass_ - baseMass;
   massScaledVertices_ = 0;
   for (std::size_t i = 0; i < mass_.size(); ++i) massScaledVertices_ += mass_[i] > base[i] ? 1 : 0;
   if (addedMass_ > scaling.maxAddedFraction * baseMass) {
     double stableStep = unscaledStep;
-    if (beta > 0.0) {  // the unscaled masses back, for the damped bound the message names
+    if (beta > 0.0 || rungeKutta) {  // the unscaled masses back, for the bound the message names
       freeMembraneOmega_ = 0.0;
       mass_ = base;
       updateInverseMasses();
-      stableStep = std::min(stableStep, dampedStableStep_s(membraneFrequency_rad_s(), beta));
+      const double omega = membraneFrequency_rad_s();
+      stableStep = rungeKutta ? rungeKuttaStableStep_s(omega, beta)
+                              : std::min(stableStep, dampedStableStep_s(omega, beta));
     }
     const std::string stableAt =
         scaling.frameRate_hz > 0.0
@@ -262,10 +270,11 @@ void ClothModel::applyMassScaling(const mesh::TriMesh& mesh, const MassScaling& 
                           static_cast<long>(std::ceil(1.0 / (scaling.frameRate_hz * stableStep))))
             : fmt::format("a substep of {:.3g} ms", 1e3 * stableStep);
     const std::string damped = beta > 0.0 ? fmt::format(" with internal damping of {:.3g} s", beta) : "";
-    throw Error(fmt::format("{}: keeping the substep of {:.3g} ms stable{} needs {:.1f} % more mass on {} of {} "
+    const std::string by = rungeKutta ? fmt::format(" for the {} step", integratorName(scaling.integrator)) : "";
+    throw Error(fmt::format("{}: keeping the substep of {:.3g} ms stable{}{} needs {:.1f} % more mass on {} of {} "
                             "vertices, more than maxAddedMass {:g} allows; use more substeps per frame (the "
                             "garment is stable without mass scaling at {}) or allow more added mass",
-                            name_, 1e3 * step, damped, 100.0 * addedMass_ / baseMass, massScaledVertices_,
+                            name_, 1e3 * step, by, damped, 100.0 * addedMass_ / baseMass, massScaledVertices_,
                             mass_.size(), scaling.maxAddedFraction, stableAt));
   }
 }
@@ -292,26 +301,43 @@ void ClothModel::scaleMassesFor(const mesh::TriMesh& mesh, const std::vector<dou
   bendingOmega_ = estimateBendingOmega(mesh);
 }
 
-// Internal damping beta shortens the membrane's stable step: a mode of frequency omega needs
-// omega^2 dt (dt + 2 beta) < 4, so masses scaled for dt alone can leave the stiffest mode too
-// fast. Its slivers are then scaled for a longer step, in proportion to how much too fast it
-// is (a scaled triangle's frequency goes as one over its target), measured again, and so on
-// for a few rounds; bending is not damped and keeps dt. A mode still too fast after the last
-// round is the solver's to refuse (checkDampedStep), with the way out in its message.
-void ClothModel::holdDampedStep(const mesh::TriMesh& mesh, const std::vector<double>& base, double step_s) {
+// Internal damping beta shortens symplectic Euler's stable step: a mode of frequency omega
+// needs omega^2 dt (dt + 2 beta) < 4, so masses scaled for dt alone can leave the stiffest
+// mode too fast; and the Runge-Kutta step's bound is on that mode, which the element
+// estimates do not bound. The slivers are then scaled for a longer step, in proportion to how
+// much too fast the mode is (a scaled triangle's frequency goes as one over its target),
+// measured again, and so on for a few rounds; bending is not damped and keeps its target. A
+// mode still too fast after the last round is the solver's to refuse (checkDampedStep,
+// checkRungeKuttaStep), with the way out in its message.
+void ClothModel::holdMeasuredStep(const mesh::TriMesh& mesh, const std::vector<double>& base, double membraneTarget_s,
+                                  double bendingTarget_s, double allowedOmega) {
   constexpr int kRounds = 4;
   constexpr double kOvershoot = 1.02;  // the next round aims a little past the bound
-  const double allowed = 2.0 * kDampedStepMargin / undampedEquivalentStep_s(step_s, material_.damping_s);
-  double membraneTarget = step_s;
+  double membraneTarget = membraneTarget_s;
   for (int round = 0; round < kRounds; ++round) {
     const double omega = membraneFrequency_rad_s();
-    if (omega <= allowed) {
+    if (omega <= allowedOmega) {
       freeMembraneOmega_ = omega;  // the masses are final: the substep search asks again
       return;
     }
-    membraneTarget *= kOvershoot * omega / allowed;
-    scaleMassesFor(mesh, base, membraneTarget, step_s);
+    membraneTarget *= kOvershoot * omega / allowedOmega;
+    scaleMassesFor(mesh, base, membraneTarget, bendingTarget_s);
   }
+}
+
+// The element estimates are symplectic Euler's; undamped, the Runge-Kutta step reaches
+// sqrt(2) times as far on every mode, so the triangles and hinges are scaled for that shorter
+// step, and then, as for the damped symplectic step, the measured stiffest mode is held to
+// the step's own bound (the element estimates do not bound it, and damping moves the bound).
+// The estimates are cautious on slivers, and that caution is kept on purpose: scaling only
+// until the mode measured at rest keeps the bound left the walking dress's slivers light
+// enough to diverge where the walk stretches them (frames computed again at every count from
+// 66 to 108; docs/PERFORMANCE.md, "Mass scaling for the Runge-Kutta step").
+void ClothModel::scaleForRungeKutta(const mesh::TriMesh& mesh, const std::vector<double>& base, double step_s) {
+  const double elementStep = step_s / std::sqrt(2.0);
+  scaleMassesFor(mesh, base, elementStep, elementStep);
+  holdMeasuredStep(mesh, base, elementStep, elementStep,
+                   stableOmega(IntegratorKind::RungeKutta4, step_s, material_.damping_s));
 }
 
 double undampedEquivalentStep_s(double step_s, double damping_s) {
@@ -549,6 +575,21 @@ double rungeKuttaStableStep_s(double omega_rad_s, double damping_s) {
   return rungeKuttaReach(std::complex<double>(-1.0, 0.0)) / largest;
 }
 
+double stableOmega(IntegratorKind integrator, double step_s, double damping_s) {
+  if (integrator != IntegratorKind::RungeKutta4)
+    return 2.0 * kDampedStepMargin / undampedEquivalentStep_s(step_s, damping_s);
+  // The Runge-Kutta bound falls as the frequency rises (zeta rises with it, and past zeta = 1
+  // the larger real eigenvalue grows faster than omega): bisection on omega.
+  double below = 0.0;
+  double above = 2.0 * std::sqrt(2.0) / step_s;  // the undamped bound, without the margin
+  while (rungeKuttaStableStep_s(above, damping_s) >= step_s) above *= 2.0;
+  for (int k = 0; k < 60; ++k) {
+    const double mid = 0.5 * (below + above);
+    (rungeKuttaStableStep_s(mid, damping_s) >= step_s ? below : above) = mid;
+  }
+  return below;
+}
+
 int rungeKuttaSubsteps(const ClothModel& model, double frameRate_hz) {
   const double most = rungeKuttaStableStep_s(model.membraneFrequency_rad_s(), model.material().damping_s);
   return std::clamp(static_cast<int>(std::ceil(1.0 / (frameRate_hz * most))), 1, 100000);
@@ -576,20 +617,25 @@ int suggestedBendEvery(const ClothModel& model, double substep_s) {
 }
 
 double addedMassFractionAt(const mesh::TriMesh& mesh, const mesh::Topology& topology, const Material& material,
-                           double frameRate_hz, int substepsPerFrame) {
+                           double frameRate_hz, int substepsPerFrame, IntegratorKind integrator) {
   // An unbounded allowance: the model reports the mass it needs instead of refusing.
-  const MassScaling scaling{1.0 / (frameRate_hz * substepsPerFrame), std::numeric_limits<double>::infinity()};
+  const MassScaling scaling{1.0 / (frameRate_hz * substepsPerFrame), std::numeric_limits<double>::infinity(), 0.0,
+                            integrator};
   return ClothModel::build(mesh, topology, material, scaling)->addedMassFraction();
 }
 
 SubstepChoice fewestStableSubsteps(const mesh::TriMesh& mesh, const mesh::Topology& topology,
                                    const Material& material, double frameRate_hz, double maxAddedFraction,
-                                   int least) {
+                                   int least, IntegratorKind integrator) {
   constexpr int kMost = 100000;
   const double beta = material.damping_s;
-  // The step a model allows: the wave-speed estimate, and with internal damping the bound of
-  // the membrane's highest frequency (every vertex free: the garment's pins are not known here).
+  const bool rungeKutta = integrator == IntegratorKind::RungeKutta4;
+  const bool measured = beta > 0.0 || rungeKutta;  // the stiffest mode's bound is checked
+  // The step a model allows: symplectic Euler's wave-speed estimate, and with internal damping
+  // the bound of the membrane's highest frequency; the Runge-Kutta step's bound on that
+  // frequency (every vertex free: the garment's pins are not known here).
   const auto allowedStep = [&](const ClothModel& model) {
+    if (rungeKutta) return rungeKuttaStableStep_s(model.membraneFrequency_rad_s(), beta);
     const double step = model.estimatedStableStep_s();
     return beta > 0.0 ? std::min(step, dampedStableStep_s(model.membraneFrequency_rad_s(), beta)) : step;
   };
@@ -605,18 +651,37 @@ SubstepChoice fewestStableSubsteps(const mesh::TriMesh& mesh, const mesh::Topolo
   const auto scaledAt = [&](int n) -> std::optional<double> {
     const double step = 1.0 / (frameRate_hz * n);
     // An unbounded allowance: the model reports the mass it needs instead of refusing.
-    const auto model = ClothModel::build(mesh, topology, material, {step, std::numeric_limits<double>::infinity()});
+    const auto model =
+        ClothModel::build(mesh, topology, material, {step, std::numeric_limits<double>::infinity(), 0.0, integrator});
     const double added = model->addedMassFraction();
-    if (added <= maxAddedFraction && (!(beta > 0.0) || step <= allowedStep(*model))) return added;
+    if (added <= maxAddedFraction && (!measured || step <= allowedStep(*model))) return added;
     return std::nullopt;
   };
+  // Between a failing count and a passing one (its mass `added`), the fewest that passes:
+  // more substeps never need more mass.
+  const auto narrowed = [&](int failing, int passing, double added) -> SubstepChoice {
+    while (passing - failing > 1) {
+      const int mid = failing + (passing - failing) / 2;
+      if (const std::optional<double> a = scaledAt(mid)) {
+        passing = mid;
+        added = *a;
+      } else {
+        failing = mid;
+      }
+    }
+    return {passing, added};
+  };
   // A ladder of 5 % rungs up to the first count that passes, then bisection between it and
-  // the rung below: more substeps never need more mass, so that is the fewest.
+  // the rung below.
   const auto nextRung = [](int n) { return std::max(n + 1, static_cast<int>(std::ceil(n * 1.05))); };
   int failing = std::max(1, least) - 1;
   int n = std::max(1, least);
-  if (beta > 0.0) {
-    // Damping only adds mass (ClothModel::holdDampedStep, a power iteration per model): the
+  // Every Runge-Kutta model measures its stiffest mode (a power iteration), and the counts
+  // far below the unscaled one need far more mass than any allowance: bisection from the
+  // unscaled count down, about log2 of it models, instead of the ladder.
+  if (rungeKutta && n < none) return narrowed(failing, none, 0.0);
+  if (beta > 0.0 && !rungeKutta) {
+    // Damping only adds mass (ClothModel::holdMeasuredStep, a power iteration per model): the
     // rungs that the undamped masses already put over the allowance are passed over first,
     // on models that need none.
     Material undamped = material;
@@ -629,22 +694,8 @@ SubstepChoice fewestStableSubsteps(const mesh::TriMesh& mesh, const mesh::Topolo
     }
   }
   for (; n < none; n = nextRung(n)) {
-    std::optional<double> added = scaledAt(n);
-    if (!added) {
-      failing = n;
-      continue;
-    }
-    int passing = n;
-    while (passing - failing > 1) {
-      const int mid = failing + (passing - failing) / 2;
-      if (const std::optional<double> a = scaledAt(mid)) {
-        passing = mid;
-        added = a;
-      } else {
-        failing = mid;
-      }
-    }
-    return {passing, *added};
+    if (const std::optional<double> added = scaledAt(n)) return narrowed(failing, n, *added);
+    failing = n;
   }
   return {none, 0.0};
 }

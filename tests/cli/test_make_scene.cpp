@@ -444,6 +444,29 @@ TEST(MakeScene, BackwardEulerAsksAnEighthOfTheSubstepsAndNoMass) {
   const std::size_t at = rungeKutta.out.find(head);
   ASSERT_NE(at, std::string::npos) << rungeKutta.out;
   EXPECT_LT(rk.simulation.stepsPerFrame, std::stoi(rungeKutta.out.substr(at + head.size()))) << rungeKutta.out;
+  // With more mass allowed, scaling aimed at the Runge-Kutta step's own bound (its elements
+  // for a step sqrt(2) shorter) asks fewer still, about 1 / sqrt(2) of symplectic Euler's
+  // count within the same allowance.
+  const CliResult scaled =
+      runDrape(makeDressScene("obj", "--integrator runge-kutta-4 --max-added-mass 0.1", dir / "rk-scaled"), dir);
+  ASSERT_EQ(scaled.code, 0) << scaled.err;
+  const scene::Scene rkScaled = scene::loadScene(dir / "rk-scaled" + "/scene.wrl");
+  EXPECT_FLOAT_EQ(rkScaled.simulation.maxAddedMass, 0.1);
+  EXPECT_LT(rkScaled.simulation.stepsPerFrame, rk.simulation.stepsPerFrame);
+  const std::string scaledHead = std::to_string(rkScaled.simulation.stepsPerFrame) +
+                                 " substeps per frame at 30 frames/s, each a fourth-order Runge-Kutta step (mass "
+                                 "scaling adds ";
+  const std::size_t scaledAt = scaled.out.find(scaledHead);
+  ASSERT_NE(scaledAt, std::string::npos) << scaled.out;
+  const double addedPercent = std::stod(scaled.out.substr(scaledAt + scaledHead.size()));
+  EXPECT_GT(addedPercent, 0.0);
+  EXPECT_LE(addedPercent, 10.0);
+  const std::string symplecticHead = "% of the mass; symplectic Euler would take ";
+  const std::size_t symplecticAt = scaled.out.find(symplecticHead, scaledAt);
+  ASSERT_NE(symplecticAt, std::string::npos) << scaled.out;
+  const int symplecticCount = std::stoi(scaled.out.substr(symplecticAt + symplecticHead.size()));
+  EXPECT_NEAR(rkScaled.simulation.stepsPerFrame, symplecticCount / std::sqrt(2.0), 0.05 * symplecticCount)
+      << scaled.out;
   const CliResult unknown = runDrape(makeDressScene("obj", "--integrator implicit", dir / "unknown"), dir);
   EXPECT_NE(unknown.code, 0);
   EXPECT_NE(unknown.err.find(

@@ -1,6 +1,7 @@
 #pragma once
 // Shared set-up for the cloth tests: a sheet, a model and a solver in a line or two.
 
+#include <concepts>
 #include <memory>
 #include <string>
 #include <utility>
@@ -107,6 +108,18 @@ inline long firstUnstableFrame(ClothSolver& solver, long frames) {
 inline std::string refusal(const StepSettings& settings) {
   try {
     settings.validate("--");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+/// What `act` throws drape::Error with; empty when it does not throw.
+template <class F>
+  requires std::invocable<F>
+std::string refusal(F&& act) {
+  try {
+    std::forward<F>(act)();
   } catch (const Error& e) {
     return e.what();
   }

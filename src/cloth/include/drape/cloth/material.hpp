@@ -66,6 +66,10 @@ struct MassScaling {
   double targetStep_s = 0.0;      ///< the substep the model must stay stable at, s
   double maxAddedFraction = 0.0;  ///< largest added mass, as a fraction of the garment's mass
   double frameRate_hz = 0.0;      ///< for messages: substeps per frame instead of seconds
+  /// Whose stability bound the masses are scaled for: symplectic Euler's (also taken for
+  /// forward Euler, whose damping window the solver checks), or the Runge-Kutta step's,
+  /// which is the longer on every mode and so needs less mass at the same substep.
+  IntegratorKind integrator = IntegratorKind::SymplecticEuler;
 };
 
 /// Environment and time stepping (the paper's Simulation node).
@@ -115,12 +119,14 @@ struct StepSettings {
     return kind == IntegratorKind::SymplecticEuler || kind == IntegratorKind::ForwardEuler;
   }
   /// What ClothModel::build needs to honour maxAddedMass: none for the implicit step, which
-  /// needs no mass added to be stable. The Runge-Kutta step takes symplectic Euler's, which
-  /// is cautious for it: its bound on every mode of the membrane is the longer.
+  /// needs no mass added to be stable; for the Runge-Kutta step, the mass its own bound asks.
   [[nodiscard]] MassScaling massScaling() const {
-    return maxAddedMass > 0.0 && integrator != IntegratorKind::BackwardEuler
-               ? MassScaling{substep_s(), maxAddedMass, frameRate_hz}
-               : MassScaling{};
+    if (!(maxAddedMass > 0.0) || integrator == IntegratorKind::BackwardEuler) return {};
+    return {substep_s(), maxAddedMass, frameRate_hz, massScalingBound()};
+  }
+  /// Whose stability bound mass scaling aims at for this integrator (MassScaling::integrator).
+  [[nodiscard]] IntegratorKind massScalingBound() const {
+    return integrator == IntegratorKind::RungeKutta4 ? integrator : IntegratorKind::SymplecticEuler;
   }
   void validate(const std::string& prefix = "--") const;
 };

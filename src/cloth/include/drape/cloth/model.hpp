@@ -167,7 +167,12 @@ class ClothModel {
   /// topped up for a bending step of bendingTarget_s.
   void scaleMassesFor(const mesh::TriMesh& mesh, const std::vector<double>& base, double membraneTarget_s,
                       double bendingTarget_s);
-  void holdDampedStep(const mesh::TriMesh& mesh, const std::vector<double>& base, double step_s);
+  /// Scales the slivers further, from masses scaled for membraneTarget_s, until the
+  /// membrane's measured stiffest mode (every vertex free) is at most allowedOmega.
+  void holdMeasuredStep(const mesh::TriMesh& mesh, const std::vector<double>& base, double membraneTarget_s,
+                        double bendingTarget_s, double allowedOmega);
+  /// Masses for the Runge-Kutta step at step_s: its bound on the measured stiffest mode.
+  void scaleForRungeKutta(const mesh::TriMesh& mesh, const std::vector<double>& base, double step_s);
   void updateInverseMasses();
   [[nodiscard]] std::vector<double> bendingRowSums(const mesh::TriMesh& mesh) const;
   [[nodiscard]] double estimateBendingOmega(const mesh::TriMesh& mesh) const;
@@ -234,6 +239,11 @@ struct ForwardEulerDampingWindow {
 /// along the eigenvalues' rays by bisection, with omega / kDampedStepMargin (infinite for
 /// omega = 0).
 [[nodiscard]] double rungeKuttaStableStep_s(double omega_rad_s, double damping_s);
+/// The highest frequency of a membrane mode that `integrator` keeps stable at `step_s` with
+/// damping `damping_s`: 2 kDampedStepMargin / undampedEquivalentStep_s for symplectic Euler
+/// (and forward Euler, whose window the solver checks), and for the Runge-Kutta step the
+/// frequency whose rungeKuttaStableStep_s is `step_s`.
+[[nodiscard]] double stableOmega(IntegratorKind integrator, double step_s, double damping_s);
 /// The fewest substeps per frame of `frameRate_hz` at which the Runge-Kutta step keeps the
 /// model's membrane stable, every vertex free (at least the frequency with pins held).
 [[nodiscard]] int rungeKuttaSubsteps(const ClothModel& model, double frameRate_hz);
@@ -247,7 +257,8 @@ struct SubstepChoice {
 /// The fraction of the garment's mass that mass scaling adds to keep it stable at
 /// `substepsPerFrame` per frame of `frameRate_hz` (builds the model once).
 [[nodiscard]] double addedMassFractionAt(const mesh::TriMesh& mesh, const mesh::Topology& topology,
-                                         const Material& material, double frameRate_hz, int substepsPerFrame);
+                                         const Material& material, double frameRate_hz, int substepsPerFrame,
+                                         IntegratorKind integrator = IntegratorKind::SymplecticEuler);
 
 /// The fewest substeps per frame, from `least` up, at which the garment is stable when mass
 /// scaling may add at most `maxAddedFraction` of its mass (0: no scaling: the estimated
@@ -256,11 +267,13 @@ struct SubstepChoice {
 /// by bisection down to the rung below (more substeps never need more mass); at most 100000.
 /// With internal damping
 /// a count must also keep dampedStableStep_s of the membrane's highest frequency (every
-/// vertex free), which mass scaling lowers. Throws drape::Error naming the garment when none
-/// is stable.
+/// vertex free), which mass scaling lowers. For `integrator` RungeKutta4 the counts, the mass
+/// scaling and the bound are that step's: rungeKuttaStableStep_s of the same frequency, with
+/// or without damping. Throws drape::Error naming the garment when none is stable.
 [[nodiscard]] SubstepChoice fewestStableSubsteps(const mesh::TriMesh& mesh, const mesh::Topology& topology,
                                                  const Material& material, double frameRate_hz,
-                                                 double maxAddedFraction, int least = 1);
+                                                 double maxAddedFraction, int least = 1,
+                                                 IntegratorKind integrator = IntegratorKind::SymplecticEuler);
 
 /// The bending rhythm (StepSettings::bendEvery) to write into a scene stepping at
 /// `substep_s`: the most substeps, up to 8, that span at most a tenth of the bending forces'

@@ -49,7 +49,8 @@ struct SceneIntegrator {
         "--integrator", [this](const std::string& name) { kind = cloth::parseIntegrator(name); },
         "The scene's integrator: symplectic-euler (default), forward-euler, backward-euler (implicit: no mass "
         "added, bending every substep, " + implicitSubsteps + ") or runge-kutta-4 (four force evaluations per "
-        "substep, bending in each, as few substeps as its stability bound allows)");
+        "substep, bending in each, as few substeps as its stability bound allows, with mass scaling aimed at "
+        "that bound)");
     app.add_option("--implicit-tolerance", implicitTolerance,
                    "backward-euler: the residual at which each substep's solve stops, written as the scene's "
                    "implicitTolerance")

@@ -274,24 +274,21 @@ int makeScene(MakeSceneOptions& o) {
     // rhythm; a rhythm asked for is held to the bending forces' stable step, as drape run
     // holds it.
     const auto unscaled = cloth::ClothModel::build(garment, topology, o.material);
-    // Runge-Kutta: its own bound, and mass scaling for it, from any count up; where its count
-    // needs no mass on the unscaled membrane, none is added, not even the little the element
-    // estimates would add.
+    // Runge-Kutta: its own bound, and mass scaling for it, from any count up (none where the
+    // unscaled membrane keeps the bound, and then the scene allows none).
     const bool rungeKutta = o.integrator.kind == cloth::IntegratorKind::RungeKutta4;
     const cloth::IntegratorKind bound = rungeKutta ? o.integrator.kind : cloth::IntegratorKind::SymplecticEuler;
     const cloth::SubstepChoice own =
         rungeKutta ? cloth::fewestStableSubsteps(garment, topology, o.material, o.frameRate, o.maxAddedMass,
                                                  std::max(1, o.stepsPerFrame), bound)
                    : choice;
-    const int rungeKuttaCount = rungeKutta ? cloth::rungeKuttaSubsteps(*unscaled, o.frameRate) : 0;
     if (o.stepsPerFrame == 0) o.stepsPerFrame = own.substepsPerFrame;
-    const bool unscaledRungeKutta = rungeKutta && o.stepsPerFrame >= rungeKuttaCount;
+    const double added = o.stepsPerFrame == own.substepsPerFrame
+                             ? own.addedMassFraction
+                             : cloth::addedMassFractionAt(garment, topology, o.material, o.frameRate,
+                                                          o.stepsPerFrame, bound);
+    const bool unscaledRungeKutta = rungeKutta && added == 0.0;
     if (unscaledRungeKutta) o.maxAddedMass = 0.0;
-    const double added =
-        unscaledRungeKutta                        ? 0.0
-        : o.stepsPerFrame == own.substepsPerFrame ? own.addedMassFraction
-                                                  : cloth::addedMassFractionAt(garment, topology, o.material,
-                                                                               o.frameRate, o.stepsPerFrame, bound);
     if (added > o.maxAddedMass)
       throw Error(fmt::format("--substeps {}: mass scaling would add {:.2f} % of the garment's mass, more than "
                               "--max-added-mass {:g}; {} substeps per frame need no more than that",

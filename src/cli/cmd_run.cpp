@@ -380,17 +380,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
                   "is stable at any: give a count (--substeps 4 walks the bundled skirt, 20 the bundled dress)");
     if (substeps == 0) {
       setup.settings.substepsPerFrame = stableSubsteps(setup);
-      bool scaled = setup.settings.maxAddedMass > 0.0;
-      // Runge-Kutta: where its own count needs no mass (every vertex free), none is added,
-      // not even the little the element estimates would add to slivers.
-      if (setup.settings.integrator == cloth::IntegratorKind::RungeKutta4) {
-        const int unscaled = rungeKuttaSubsteps(setup);
-        if (unscaled <= setup.settings.substepsPerFrame) {
-          setup.settings.substepsPerFrame = unscaled;
-          setup.settings.maxAddedMass = 0.0;
-          scaled = false;
-        }
-      }
+      const bool scaled = setup.settings.maxAddedMass > 0.0;
       spdlog::info("--substeps auto: {} substeps per frame ({:.3f} ms){}", setup.settings.substepsPerFrame,
                    1e3 * setup.settings.substep_s(), scaled ? ", with mass scaling within --max-added-mass" : "");
     }

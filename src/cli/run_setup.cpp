@@ -777,16 +777,6 @@ int stableSubsteps(const RunSetup& setup) {
   return n;
 }
 
-int rungeKuttaSubsteps(const RunSetup& setup) {
-  int n = 1;
-  for (const GarmentSetup& g : setup.garments) {
-    const auto model =
-        cloth::ClothModel::build(g.mesh, mesh::Topology::build(g.mesh, kMinTriangleArea_m2), g.material);
-    n = std::max(n, cloth::rungeKuttaSubsteps(*model, setup.settings.frameRate_hz));
-  }
-  return n;
-}
-
 std::vector<std::string> facePartsOption(const std::vector<std::string>& given) {
   return given == std::vector<std::string>{"none"} ? std::vector<std::string>{} : given;
 }

@@ -274,9 +274,6 @@ void validateRunSetup(const RunSetup& setup);
 /// maxAddedMass of each (cloth::fewestStableSubsteps: the Runge-Kutta step's own bound and
 /// scaling for it, symplectic Euler's for the others), at least 1.
 [[nodiscard]] int stableSubsteps(const RunSetup& setup);
-/// The smallest substep count per frame at which the Runge-Kutta step keeps every garment's
-/// membrane stable with no mass added (cloth::rungeKuttaStableStep_s), at least 1.
-[[nodiscard]] int rungeKuttaSubsteps(const RunSetup& setup);
 
 /// Simulates and writes every output (each frame once `gate`, if given, lets it: a live
 /// motion's). Returns 0; on instability it finishes the files written so far (caches, stats

@@ -325,19 +325,25 @@ void ClothModel::holdMeasuredStep(const mesh::TriMesh& mesh, const std::vector<d
   }
 }
 
-// The element estimates are symplectic Euler's; undamped, the Runge-Kutta step reaches
-// sqrt(2) times as far on every mode, so the triangles and hinges are scaled for that shorter
-// step, and then, as for the damped symplectic step, the measured stiffest mode is held to
-// the step's own bound (the element estimates do not bound it, and damping moves the bound).
-// The estimates are cautious on slivers, and that caution is kept on purpose: scaling only
-// until the mode measured at rest keeps the bound left the walking dress's slivers light
+// Where the unscaled membrane's measured stiffest mode keeps the Runge-Kutta step's bound,
+// nothing is added: the element estimates would add mass to slivers that do not need it.
+// Otherwise the element estimates are symplectic Euler's; undamped, the Runge-Kutta step
+// reaches sqrt(2) times as far on every mode, so the triangles and hinges are scaled for that
+// shorter step, and then, as for the damped symplectic step, the measured stiffest mode is
+// held to the step's own bound (the element estimates do not bound it, and damping moves the
+// bound). The estimates are cautious on slivers, and that caution is kept on purpose: scaling
+// only until the mode measured at rest keeps the bound left the walking dress's slivers light
 // enough to diverge where the walk stretches them (frames computed again at every count from
 // 66 to 108; docs/PERFORMANCE.md, "Mass scaling for the Runge-Kutta step").
 void ClothModel::scaleForRungeKutta(const mesh::TriMesh& mesh, const std::vector<double>& base, double step_s) {
+  const double allowed = stableOmega(IntegratorKind::RungeKutta4, step_s, material_.damping_s);
+  if (const double unscaled = membraneFrequency_rad_s(); unscaled <= allowed) {
+    freeMembraneOmega_ = unscaled;  // the masses are final
+    return;
+  }
   const double elementStep = step_s / std::sqrt(2.0);
   scaleMassesFor(mesh, base, elementStep, elementStep);
-  holdMeasuredStep(mesh, base, elementStep, elementStep,
-                   stableOmega(IntegratorKind::RungeKutta4, step_s, material_.damping_s));
+  holdMeasuredStep(mesh, base, elementStep, elementStep, allowed);
 }
 
 double undampedEquivalentStep_s(double step_s, double damping_s) {

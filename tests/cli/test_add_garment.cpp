@@ -315,4 +315,32 @@ TEST(AddGarment, AGarmentTheSceneCannotTakeLeavesItAsItWas) {
   EXPECT_NE(added.find("  avatar USE Body\n  collidesWith", named.size()), std::string::npos);
 }
 
+TEST(AddGarment, AnImplicitOrRungeKuttaSceneTakesAGarmentAtItsOwnSubsteps) {
+  // A skirt added to a scene stepped by backward Euler (5 substeps) or by the Runge-Kutta step
+  // at its own bound (11, no mass allowed) is judged by that scene's integrator: backward
+  // Euler needs no mass at any substep, and the Runge-Kutta step none where the unscaled
+  // membrane keeps its bound, so both take it as they are. (Judged by symplectic Euler's
+  // bound, or by element estimates that add mass where none is needed, both were refused.)
+  ScratchDir dir("add-garment-integrators");
+  for (const std::string integrator : {"backward-euler", "runge-kutta-4"}) {
+    SCOPED_TRACE(integrator);
+    const std::string out = dir / integrator;
+    const CliResult petticoat = runDrape("make-skirt " + kBody + " --integrator " + integrator +
+                                             " --clearance 0.02 --flare 0.12 --length 0.38 --name Petticoat --out '" +
+                                             out + "'",
+                                         dir);
+    ASSERT_EQ(petticoat.code, 0) << petticoat.err;
+    const scene::Scene before = scene::loadScene(out + "/scene.wrl");
+    EXPECT_EQ(before.simulation.maxAddedMass, 0.0);
+    const CliResult skirt = runDrape(
+        "make-skirt --add-to '" + out + "/scene.wrl' --clearance 0.035 --flare 0.25 --over Petticoat", dir);
+    ASSERT_EQ(skirt.code, 0) << skirt.err;
+    EXPECT_NE(skirt.out.find("substeps per frame keep it stable"), std::string::npos) << skirt.out;
+    const scene::Scene after = scene::loadScene(out + "/scene.wrl");
+    EXPECT_EQ(after.garments.size(), 2u);
+    EXPECT_EQ(after.simulation.integrator, integrator);
+    EXPECT_EQ(after.simulation.stepsPerFrame, before.simulation.stepsPerFrame);
+  }
+}
+
 }  // namespace drape::add_garment

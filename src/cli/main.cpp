@@ -11,6 +11,7 @@
 #include "command.hpp"
 #include "drape/core/error.hpp"
 #include "drape/core/log.hpp"
+#include "parse_errors.hpp"
 
 namespace drape::cli {
 namespace {
@@ -81,8 +82,9 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : static_cast<int>(ExitCode::BadInput);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::fprintf(stderr, "%s\n", cli::parseErrorMessage(app, e).c_str());
+    return static_cast<int>(ExitCode::BadInput);
   }
 
   cli::mutableGlobals().verbosity = quiet ? -1 : verbose;

@@ -1,6 +1,7 @@
 // Every command's --help, found by walking the subcommand lists the help itself prints:
 // each exits 0 and none shows the directory drape was built in (a user's copy of the binary
-// would show someone else's paths).
+// would show someone else's paths). And a command line drape cannot read: the command it
+// was for, what is wrong, what a mistyped word meant, where the options are listed.
 #include <gtest/gtest.h>
 
 #include <sstream>
@@ -62,6 +63,41 @@ TEST(Help, EveryCommandHelpsWithoutTheBuildDirectory) {
   }
   // drape itself, its ten commands and bench's five benchmarks.
   EXPECT_GE(commands, 16);
+}
+
+TEST(Help, AMistypedCommandLineNamesItsCommandAndWhatWasMeant) {
+  ScratchDir dir("parse-errors");
+  struct Case {
+    std::string args;
+    std::vector<std::string> said;  ///< lines of standard error, in order
+  };
+  const std::vector<Case> cases = {
+      {"bench paper --jsn",
+       {"drape bench paper: the following argument was not expected: --jsn", "  --jsn: did you mean --json?",
+        "'drape bench paper --help' lists its options"}},
+      // Two letters swapped are one slip.
+      {"bench paper --josn", {"  --josn: did you mean --json?"}},
+      {"bnech", {"drape: a subcommand is required", "  bnech: did you mean bench?",
+                 "'drape --help' lists its options and commands"}},
+      // Another error first (--out missing), and an option of drape itself mistyped after
+      // the command (drape's own options are taken there too).
+      {"run scene.wrl --thread 2", {"drape run: --out is required", "  --thread: did you mean --threads?"}},
+      // Nothing near --out among render's options: no guess.
+      {"render some/run --out pictures", {"drape render: the following arguments were not expected: pictures --out",
+                                          "'drape render --help' lists its options"}},
+  };
+  for (const Case& c : cases) {
+    const CliResult r = runDrape(c.args, dir);
+    EXPECT_EQ(r.code, 2) << c.args;
+    std::size_t from = 0;
+    for (const std::string& line : c.said) {
+      const std::size_t at = r.err.find(line + "\n", from);
+      ASSERT_NE(at, std::string::npos) << "drape " << c.args << ": no line '" << line << "' (in order) in\n" << r.err;
+      from = at + line.size();
+    }
+    if (c.args.rfind("render", 0) == 0) EXPECT_EQ(r.err.find("did you mean"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("Run with --help"), std::string::npos) << r.err;
+  }
 }
 
 }  // namespace

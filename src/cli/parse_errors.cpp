@@ -1,0 +1,108 @@
+#include "parse_errors.hpp"
+
+#include <algorithm>
+#include <cctype>
+
+#include <fmt/format.h>
+
+namespace drape::cli {
+
+std::size_t editDistance(std::string_view a, std::string_view b) {
+  // Optimal string alignment: Levenshtein's three edits and a swap of two neighbours (the
+  // commonest slip of a typing hand), over three rows of the table.
+  std::vector<std::size_t> before(b.size() + 1), last(b.size() + 1), row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) last[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t substitution = last[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1);
+      row[j] = std::min({last[j] + 1, row[j - 1] + 1, substitution});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) row[j] = std::min(row[j], before[j - 2] + 1);
+    }
+    before.swap(last);
+    last.swap(row);
+  }
+  return last[b.size()];
+}
+
+std::optional<std::string> nearestName(std::string_view word, const std::vector<std::string>& names) {
+  std::string_view letters = word;
+  while (!letters.empty() && letters.front() == '-') letters.remove_prefix(1);
+  const std::size_t allowed = letters.size() <= 5 ? 1 : 2;
+  std::optional<std::string> nearest;
+  std::size_t best = allowed + 1;
+  bool tied = false;
+  for (const std::string& name : names) {
+    if (name == word) continue;
+    const std::size_t d = editDistance(word, name);
+    if (d < best) {
+      best = d;
+      nearest = name;
+      tied = false;
+    } else if (d == best && name != nearest) {
+      tied = true;
+    }
+  }
+  if (tied) return std::nullopt;
+  return nearest;
+}
+
+std::vector<std::string> namesTakenBy(const CLI::App& app) {
+  std::vector<std::string> names;
+  for (const CLI::App* a = &app; a != nullptr; a = a->get_parent()) {
+    for (const CLI::Option* option : a->get_options()) {
+      for (const std::string& n : option->get_lnames()) names.push_back("--" + n);
+      for (const std::string& n : option->get_snames()) names.push_back("-" + n);
+    }
+    if (!a->get_fallthrough()) break;
+  }
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) names.push_back(sub->get_name());
+  std::sort(names.begin(), names.end());
+  names.erase(std::unique(names.begin(), names.end()), names.end());
+  return names;
+}
+
+const CLI::App& deepestCommand(const CLI::App& root) {
+  const CLI::App* app = &root;
+  for (;;) {
+    const std::vector<CLI::App*> parsed = app->get_subcommands();
+    if (parsed.empty()) return *app;
+    app = parsed.front();
+  }
+}
+
+namespace {
+
+/// "drape bench paper": the program and the commands down to `app`.
+std::string commandLineOf(const CLI::App& app) {
+  std::vector<std::string> names;
+  for (const CLI::App* a = &app; a->get_parent() != nullptr; a = a->get_parent()) names.push_back(a->get_name());
+  std::string line = "drape";
+  for (auto it = names.rbegin(); it != names.rend(); ++it) line += " " + *it;
+  return line;
+}
+
+}  // namespace
+
+std::string parseErrorMessage(const CLI::App& root, const CLI::ParseError& e) {
+  const CLI::App& command = deepestCommand(root);
+  const std::string name = commandLineOf(command);
+  std::string said = e.what();
+  if (said.size() > 1 && std::isupper(static_cast<unsigned char>(said[0])) &&
+      !std::isupper(static_cast<unsigned char>(said[1])))  // "The following ...", "A subcommand ...", not "VRML"
+    said[0] = static_cast<char>(std::tolower(static_cast<unsigned char>(said[0])));
+  std::string message = fmt::format("{}: {}", name, said);
+  const std::vector<std::string> taken = namesTakenBy(command);
+  // The words CLI11 left over: a mistyped option or command among them (also where the
+  // error itself is another, such as a required option missing).
+  for (const std::string& word : root.remaining(true))
+    if (const std::optional<std::string> meant = nearestName(word, taken))
+      message += fmt::format("\n  {}: did you mean {}?", word, *meant);
+  message += fmt::format("\n'{} --help' lists {}", name,
+                         command.get_subcommands([](const CLI::App*) { return true; }).empty()
+                             ? "its options"
+                             : "its options and commands");
+  return message;
+}
+
+}  // namespace drape::cli

@@ -74,19 +74,7 @@ void BackwardEuler::prepare(const ClothModel& model, const StepSettings& setting
 }
 
 void BackwardEuler::holdPinched(std::span<const PinchedPoint> points) {
-  for (const PinchedPoint& p : points) {
-    if (p.vertex >= held_.size() || held_[p.vertex] || isPinched_[p.vertex]) continue;  // one hold a vertex
-    Pinched q{p.vertex, 0, {}};
-    for (const Vec3& along : p.along) {
-      Vec3 e = along;
-      for (int k = 0; k < q.directions; ++k) e -= e.dot(q.e[k]) * q.e[k];
-      const double length = e.norm();
-      if (length > 1e-3) q.e[q.directions++] = e / length;  // not along one it holds already
-    }
-    if (q.directions == 0) continue;
-    isPinched_[p.vertex] = 1;
-    pinched_.push_back(q);
-  }
+  addHolds(points, held_, isPinched_, pinched_);
 }
 
 void BackwardEuler::linearise(const ClothModel& model, const ClothState& s) {
@@ -316,10 +304,9 @@ void BackwardEuler::filter(std::span<double> v) const {
 
 void BackwardEuler::filterPinched(std::span<double> v) const {
   const std::size_t n = held_.size();
-  for (const Pinched& p : pinched_) {
+  for (const HeldPoint& p : pinched_) {
     const std::size_t i = p.vertex;
-    Vec3 a(v[i], v[n + i], v[2 * n + i]);
-    for (int k = 0; k < p.directions; ++k) a -= a.dot(p.e[k]) * p.e[k];
+    const Vec3 a = p.filtered(Vec3(v[i], v[n + i], v[2 * n + i]));
     v[i] = a.x(), v[n + i] = a.y(), v[2 * n + i] = a.z();
   }
 }
@@ -432,8 +419,7 @@ void BackwardEuler::advance(const ClothModel& model, const Vec3& g, double h, Cl
       v[c][i] += held_[i] ? h * gravity[c] : dv_[c * n + i];
       x[c][i] += h * v[c][i];
     }
-  for (const Pinched& p : pinched_) isPinched_[p.vertex] = 0;  // for this solve alone
-  pinched_.clear();
+  clearHolds(isPinched_, pinched_);  // for this solve alone
 }
 
 }  // namespace drape::cloth

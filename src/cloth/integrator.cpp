@@ -96,11 +96,20 @@ class RungeKutta4 final : public Integrator {
  public:
   [[nodiscard]] IntegratorKind kind() const override { return IntegratorKind::RungeKutta4; }
   void prepare(const ClothModel& model, const StepSettings& /*settings*/,
-               std::span<const std::uint8_t> /*fixed*/) override {
+               std::span<const std::uint8_t> fixed) override {
     sizedFor_ = nullptr;
     size(model);
+    skip_.assign(model.vertexCount(), 0);
+    for (std::size_t v = 0; v < skip_.size(); ++v)
+      skip_[v] = static_cast<std::uint8_t>((v < fixed.size() && fixed[v]) || !(model.inverseMass()[v] > 0.0));
+    holds_.reserve(model.vertexCount());
   }
   void useStageForces(StageForces* forces) override { forces_ = forces; }
+  // Its substep is longer than symplectic Euler's (sqrt(2) times the bound, and mass scaling
+  // aims at it), and its stages feel no contact: a pinched point, pulled into the crease by
+  // the cloth around it over the whole substep, ended a few hundredths of a millimetre
+  // inside a part on two walks (docs/PERFORMANCE.md). Held as the implicit solve holds it.
+  void holdPinched(std::span<const PinchedPoint> points) override { addHolds(points, skip_, isHeld_, holds_); }
 
   void advance(const ClothModel& model, const Vec3& g, double dt, ClothState& io) override {
     if (forces_ == nullptr)
@@ -115,6 +124,7 @@ class RungeKutta4 final : public Integrator {
     const std::array<double*, 3> x{stage_.x.data(), stage_.y.data(), stage_.z.data()};
     const std::array<double*, 3> v{stage_.vx.data(), stage_.vy.data(), stage_.vz.data()};
     const std::array<double*, 3> f{stage_.fx.data(), stage_.fy.data(), stage_.fz.data()};
+    holdAccelerations(w, g, io);
     for (int c = 0; c < 3; ++c) {
       std::fill(dx_[c].begin(), dx_[c].end(), 0.0);
       std::fill(dv_[c].begin(), dv_[c].end(), 0.0);
@@ -130,6 +140,7 @@ class RungeKutta4 final : public Integrator {
         stageComponent(n, reach[k], gravity[c], w, x0[c], v0[c], vPrev, fPrev, x[c], v[c]);
       }
       forces_->accumulate(stage_);
+      holdAccelerations(w, g, stage_);
       for (int c = 0; c < 3; ++c) addSlopes(n, weight[k], gravity[c], w, v[c], f[c], dx_[c].data(), dv_[c].data());
     }
     const double sixth = dt / 6.0;
@@ -141,13 +152,29 @@ class RungeKutta4 final : public Integrator {
         vo[c][i] += sixth * dv_[c][i];
       }
     forces_ = nullptr;  // given again before each advance
+    clearHolds(isHeld_, holds_);  // for this step alone
   }
 
  private:
+  /// The held points' forces in `s` less what would accelerate them along their held
+  /// directions (gravity included): every stage's velocity, and so the step's, keeps the
+  /// component the colliders gave it there.
+  void holdAccelerations(const double* w, const Vec3& g, ClothState& s) const {
+    for (const HeldPoint& h : holds_) {
+      const std::size_t i = h.vertex;
+      const Vec3 a = Vec3(s.fx[i], s.fy[i], s.fz[i]) * w[i] + g;
+      const Vec3 drop = (a - h.filtered(a)) / w[i];
+      s.fx[i] -= drop.x();
+      s.fy[i] -= drop.y();
+      s.fz[i] -= drop.z();
+    }
+  }
+
   void size(const ClothModel& model) {
     if (&model == sizedFor_) return;
     sizedFor_ = &model;
     stage_ = ClothState::atRest(model);
+    isHeld_.assign(model.vertexCount(), 0);
     for (int c = 0; c < 3; ++c) {
       dx_[c].assign(model.vertexCount(), 0.0);
       dv_[c].assign(model.vertexCount(), 0.0);
@@ -158,9 +185,34 @@ class RungeKutta4 final : public Integrator {
   const ClothModel* sizedFor_ = nullptr;      ///< the model the workspace was sized for
   ClothState stage_;                          ///< the stage's positions, velocities and forces
   std::array<std::vector<double>, 3> dx_, dv_;  ///< the weighted sums of the stages' slopes
+  std::vector<std::uint8_t> skip_;    ///< per vertex: placed by a fixture, or massless (never held)
+  std::vector<std::uint8_t> isHeld_;  ///< per vertex: in holds_
+  std::vector<HeldPoint> holds_;      ///< for the next step alone (holdPinched)
 };
 
 }  // namespace
+
+void addHolds(std::span<const PinchedPoint> points, std::span<const std::uint8_t> skip, std::vector<std::uint8_t>& held,
+              std::vector<HeldPoint>& holds) {
+  for (const PinchedPoint& p : points) {
+    if (p.vertex >= held.size() || (p.vertex < skip.size() && skip[p.vertex]) || held[p.vertex]) continue;  // one hold a vertex
+    HeldPoint h{p.vertex, 0, {}};
+    for (const Vec3& along : p.along) {
+      Vec3 e = along;
+      for (int k = 0; k < h.directions; ++k) e -= e.dot(h.e[k]) * h.e[k];
+      const double length = e.norm();
+      if (length > 1e-3) h.e[h.directions++] = e / length;  // not along one it holds already
+    }
+    if (h.directions == 0) continue;
+    held[p.vertex] = 1;
+    holds.push_back(h);
+  }
+}
+
+void clearHolds(std::vector<std::uint8_t>& held, std::vector<HeldPoint>& holds) {
+  for (const HeldPoint& h : holds) held[h.vertex] = 0;
+  holds.clear();
+}
 
 std::unique_ptr<Integrator> makeIntegrator(IntegratorKind kind) {
   switch (kind) {

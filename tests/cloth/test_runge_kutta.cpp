@@ -127,6 +127,67 @@ TEST(RungeKutta4, HoldsAnOscillatorUpToTwoRootTwoRadiansPerStep) {
 }
 
 // ---------------------------------------------------------------------------------------
+// A point the colliders found pinched between two parts is held along their normals for one
+// step, as the implicit solve holds it: every stage's velocity, and so the step's, keeps the
+// component the colliders gave it there, and its position moves that far along them. It is
+// free across them, the other vertices step as without the hold (to the bit: the springs act
+// on each vertex alone), a fixed vertex is never held, and the next step frees it.
+TEST(RungeKutta4, APinchedPointKeepsItsVelocityAlongItsPartsNormalsForOneStep) {
+  const auto model = smallSheet();
+  const std::size_t n = model->vertexCount();
+  const double omega = 40.0, dt = 0.01;
+  std::mt19937 rng(20261207);
+  std::normal_distribution<double> gauss;
+  const auto unit = [&] { return Vec3(gauss(rng), gauss(rng), gauss(rng)).normalized(); };
+  ClothState start = ClothState::atRest(*model);
+  for (std::size_t i = 0; i < n; ++i) {
+    start.setPosition(i, start.position(i) + 0.05 * Vec3(gauss(rng), gauss(rng), gauss(rng)));
+    start.setVelocity(i, 0.3 * Vec3(gauss(rng), gauss(rng), gauss(rng)));
+  }
+  // Vertex 5 between two parts, vertex 7 on one part's normal, vertex 0 fixed, and vertex 5
+  // again (from another collider): its first hold stands.
+  const std::vector<PinchedPoint> pinched = {
+      {5, {unit(), unit()}}, {7, {unit(), Vec3::Zero()}}, {0, {unit(), unit()}}, {5, {unit(), unit()}}};
+  std::vector<std::uint8_t> fixed(n, 0);
+  fixed[0] = 1;
+  const Vec3 gravity(0.0, -9.81, 0.0);
+  OriginSprings springs(*model, omega);
+  const auto step = [&](ClothState s, bool hold, Integrator& rk) {
+    if (hold) rk.holdPinched(pinched);
+    springs.accumulate(s);
+    rk.useStageForces(&springs);
+    rk.advance(*model, gravity, dt, s);
+    return s;
+  };
+  const std::unique_ptr<Integrator> held = makeIntegrator(IntegratorKind::RungeKutta4);
+  const std::unique_ptr<Integrator> free = makeIntegrator(IntegratorKind::RungeKutta4);
+  held->prepare(*model, StepSettings{}, fixed);
+  free->prepare(*model, StepSettings{}, fixed);
+  const ClothState withHold = step(start, true, *held), without = step(start, false, *free);
+
+  const auto dv = [&](const ClothState& s, std::size_t i) { return Vec3(s.velocity(i) - start.velocity(i)); };
+  for (const Vec3& e : pinched[0].along) {
+    EXPECT_NEAR(dv(withHold, 5).dot(e), 0.0, 1e-12);
+    EXPECT_NEAR((withHold.position(5) - start.position(5)).dot(e), dt * start.velocity(5).dot(e), 1e-14);
+    EXPECT_GT(std::abs(dv(without, 5).dot(e)), 1e-3) << "the springs and gravity would move it along e";
+  }
+  const Vec3 crease = pinched[0].along[0].cross(pinched[0].along[1]).normalized();
+  EXPECT_GT(std::abs(dv(withHold, 5).dot(crease)), 1e-3) << "free along the crease";
+  EXPECT_NEAR(dv(withHold, 7).dot(pinched[1].along[0]), 0.0, 1e-12);
+  EXPECT_GT((dv(withHold, 7) - dv(withHold, 7).dot(pinched[1].along[0]) * pinched[1].along[0]).norm(), 1e-3)
+      << "free along the part's surface";
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i == 5 || i == 7) continue;
+    EXPECT_EQ(withHold.position(i), without.position(i)) << "vertex " << i;
+    EXPECT_EQ(withHold.velocity(i), without.velocity(i)) << "vertex " << i;
+  }
+
+  // The next step, with no pinch, moves vertex 5 along those directions again.
+  const ClothState next = step(withHold, false, *held);
+  EXPECT_GT(std::abs((next.velocity(5) - withHold.velocity(5)).dot(pinched[0].along[0])), 1e-3);
+}
+
+// ---------------------------------------------------------------------------------------
 // No internal force acts on the centre of mass, and the step integrates constant
 // acceleration exactly: it falls g t^2 / 2 (and moves v0 t), where symplectic Euler's falls
 // g h^2 k (k + 1) / 2, g h t / 2 further (here a relative 2e-3). The sheet is deformed and

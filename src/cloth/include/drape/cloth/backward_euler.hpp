@@ -78,12 +78,7 @@ class BackwardEuler final : public Integrator {
   std::vector<std::uint8_t> held_;  ///< per vertex: placed by a fixture, or massless
   /// For this solve alone: the vertices pinched between parts at the last collision test,
   /// each with an orthonormal basis of the directions it may not move along (one or two).
-  struct Pinched {
-    std::uint32_t vertex = 0;
-    int directions = 0;
-    Vec3 e[2] = {Vec3::Zero(), Vec3::Zero()};
-  };
-  std::vector<Pinched> pinched_;
+  std::vector<HeldPoint> pinched_;
   std::vector<std::uint8_t> isPinched_;  ///< per vertex: in pinched_
   /// Per membrane element, at the last linearisation: the deformation gradient's columns
   /// (Fu, Fv: 6 values) and the stress with its compressive part dropped (S11, S22, S12).

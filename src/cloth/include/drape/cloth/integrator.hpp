@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include "drape/cloth/collider.hpp"
 #include "drape/cloth/material.hpp"
@@ -37,6 +38,30 @@ struct SolveStats {
   }
 };
 
+/// A vertex held for one step along one or two orthonormal directions: a point the colliders
+/// found pinched between parts, along their normals there (PinchedPoint). Its velocity
+/// along them stays what the colliders gave it, their parts' mean.
+struct HeldPoint {
+  std::uint32_t vertex = 0;
+  int directions = 0;
+  Vec3 e[2] = {Vec3::Zero(), Vec3::Zero()};
+  /// `a` without its components along the held directions.
+  [[nodiscard]] Vec3 filtered(Vec3 a) const {
+    for (int k = 0; k < directions; ++k) a -= a.dot(e[k]) * e[k];
+    return a;
+  }
+};
+
+/// Adds to `holds` each of `points` whose vertex `skip` does not name (one flag per vertex:
+/// placed by a fixture, or massless) and `held` does not have yet (one flag per vertex, set
+/// for each one added): its directions made orthonormal, a direction within 1e-3 of the
+/// ones before it left out, and a point left with none not held.
+void addHolds(std::span<const PinchedPoint> points, std::span<const std::uint8_t> skip, std::vector<std::uint8_t>& held,
+              std::vector<HeldPoint>& holds);
+
+/// Ends the holds of one step: `held`'s flags cleared and `holds` emptied.
+void clearHolds(std::vector<std::uint8_t>& held, std::vector<HeldPoint>& holds);
+
 /// The forces at a stage of a multi-stage step: every force the step applies (membrane,
 /// bending, drag), for the positions and velocities in `io`, into io.f* (cleared first).
 class StageForces {
@@ -58,9 +83,9 @@ class Integrator {
   /// state: every force the step applies).
   virtual void advance(const ClothModel& model, const Vec3& gravity_m_s2, double dt_s, ClothState& io) = 0;
   /// The points the colliders found pinched between parts at their last test, for the next
-  /// advance alone. An implicit solve keeps their velocity along the parts' normals (the
-  /// velocity the colliders gave them, their parts' mean); an explicit step ignores them,
-  /// its substeps being short.
+  /// advance alone. The implicit solve and the Runge-Kutta step keep their velocity along
+  /// the parts' normals (the velocity the colliders gave them, their parts' mean; HeldPoint);
+  /// the one-stage explicit steps ignore them, their substeps being short.
   virtual void holdPinched(std::span<const PinchedPoint> /*points*/) {}
   /// Where the next advance evaluates its further stages' forces (the multi-stage steps
   /// alone; the others ignore it). Given before each advance: the caller owns it.

@@ -195,7 +195,8 @@ class RungeKutta4 final : public Integrator {
 void addHolds(std::span<const PinchedPoint> points, std::span<const std::uint8_t> skip, std::vector<std::uint8_t>& held,
               std::vector<HeldPoint>& holds) {
   for (const PinchedPoint& p : points) {
-    if (p.vertex >= held.size() || (p.vertex < skip.size() && skip[p.vertex]) || held[p.vertex]) continue;  // one hold a vertex
+    const bool skipped = p.vertex < skip.size() && skip[p.vertex];
+    if (p.vertex >= held.size() || skipped || held[p.vertex]) continue;  // one hold a vertex
     HeldPoint h{p.vertex, 0, {}};
     for (const Vec3& along : p.along) {
       Vec3 e = along;

@@ -267,6 +267,26 @@ TEST(Run, AnUnstableFrameIsComputedAgainWithMoreSubsteps) {
   EXPECT_LE(stats["garments"][0]["frames_refined"].get<int>(), 3);
 }
 
+TEST(Run, FramesWithinTheLeadInAreSaidToEndBeforeTheMotion) {
+  // --frames counts from the lead-in's first frame: 0.2 s at 30 Hz is 6 frames blending into
+  // the walk, so --frames 3 ends before its first frame, 6 on it, and 7 is past it.
+  ScratchDir dir("run-frames-lead-in");
+  const std::string example = std::string(DRAPE_SOURCE_DIR) + "/examples/walking_skirt/";
+  const auto run = [&](long frames) {
+    const std::string args = fmt::format("run '{}scene.wrl' --motion '{}walk.bvh' --lead-in 0.2 --frames {} --out '{}'",
+                                         example, example, frames, dir / std::to_string(frames));
+    const CliResult r = runDrape(args, dir);
+    EXPECT_EQ(r.code, 0) << r.err;
+    return r.err;
+  };
+  EXPECT_NE(run(3).find("warning: --frames 3 ends before the motion's first frame: the first 6 frames are the 0.2 s "
+                        "lead-in, blending from the rest pose into the motion; --frames 9 simulates 3 frames of the "
+                        "motion itself (or give --lead-in 0)"),
+            std::string::npos);
+  EXPECT_NE(run(6).find("warning: --frames 6 ends at the motion's first frame"), std::string::npos);
+  EXPECT_EQ(run(7).find("lead-in, blending"), std::string::npos);
+}
+
 TEST(Run, TheScenesLastResortsReachTheSolverAndTheCommandLineOverridesThem) {
   // A scene's Simulation maxRefinement and strainLimit, as written, and as --max-refinement
   // and --strain-limit replace them.

@@ -60,6 +60,7 @@ int playScene(const PlayOptions& o, render::PlayerOptions options) {
     options.close = &stopOnSignals();  // Ctrl-C closes the window
   } else {
     addSceneMotions(setup, o.run, o.motions, o.animation);
+    if (o.frames > 0) warnOfFramesWithinTheLeadIn(setup, {o.frames, o.frames - 1, "shows", false});
   }
   SetupWorlds worlds(setup);
   for (std::size_t c = 0; c < worlds.size(); ++c) (void)settleWorld(setup.characters[c], worlds.world(c));
@@ -146,7 +147,8 @@ RunFunction setupPlay(CLI::App& app) {
   app.add_option("--live-header", o.liveHeader, kLiveHeaderHelp)->type_name("FILE.bvh");
   app.add_option("--give-up", o.giveUp_s, "With --live: stop simulating after S seconds without a line")
       ->check(CLI::PositiveNumber);
-  app.add_option("--frames", o.frames, "Close by itself after showing N frames")->check(CLI::PositiveNumber);
+  app.add_option("--frames", o.frames, "Close by itself after showing N frames (a scene's counted from the lead-in's first)")
+      ->check(CLI::PositiveNumber);
   app.add_flag("--once", o.once, "Stop at the last frame instead of starting over");
   app.add_flag("--fast", o.fast, "Show a new frame on every redraw instead of at the run's frame rate");
   app.add_option("--screenshot", o.screenshot, "Save the window's last picture as a PNG when it closes");

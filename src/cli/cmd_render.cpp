@@ -48,7 +48,9 @@ RunFunction setupRender(CLI::App& app) {
                                             kMotionPerCharacterHelp)
       ->type_name("FILE|NAME=FILE");
   app.add_option("--animation", o.animation, kAnimationHelp);
-  app.add_option("--frames", o.frames, "With a scene: frames to simulate (default: the lead-in and the whole motion)");
+  app.add_option("--frames", o.frames,
+                 "With a scene: frames to simulate, counted from the lead-in's first (default: the lead-in and the "
+                 "whole motion)");
   app.add_option("--run-out", o.runOut, "With a scene: keep the simulated run in this directory (default: a temporary one)");
   app.add_option("--range", o.range,
                  "Only the run's frames FIRST:LAST (0-based, inclusive; FIRST: to the end; one FRAME), for every output; the "
@@ -80,6 +82,7 @@ RunFunction setupRender(CLI::App& app) {
       RunSetup setup = runSetupFromScene(o.run);
       addSceneMotions(setup, o.run, o.motions, o.animation);
       setup.frames = o.frames > 0 ? o.frames : defaultFrames(setup);
+      if (o.frames > 0) warnOfFramesWithinTheLeadIn(setup, {o.frames, o.frames, "renders", false});
       if (o.runOut.empty()) {
         scratch = std::filesystem::temp_directory_path() / fmt::format("drape-render-{}", ::getpid());
         runDir = scratch.string();

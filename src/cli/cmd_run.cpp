@@ -266,25 +266,6 @@ void stampTimeCode(const RunOptions& o, RunSetup& setup, double earlier_s = 0.0)
                                : studio::clothTimeCode(0, motionStart, setup.characters.front().leadIn_s).frame;
 }
 
-/// --frames counts from the lead-in's first frame: a run no longer than the lead-in ends
-/// before the motion has moved the body at all (a common slip on an avatar file that plays
-/// its own animation, where no --motion reminds the user of the lead-in).
-void warnOfFramesWithinTheLeadIn(const RunSetup& setup, long frames) {
-  double leadIn_s = 0.0;
-  for (const CharacterSetup& c : setup.characters)
-    if (c.animation) leadIn_s = std::max(leadIn_s, c.leadIn_s);
-  const double rate = setup.settings.frameRate_hz;
-  const double leadInFrames = leadIn_s * rate;
-  constexpr double kRounding = 1e-9;  // 0.2 s at 30 Hz is 6 frames, not a hair past
-  if (!(leadInFrames > 0.0) || static_cast<double>(frames) > leadInFrames + kRounding) return;
-  const long motionStarts = static_cast<long>(std::ceil(leadInFrames - kRounding));
-  spdlog::warn("--frames {} ends {} the motion's first frame: the first {} frames are the {:g} s lead-in, blending "
-               "from the rest pose into the motion; --frames {} simulates {} frames of the motion itself (or give "
-               "--lead-in 0)",
-               frames, static_cast<double>(frames) < leadInFrames - kRounding ? "before" : "at", motionStarts, leadIn_s,
-               motionStarts + frames, frames);
-}
-
 /// `--live SOURCE` (or NAME=SOURCE per character): the run on captures as they come, until a
 /// source ends (it closes, Ctrl-C, or silence past --give-up: exit code 4) or --frames; what
 /// came is written as any run is. The characters without a source play their Avatar node's
@@ -407,7 +388,7 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   // Frames: as asked, or the lead-in plus the whole motion (a live one: as long as it comes).
   setup.frames = o.frames;
   if (!app.count("--frames") && o.lives.empty()) setup.frames = defaultFrames(setup);
-  if (app.count("--frames") && moving && o.lives.empty()) warnOfFramesWithinTheLeadIn(setup, o.frames);
+  if (app.count("--frames") && moving && o.lives.empty()) warnOfFramesWithinTheLeadIn(setup, {o.frames, o.frames, "simulates", true});
   setup.objEvery = o.every;
   setup.outDir = o.out;
   setup.preview = o.preview;

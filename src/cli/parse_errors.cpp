@@ -2,11 +2,16 @@
 
 #include <algorithm>
 #include <cctype>
+#include <optional>
+#include <string_view>
+#include <vector>
 
 #include <fmt/format.h>
 
 namespace drape::cli {
+namespace {
 
+/// Edits (insertions, deletions, substitutions, swaps of neighbours) between two words.
 std::size_t editDistance(std::string_view a, std::string_view b) {
   // Optimal string alignment: Levenshtein's three edits and a swap of two neighbours (the
   // commonest slip of a typing hand), over three rows of the table.
@@ -25,6 +30,8 @@ std::size_t editDistance(std::string_view a, std::string_view b) {
   return last[b.size()];
 }
 
+/// Of `names` (distinct), the one nearest `word` if it is near enough to be what was meant (at
+/// most one edit in a word of up to five letters, two in a longer one) and nearer than any other.
 std::optional<std::string> nearestName(std::string_view word, const std::vector<std::string>& names) {
   std::string_view letters = word;
   while (!letters.empty() && letters.front() == '-') letters.remove_prefix(1);
@@ -39,7 +46,7 @@ std::optional<std::string> nearestName(std::string_view word, const std::vector<
       best = d;
       nearest = name;
       tied = false;
-    } else if (d == best && name != nearest) {
+    } else if (d == best) {  // the names are distinct: another as near
       tied = true;
     }
   }
@@ -47,6 +54,8 @@ std::optional<std::string> nearestName(std::string_view word, const std::vector<
   return nearest;
 }
 
+/// The long and short names (with their dashes) of the options `app` takes, the ones of the
+/// commands it falls through to included, and the names of its subcommands.
 std::vector<std::string> namesTakenBy(const CLI::App& app) {
   std::vector<std::string> names;
   for (const CLI::App* a = &app; a != nullptr; a = a->get_parent()) {
@@ -63,6 +72,7 @@ std::vector<std::string> namesTakenBy(const CLI::App& app) {
   return names;
 }
 
+/// The command line's deepest command CLI11 had reached ("drape bench paper").
 const CLI::App& deepestCommand(const CLI::App& root) {
   const CLI::App* app = &root;
   for (;;) {
@@ -71,8 +81,6 @@ const CLI::App& deepestCommand(const CLI::App& root) {
     app = parsed.front();
   }
 }
-
-namespace {
 
 /// "drape bench paper": the program and the commands down to `app`.
 std::string commandLineOf(const CLI::App& app) {

@@ -738,6 +738,21 @@ long defaultFrames(const RunSetup& setup) {
   return static_cast<long>(std::ceil(seconds * setup.settings.frameRate_hz));
 }
 
+void warnOfFramesWithinTheLeadIn(const RunSetup& setup, const FramesAsked& asked) {
+  double leadIn_s = 0.0;
+  for (const CharacterSetup& c : setup.characters)
+    if (c.animation) leadIn_s = std::max(leadIn_s, c.leadIn_s);
+  const double leadInFrames = leadIn_s * setup.settings.frameRate_hz;
+  constexpr double kRounding = 1e-9;  // 0.2 s at 30 Hz is 6 frames, not a hair past
+  const auto last = static_cast<double>(asked.lastFrame);
+  if (!(leadInFrames > 0.0) || last > leadInFrames + kRounding) return;
+  const long motionStarts = static_cast<long>(std::ceil(leadInFrames - kRounding));
+  spdlog::warn("--frames {} ends {} the motion's first frame: the first {} frames are the {:g} s lead-in, blending "
+               "from the rest pose into the motion; --frames {} {} {} frames of the motion itself{}",
+               asked.frames, last < leadInFrames - kRounding ? "before" : "at", motionStarts, leadIn_s,
+               motionStarts + asked.frames, asked.verb, asked.frames, asked.takesLeadIn ? " (or give --lead-in 0)" : "");
+}
+
 void validateRunSetup(const RunSetup& setup) {
   if (setup.garments.empty()) throw Error("drape run: no garment to simulate");
   std::vector<int> wornBy(setup.garments.size(), 0);

@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -264,6 +265,21 @@ void setKeepApart(CharacterSetup& character, const std::vector<std::string>& opt
 /// Frames to simulate when none are asked for: the lead-in plus the longest motion. Throws
 /// naming --frames when no character has a motion.
 [[nodiscard]] long defaultFrames(const RunSetup& setup);
+
+/// What a command's --frames asks: `frames` as given, the frame it ends on (frame 0 is the
+/// rest pose: `drape run` ends on frame N, `drape play`, which shows frame 0 first, on N - 1),
+/// what it does with them ("simulates", "shows") and whether the command has --lead-in.
+struct FramesAsked {
+  long frames = 0;
+  long lastFrame = 0;
+  std::string_view verb;
+  bool takesLeadIn = false;
+};
+/// Warns when --frames, counted from the lead-in's first frame, ends before or at the motion's
+/// first: such a run never shows the body moved by its motion (a common slip on an avatar file
+/// that plays its own animation, where no --motion recalls the lead-in). Nothing when no
+/// character has a motion.
+void warnOfFramesWithinTheLeadIn(const RunSetup& setup, const FramesAsked& asked);
 
 /// Checks the setup (garment topology, materials, settings, pins) and throws drape::Error
 /// (BadInput) with one line naming what is wrong.

@@ -511,6 +511,12 @@ TEST(PlayScene, SimulatesTheWalkingSkirtLiveUnderXvfb) {
   const std::string out = slurp(dir / "out.txt");
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << out;
   EXPECT_NE(out.find("simulated and showed 4 frames"), std::string::npos) << out;
+  // Frames 0 to 3 of the 1 s lead-in: said, without drape run's --lead-in.
+  EXPECT_NE(out.find("warning: --frames 4 ends before the motion's first frame: the first 30 frames are the 1 s "
+                     "lead-in, blending from the rest pose into the motion; --frames 34 shows 4 frames of the motion "
+                     "itself\n"),
+            std::string::npos)
+      << out;
   EXPECT_TRUE(std::filesystem::exists(shot));
 }
 
@@ -529,6 +535,13 @@ TEST(RenderScene, SimulatesThenRendersAContactSheet) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(std::filesystem::exists(sheet));
   EXPECT_EQ(formats::readRunManifest(run).frames, 7);
+  // Six frames of the 1 s lead-in (30 frames) never reach the walk: said, without drape run's
+  // --lead-in, which drape render does not take.
+  EXPECT_NE(r.err.find("warning: --frames 6 ends before the motion's first frame: the first 30 frames are the 1 s "
+                       "lead-in, blending from the rest pose into the motion; --frames 36 renders 6 frames of the "
+                       "motion itself\n"),
+            std::string::npos)
+      << r.err;
 }
 
 }  // namespace

@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
   app.add_option("-j,--threads", threads,
                  "Threads for the simulation (default: every core; one for 'bench paper'). Garments run side by "
                  "side; a garment of 1,024 vertices or more also splits its collision tests over them, and one "
-                 "of 2,048 triangles or more its forces. The results are the same to the bit with any number")
+                 "of 2,048 triangles or more its forces. The results are the same to the bit with any number of threads")
       ->check(CLI::Range(1, 1024));
 
   // Top-level commands first, then the ones nested under them ("bench cloth").

@@ -398,10 +398,15 @@ class Scanner {
       case Tok::OpenBracket: {
         const Token bracket = take();
         open(bracket);
+        bool numbers = false;  // a list holds one kind of value: after a number, only numbers
         while (current_.kind != Tok::CloseBracket) {
           if (current_.kind == Tok::End)
             fail(current_, fmt::format("unexpected end of file in the value of {} (the '[' at line {} is not closed)",
                                        field, bracket.line));
+          if (numbers && current_.kind != Tok::Number)
+            fail(current_, fmt::format("expected a number or ']' in the value of field '{}', found {}", field,
+                                       describe(current_)));
+          numbers = current_.kind == Tok::Number;
           element(field);
         }
         take();

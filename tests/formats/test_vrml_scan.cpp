@@ -36,8 +36,15 @@ TEST(VrmlScan, AcceptsValidStructure) {
 TEST(VrmlScan, ReportsLineAndColumn) {
   EXPECT_EQ(errorOf("#VRML V2.0 utf8\nGroup {\n  children [ Shape { } ]\n  }\n}\n"),
             "t.wrl:5:1: expected a node type, found '}'");
+  EXPECT_EQ(errorOf("#VRML V2.0 utf8\nGroup { children [ Group ) ] }\n"),
+            "t.wrl:2:26: expected '{' after the node type Group, found ')'");
+  // A list holds one kind of value: a word among numbers is a number mistyped, not a node.
   EXPECT_EQ(errorOf("#VRML V2.0 utf8\nGroup { children [ 1 2 ) ] }\n"),
-            "t.wrl:2:26: expected '{' after the node type ), found ']'");
+            "t.wrl:2:24: expected a number or ']' in the value of field 'children', found ')'");
+  EXPECT_EQ(errorOf("#VRML V2.0 utf8\nCoordinate { point [ 0 1 2,\n  0 nan 2 ] }\n"),
+            "t.wrl:3:5: expected a number or ']' in the value of field 'point', found 'nan'");
+  EXPECT_EQ(errorOf("#VRML V2.0 utf8\nCoordinate { point [ 0 1 2, 0 1\n }\n"),
+            "t.wrl:3:2: expected a number or ']' in the value of field 'point', found '}'");
   EXPECT_EQ(errorOf("#VRML V2.0 utf8\nWorldInfo { title 'x' }\n"), "t.wrl:2:19: unexpected character '''");
   EXPECT_EQ(errorOf(std::string("#VRML V2.0 utf8\nGroup { \x01 }\n", 28)), "t.wrl:2:9: unexpected byte 0x01");
   EXPECT_EQ(errorOf("#VRML V2.0 utf8\nGroup {"),

@@ -251,6 +251,7 @@ FieldCollider::FieldCollider(std::string garmentName, std::vector<CollisionPart>
   steps_.resize(parts_.size());
   holds_.assign(parts_.size(), 0);
   outOfReach_.assign(parts_.size(), 0);
+  idle_.assign(parts_.size(), 0);
 }
 
 FieldCollider::~FieldCollider() = default;
@@ -264,6 +265,7 @@ void FieldCollider::setFixedVertices(const std::vector<std::uint32_t>& vertices,
     free_[v] = 0;
   }
   freeCount_ = static_cast<std::size_t>(std::count(free_.begin(), free_.end(), std::uint8_t{1}));
+  std::fill(idle_.begin(), idle_.end(), std::uint8_t{0});
 }
 
 void FieldCollider::initialise(const ClothState& state, double t_s) {
@@ -311,6 +313,7 @@ void FieldCollider::initialise(const ClothState& state, double t_s) {
   ballTest_.assign(parts_.size(), std::vector<long>(n, 0));
   for (std::vector<double>* v : {&testX_, &testY_, &testZ_, &nextTestX_, &nextTestY_, &nextTestZ_}) v->assign(n, 0.0);
   tests_ = 0;
+  std::fill(idle_.begin(), idle_.end(), std::uint8_t{0});
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     const field::DistanceField& f = *parts_[k].field;
     const Affine toVoxel = worldToVoxel(f, parts_[k].motion->poseAt(t_s));
@@ -344,6 +347,7 @@ void FieldCollider::restartFrame(const ClothState& state, double t_s) {
   std::fill(holds_.begin(), holds_.end(), std::uint8_t{0});
   for (const PinchedPoint& p : pinchedPoints_) pinchedNow_[p.vertex] = 0;
   pinchedPoints_.clear();
+  std::fill(idle_.begin(), idle_.end(), std::uint8_t{0});
   for (std::size_t k = 0; k < parts_.size(); ++k) {
     const field::DistanceField& f = *parts_[k].field;
     const Affine toVoxel = worldToVoxel(f, parts_[k].motion->poseAt(t_s));
@@ -434,6 +438,8 @@ void FieldCollider::collide(const ClothModel& model, double t0_s, double t1_s, C
       field_.partsOutOfReach += outOfReach_[k];
     }
   }
+  for (std::size_t k = 0; k < parts_.size(); ++k)
+    if (!outOfReach_[k]) idle_[k] = 0;  // tested: its pairs may change
   // Where the points are before this test's corrections: where the walks of the pairs
   // resting now would start at the next test (wake).
   std::copy(io.x.begin(), io.x.end(), nextTestX_.begin());
@@ -549,7 +555,7 @@ void FieldCollider::setRanges(std::size_t vertices, std::size_t rangeVertices) {
   }
 }
 
-bool FieldCollider::outOfReach(std::size_t k, const PartFrame& frame, const Vec3& lo, const Vec3& hi) const {
+bool FieldCollider::outOfReach(std::size_t k, const PartFrame& frame, const Vec3& lo, const Vec3& hi) {
   if (!(lo.x() <= hi.x())) return true;  // no free point
   // The box's corners in the part's voxels, bounded, a voxel wider than rounding could need.
   Vec3 vlo = Vec3::Constant(std::numeric_limits<double>::infinity()), vhi = -vlo;
@@ -563,10 +569,12 @@ bool FieldCollider::outOfReach(std::size_t k, const PartFrame& frame, const Vec3
   const Vec3 boxMax(d.nx - 1.5, d.ny - 1.5, d.nz - 1.5);  // as selectCandidates' walkable box
   const bool clear = (vhi.array() + 1.0 < 0.5).any() || (vlo.array() - 1.0 >= boxMax.array()).any();
   if (!clear) return false;
+  if (idle_[k]) return true;  // left out since its pairs were found idle: nothing has changed them
   const std::vector<PointState>& states = states_[k];
   const std::vector<double>& balls = ballR2_[k];
   for (std::size_t i = 0; i < states.size(); ++i)
     if ((free_[i] && states[i] != PointState::OutsideVol) || balls[i] >= 0) return false;
+  idle_[k] = 1;
   return true;
 }
 

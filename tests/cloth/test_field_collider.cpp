@@ -568,6 +568,58 @@ TEST(FieldCollider, BoxCullingChangesNothing) {
   EXPECT_LT(c.partsOutOfReach, 2u * 400u);
 }
 
+/// At the origin from `arrives` to `leaves` (seconds), 3 m off along -x before and after:
+/// a part that comes within the points' reach and goes out of it in one test each.
+class VisitingMotion final : public FixtureMotion {
+ public:
+  VisitingMotion(double arrives, double leaves) : arrives_(arrives), leaves_(leaves) {}
+  [[nodiscard]] RigidTransform poseAt(double t) const override {
+    return {Quat::Identity(), t >= arrives_ && t < leaves_ ? Vec3(0, 0, 0) : Vec3(-3, 0, 0)};
+  }
+
+ private:
+  double arrives_, leaves_;
+};
+
+TEST(FieldCollider, APartThatLeavesWithPointsInsideItIsTestedOnceMore) {
+  // Points inside a sphere's volume between T2 and T3, on its +x side. The sphere comes from
+  // 3 m along -x at the 11th test (the points' relative path, along x from far on the +x
+  // side, meets no offset surface: nothing collides) and goes back at the 12th. That test
+  // finds the sphere clear of the points' box but their pairs InsideVol: it must walk them
+  // out (OutsideVol) before the part is left out again, not take the part for as idle as it
+  // was before it came.
+  const field::DistanceField f = buildField(field::makeSphere(0.06, Vec3::Zero(), 32, 16));
+  const double dt = 1e-3;
+  const std::vector<CollisionPart> parts = {
+      {"visitor", &f, std::make_shared<VisitingMotion>(10.5 * dt, 11.5 * dt)}};
+  ClothState s;
+  const double r = 0.06 + 0.5 * (kOffsets.t2_m + kOffsets.t3_m);
+  for (const double y : {-0.01, 0.0, 0.01})
+    for (const double z : {-0.01, 0.0, 0.01}) {
+      s.x.push_back(std::sqrt(r * r - y * y - z * z));
+      s.y.push_back(y);
+      s.z.push_back(z);
+    }
+  const std::size_t n = s.x.size();
+  for (auto* v : {&s.vx, &s.vy, &s.vz, &s.fx, &s.fy, &s.fz}) v->assign(n, 0.0);
+  const ClothState start = s;
+  FieldCollider c("test", parts, kOffsets, 0.5, 0.3);
+  c.initialise(s, 0.0);
+  const Point anchor(Vec3::Zero());
+  const auto test = [&](int step) { c.collide(*anchor.model, step * dt, (step + 1) * dt, s); };
+  for (int step = 0; step < 10; ++step) test(step);
+  EXPECT_EQ(c.fieldCounters().partsOutOfReach, 10u);
+  test(10);
+  for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(c.state(0, i), PointState::InsideVol) << "vertex " << i;
+  test(11);
+  for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(c.state(0, i), PointState::OutsideVol) << "vertex " << i;
+  EXPECT_EQ(c.fieldCounters().partsOutOfReach, 10u) << "the test the sphere left at walked its pairs";
+  for (int step = 12; step < 16; ++step) test(step);
+  EXPECT_EQ(c.fieldCounters().partsOutOfReach, 14u);
+  EXPECT_EQ(c.fieldCounters().collisions, 0u);
+  EXPECT_EQ(s.hash(), start.hash()) << "nothing collided: nothing moved";
+}
+
 TEST(FieldCollider, ParallelRangesChangeNothing) {
   // Ranges of 64 of the 600 points (nine), run on two of TBB's threads, against one range.
   const tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);

@@ -367,8 +367,9 @@ class FieldCollider final : public Collider {
   /// box, mapped into the part's voxels and widened by a voxel, clear of its walkable box.
   /// The cull would then keep none of its pairs, which go OutsideVol -> OutsideVol untraced:
   /// leaving the part out of the test changes nothing but time (a part of another character
-  /// across the room, a shin far below a cape).
-  [[nodiscard]] bool outOfReach(std::size_t k, const PartFrame& frame, const Vec3& lo, const Vec3& hi) const;
+  /// across the room, a shin far below a cape). The pairs are read once: a part found idle
+  /// stays so (idle_) while it is left out, since only its own tests change its pairs.
+  [[nodiscard]] bool outOfReach(std::size_t k, const PartFrame& frame, const Vec3& lo, const Vec3& hi);
   struct PartStep;   // one part's rigid motion over an untested substep (field_collider.cpp)
   PartFrame framePart(const CollisionPart& part, const RigidTransform& pose0, const RigidTransform& pose1) const;
   /// The interval's end transforms of `frame` (framePart's, the start's left as they are).
@@ -531,6 +532,10 @@ class FieldCollider final : public Collider {
   std::vector<std::uint8_t> keep_;                ///< per vertex: the current part must test it
   /// Per part, at this test: out of the garment's reach (outOfReach), its pairs left as they are.
   std::vector<std::uint8_t> outOfReach_;
+  /// Per part: every pair found OutsideVol without a ball by outOfReach, and the part left out
+  /// of every test since (cleared when it is tested, and by initialise, restartFrame and
+  /// setFixedVertices).
+  std::vector<std::uint8_t> idle_;
   std::vector<std::uint32_t> candidates_;         ///< the vertices kept, ascending, each range's from its first
   std::size_t rangeVertices_ = kRange_vertices;   ///< setParallelRanges
   std::size_t parallelFrom_ = kParallelFrom_vertices;

@@ -10,6 +10,7 @@
 #include "inspect_humanoid.hpp"
 #include "run_setup.hpp"
 #include "stitch_gaps.hpp"
+#include "drape/cloth/field_collider.hpp"
 #include "drape/formats/hanim_motion.hpp"
 #include "drape/mesh/topology.hpp"
 #include "drape/scene/scene.hpp"
@@ -188,8 +189,12 @@ void inspectScene(const std::string& path, std::ostream& out) {
              sim.frameRate, sim.stepsPerFrame, sim.integrator,
              sim.integrator == "backward-euler" ? fmt::format(", solves to {:g}", sim.implicitTolerance) : "",
              sim.collisionEvery, sim.collisionEvery == 1 ? "" : "s", sim.bendEvery, sim.bendEvery == 1 ? "" : "s");
-  fmt::print(out, "  offsets T0..T3 {:g} {:g} {:g} {:g} m, voxel size {:g} m, unit scale {:g} m per file unit\n",
-             sim.offsets[0], sim.offsets[1], sim.offsets[2], sim.offsets[3], sim.voxelSize, sim.unitScale);
+  const cloth::OffsetSurfaces t = sim.offsetsWritten ? cloth::OffsetSurfaces{sim.offsets[0], sim.offsets[1],
+                                                                             sim.offsets[2], sim.offsets[3]}
+                                                     : cloth::OffsetSurfaces::fromVoxelSize(sim.voxelSize);
+  fmt::print(out, "  offsets T0..T3 {:g} {:g} {:g} {:g} m{}, voxel size {:g} m, unit scale {:g} m per file unit\n",
+             t.t0_m, t.t1_m, t.t2_m, t.t3_m, sim.offsetsWritten ? "" : " (1, 2, 3 and 6 voxels: none written)",
+             sim.voxelSize, sim.unitScale);
   fmt::print(out, "  an unstable frame is computed again with up to {} times the steps{}\n", sim.maxRefinement,
              strainLimitText(sim));
   if (!sim.keepApart.empty())

@@ -154,7 +154,11 @@ class Builder {
       take("stepsPerFrame", [&] { s.stepsPerFrame = static_cast<int>(number(n, "stepsPerFrame", s.stepsPerFrame)); });
       take("airViscosity", [&] { s.airViscosity = number(n, "airViscosity", s.airViscosity); });
       take("wind", [&] { s.wind = vec3(n, "wind", s.wind); });
-      take("offsets", [&] { s.offsets = fourOffsets(n, "Simulation"); });
+      if (const Field* f = n.field("offsets"); f != nullptr && !f->isDefault)
+        take("offsets", [&] {
+          s.offsets = fourOffsets(n, "Simulation");
+          s.offsetsWritten = true;
+        });
       take("voxelSize", [&] { s.voxelSize = number(n, "voxelSize", s.voxelSize); });
       take("integrator", [&] { s.integrator = string(n, "integrator"); });
       take("collisionEvery",

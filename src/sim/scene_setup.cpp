@@ -102,7 +102,7 @@ GarmentSpec garmentSpec(const scene::Scene& scene, const scene::Garment& g, cons
   // The garment's own offsets, else the Simulation node's, else (none given) the voxel size's.
   const auto& o = g.offsets ? *g.offsets : scene.simulation.offsets;
   spec.offsets = {o[0], o[1], o[2], o[3]};
-  spec.offsetsGiven = g.offsets.has_value() || scene.simulation.source.line > 0;
+  spec.offsetsGiven = g.offsets.has_value() || scene.simulation.offsetsWritten;
   spec.collisionEvery = scene.simulation.collisionEvery;
   spec.colour = g.colour;
   return spec;

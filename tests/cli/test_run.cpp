@@ -287,6 +287,40 @@ TEST(Run, FramesWithinTheLeadInAreSaidToEndBeforeTheMotion) {
   EXPECT_EQ(run(7).find("lead-in, blending"), std::string::npos);
 }
 
+TEST(Run, OffsetsASimulationNodeDoesNotWriteFollowTheVoxelSize) {
+  // The dressed avatar's Simulation node writes offsets 4, 8, 12 and 16 mm on 10 mm voxels;
+  // without them, as without a Simulation node, each garment's are 1, 2, 3 and 6 voxels (the
+  // paper's T3 = 6 voxels), and `drape inspect` says so, not the node's unwritten default.
+  ScratchDir dir("run-offsets-from-voxels");
+  std::ifstream in(std::string(DRAPE_SOURCE_DIR) + "/examples/dressed_avatar/scene.wrl");
+  std::string scene((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string written = "  offsets [ 0.004 0.008 0.012 0.016 ]\n";
+  ASSERT_NE(scene.find(written), std::string::npos);
+  const auto offsetsOf = [&](const std::string& name, const std::string& text) {
+    const std::string path = dir / (name + ".wrl");
+    std::ofstream(path) << text;
+    const nlohmann::json stats = statsOf(testing::runInto(dir, name, fmt::format("'{}' --frames 1", path)));
+    return stats["garments"][0]["offsets_m"].get<std::vector<double>>();
+  };
+  const std::vector<double> asWritten = offsetsOf("written", scene);
+  std::string unwritten = scene;
+  unwritten.erase(unwritten.find(written), written.size());
+  const std::vector<double> fromVoxels = offsetsOf("unwritten", unwritten);
+  const std::vector<double> want[2] = {{0.004, 0.008, 0.012, 0.016}, {0.01, 0.02, 0.03, 0.06}};
+  ASSERT_EQ(asWritten.size(), 4u);
+  ASSERT_EQ(fromVoxels.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_NEAR(asWritten[i], want[0][i], 1e-7);
+    EXPECT_NEAR(fromVoxels[i], want[1][i], 1e-7);
+  }
+  const CliResult inspected = runDrape(fmt::format("inspect '{}'", dir / "unwritten.wrl"), dir);
+  EXPECT_EQ(inspected.code, 0) << inspected.err;
+  EXPECT_NE(inspected.out.find("offsets T0..T3 0.01 0.02 0.03 0.06 m (1, 2, 3 and 6 voxels: none written), voxel "
+                               "size 0.01 m"),
+            std::string::npos)
+      << inspected.out;
+}
+
 TEST(Run, TheScenesLastResortsReachTheSolverAndTheCommandLineOverridesThem) {
   // A scene's Simulation maxRefinement and strainLimit, as written, and as --max-refinement
   // and --strain-limit replace them.

@@ -82,6 +82,42 @@ const CLI::App& deepestCommand(const CLI::App& root) {
   }
 }
 
+/// Words other tools, or drape's other commands, use for what a command names otherwise
+/// (`drape export RUN --out x.glb` means --glb), each with the names it may mean, offered in
+/// this order where the command takes them. Spelling alone finds none of these.
+struct Meaning {
+  std::vector<std::string_view> words;
+  std::vector<std::string_view> names;
+};
+const std::vector<Meaning>& meanings() {
+  static const std::vector<Meaning> table = {
+      {{"--out", "-o", "--output"}, {"--out", "--glb", "--png", "--video", "--contact-sheet", "--record", "--screenshot"}},
+      {{"--nats", "--url", "--bus", "--nats-server"}, {"--server"}},
+      {{"--steps", "--steps-per-frame"}, {"--substeps"}},
+  };
+  return table;
+}
+
+/// The names `word` may mean (meanings()) among those `taken`, in the table's order.
+std::vector<std::string> meantBy(std::string_view word, const std::vector<std::string>& taken) {
+  std::vector<std::string> meant;
+  for (const Meaning& m : meanings()) {
+    if (std::find(m.words.begin(), m.words.end(), word) == m.words.end()) continue;
+    for (const std::string_view name : m.names)
+      if (name != word && std::binary_search(taken.begin(), taken.end(), std::string(name)))
+        meant.emplace_back(name);
+  }
+  return meant;
+}
+
+/// "A", "A or B", "A, B or C".
+std::string oneOf(const std::vector<std::string>& names) {
+  std::string text;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    text += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  return text;
+}
+
 /// "drape bench paper": the program and the commands down to `app`.
 std::string commandLineOf(const CLI::App& app) {
   std::vector<std::string> names;
@@ -104,9 +140,11 @@ std::string parseErrorMessage(const CLI::App& root, const CLI::ParseError& e) {
   const std::vector<std::string> taken = namesTakenBy(command);
   // The words CLI11 left over: a mistyped option or command among them (also where the
   // error itself is another, such as a required option missing).
-  for (const std::string& word : root.remaining(true))
-    if (const std::optional<std::string> meant = nearestName(word, taken))
-      message += fmt::format("\n  {}: did you mean {}?", word, *meant);
+  for (const std::string& word : root.remaining(true)) {
+    const std::optional<std::string> nearest = nearestName(word, taken);
+    const std::vector<std::string> meant = nearest ? std::vector<std::string>{*nearest} : meantBy(word, taken);
+    if (!meant.empty()) message += fmt::format("\n  {}: did you mean {}?", word, oneOf(meant));
+  }
   message += fmt::format("\n'{} --help' lists {}", name,
                          command.get_subcommands([](const CLI::App*) { return true; }).empty()
                              ? "its options"

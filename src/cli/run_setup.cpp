@@ -976,6 +976,12 @@ int simulateInto(const RunSetup& setup, FrameSink& sink, const FrameGate& gate) 
       collider->setCountEverySubstep(setup.countEverySubstep);
       collider->setContactPlanes(!setup.exactSliding);
       collider->setPinchHold(!setup.freePinches);
+      if (!g.offsetsGiven) {
+        const cloth::OffsetSurfaces& t = collider->offsets();
+        spdlog::info("{}: offset surfaces T0..T3 {:.3g}, {:.3g}, {:.3g} and {:.3g} mm: 1, 2, 3 and 6 voxels, as no "
+                     "offsets are written (the Simulation node's or the garment's offsets, or --offsets)",
+                     g.name, 1e3 * t.t0_m, 1e3 * t.t1_m, 1e3 * t.t2_m, 1e3 * t.t3_m);
+      }
       logEasedPairs(g.name, *collider);
       const sim::CharacterWorld& world = worlds.world(worlds.characterOf(gi));
       r.layers = world.layerCollider(worlds.indexInWorld(gi));

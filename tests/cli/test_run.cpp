@@ -296,16 +296,23 @@ TEST(Run, OffsetsASimulationNodeDoesNotWriteFollowTheVoxelSize) {
   std::string scene((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string written = "  offsets [ 0.004 0.008 0.012 0.016 ]\n";
   ASSERT_NE(scene.find(written), std::string::npos);
+  std::string said;
   const auto offsetsOf = [&](const std::string& name, const std::string& text) {
     const std::string path = dir / (name + ".wrl");
     std::ofstream(path) << text;
-    const nlohmann::json stats = statsOf(testing::runInto(dir, name, fmt::format("'{}' --frames 1", path)));
-    return stats["garments"][0]["offsets_m"].get<std::vector<double>>();
+    const CliResult r = runDrape(fmt::format("run '{}' --frames 1 --out '{}'", path, dir / name), dir);
+    EXPECT_EQ(r.code, 0) << r.err;
+    said = r.err;
+    return statsOf(dir / name)["garments"][0]["offsets_m"].get<std::vector<double>>();
   };
   const std::vector<double> asWritten = offsetsOf("written", scene);
+  EXPECT_EQ(said.find("offset surfaces T0..T3"), std::string::npos) << said;
   std::string unwritten = scene;
   unwritten.erase(unwritten.find(written), written.size());
   const std::vector<double> fromVoxels = offsetsOf("unwritten", unwritten);
+  EXPECT_NE(said.find("offset surfaces T0..T3 10, 20, 30 and 60 mm: 1, 2, 3 and 6 voxels, as no offsets are written"),
+            std::string::npos)
+      << said;
   const std::vector<double> want[2] = {{0.004, 0.008, 0.012, 0.016}, {0.01, 0.02, 0.03, 0.06}};
   ASSERT_EQ(asWritten.size(), 4u);
   ASSERT_EQ(fromVoxels.size(), 4u);

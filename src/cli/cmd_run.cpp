@@ -388,7 +388,8 @@ int runCommand(const CLI::App& app, RunOptions& o) {
   // Frames: as asked, or the lead-in plus the whole motion (a live one: as long as it comes).
   setup.frames = o.frames;
   if (!app.count("--frames") && o.lives.empty()) setup.frames = defaultFrames(setup);
-  if (app.count("--frames") && moving && o.lives.empty()) warnOfFramesWithinTheLeadIn(setup, {o.frames, o.frames, "simulates", true});
+  if (app.count("--frames") && moving && o.lives.empty())
+    warnOfFramesWithinTheLeadIn(setup, {o.frames, o.frames, "simulates", true});
   setup.objEvery = o.every;
   setup.outDir = o.out;
   setup.preview = o.preview;

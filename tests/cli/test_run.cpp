@@ -25,6 +25,7 @@ using testing::CliResult;
 using testing::lineCount;
 using testing::runDrape;
 using testing::ScratchDir;
+using testing::slurp;
 using testing::statsOf;
 
 const std::string kDress = std::string(DRAPE_SOURCE_DIR) + "/examples/hanging_dress/dress.obj";
@@ -292,8 +293,7 @@ TEST(Run, OffsetsASimulationNodeDoesNotWriteFollowTheVoxelSize) {
   // without them, as without a Simulation node, each garment's are 1, 2, 3 and 6 voxels (the
   // paper's T3 = 6 voxels), and `drape inspect` says so, not the node's unwritten default.
   ScratchDir dir("run-offsets-from-voxels");
-  std::ifstream in(std::string(DRAPE_SOURCE_DIR) + "/examples/dressed_avatar/scene.wrl");
-  std::string scene((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string scene = slurp(std::string(DRAPE_SOURCE_DIR) + "/examples/dressed_avatar/scene.wrl");
   const std::string written = "  offsets [ 0.004 0.008 0.012 0.016 ]\n";
   ASSERT_NE(scene.find(written), std::string::npos);
   std::string said;
@@ -332,8 +332,7 @@ TEST(Run, TheScenesLastResortsReachTheSolverAndTheCommandLineOverridesThem) {
   // A scene's Simulation maxRefinement and strainLimit, as written, and as --max-refinement
   // and --strain-limit replace them.
   ScratchDir dir("run-scene-last-resorts");
-  std::ifstream in(std::string(DRAPE_SOURCE_DIR) + "/examples/dressed_avatar/scene.wrl");
-  std::string scene((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string scene = slurp(std::string(DRAPE_SOURCE_DIR) + "/examples/dressed_avatar/scene.wrl");
   const std::string anchor = "integrator \"symplectic-euler\"\n";
   ASSERT_NE(scene.find(anchor), std::string::npos);
   scene.insert(scene.find(anchor) + anchor.size(), "  maxRefinement 2\n  strainLimit 0.3\n");

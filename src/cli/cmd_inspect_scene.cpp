@@ -189,11 +189,11 @@ void inspectScene(const std::string& path, std::ostream& out) {
              sim.frameRate, sim.stepsPerFrame, sim.integrator,
              sim.integrator == "backward-euler" ? fmt::format(", solves to {:g}", sim.implicitTolerance) : "",
              sim.collisionEvery, sim.collisionEvery == 1 ? "" : "s", sim.bendEvery, sim.bendEvery == 1 ? "" : "s");
-  const cloth::OffsetSurfaces t = sim.offsetsWritten ? cloth::OffsetSurfaces{sim.offsets[0], sim.offsets[1],
-                                                                             sim.offsets[2], sim.offsets[3]}
-                                                     : cloth::OffsetSurfaces::fromVoxelSize(sim.voxelSize);
+  const cloth::OffsetSurfaces t =
+      sim.offsets ? cloth::OffsetSurfaces{(*sim.offsets)[0], (*sim.offsets)[1], (*sim.offsets)[2], (*sim.offsets)[3]}
+                  : cloth::OffsetSurfaces::fromVoxelSize(sim.voxelSize);
   fmt::print(out, "  offsets T0..T3 {:g} {:g} {:g} {:g} m{}, voxel size {:g} m, unit scale {:g} m per file unit\n",
-             t.t0_m, t.t1_m, t.t2_m, t.t3_m, sim.offsetsWritten ? "" : " (1, 2, 3 and 6 voxels: none written)",
+             t.t0_m, t.t1_m, t.t2_m, t.t3_m, sim.offsets ? "" : " (1, 2, 3 and 6 voxels: none written)",
              sim.voxelSize, sim.unitScale);
   fmt::print(out, "  an unstable frame is computed again with up to {} times the steps{}\n", sim.maxRefinement,
              strainLimitText(sim));

@@ -134,7 +134,8 @@ void validate(const SimulationSettings& s) {
   if (!std::isfinite(s.airViscosity) || s.airViscosity < 0.0)
     bad(s.source, node, fmt::format("airViscosity {:g} is negative", s.airViscosity));
   if (!s.gravity.allFinite() || !s.wind.allFinite()) bad(s.source, node, "gravity and wind must be finite");
-  if (const std::string problem = offsetsProblem(s.offsets); !problem.empty()) bad(s.source, node, problem);
+  if (s.offsets)
+    if (const std::string problem = offsetsProblem(*s.offsets); !problem.empty()) bad(s.source, node, problem);
   if (s.integrator.empty()) bad(s.source, node, "integrator is empty");
 }
 

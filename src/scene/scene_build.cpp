@@ -155,10 +155,7 @@ class Builder {
       take("airViscosity", [&] { s.airViscosity = number(n, "airViscosity", s.airViscosity); });
       take("wind", [&] { s.wind = vec3(n, "wind", s.wind); });
       if (const Field* f = n.field("offsets"); f != nullptr && !f->isDefault)
-        take("offsets", [&] {
-          s.offsets = fourOffsets(n, "Simulation");
-          s.offsetsWritten = true;
-        });
+        take("offsets", [&] { s.offsets = fourOffsets(n, "Simulation"); });
       take("voxelSize", [&] { s.voxelSize = number(n, "voxelSize", s.voxelSize); });
       take("integrator", [&] { s.integrator = string(n, "integrator"); });
       take("collisionEvery",

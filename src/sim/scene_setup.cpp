@@ -100,9 +100,10 @@ GarmentSpec garmentSpec(const scene::Scene& scene, const scene::Garment& g, cons
     spec.pinned = g.maskVertices;  // no body to bind to: the mask pins in place
   }
   // The garment's own offsets, else the Simulation node's, else (none given) the voxel size's.
-  const auto& o = g.offsets ? *g.offsets : scene.simulation.offsets;
-  spec.offsets = {o[0], o[1], o[2], o[3]};
-  spec.offsetsGiven = g.offsets.has_value() || scene.simulation.offsetsWritten;
+  if (const std::optional<std::array<double, 4>>& o = g.offsets ? g.offsets : scene.simulation.offsets) {
+    spec.offsets = {(*o)[0], (*o)[1], (*o)[2], (*o)[3]};
+    spec.offsetsGiven = true;
+  }
   spec.collisionEvery = scene.simulation.collisionEvery;
   spec.colour = g.colour;
   return spec;

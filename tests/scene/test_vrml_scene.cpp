@@ -113,9 +113,9 @@ TEST(VrmlScene, EveryFieldWithValues) {
   EXPECT_EQ(sim.stepsPerFrame, 40);
   EXPECT_NEAR(sim.airViscosity, 0.05, 1e-7);
   EXPECT_EQ(sim.wind, Vec3(1, 0, 0.5));
-  EXPECT_NEAR(sim.offsets[0], 0.001, 1e-9);
-  EXPECT_NEAR(sim.offsets[3], 0.004, 1e-9);
-  EXPECT_TRUE(sim.offsetsWritten);
+  ASSERT_TRUE(sim.offsets.has_value());
+  EXPECT_NEAR((*sim.offsets)[0], 0.001, 1e-9);
+  EXPECT_NEAR((*sim.offsets)[3], 0.004, 1e-9);
   EXPECT_NEAR(sim.voxelSize, 0.005, 1e-9);
   EXPECT_EQ(sim.integrator, "euler");
   EXPECT_EQ(sim.collisionEvery, 2);
@@ -178,8 +178,7 @@ TEST(VrmlScene, EveryFieldDefaults) {
   EXPECT_EQ(s.simulation.stepsPerFrame, defaults.stepsPerFrame);
   EXPECT_NEAR(s.simulation.airViscosity, defaults.airViscosity, 1e-7);
   EXPECT_EQ(s.simulation.wind, defaults.wind);
-  for (std::size_t i = 0; i < 4; ++i) EXPECT_NEAR(s.simulation.offsets[i], defaults.offsets[i], 1e-9);
-  EXPECT_FALSE(s.simulation.offsetsWritten);  // each garment's then follow the voxel size
+  EXPECT_FALSE(s.simulation.offsets.has_value());  // each garment's then follow the voxel size
   EXPECT_NEAR(s.simulation.voxelSize, defaults.voxelSize, 1e-9);
   EXPECT_EQ(s.simulation.integrator, defaults.integrator);
   EXPECT_EQ(s.simulation.collisionEvery, defaults.collisionEvery);

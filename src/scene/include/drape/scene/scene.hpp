@@ -47,10 +47,9 @@ struct SimulationSettings {
   double airViscosity = 0.02;     ///< N s/m^2 per unit area: drag on velocity relative to wind
   Vec3 wind{0.0, 0.0, 0.0};       ///< m/s
   /// m: the collision offset surfaces T0 < T1 < T2 < T3 of paper section 4.3.3, where the
-  /// node writes them (offsetsWritten); else each garment's follow the voxel size (1, 2, 3
-  /// and 6 voxels, the paper's proportions), as without a Simulation node.
-  std::array<double, 4> offsets{0.002, 0.004, 0.006, 0.008};
-  bool offsetsWritten = false;
+  /// node writes them; else each garment's follow the voxel size (1, 2, 3 and 6 voxels, the
+  /// paper's proportions), as without a Simulation node.
+  std::optional<std::array<double, 4>> offsets;
   double voxelSize = 0.01;                      ///< m, edge of a distance-field voxel
   std::string integrator = "symplectic-euler";  ///< name the cloth solver resolves
   int collisionEvery = 1;                       ///< collide every N substeps
